@@ -1,0 +1,210 @@
+//! ISO 11898-1 fault confinement (§12.1.4): the error counters and the rules that move them.
+//!
+//! Both controllers implement these rules in hardware; the behavioural models and the
+//! simulated bus share this one implementation of the standard, so that the rule set is
+//! written (and tested) once. The driver never uses it: it reads its controller's counters.
+
+use crate::error::{ErrorCounters, ErrorState, LastErrorCode};
+
+/// Error counters of one node with the standard's update rules.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct FaultConfinement {
+    tec: u16,
+    rec: u16,
+    bus_off: bool,
+    /// Sequences of 11 consecutive recessive bits seen while bus-off.
+    recovery_sequences: u16,
+    /// Recessive bits in the current run while bus-off.
+    recessive_run: u16,
+}
+
+/// The number of 11-recessive-bit sequences after which a bus-off node may recover.
+pub const BUS_OFF_RECOVERY_SEQUENCES: u16 = 128;
+
+impl FaultConfinement {
+    /// A node fresh from reset: error-active, both counters zero.
+    pub const fn new() -> Self {
+        FaultConfinement { tec: 0, rec: 0, bus_off: false, recovery_sequences: 0, recessive_run: 0 }
+    }
+
+    /// The counters; TEC reads 256 while bus-off (ACAN §17 convention).
+    pub const fn counters(&self) -> ErrorCounters {
+        ErrorCounters { tec: if self.bus_off { 256 } else { self.tec }, rec: self.rec }
+    }
+
+    /// The raw 8-bit transmit counter as the hardware registers show it.
+    pub const fn tec_register(&self) -> u8 {
+        (self.tec & 0xFF) as u8
+    }
+
+    /// The raw 8-bit receive counter as the hardware registers show it.
+    pub const fn rec_register(&self) -> u8 {
+        if self.rec > 255 {
+            255
+        } else {
+            self.rec as u8
+        }
+    }
+
+    /// The fault-confinement state.
+    pub const fn state(&self) -> ErrorState {
+        if self.bus_off {
+            ErrorState::BusOff
+        } else {
+            ErrorState::from_counters(ErrorCounters { tec: self.tec, rec: self.rec })
+        }
+    }
+
+    /// Whether the node is error-passive (sends passive error flags).
+    pub const fn is_passive(&self) -> bool {
+        !self.bus_off && (self.tec >= 128 || self.rec >= 128)
+    }
+
+    /// Whether the node is bus-off.
+    pub const fn is_bus_off(&self) -> bool {
+        self.bus_off
+    }
+
+    /// Rule 7: a successful transmission decrements TEC.
+    pub fn transmit_succeeded(&mut self) {
+        if !self.bus_off {
+            self.tec = self.tec.saturating_sub(1);
+        }
+    }
+
+    /// Rule 8: a successful reception decrements REC (1..=127), or brings it back into
+    /// 119..=127 when above 127 (this implementation chooses 127).
+    pub fn receive_succeeded(&mut self) {
+        if self.rec > 127 {
+            self.rec = 127;
+        } else if self.rec > 0 {
+            self.rec -= 1;
+        }
+    }
+
+    /// Rule 3: the transmitter sends an error flag, TEC += 8 — except (exception 1) an
+    /// error-passive transmitter that detects an acknowledge error (and no dominant bit
+    /// during its passive error flag): no change. Returns whether bus-off was entered.
+    pub fn transmit_error(&mut self, code: LastErrorCode) -> bool {
+        if self.bus_off {
+            return false;
+        }
+        if code == LastErrorCode::Acknowledge && self.is_passive() {
+            return false;
+        }
+        self.tec += 8;
+        if self.tec > 255 {
+            self.bus_off = true;
+            self.recovery_sequences = 0;
+            self.recessive_run = 0;
+            return true;
+        }
+        false
+    }
+
+    /// Rule 1: a receiver detects an error, REC += 1; rule 2 (a dominant bit right after
+    /// its own error flag) adds 8 instead. REC saturates at 255 (a receiver never goes
+    /// bus-off).
+    pub fn receive_error(&mut self, dominant_after_flag: bool) {
+        if self.bus_off {
+            return;
+        }
+        let add = if dominant_after_flag { 8 } else { 1 };
+        self.rec = (self.rec + add).min(255);
+    }
+
+    /// Feeds `bits` bus bits while bus-off: recessive bits count toward the 128 × 11
+    /// recessive-bit recovery sequence, a dominant bit restarts the current run of 11.
+    /// Returns `true` when the condition for recovery has just been met.
+    ///
+    /// Whether the node then leaves bus-off at once (bxCAN ABOM, FlexCAN automatic
+    /// recovery) or waits for software (bxCAN manual recovery) is the controller's
+    /// business: it calls [`FaultConfinement::recover`].
+    pub fn idle_bits(&mut self, bits: u64) -> bool {
+        if !self.bus_off || self.recovery_sequences >= BUS_OFF_RECOVERY_SEQUENCES {
+            return false;
+        }
+        let total = self.recessive_run as u64 + bits;
+        let seqs = total / 11;
+        self.recessive_run = (total % 11) as u16;
+        let done = self.recovery_sequences as u64 + seqs;
+        if done >= BUS_OFF_RECOVERY_SEQUENCES as u64 {
+            self.recovery_sequences = BUS_OFF_RECOVERY_SEQUENCES;
+            true
+        } else {
+            self.recovery_sequences = done as u16;
+            false
+        }
+    }
+
+    /// A dominant bit seen while bus-off interrupts the current run of recessive bits.
+    pub fn dominant_bit(&mut self) {
+        self.recessive_run = 0;
+    }
+
+    /// Whether the 128 × 11 recessive-bit condition has been met while bus-off.
+    pub const fn recovery_condition_met(&self) -> bool {
+        self.bus_off && self.recovery_sequences >= BUS_OFF_RECOVERY_SEQUENCES
+    }
+
+    /// Leaves bus-off: error-active with both counters zero (ISO 11898-1 §12.1.4.2).
+    pub fn recover(&mut self) {
+        *self = Self::new();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lone_transmitter_stops_at_error_passive() {
+        let mut f = FaultConfinement::new();
+        for _ in 0..100 {
+            assert!(!f.transmit_error(LastErrorCode::Acknowledge));
+        }
+        assert_eq!(f.counters().tec, 128);
+        assert_eq!(f.state(), ErrorState::Passive);
+    }
+
+    #[test]
+    fn bus_off_after_32_errors_and_recovery() {
+        let mut f = FaultConfinement::new();
+        for i in 0..32 {
+            let off = f.transmit_error(LastErrorCode::BitDominant);
+            assert_eq!(off, i == 31);
+        }
+        assert_eq!(f.state(), ErrorState::BusOff);
+        assert_eq!(f.counters().tec, 256);
+        assert!(!f.idle_bits(11 * 127 + 10));
+        f.dominant_bit();
+        assert!(!f.idle_bits(10));
+        assert!(f.idle_bits(1));
+        assert!(f.recovery_condition_met());
+        f.recover();
+        assert_eq!(f.state(), ErrorState::Active);
+        assert_eq!(f.counters(), ErrorCounters { tec: 0, rec: 0 });
+    }
+
+    #[test]
+    fn receive_rules() {
+        let mut f = FaultConfinement::new();
+        f.receive_error(false);
+        f.receive_error(true);
+        assert_eq!(f.counters().rec, 9);
+        f.receive_succeeded();
+        assert_eq!(f.counters().rec, 8);
+        for _ in 0..40 {
+            f.receive_error(true);
+        }
+        assert_eq!(f.counters().rec, 255);
+        assert_eq!(f.state(), ErrorState::Passive);
+        f.receive_succeeded();
+        assert_eq!(f.counters().rec, 127);
+        assert_eq!(f.state(), ErrorState::Warning);
+        f.transmit_error(LastErrorCode::Form);
+        f.transmit_succeeded();
+        assert_eq!(f.counters().tec, 7);
+    }
+}

@@ -1,0 +1,437 @@
+//! CAN 2.0 frames: data and remote, standard and extended identifiers.
+//!
+//! [`Frame`] implements [`embedded_can::Frame`] and uses its [`Id`]. Its constructors check
+//! every rule of the frame format and return a [`FrameError`] instead of panicking:
+//! identifiers in range (11 or 29 bits), DLC `0..=8`, no data on a remote frame.
+//!
+//! A remote frame carries a DLC (the length of the answer it asks for) but no data bytes.
+//! The payload can be read as bytes or, as ACAN's data union offers, as little-endian
+//! `u16`/`u32`/`u64` words (ACAN §8.1), without `unsafe`.
+
+use embedded_can::{ExtendedId, Id, StandardId};
+
+/// The largest data length code of classical CAN.
+pub const MAX_DLC: u8 = 8;
+
+/// Why a frame could not be built.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum FrameError {
+    /// A standard identifier above `0x7FF`.
+    StandardIdOutOfRange(u32),
+    /// An extended identifier above `0x1FFF_FFFF`.
+    ExtendedIdOutOfRange(u32),
+    /// A data length code above 8 (classical CAN).
+    DlcTooLarge(u8),
+    /// More than 8 data bytes.
+    TooMuchData(usize),
+    /// A data-bearing operation was asked of a remote frame.
+    DataOnRemoteFrame,
+    /// A word view that does not fit inside the frame's DLC.
+    OutOfBounds,
+}
+
+/// Builds a standard [`Id`] from a raw value, checking its range.
+pub const fn standard_id(raw: u16) -> Result<Id, FrameError> {
+    match StandardId::new(raw) {
+        Some(id) => Ok(Id::Standard(id)),
+        None => Err(FrameError::StandardIdOutOfRange(raw as u32)),
+    }
+}
+
+/// Builds an extended [`Id`] from a raw value, checking its range.
+pub const fn extended_id(raw: u32) -> Result<Id, FrameError> {
+    match ExtendedId::new(raw) {
+        Some(id) => Ok(Id::Extended(id)),
+        None => Err(FrameError::ExtendedIdOutOfRange(raw)),
+    }
+}
+
+/// The raw numeric value of an identifier (11 or 29 bits).
+pub fn id_raw(id: &Id) -> u32 {
+    match id {
+        Id::Standard(s) => s.as_raw() as u32,
+        Id::Extended(e) => e.as_raw(),
+    }
+}
+
+/// Builds an [`Id`] from a raw value and a format flag, checking its range.
+pub const fn raw_to_id(raw: u32, extended: bool) -> Result<Id, FrameError> {
+    if extended {
+        extended_id(raw)
+    } else if raw > 0x7FF {
+        Err(FrameError::StandardIdOutOfRange(raw))
+    } else {
+        standard_id(raw as u16)
+    }
+}
+
+/// Whether an identifier is extended (29 bits).
+pub const fn id_is_extended(id: &Id) -> bool {
+    matches!(id, Id::Extended(_))
+}
+
+/// A classical CAN frame (data or remote).
+///
+/// Equality compares identifier, kind, DLC and the first `dlc` data bytes only.
+#[derive(Debug, Clone, Copy)]
+pub struct Frame {
+    id: Id,
+    /// `id` as a number, kept beside it so that const code can read it.
+    raw_id: u32,
+    remote: bool,
+    dlc: u8,
+    data: [u8; 8],
+}
+
+impl PartialEq for Frame {
+    fn eq(&self, other: &Self) -> bool {
+        self.raw_id == other.raw_id
+            && self.id == other.id
+            && self.remote == other.remote
+            && self.dlc == other.dlc
+            && self.data() == other.data()
+    }
+}
+impl Eq for Frame {}
+
+#[cfg(feature = "defmt")]
+impl defmt::Format for Frame {
+    fn format(&self, f: defmt::Formatter) {
+        if self.remote {
+            defmt::write!(f, "Frame {{ id: {:x}, ext: {}, remote, dlc: {} }}", id_raw(&self.id), self.is_extended(), self.dlc)
+        } else {
+            defmt::write!(f, "Frame {{ id: {:x}, ext: {}, data: {=[u8]:x} }}", id_raw(&self.id), self.is_extended(), self.data())
+        }
+    }
+}
+
+impl Frame {
+    /// A data frame; `data.len()` becomes the DLC.
+    pub fn new_data(id: Id, data: &[u8]) -> Result<Self, FrameError> {
+        Self::data_frame(id, id_raw(&id), data)
+    }
+
+    const fn data_frame(id: Id, raw_id: u32, data: &[u8]) -> Result<Self, FrameError> {
+        if data.len() > MAX_DLC as usize {
+            return Err(FrameError::TooMuchData(data.len()));
+        }
+        let mut bytes = [0u8; 8];
+        let mut i = 0;
+        while i < data.len() {
+            bytes[i] = data[i];
+            i += 1;
+        }
+        Ok(Frame { id, raw_id, remote: false, dlc: data.len() as u8, data: bytes })
+    }
+
+    /// A remote frame asking for `dlc` bytes.
+    pub fn new_remote(id: Id, dlc: u8) -> Result<Self, FrameError> {
+        if dlc > MAX_DLC {
+            return Err(FrameError::DlcTooLarge(dlc));
+        }
+        Ok(Frame { id, raw_id: id_raw(&id), remote: true, dlc, data: [0; 8] })
+    }
+
+    /// A remote frame with a raw identifier (`extended` selects 29 bits).
+    pub const fn remote(raw_id: u32, extended: bool, dlc: u8) -> Result<Self, FrameError> {
+        let id = match raw_to_id(raw_id, extended) {
+            Ok(id) => id,
+            Err(e) => return Err(e),
+        };
+        if dlc > MAX_DLC {
+            return Err(FrameError::DlcTooLarge(dlc));
+        }
+        Ok(Frame { id, raw_id, remote: true, dlc, data: [0; 8] })
+    }
+
+    /// A data frame with a standard identifier given as a raw number.
+    pub const fn standard(raw_id: u16, data: &[u8]) -> Result<Self, FrameError> {
+        match standard_id(raw_id) {
+            Ok(id) => Self::data_frame(id, raw_id as u32, data),
+            Err(e) => Err(e),
+        }
+    }
+
+    /// A data frame with an extended identifier given as a raw number.
+    pub const fn extended(raw_id: u32, data: &[u8]) -> Result<Self, FrameError> {
+        match extended_id(raw_id) {
+            Ok(id) => Self::data_frame(id, raw_id, data),
+            Err(e) => Err(e),
+        }
+    }
+
+    /// Builds a frame from the raw fields a controller register holds.
+    ///
+    /// `data` is always 8 bytes as read from a mailbox; bytes beyond `dlc` are ignored
+    /// for a data frame and dropped for a remote frame. A DLC above 8 is an error here:
+    /// a backend that reads a hardware DLC of 9..=15 clamps it first (ISO 11898-1 treats
+    /// such codes as 8 bytes).
+    pub fn from_raw_parts(id: Id, remote: bool, dlc: u8, data: [u8; 8]) -> Result<Self, FrameError> {
+        Self::from_registers(id_raw(&id), id_is_extended(&id), remote, dlc, data)
+    }
+
+    /// Like [`Frame::from_raw_parts`] with the identifier as a raw number.
+    pub const fn from_registers(
+        raw_id: u32,
+        extended: bool,
+        remote: bool,
+        dlc: u8,
+        data: [u8; 8],
+    ) -> Result<Self, FrameError> {
+        let id = match raw_to_id(raw_id, extended) {
+            Ok(id) => id,
+            Err(e) => return Err(e),
+        };
+        if dlc > MAX_DLC {
+            return Err(FrameError::DlcTooLarge(dlc));
+        }
+        let mut bytes = [0u8; 8];
+        if !remote {
+            let mut i = 0;
+            while i < dlc as usize {
+                bytes[i] = data[i];
+                i += 1;
+            }
+        }
+        Ok(Frame { id, raw_id, remote, dlc, data: bytes })
+    }
+
+    /// The identifier.
+    pub const fn id(&self) -> Id {
+        self.id
+    }
+
+    /// The raw identifier value (11 or 29 bits).
+    pub const fn raw_id(&self) -> u32 {
+        self.raw_id
+    }
+
+    /// Whether the identifier is extended.
+    pub const fn is_extended(&self) -> bool {
+        id_is_extended(&self.id)
+    }
+
+    /// Whether this is a remote frame.
+    pub const fn is_remote(&self) -> bool {
+        self.remote
+    }
+
+    /// The data length code, `0..=8`.
+    pub const fn dlc(&self) -> u8 {
+        self.dlc
+    }
+
+    /// The data bytes (empty for a remote frame).
+    pub fn data(&self) -> &[u8] {
+        if self.remote {
+            &[]
+        } else {
+            &self.data[..self.dlc as usize]
+        }
+    }
+
+    /// All eight data bytes, zero beyond the DLC (what a mailbox register pair holds).
+    pub const fn data_padded(&self) -> [u8; 8] {
+        self.data
+    }
+
+    /// Data byte `index`, if it lies within the DLC of a data frame.
+    pub fn byte(&self, index: usize) -> Option<u8> {
+        self.data().get(index).copied()
+    }
+
+    /// Sets data byte `index` (within the DLC of a data frame).
+    pub fn set_byte(&mut self, index: usize, value: u8) -> Result<(), FrameError> {
+        if self.remote {
+            return Err(FrameError::DataOnRemoteFrame);
+        }
+        if index >= self.dlc as usize {
+            return Err(FrameError::OutOfBounds);
+        }
+        self.data[index] = value;
+        Ok(())
+    }
+
+    /// Replaces the payload (and DLC) of a data frame.
+    pub fn set_data(&mut self, data: &[u8]) -> Result<(), FrameError> {
+        if self.remote {
+            return Err(FrameError::DataOnRemoteFrame);
+        }
+        *self = Self::new_data(self.id, data)?;
+        Ok(())
+    }
+
+    fn word<const W: usize>(&self, index: usize) -> Option<[u8; W]> {
+        let start = index.checked_mul(W)?;
+        let end = start.checked_add(W)?;
+        let bytes = self.data().get(start..end)?;
+        let mut out = [0u8; W];
+        out.copy_from_slice(bytes);
+        Some(out)
+    }
+
+    fn set_word<const W: usize>(&mut self, index: usize, bytes: [u8; W]) -> Result<(), FrameError> {
+        if self.remote {
+            return Err(FrameError::DataOnRemoteFrame);
+        }
+        let start = index.checked_mul(W).ok_or(FrameError::OutOfBounds)?;
+        let end = start.checked_add(W).ok_or(FrameError::OutOfBounds)?;
+        if end > self.dlc as usize {
+            return Err(FrameError::OutOfBounds);
+        }
+        self.data[start..end].copy_from_slice(&bytes);
+        Ok(())
+    }
+
+    /// Little-endian 16-bit word `index` (bytes `2*index..2*index+2`), if within the DLC.
+    pub fn data_u16(&self, index: usize) -> Option<u16> {
+        self.word::<2>(index).map(u16::from_le_bytes)
+    }
+
+    /// Little-endian 32-bit word `index` (bytes `4*index..4*index+4`), if within the DLC.
+    pub fn data_u32(&self, index: usize) -> Option<u32> {
+        self.word::<4>(index).map(u32::from_le_bytes)
+    }
+
+    /// The eight bytes as one little-endian 64-bit word, if the DLC is 8.
+    pub fn data_u64(&self) -> Option<u64> {
+        self.word::<8>(0).map(u64::from_le_bytes)
+    }
+
+    /// Writes little-endian 16-bit word `index` (must lie within the DLC).
+    pub fn set_data_u16(&mut self, index: usize, value: u16) -> Result<(), FrameError> {
+        self.set_word(index, value.to_le_bytes())
+    }
+
+    /// Writes little-endian 32-bit word `index` (must lie within the DLC).
+    pub fn set_data_u32(&mut self, index: usize, value: u32) -> Result<(), FrameError> {
+        self.set_word(index, value.to_le_bytes())
+    }
+
+    /// Writes the 64-bit little-endian payload (the DLC must be 8).
+    pub fn set_data_u64(&mut self, value: u64) -> Result<(), FrameError> {
+        self.set_word(0, value.to_le_bytes())
+    }
+
+    /// The arbitration priority key of this frame: smaller wins bus arbitration.
+    ///
+    /// See [`crate::priority`] for the ordering.
+    pub const fn priority(&self) -> crate::priority::Priority {
+        crate::priority::Priority::of(self)
+    }
+}
+
+impl embedded_can::Frame for Frame {
+    fn new(id: impl Into<Id>, data: &[u8]) -> Option<Self> {
+        Self::new_data(id.into(), data).ok()
+    }
+
+    fn new_remote(id: impl Into<Id>, dlc: usize) -> Option<Self> {
+        let dlc = u8::try_from(dlc).ok()?;
+        Frame::new_remote(id.into(), dlc).ok()
+    }
+
+    fn is_extended(&self) -> bool {
+        Frame::is_extended(self)
+    }
+
+    fn is_remote_frame(&self) -> bool {
+        self.remote
+    }
+
+    fn id(&self) -> Id {
+        self.id
+    }
+
+    fn dlc(&self) -> usize {
+        self.dlc as usize
+    }
+
+    fn data(&self) -> &[u8] {
+        Frame::data(self)
+    }
+}
+
+/// A frame taken from a controller, with where and when it was accepted.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct RxFrame {
+    /// The frame itself.
+    pub frame: Frame,
+    /// The index of the user's filter that accepted it (after the backend mapped the
+    /// hardware match index back to the order in which the user listed filters).
+    pub filter: u16,
+    /// The controller's time stamp (free-running bit-time counter) when it has one.
+    pub timestamp: Option<u16>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn dlc_and_ids_are_checked() {
+        assert_eq!(Frame::standard(0x800, &[]), Err(FrameError::StandardIdOutOfRange(0x800)));
+        assert_eq!(
+            Frame::extended(0x2000_0000, &[]),
+            Err(FrameError::ExtendedIdOutOfRange(0x2000_0000))
+        );
+        assert_eq!(Frame::standard(0x7FF, &[0; 9]), Err(FrameError::TooMuchData(9)));
+        let id = standard_id(1).unwrap();
+        assert_eq!(Frame::new_remote(id, 9), Err(FrameError::DlcTooLarge(9)));
+        assert!(Frame::new_remote(id, 8).is_ok());
+    }
+
+    #[test]
+    fn remote_frame_has_dlc_but_no_data() {
+        let mut f = Frame::new_remote(standard_id(0x123).unwrap(), 4).unwrap();
+        assert_eq!(f.dlc(), 4);
+        assert!(f.data().is_empty());
+        assert_eq!(f.set_byte(0, 1), Err(FrameError::DataOnRemoteFrame));
+        assert_eq!(f.set_data(&[1]), Err(FrameError::DataOnRemoteFrame));
+        assert_eq!(f.set_data_u16(0, 1), Err(FrameError::DataOnRemoteFrame));
+        let raw = Frame::from_raw_parts(f.id(), true, 4, [9; 8]).unwrap();
+        assert_eq!(raw.data_padded(), [0; 8]);
+    }
+
+    #[test]
+    fn little_endian_views() {
+        let mut f = Frame::extended(0x1234_5678, &[0; 8]).unwrap();
+        f.set_data_u64(0x0807_0605_0403_0201).unwrap();
+        assert_eq!(f.data(), &[1, 2, 3, 4, 5, 6, 7, 8]);
+        assert_eq!(f.data_u16(0), Some(0x0201));
+        assert_eq!(f.data_u16(3), Some(0x0807));
+        assert_eq!(f.data_u16(4), None);
+        assert_eq!(f.data_u32(1), Some(0x0807_0605));
+        f.set_data_u32(0, 0xAABB_CCDD).unwrap();
+        assert_eq!(f.byte(0), Some(0xDD));
+        let mut short = Frame::standard(1, &[1, 2, 3]).unwrap();
+        assert_eq!(short.data_u32(0), None);
+        assert_eq!(short.data_u64(), None);
+        assert_eq!(short.set_data_u32(0, 5), Err(FrameError::OutOfBounds));
+        assert_eq!(short.set_data_u16(usize::MAX, 5), Err(FrameError::OutOfBounds));
+        assert_eq!(short.data_u16(usize::MAX), None);
+    }
+
+    #[test]
+    fn embedded_can_trait() {
+        use embedded_can::Frame as _;
+        let id = StandardId::new(0x10).unwrap();
+        assert!(<Frame as embedded_can::Frame>::new(id, &[0; 9]).is_none());
+        assert!(<Frame as embedded_can::Frame>::new_remote(id, 9).is_none());
+        assert!(<Frame as embedded_can::Frame>::new_remote(id, usize::MAX).is_none());
+        let f = <Frame as embedded_can::Frame>::new(id, &[1, 2]).unwrap();
+        assert_eq!(embedded_can::Frame::dlc(&f), 2);
+        assert!(!f.is_remote_frame());
+        assert!(f.is_data_frame());
+        assert!(!embedded_can::Frame::is_extended(&f));
+    }
+
+    #[test]
+    fn equality_ignores_bytes_beyond_dlc() {
+        let a = Frame::from_raw_parts(standard_id(5).unwrap(), false, 2, [1, 2, 3, 0, 0, 0, 0, 0]);
+        let b = Frame::standard(5, &[1, 2]);
+        assert_eq!(a, b);
+    }
+}

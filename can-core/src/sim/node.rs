@@ -1,0 +1,77 @@
+//! The interface between the simulated bus and a node on it (a peripheral model).
+//!
+//! The bus owns time (in bit times) and the wire; each node owns its controller's rules.
+//! At every point where the bus is idle, the bus asks each node for the frame its
+//! controller would start ([`BusNode::poll_tx`]), resolves arbitration with
+//! [`crate::priority::Priority`], computes the frame's exact length, and reports the
+//! outcome to everyone: the winner gets [`BusNode::tx_result`], losers get
+//! [`TxResult::ArbitrationLost`], listeners get [`BusNode::rx`] or [`BusNode::rx_error`].
+//! Between frames, [`BusNode::advance`] lets time pass (timers, bus-off recovery).
+
+use crate::error::LastErrorCode;
+use crate::frame::Frame;
+
+/// A frame a node wants to start at the next start-of-frame.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct TxRequest {
+    /// The frame.
+    pub frame: Frame,
+    /// The node acknowledges its own frame (self-test: bxCAN loop-back ignores the
+    /// acknowledge slot), so it never gets an acknowledge error.
+    pub self_ack: bool,
+    /// The frame does not reach the wire at all (FlexCAN LPB, bxCAN loop-back + silent):
+    /// only the node itself sees it; it takes no part in arbitration with other nodes.
+    pub internal: bool,
+}
+
+/// How a transmission attempt ended for its transmitter.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum TxResult {
+    /// Sent without error and acknowledged.
+    Acked,
+    /// Another node's frame won arbitration; this node became a receiver of it.
+    ArbitrationLost,
+    /// An error was detected (`code` says which); an error frame followed.
+    Error(LastErrorCode),
+}
+
+/// Times of the bus event being reported, in bit times since the bus started.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct BusTime {
+    /// Start-of-frame bit of the frame concerned.
+    pub sof: u64,
+    /// The current time (end of the event).
+    pub now: u64,
+}
+
+/// A node on the simulated bus: implemented by each peripheral model.
+pub trait BusNode {
+    /// Called when the bus is idle: the frame the controller would start now, if any.
+    /// Calling it must not change the node's state (the bus may call it repeatedly).
+    fn poll_tx(&mut self, now: u64) -> Option<TxRequest>;
+
+    /// Whether the node would drive a dominant acknowledge bit for a frame it received
+    /// correctly (on the bus, not bus-off, not silent / listen-only, not asleep).
+    fn acknowledges(&self) -> bool;
+
+    /// Whether the node samples the bus at all (silent / listen-only nodes do; sleeping,
+    /// bus-off and initialization-mode nodes do not).
+    fn listens(&self) -> bool;
+
+    /// Whether an error detected by this node is signalled by an active error flag
+    /// (which destroys the frame for everyone) — true for an error-active node.
+    fn error_active(&self) -> bool;
+
+    /// The end of this node's transmission attempt of `frame`.
+    fn tx_result(&mut self, frame: &Frame, result: TxResult, time: BusTime);
+
+    /// A frame correctly received from the bus (or, for a self-receiving node, its own).
+    fn rx(&mut self, frame: &Frame, own: bool, time: BusTime);
+
+    /// An error detected while receiving; `dominant_after_flag` applies ISO 11898-1
+    /// rule 2 (REC + 8).
+    fn rx_error(&mut self, code: LastErrorCode, dominant_after_flag: bool, time: BusTime);
+
+    /// `bits` bit times passed ending at `now`; `idle` says the bus was recessive all along.
+    fn advance(&mut self, bits: u64, idle: bool, now: u64);
+}
