@@ -172,7 +172,7 @@ mod tests {
 
     #[test]
     fn conformance() {
-        assert_eq!(Filter::standard(0x800).check(), Err(FilterError::MaskOutOfRange));
+        assert_eq!(Filter::standard(0x800).check(), Err(FilterError::IdOutOfRange));
         assert_eq!(
             Filter::masked(FrameKind::Data, Format::Standard, 0x7F0, 0x800).check(),
             Err(FilterError::IdOutOfRange)

@@ -12,6 +12,7 @@ pub mod frame;
 pub mod mailbox;
 pub mod priority;
 pub mod registers;
+pub mod timing;
 #[cfg(feature = "sim")]
 pub mod sim;
 
