@@ -182,9 +182,18 @@ mod tests {
         assert_eq!(Error::Overrun.kind(), ErrorKind::Overrun);
         assert_eq!(Error::Bus(LastErrorCode::Stuff).kind(), ErrorKind::Stuff);
         assert_eq!(Error::Bus(LastErrorCode::Form).kind(), ErrorKind::Form);
-        assert_eq!(Error::Bus(LastErrorCode::Acknowledge).kind(), ErrorKind::Acknowledge);
-        assert_eq!(Error::Bus(LastErrorCode::BitDominant).kind(), ErrorKind::Bit);
-        assert_eq!(Error::Bus(LastErrorCode::BitRecessive).kind(), ErrorKind::Bit);
+        assert_eq!(
+            Error::Bus(LastErrorCode::Acknowledge).kind(),
+            ErrorKind::Acknowledge
+        );
+        assert_eq!(
+            Error::Bus(LastErrorCode::BitDominant).kind(),
+            ErrorKind::Bit
+        );
+        assert_eq!(
+            Error::Bus(LastErrorCode::BitRecessive).kind(),
+            ErrorKind::Bit
+        );
         assert_eq!(Error::Bus(LastErrorCode::Crc).kind(), ErrorKind::Crc);
         assert_eq!(Error::BusOff.kind(), ErrorKind::Other);
         assert_eq!(Error::Timeout.kind(), ErrorKind::Other);

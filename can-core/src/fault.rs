@@ -25,12 +25,21 @@ pub const BUS_OFF_RECOVERY_SEQUENCES: u16 = 128;
 impl FaultConfinement {
     /// A node fresh from reset: error-active, both counters zero.
     pub const fn new() -> Self {
-        FaultConfinement { tec: 0, rec: 0, bus_off: false, recovery_sequences: 0, recessive_run: 0 }
+        FaultConfinement {
+            tec: 0,
+            rec: 0,
+            bus_off: false,
+            recovery_sequences: 0,
+            recessive_run: 0,
+        }
     }
 
     /// The counters; TEC reads 256 while bus-off (ACAN §17 convention).
     pub const fn counters(&self) -> ErrorCounters {
-        ErrorCounters { tec: if self.bus_off { 256 } else { self.tec }, rec: self.rec }
+        ErrorCounters {
+            tec: if self.bus_off { 256 } else { self.tec },
+            rec: self.rec,
+        }
     }
 
     /// The raw 8-bit transmit counter as the hardware registers show it.
@@ -52,7 +61,10 @@ impl FaultConfinement {
         if self.bus_off {
             ErrorState::BusOff
         } else {
-            ErrorState::from_counters(ErrorCounters { tec: self.tec, rec: self.rec })
+            ErrorState::from_counters(ErrorCounters {
+                tec: self.tec,
+                rec: self.rec,
+            })
         }
     }
 

@@ -99,17 +99,32 @@ pub struct Filter {
 impl Filter {
     /// Accepts every frame (ACAN's pass-all primary filter).
     pub const fn pass_all() -> Self {
-        Filter { kind: FrameKind::Any, format: Format::Any, id: 0, mask: 0 }
+        Filter {
+            kind: FrameKind::Any,
+            format: Format::Any,
+            id: 0,
+            mask: 0,
+        }
     }
 
     /// Accepts every frame of one kind and format, whatever the identifier.
     pub const fn kind_format(kind: FrameKind, format: Format) -> Self {
-        Filter { kind, format, id: 0, mask: 0 }
+        Filter {
+            kind,
+            format,
+            id: 0,
+            mask: 0,
+        }
     }
 
     /// Accepts exactly one identifier (ACAN's `(kind, format, identifier)` filter).
     pub const fn exact(kind: FrameKind, format: Format, id: u32) -> Self {
-        Filter { kind, format, id, mask: format.id_mask() }
+        Filter {
+            kind,
+            format,
+            id,
+            mask: format.id_mask(),
+        }
     }
 
     /// A data-frame filter for one standard identifier.
@@ -125,7 +140,12 @@ impl Filter {
     /// Accepts identifiers with `id & mask == acceptance` (ACAN's `(kind, format, mask,
     /// acceptance)` filter).
     pub const fn masked(kind: FrameKind, format: Format, mask: u32, acceptance: u32) -> Self {
-        Filter { kind, format, id: acceptance, mask }
+        Filter {
+            kind,
+            format,
+            id: acceptance,
+            mask,
+        }
     }
 
     /// Checks conformance (ACAN §12.3–12.4, §13.4).
@@ -172,7 +192,10 @@ mod tests {
 
     #[test]
     fn conformance() {
-        assert_eq!(Filter::standard(0x800).check(), Err(FilterError::IdOutOfRange));
+        assert_eq!(
+            Filter::standard(0x800).check(),
+            Err(FilterError::IdOutOfRange)
+        );
         assert_eq!(
             Filter::masked(FrameKind::Data, Format::Standard, 0x7F0, 0x800).check(),
             Err(FilterError::IdOutOfRange)
@@ -191,7 +214,10 @@ mod tests {
         );
         assert_eq!(Filter::extended(0x1FFF_FFFF).check(), Ok(()));
         assert_eq!(Filter::pass_all().check(), Ok(()));
-        assert_eq!(Filter::kind_format(FrameKind::Remote, Format::Any).check(), Ok(()));
+        assert_eq!(
+            Filter::kind_format(FrameKind::Remote, Format::Any).check(),
+            Ok(())
+        );
     }
 
     #[test]

@@ -99,9 +99,21 @@ impl Eq for Frame {}
 impl defmt::Format for Frame {
     fn format(&self, f: defmt::Formatter) {
         if self.remote {
-            defmt::write!(f, "Frame {{ id: {:x}, ext: {}, remote, dlc: {} }}", id_raw(&self.id), self.is_extended(), self.dlc)
+            defmt::write!(
+                f,
+                "Frame {{ id: {:x}, ext: {}, remote, dlc: {} }}",
+                id_raw(&self.id),
+                self.is_extended(),
+                self.dlc
+            )
         } else {
-            defmt::write!(f, "Frame {{ id: {:x}, ext: {}, data: {=[u8]:x} }}", id_raw(&self.id), self.is_extended(), self.data())
+            defmt::write!(
+                f,
+                "Frame {{ id: {:x}, ext: {}, data: {=[u8]:x} }}",
+                id_raw(&self.id),
+                self.is_extended(),
+                self.data()
+            )
         }
     }
 }
@@ -122,7 +134,13 @@ impl Frame {
             bytes[i] = data[i];
             i += 1;
         }
-        Ok(Frame { id, raw_id, remote: false, dlc: data.len() as u8, data: bytes })
+        Ok(Frame {
+            id,
+            raw_id,
+            remote: false,
+            dlc: data.len() as u8,
+            data: bytes,
+        })
     }
 
     /// A remote frame asking for `dlc` bytes.
@@ -130,7 +148,13 @@ impl Frame {
         if dlc > MAX_DLC {
             return Err(FrameError::DlcTooLarge(dlc));
         }
-        Ok(Frame { id, raw_id: id_raw(&id), remote: true, dlc, data: [0; 8] })
+        Ok(Frame {
+            id,
+            raw_id: id_raw(&id),
+            remote: true,
+            dlc,
+            data: [0; 8],
+        })
     }
 
     /// A remote frame with a raw identifier (`extended` selects 29 bits).
@@ -142,7 +166,13 @@ impl Frame {
         if dlc > MAX_DLC {
             return Err(FrameError::DlcTooLarge(dlc));
         }
-        Ok(Frame { id, raw_id, remote: true, dlc, data: [0; 8] })
+        Ok(Frame {
+            id,
+            raw_id,
+            remote: true,
+            dlc,
+            data: [0; 8],
+        })
     }
 
     /// A data frame with a standard identifier given as a raw number.
@@ -167,7 +197,12 @@ impl Frame {
     /// for a data frame and dropped for a remote frame. A DLC above 8 is an error here:
     /// a backend that reads a hardware DLC of 9..=15 clamps it first (ISO 11898-1 treats
     /// such codes as 8 bytes).
-    pub fn from_raw_parts(id: Id, remote: bool, dlc: u8, data: [u8; 8]) -> Result<Self, FrameError> {
+    pub fn from_raw_parts(
+        id: Id,
+        remote: bool,
+        dlc: u8,
+        data: [u8; 8],
+    ) -> Result<Self, FrameError> {
         Self::from_registers(id_raw(&id), id_is_extended(&id), remote, dlc, data)
     }
 
@@ -194,7 +229,13 @@ impl Frame {
                 i += 1;
             }
         }
-        Ok(Frame { id, raw_id, remote, dlc, data: bytes })
+        Ok(Frame {
+            id,
+            raw_id,
+            remote,
+            dlc,
+            data: bytes,
+        })
     }
 
     /// The identifier.
@@ -372,12 +413,18 @@ mod tests {
 
     #[test]
     fn dlc_and_ids_are_checked() {
-        assert_eq!(Frame::standard(0x800, &[]), Err(FrameError::StandardIdOutOfRange(0x800)));
+        assert_eq!(
+            Frame::standard(0x800, &[]),
+            Err(FrameError::StandardIdOutOfRange(0x800))
+        );
         assert_eq!(
             Frame::extended(0x2000_0000, &[]),
             Err(FrameError::ExtendedIdOutOfRange(0x2000_0000))
         );
-        assert_eq!(Frame::standard(0x7FF, &[0; 9]), Err(FrameError::TooMuchData(9)));
+        assert_eq!(
+            Frame::standard(0x7FF, &[0; 9]),
+            Err(FrameError::TooMuchData(9))
+        );
         let id = standard_id(1).unwrap();
         assert_eq!(Frame::new_remote(id, 9), Err(FrameError::DlcTooLarge(9)));
         assert!(Frame::new_remote(id, 8).is_ok());
@@ -410,7 +457,10 @@ mod tests {
         assert_eq!(short.data_u32(0), None);
         assert_eq!(short.data_u64(), None);
         assert_eq!(short.set_data_u32(0, 5), Err(FrameError::OutOfBounds));
-        assert_eq!(short.set_data_u16(usize::MAX, 5), Err(FrameError::OutOfBounds));
+        assert_eq!(
+            short.set_data_u16(usize::MAX, 5),
+            Err(FrameError::OutOfBounds)
+        );
         assert_eq!(short.data_u16(usize::MAX), None);
     }
 

@@ -79,7 +79,9 @@ mod tests {
         assert!(d(s(0x100)).priority().beats(d(e(0x100 << 18)).priority()));
         assert!(r(s(0x100)).priority().beats(d(e(0x100 << 18)).priority()));
         // extended with a smaller base wins over standard with a larger one
-        assert!(d(e(0x0FF << 18 | 0x3FFFF)).priority().beats(d(s(0x100)).priority()));
+        assert!(d(e(0x0FF << 18 | 0x3FFFF))
+            .priority()
+            .beats(d(s(0x100)).priority()));
         assert!(d(e(5)).priority().beats(r(e(5)).priority()));
         assert!(r(e(5)).priority().beats(d(e(6)).priority()));
         assert_eq!(d(s(7)).priority(), d(s(7)).priority());

@@ -1,2 +1,218 @@
-//! The portable application shared by firmware, host demo and tests.
+//! The portable application shared by the firmware examples, the host demo and the
+//! cross-controller tests.
+//!
+//! It only speaks the `twocan-core` API, so the very same code runs on a Teensy 3.x
+//! (FlexCAN), an STM32F7 board (bxCAN) and the host simulation. Each node:
+//! - publishes a *heartbeat* (standard data frame `0x100 + node`, a 32-bit counter) and a
+//!   *measurement* (extended data frame `0x18FF_0000 | node << 8`, 8 bytes);
+//! - periodically asks its peer for a *status* with a remote frame
+//!   (standard `0x200 + peer`, DLC 4) and answers the peer's remote requests with a data
+//!   frame of the same identifier;
+//! - receives through [`App::filters`] (the same portable filter list on every controller)
+//!   and handles frames by filter index through a [`Dispatcher`].
+//!
+//! ```
+//! use twocan_app::{App, FILTER_COUNT};
+//! let app = App::new(1, 2);
+//! let filters = app.filters();
+//! assert_eq!(filters.len(), FILTER_COUNT);
+//! assert!(filters.iter().all(|f| f.check().is_ok()));
+//! ```
 #![no_std]
+#![deny(missing_docs)]
+
+use twocan_core::{Controller, Dispatcher, Driver, Filter, Format, Frame, FrameKind, RxFrame};
+
+/// Number of filters of the application's list.
+pub const FILTER_COUNT: usize = 4;
+
+/// Filter index: the peer's heartbeat.
+pub const F_HEARTBEAT: usize = 0;
+/// Filter index: the peer's measurements (extended, masked).
+pub const F_MEASUREMENT: usize = 1;
+/// Filter index: remote requests for our status.
+pub const F_STATUS_REQUEST: usize = 2;
+/// Filter index: the peer's status answers.
+pub const F_STATUS: usize = 3;
+
+/// Counters of what the application saw and did.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct AppStats {
+    /// Frames accepted by the driver's transmit queue.
+    pub sent: u32,
+    /// Frames refused because the transmit queue was full (retried later).
+    pub tx_full: u32,
+    /// Heartbeats received from the peer.
+    pub heartbeats: u32,
+    /// Heartbeats whose counter skipped values (frames lost between the peers).
+    pub heartbeat_gaps: u32,
+    /// Measurements received.
+    pub measurements: u32,
+    /// Remote status requests received.
+    pub requests: u32,
+    /// Status answers received.
+    pub answers: u32,
+    /// Frames taken by a filter without call-back (none expected).
+    pub unhandled: u32,
+}
+
+/// The state the call-backs work on.
+#[derive(Debug, Default)]
+pub struct AppState {
+    /// Counters.
+    pub stats: AppStats,
+    /// Next expected heartbeat counter from the peer.
+    expected: Option<u32>,
+    /// Status requests waiting to be answered.
+    pending_answers: u32,
+}
+
+/// One node of the demo.
+pub struct App {
+    node: u8,
+    peer: u8,
+    counter: u32,
+    tick: u32,
+    /// What the node saw.
+    pub state: AppState,
+    dispatcher: Dispatcher<AppState, FILTER_COUNT>,
+    pending: Option<Frame>,
+}
+
+impl App {
+    /// A node `node` talking with `peer` (both `0..=255`).
+    pub fn new(node: u8, peer: u8) -> Self {
+        let mut dispatcher = Dispatcher::new();
+        // Indices are constants below FILTER_COUNT, so `set` cannot fail.
+        let _ = dispatcher.set(F_HEARTBEAT, on_heartbeat);
+        let _ = dispatcher.set(F_MEASUREMENT, on_measurement);
+        let _ = dispatcher.set(F_STATUS_REQUEST, on_status_request);
+        let _ = dispatcher.set(F_STATUS, on_status);
+        App {
+            node,
+            peer,
+            counter: 0,
+            tick: 0,
+            state: AppState::default(),
+            dispatcher,
+            pending: None,
+        }
+    }
+
+    /// The portable filter list, in the order of the `F_*` indices.
+    pub fn filters(&self) -> [Filter; FILTER_COUNT] {
+        [
+            Filter::standard(0x100 + self.peer as u16),
+            Filter::masked(
+                FrameKind::Data,
+                Format::Extended,
+                0x1FFF_FF00,
+                0x18FF_0000 | (self.peer as u32) << 8,
+            ),
+            Filter::exact(
+                FrameKind::Remote,
+                Format::Standard,
+                0x200 + self.node as u32,
+            ),
+            Filter::exact(FrameKind::Data, Format::Standard, 0x200 + self.peer as u32),
+        ]
+    }
+
+    /// Runs one period of the application: handle what was received, answer requests,
+    /// publish. Call it from the main loop (on the host: every simulated millisecond).
+    pub fn step<C: Controller, const RX: usize, const TX: usize>(
+        &mut self,
+        driver: &mut Driver<C, RX, TX>,
+    ) {
+        while driver.dispatch(&mut self.dispatcher, &mut self.state) {}
+        self.state.stats.unhandled = self.dispatcher.unhandled();
+        self.tick = self.tick.wrapping_add(1);
+        // A frame refused earlier goes first, so that the heartbeat counter stays in order.
+        if let Some(f) = self.pending.take() {
+            if !self.send(driver, f) {
+                return;
+            }
+        }
+        while self.state.pending_answers > 0 {
+            let answer = Frame::standard(0x200 + self.node as u16, &self.counter.to_le_bytes());
+            self.state.pending_answers -= 1;
+            if let Ok(f) = answer {
+                if !self.send(driver, f) {
+                    return;
+                }
+            }
+        }
+        let heartbeat = Frame::standard(0x100 + self.node as u16, &self.counter.to_le_bytes());
+        if let Ok(f) = heartbeat {
+            // The counter moves on even if the frame waits in `pending`: it goes first next time.
+            self.counter = self.counter.wrapping_add(1);
+            if !self.send(driver, f) {
+                return;
+            }
+        }
+        if self.tick.is_multiple_of(4) {
+            let mut m = [0u8; 8];
+            m[..4].copy_from_slice(&self.tick.to_le_bytes());
+            m[4..].copy_from_slice(&(self.counter ^ 0xA5A5_A5A5).to_le_bytes());
+            if let Ok(f) = Frame::extended(0x18FF_0000 | (self.node as u32) << 8, &m) {
+                if !self.send(driver, f) {
+                    return;
+                }
+            }
+        }
+        if self.tick.is_multiple_of(10) {
+            if let Ok(f) = Frame::remote(0x200 + self.peer as u32, false, 4) {
+                self.send(driver, f);
+            }
+        }
+    }
+
+    /// Queues `frame`; if the queue is full keeps it for the next step and returns false.
+    fn send<C: Controller, const RX: usize, const TX: usize>(
+        &mut self,
+        driver: &mut Driver<C, RX, TX>,
+        frame: Frame,
+    ) -> bool {
+        match driver.try_send(&frame) {
+            Ok(()) => {
+                self.state.stats.sent += 1;
+                true
+            }
+            Err(_) => {
+                self.state.stats.tx_full += 1;
+                self.pending = Some(frame);
+                false
+            }
+        }
+    }
+
+    /// Counters.
+    pub fn stats(&self) -> AppStats {
+        self.state.stats
+    }
+}
+
+fn on_heartbeat(s: &mut AppState, rx: &RxFrame) {
+    s.stats.heartbeats += 1;
+    if let Some(n) = rx.frame.data_u32(0) {
+        if let Some(expected) = s.expected {
+            if n != expected {
+                s.stats.heartbeat_gaps += 1;
+            }
+        }
+        s.expected = Some(n.wrapping_add(1));
+    }
+}
+
+fn on_measurement(s: &mut AppState, _rx: &RxFrame) {
+    s.stats.measurements += 1;
+}
+
+fn on_status_request(s: &mut AppState, _rx: &RxFrame) {
+    s.stats.requests += 1;
+    s.pending_answers += 1;
+}
+
+fn on_status(s: &mut AppState, _rx: &RxFrame) {
+    s.stats.answers += 1;
+}
