@@ -1,0 +1,59 @@
+//! Why a bit timing could not be computed, encoded or accepted.
+
+use core::fmt;
+
+use super::segments::Consistency;
+
+/// Bit timing errors. Bad input always gives one of these, never a panic.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum TimingError {
+    /// The CAN clock is 0 Hz.
+    ClockZero,
+    /// The wished bit rate is 0 bit/s.
+    BitrateZero,
+    /// The wished bit rate is above clock / minimum quanta per bit (prescaler 1,
+    /// shortest bit): no timing can be that fast (16 MHz FlexCAN: 3.2 Mbit/s,
+    /// ACAN §16.1).
+    BitrateTooHigh,
+    /// The sample point target is not strictly between 50 % and 100 %
+    /// (valid: 501..=999 per mille).
+    SamplePointOutOfRange,
+    /// The [`Limits`](super::Limits) are unusable (see
+    /// [`Limits::is_valid`](super::Limits::is_valid)).
+    InvalidLimits,
+    /// The timing is not within the tolerance of the wished bit rate (ACAN
+    /// §15.2.1 "CAN Bit setting too far from wished rate").
+    TooFarFromWishedBitrate,
+    /// The counts break the listed rules (ACAN §15.2.2 "CAN Bit inconsistent
+    /// configuration", §16.2).
+    Inconsistent(Consistency),
+    /// A register encoding for the other controller was asked for (e.g. a bxCAN
+    /// BTR from FlexCAN limits).
+    WrongController,
+}
+
+impl fmt::Display for TimingError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            TimingError::ClockZero => f.write_str("CAN clock is 0 Hz"),
+            TimingError::BitrateZero => f.write_str("bit rate is 0 bit/s"),
+            TimingError::BitrateTooHigh => {
+                f.write_str("bit rate above clock / minimum quanta per bit")
+            }
+            TimingError::SamplePointOutOfRange => {
+                f.write_str("sample point must be above 50 % and below 100 %")
+            }
+            TimingError::InvalidLimits => f.write_str("invalid controller limits"),
+            TimingError::TooFarFromWishedBitrate => {
+                f.write_str("CAN bit setting too far from wished bit rate")
+            }
+            TimingError::Inconsistent(c) => write!(f, "inconsistent CAN bit setting: {c}"),
+            TimingError::WrongController => {
+                f.write_str("register encoding asked for another controller")
+            }
+        }
+    }
+}
+
+impl core::error::Error for TimingError {}
