@@ -1,2 +1,120 @@
-//! placeholder
-#![no_std]
+//! FlexCAN backend of twocan: the ACAN driver's feature set for Teensy 3.1/3.2, 3.5 and
+//! 3.6 (ACAN 1.0.5 manual, Pierre Molinaro), in Rust over twocan-core's
+//! [`Controller`](twocan_core::Controller) seam.
+//!
+//! ACAN §4's LoopBackDemo, on the host over the behavioural model of the module
+//! (feature `model`) and twocan-core's simulated bus:
+//!
+//! ```
+//! # #[cfg(feature = "model")] {
+//! use twocan_core::sim::Bus;
+//! use twocan_core::{Filter, Format, Frame, FrameKind};
+//! use twocan_flexcan::model::FlexCanModel;
+//! use twocan_flexcan::{AcanDriver, Board, FlexCan, HostSystem, Instance, Settings, Target};
+//!
+//! // ACAN §4, §16: 125 kbit/s from the 16 MHz clock, loop-back, self reception.
+//! let mut settings = Settings::new(125_000);
+//! settings.loop_back = true;
+//! settings.self_reception = true;
+//! assert!(settings.bit_rate_close_to_wished());
+//!
+//! // ACAN §12, §13: filter 0 is primary, filter 1 secondary.
+//! let primary = [Filter::exact(FrameKind::Data, Format::Standard, 0x542)];
+//! let secondary = [Filter::exact(FrameKind::Remote, Format::Extended, 0x1234)];
+//!
+//! // The model stands for FlexCAN0 of a Teensy 3.2 (firmware: `Can0::take()`).
+//! let model = FlexCanModel::mk20dx256();
+//! let target = Target::new(Board::Teensy32, Instance::Can0);
+//! let controller =
+//!     FlexCan::begin(model.clone(), &mut HostSystem::new(), target, &settings, &primary, &secondary)
+//!         .expect("begin: no error of ACAN table 5");
+//! // ACAN's buffers: receive 32, transmit 16.
+//! let mut can: AcanDriver<FlexCanModel> = AcanDriver::new(controller);
+//!
+//! can.try_send(&Frame::standard(0x542, &[1, 2]).unwrap()).unwrap(); // tryToSend
+//! can.try_send(&Frame::remote(0x1234, true, 0).unwrap()).unwrap();
+//!
+//! // The bus runs; the "interrupt handler" runs between bus events.
+//! let mut bus = Bus::new(125_000).unwrap();
+//! bus.attach("can0", model.clone());
+//! while bus.step_until(1_000).is_some() {
+//!     if model.irq_pending() {
+//!         can.on_interrupt();
+//!     }
+//! }
+//! // `receive`, with the filter index (ACAN `idx`). The remote frame sits in its own
+//! // mailbox and wins arbitration (extended 0x1234 ranks before standard 0x542).
+//! let first = can.receive().unwrap();
+//! assert_eq!((first.frame.raw_id(), first.filter), (0x1234, 1));
+//! let second = can.receive().unwrap();
+//! assert_eq!((second.frame.raw_id(), second.filter), (0x542, 0));
+//! assert_eq!(can.rx_stats().peak, 2); // receiveBufferPeakCount
+//! # }
+//! ```
+//!
+//! On a Teensy (feature `teensy32`, `teensy35` or `teensy36`, target
+//! `thumbv7em-none-eabihf`), the singleton token gives the controller:
+//!
+//! ```ignore
+//! use twocan_flexcan::{AcanDriver, Can0, Settings};
+//! let settings = Settings::new(500_000);
+//! let controller = Can0::take().unwrap().begin(&settings, &[], &[]).map_err(|(_, e)| e)?;
+//! let irqs = controller.target().irqs().unwrap(); // enable irqs.message in the NVIC
+//! let can: AcanDriver<_> = AcanDriver::new(controller);
+//! // Put `can` in a critical_section::Mutex<RefCell<Option<_>>>, call `on_interrupt`
+//! // from the CAN interrupt handler, `try_send` / `receive` / `dispatch` from thread code.
+//! ```
+//!
+//! # Map of the ACAN manual
+//!
+//! | ACAN | here |
+//! |---|---|
+//! | §4 `ACANSettings`, §16, table 7 | [`Settings`] (bit timing from [`twocan_core::timing`]) |
+//! | §6 `ACAN::can0`, `ACAN::can1` | `Can0::take()`, `Can1::take()` ([`instance`]); [`Target`] on the host |
+//! | §7 alternate pins, §16.7.5–6 | [`Settings`] fields, [`Board::pins`], [`system`] |
+//! | §8, §9 `tryToSend`, transmit buffer | [`twocan_core::Driver::try_send`], `tx_stats` ([`controller`] explains the mailboxes) |
+//! | §10 `receive`, receive buffer | [`twocan_core::Driver::receive`], `rx_stats` |
+//! | §11 `mConfiguration` | [`Configuration`] |
+//! | §12, §13 primary / secondary filters | [`twocan_core::Filter`] lists, compiled by [`FilterTable`] |
+//! | §14 `dispatchReceivedMessage` | [`twocan_core::Driver::dispatch`] with a [`twocan_core::Dispatcher`] |
+//! | §15 `begin`, table 5 | [`FlexCan::begin`], [`check`], [`ConfigErrors`], [`BeginError`] |
+//! | §17 controller state, REC, TEC | [`twocan_core::Driver::state`], `counters` |
+#![cfg_attr(not(any(test, feature = "model")), no_std)]
+#![deny(missing_docs)]
+
+pub mod begin;
+pub mod begin_error;
+pub mod board;
+pub mod configuration;
+pub mod controller;
+pub mod filters;
+pub mod handshake;
+pub mod instance;
+pub mod message_buffer;
+pub mod settings;
+pub mod status;
+pub mod system;
+
+pub mod regs;
+
+#[cfg(feature = "model")]
+pub mod model;
+
+pub use begin::check;
+pub use begin_error::{BeginError, ConfigErrors};
+pub use board::{Board, Chip, InstancePins};
+pub use configuration::Configuration;
+pub use controller::FlexCan;
+pub use filters::FilterTable;
+#[cfg(any(feature = "teensy32", feature = "teensy35", feature = "teensy36"))]
+pub use instance::Can0;
+#[cfg(feature = "teensy36")]
+pub use instance::Can1;
+pub use instance::{Instance, Irqs, Target};
+pub use settings::{Settings, CAN_CLOCK_HZ, RECEIVE_BUFFER_SIZE, TRANSMIT_BUFFER_SIZE};
+pub use system::HostSystem;
+
+/// The driver with ACAN's default buffer sizes: a receive ring of 32 frames and a
+/// transmit ring of 16 (ACAN table 7, §8.2, §10.1). Choose other sizes with
+/// `twocan_core::Driver<FlexCan<R>, RX, TX>`.
+pub type AcanDriver<R> = twocan_core::Driver<FlexCan<R>, RECEIVE_BUFFER_SIZE, TRANSMIT_BUFFER_SIZE>;

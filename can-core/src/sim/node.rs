@@ -74,4 +74,48 @@ pub trait BusNode {
 
     /// `bits` bit times passed ending at `now`; `idle` says the bus was recessive all along.
     fn advance(&mut self, bits: u64, idle: bool, now: u64);
+
+    /// The earliest bus time after `now` at which this node may start a frame on its own,
+    /// without software doing anything: the end of its suspend-transmission time, the moment
+    /// its bus-off recovery completes, a timer. The bus ends idle stretches there, so that the
+    /// node's SOF is exact. `None` (the default) if nothing of the kind is pending; a node
+    /// without this hint is still polled after every idle stretch the caller asks for.
+    fn next_wakeup(&self, now: u64) -> Option<u64> {
+        let _ = now;
+        None
+    }
+}
+
+/// A shared node: the bus drives it while the test keeps its own clone of the `Rc`.
+///
+/// Each call borrows the `RefCell` for its duration only; holding a borrow of the node
+/// across a call into the bus is a programming error that makes `RefCell` panic.
+impl<T: BusNode + ?Sized> BusNode for std::rc::Rc<core::cell::RefCell<T>> {
+    fn poll_tx(&mut self, now: u64) -> Option<TxRequest> {
+        self.borrow_mut().poll_tx(now)
+    }
+    fn acknowledges(&self) -> bool {
+        self.borrow().acknowledges()
+    }
+    fn listens(&self) -> bool {
+        self.borrow().listens()
+    }
+    fn error_active(&self) -> bool {
+        self.borrow().error_active()
+    }
+    fn tx_result(&mut self, frame: &Frame, result: TxResult, time: BusTime) {
+        self.borrow_mut().tx_result(frame, result, time)
+    }
+    fn rx(&mut self, frame: &Frame, own: bool, time: BusTime) {
+        self.borrow_mut().rx(frame, own, time)
+    }
+    fn rx_error(&mut self, code: LastErrorCode, dominant_after_flag: bool, time: BusTime) {
+        self.borrow_mut().rx_error(code, dominant_after_flag, time)
+    }
+    fn advance(&mut self, bits: u64, idle: bool, now: u64) {
+        self.borrow_mut().advance(bits, idle, now)
+    }
+    fn next_wakeup(&self, now: u64) -> Option<u64> {
+        self.borrow().next_wakeup(now)
+    }
 }

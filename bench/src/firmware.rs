@@ -1,0 +1,236 @@
+//! Building firmware with cargo: the bench firmware workspace (`bench/firmware`) and the
+//! firmware examples of the twocan workspace (`examples/*`).
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::time::Duration;
+
+use crate::cmd::{self, Context, Error, Result};
+
+/// The cross target of every firmware.
+pub const TARGET: &str = "thumbv7em-none-eabihf";
+
+/// Time allowed for one cargo build.
+const BUILD_LIMIT: Duration = Duration::from_secs(900);
+
+/// Where things are.
+#[derive(Debug, Clone)]
+pub struct Paths {
+    /// The twocan workspace root.
+    pub root: PathBuf,
+    /// The target directory base: `$CARGO_TARGET_DIR` or `<root>/target`.
+    pub target: PathBuf,
+}
+
+impl Paths {
+    /// From this package's location (`<root>/bench`).
+    pub fn discover() -> Result<Paths> {
+        let manifest = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+        let root = manifest
+            .parent()
+            .ok_or_else(|| Error::new("bench/ has no parent directory"))?
+            .to_path_buf();
+        if !root.join("Cargo.toml").is_file() {
+            return Err(Error::new(format!(
+                "{} is not the twocan workspace (no Cargo.toml)",
+                root.display()
+            )));
+        }
+        let target = match std::env::var_os("CARGO_TARGET_DIR") {
+            Some(t) if !t.is_empty() => {
+                let t = PathBuf::from(t);
+                if t.is_absolute() {
+                    t
+                } else {
+                    root.join(t)
+                }
+            }
+            _ => root.join("target"),
+        };
+        Ok(Paths { root, target })
+    }
+
+    /// The bench firmware workspace.
+    pub fn firmware(&self) -> PathBuf {
+        self.root.join("bench").join("firmware")
+    }
+
+    /// A directory of our own under the target directory.
+    pub fn scratch(&self, name: &str) -> PathBuf {
+        self.target.join(name)
+    }
+}
+
+/// The cargo that runs us (`$CARGO`, set by `cargo run`), else `cargo` from `PATH`.
+pub fn cargo() -> Command {
+    let program = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
+    let mut c = Command::new(program);
+    // The child gets an explicit --target-dir; variables of the outer build must not leak.
+    for var in [
+        "CARGO_TARGET_DIR",
+        "CARGO_BUILD_TARGET",
+        "CARGO_BUILD_TARGET_DIR",
+        "RUSTFLAGS",
+        "CARGO_ENCODED_RUSTFLAGS",
+    ] {
+        c.env_remove(var);
+    }
+    c
+}
+
+/// Makes sure the cross target is installed (`rustup target add` if rustup is there).
+pub fn ensure_target() -> Result<()> {
+    let Some(rustup) = cmd::which("rustup") else {
+        // No rustup: the build itself will say whether the target's std is there.
+        return Ok(());
+    };
+    let out = cmd::run_ok(
+        Command::new(&rustup).args(["target", "list", "--installed"]),
+        Duration::from_secs(60),
+    )?;
+    if out.stdout.lines().any(|l| l.trim() == TARGET) {
+        return Ok(());
+    }
+    eprintln!("can-bench: installing the {TARGET} target (rustup target add {TARGET})");
+    cmd::run_ok(
+        Command::new(&rustup).args(["target", "add", TARGET]),
+        Duration::from_secs(600),
+    )
+    .context(format!(
+        "the {TARGET} target is needed to cross-build the firmware"
+    ))?;
+    Ok(())
+}
+
+/// Builds the bench firmware workspace with cargo profile `profile`; returns the
+/// directory holding its ELFs.
+pub fn bench_firmware(paths: &Paths, profile: &str) -> Result<PathBuf> {
+    let target_dir = paths.scratch("bench-firmware");
+    let manifest = paths.firmware().join("Cargo.toml");
+    let mut c = cargo();
+    c.current_dir(paths.firmware())
+        .arg("build")
+        .args(["--profile", profile, "--target", TARGET])
+        .arg("--manifest-path")
+        .arg(&manifest)
+        .arg("--target-dir")
+        .arg(&target_dir);
+    eprintln!("can-bench: {}", cmd::display(&c));
+    cmd::run_ok(&mut c, BUILD_LIMIT).context("building the bench firmware")?;
+    Ok(target_dir.join(TARGET).join(profile))
+}
+
+/// A firmware example package of the workspace, as `cargo metadata` describes it.
+#[derive(Debug, Clone)]
+pub struct ExamplePackage {
+    /// Package name.
+    pub name: String,
+    /// Folder relative to the workspace root.
+    pub dir: String,
+    /// Binary targets with their required features.
+    pub bins: Vec<(String, Vec<String>)>,
+    /// Feature names (without `default`).
+    pub features: Vec<String>,
+}
+
+/// The packages under `examples/` that have binary targets.
+pub fn example_packages(paths: &Paths) -> Result<Vec<ExamplePackage>> {
+    let mut c = cargo();
+    c.current_dir(&paths.root)
+        .args(["metadata", "--no-deps", "--format-version", "1", "--offline"]);
+    let out = match cmd::run_ok(&mut c, Duration::from_secs(120)) {
+        Ok(o) => o,
+        // --offline fails when something is not downloaded yet; try online.
+        Err(_) => {
+            let mut c = cargo();
+            c.current_dir(&paths.root)
+                .args(["metadata", "--no-deps", "--format-version", "1"]);
+            cmd::run_ok(&mut c, Duration::from_secs(300)).context("cargo metadata")?
+        }
+    };
+    let meta: serde_json::Value =
+        serde_json::from_str(&out.stdout).context("parsing cargo metadata")?;
+    let examples = paths.root.join("examples");
+    let mut found = Vec::new();
+    for p in meta["packages"].as_array().into_iter().flatten() {
+        let manifest = PathBuf::from(p["manifest_path"].as_str().unwrap_or(""));
+        let Some(dir) = manifest.parent() else {
+            continue;
+        };
+        if !dir.starts_with(&examples) {
+            continue;
+        }
+        let bins: Vec<(String, Vec<String>)> = p["targets"]
+            .as_array()
+            .into_iter()
+            .flatten()
+            .filter(|t| {
+                t["kind"]
+                    .as_array()
+                    .is_some_and(|k| k.iter().any(|k| k == "bin"))
+            })
+            .map(|t| {
+                let req = t["required-features"]
+                    .as_array()
+                    .into_iter()
+                    .flatten()
+                    .filter_map(|f| f.as_str().map(String::from))
+                    .collect();
+                (t["name"].as_str().unwrap_or("?").to_string(), req)
+            })
+            .collect();
+        if bins.is_empty() {
+            continue;
+        }
+        let features = p["features"]
+            .as_object()
+            .map(|m| m.keys().filter(|k| *k != "default").cloned().collect())
+            .unwrap_or_default();
+        found.push(ExamplePackage {
+            name: p["name"].as_str().unwrap_or("?").to_string(),
+            dir: dir
+                .strip_prefix(&paths.root)
+                .unwrap_or(dir)
+                .display()
+                .to_string(),
+            bins,
+            features,
+        });
+    }
+    found.sort_by(|a, b| a.name.cmp(&b.name));
+    Ok(found)
+}
+
+/// Builds the binaries of `package` for one feature set (`--release`); returns the ELF
+/// directory.
+pub fn example(paths: &Paths, package: &str, features: &[String]) -> Result<PathBuf> {
+    let target_dir = paths.scratch("bench-examples");
+    let mut c = cargo();
+    c.current_dir(&paths.root)
+        .arg("build")
+        .args(["--release", "--target", TARGET, "-p", package, "--bins"])
+        .arg("--target-dir")
+        .arg(&target_dir);
+    if !features.is_empty() {
+        c.arg("--features").arg(features.join(","));
+    }
+    eprintln!("can-bench: {}", cmd::display(&c));
+    cmd::run_ok(&mut c, BUILD_LIMIT).context(format!("building the example {package}"))?;
+    Ok(target_dir.join(TARGET).join("release"))
+}
+
+/// The version of a package in a Cargo.lock file (`None` if absent).
+pub fn locked_version(lock: &Path, package: &str) -> Option<String> {
+    let text = std::fs::read_to_string(lock).ok()?;
+    let mut lines = text.lines();
+    while let Some(line) = lines.next() {
+        if line.trim() == format!("name = \"{package}\"") {
+            let v = lines.next()?.trim();
+            return v
+                .strip_prefix("version = \"")
+                .and_then(|v| v.strip_suffix('"'))
+                .map(String::from);
+        }
+    }
+    None
+}

@@ -1,0 +1,2 @@
+//! can-bench (being written).
+fn main() {}

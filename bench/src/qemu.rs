@@ -1,0 +1,304 @@
+//! Instructions per frame under QEMU: the tools (QEMU, gcc), the counting plugin and the
+//! run of the `insn-count` firmware.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::time::Duration;
+
+use crate::cmd::{self, Context, Error, Result};
+use crate::firmware::Paths;
+
+/// The board QEMU emulates: a Cortex-M4 (ARM MPS2 with the AN386 FPGA image).
+pub const MACHINE: &str = "mps2-an386";
+/// Time allowed for one firmware run under QEMU.
+const RUN_LIMIT: Duration = Duration::from_secs(120);
+/// The ELF symbol holding the marker window address.
+const WINDOW_SYMBOL: &str = "BENCH_MARKER_WINDOW";
+
+/// The tools found (or installed) for this step.
+#[derive(Debug, Clone)]
+pub struct Tools {
+    /// `qemu-system-arm`.
+    pub qemu: PathBuf,
+    /// Its `--version` first line.
+    pub qemu_version: String,
+    /// Whether can-bench installed QEMU in this run.
+    pub qemu_installed_now: bool,
+    /// `gcc`.
+    pub gcc: PathBuf,
+    /// Its `--version` first line.
+    pub gcc_version: String,
+}
+
+fn is_root() -> bool {
+    cmd::first_line("id", &["-u"]).as_deref() == Some("0")
+}
+
+fn apt_install(package: &str) -> Result<()> {
+    if cmd::which("apt-get").is_none() {
+        return Err(Error::new(format!(
+            "`{package}` is missing and there is no apt-get to install it"
+        )));
+    }
+    let install = || {
+        let mut c = Command::new("apt-get");
+        c.args(["install", "-y", "-q", package])
+            .env("DEBIAN_FRONTEND", "noninteractive");
+        eprintln!("can-bench: {}", cmd::display(&c));
+        cmd::run_ok(&mut c, Duration::from_secs(900))
+    };
+    if install().is_ok() {
+        return Ok(());
+    }
+    // The package lists may be missing or stale: update them once and retry.
+    let mut update = Command::new("apt-get");
+    update.args(["update", "-q"]);
+    eprintln!("can-bench: {}", cmd::display(&update));
+    cmd::run_ok(&mut update, Duration::from_secs(600)).context("apt-get update")?;
+    install().context(format!("apt-get install -y {package}"))?;
+    Ok(())
+}
+
+/// Finds `program`, installing Debian `package` when running as root; a clear error
+/// otherwise.
+fn ensure(program: &str, package: &str) -> Result<(PathBuf, bool)> {
+    if let Some(p) = cmd::which(program) {
+        return Ok((p, false));
+    }
+    if !is_root() {
+        return Err(Error::new(format!(
+            "`{program}` is not installed and can-bench does not run as root (id -u is not 0), \
+             so it cannot install it: run `sudo apt-get install -y {package}` (Debian package \
+             `{package}`) and start can-bench again"
+        )));
+    }
+    eprintln!("can-bench: `{program}` not found; installing the Debian package `{package}`");
+    apt_install(package)?;
+    let p = cmd::which(program).ok_or_else(|| {
+        Error::new(format!(
+            "`{program}` is still not in PATH after installing `{package}`"
+        ))
+    })?;
+    Ok((p, true))
+}
+
+/// QEMU (with the mps2-an386 machine) and gcc.
+pub fn tools() -> Result<Tools> {
+    let (qemu, qemu_installed_now) = ensure("qemu-system-arm", "qemu-system-arm")?;
+    let qemu_s = qemu.to_string_lossy().into_owned();
+    let qemu_version = cmd::first_line(&qemu_s, &["--version"])
+        .ok_or_else(|| Error::new(format!("`{qemu_s} --version` failed")))?;
+    let machines = cmd::run_ok(
+        Command::new(&qemu).args(["-machine", "help"]),
+        Duration::from_secs(30),
+    )?;
+    if !machines.stdout.lines().any(|l| l.split_whitespace().next() == Some(MACHINE)) {
+        return Err(Error::new(format!(
+            "{qemu_version} has no `{MACHINE}` machine (QEMU 6.0 or newer is needed)"
+        )));
+    }
+    let (gcc, _) = ensure("gcc", "gcc")?;
+    let gcc_version = cmd::first_line(&gcc.to_string_lossy(), &["--version"])
+        .ok_or_else(|| Error::new("`gcc --version` failed"))?;
+    Ok(Tools {
+        qemu,
+        qemu_version,
+        qemu_installed_now,
+        gcc,
+        gcc_version,
+    })
+}
+
+/// The gcc command line that builds the plugin (for the report too).
+pub const PLUGIN_FLAGS: [&str; 7] = [
+    "-shared",
+    "-fPIC",
+    "-O2",
+    "-fvisibility=hidden",
+    "-Wall",
+    "-Wextra",
+    "-Werror",
+];
+
+/// Builds `bench/plugin/insn_count.c` into a shared object; returns its path.
+pub fn build_plugin(paths: &Paths, tools: &Tools) -> Result<PathBuf> {
+    let source = paths.root.join("bench").join("plugin").join("insn_count.c");
+    let dir = paths.scratch("bench-plugin");
+    std::fs::create_dir_all(&dir).context(format!("creating {}", dir.display()))?;
+    let so = dir.join("insn_count.so");
+    let mut c = Command::new(&tools.gcc);
+    c.args(PLUGIN_FLAGS).arg("-o").arg(&so).arg(&source);
+    eprintln!("can-bench: {}", cmd::display(&c));
+    cmd::run_ok(&mut c, Duration::from_secs(120)).context("building the QEMU plugin")?;
+    Ok(so)
+}
+
+/// One measured region.
+#[derive(Debug, Clone)]
+pub struct Region {
+    /// Its key (`twocan.try_send.direct`, ...), as the firmware names it.
+    pub key: String,
+    /// Raw counts of each measurement (marker overhead included).
+    pub raw: Vec<u64>,
+}
+
+/// The outcome of one firmware run.
+#[derive(Debug, Clone)]
+pub struct Counts {
+    /// Regions by key.
+    pub regions: BTreeMap<String, Region>,
+    /// Instructions of an empty region (the end marker store), subtracted from the others.
+    pub overhead: u64,
+    /// Instructions the guest executed in the whole run.
+    pub total: u64,
+}
+
+impl Counts {
+    /// Net instructions of `key`: (min, max) over its measurements.
+    pub fn net(&self, key: &str) -> Result<(u64, u64)> {
+        let r = self
+            .regions
+            .get(key)
+            .ok_or_else(|| Error::new(format!("the firmware measured no region `{key}`")))?;
+        let min = r.raw.iter().min().copied().unwrap_or(0);
+        let max = r.raw.iter().max().copied().unwrap_or(0);
+        Ok((
+            min.saturating_sub(self.overhead),
+            max.saturating_sub(self.overhead),
+        ))
+    }
+
+    /// Net instructions of `key` when every measurement agreed; an error otherwise.
+    pub fn exact(&self, key: &str) -> Result<u64> {
+        let (lo, hi) = self.net(key)?;
+        if lo != hi {
+            return Err(Error::new(format!(
+                "region `{key}` was not deterministic: {lo}..{hi} instructions"
+            )));
+        }
+        Ok(lo)
+    }
+
+    /// Measurements per region (the same for every region).
+    pub fn repeats(&self) -> usize {
+        self.regions.values().map(|r| r.raw.len()).min().unwrap_or(0)
+    }
+}
+
+/// The QEMU command line for `elf` (for running and for the report).
+pub fn command(tools: &Tools, elf: &Path, plugin: &Path, window: u32, out: &Path) -> Command {
+    let mut c = Command::new(&tools.qemu);
+    c.args(["-machine", MACHINE, "-cpu", "cortex-m4", "-nographic"])
+        .args(["-monitor", "none", "-serial", "none"])
+        .args(["-semihosting-config", "enable=on,target=native"])
+        .arg("-kernel")
+        .arg(elf)
+        .arg("-plugin")
+        .arg(format!(
+            "{},base={window:#x},outfile={}",
+            plugin.display(),
+            out.display()
+        ));
+    c
+}
+
+/// Runs the `insn-count` firmware `elf` under QEMU with the plugin and collects the counts.
+pub fn run(paths: &Paths, tools: &Tools, plugin: &Path, elf: &Path, tag: &str) -> Result<Counts> {
+    let window = crate::sizes::read_u32_symbol(elf, WINDOW_SYMBOL)?;
+    let out_file = paths.scratch("bench-plugin").join(format!("counts-{tag}.txt"));
+    let _ = std::fs::remove_file(&out_file);
+    let mut c = command(tools, elf, plugin, window, &out_file);
+    eprintln!("can-bench: {}", cmd::display(&c));
+    let out = cmd::run(&mut c, RUN_LIMIT).context("running the firmware under QEMU")?;
+    let failed = out.stdout.lines().find(|l| l.starts_with("FAIL"));
+    if out.code != Some(0) || failed.is_some() || !out.stdout.lines().any(|l| l == "done") {
+        return Err(Error::new(format!(
+            "the insn-count firmware failed under QEMU (exit {:?}){}\nstdout:\n{}\nstderr:\n{}",
+            out.code,
+            failed.map(|f| format!(": {f}")).unwrap_or_default(),
+            cmd::tail(&out.stdout, 20),
+            cmd::tail(&out.stderr, 20)
+        )));
+    }
+    // The firmware names its regions; the plugin counts them.
+    let mut keys = BTreeMap::new();
+    for line in out.stdout.lines() {
+        let mut w = line.split_whitespace();
+        match (w.next(), w.next(), w.next()) {
+            (Some("window"), Some(addr), None) => {
+                let addr = u32::from_str_radix(addr.trim_start_matches("0x"), 16)
+                    .context("firmware window line")?;
+                if addr != window {
+                    return Err(Error::new(format!(
+                        "the firmware says its marker window is {addr:#x}, the ELF symbol \
+                         {WINDOW_SYMBOL} says {window:#x}"
+                    )));
+                }
+            }
+            (Some("region"), Some(n), Some(key)) => {
+                let n: u32 = n.parse().context("firmware region line")?;
+                keys.insert(n, key.to_string());
+            }
+            _ => {}
+        }
+    }
+    let counts = std::fs::read_to_string(&out_file).context(format!(
+        "reading the plugin output {} (did the plugin load?)",
+        out_file.display()
+    ))?;
+    let mut regions: BTreeMap<String, Region> = BTreeMap::new();
+    let mut total = None;
+    for line in counts.lines() {
+        let w: Vec<&str> = line.split_whitespace().collect();
+        match w.as_slice() {
+            ["region", n, count] => {
+                let n: u32 = n.parse().context("plugin output")?;
+                let count: u64 = count.parse().context("plugin output")?;
+                let key = keys.get(&n).ok_or_else(|| {
+                    Error::new(format!("the plugin measured region {n}, which the firmware did not name"))
+                })?;
+                regions
+                    .entry(key.clone())
+                    .or_insert_with(|| Region {
+                        key: key.clone(),
+                        raw: Vec::new(),
+                    })
+                    .raw
+                    .push(count);
+            }
+            ["total", t, "completed", _, "unmatched", u] => {
+                if *u != "0" {
+                    return Err(Error::new(format!(
+                        "the plugin saw {u} end markers without a start"
+                    )));
+                }
+                total = Some(t.parse::<u64>().context("plugin output")?);
+            }
+            _ => {}
+        }
+    }
+    let total = total.ok_or_else(|| {
+        Error::new("the plugin output has no `total` line (QEMU did not exit normally)")
+    })?;
+    for key in keys.values() {
+        if !regions.contains_key(key) {
+            return Err(Error::new(format!("region `{key}` was never measured")));
+        }
+    }
+    let empty = regions
+        .get("empty")
+        .ok_or_else(|| Error::new("no calibration region `empty`"))?;
+    let overhead = *empty.raw.iter().min().unwrap_or(&0);
+    if empty.raw.iter().any(|&c| c != overhead) {
+        return Err(Error::new(format!(
+            "the empty region was not constant: {:?}",
+            empty.raw
+        )));
+    }
+    Ok(Counts {
+        regions,
+        overhead,
+        total,
+    })
+}

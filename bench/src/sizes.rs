@@ -1,0 +1,164 @@
+//! Flash and RAM of a firmware ELF, from its section headers.
+//!
+//! Only allocated sections (`SHF_ALLOC`) occupy the target's memories:
+//!
+//! - `SHT_NOBITS` (`.bss`, `.uninit`): RAM only (zeroed or left alone at start-up);
+//! - `SHT_PROGBITS` with `SHF_WRITE` (`.data`): RAM, **and** flash for its initial image
+//!   that the start-up code copies;
+//! - any other allocated section (`.vector_table`, `.text`, `.rodata`, `.flash_config`):
+//!   flash-resident code and constants.
+//!
+//! So `flash = code + data` and `RAM = data + bss`. The stack (the rest of RAM, placed by
+//! cortex-m-rt) is not a section and is not counted.
+
+use std::path::Path;
+
+use object::elf::{SHF_ALLOC, SHF_WRITE, SHT_NOBITS};
+use object::read::elf::{ElfFile32, SectionHeader};
+use object::{LittleEndian, Object, ObjectSection, ObjectSymbol};
+
+use crate::cmd::{Context, Error, Result};
+
+/// Where a section lives.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Class {
+    /// Flash-resident code and constants.
+    Code,
+    /// Initialised data: RAM, and its image in flash.
+    Data,
+    /// Zero-initialised or uninitialised data: RAM only.
+    Bss,
+}
+
+impl Class {
+    /// A short name for tables.
+    pub fn name(self) -> &'static str {
+        match self {
+            Class::Code => "code",
+            Class::Data => "data",
+            Class::Bss => "bss",
+        }
+    }
+}
+
+/// One allocated section.
+#[derive(Debug, Clone)]
+pub struct Section {
+    /// Its name.
+    pub name: String,
+    /// Bytes.
+    pub size: u64,
+    /// Where it lives.
+    pub class: Class,
+}
+
+/// The memory use of one ELF.
+#[derive(Debug, Clone)]
+pub struct Size {
+    /// Allocated sections, in file order (empty ones left out).
+    pub sections: Vec<Section>,
+}
+
+impl Size {
+    fn total(&self, class: Class) -> u64 {
+        self.sections
+            .iter()
+            .filter(|s| s.class == class)
+            .map(|s| s.size)
+            .sum()
+    }
+
+    /// Flash-resident code and constants.
+    pub fn code(&self) -> u64 {
+        self.total(Class::Code)
+    }
+
+    /// Initialised data.
+    pub fn data(&self) -> u64 {
+        self.total(Class::Data)
+    }
+
+    /// Zero-initialised / uninitialised data.
+    pub fn bss(&self) -> u64 {
+        self.total(Class::Bss)
+    }
+
+    /// Flash: code + data.
+    pub fn flash(&self) -> u64 {
+        self.code() + self.data()
+    }
+
+    /// RAM: data + bss.
+    pub fn ram(&self) -> u64 {
+        self.data() + self.bss()
+    }
+
+    /// `name size, ...` of the non-empty sections, for the report.
+    pub fn section_list(&self) -> String {
+        self.sections
+            .iter()
+            .map(|s| format!("`{}` {} ({})", s.name, s.size, s.class.name()))
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
+}
+
+fn parse(data: &[u8]) -> Result<ElfFile32<'_, LittleEndian>> {
+    ElfFile32::<LittleEndian>::parse(data).context("not a 32-bit little-endian ELF")
+}
+
+/// Reads the section headers of the ELF at `path`.
+pub fn measure(path: &Path) -> Result<Size> {
+    let data = std::fs::read(path).context(format!("reading {}", path.display()))?;
+    let elf = parse(&data).context(path.display())?;
+    let endian = elf.endian();
+    let mut sections = Vec::new();
+    for section in elf.sections() {
+        let header = section.elf_section_header();
+        let flags = u64::from(header.sh_flags(endian));
+        if flags & u64::from(SHF_ALLOC) == 0 {
+            continue;
+        }
+        let size = u64::from(header.sh_size(endian));
+        if size == 0 {
+            continue;
+        }
+        let class = if header.sh_type(endian) == SHT_NOBITS {
+            Class::Bss
+        } else if flags & u64::from(SHF_WRITE) != 0 {
+            Class::Data
+        } else {
+            Class::Code
+        };
+        let name = section.name().unwrap_or("?").to_string();
+        sections.push(Section { name, size, class });
+    }
+    if sections.is_empty() {
+        return Err(Error::new(format!(
+            "{}: no allocated section",
+            path.display()
+        )));
+    }
+    Ok(Size { sections })
+}
+
+/// The 32-bit little-endian value of the static `symbol` in the ELF at `path`.
+pub fn read_u32_symbol(path: &Path, symbol: &str) -> Result<u32> {
+    let data = std::fs::read(path).context(format!("reading {}", path.display()))?;
+    let elf = parse(&data).context(path.display())?;
+    let sym = elf
+        .symbols()
+        .find(|s| s.name() == Ok(symbol))
+        .ok_or_else(|| Error::new(format!("{}: no symbol `{symbol}`", path.display())))?;
+    let addr = sym.address();
+    for section in elf.sections() {
+        if let Ok(Some(bytes)) = section.data_range(addr, 4) {
+            let v = u32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]]);
+            return Ok(v);
+        }
+    }
+    Err(Error::new(format!(
+        "{}: symbol `{symbol}` at {addr:#x} has no data",
+        path.display()
+    )))
+}

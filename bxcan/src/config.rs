@@ -1,0 +1,400 @@
+//! The configuration builder: bit timing, test modes and the `CAN_MCR` options.
+//!
+//! Everything here is written while the controller is in initialization mode (RM0410
+//! §40.4.1 "Initialization mode": `CAN_BTR` can only be written there; the notes'
+//! `CAN_MCR` bit list for TTCM, ABOM, AWUM, NART, RFLM, TXFP, DBF).
+
+use twocan_core::timing::{solve, solve_cia, Limits, Timing, TimingError, DEFAULT_TOLERANCE_PPM};
+use twocan_core::TxPolicy;
+
+use crate::regs::{btr, ier, mcr, FILTER_BANKS};
+
+/// Why a configuration was refused.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum ConfigError {
+    /// The bit timing could not be computed, does not fit `CAN_BTR`, or is outside the
+    /// tolerance of the wished bit rate.
+    Timing(TimingError),
+    /// A raw `CAN_BTR` value with bits outside `BRP`, `TS1`, `TS2`, `SJW` (reserved bits,
+    /// or the `LBKM`/`SILM` mode bits, which the builder sets with
+    /// [`Config::loopback`]/[`Config::silent`]).
+    BtrReservedBits,
+    /// A CAN2 start bank above 28 (RM0410 `CAN_FMR.CAN2SB`).
+    StartBankOutOfRange,
+}
+
+impl From<TimingError> for ConfigError {
+    fn from(e: TimingError) -> Self {
+        ConfigError::Timing(e)
+    }
+}
+
+/// How the controller leaves bus-off (notes "Bus-off recovery"; `CAN_MCR.ABOM`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Recovery {
+    /// `ABOM = 1`: the hardware starts the recovery sequence (128 × 11 recessive bits) by
+    /// itself.
+    Automatic,
+    /// `ABOM = 0`: software starts it by entering and leaving initialization mode
+    /// ([`twocan_core::Controller::recover`]).
+    #[default]
+    Manual,
+}
+
+/// The `CAN_BTR` timing fields (BRP, TS1, TS2, SJW).
+const BTR_TIMING: u32 = btr::BRP.mask() | btr::TS1.mask() | btr::TS2.mask() | btr::SJW.mask();
+
+/// The interrupts the driver services in [`twocan_core::Driver::on_interrupt`]: mailbox
+/// empty, message pending / full / overrun of both FIFOs, error (warning, passive,
+/// bus-off, last error code), wake-up (RM0410 §40.8 "bxCAN interrupts").
+pub const DEFAULT_INTERRUPTS: u32 = ier::TMEIE
+    | ier::FMPIE0
+    | ier::FOVIE0
+    | ier::FMPIE1
+    | ier::FOVIE1
+    | ier::EWGIE
+    | ier::EPVIE
+    | ier::BOFIE
+    | ier::LECIE
+    | ier::ERRIE
+    | ier::WKUIE;
+
+/// Default bound on every wait for an acknowledge bit (`INAK`, `SLAK`): register reads.
+///
+/// Leaving initialization mode takes 11 consecutive recessive bits on CANRX (RM0410
+/// §40.4.1): 11 ms at 1 kbit/s. One read of an APB1 register costs at least 4 CPU cycles,
+/// so 1,000,000 reads last at least 18 ms at 216 MHz — longer than that — and end in
+/// [`twocan_core::Error::Timeout`] when the acknowledge never comes (no transceiver, no
+/// clock).
+pub const DEFAULT_WAIT_ITERATIONS: u32 = 1_000_000;
+
+/// Configuration of one bxCAN instance (builder; every setter is `const`).
+///
+/// ```
+/// use twocan_bxcan::{Config, Recovery};
+/// use twocan_core::TxPolicy;
+/// // APB1 = 54 MHz (216 MHz SYSCLK / 4), 500 kbit/s, CiA sample point, 0.1 % tolerance.
+/// const CONFIG: Config = match Config::from_bitrate(54_000_000, 500_000) {
+///     Ok(c) => c.tx_policy(TxPolicy::Priority).recovery(Recovery::Automatic),
+///     Err(_) => panic!("no timing"),
+/// };
+/// assert_eq!(CONFIG.btr_value() & 0x3FF, 5); // BRP = 6 - 1
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Config {
+    btr: u32,
+    loopback: bool,
+    silent: bool,
+    tx_policy: TxPolicy,
+    one_shot: bool,
+    recovery: Recovery,
+    rx_fifo_lock: bool,
+    timestamps: bool,
+    auto_wakeup: bool,
+    debug_freeze: bool,
+    interrupts: u32,
+    can2_start_bank: Option<u8>,
+    wait_iterations: u32,
+}
+
+impl Config {
+    const fn with_btr(btr: u32) -> Config {
+        Config {
+            btr,
+            loopback: false,
+            silent: false,
+            tx_policy: TxPolicy::Fifo,
+            one_shot: false,
+            recovery: Recovery::Manual,
+            rx_fifo_lock: false,
+            timestamps: false,
+            auto_wakeup: false,
+            debug_freeze: false,
+            interrupts: DEFAULT_INTERRUPTS,
+            can2_start_bank: None,
+            wait_iterations: DEFAULT_WAIT_ITERATIONS,
+        }
+    }
+
+    /// A configuration with a raw `CAN_BTR` timing value (RM0410 §40.9.2 "CAN bit timing
+    /// register": `BRP[9:0]`, `TS1[19:16]`, `TS2[22:20]`, `SJW[25:24]`).
+    pub const fn from_btr(btr_value: u32) -> Result<Config, ConfigError> {
+        if btr_value & !BTR_TIMING != 0 {
+            return Err(ConfigError::BtrReservedBits);
+        }
+        Ok(Self::with_btr(btr_value))
+    }
+
+    /// A configuration from a [`Timing`] (for example adjusted by hand), accepted when
+    /// consistent with [`Limits::BXCAN`] and within `tolerance_ppm` of its wished bit
+    /// rate ([`Timing::validate`]).
+    pub const fn from_timing(timing: Timing, tolerance_ppm: u32) -> Result<Config, ConfigError> {
+        let t = match timing.validate(tolerance_ppm) {
+            Ok(t) => t,
+            Err(e) => return Err(ConfigError::Timing(e)),
+        };
+        match t.bxcan_btr() {
+            Ok(b) => Ok(Self::with_btr(b)),
+            Err(e) => Err(ConfigError::Timing(e)),
+        }
+    }
+
+    /// Bit timing solved for `bitrate` from the APB1 clock `apb1_hz` (the bxCAN kernel
+    /// clock, RM0410 §40.7.7 "Bit timing": tq = (BRP + 1) × tPCLK), CiA sample point,
+    /// refused beyond [`DEFAULT_TOLERANCE_PPM`] (0.1 %) from the wished rate.
+    pub const fn from_bitrate(apb1_hz: u32, bitrate: u32) -> Result<Config, ConfigError> {
+        match solve_cia(apb1_hz, bitrate, &Limits::BXCAN) {
+            Ok(t) => Self::from_timing(t, DEFAULT_TOLERANCE_PPM),
+            Err(e) => Err(ConfigError::Timing(e)),
+        }
+    }
+
+    /// Like [`Config::from_bitrate`] with a sample point (per mille) and a tolerance.
+    pub const fn from_bitrate_with(
+        apb1_hz: u32,
+        bitrate: u32,
+        sample_point_permille: u16,
+        tolerance_ppm: u32,
+    ) -> Result<Config, ConfigError> {
+        match solve(apb1_hz, bitrate, &Limits::BXCAN, sample_point_permille) {
+            Ok(t) => Self::from_timing(t, tolerance_ppm),
+            Err(e) => Err(ConfigError::Timing(e)),
+        }
+    }
+
+    /// Loop-back mode (`CAN_BTR.LBKM`, RM0410 §40.5.2): transmitted frames are received
+    /// back and the acknowledge slot is ignored.
+    pub const fn loopback(self, on: bool) -> Self {
+        Config {
+            loopback: on,
+            ..self
+        }
+    }
+
+    /// Silent mode (`CAN_BTR.SILM`, RM0410 §40.5.1): listen only, send recessive bits.
+    /// With loop-back: "loop back combined with silent", a self-test that leaves the bus
+    /// alone.
+    pub const fn silent(self, on: bool) -> Self {
+        Config { silent: on, ..self }
+    }
+
+    /// Transmit order among loaded mailboxes (`CAN_MCR.TXFP`; notes "Transmit priority"):
+    /// [`TxPolicy::Fifo`] sets TXFP (request order), [`TxPolicy::Priority`] clears it
+    /// (identifier order).
+    pub const fn tx_policy(self, policy: TxPolicy) -> Self {
+        Config {
+            tx_policy: policy,
+            ..self
+        }
+    }
+
+    /// No automatic retransmission (`CAN_MCR.NART`; notes "Non automatic retransmission
+    /// mode"): each frame is tried once; a failure is reported as
+    /// [`twocan_core::Events::failed`].
+    pub const fn one_shot(self, on: bool) -> Self {
+        Config {
+            one_shot: on,
+            ..self
+        }
+    }
+
+    /// Bus-off recovery (`CAN_MCR.ABOM`).
+    pub const fn recovery(self, recovery: Recovery) -> Self {
+        Config { recovery, ..self }
+    }
+
+    /// Receive FIFO locked mode (`CAN_MCR.RFLM`; notes "FIFO overrun"): when a FIFO is
+    /// full, keep the three oldest frames and drop the new one (else the newest replaces
+    /// the last stored).
+    pub const fn rx_fifo_lock(self, on: bool) -> Self {
+        Config {
+            rx_fifo_lock: on,
+            ..self
+        }
+    }
+
+    /// Time-triggered communication mode (`CAN_MCR.TTCM`; notes "Time triggered
+    /// communication mode"): the bit-time counter is captured at the start of frame and
+    /// reported in [`twocan_core::RxFrame::timestamp`].
+    pub const fn timestamps(self, on: bool) -> Self {
+        Config {
+            timestamps: on,
+            ..self
+        }
+    }
+
+    /// Automatic wake-up on bus activity (`CAN_MCR.AWUM`, RM0410 §40.4.3 "Sleep mode").
+    pub const fn auto_wakeup(self, on: bool) -> Self {
+        Config {
+            auto_wakeup: on,
+            ..self
+        }
+    }
+
+    /// Freeze the controller while the core is halted by a debugger (`CAN_MCR.DBF`).
+    pub const fn debug_freeze(self, on: bool) -> Self {
+        Config {
+            debug_freeze: on,
+            ..self
+        }
+    }
+
+    /// The `CAN_IER` value written at configuration (default [`DEFAULT_INTERRUPTS`]).
+    pub const fn interrupts(self, ier_value: u32) -> Self {
+        Config {
+            interrupts: ier_value,
+            ..self
+        }
+    }
+
+    /// CAN1 only: the first filter bank of CAN2 (`CAN_FMR.CAN2SB`): CAN1 gets banks
+    /// `0..bank`, CAN2 `bank..28`; 28 gives every bank to CAN1 (the notes' "sets to zero
+    /// for one CAN" would give them all to CAN2: see `docs/filters.md`). Unset: the value
+    /// in the register is kept (14 after reset). Ignored by CAN2 and CAN3.
+    pub const fn can2_start_bank(self, bank: u8) -> Result<Self, ConfigError> {
+        if bank as usize > FILTER_BANKS {
+            return Err(ConfigError::StartBankOutOfRange);
+        }
+        Ok(Config {
+            can2_start_bank: Some(bank),
+            ..self
+        })
+    }
+
+    /// The bound, in register reads, on every wait for an acknowledge bit (default
+    /// [`DEFAULT_WAIT_ITERATIONS`]); at least 1.
+    pub const fn wait_iterations(self, reads: u32) -> Self {
+        Config {
+            wait_iterations: if reads == 0 { 1 } else { reads },
+            ..self
+        }
+    }
+
+    /// The `CAN_BTR` value written (timing fields and the LBKM/SILM mode bits).
+    pub const fn btr_value(&self) -> u32 {
+        let mut v = self.btr;
+        if self.loopback {
+            v |= btr::LBKM;
+        }
+        if self.silent {
+            v |= btr::SILM;
+        }
+        v
+    }
+
+    /// The `CAN_MCR` option bits (INRQ and SLEEP excluded).
+    pub const fn mcr_options(&self) -> u32 {
+        let mut v = 0;
+        if let TxPolicy::Fifo = self.tx_policy {
+            v |= mcr::TXFP;
+        }
+        if self.rx_fifo_lock {
+            v |= mcr::RFLM;
+        }
+        if self.one_shot {
+            v |= mcr::NART;
+        }
+        if self.auto_wakeup {
+            v |= mcr::AWUM;
+        }
+        if let Recovery::Automatic = self.recovery {
+            v |= mcr::ABOM;
+        }
+        if self.timestamps {
+            v |= mcr::TTCM;
+        }
+        if self.debug_freeze {
+            v |= mcr::DBF;
+        }
+        v
+    }
+
+    /// The transmit policy.
+    pub const fn get_tx_policy(&self) -> TxPolicy {
+        self.tx_policy
+    }
+
+    /// The recovery mode.
+    pub const fn get_recovery(&self) -> Recovery {
+        self.recovery
+    }
+
+    /// Whether time stamps are on.
+    pub const fn get_timestamps(&self) -> bool {
+        self.timestamps
+    }
+
+    /// The `CAN_IER` value.
+    pub const fn get_interrupts(&self) -> u32 {
+        self.interrupts
+    }
+
+    /// The CAN2 start bank to write, if any.
+    pub const fn get_can2_start_bank(&self) -> Option<u8> {
+        self.can2_start_bank
+    }
+
+    /// The acknowledge wait bound.
+    pub const fn get_wait_iterations(&self) -> u32 {
+        self.wait_iterations
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn raw_btr_is_checked() {
+        assert_eq!(
+            Config::from_btr(btr::LBKM),
+            Err(ConfigError::BtrReservedBits)
+        );
+        assert_eq!(Config::from_btr(1 << 23), Err(ConfigError::BtrReservedBits));
+        let c = Config::from_btr(0x001C_0005)
+            .unwrap()
+            .loopback(true)
+            .silent(true);
+        assert_eq!(c.btr_value(), 0x001C_0005 | btr::LBKM | btr::SILM);
+    }
+
+    #[test]
+    fn options_map_to_mcr_bits() {
+        let c = Config::from_btr(0).unwrap();
+        assert_eq!(c.mcr_options(), mcr::TXFP);
+        let c = c
+            .tx_policy(TxPolicy::Priority)
+            .one_shot(true)
+            .recovery(Recovery::Automatic)
+            .rx_fifo_lock(true)
+            .timestamps(true)
+            .auto_wakeup(true)
+            .debug_freeze(true);
+        assert_eq!(
+            c.mcr_options(),
+            mcr::RFLM | mcr::NART | mcr::AWUM | mcr::ABOM | mcr::TTCM | mcr::DBF
+        );
+    }
+
+    #[test]
+    fn timing_out_of_tolerance_is_refused() {
+        // 54 MHz / 500 kbit/s = 108 clocks: exact.
+        assert!(Config::from_bitrate(54_000_000, 500_000).is_ok());
+        // 1 bit/s cannot be reached (BRP ≤ 1024, ≤ 25 quanta).
+        assert_eq!(
+            Config::from_bitrate(54_000_000, 1),
+            Err(ConfigError::Timing(TimingError::TooFarFromWishedBitrate))
+        );
+        assert_eq!(
+            Config::from_bitrate(0, 500_000),
+            Err(ConfigError::Timing(TimingError::ClockZero))
+        );
+        assert_eq!(
+            Config::can2_start_bank(Config::from_btr(0).unwrap(), 29),
+            Err(ConfigError::StartBankOutOfRange)
+        );
+    }
+}

@@ -1,0 +1,576 @@
+//! The bxCAN controller: configuration entry points ([`Can::can1`], [`Can::can2`],
+//! [`Can::can3`]), the initialization-mode value [`Init`], and the
+//! [`twocan_core::Controller`] implementation the portable [`twocan_core::Driver`] uses.
+
+use twocan_core::{
+    Controller, Error, ErrorCounters, ErrorState, ErrorStatus, Events, Frame, LastErrorCode,
+    MailboxId, MailboxState, Mode, Priority, Registers, RxFrame, TxPolicy,
+};
+
+use crate::config::{Config, Recovery};
+use crate::filter_block;
+use crate::filters::{Fifo, FilterPlan, FmiMap};
+use crate::instance::Instance;
+use crate::mailbox;
+use crate::mode;
+use crate::planner::{self, FifoPolicy, PlanOptions};
+use crate::regs::{esr, ier, mcr, msr, rfxr, tsr, BTR, ESR, IER, MCR, MSR, TSR, TX_MAILBOXES};
+
+/// Register reads spent waiting for an aborted mailbox to become empty (notes "Abort":
+/// a pending or scheduled mailbox is aborted at once; one on the bus finishes first, and
+/// is then not waited for).
+pub const ABORT_WAIT_ITERATIONS: u32 = 16;
+
+/// An operation that failed, with the value it consumed, so nothing is lost: convert it
+/// into [`Error`] with `?` or take [`Failed::value`] back.
+#[derive(Debug)]
+pub struct Failed<T> {
+    /// Why.
+    pub error: Error,
+    /// What the operation was given back.
+    pub value: T,
+}
+
+impl<T> From<Failed<T>> for Error {
+    fn from(f: Failed<T>) -> Error {
+        f.error
+    }
+}
+
+/// A bxCAN instance over its registers `R` (volatile [`twocan_core::Mmio`] on target, the
+/// behavioural model on the host). `F` reaches the filter registers of CAN1 for CAN2
+/// (see [`Can::can2`]); CAN1 and CAN3 use their own registers and `F` is unused.
+#[derive(Debug)]
+pub struct Can<R: Registers, F: Registers = R> {
+    regs: R,
+    filter_regs: Option<F>,
+    instance: Instance,
+    config: Config,
+    fmi: FmiMap,
+    /// Request order of each loaded mailbox (TXFP = 1 scheduling), for `mailbox_state`.
+    seq: [u32; TX_MAILBOXES],
+    next_seq: u32,
+    /// Mailboxes whose abort was requested (to tell an abort from a one-shot failure).
+    abort_requested: u8,
+    /// Frames read back from mailboxes whose displacement abort was still in flight.
+    displaced: [Option<Frame>; TX_MAILBOXES],
+    /// Completions noticed outside `take_events` (a reload clears RQCP), reported next.
+    pending: Events,
+    last_state: ErrorState,
+}
+
+/// A controller in initialization mode (RM0410 §40.4.1), configured but off the bus.
+/// Install filters with [`Init::set_filters`], then go on the bus with [`Init::enable`].
+#[must_use = "the controller stays in initialization mode, off the bus, until `enable` is called"]
+#[derive(Debug)]
+pub struct Init<R: Registers, F: Registers = R> {
+    can: Can<R, F>,
+}
+
+// The error values hand the whole controller back (nothing is lost on a timeout); its
+// size (mostly the FMI map) only moves on that error path.
+#[allow(clippy::result_large_err)]
+impl<R: Registers> Can<R, R> {
+    /// Configures CAN1 (the master, owner of the dual filter block): requests
+    /// initialization mode (leaving sleep), waits for INAK (bounded), writes `CAN_MCR`
+    /// options, `CAN_BTR`, `CAN_IER` and, if configured, `CAN_FMR.CAN2SB`.
+    ///
+    /// Errors: [`Error::Timeout`] when INAK does not come (no clock, stuck peripheral),
+    /// with the registers handed back in [`Failed::value`].
+    pub fn can1(regs: R, config: &Config) -> Result<Init<R, R>, Failed<Can<R, R>>> {
+        Can::new(regs, None, Instance::Can1, config).configure(config)
+    }
+
+    /// Configures CAN3 (F76x/F77x: single CAN with its own 14 filter banks); as
+    /// [`Can::can1`].
+    pub fn can3(regs: R, config: &Config) -> Result<Init<R, R>, Failed<Can<R, R>>> {
+        Can::new(regs, None, Instance::Can3, config).configure(config)
+    }
+}
+
+#[allow(clippy::result_large_err)]
+impl<R: Registers, F: Registers> Can<R, F> {
+    /// Configures CAN2 (the slave): `regs` are CAN2's registers, `can1_filters` reaches
+    /// CAN1's register block, used for the filter registers only (`CAN_FMR` ..
+    /// `CAN_F27R2`, RM0410 §40.9.4: CAN2 has none of its own). CAN1 must be clocked;
+    /// CAN2 owns banks `CAN2SB..28`.
+    pub fn can2(
+        regs: R,
+        can1_filters: F,
+        config: &Config,
+    ) -> Result<Init<R, F>, Failed<Can<R, F>>> {
+        Can::new(regs, Some(can1_filters), Instance::Can2, config).configure(config)
+    }
+
+    fn new(regs: R, filter_regs: Option<F>, instance: Instance, config: &Config) -> Self {
+        Can {
+            regs,
+            filter_regs,
+            instance,
+            config: *config,
+            fmi: FmiMap::empty(),
+            seq: [0; TX_MAILBOXES],
+            next_seq: 0,
+            abort_requested: 0,
+            displaced: [None; TX_MAILBOXES],
+            pending: Events::default(),
+            last_state: ErrorState::Stopped,
+        }
+    }
+
+    fn configure(mut self, config: &Config) -> Result<Init<R, F>, Failed<Can<R, F>>> {
+        self.config = *config;
+        let bound = config.get_wait_iterations();
+        if let Err(error) = mode::request(&mut self.regs, Mode::Stopped, bound) {
+            return Err(Failed { error, value: self });
+        }
+        let keep = mcr::INRQ;
+        self.regs.write32(MCR, keep | config.mcr_options());
+        self.regs.write32(BTR, config.btr_value());
+        self.regs.write32(IER, config.get_interrupts());
+        if let (Instance::Can1, Some(start)) = (self.instance, config.get_can2_start_bank()) {
+            filter_block::set_can2sb(&mut self.regs, start);
+        }
+        self.last_state = ErrorState::Stopped;
+        Ok(Init { can: self })
+    }
+
+    /// Re-enters initialization mode with a new configuration (the filters stay).
+    pub fn reconfigure(self, config: &Config) -> Result<Init<R, F>, Failed<Can<R, F>>> {
+        self.configure(config)
+    }
+
+    /// Gives the register handles back (CAN1's for CAN2's filters as the second value).
+    pub fn release(self) -> (R, Option<F>) {
+        (self.regs, self.filter_regs)
+    }
+
+    /// The instance.
+    pub fn instance(&self) -> Instance {
+        self.instance
+    }
+
+    /// The operating mode the acknowledge bits (`CAN_MSR.INAK`, `SLAK`) show now.
+    pub fn mode(&self) -> Mode {
+        mode::current(&self.regs)
+    }
+
+    /// The configuration in force.
+    pub fn config(&self) -> &Config {
+        &self.config
+    }
+
+    /// The registers (for inspection; writing them behind the driver's back voids its
+    /// bookkeeping).
+    pub fn registers(&self) -> &R {
+        &self.regs
+    }
+
+    /// The registers, mutably (see [`Can::registers`]).
+    pub fn registers_mut(&mut self) -> &mut R {
+        &mut self.regs
+    }
+
+    /// The banks (`start..end`, hardware numbering) this instance owns now.
+    pub fn bank_range(&self) -> (usize, usize) {
+        match &self.filter_regs {
+            Some(f) => filter_block::banks_of(f, self.instance),
+            None => filter_block::banks_of(&self.regs, self.instance),
+        }
+    }
+
+    /// Planner options for this instance: its bank count and `fifo`.
+    pub fn plan_options(&self, fifo: FifoPolicy) -> PlanOptions {
+        let (s, e) = self.bank_range();
+        PlanOptions::new((e - s) as u8).fifo(fifo)
+    }
+
+    /// Compiles `filters` for this instance's banks ([`planner::plan`]).
+    pub fn plan(
+        &self,
+        filters: &[twocan_core::Filter],
+        fifo: FifoPolicy,
+    ) -> Result<FilterPlan, crate::filters::PlanError> {
+        planner::plan(filters, self.plan_options(fifo))
+    }
+
+    /// Clears the last error code by software (`CAN_ESR.LEC = 0b111`, "set by software":
+    /// the hardware overwrites it with the next bus event).
+    pub fn clear_last_error(&mut self) {
+        self.regs.write32(ESR, esr::LEC.val(esr::LEC_SOFTWARE));
+    }
+
+    fn bound(&self) -> u32 {
+        self.config.get_wait_iterations()
+    }
+
+    fn write_filters(&mut self, plan: &FilterPlan) -> Result<(), Error> {
+        let instance = self.instance;
+        let r = match &mut self.filter_regs {
+            Some(f) => filter_block::program(f, instance, plan),
+            None => filter_block::program(&mut self.regs, instance, plan),
+        };
+        r.map_err(|_| Error::InvalidArgument)?;
+        self.fmi = plan.fmi_map();
+        Ok(())
+    }
+
+    /// Counts the completion of mailbox `x` if its RQCP is set, and acknowledges it.
+    /// Returns the displaced frame when `x` ended an in-flight displacement abort.
+    fn complete(&mut self, x: usize, tsr_value: u32) -> Option<Frame> {
+        if tsr_value & tsr::rqcp(x) == 0 {
+            return None;
+        }
+        let bit = 1u8 << x;
+        let displaced = self.displaced[x].take();
+        let mut give_back = None;
+        if tsr_value & tsr::txok(x) != 0 {
+            self.pending.sent = self.pending.sent.saturating_add(1);
+        } else if self.abort_requested & bit != 0 {
+            match displaced {
+                Some(f) => give_back = Some(f),
+                None => self.pending.aborted = self.pending.aborted.saturating_add(1),
+            }
+        } else {
+            self.pending.failed = self.pending.failed.saturating_add(1);
+        }
+        self.abort_requested &= !bit;
+        self.regs.write32(TSR, tsr::rqcp(x));
+        give_back
+    }
+
+    fn load(&mut self, x: usize, frame: &Frame) {
+        self.seq[x] = self.next_seq;
+        self.next_seq = self.next_seq.wrapping_add(1);
+        mailbox::load(&mut self.regs, x, frame);
+    }
+
+    /// The pending mailbox that is lowest in the hardware's transmit order, by the
+    /// policy: largest arbitration key (ties: higher mailbox number, notes "Transmit
+    /// priority"), or the latest request (TXFP = 1).
+    fn lowest_pending(&self, frames: &[Frame; TX_MAILBOXES]) -> usize {
+        let mut low = 0;
+        for x in 1..TX_MAILBOXES {
+            let worse = match self.config.get_tx_policy() {
+                TxPolicy::Priority => !Priority::of(&frames[x]).beats(Priority::of(&frames[low])),
+                TxPolicy::Fifo => self.seq[x].wrapping_sub(self.seq[low]) < u32::MAX / 2,
+            };
+            if worse {
+                low = x;
+            }
+        }
+        low
+    }
+
+    fn state_now(&self) -> ErrorStatus {
+        let e = self.regs.read32(ESR);
+        let m = self.regs.read32(MSR);
+        let boff = e & esr::BOFF != 0;
+        let counters = ErrorCounters {
+            tec: if boff { 256 } else { esr::TEC.get(e) as u16 },
+            rec: esr::REC.get(e) as u16,
+        };
+        let state = if m & msr::SLAK != 0 {
+            ErrorState::Sleeping
+        } else if m & msr::INAK != 0 {
+            ErrorState::Stopped
+        } else if boff {
+            ErrorState::BusOff
+        } else if e & esr::EPVF != 0 {
+            ErrorState::Passive
+        } else if e & esr::EWGF != 0 {
+            ErrorState::Warning
+        } else {
+            ErrorState::from_counters(counters)
+        };
+        ErrorStatus {
+            state,
+            counters,
+            last_error: lec(esr::LEC.get(e)),
+        }
+    }
+}
+
+/// `CAN_ESR.LEC` as a last-error code (notes "Error management": 0 none, 1 stuff, 2 form,
+/// 3 acknowledgment, 4 bit recessive, 5 bit dominant, 6 CRC, 7 set by software).
+pub fn lec(code: u32) -> LastErrorCode {
+    match code {
+        esr::LEC_STUFF => LastErrorCode::Stuff,
+        esr::LEC_FORM => LastErrorCode::Form,
+        esr::LEC_ACK => LastErrorCode::Acknowledge,
+        esr::LEC_BIT_RECESSIVE => LastErrorCode::BitRecessive,
+        esr::LEC_BIT_DOMINANT => LastErrorCode::BitDominant,
+        esr::LEC_CRC => LastErrorCode::Crc,
+        _ => LastErrorCode::None,
+    }
+}
+
+#[allow(clippy::result_large_err)]
+impl<R: Registers, F: Registers> Init<R, F> {
+    /// Installs filters before going on the bus (see [`Controller::install_filters`]).
+    pub fn set_filters(&mut self, plan: &FilterPlan) -> Result<(), Error> {
+        self.can.write_filters(plan)
+    }
+
+    /// The controller, still in initialization mode (to plan filters for its banks).
+    pub fn can(&self) -> &Can<R, F> {
+        &self.can
+    }
+
+    /// The controller, still in initialization mode, mutably.
+    pub fn can_mut(&mut self) -> &mut Can<R, F> {
+        &mut self.can
+    }
+
+    /// Leaves initialization mode: clears INRQ and waits (bounded) for INAK = 0, which the
+    /// hardware gives after 11 recessive bits on CANRX (RM0410 §40.4.2).
+    ///
+    /// Errors: [`Error::Timeout`], with this value handed back in [`Failed::value`].
+    pub fn enable(mut self) -> Result<Can<R, F>, Failed<Init<R, F>>> {
+        let bound = self.can.bound();
+        match mode::request(&mut self.can.regs, Mode::Normal, bound) {
+            Ok(()) => {
+                self.can.last_state = self.can.state_now().state;
+                Ok(self.can)
+            }
+            Err(error) => Err(Failed { error, value: self }),
+        }
+    }
+
+    /// Gives the register handles back, leaving the peripheral in initialization mode.
+    pub fn release(self) -> (R, Option<F>) {
+        self.can.release()
+    }
+}
+
+impl<R: Registers, F: Registers> Controller for Can<R, F> {
+    type Filters = FilterPlan;
+
+    /// Writes the plan to this instance's banks under `CAN_FMR.FINIT` (see
+    /// [`crate::filter_block`]); the operating mode (`CAN_MCR`) is not touched. Error
+    /// [`Error::InvalidArgument`] when the plan has more banks than the instance owns.
+    fn install_filters(&mut self, filters: &FilterPlan) -> Result<(), Error> {
+        self.write_filters(filters)
+    }
+
+    /// `CAN_MCR.TXFP` set: [`TxPolicy::Fifo`]; clear: [`TxPolicy::Priority`].
+    fn tx_policy(&self) -> TxPolicy {
+        if self.regs.read32(MCR) & mcr::TXFP != 0 {
+            TxPolicy::Fifo
+        } else {
+            TxPolicy::Priority
+        }
+    }
+
+    fn mailbox_count(&self) -> u8 {
+        TX_MAILBOXES as u8
+    }
+
+    /// Loads an empty mailbox (`CAN_TSR.TMEx`), or under [`TxPolicy::Priority`] displaces
+    /// the lowest-priority pending mailbox when `frame` beats it: ABRQ, then if the
+    /// mailbox emptied without TXOK the frame read back from its registers is returned.
+    /// A displacement whose mailbox is on the bus cannot be decided at once:
+    /// `WouldBlock`, and the frame comes back from a later call once the abort ends.
+    fn transmit(&mut self, frame: &Frame) -> nb::Result<Option<Frame>, Error> {
+        let t = self.regs.read32(TSR);
+        // A mailbox whose displacement abort has ended: reuse it, hand the frame back.
+        for x in 0..TX_MAILBOXES {
+            if self.displaced[x].is_some() && t & tsr::tme(x) != 0 {
+                let sent = t & tsr::txok(x) != 0;
+                let back = self.complete(x, t);
+                let parked = self.displaced[x].take();
+                self.abort_requested &= !(1 << x);
+                self.load(x, frame);
+                return Ok(if sent { None } else { back.or(parked) });
+            }
+        }
+        if let Some(x) = (0..TX_MAILBOXES).find(|&x| t & tsr::tme(x) != 0) {
+            let _ = self.complete(x, t);
+            self.load(x, frame);
+            return Ok(None);
+        }
+        if self.config.get_tx_policy() != TxPolicy::Priority
+            || self.displaced.iter().any(Option::is_some)
+        {
+            return Err(nb::Error::WouldBlock);
+        }
+        let mut frames = [*frame; TX_MAILBOXES];
+        for (x, f) in frames.iter_mut().enumerate() {
+            *f = mailbox::read_tx(&self.regs, x).map_err(|e| nb::Error::Other(Error::Frame(e)))?;
+        }
+        let low = self.lowest_pending(&frames);
+        if !Priority::of(frame).beats(Priority::of(&frames[low])) {
+            return Err(nb::Error::WouldBlock);
+        }
+        self.abort_requested |= 1 << low;
+        self.displaced[low] = Some(frames[low]);
+        self.regs.write32(TSR, tsr::abrq(low));
+        for _ in 0..ABORT_WAIT_ITERATIONS {
+            let t = self.regs.read32(TSR);
+            if t & tsr::tme(low) != 0 {
+                let back = self.complete(low, t);
+                self.load(low, frame);
+                return Ok(back);
+            }
+        }
+        Err(nb::Error::WouldBlock)
+    }
+
+    /// `Empty` when `CAN_TSR.TMEx`; otherwise the highest mailbox in transmit order is
+    /// `Transmitting` while `CAN_MSR.TXM` is set and `Scheduled` before, the others
+    /// `Pending` (notes "Transmit mailbox states"). An index ≥ 3 reads `Empty`.
+    fn mailbox_state(&self, mailbox: MailboxId) -> MailboxState {
+        let x = mailbox.0 as usize;
+        let t = self.regs.read32(TSR);
+        if x >= TX_MAILBOXES || t & tsr::tme(x) != 0 {
+            return MailboxState::Empty;
+        }
+        let mut first = x;
+        for y in (0..TX_MAILBOXES).filter(|&y| y != x && t & tsr::tme(y) == 0) {
+            let ahead = match self.config.get_tx_policy() {
+                TxPolicy::Fifo => self.seq[y].wrapping_sub(self.seq[first]) > u32::MAX / 2,
+                TxPolicy::Priority => match (
+                    mailbox::read_tx(&self.regs, y),
+                    mailbox::read_tx(&self.regs, first),
+                ) {
+                    (Ok(a), Ok(b)) => {
+                        let (pa, pb) = (Priority::of(&a), Priority::of(&b));
+                        pa.beats(pb) || (pa == pb && y < first)
+                    }
+                    _ => false,
+                },
+            };
+            if ahead {
+                first = y;
+            }
+        }
+        if first != x {
+            MailboxState::Pending
+        } else if self.regs.read32(MSR) & msr::TXM != 0 {
+            MailboxState::Transmitting
+        } else {
+            MailboxState::Scheduled
+        }
+    }
+
+    /// Sets `CAN_TSR.ABRQx` and waits [`ABORT_WAIT_ITERATIONS`] reads for TMEx: `true`
+    /// when the mailbox emptied without TXOK (it was pending or scheduled). The abort is
+    /// counted in [`Events::aborted`]. An index ≥ 3 returns `false`.
+    fn abort(&mut self, mailbox: MailboxId) -> bool {
+        let x = mailbox.0 as usize;
+        if x >= TX_MAILBOXES {
+            return false;
+        }
+        let t = self.regs.read32(TSR);
+        if t & tsr::tme(x) != 0 {
+            return false;
+        }
+        self.abort_requested |= 1 << x;
+        self.regs.write32(TSR, tsr::abrq(x));
+        for _ in 0..ABORT_WAIT_ITERATIONS {
+            let t = self.regs.read32(TSR);
+            if t & tsr::tme(x) != 0 {
+                return t & tsr::txok(x) == 0;
+            }
+        }
+        false
+    }
+
+    /// FIFO 0 first, then FIFO 1: reads the output mailbox, releases it (`RFOMx`), maps
+    /// the FMI to the user's filter index ([`crate::filters::NO_FILTER`] if the installed
+    /// plan has none) and adds the time stamp when TTCM is on.
+    fn receive(&mut self) -> nb::Result<RxFrame, Error> {
+        for (x, fifo) in [(0, Fifo::Fifo0), (1, Fifo::Fifo1)] {
+            if rfxr::FMP.get(self.regs.read32(crate::regs::rfxr(x))) == 0 {
+                continue;
+            }
+            let got = mailbox::read_rx(&self.regs, x);
+            self.regs.write32(crate::regs::rfxr(x), rfxr::RFOM);
+            let frame = got.frame.map_err(|e| nb::Error::Other(Error::Frame(e)))?;
+            return Ok(RxFrame {
+                frame,
+                filter: self.fmi.get(fifo, got.fmi),
+                timestamp: if self.config.get_timestamps() {
+                    Some(got.time)
+                } else {
+                    None
+                },
+            });
+        }
+        Err(nb::Error::WouldBlock)
+    }
+
+    /// Reads and acknowledges (write 1 to clear): RQCPx (with TXOKx/ALSTx/TERRx) →
+    /// sent / failed / aborted; FULLx, FOVRx → one overrun per FOVR occurrence (the
+    /// hardware does not count lost frames); ERRI, WKUI, SLAKI; LEC (reported, then set
+    /// to 0b111 by software so the next error is seen as new).
+    fn take_events(&mut self) -> Events {
+        let t = self.regs.read32(TSR);
+        for x in 0..TX_MAILBOXES {
+            // An ended displacement abort is left for `transmit`, which hands the frame back.
+            let parked = self.displaced[x].is_some() && t & tsr::txok(x) == 0;
+            if !parked {
+                let _ = self.complete(x, t);
+            }
+        }
+        let mut ev = core::mem::take(&mut self.pending);
+        for x in 0..2 {
+            let r = self.regs.read32(crate::regs::rfxr(x));
+            if r & rfxr::FOVR != 0 {
+                ev.overruns = ev.overruns.saturating_add(1);
+            }
+            let ack = r & (rfxr::FULL | rfxr::FOVR);
+            if ack != 0 {
+                self.regs.write32(crate::regs::rfxr(x), ack);
+            }
+        }
+        let m = self.regs.read32(MSR);
+        let ack = m & (msr::ERRI | msr::WKUI | msr::SLAKI);
+        if ack != 0 {
+            self.regs.write32(MSR, ack);
+        }
+        ev.wakeup = m & msr::WKUI != 0;
+        let code = lec(esr::LEC.get(self.regs.read32(ESR)));
+        if code != LastErrorCode::None {
+            ev.bus_error = Some(code);
+            self.clear_last_error();
+        }
+        let state = self.state_now().state;
+        ev.state_changed = m & msr::ERRI != 0 || state != self.last_state;
+        self.last_state = state;
+        ev
+    }
+
+    /// From `CAN_ESR` and `CAN_MSR`: sleeping (SLAK), stopped (INAK), bus-off (BOFF; TEC
+    /// reported as 256), passive (EPVF), warning (EWGF), active; LEC as last error.
+    fn error_status(&self) -> ErrorStatus {
+        self.state_now()
+    }
+
+    /// Normal, stopped (initialization) or sleep, with the bounded acknowledge wait.
+    fn set_mode(&mut self, mode: Mode) -> Result<(), Error> {
+        let bound = self.bound();
+        mode::request(&mut self.regs, mode, bound)
+    }
+
+    /// Manual bus-off recovery (`ABOM = 0`, notes "Bus-off recovery"): when `BOFF` is set,
+    /// enter and leave initialization mode; the hardware then waits for 128 × 11
+    /// recessive bits before it is error-active again. A no-op with automatic recovery
+    /// or when not bus-off.
+    fn recover(&mut self) -> Result<(), Error> {
+        if self.config.get_recovery() == Recovery::Automatic
+            || self.regs.read32(ESR) & esr::BOFF == 0
+        {
+            return Ok(());
+        }
+        let bound = self.bound();
+        mode::request(&mut self.regs, Mode::Stopped, bound)?;
+        mode::request(&mut self.regs, Mode::Normal, bound)
+    }
+}
+
+/// Interrupt enable bits that the driver needs serviced for a FIFO (for firmware that
+/// builds its own `CAN_IER` value).
+pub const fn fifo_interrupts(fifo: Fifo) -> u32 {
+    ier::fmpie(fifo.index()) | ier::fovie(fifo.index())
+}

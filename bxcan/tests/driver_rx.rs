@@ -1,0 +1,88 @@
+//! Reception against the model: FIFO 0 before FIFO 1, order within a FIFO, overrun in
+//! both lock modes counted into `Events::overruns` and the driver's statistics.
+#![cfg(feature = "model")]
+
+mod common;
+
+use common::*;
+use twocan_bxcan::{Bank, Fifo, FilterPlan};
+use twocan_core::{Controller, Driver, Filter, TxPolicy};
+
+#[test]
+fn fifo0_first_and_order_within_each_fifo() {
+    let mut p = FilterPlan::manual();
+    let odd = Filter::masked(
+        twocan_core::FrameKind::Data,
+        twocan_core::Format::Standard,
+        1,
+        1,
+    );
+    let even = Filter::masked(
+        twocan_core::FrameKind::Data,
+        twocan_core::Format::Standard,
+        1,
+        0,
+    );
+    p.set_bank(0, Bank::mask32(&odd, Fifo::Fifo1).unwrap())
+        .unwrap();
+    p.set_bank(1, Bank::mask32(&even, Fifo::Fifo0).unwrap())
+        .unwrap();
+    let (mut can, _regs, bus) = can1_with(&loopback_config(TxPolicy::Fifo), &p);
+    for id in [1, 3, 2, 5, 4] {
+        can.transmit(&std(id)).unwrap();
+        settle(&bus);
+    }
+    let got: Vec<(u32, u16)> = drain(&mut can)
+        .iter()
+        .map(|r| (r.frame.raw_id(), r.filter))
+        .collect();
+    assert_eq!(got, [(2, 4), (4, 4), (1, 0), (3, 0), (5, 0)]);
+}
+
+fn overrun(lock: bool) -> Vec<u32> {
+    let cfg = loopback_config(TxPolicy::Fifo).rx_fifo_lock(lock);
+    let (mut can, _regs, bus) = can1_with(&cfg, &pass_all());
+    for id in 1..=3 {
+        can.transmit(&std(id)).unwrap();
+        settle(&bus);
+    }
+    assert_eq!(can.take_events().overruns, 0);
+    can.transmit(&std(4)).unwrap();
+    settle(&bus);
+    assert_eq!(can.take_events().overruns, 1);
+    can.transmit(&std(5)).unwrap();
+    settle(&bus);
+    assert_eq!(
+        can.take_events().overruns,
+        1,
+        "FOVR was acknowledged, set again"
+    );
+    assert_eq!(can.take_events().overruns, 0);
+    drain(&mut can).iter().map(|r| r.frame.raw_id()).collect()
+}
+
+#[test]
+fn overrun_without_lock_keeps_the_newest() {
+    // RFLM = 0: the last message stored is overwritten by the new one.
+    assert_eq!(overrun(false), [1, 2, 5]);
+}
+
+#[test]
+fn overrun_with_lock_keeps_the_oldest() {
+    // RFLM = 1: the new message is discarded.
+    assert_eq!(overrun(true), [1, 2, 3]);
+}
+
+#[test]
+fn driver_counts_hardware_overruns() {
+    let (can, regs, bus) = can1_with(&loopback_config(TxPolicy::Fifo), &pass_all());
+    regs.ticking.set(false);
+    let mut d: Driver<_, 16, 8> = Driver::new(can);
+    for id in 1..=5 {
+        d.controller_mut().transmit(&std(id)).unwrap();
+        settle(&bus);
+    }
+    d.on_interrupt();
+    assert_eq!(d.error_stats().hardware_overruns, 1);
+    assert_eq!(d.traffic().received, 3);
+}

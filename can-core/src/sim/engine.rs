@@ -1,0 +1,565 @@
+//! One frame attempt played bit by bit: who detects which error when, the error flags and
+//! their echoes, the delimiters, and so the exact length of the attempt.
+//!
+//! Every participant runs a small ISO 11898-1 state machine. The wire value of each bit is
+//! the wired-AND of what the participants drive (dominant wins):
+//!
+//! - a transmitter drives its stuffed frame bits, then recessive delimiters, ACK slot and EOF;
+//!   it detects a bit error when it reads another value than it sent (except in the ACK slot,
+//!   where it detects an acknowledge error if it reads recessive and does not self-acknowledge);
+//! - a receiver drives a dominant ACK slot if it acknowledges and its CRC matched; it detects a
+//!   stuff error at six equal bits in the stuffed region, a form error at a dominant CRC
+//!   delimiter, ACK delimiter or EOF bit 1..6 (a dominant last EOF bit is an overload
+//!   condition, not an error: the frame is already valid), and a CRC error — signalled from the
+//!   bit after the ACK delimiter — when what it read differs from the frame it follows or an
+//!   injected fault says so;
+//! - a node that detects an error sends an active error flag (6 dominant bits) if it is
+//!   error-active and able to drive the bus, otherwise a passive one (it drives nothing and
+//!   waits for 6 equal consecutive bits); then it waits for a recessive bit (ISO rule 2: a
+//!   receiver that reads dominant as the first bit after its flag reports it) and counts the
+//!   8-bit error delimiter.
+//!
+//! The attempt ends when every node that can drive the bus — the transmitters and the
+//! error-active receivers — has finished its EOF or error delimiter. A node sending a passive
+//! error flag drives nothing, so it does not lengthen the attempt: when a single active flag
+//! (6 dominant bits, no echo) meets a passive receiver that detected it at its first bit, ISO
+//! 11898-1 would keep that receiver waiting for six equal bits a few bits longer than the
+//! others; here it is taken to be done with the others (it would resynchronise on the next
+//! idle bits anyway). Its detected error and rule-2 flag are still reported.
+//!
+//! Not modelled: overload frames, errors during error flags (rules 4 to 6), the "14/7
+//! dominant bits" tolerance, hard synchronisation effects.
+
+use super::bits::FrameBits;
+use super::inject::{RxFault, TxFault};
+use crate::error::LastErrorCode;
+
+/// A transmitter of the frame attempt.
+#[derive(Debug, Clone)]
+pub(crate) struct TxSpec<'a> {
+    /// Its stuffed bits, SOF through CRC.
+    pub stream: &'a [bool],
+    /// Its frame layout.
+    pub bits: FrameBits,
+    /// It ignores the ACK slot.
+    pub self_ack: bool,
+    /// It sends active error flags.
+    pub active: bool,
+    /// Injected faults.
+    pub faults: Vec<TxFault>,
+}
+
+/// A receiver of the frame attempt.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct RxSpec {
+    /// It drives a dominant ACK bit for a frame it received correctly.
+    pub acks: bool,
+    /// It sends active error flags.
+    pub active: bool,
+    /// Injected faults.
+    pub faults: Vec<RxFault>,
+}
+
+/// How the attempt ended for one participant.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum PartOutcome {
+    /// Transmitted / received without error; `done` bits after SOF (end of its EOF).
+    Ok {
+        /// One past the node's last EOF bit.
+        done: u32,
+    },
+    /// Detected an error at wire bit `at`.
+    Error {
+        /// The error.
+        code: LastErrorCode,
+        /// Wire-bit index from SOF.
+        at: u32,
+        /// A receiver read a dominant bit right after its error flag (ISO rule 2).
+        dominant_after_flag: bool,
+    },
+}
+
+/// The result of one frame attempt.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub(crate) struct Resolution {
+    /// Per transmitter, in input order.
+    pub tx: Vec<PartOutcome>,
+    /// Per receiver, in input order.
+    pub rx: Vec<PartOutcome>,
+    /// A fault-free, non-driving listener would have accepted the frame.
+    pub observer_ok: bool,
+    /// Some receiver drove the ACK slot dominant.
+    pub acked: bool,
+    /// Bits from SOF to the end of EOF or of the last error delimiter (no intermission).
+    pub end: u32,
+    /// One past the index of the last dominant bit on the wire.
+    pub last_dominant_end: u32,
+    /// The wire, bit by bit, from SOF for `end` bits (`true` = recessive).
+    pub wire: Vec<bool>,
+    /// Index into the transmitters of the frame the receivers followed.
+    pub reference: usize,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Phase {
+    Frame,
+    ActiveFlag(u8),
+    PassiveFlag { last: bool, run: u8 },
+    AfterFlag { first: bool },
+    Delimiter(u8),
+    Done,
+}
+
+#[derive(Debug, Clone, Copy)]
+struct Part {
+    phase: Phase,
+    can_flag: bool,
+    error: Option<(LastErrorCode, u32)>,
+    dominant_after_flag: bool,
+    ok: Option<u32>,
+    // receiver bookkeeping
+    run_last: bool,
+    run: u8,
+    mismatch: bool,
+    crc_bad: bool,
+}
+
+impl Part {
+    fn new(can_flag: bool) -> Self {
+        Part {
+            phase: Phase::Frame,
+            can_flag,
+            error: None,
+            dominant_after_flag: false,
+            ok: None,
+            run_last: true,
+            run: 0,
+            mismatch: false,
+            crc_bad: false,
+        }
+    }
+
+    fn detect(&mut self, code: LastErrorCode, at: u32) {
+        self.error = Some((code, at));
+        self.phase = if self.can_flag {
+            Phase::ActiveFlag(0)
+        } else {
+            Phase::PassiveFlag { last: true, run: 0 }
+        };
+    }
+
+    fn drives_flag(&self) -> bool {
+        matches!(self.phase, Phase::ActiveFlag(_))
+    }
+
+    /// Reads one bit while in an error phase.
+    fn error_phase(&mut self, wire: bool) {
+        self.phase = match self.phase {
+            Phase::ActiveFlag(n) if n + 1 >= 6 => Phase::AfterFlag { first: true },
+            Phase::ActiveFlag(n) => Phase::ActiveFlag(n + 1),
+            Phase::PassiveFlag { last, run } => {
+                let run = if run == 0 || wire == last { run + 1 } else { 1 };
+                if run >= 6 {
+                    Phase::AfterFlag { first: true }
+                } else {
+                    Phase::PassiveFlag { last: wire, run }
+                }
+            }
+            Phase::AfterFlag { first } => {
+                if wire {
+                    Phase::Delimiter(1)
+                } else {
+                    if first {
+                        self.dominant_after_flag = true;
+                    }
+                    Phase::AfterFlag { first: false }
+                }
+            }
+            Phase::Delimiter(n) if wire && n + 1 >= 8 => Phase::Done,
+            Phase::Delimiter(n) if wire => Phase::Delimiter(n + 1),
+            other => other,
+        };
+    }
+
+    fn outcome(&self, end: u32) -> PartOutcome {
+        match self.error {
+            Some((code, at)) => PartOutcome::Error {
+                code,
+                at,
+                dominant_after_flag: self.dominant_after_flag,
+            },
+            None => match self.ok {
+                Some(done) => PartOutcome::Ok { done },
+                // Cut off by the safety limit (cannot happen with the rules above).
+                None => PartOutcome::Error {
+                    code: LastErrorCode::Form,
+                    at: end,
+                    dominant_after_flag: false,
+                },
+            },
+        }
+    }
+}
+
+fn tx_bit(tx: &TxSpec<'_>, i: u32) -> bool {
+    if i < tx.bits.crc_end {
+        tx.stream.get(i as usize).copied().unwrap_or(true)
+    } else {
+        true
+    }
+}
+
+fn tx_read(tx: &TxSpec<'_>, p: &mut Part, wire: bool, i: u32) {
+    let sent = tx_bit(tx, i);
+    let mismatch_code = if sent {
+        LastErrorCode::BitRecessive
+    } else {
+        LastErrorCode::BitDominant
+    };
+    let code = if tx.faults.contains(&TxFault::Bit(i)) {
+        Some(mismatch_code)
+    } else if i == tx.bits.crc_end + 1 {
+        let read_recessive = wire || tx.faults.contains(&TxFault::Ack);
+        (read_recessive && !tx.self_ack).then_some(LastErrorCode::Acknowledge)
+    } else if wire != sent {
+        Some(mismatch_code)
+    } else {
+        None
+    };
+    match code {
+        Some(c) => p.detect(c, i),
+        None if i >= tx.bits.crc_end + 9 => {
+            p.ok = Some(i + 1);
+            p.phase = Phase::Done;
+        }
+        None => {}
+    }
+}
+
+fn rx_read(rx: &RxSpec, p: &mut Part, wire: bool, i: u32, reference: &[bool], ce: u32) {
+    let form_forced = rx.faults.contains(&RxFault::Form(i));
+    let mut code = None;
+    if i < ce {
+        if wire == p.run_last {
+            p.run = p.run.saturating_add(1);
+        } else {
+            p.run_last = wire;
+            p.run = 1;
+        }
+        if p.run >= 6 || rx.faults.contains(&RxFault::Stuff(i)) {
+            code = Some(LastErrorCode::Stuff);
+        }
+        if reference.get(i as usize).copied() != Some(wire) {
+            p.mismatch = true;
+        }
+    } else if i == ce {
+        if !wire || form_forced {
+            code = Some(LastErrorCode::Form);
+        }
+        p.crc_bad = p.mismatch || rx.faults.contains(&RxFault::Crc);
+    } else if i == ce + 1 {
+        // ACK slot: anything goes.
+    } else if i == ce + 2 {
+        if !wire || form_forced {
+            code = Some(LastErrorCode::Form);
+        } else if p.crc_bad {
+            code = Some(LastErrorCode::Crc);
+        }
+    } else if i <= ce + 8 {
+        if !wire || form_forced {
+            code = Some(LastErrorCode::Form);
+        }
+    } else {
+        // Last EOF bit: the frame is valid for a receiver; a dominant bit here would only
+        // start an overload frame (not modelled).
+        p.ok = Some(i + 1);
+        p.phase = Phase::Done;
+    }
+    if let Some(c) = code {
+        p.detect(c, i);
+    }
+}
+
+/// Plays one frame attempt. `txs` must not be empty (an empty slice gives an empty result).
+pub(crate) fn resolve(txs: &[TxSpec<'_>], rxs: &[RxSpec]) -> Resolution {
+    let reference = (0..txs.len())
+        .min_by(|&a, &b| txs[a].stream.cmp(txs[b].stream))
+        .unwrap_or(0);
+    let Some(ref_tx) = txs.get(reference) else {
+        return Resolution {
+            tx: Vec::new(),
+            rx: Vec::new(),
+            observer_ok: false,
+            acked: false,
+            end: 0,
+            last_dominant_end: 0,
+            wire: Vec::new(),
+            reference: 0,
+        };
+    };
+    let ce = ref_tx.bits.crc_end;
+    let ref_stream = ref_tx.stream;
+
+    let observer = RxSpec::default();
+    let mut tx_parts: Vec<Part> = txs.iter().map(|t| Part::new(t.active)).collect();
+    let mut rx_parts: Vec<Part> = rxs.iter().map(|r| Part::new(r.active)).collect();
+    let mut obs_part = Part::new(false);
+
+    let longest = txs.iter().map(|t| t.bits.crc_end).max().unwrap_or(ce);
+    let limit = longest + 10 + 64;
+    let mut acked = false;
+    let mut last_dominant_end = 0;
+    let mut i = 0u32;
+    let mut drivers_end = None;
+    let mut bus = Vec::with_capacity(limit as usize);
+    let end = loop {
+        // What the participants drive.
+        let mut wire = true;
+        for (t, p) in txs.iter().zip(&tx_parts) {
+            let drives_dominant = match p.phase {
+                Phase::Frame => !tx_bit(t, i),
+                _ => p.drives_flag(),
+            };
+            wire &= !drives_dominant;
+        }
+        for (r, p) in rxs.iter().zip(&rx_parts) {
+            let drives_dominant = match p.phase {
+                Phase::Frame => i == ce + 1 && r.acks && !p.crc_bad,
+                _ => p.drives_flag(),
+            };
+            if drives_dominant && p.phase == Phase::Frame {
+                acked = true;
+            }
+            wire &= !drives_dominant;
+        }
+        if !wire {
+            last_dominant_end = i + 1;
+        }
+        bus.push(wire);
+
+        // What they read.
+        for (t, p) in txs.iter().zip(tx_parts.iter_mut()) {
+            match p.phase {
+                Phase::Frame => tx_read(t, p, wire, i),
+                Phase::Done => {}
+                _ => p.error_phase(wire),
+            }
+        }
+        for (r, p) in rxs
+            .iter()
+            .chain(core::iter::once(&observer))
+            .zip(rx_parts.iter_mut().chain(core::iter::once(&mut obs_part)))
+        {
+            match p.phase {
+                Phase::Frame => rx_read(r, p, wire, i, ref_stream, ce),
+                Phase::Done => {}
+                _ => p.error_phase(wire),
+            }
+        }
+
+        i += 1;
+        let drivers_done = tx_parts.iter().all(|p| p.phase == Phase::Done)
+            && rx_parts
+                .iter()
+                .zip(rxs)
+                .all(|(p, r)| !r.active || p.phase == Phase::Done);
+        if drivers_done && drivers_end.is_none() {
+            drivers_end = Some(i);
+        }
+        let decided = rx_parts
+            .iter()
+            .chain(core::iter::once(&obs_part))
+            .all(|p| p.phase != Phase::Frame);
+        if (drivers_done && decided) || i >= limit {
+            break drivers_end.unwrap_or(i);
+        }
+    };
+
+    Resolution {
+        tx: tx_parts.iter().map(|p| p.outcome(end)).collect(),
+        rx: rx_parts.iter().map(|p| p.outcome(end)).collect(),
+        observer_ok: obs_part.error.is_none() && obs_part.ok.is_some(),
+        acked,
+        end,
+        last_dominant_end,
+        wire: {
+            bus.truncate(end as usize);
+            bus
+        },
+        reference,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::frame::Frame;
+    use crate::sim::bits::wire_bits;
+    use LastErrorCode as L;
+
+    fn tx<'a>(w: &'a (Vec<bool>, FrameBits), active: bool) -> TxSpec<'a> {
+        TxSpec {
+            stream: &w.0,
+            bits: w.1,
+            self_ack: false,
+            active,
+            faults: Vec::new(),
+        }
+    }
+    fn rx(acks: bool, active: bool) -> RxSpec {
+        RxSpec {
+            acks,
+            active,
+            faults: Vec::new(),
+        }
+    }
+    fn err(code: L, at: u32, dom: bool) -> PartOutcome {
+        PartOutcome::Error {
+            code,
+            at,
+            dominant_after_flag: dom,
+        }
+    }
+
+    #[test]
+    fn good_frame() {
+        let w = wire_bits(&Frame::standard(0x123, &[1, 2, 3]).unwrap());
+        let r = resolve(&[tx(&w, true)], &[rx(true, true), rx(false, false)]);
+        let t = w.1.total;
+        assert_eq!(r.tx, vec![PartOutcome::Ok { done: t }]);
+        assert_eq!(
+            r.rx,
+            vec![PartOutcome::Ok { done: t }, PartOutcome::Ok { done: t }]
+        );
+        assert_eq!(r.wire.len() as u32, t);
+        assert_eq!(&r.wire[..w.1.crc_end as usize], &w.0[..]);
+        assert!(r.acked && r.observer_ok);
+        assert_eq!(r.end, w.1.total);
+        assert_eq!(
+            r.last_dominant_end,
+            w.1.crc_end + 2,
+            "the ACK slot is the last dominant bit"
+        );
+    }
+
+    #[test]
+    fn lone_active_transmitter_ack_error() {
+        let w = wire_bits(&Frame::standard(0x123, &[]).unwrap());
+        let ce = w.1.crc_end;
+        // A listen-only receiver sees the active error flag as a form error at the ACK delimiter.
+        let r = resolve(&[tx(&w, true)], &[rx(false, false)]);
+        assert_eq!(r.tx, vec![err(L::Acknowledge, ce + 1, false)]);
+        assert_eq!(r.rx, vec![err(L::Form, ce + 2, false)]);
+        assert!(!r.observer_ok && !r.acked);
+        // Flag ce+2..=ce+7, delimiter ce+8..=ce+15.
+        assert_eq!(r.end, ce + 16);
+        assert_eq!(r.last_dominant_end, ce + 8);
+    }
+
+    #[test]
+    fn lone_passive_transmitter_ack_error_frame_still_valid_for_listeners() {
+        let w = wire_bits(&Frame::standard(0x123, &[]).unwrap());
+        let ce = w.1.crc_end;
+        let r = resolve(&[tx(&w, false)], &[rx(false, false)]);
+        assert_eq!(r.tx, vec![err(L::Acknowledge, ce + 1, false)]);
+        assert_eq!(r.rx, vec![PartOutcome::Ok { done: ce + 10 }]);
+        assert!(r.observer_ok);
+        // Passive flag ce+2..=ce+7 (recessive), delimiter ce+8..=ce+15.
+        assert_eq!(r.end, ce + 16);
+    }
+
+    #[test]
+    fn crc_error_at_one_receiver() {
+        let w = wire_bits(&Frame::standard(0x321, &[0xAA]).unwrap());
+        let ce = w.1.crc_end;
+        let mut bad = rx(true, true);
+        bad.faults.push(RxFault::Crc);
+        let r = resolve(&[tx(&w, true)], &[bad, rx(true, true)]);
+        // The other receiver acknowledged; the bad one flags from EOF bit 1 (ce+3).
+        assert!(r.acked);
+        assert_eq!(
+            r.rx[0],
+            err(L::Crc, ce + 2, true),
+            "others' echo flags follow its own"
+        );
+        assert_eq!(r.rx[1], err(L::Form, ce + 3, false));
+        assert_eq!(r.tx[0], err(L::BitRecessive, ce + 3, false));
+        // Flags ce+3..=ce+9 (6 + 1 echo), delimiter ce+10..=ce+17.
+        assert_eq!(r.last_dominant_end, ce + 10);
+        assert_eq!(r.end, ce + 18);
+    }
+
+    #[test]
+    fn transmitter_bit_error_gives_receivers_a_stuff_error() {
+        let w = wire_bits(&Frame::standard(0x7F0, &[0x0F, 0xF0]).unwrap());
+        let mut t = tx(&w, true);
+        let at = w.1.arbitration_end + 2;
+        t.faults.push(TxFault::Bit(at));
+        let r = resolve(&[t], &[rx(true, true)]);
+        assert!(matches!(r.tx[0], PartOutcome::Error { at: a, .. } if a == at));
+        match r.rx[0] {
+            PartOutcome::Error {
+                code: L::Stuff,
+                at: a,
+                ..
+            } => assert!(a > at && a <= at + 6),
+            other => panic!("{other:?}"),
+        }
+        assert!(r.end <= at + 1 + 12 + 8);
+    }
+
+    #[test]
+    fn collision_with_same_arbitration_field() {
+        // Same identifier, different data: the one sending recessive first gets a bit error.
+        let a = wire_bits(&Frame::standard(0x100, &[0x01]).unwrap());
+        let b = wire_bits(&Frame::standard(0x100, &[0x00]).unwrap());
+        let r = resolve(&[tx(&a, true), tx(&b, true)], &[rx(true, true)]);
+        assert_eq!(r.reference, 1);
+        assert!(matches!(
+            r.tx[0],
+            PartOutcome::Error {
+                code: L::BitRecessive,
+                ..
+            }
+        ));
+        assert!(matches!(
+            r.tx[1],
+            PartOutcome::Error {
+                code: L::BitRecessive,
+                ..
+            }
+        ));
+        // If the loser is error-passive, the other frame survives.
+        let r = resolve(&[tx(&a, false), tx(&b, true)], &[rx(true, true)]);
+        assert!(matches!(
+            r.tx[0],
+            PartOutcome::Error {
+                code: L::BitRecessive,
+                ..
+            }
+        ));
+        assert!(matches!(r.tx[1], PartOutcome::Ok { .. }));
+        assert!(matches!(r.rx[0], PartOutcome::Ok { .. }));
+        // Identical frames: both succeed.
+        let c = wire_bits(&Frame::standard(0x100, &[0x01]).unwrap());
+        let r = resolve(&[tx(&a, true), tx(&c, true)], &[rx(true, true)]);
+        assert!(r.tx.iter().all(|o| matches!(o, PartOutcome::Ok { .. })));
+    }
+
+    #[test]
+    fn form_error_in_last_but_one_eof_bit_leaves_other_receivers_with_the_frame() {
+        let w = wire_bits(&Frame::standard(0x55, &[1]).unwrap());
+        let ce = w.1.crc_end;
+        let mut bad = rx(true, true);
+        bad.faults.push(RxFault::Form(ce + 8));
+        let r = resolve(&[tx(&w, true)], &[bad, rx(true, true)]);
+        assert_eq!(
+            r.rx[1],
+            PartOutcome::Ok { done: ce + 10 },
+            "a dominant last EOF bit is an overload condition"
+        );
+        assert!(
+            matches!(r.tx[0], PartOutcome::Error { code: L::BitRecessive, at, .. } if at == ce + 9)
+        );
+    }
+}

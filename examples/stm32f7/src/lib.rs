@@ -1,0 +1,41 @@
+//! Firmware support and examples for two STM32F7 boards with bxCAN, on `twocan-bxcan`:
+//! the NUCLEO-F767ZI (feature `nucleo-f767zi`) and the 32F746G-DISCOVERY (feature
+//! `disco-f746g`). Cross-build for `thumbv7em-none-eabihf`; see `docs/firmware.md`.
+//!
+//! - [`board`]: the board facts (oscillator, CAN pins, LED), plain data;
+//! - `rt` (target only): clocks with `stm32f7xx-hal` after a bounded probe of the
+//!   external oscillator, CAN peripheral clocks and pins, SysTick, the panic handler;
+//! - [`time`], [`shared`]: the SysTick time base and the driver shared with its
+//!   interrupt handlers — the very files of `twocan-teensy` (nothing in them is
+//!   chip-specific).
+#![cfg_attr(not(test), no_std)]
+#![deny(missing_docs)]
+
+#[cfg(all(
+    target_os = "none",
+    not(any(feature = "nucleo-f767zi", feature = "disco-f746g"))
+))]
+compile_error!("choose the board: --features nucleo-f767zi or disco-f746g");
+
+#[cfg(all(feature = "nucleo-f767zi", feature = "disco-f746g"))]
+compile_error!("choose one board feature only");
+
+pub mod board;
+#[cfg(target_os = "none")]
+pub mod rt;
+#[path = "../../teensy/src/shared.rs"]
+pub mod shared;
+#[path = "../../teensy/src/time.rs"]
+pub mod time;
+
+#[cfg(any(feature = "nucleo-f767zi", feature = "disco-f746g"))]
+pub use board::BOARD;
+pub use board::Board;
+
+/// What the host build of a firmware example does: say how to build the real thing.
+pub fn host_stub(example: &str) -> &'static str {
+    let _ = example;
+    "this is STM32F7 firmware: cross-build it with \
+     `cargo build --release --target thumbv7em-none-eabihf -p twocan-stm32f7 \
+     --features nucleo-f767zi --bin <example>` (or disco-f746g), see docs/firmware.md"
+}

@@ -1,0 +1,89 @@
+//! The portable application (`twocan_app::App`, the same module as the host demo) on
+//! FlexCAN0 at 500 kbit/s, as node 1 talking with node 2.
+//!
+//! Node 2 is any other board running its `app` example with the roles swapped — the
+//! STM32F7 `app` example is node 2 — on the same bus, through transceivers (Teensy
+//! pins 3 = CAN0 TX, 4 = CAN0 RX; 120 Ω at each end). Without a peer, frames are not
+//! acknowledged and the controller goes error passive: the LED then stays still.
+//!
+//! The application runs every 10 ms; the LED toggles every 50 heartbeats received from
+//! the peer. `STATS` mirrors the application's counters for a debugger.
+//!
+//! Blink codes when it stops: 2–4 clock start-up, 5 FlexCAN `begin`, 6 panic.
+#![cfg_attr(target_os = "none", no_std, no_main)]
+
+#[cfg(target_os = "none")]
+mod firmware {
+    use core::cell::RefCell;
+
+    use critical_section::Mutex;
+    use twocan_app::{App, AppStats};
+    use twocan_core::Mmio;
+    use twocan_flexcan::{
+        AcanDriver, Can0, FlexCan, Settings, RECEIVE_BUFFER_SIZE, TRANSMIT_BUFFER_SIZE,
+    };
+    use twocan_teensy::rt::{self, CAN_BLINKS};
+    use twocan_teensy::shared::SharedDriver;
+    use twocan_teensy::time::{self, Every};
+
+    /// This node and its peer.
+    const NODE: u8 = 1;
+    const PEER: u8 = 2;
+
+    static CAN0: SharedDriver<FlexCan<Mmio>, RECEIVE_BUFFER_SIZE, TRANSMIT_BUFFER_SIZE> =
+        SharedDriver::new();
+
+    /// The application's counters, copied after each step.
+    pub static STATS: Mutex<RefCell<AppStats>> = Mutex::new(RefCell::new(AppStats {
+        sent: 0,
+        tx_full: 0,
+        heartbeats: 0,
+        heartbeat_gaps: 0,
+        measurements: 0,
+        requests: 0,
+        answers: 0,
+        unhandled: 0,
+    }));
+
+    #[no_mangle]
+    extern "C" fn CAN0_ORED_MESSAGE_BUFFER() {
+        CAN0.on_interrupt();
+    }
+
+    #[cortex_m_rt::entry]
+    fn main() -> ! {
+        let mut boot = rt::boot();
+        let mut app = App::new(NODE, PEER);
+        let settings = Settings::new(500_000);
+        let token = Can0::take().unwrap_or_else(|| rt::halt(CAN_BLINKS));
+        // The application's portable filter list, as primary filters.
+        let can = token
+            .begin(&settings, &app.filters(), &[])
+            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
+        rt::enable_can_irq(&mut boot.core.NVIC, &can);
+        let driver: AcanDriver<Mmio> = AcanDriver::new(can);
+        if CAN0.install(driver).is_err() {
+            rt::halt(CAN_BLINKS);
+        }
+
+        let mut period = Every::new(time::millis(), 10);
+        let mut shown = 0;
+        loop {
+            if period.due(time::millis()) {
+                CAN0.with(|d| app.step(d));
+                let stats = app.stats();
+                critical_section::with(|cs| *STATS.borrow_ref_mut(cs) = stats);
+                if stats.heartbeats >= shown + 50 {
+                    shown = stats.heartbeats;
+                    boot.led.toggle();
+                }
+            }
+            cortex_m::asm::wfi();
+        }
+    }
+}
+
+#[cfg(not(target_os = "none"))]
+fn main() {
+    eprintln!("{}", twocan_teensy::host_stub("app"));
+}

@@ -1,0 +1,103 @@
+//! Teensy 3.6 only: FlexCAN0 and FlexCAN1 talking to each other through their
+//! transceivers, each running the portable application (`twocan_app::App`): CAN0 is
+//! node 1, CAN1 node 2, at 500 kbit/s.
+//!
+//! Wiring: a transceiver on CAN0 (pins 3 = TX, 4 = RX) and one on CAN1 (pins 33 = TX,
+//! 34 = RX), their CANH together and CANL together, 120 Ω at each end of that bus.
+//!
+//! Both applications run every 10 ms; the LED toggles every 50 heartbeats each node got
+//! from the other. `STATS` holds both nodes' counters for a debugger.
+//!
+//! Blink codes when it stops: 2–4 clock start-up, 5 FlexCAN `begin`, 6 panic.
+#![cfg_attr(target_os = "none", no_std, no_main)]
+
+#[cfg(target_os = "none")]
+mod firmware {
+    use core::cell::RefCell;
+
+    use critical_section::Mutex;
+    use twocan_app::{App, AppStats};
+    use twocan_core::Mmio;
+    use twocan_flexcan::{
+        AcanDriver, Can0, Can1, FlexCan, Settings, RECEIVE_BUFFER_SIZE, TRANSMIT_BUFFER_SIZE,
+    };
+    use twocan_teensy::rt::{self, CAN_BLINKS};
+    use twocan_teensy::shared::SharedDriver;
+    use twocan_teensy::time::{self, Every};
+
+    static CAN0: SharedDriver<FlexCan<Mmio>, RECEIVE_BUFFER_SIZE, TRANSMIT_BUFFER_SIZE> =
+        SharedDriver::new();
+    static CAN1: SharedDriver<FlexCan<Mmio>, RECEIVE_BUFFER_SIZE, TRANSMIT_BUFFER_SIZE> =
+        SharedDriver::new();
+
+    const NO_STATS: AppStats = AppStats {
+        sent: 0,
+        tx_full: 0,
+        heartbeats: 0,
+        heartbeat_gaps: 0,
+        measurements: 0,
+        requests: 0,
+        answers: 0,
+        unhandled: 0,
+    };
+
+    /// The counters of node 1 (CAN0) and node 2 (CAN1), copied after each step.
+    pub static STATS: Mutex<RefCell<[AppStats; 2]>> =
+        Mutex::new(RefCell::new([NO_STATS, NO_STATS]));
+
+    #[no_mangle]
+    extern "C" fn CAN0_ORED_MESSAGE_BUFFER() {
+        CAN0.on_interrupt();
+    }
+
+    #[no_mangle]
+    extern "C" fn CAN1_ORED_MESSAGE_BUFFER() {
+        CAN1.on_interrupt();
+    }
+
+    #[cortex_m_rt::entry]
+    fn main() -> ! {
+        let mut boot = rt::boot();
+        let settings = Settings::new(500_000);
+        let mut node1 = App::new(1, 2);
+        let mut node2 = App::new(2, 1);
+
+        let can0 = Can0::take()
+            .unwrap_or_else(|| rt::halt(CAN_BLINKS))
+            .begin(&settings, &node1.filters(), &[])
+            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
+        let can1 = Can1::take()
+            .unwrap_or_else(|| rt::halt(CAN_BLINKS))
+            .begin(&settings, &node2.filters(), &[])
+            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
+        rt::enable_can_irq(&mut boot.core.NVIC, &can0);
+        rt::enable_can_irq(&mut boot.core.NVIC, &can1);
+        let d0: AcanDriver<Mmio> = AcanDriver::new(can0);
+        let d1: AcanDriver<Mmio> = AcanDriver::new(can1);
+        if CAN0.install(d0).is_err() || CAN1.install(d1).is_err() {
+            rt::halt(CAN_BLINKS);
+        }
+
+        let mut period = Every::new(time::millis(), 10);
+        let mut shown = 0;
+        loop {
+            if period.due(time::millis()) {
+                CAN0.with(|d| node1.step(d));
+                CAN1.with(|d| node2.step(d));
+                let stats = [node1.stats(), node2.stats()];
+                critical_section::with(|cs| *STATS.borrow_ref_mut(cs) = stats);
+                let both = stats[0].heartbeats.min(stats[1].heartbeats);
+                if both >= shown + 50 {
+                    shown = both;
+                    boot.led.toggle();
+                }
+            }
+            cortex_m::asm::wfi();
+        }
+    }
+}
+
+#[cfg(not(target_os = "none"))]
+fn main() {
+    eprintln!("{}", twocan_teensy::host_stub("can0-can1"));
+}

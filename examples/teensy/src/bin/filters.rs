@@ -1,0 +1,153 @@
+//! Primary and secondary filters with call-backs (ACAN manual §12–§14) on FlexCAN0, in
+//! loop-back with self reception (no transceiver needed).
+//!
+//! Filters, numbered as ACAN numbers them (primary first, then secondary):
+//! - #0 primary: extended data frame 0x123456 (ACAN §12.1);
+//! - #1 primary: standard data frame 0x234;
+//! - #2 primary: standard remote frame 0x542;
+//! - #3 secondary: standard data frames 0x300–0x30F (ACAN §13.2, with a mask);
+//! - #4 secondary: any extended data frame 0x18FF_xx00 (a masked extended filter).
+//!
+//! Every 100 ms the example sends the next frame of a list that hits each filter once and
+//! one frame (0x777) that no filter accepts; each filter's call-back counts its frames
+//! (`HITS`), `dispatch` hands frames to them by filter index. The LED toggles each time
+//! a complete round arrived with the counts as expected; it stays still (and `ERRORS`
+//! counts) when a frame reaches the wrong call-back or a rejected frame gets through.
+//!
+//! Blink codes when it stops: 2–4 clock start-up, 5 FlexCAN `begin`, 6 panic.
+#![cfg_attr(target_os = "none", no_std, no_main)]
+
+#[cfg(target_os = "none")]
+mod firmware {
+    use core::sync::atomic::{AtomicU32, Ordering};
+
+    use twocan_core::{Dispatcher, Filter, Format, Frame, FrameKind, Mmio, RxFrame};
+    use twocan_flexcan::{
+        AcanDriver, Can0, FlexCan, Settings, RECEIVE_BUFFER_SIZE, TRANSMIT_BUFFER_SIZE,
+    };
+    use twocan_teensy::rt::{self, CAN_BLINKS};
+    use twocan_teensy::shared::SharedDriver;
+    use twocan_teensy::time::{self, Every};
+
+    const FILTERS: usize = 5;
+
+    static CAN0: SharedDriver<FlexCan<Mmio>, RECEIVE_BUFFER_SIZE, TRANSMIT_BUFFER_SIZE> =
+        SharedDriver::new();
+
+    /// Frames per filter index.
+    pub static HITS: [AtomicU32; FILTERS] = [const { AtomicU32::new(0) }; FILTERS];
+    /// Frames that reached a call-back they do not belong to (frames of a filter without
+    /// call-back are counted by the dispatcher).
+    pub static ERRORS: AtomicU32 = AtomicU32::new(0);
+
+    #[no_mangle]
+    extern "C" fn CAN0_ORED_MESSAGE_BUFFER() {
+        CAN0.on_interrupt();
+    }
+
+    /// The frames sent, in order, with the filter index each must arrive through
+    /// (`None`: rejected by every filter).
+    fn frames() -> [(Result<Frame, twocan_core::FrameError>, Option<usize>); 6] {
+        [
+            (Frame::extended(0x12_3456, &[0]), Some(0)),
+            (Frame::standard(0x234, &[1, 2]), Some(1)),
+            (Frame::remote(0x542, false, 0), Some(2)),
+            (Frame::standard(0x305, &[3]), Some(3)),
+            (Frame::extended(0x18FF_2A00, &[4; 8]), Some(4)),
+            (Frame::standard(0x777, &[5]), None),
+        ]
+    }
+
+    fn check(expected: usize, rx: &RxFrame) {
+        let ok = rx.filter as usize == expected
+            && frames()
+                .iter()
+                .any(|(f, i)| *i == Some(expected) && f.as_ref().ok() == Some(&rx.frame));
+        HITS[expected].fetch_add(1, Ordering::Relaxed);
+        if !ok {
+            ERRORS.fetch_add(1, Ordering::Relaxed);
+        }
+    }
+
+    fn on_0(_: &mut (), rx: &RxFrame) {
+        check(0, rx)
+    }
+    fn on_1(_: &mut (), rx: &RxFrame) {
+        check(1, rx)
+    }
+    fn on_2(_: &mut (), rx: &RxFrame) {
+        check(2, rx)
+    }
+    fn on_3(_: &mut (), rx: &RxFrame) {
+        check(3, rx)
+    }
+    fn on_4(_: &mut (), rx: &RxFrame) {
+        check(4, rx)
+    }
+
+    #[cortex_m_rt::entry]
+    fn main() -> ! {
+        let mut boot = rt::boot();
+        let mut settings = Settings::new(125_000);
+        settings.loop_back = true;
+        settings.self_reception = true;
+        let primary = [
+            Filter::exact(FrameKind::Data, Format::Extended, 0x12_3456),
+            Filter::exact(FrameKind::Data, Format::Standard, 0x234),
+            Filter::exact(FrameKind::Remote, Format::Standard, 0x542),
+        ];
+        let secondary = [
+            Filter::masked(FrameKind::Data, Format::Standard, 0x7F0, 0x300),
+            Filter::masked(FrameKind::Data, Format::Extended, 0x1FFF_00FF, 0x18FF_0000),
+        ];
+        let token = Can0::take().unwrap_or_else(|| rt::halt(CAN_BLINKS));
+        let can = token
+            .begin(&settings, &primary, &secondary)
+            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
+        rt::enable_can_irq(&mut boot.core.NVIC, &can);
+        let driver: AcanDriver<Mmio> = AcanDriver::new(can);
+        if CAN0.install(driver).is_err() {
+            rt::halt(CAN_BLINKS);
+        }
+
+        let mut dispatcher: Dispatcher<(), FILTERS> = Dispatcher::new();
+        let callbacks: [fn(&mut (), &RxFrame); FILTERS] = [on_0, on_1, on_2, on_3, on_4];
+        for (i, f) in callbacks.into_iter().enumerate() {
+            if dispatcher.set(i, f).is_err() {
+                rt::halt(CAN_BLINKS);
+            }
+        }
+
+        let list = frames();
+        let mut next = 0;
+        let mut send = Every::new(time::millis(), 100);
+        let mut rounds_seen = 0;
+        loop {
+            if send.due(time::millis()) {
+                if let (Ok(frame), _) = &list[next] {
+                    if CAN0.with(|d| d.try_send(frame).is_ok()) == Some(true) {
+                        next = (next + 1) % list.len();
+                    }
+                }
+            }
+            while CAN0.with(|d| d.dispatch(&mut dispatcher, &mut ())) == Some(true) {}
+            // A round is complete when every filter saw one more frame.
+            let rounds = HITS
+                .iter()
+                .map(|h| h.load(Ordering::Relaxed))
+                .min()
+                .unwrap_or(0);
+            let errors = ERRORS.load(Ordering::Relaxed) + dispatcher.unhandled();
+            if rounds > rounds_seen && errors == 0 {
+                rounds_seen = rounds;
+                boot.led.toggle();
+            }
+            cortex_m::asm::wfi();
+        }
+    }
+}
+
+#[cfg(not(target_os = "none"))]
+fn main() {
+    eprintln!("{}", twocan_teensy::host_stub("filters"));
+}

@@ -1,0 +1,242 @@
+//! `begin`: check everything, then configure the module (ACAN §15).
+//!
+//! [`check`] computes every error flag of ACAN table 5 at once without any
+//! hardware access. [`FlexCan::begin`] runs the same check and returns
+//! [`BeginError::Config`] before writing any register; only valid settings reach the
+//! hardware, in the order of the Kinetis reference manuals' "FlexCAN initialization
+//! sequence":
+//!
+//! 1. SIM clock gates of the ports and the module, pin mux of Tx and Rx (ALT2, open
+//!    drain, pull-up; ACAN §7, §16.7.5–6);
+//! 2. module disabled (`MDIS`, wait `LPMACK`), engine clock = oscillator
+//!    (`CTRL1.CLKSRC` = 0, writable only while disabled), module enabled;
+//! 3. soft reset (`SOFTRST`, wait until it clears), freeze (wait `FRZACK`);
+//! 4. in freeze: `MCR` (Rx FIFO, individual masks, abort enable, self reception,
+//!    format A, 16 MBs, warnings), `CTRL1` (bit timing, listen-only, loop-back,
+//!    automatic bus-off recovery, error interrupt masks), `CTRL2` (`RFFN`, remote frames stored), the ID filter
+//!    table, `RXIMR`, `RXFGMASK`, the transmit mailboxes inactive, flags cleared,
+//!    `IMASK1` (FIFO frames available and overflow, every transmit mailbox);
+//! 5. leave freeze (wait `FRZACK` and `NOTRDY` to clear).
+//!
+//! Every wait is bounded by [`Settings::handshake_polls`]; a missing acknowledge is
+//! [`BeginError::Hardware`]`(`[`Error::Timeout`]`)`.
+
+use twocan_core::{Error, Filter, Registers};
+
+use crate::begin_error::{BeginError, ConfigErrors};
+use crate::configuration::{Configuration, DATA_MAILBOX, MESSAGE_BUFFERS};
+use crate::controller::FlexCan;
+use crate::filters::FilterTable;
+use crate::handshake;
+use crate::instance::Target;
+use crate::regs::{self, code, cs, ctrl1, ctrl2, iflag1, mcr, CTRL1, CTRL2, IFLAG1, IMASK1, MCR};
+use crate::settings::{Settings, CAN_CLOCK_HZ};
+use crate::system::{choose_pins, SystemPlan};
+
+/// Everything `begin` will write, computed before anything is written.
+#[derive(Debug, Clone)]
+struct Plan {
+    system: SystemPlan,
+    mcr: u32,
+    ctrl1: u32,
+    configuration: Configuration,
+    table: FilterTable,
+}
+
+/// The checks of ACAN table 5, all of them, then the register values.
+fn plan(target: Target, settings: &Settings, primary: &[Filter], secondary: &[Filter]) -> Result<Plan, ConfigErrors> {
+    let mut errors = ConfigErrors::NONE;
+
+    if !settings.bit_rate_close_to_wished() {
+        errors |= ConfigErrors::BIT_RATE_TOO_FAR;
+    }
+    // The table-6 rules, the register widths, and the clock the counts were made for.
+    let timing_bits = settings.timing.flexcan_ctrl1();
+    if !settings.consistency().is_ok() || timing_bits.is_err() || settings.timing.clock_hz != CAN_CLOCK_HZ {
+        errors |= ConfigErrors::BIT_TIMING_INCONSISTENT;
+    }
+
+    let table = FilterTable::compile(settings.configuration, primary, secondary);
+    if let Err(e) = &table {
+        errors |= *e;
+    }
+
+    let pins = match target.board.pins(target.instance) {
+        None => {
+            errors |= ConfigErrors::NO_SUCH_INSTANCE;
+            None
+        }
+        Some(pins) => match choose_pins(pins, settings.use_alternate_tx_pin, settings.use_alternate_rx_pin) {
+            Ok(chosen) => Some(chosen),
+            Err((no_tx, no_rx)) => {
+                if no_tx {
+                    errors |= ConfigErrors::NO_ALTERNATE_TX_PIN;
+                }
+                if no_rx {
+                    errors |= ConfigErrors::NO_ALTERNATE_RX_PIN;
+                }
+                None
+            }
+        },
+    };
+
+    match (errors.is_empty(), timing_bits, table, pins) {
+        (true, Ok(timing_bits), Ok(table), Some((tx, rx))) => {
+            let system = SystemPlan::new(
+                target.instance.clock_gate(),
+                tx,
+                rx,
+                settings.tx_pin_open_collector,
+                settings.rx_pin_pull_up,
+            );
+            let mut mcr = mcr::FRZ
+                | mcr::HALT
+                | mcr::RFEN
+                | mcr::IRMQ
+                | mcr::AEN
+                | mcr::IDAM.val(mcr::IDAM_FORMAT_A)
+                | mcr::MAXMB.val(MESSAGE_BUFFERS as u32 - 1);
+            if !settings.self_reception {
+                mcr |= mcr::SRXDIS;
+            }
+            let mut ctrl1 = timing_bits;
+            if settings.listen_only {
+                ctrl1 |= ctrl1::LOM;
+            }
+            if settings.loop_back {
+                ctrl1 |= ctrl1::LPB;
+            }
+            if settings.error_interrupts {
+                ctrl1 |= ctrl1::ERRMSK | ctrl1::BOFFMSK | ctrl1::TWRNMSK | ctrl1::RWRNMSK;
+                mcr |= mcr::WRNEN;
+            }
+            Ok(Plan { system, mcr, ctrl1, configuration: settings.configuration, table })
+        }
+        _ => Err(errors),
+    }
+}
+
+/// Writes the plan (steps 2–5 of the module docs).
+fn configure<R: Registers>(regs: &mut R, plan: &Plan, polls: u32) -> Result<(), Error> {
+    handshake::disable(regs, polls)?;
+    regs.modify32(CTRL1, |v| v & !ctrl1::CLKSRC);
+    handshake::enable(regs, polls)?;
+    handshake::soft_reset(regs, polls)?;
+    handshake::freeze(regs, polls)?;
+
+    let supervisor = regs.read32(MCR) & mcr::SUPV;
+    regs.write32(MCR, plan.mcr | supervisor);
+    regs.write32(CTRL1, plan.ctrl1);
+    regs.modify32(CTRL2, |v| {
+        let kept = v & ctrl2::TASD.mask();
+        kept | ctrl2::RFFN.val(plan.configuration.rffn() as u32) | ctrl2::RRS
+    });
+    FlexCan::<R>::write_filters(regs, &plan.table);
+    // Masks of the transmit mailboxes: a remote-frame mailbox briefly receives after
+    // its transmission; exact matching keeps it to its own identifier.
+    for n in plan.configuration.primary_filter_capacity()..MESSAGE_BUFFERS as usize {
+        regs.write32(regs::rximr(n), u32::MAX);
+    }
+    let mut tx_flags = 0;
+    for mb in plan.configuration.first_remote_mailbox() as usize..=DATA_MAILBOX as usize {
+        regs.write32(regs::mb_cs(mb), cs::CODE.val(code::TX_INACTIVE));
+        regs.write32(regs::mb_id(mb), 0);
+        regs.write32(regs::mb_word0(mb), 0);
+        regs.write32(regs::mb_word1(mb), 0);
+        tx_flags |= iflag1::buf(mb);
+    }
+    regs.write32(IFLAG1, u32::MAX);
+    regs.write32(IMASK1, iflag1::BUF5I | iflag1::BUF7I | tx_flags);
+    handshake::unfreeze(regs, polls)
+}
+
+/// Every error `begin` would report for these arguments (ACAN table 5), found
+/// without touching any register. [`ConfigErrors::NONE`] when `begin` would proceed.
+pub fn check(target: Target, settings: &Settings, primary: &[Filter], secondary: &[Filter]) -> ConfigErrors {
+    match plan(target, settings, primary, secondary) {
+        Ok(_) => ConfigErrors::NONE,
+        Err(e) => e,
+    }
+}
+
+impl<R: Registers> FlexCan<R> {
+    /// Configures the module `target` over `regs` (ACAN `begin (settings,
+    /// primaryFilters, primaryFilterCount, secondaryFilters, secondaryFilterCount)`,
+    /// §15.1; empty lists for the shorter forms — with no filter at all, every frame
+    /// is received with filter index 0).
+    ///
+    /// `sys` reaches the SIM and PORT registers by absolute address (firmware:
+    /// `Mmio` at base 0, as `Can0::begin` does; host: [`crate::HostSystem`]).
+    /// `regs` may be `&mut M` to keep the registers (a model) after an error.
+    pub fn begin<S: Registers>(
+        mut regs: R,
+        sys: &mut S,
+        target: Target,
+        settings: &Settings,
+        primary: &[Filter],
+        secondary: &[Filter],
+    ) -> Result<Self, BeginError> {
+        let plan = plan(target, settings, primary, secondary).map_err(BeginError::Config)?;
+        plan.system.apply(sys);
+        configure(&mut regs, &plan, settings.handshake_polls)?;
+        Ok(FlexCan::configured(
+            regs,
+            target,
+            plan.table,
+            settings.listen_only,
+            settings.handshake_polls,
+            settings.message_irq_priority,
+        ))
+    }
+}
+
+#[cfg(all(target_os = "none", any(feature = "teensy32", feature = "teensy35", feature = "teensy36")))]
+mod firmware {
+    use twocan_core::{Filter, Mmio};
+
+    use super::*;
+    use crate::instance::Can0;
+    #[cfg(feature = "teensy36")]
+    use crate::instance::Can1;
+
+    /// The SIM and PORT registers, addressed absolutely.
+    fn system() -> Mmio {
+        // SAFETY: base 0 with absolute offsets: `begin` only touches SIM_SCGC3/5/6 and
+        // the PCRs of this instance's pins, read-modify-writes of SIM in a critical
+        // section; those registers exist on every Teensy 3.x chip.
+        unsafe { Mmio::new(0) }
+    }
+
+    impl Can0 {
+        /// ACAN `ACAN::can0.begin` (§15): configures FlexCAN0 and gives the
+        /// controller. On error the token comes back with the reason.
+        pub fn begin(
+            self,
+            settings: &Settings,
+            primary: &[Filter],
+            secondary: &[Filter],
+        ) -> Result<FlexCan<Mmio>, (Self, BeginError)> {
+            let target = self.target();
+            // SAFETY: the token is unique (taken once) and consumed here, so this is
+            // the only access to FlexCAN0, at its reference-manual base address.
+            let regs = unsafe { Mmio::new(target.instance.base()) };
+            FlexCan::begin(regs, &mut system(), target, settings, primary, secondary).map_err(|e| (self, e))
+        }
+    }
+
+    #[cfg(feature = "teensy36")]
+    impl Can1 {
+        /// ACAN `ACAN::can1.begin` (§15): configures FlexCAN1 (Teensy 3.6).
+        pub fn begin(
+            self,
+            settings: &Settings,
+            primary: &[Filter],
+            secondary: &[Filter],
+        ) -> Result<FlexCan<Mmio>, (Self, BeginError)> {
+            let target = self.target();
+            // SAFETY: as for `Can0::begin`, for FlexCAN1.
+            let regs = unsafe { Mmio::new(target.instance.base()) };
+            FlexCan::begin(regs, &mut system(), target, settings, primary, secondary).map_err(|e| (self, e))
+        }
+    }
+}

@@ -1,0 +1,197 @@
+//! What `begin` reports (ACAN §15.2, table 5).
+//!
+//! `begin` checks everything first and collects every problem it finds in one
+//! [`ConfigErrors`] value; when it is not empty, nothing has been written to any
+//! register. Only once the settings are valid does `begin` touch the hardware, and a
+//! controller that then fails to acknowledge a mode change gives
+//! [`BeginError::Hardware`] with [`twocan_core::Error::Timeout`].
+
+use core::fmt;
+
+/// The error flags of ACAN table 5 (bits 0–7 at ACAN's positions), plus bit 8 for
+/// an instance the board does not have.
+///
+/// The table, as extracted from the manual's PDF, shows bits 1–0 as `0 0` on the
+/// rows of bits 2–7; read with the §15.2 text ("an error code could report several
+/// errors") they are "don't care": this driver reports every flag that applies, the
+/// timing flags included, in one value.
+#[derive(Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct ConfigErrors(u32);
+
+impl ConfigErrors {
+    /// No error (ACAN: error code 0).
+    pub const NONE: ConfigErrors = ConfigErrors(0);
+    /// Bit 0: the bit timing is too far from the wished bit rate (ACAN §15.2.1,
+    /// `kCANBitConfigurationTooFarFromWishedBitRateErrorMask`).
+    pub const BIT_RATE_TOO_FAR: ConfigErrors = ConfigErrors(1 << 0);
+    /// Bit 1: the bit timing is inconsistent (ACAN §15.2.2, §16.2).
+    pub const BIT_TIMING_INCONSISTENT: ConfigErrors = ConfigErrors(1 << 1);
+    /// Bit 2: more primary filters than the configuration allows (ACAN §15.2.3).
+    pub const TOO_MANY_PRIMARY_FILTERS: ConfigErrors = ConfigErrors(1 << 2);
+    /// Bit 3: a primary filter does not conform (ACAN §15.3, §12.4).
+    pub const PRIMARY_FILTER_NOT_CONFORM: ConfigErrors = ConfigErrors(1 << 3);
+    /// Bit 4: more secondary filters than the configuration allows (ACAN §15.3.1).
+    pub const TOO_MANY_SECONDARY_FILTERS: ConfigErrors = ConfigErrors(1 << 4);
+    /// Bit 5: a secondary filter does not conform (ACAN §15.3.2, §13.4).
+    pub const SECONDARY_FILTER_NOT_CONFORM: ConfigErrors = ConfigErrors(1 << 5);
+    /// Bit 6: an alternate Tx pin was asked for `can1`, which has none (ACAN §15.3.3).
+    pub const NO_ALTERNATE_TX_PIN: ConfigErrors = ConfigErrors(1 << 6);
+    /// Bit 7: an alternate Rx pin was asked for `can1`, which has none (ACAN §15.3.4).
+    pub const NO_ALTERNATE_RX_PIN: ConfigErrors = ConfigErrors(1 << 7);
+    /// Bit 8 (not in ACAN): the board has no such FlexCAN instance (`can1` exists on
+    /// the Teensy 3.6 only, ACAN §6 table 2).
+    pub const NO_SUCH_INSTANCE: ConfigErrors = ConfigErrors(1 << 8);
+    /// Every flag.
+    pub const ALL: ConfigErrors = ConfigErrors((1 << 9) - 1);
+
+    const NAMES: [&'static str; 9] = [
+        "BIT_RATE_TOO_FAR",
+        "BIT_TIMING_INCONSISTENT",
+        "TOO_MANY_PRIMARY_FILTERS",
+        "PRIMARY_FILTER_NOT_CONFORM",
+        "TOO_MANY_SECONDARY_FILTERS",
+        "SECONDARY_FILTER_NOT_CONFORM",
+        "NO_ALTERNATE_TX_PIN",
+        "NO_ALTERNATE_RX_PIN",
+        "NO_SUCH_INSTANCE",
+    ];
+
+    /// The raw bits (ACAN's error code for bits 0–7).
+    pub const fn bits(self) -> u32 {
+        self.0
+    }
+
+    /// Flags from raw bits; unknown bits are dropped.
+    pub const fn from_bits_truncate(bits: u32) -> Self {
+        ConfigErrors(bits & Self::ALL.0)
+    }
+
+    /// No flag set.
+    pub const fn is_empty(self) -> bool {
+        self.0 == 0
+    }
+
+    /// Every flag of `other` is set.
+    pub const fn contains(self, other: ConfigErrors) -> bool {
+        self.0 & other.0 == other.0
+    }
+
+    /// Flags of both.
+    pub const fn union(self, other: ConfigErrors) -> Self {
+        ConfigErrors(self.0 | other.0)
+    }
+
+    /// Number of flags set.
+    pub const fn count(self) -> u32 {
+        self.0.count_ones()
+    }
+
+    /// Names of the set flags, lowest bit first.
+    pub fn names(self) -> impl Iterator<Item = &'static str> {
+        Self::NAMES
+            .iter()
+            .enumerate()
+            .filter(move |(i, _)| self.0 & (1 << i) != 0)
+            .map(|(_, n)| *n)
+    }
+}
+
+impl core::ops::BitOr for ConfigErrors {
+    type Output = ConfigErrors;
+    fn bitor(self, rhs: ConfigErrors) -> ConfigErrors {
+        self.union(rhs)
+    }
+}
+
+impl core::ops::BitOrAssign for ConfigErrors {
+    fn bitor_assign(&mut self, rhs: ConfigErrors) {
+        *self = self.union(rhs);
+    }
+}
+
+impl fmt::Debug for ConfigErrors {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str("ConfigErrors(")?;
+        if self.is_empty() {
+            f.write_str("NONE")?;
+        }
+        for (i, name) in self.names().enumerate() {
+            if i > 0 {
+                f.write_str(" | ")?;
+            }
+            f.write_str(name)?;
+        }
+        f.write_str(")")
+    }
+}
+
+impl fmt::Display for ConfigErrors {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        fmt::Debug::fmt(self, f)
+    }
+}
+
+/// Why `begin` failed (ACAN §15).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum BeginError {
+    /// The settings, filters or pins are invalid (ACAN table 5); no register was
+    /// written.
+    Config(ConfigErrors),
+    /// The controller did not acknowledge a mode change within
+    /// [`crate::Settings::handshake_polls`] ([`twocan_core::Error::Timeout`]); the
+    /// module is left partly configured and should be given to `begin` again.
+    Hardware(twocan_core::Error),
+}
+
+impl BeginError {
+    /// The table-5 flags ([`ConfigErrors::NONE`] for a hardware failure).
+    pub const fn flags(&self) -> ConfigErrors {
+        match self {
+            BeginError::Config(f) => *f,
+            BeginError::Hardware(_) => ConfigErrors::NONE,
+        }
+    }
+}
+
+impl From<twocan_core::Error> for BeginError {
+    fn from(e: twocan_core::Error) -> Self {
+        BeginError::Hardware(e)
+    }
+}
+
+impl fmt::Display for BeginError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            BeginError::Config(c) => write!(f, "invalid configuration: {c}"),
+            BeginError::Hardware(e) => write!(f, "controller failure: {e}"),
+        }
+    }
+}
+
+impl core::error::Error for BeginError {}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn acan_bit_positions_and_formatting() {
+        assert_eq!(ConfigErrors::BIT_RATE_TOO_FAR.bits(), 0x01);
+        assert_eq!(ConfigErrors::BIT_TIMING_INCONSISTENT.bits(), 0x02);
+        assert_eq!(ConfigErrors::TOO_MANY_PRIMARY_FILTERS.bits(), 0x04);
+        assert_eq!(ConfigErrors::PRIMARY_FILTER_NOT_CONFORM.bits(), 0x08);
+        assert_eq!(ConfigErrors::TOO_MANY_SECONDARY_FILTERS.bits(), 0x10);
+        assert_eq!(ConfigErrors::SECONDARY_FILTER_NOT_CONFORM.bits(), 0x20);
+        assert_eq!(ConfigErrors::NO_ALTERNATE_TX_PIN.bits(), 0x40);
+        assert_eq!(ConfigErrors::NO_ALTERNATE_RX_PIN.bits(), 0x80);
+        let e = ConfigErrors::NO_ALTERNATE_RX_PIN | ConfigErrors::BIT_RATE_TOO_FAR;
+        assert_eq!(format!("{e:?}"), "ConfigErrors(BIT_RATE_TOO_FAR | NO_ALTERNATE_RX_PIN)");
+        assert_eq!(format!("{:?}", ConfigErrors::NONE), "ConfigErrors(NONE)");
+        assert_eq!(ConfigErrors::from_bits_truncate(u32::MAX), ConfigErrors::ALL);
+        assert_eq!(ConfigErrors::ALL.count(), 9);
+        assert_eq!(BeginError::Config(e).flags(), e);
+        assert_eq!(BeginError::from(twocan_core::Error::Timeout).flags(), ConfigErrors::NONE);
+    }
+}

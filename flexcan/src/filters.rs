@@ -1,0 +1,373 @@
+//! Primary and secondary receive filters compiled into the Rx FIFO ID filter table
+//! (ACAN §12, §13; Kinetis reference manuals, FlexCAN "Rx FIFO structure").
+//!
+//! Filters are twocan-core's portable [`Filter`]s. ACAN's two kinds differ by where
+//! they land in the hardware:
+//!
+//! - **primary filters** use the table elements matched with an individual mask
+//!   (`RXIMRn`): kind, format, identifier, or mask + acceptance, or pass-all
+//!   (§12.1–12.3). Their conformance is [`Filter::check`] (§12.4); a filter of
+//!   kind [`FrameKind::Any`](twocan_core::FrameKind::Any) (not in ACAN) works too.
+//! - **secondary filters** share the one global mask `RXFGMASK`: each names a single
+//!   identifier with a data or remote kind and a standard or extended format, or is
+//!   the pass-all filter (§13, §13.4). Anything else is a secondary conformance error.
+//!
+//! Numbering (§13.5): primary filters are 0, 1, …, then secondary filters continue.
+//! That number is [`twocan_core::RxFrame::filter`] and the dispatcher's index.
+//!
+//! # Table format A
+//!
+//! `MCR.IDAM = 0`: each element holds one identifier, bit 31 RTR, bit 30 IDE, an
+//! extended identifier in bits 29–1, a standard one in bits 29–19. A mask has the
+//! same layout: a set bit is compared, a clear bit is not. Elements are examined in
+//! order and the first match wins, reported by `RXFIR.IDHIT` — so a duplicate filter,
+//! or one after a pass-all filter, never matches (§12.1, §12.2, §13.2, §13.3).
+//!
+//! # Unused elements
+//!
+//! A configuration has a fixed number of elements; those the user's lists do not fill
+//! must not accept any extra frame. An unused primary element repeats the last
+//! primary filter (it sits after it, so it is never hit); an unused secondary element
+//! repeats the last secondary filter, or, with no secondary filter, the last primary
+//! filter's element under the global mask (a subset of what that filter accepts,
+//! after it). With no primary filter, the primary elements repeat the first secondary
+//! filter: they come before it but accept exactly what it accepts, and report its
+//! index. With no filter at all, the list is one pass-all primary filter (§4: "receive
+//! all frames"), index 0.
+//!
+//! # Secondary pass-all
+//!
+//! One global mask cannot compare identifiers for some secondary elements and ignore
+//! them for the pass-all one. When a secondary list holds a pass-all filter, the
+//! global mask is 0: every frame no primary filter takes is accepted (the pass-all
+//! filter would have accepted it), and the driver finds the secondary filter that
+//! matches first in software ([`Filter::matches`], the reference semantics), so the
+//! reported index is still the one §13.3 describes.
+
+use twocan_core::{Filter, Format, Frame, FrameKind};
+
+use crate::begin_error::ConfigErrors;
+use crate::configuration::{Configuration, MAX_PRIMARY_FILTERS, MAX_SECONDARY_FILTERS, MAX_TABLE_ELEMENTS};
+
+/// Format A element / mask bit 31: remote frame.
+pub const ELEMENT_RTR: u32 = 1 << 31;
+/// Format A element / mask bit 30: extended frame.
+pub const ELEMENT_IDE: u32 = 1 << 30;
+/// Position of an extended identifier in a format A element (bits 29–1).
+pub const ELEMENT_EXT_SHIFT: u32 = 1;
+/// Position of a standard identifier in a format A element (bits 29–19).
+pub const ELEMENT_STD_SHIFT: u32 = 19;
+/// The mask that compares kind, format and the whole identifier.
+pub const FULL_MASK: u32 = ELEMENT_RTR | ELEMENT_IDE | (0x1FFF_FFFF << ELEMENT_EXT_SHIFT);
+
+/// What a table element's hit means.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Hit {
+    /// The frame was accepted by the user's filter of this index.
+    Filter(u16),
+    /// Accepted under a zero global mask: the first matching secondary filter (found
+    /// in software) gives the index.
+    ScanSecondary,
+}
+
+/// A filter list compiled for one [`Configuration`]: the ID filter table, the masks
+/// and the map from `RXFIR.IDHIT` back to the user's filter index.
+///
+/// This is the FlexCAN [`twocan_core::Controller::Filters`] type.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct FilterTable {
+    configuration: Configuration,
+    elements: [u32; MAX_TABLE_ELEMENTS],
+    individual_masks: [u32; MAX_PRIMARY_FILTERS],
+    global_mask: u32,
+    hits: [Hit; MAX_TABLE_ELEMENTS],
+    secondary: [Filter; MAX_SECONDARY_FILTERS],
+    primary_count: u8,
+    secondary_count: u8,
+}
+
+/// Whether `f` conforms as a secondary filter (ACAN §13.4).
+pub fn secondary_conforms(f: &Filter) -> bool {
+    f.check().is_ok()
+        && (f.is_pass_all() || (f.is_exact() && !matches!(f.kind, FrameKind::Any)))
+}
+
+/// The format A element of a filter.
+pub const fn element_of(f: &Filter) -> u32 {
+    let rtr = if matches!(f.kind, FrameKind::Remote) { ELEMENT_RTR } else { 0 };
+    let (ide, id) = match f.format {
+        Format::Standard => (0, f.id << ELEMENT_STD_SHIFT),
+        Format::Extended => (ELEMENT_IDE, f.id << ELEMENT_EXT_SHIFT),
+        Format::Any => (0, 0),
+    };
+    rtr | ide | id
+}
+
+/// The format A individual mask of a primary filter.
+pub const fn mask_of(f: &Filter) -> u32 {
+    let rtr = if matches!(f.kind, FrameKind::Any) { 0 } else { ELEMENT_RTR };
+    let (ide, id) = match f.format {
+        Format::Standard => (ELEMENT_IDE, f.mask << ELEMENT_STD_SHIFT),
+        Format::Extended => (ELEMENT_IDE, f.mask << ELEMENT_EXT_SHIFT),
+        Format::Any => (0, 0),
+    };
+    rtr | ide | id
+}
+
+impl FilterTable {
+    /// Checks and compiles the lists (ACAN §12–§13). Every problem is reported at once
+    /// (ACAN table 5 bits 2–5).
+    pub fn compile(
+        configuration: Configuration,
+        primary: &[Filter],
+        secondary: &[Filter],
+    ) -> Result<Self, ConfigErrors> {
+        let mut errors = ConfigErrors::NONE;
+        if primary.len() > configuration.primary_filter_capacity() {
+            errors |= ConfigErrors::TOO_MANY_PRIMARY_FILTERS;
+        }
+        if primary.iter().any(|f| f.check().is_err()) {
+            errors |= ConfigErrors::PRIMARY_FILTER_NOT_CONFORM;
+        }
+        if secondary.len() > configuration.secondary_filter_capacity() {
+            errors |= ConfigErrors::TOO_MANY_SECONDARY_FILTERS;
+        }
+        if !secondary.iter().all(secondary_conforms) {
+            errors |= ConfigErrors::SECONDARY_FILTER_NOT_CONFORM;
+        }
+        if !errors.is_empty() {
+            return Err(errors);
+        }
+        Ok(Self::build(configuration, primary, secondary))
+    }
+
+    /// Builds a table from lists already checked.
+    fn build(configuration: Configuration, primary: &[Filter], secondary: &[Filter]) -> Self {
+        const PASS_ALL: [Filter; 1] = [Filter::pass_all()];
+        let primary = if primary.is_empty() && secondary.is_empty() { &PASS_ALL[..] } else { primary };
+        let p = primary.len();
+        let s = secondary.len();
+        let capacity_p = configuration.primary_filter_capacity();
+        let capacity_s = configuration.secondary_filter_capacity();
+        let scan = secondary.iter().any(Filter::is_pass_all);
+        let global_mask = if scan {
+            0
+        } else if secondary.iter().any(|f| matches!(f.format, Format::Extended)) || s == 0 {
+            FULL_MASK
+        } else {
+            // Only standard identifiers: the extended bits need no comparison.
+            ELEMENT_RTR | ELEMENT_IDE | (0x7FF << ELEMENT_STD_SHIFT)
+        };
+        let secondary_hit = |j: usize| if scan { Hit::ScanSecondary } else { Hit::Filter((p + j) as u16) };
+
+        let mut t = FilterTable {
+            configuration,
+            elements: [0; MAX_TABLE_ELEMENTS],
+            individual_masks: [FULL_MASK; MAX_PRIMARY_FILTERS],
+            global_mask,
+            hits: [Hit::Filter(0); MAX_TABLE_ELEMENTS],
+            secondary: [Filter::pass_all(); MAX_SECONDARY_FILTERS],
+            primary_count: p as u8,
+            secondary_count: s as u8,
+        };
+        t.secondary[..s].copy_from_slice(secondary);
+
+        for i in 0..capacity_p {
+            let (element, mask, hit) = match (primary.get(i), primary.last(), secondary.first()) {
+                (Some(f), _, _) => (element_of(f), mask_of(f), Hit::Filter(i as u16)),
+                (None, Some(last), _) => (element_of(last), mask_of(last), Hit::Filter((p - 1) as u16)),
+                (None, None, Some(first)) => (element_of(first), global_mask, secondary_hit(0)),
+                // Not reachable: an empty pair of lists became one pass-all filter.
+                (None, None, None) => (0, 0, Hit::Filter(0)),
+            };
+            t.elements[i] = element;
+            t.individual_masks[i] = mask;
+            t.hits[i] = hit;
+        }
+        for j in 0..capacity_s {
+            let (element, hit) = match (secondary.get(j), secondary.last(), primary.last()) {
+                (Some(f), _, _) => (element_of(f), secondary_hit(j)),
+                (None, Some(last), _) => (element_of(last), secondary_hit(s - 1)),
+                (None, None, Some(last)) => (element_of(last), Hit::Filter((p - 1) as u16)),
+                (None, None, None) => (0, Hit::Filter(0)),
+            };
+            t.elements[capacity_p + j] = element;
+            t.hits[capacity_p + j] = hit;
+        }
+        t
+    }
+
+    /// The configuration the table was compiled for.
+    pub const fn configuration(&self) -> Configuration {
+        self.configuration
+    }
+
+    /// Number of primary filters (after an empty pair of lists became one pass-all).
+    pub const fn primary_count(&self) -> usize {
+        self.primary_count as usize
+    }
+
+    /// Number of secondary filters.
+    pub const fn secondary_count(&self) -> usize {
+        self.secondary_count as usize
+    }
+
+    /// The user index of secondary filter `j` (ACAN §13.5: after the primary ones).
+    pub const fn secondary_index(&self, j: usize) -> usize {
+        self.primary_count as usize + j
+    }
+
+    /// The table elements, in hardware order (`8 × (RFFN + 1)` of them).
+    pub fn elements(&self) -> &[u32] {
+        &self.elements[..self.configuration.table_elements()]
+    }
+
+    /// The individual masks `RXIMR0…`, one per primary element.
+    pub fn individual_masks(&self) -> &[u32] {
+        &self.individual_masks[..self.configuration.primary_filter_capacity()]
+    }
+
+    /// The global mask `RXFGMASK` of the secondary elements.
+    pub const fn global_mask(&self) -> u32 {
+        self.global_mask
+    }
+
+    /// What a hit on table element `element` means (`None` beyond the table).
+    pub fn hit(&self, element: usize) -> Option<Hit> {
+        self.elements().get(element).map(|_| self.hits[element])
+    }
+
+    /// The user's filter index for a frame the hardware accepted with `RXFIR.IDHIT`
+    /// = `element` (ACAN §12.5, §13.5).
+    ///
+    /// An `IDHIT` beyond the table (which the hardware does not produce) is resolved
+    /// like a zero-mask hit, by the first secondary filter that matches; failing that
+    /// it gives index 0.
+    pub fn filter_index(&self, element: usize, frame: &Frame) -> u16 {
+        match self.hit(element) {
+            Some(Hit::Filter(i)) => i,
+            Some(Hit::ScanSecondary) | None => self.secondary[..self.secondary_count()]
+                .iter()
+                .position(|f| f.matches(frame))
+                .map_or(0, |j| self.secondary_index(j) as u16),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use twocan_core::frame::standard_id;
+
+    fn d_ext(id: u32) -> Filter {
+        Filter::exact(FrameKind::Data, Format::Extended, id)
+    }
+    fn d_std(id: u32) -> Filter {
+        Filter::exact(FrameKind::Data, Format::Standard, id)
+    }
+    fn r_std(id: u32) -> Filter {
+        Filter::exact(FrameKind::Remote, Format::Standard, id)
+    }
+
+    /// The hardware's rule on a compiled table: first element whose masked bits agree.
+    fn hw_match(t: &FilterTable, frame: &Frame) -> Option<usize> {
+        let word = if frame.is_extended() {
+            ELEMENT_IDE | frame.raw_id() << ELEMENT_EXT_SHIFT
+        } else {
+            frame.raw_id() << ELEMENT_STD_SHIFT
+        } | if frame.is_remote() { ELEMENT_RTR } else { 0 };
+        let p = t.configuration().primary_filter_capacity();
+        t.elements().iter().enumerate().position(|(i, e)| {
+            let m = if i < p { t.individual_masks()[i] } else { t.global_mask() };
+            (word ^ e) & m == 0
+        })
+    }
+
+    fn reference(primary: &[Filter], secondary: &[Filter], frame: &Frame) -> Option<u16> {
+        if primary.is_empty() && secondary.is_empty() {
+            return Some(0);
+        }
+        primary.iter().chain(secondary).position(|f| f.matches(frame)).map(|i| i as u16)
+    }
+
+    fn frames() -> impl Iterator<Item = Frame> {
+        let ids = [0u32, 1, 0x234, 0x540, 0x541, 0x542, 0x543, 0x544, 0x7FF];
+        let ext = [0u32, 0x234, 0x542, 0x123456, 0x123457, 0x1FFF_FFFF, 0x234 << 18];
+        let std_frames = ids.into_iter().flat_map(|id| {
+            [Frame::standard(id as u16, &[1]).unwrap(), Frame::remote(id, false, 0).unwrap()]
+        });
+        let ext_frames = ext.into_iter().flat_map(|id| {
+            [Frame::extended(id, &[1]).unwrap(), Frame::remote(id, true, 0).unwrap()]
+        });
+        std_frames.chain(ext_frames)
+    }
+
+    fn agrees(c: Configuration, primary: &[Filter], secondary: &[Filter]) {
+        let t = FilterTable::compile(c, primary, secondary).unwrap();
+        for frame in frames() {
+            let want = reference(primary, secondary, &frame);
+            let got = hw_match(&t, &frame).map(|e| t.filter_index(e, &frame));
+            assert_eq!(got, want, "{c:?} {frame:?}");
+        }
+    }
+
+    #[test]
+    fn compiled_tables_agree_with_reference_semantics() {
+        let lists: [(&[Filter], &[Filter]); 9] = [
+            (&[], &[]),
+            (&[d_ext(0x123456), d_std(0x234), r_std(0x542)], &[]),
+            (&[d_ext(0x123456), d_std(0x234), r_std(0x542), d_std(0x234)], &[]),
+            (&[d_ext(0x123456), d_std(0x234), Filter::pass_all(), r_std(0x542)], &[]),
+            (&[], &[d_ext(0x123456), d_std(0x234), r_std(0x542)]),
+            (&[d_ext(0x123456)], &[d_std(0x234), r_std(0x542)]),
+            (&[], &[d_ext(0x123456), d_std(0x234), r_std(0x542), Filter::pass_all()]),
+            (&[d_std(0x234)], &[d_std(0x234), Filter::pass_all(), r_std(0x542)]),
+            (
+                &[Filter::masked(FrameKind::Data, Format::Standard, 0x7FC, 0x540)],
+                &[d_std(0x540), r_std(0x7FF), Filter::extended(0x234 << 18)],
+            ),
+        ];
+        for c in Configuration::ALL {
+            for (p, s) in lists {
+                if s.len() <= c.secondary_filter_capacity() {
+                    agrees(c, p, s);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn every_error_at_once() {
+        let bad_primary = Filter::masked(FrameKind::Data, Format::Standard, 0x7FC, 0x541);
+        let bad_secondary = Filter::masked(FrameKind::Data, Format::Standard, 0x7F0, 0x540);
+        let primary = [bad_primary; 9];
+        let secondary = [bad_secondary];
+        let e = FilterTable::compile(Configuration::Filters8_0, &primary, &secondary).unwrap_err();
+        assert_eq!(
+            e,
+            ConfigErrors::TOO_MANY_PRIMARY_FILTERS
+                | ConfigErrors::PRIMARY_FILTER_NOT_CONFORM
+                | ConfigErrors::TOO_MANY_SECONDARY_FILTERS
+                | ConfigErrors::SECONDARY_FILTER_NOT_CONFORM
+        );
+        // A kind-any exact filter is no secondary filter, but is a fine primary one.
+        let any = Filter::exact(FrameKind::Any, Format::Standard, 5);
+        assert!(!secondary_conforms(&any));
+        assert!(FilterTable::compile(Configuration::Filters12_12, &[any], &[]).is_ok());
+    }
+
+    #[test]
+    fn numbering_and_masks() {
+        let t = FilterTable::compile(Configuration::Filters12_12, &[d_ext(0x123456)], &[d_std(0x234)]).unwrap();
+        assert_eq!(t.elements().len(), 24);
+        assert_eq!(t.individual_masks().len(), 12);
+        assert_eq!(t.elements()[0], ELEMENT_IDE | 0x123456 << 1);
+        assert_eq!(t.individual_masks()[0], FULL_MASK);
+        assert_eq!(t.elements()[12], 0x234 << 19);
+        assert_eq!(t.hit(12), Some(Hit::Filter(1)));
+        assert_eq!(t.hit(24), None);
+        let remote = Frame::new_remote(standard_id(0x234).unwrap(), 0).unwrap();
+        assert_eq!(t.filter_index(99, &remote), 0);
+    }
+}

@@ -1,0 +1,242 @@
+//! Driver settings: ACAN's `ACANSettings` (ACAN §16, table 7).
+//!
+//! [`Settings::new`] computes the bit timing for a wished bit rate from the 16 MHz
+//! oscillator clock with twocan-core's solver ([`twocan_core::timing::solve`]) and
+//! fills every other property with its table-7 default. Every field is public: change
+//! what you need, then hand the settings to `begin`, which checks them all before it
+//! touches the hardware.
+//!
+//! Two table-7 properties are not fields: the receive and transmit buffer sizes
+//! (`mReceiveBufferSize` 32, `mTransmitBufferSize` 16) are the `RX` and `TX` const
+//! generics of [`twocan_core::Driver`] ([`RECEIVE_BUFFER_SIZE`] and
+//! [`TRANSMIT_BUFFER_SIZE`] are ACAN's defaults, [`crate::AcanDriver`] uses them).
+
+use twocan_core::timing::{solve, Consistency, Limits, Timing, DEFAULT_TOLERANCE_PPM};
+
+use crate::configuration::Configuration;
+
+/// The FlexCAN engine clock ACAN uses: the 16 MHz crystal oscillator of every
+/// Teensy 3.x, selected by `CTRL1.CLKSRC = 0` (ACAN §16.1 bit-rate formula).
+pub const CAN_CLOCK_HZ: u32 = 16_000_000;
+
+/// The bit rate of the default settings (ACAN table 7: `mWhishedBitRate` 250,000).
+pub const DEFAULT_BIT_RATE: u32 = 250_000;
+
+/// The sample point the solver aims at, in per mille.
+///
+/// ACAN's own bit settings put the sample point at 68.75 % of a 16-quantum bit
+/// (table 7: 1 + 5 + 5 of 16 quanta) and at 12 of 18 quanta for 440 kbit/s (§16.1).
+/// Aiming at 687 ‰ makes the solver reproduce both decompositions exactly; it also
+/// lies in the 65–80 % band §16.6 recommends.
+pub const SAMPLE_POINT_PERMILLE: u16 = 687;
+
+/// ACAN's default driver receive buffer size (table 7 `mReceiveBufferSize`, §10.1).
+pub const RECEIVE_BUFFER_SIZE: usize = 32;
+
+/// ACAN's default driver transmit buffer size (table 7 `mTransmitBufferSize`, §8.2).
+pub const TRANSMIT_BUFFER_SIZE: usize = 16;
+
+/// ACAN's default message interrupt priority (table 7 `mMessageIRQPriority`).
+pub const DEFAULT_IRQ_PRIORITY: u8 = 64;
+
+/// Default bound of every acknowledge wait (`FRZACK`, `LPMACK`, `NOTRDY`,
+/// `SOFTRST`), in register polls. At 180 MHz one poll is a few tens of
+/// nanoseconds; the longest legitimate wait (freeze at the end of a frame at
+/// 2.5 kbit/s, about 60 ms) is covered with margin.
+pub const DEFAULT_HANDSHAKE_POLLS: u32 = 2_000_000;
+
+/// The driver settings (ACAN `ACANSettings`, §16; table 7 gives the defaults).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Settings {
+    /// The bit timing: wished bit rate (`mWhishedBitRate`), prescaler
+    /// (`mBitRatePrescaler`), propagation segment (`mPropagationSegment`), phase
+    /// segments 1 and 2 (`mPhaseSegment1`, `mPhaseSegment2`), resynchronisation jump
+    /// width (`mRJW`) and triple sampling (`mTripleSampling`) — ACAN §16.1. Any count
+    /// may be changed; [`Settings::consistency`] checks them (§16.2).
+    pub timing: Timing,
+    /// Largest accepted distance of the actual from the wished bit rate, in ppm
+    /// (ACAN §16.1: 1,000 by default, the constructor's second argument; 0 asks for
+    /// the exact rate). See [`Settings::bit_rate_close_to_wished`].
+    pub tolerance_ppm: u32,
+    /// Listen-only mode: `CTRL1.LOM` (ACAN §16.7.1). Default `false`.
+    pub listen_only: bool,
+    /// Self reception: the complement of `MCR.SRXDIS` (ACAN §16.7.2). Default `false`.
+    pub self_reception: bool,
+    /// Loop-back mode: `CTRL1.LPB` (ACAN §16.7.3). Default `false`.
+    pub loop_back: bool,
+    /// The message buffer partition (ACAN §11). Default [`Configuration::Filters12_12`].
+    pub configuration: Configuration,
+    /// Use the alternate Tx pin (ACAN §7, table 3). Default `false`.
+    pub use_alternate_tx_pin: bool,
+    /// Use the alternate Rx pin (ACAN §7, table 3). Default `false`.
+    pub use_alternate_rx_pin: bool,
+    /// Priority of the message interrupt, 0 highest, 255 lowest (ACAN §16.7.4,
+    /// default 64). The driver only stores it: the firmware writes it to the NVIC
+    /// for [`crate::Irqs::message`] (Kinetis implements the 4 upper bits, so 64 is
+    /// level 4).
+    pub message_irq_priority: u8,
+    /// The Tx pin is open-drain: recessive leaves it Hi-Z (`PORTx_PCRn.ODE`, ACAN
+    /// §16.7.5). Default `false`.
+    pub tx_pin_open_collector: bool,
+    /// The Rx pin gets its internal pull-up (`PORTx_PCRn.PE | PS`, ACAN §16.7.6).
+    /// Default `false`.
+    pub rx_pin_pull_up: bool,
+    /// Bound of every acknowledge wait, in register polls (not in ACAN: a controller
+    /// that never acknowledges ends in [`twocan_core::Error::Timeout`]).
+    pub handshake_polls: u32,
+    /// Also interrupt on bus errors, bus-off and the warning levels (`CTRL1.ERRMSK`,
+    /// `BOFFMSK`, `TWRNMSK`, `RWRNMSK`, `MCR.WRNEN`), so that the driver's error
+    /// statistics and state tracking see every event. Not in ACAN, which services the
+    /// message interrupt only; default `true`. The firmware routes the error, bus-off
+    /// and warning vectors of [`crate::Irqs`] to the same handler.
+    pub error_interrupts: bool,
+}
+
+impl Default for Settings {
+    /// The table-7 defaults: 250 kbit/s.
+    fn default() -> Self {
+        Settings::new(DEFAULT_BIT_RATE)
+    }
+}
+
+impl Settings {
+    /// Settings for `bit_rate` with the default tolerance of 1,000 ppm (ACAN §16.1,
+    /// `ACANSettings (bitRate)`). Usable in `const` items.
+    ///
+    /// The computation never fails: a wished rate the 16 MHz clock cannot reach (1
+    /// bit/s, 0, above 3.2 Mbit/s) gives the closest consistent timing, and
+    /// [`Settings::bit_rate_close_to_wished`] is then `false` — `begin` reports it.
+    pub const fn new(bit_rate: u32) -> Self {
+        Self::with_tolerance(bit_rate, DEFAULT_TOLERANCE_PPM)
+    }
+
+    /// Settings for `bit_rate` accepted within `tolerance_ppm` (ACAN §16.1,
+    /// `ACANSettings (bitRate, tolerance)`: the tolerance does not change the
+    /// computation, only the acceptance test).
+    pub const fn with_tolerance(bit_rate: u32, tolerance_ppm: u32) -> Self {
+        Settings {
+            timing: timing_for(bit_rate),
+            tolerance_ppm,
+            listen_only: false,
+            self_reception: false,
+            loop_back: false,
+            configuration: Configuration::Filters12_12,
+            use_alternate_tx_pin: false,
+            use_alternate_rx_pin: false,
+            message_irq_priority: DEFAULT_IRQ_PRIORITY,
+            tx_pin_open_collector: false,
+            rx_pin_pull_up: false,
+            handshake_polls: DEFAULT_HANDSHAKE_POLLS,
+            error_interrupts: true,
+        }
+    }
+
+    /// The wished bit rate (ACAN `mWhishedBitRate`).
+    pub const fn wished_bit_rate(&self) -> u32 {
+        self.timing.bitrate
+    }
+
+    /// Whether the actual bit rate is within [`Settings::tolerance_ppm`] of the wished
+    /// one (ACAN `mBitConfigurationClosedToWishedRate`, §16.1; §15.2.1 when false).
+    ///
+    /// ACAN stores this flag when the settings are built; here it follows the current
+    /// counts, so hand-changed segments are judged too.
+    pub const fn bit_rate_close_to_wished(&self) -> bool {
+        self.timing.within_tolerance(self.tolerance_ppm)
+    }
+
+    /// The actual bit rate, `16 MHz / (prescaler × quanta)` rounded down (ACAN §16.3).
+    /// Irrelevant when [`Settings::consistency`] reports an error.
+    pub const fn actual_bit_rate(&self) -> u32 {
+        self.timing.actual_bitrate()
+    }
+
+    /// Whether the actual bit rate is exactly the wished one (ACAN §16.4).
+    pub const fn exact_bit_rate(&self) -> bool {
+        self.timing.is_exact()
+    }
+
+    /// Distance of the actual from the wished bit rate in ppm (ACAN §16.5).
+    pub const fn ppm_from_wished_bit_rate(&self) -> u64 {
+        self.timing.ppm_from_wished()
+    }
+
+    /// Sample point in per cent of the bit from its start, the first of three samples
+    /// with triple sampling (ACAN §16.6).
+    pub const fn sample_point_from_bit_start(&self) -> u16 {
+        self.timing.first_sample_point() / 10
+    }
+
+    /// Every violated bit-timing rule (ACAN §16.2, table 6; empty means consistent).
+    /// Bits 0–10 are table 6; bits 11–13 add the rules table 6 does not list (RJW ≤
+    /// phase segment 1, triple sampling with phase segment 1 ≥ 2), see
+    /// [`Consistency`].
+    pub const fn consistency(&self) -> Consistency {
+        self.timing.consistency()
+    }
+}
+
+/// The timing ACAN §16.1 describes for `bit_rate`: the closest rate from the 16 MHz
+/// clock, always consistent. Rates the solver refuses (0, above 3.2 Mbit/s) get the
+/// slowest or fastest timing, still carrying the wished rate so that the distance
+/// shows.
+const fn timing_for(bit_rate: u32) -> Timing {
+    let limits = Limits::FLEXCAN;
+    let solvable = if bit_rate == 0 {
+        1
+    } else if bit_rate as u64 * limits.min_quanta() as u64 > CAN_CLOCK_HZ as u64 {
+        CAN_CLOCK_HZ / limits.min_quanta()
+    } else {
+        bit_rate
+    };
+    let mut t = match solve(CAN_CLOCK_HZ, solvable, &limits, SAMPLE_POINT_PERMILLE) {
+        Ok(t) => t,
+        // Unreachable with the FlexCAN limits and a rate in range; keep ACAN's
+        // table-7 timing rather than panic.
+        Err(_) => Timing {
+            clock_hz: CAN_CLOCK_HZ,
+            bitrate: DEFAULT_BIT_RATE,
+            limits,
+            prescaler: 4,
+            prop_seg: 5,
+            phase_seg1: 5,
+            phase_seg2: 5,
+            sjw: 4,
+            triple_sampling: false,
+        },
+    };
+    t.bitrate = bit_rate;
+    t
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn table_7_defaults() {
+        let s = Settings::default();
+        assert_eq!(s.wished_bit_rate(), 250_000);
+        let t = s.timing;
+        assert_eq!((t.prescaler, t.prop_seg, t.phase_seg1, t.phase_seg2, t.sjw), (4, 5, 5, 5, 4));
+        assert!(!t.triple_sampling);
+        assert!(s.bit_rate_close_to_wished());
+        assert!(!s.listen_only && !s.self_reception && !s.loop_back);
+        assert_eq!(s.configuration, Configuration::Filters12_12);
+        assert!(!s.use_alternate_tx_pin && !s.use_alternate_rx_pin);
+        assert_eq!(s.message_irq_priority, 64);
+        assert!(!s.tx_pin_open_collector && !s.rx_pin_pull_up);
+    }
+
+    #[test]
+    fn out_of_range_rates_do_not_panic() {
+        for rate in [0, 1, 3_300_000, 10_000_000, u32::MAX] {
+            let s = Settings::new(rate);
+            assert!(s.consistency().is_ok(), "{rate}");
+            assert!(!s.bit_rate_close_to_wished(), "{rate}");
+        }
+        assert!(Settings::new(3_200_000).exact_bit_rate());
+        assert!(Settings::new(2_500).exact_bit_rate());
+    }
+}

@@ -1,0 +1,153 @@
+//! The chip-level registers `begin` writes besides the FlexCAN module: the SIM clock
+//! gates and the PORT pin control of the Tx and Rx pins (Kinetis reference manuals,
+//! chapters "SIM" and "PORT"; ACAN §7, §16.7.5, §16.7.6).
+//!
+//! They are reached through a [`Registers`] whose offsets are absolute addresses. On
+//! the target that is [`twocan_core::Mmio`] at base 0 (see `Can0::begin`); on the host
+//! [`HostSystem`] stands in and remembers what was written, so tests can check the
+//! pin set-up.
+
+use twocan_core::Registers;
+
+use crate::board::InstancePins;
+use crate::regs::pins::CanPin;
+use crate::regs::port::{PCR_MUX, PCR_ODE, PCR_PE, PCR_PS};
+use crate::regs::sim;
+
+/// Host stand-in for the SIM and PORT registers: reads give back the last value
+/// written to an address (0 before any write). It holds up to 16 addresses; writes
+/// beyond are dropped, which `begin` (5 addresses) never reaches.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct HostSystem {
+    cells: [(usize, u32); 16],
+    len: usize,
+}
+
+impl HostSystem {
+    /// An empty register space.
+    pub const fn new() -> Self {
+        HostSystem { cells: [(0, 0); 16], len: 0 }
+    }
+
+    /// The addresses written so far, with their values, in first-write order.
+    pub fn written(&self) -> &[(usize, u32)] {
+        &self.cells[..self.len]
+    }
+}
+
+impl Registers for HostSystem {
+    fn read32(&self, offset: usize) -> u32 {
+        self.written().iter().find(|(a, _)| *a == offset).map_or(0, |(_, v)| *v)
+    }
+
+    fn write32(&mut self, offset: usize, value: u32) {
+        let len = self.len;
+        if let Some(cell) = self.cells[..len].iter_mut().find(|(a, _)| *a == offset) {
+            cell.1 = value;
+        } else if let Some(cell) = self.cells.get_mut(len) {
+            *cell = (offset, value);
+            self.len += 1;
+        }
+    }
+}
+
+/// The PCR value of the Tx pin: CAN function, open drain if asked (ACAN §16.7.5).
+pub const fn tx_pcr(pin: CanPin, open_collector: bool) -> u32 {
+    PCR_MUX.val(pin.alt) | if open_collector { PCR_ODE } else { 0 }
+}
+
+/// The PCR value of the Rx pin: CAN function, pull-up if asked (ACAN §16.7.6).
+pub const fn rx_pcr(pin: CanPin, pull_up: bool) -> u32 {
+    PCR_MUX.val(pin.alt) | if pull_up { PCR_PE | PCR_PS } else { 0 }
+}
+
+/// What `begin` writes to the chip-level registers, computed before anything is
+/// written.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct SystemPlan {
+    /// The module's clock gate (register, bit).
+    pub clock_gate: (usize, u32),
+    /// The Tx pin and its PCR value.
+    pub tx: (CanPin, u32),
+    /// The Rx pin and its PCR value.
+    pub rx: (CanPin, u32),
+}
+
+impl SystemPlan {
+    /// The plan for the chosen pins.
+    pub const fn new(clock_gate: (usize, u32), tx: CanPin, rx: CanPin, open_collector: bool, pull_up: bool) -> Self {
+        SystemPlan { clock_gate, tx: (tx, tx_pcr(tx, open_collector)), rx: (rx, rx_pcr(rx, pull_up)) }
+    }
+
+    /// Enables the clocks (ports, then the module: a FlexCAN register access with its
+    /// gate closed faults) and muxes the pins. The read-modify-writes of the shared
+    /// SIM registers run in a critical section.
+    pub fn apply<S: Registers>(&self, sys: &mut S) {
+        let ports = self.tx.0.port.scgc5_bit() | self.rx.0.port.scgc5_bit();
+        let (gate, bit) = self.clock_gate;
+        critical_section::with(|_| {
+            sys.modify32(sim::SIM_SCGC5, |v| v | ports);
+            sys.modify32(gate, |v| v | bit);
+        });
+        sys.write32(self.tx.0.pcr(), self.tx.1);
+        sys.write32(self.rx.0.pcr(), self.rx.1);
+    }
+}
+
+/// Picks the pins (ACAN §7). `Err((no_tx, no_rx))` says which alternate was asked
+/// for but does not exist.
+pub const fn choose_pins(
+    pins: InstancePins,
+    alternate_tx: bool,
+    alternate_rx: bool,
+) -> Result<(CanPin, CanPin), (bool, bool)> {
+    let tx = match (alternate_tx, pins.alternate_tx) {
+        (false, _) => Some(pins.tx),
+        (true, alt) => alt,
+    };
+    let rx = match (alternate_rx, pins.alternate_rx) {
+        (false, _) => Some(pins.rx),
+        (true, alt) => alt,
+    };
+    match (tx, rx) {
+        (Some(tx), Some(rx)) => Ok((tx, rx)),
+        (tx, rx) => Err((tx.is_none(), rx.is_none())),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::board::Board;
+    use crate::instance::Instance;
+    use crate::regs::port::Port;
+
+    #[test]
+    fn host_system_remembers() {
+        let mut s = HostSystem::new();
+        assert_eq!(s.read32(0x10), 0);
+        s.write32(0x10, 5);
+        s.modify32(0x10, |v| v | 2);
+        assert_eq!(s.read32(0x10), 7);
+        for a in 0..20 {
+            s.write32(0x100 + a, 1);
+        }
+        assert_eq!(s.written().len(), 16);
+    }
+
+    #[test]
+    fn pin_setup() {
+        let pins = Board::Teensy36.pins(Instance::Can1).unwrap();
+        assert_eq!(choose_pins(pins, true, true), Err((true, true)));
+        assert_eq!(choose_pins(pins, false, true), Err((false, true)));
+        let (tx, rx) = choose_pins(Board::Teensy32.pins(Instance::Can0).unwrap(), true, false).unwrap();
+        assert_eq!((tx.teensy_pin, rx.teensy_pin), (32, 4));
+        let plan = SystemPlan::new(Instance::Can0.clock_gate(), tx, rx, true, true);
+        let mut sys = HostSystem::new();
+        plan.apply(&mut sys);
+        assert_eq!(sys.read32(sim::SIM_SCGC6), sim::SCGC6_FLEXCAN0);
+        assert_eq!(sys.read32(sim::SIM_SCGC5), sim::SCGC5_PORTA | sim::SCGC5_PORTB);
+        assert_eq!(sys.read32(Port::B.pcr(18)), 0x200 | PCR_ODE);
+        assert_eq!(sys.read32(Port::A.pcr(13)), 0x200 | PCR_PE | PCR_PS);
+    }
+}

@@ -1,0 +1,190 @@
+//! ACAN §15, table 5: every error of `begin`, all found at once, nothing configured on
+//! error; the bounded handshake waits (a typed timeout, not a table-5 flag).
+#![cfg(feature = "model")]
+
+mod common;
+
+use common::*;
+use twocan_core::{Error, Filter, Format, FrameKind};
+use twocan_flexcan::model::{FlexCanModel, ModelMode};
+use twocan_flexcan::regs::{self, mcr};
+use twocan_flexcan::{BeginError, Board, ConfigErrors, Configuration, FlexCan, HostSystem, Instance, Settings, Target};
+
+const T32_CAN0: Target = Target::new(Board::Teensy32, Instance::Can0);
+const T36_CAN1: Target = Target::new(Board::Teensy36, Instance::Can1);
+
+/// Runs `begin` over a fresh model and checks that an error leaves every register
+/// untouched: the module still in reset (disabled), no SIM / PORT write.
+fn begin_error(target: Target, settings: &Settings, primary: &[Filter], secondary: &[Filter]) -> ConfigErrors {
+    let model = model_for(target.board);
+    let reset_mcr = model.peek32(regs::MCR);
+    let reset_ctrl1 = model.peek32(regs::CTRL1);
+    let mut sys = HostSystem::new();
+    let flags = twocan_flexcan::check(target, settings, primary, secondary);
+    match FlexCan::begin(model.clone(), &mut sys, target, settings, primary, secondary) {
+        Ok(_) => panic!("begin succeeded"),
+        Err(BeginError::Hardware(e)) => panic!("hardware error {e:?}"),
+        Err(BeginError::Config(f)) => {
+            assert_eq!(f, flags, "check() and begin() agree");
+            assert!(sys.written().is_empty(), "no SIM / PORT write: {:?}", sys.written());
+            assert_eq!(model.mode(), ModelMode::Disabled);
+            assert_eq!(model.peek32(regs::MCR), reset_mcr);
+            assert_eq!(model.peek32(regs::CTRL1), reset_ctrl1);
+            f
+        }
+    }
+}
+
+#[test]
+fn no_error() {
+    let flags = twocan_flexcan::check(T32_CAN0, &Settings::new(125_000), &[], &[]);
+    assert_eq!(flags, ConfigErrors::NONE);
+    assert_eq!(flags.bits(), 0);
+}
+
+#[test]
+fn bit_rate_too_far_15_2_1() {
+    // `ACANSettings settings (1)`: 1 bit/s; the error code is exactly bit 0.
+    let f = begin_error(T32_CAN0, &Settings::new(1), &[], &[]);
+    assert_eq!(f, ConfigErrors::BIT_RATE_TOO_FAR);
+    assert_eq!(f.bits(), 1 << 0);
+}
+
+#[test]
+fn inconsistent_bit_configuration_15_2_2() {
+    let mut s = Settings::new(500_000);
+    s.timing.sjw = 0; // RJW 0: inconsistent, the bit rate is unchanged.
+    assert_eq!(begin_error(T32_CAN0, &s, &[], &[]), ConfigErrors::BIT_TIMING_INCONSISTENT);
+    // §16.2's example (PS1 = 0) also moves the bit rate 45 % away: both flags.
+    let mut s = Settings::new(500_000);
+    s.timing.phase_seg1 = 0;
+    assert_eq!(
+        begin_error(T32_CAN0, &s, &[], &[]),
+        ConfigErrors::BIT_TIMING_INCONSISTENT | ConfigErrors::BIT_RATE_TOO_FAR
+    );
+    // Counts for another clock than the 16 MHz oscillator.
+    let mut s = Settings::new(500_000);
+    s.timing.clock_hz = 8_000_000;
+    assert!(begin_error(T32_CAN0, &s, &[], &[]).contains(ConfigErrors::BIT_TIMING_INCONSISTENT));
+}
+
+#[test]
+fn too_many_primary_filters_15_2_3() {
+    for c in Configuration::ALL {
+        let mut s = Settings::new(125_000);
+        s.configuration = c;
+        let list: Vec<Filter> = (0..=c.primary_filter_capacity() as u16).map(Filter::standard).collect();
+        assert_eq!(begin_error(T32_CAN0, &s, &list, &[]), ConfigErrors::TOO_MANY_PRIMARY_FILTERS, "{c:?}");
+    }
+}
+
+#[test]
+fn primary_filter_conformance_15_3() {
+    let s = Settings::new(125_000);
+    let not_conform = [
+        Filter::masked(FrameKind::Data, Format::Standard, 0x7FC, 0x541), // §12.3's example
+        Filter::standard(0x800),
+        Filter::extended(0x2000_0000),
+        Filter::masked(FrameKind::Data, Format::Standard, 0xFFF, 0),
+    ];
+    for f in not_conform {
+        assert_eq!(begin_error(T32_CAN0, &s, &[f], &[]), ConfigErrors::PRIMARY_FILTER_NOT_CONFORM, "{f:?}");
+    }
+}
+
+#[test]
+fn too_many_secondary_filters_15_3_1() {
+    for c in Configuration::ALL {
+        let mut s = Settings::new(125_000);
+        s.configuration = c;
+        let list: Vec<Filter> = (0..=c.secondary_filter_capacity() as u16).map(Filter::standard).collect();
+        assert_eq!(begin_error(T32_CAN0, &s, &[], &list), ConfigErrors::TOO_MANY_SECONDARY_FILTERS, "{c:?}");
+    }
+}
+
+#[test]
+fn secondary_filter_conformance_15_3_2() {
+    let s = Settings::new(125_000);
+    let not_conform = [
+        Filter::standard(0x800),
+        Filter::extended(0x2000_0000),
+        // A secondary filter names one identifier: no mask, no "any" kind.
+        Filter::masked(FrameKind::Data, Format::Standard, 0x7FC, 0x540),
+        Filter::exact(FrameKind::Any, Format::Standard, 0x123),
+        Filter::kind_format(FrameKind::Remote, Format::Any),
+    ];
+    for f in not_conform {
+        assert_eq!(begin_error(T32_CAN0, &s, &[], &[f]), ConfigErrors::SECONDARY_FILTER_NOT_CONFORM, "{f:?}");
+    }
+}
+
+#[test]
+fn can1_has_no_alternate_pins_15_3_3_and_15_3_4() {
+    let mut s = Settings::new(125_000);
+    s.use_alternate_tx_pin = true;
+    assert_eq!(begin_error(T36_CAN1, &s, &[], &[]), ConfigErrors::NO_ALTERNATE_TX_PIN);
+    s.use_alternate_rx_pin = true;
+    assert_eq!(begin_error(T36_CAN1, &s, &[], &[]), ConfigErrors::NO_ALTERNATE_TX_PIN | ConfigErrors::NO_ALTERNATE_RX_PIN);
+    s.use_alternate_tx_pin = false;
+    assert_eq!(begin_error(T36_CAN1, &s, &[], &[]), ConfigErrors::NO_ALTERNATE_RX_PIN);
+    assert_eq!(ConfigErrors::NO_ALTERNATE_TX_PIN.bits(), 0x40);
+    assert_eq!(ConfigErrors::NO_ALTERNATE_RX_PIN.bits(), 0x80);
+}
+
+#[test]
+fn can1_only_on_teensy_36() {
+    let s = Settings::new(125_000);
+    for board in [Board::Teensy32, Board::Teensy35] {
+        assert_eq!(begin_error(Target::new(board, Instance::Can1), &s, &[], &[]), ConfigErrors::NO_SUCH_INSTANCE);
+    }
+}
+
+#[test]
+fn every_flag_at_once() {
+    let mut s = Settings::new(1);
+    s.timing.sjw = 0;
+    s.configuration = Configuration::Filters8_0;
+    s.use_alternate_tx_pin = true;
+    s.use_alternate_rx_pin = true;
+    let primary: Vec<Filter> = (0..9).map(|_| Filter::standard(0x800)).collect();
+    let secondary = [Filter::extended(0x2000_0000)];
+    let f = begin_error(T36_CAN1, &s, &primary, &secondary);
+    assert_eq!(f.bits(), 0xFF);
+    assert_eq!(f.count(), 8);
+}
+
+#[test]
+fn alternate_pins_accepted_on_can0() {
+    for board in Board::ALL {
+        let mut s = Settings::new(125_000);
+        s.use_alternate_tx_pin = true;
+        s.use_alternate_rx_pin = true;
+        assert_eq!(twocan_flexcan::check(Target::new(board, Instance::Can0), &s, &[], &[]), ConfigErrors::NONE);
+    }
+}
+
+#[test]
+fn handshake_timeout_is_typed_and_retry_works() {
+    let model = FlexCanModel::mk20dx256();
+    model.set_freeze_ack_stuck(true);
+    let mut s = Settings::new(125_000);
+    s.handshake_polls = 1_000;
+    let e = FlexCan::begin(model.clone(), &mut HostSystem::new(), T32_CAN0, &s, &[], &[]).unwrap_err();
+    assert_eq!(e, BeginError::Hardware(Error::Timeout));
+    assert_eq!(e.flags(), ConfigErrors::NONE);
+    // Once the module acknowledges again, `begin` succeeds on the same module.
+    model.set_freeze_ack_stuck(false);
+    let can = FlexCan::begin(model.clone(), &mut HostSystem::new(), T32_CAN0, &s, &[], &[]).unwrap();
+    assert_eq!(model.mode(), ModelMode::Normal);
+    assert_eq!(model.peek32(regs::MCR) & (mcr::FRZACK | mcr::LPMACK | mcr::NOTRDY), 0);
+    drop(can);
+}
+
+#[test]
+fn begin_keeps_the_model_by_reference() {
+    // `regs` may be `&mut M`: the caller keeps the registers after an error.
+    let mut model = FlexCanModel::mk20dx256();
+    let e = FlexCan::begin(&mut model, &mut HostSystem::new(), T32_CAN0, &Settings::new(1), &[], &[]);
+    assert!(matches!(e, Err(BeginError::Config(_))));
+    assert_eq!(model.mode(), ModelMode::Disabled);
+}

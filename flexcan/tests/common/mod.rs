@@ -1,0 +1,135 @@
+//! Shared test harness: the real driver over the FlexCAN model on twocan-core's
+//! simulated bus, interrupts serviced by the test between bus events.
+#![allow(dead_code)]
+
+use twocan_core::sim::Bus;
+use twocan_core::{Driver, Filter, Frame, RxFrame};
+use twocan_flexcan::model::FlexCanModel;
+use twocan_flexcan::{BeginError, Board, FlexCan, HostSystem, Instance, Settings, Target};
+
+/// The driver over the model with receive ring `RX` and transmit ring `TX`.
+pub type Can<const RX: usize, const TX: usize> = Driver<FlexCan<FlexCanModel>, RX, TX>;
+
+/// A fresh model of the board's chip.
+pub fn model_for(board: Board) -> FlexCanModel {
+    match board {
+        Board::Teensy32 => FlexCanModel::mk20dx256(),
+        Board::Teensy35 => FlexCanModel::mk64fx512(),
+        Board::Teensy36 => FlexCanModel::mk66fx1m0(),
+    }
+}
+
+/// `begin` on `target` over a fresh model; gives the model handle and the driver.
+pub fn begin_on<const RX: usize, const TX: usize>(
+    target: Target,
+    settings: &Settings,
+    primary: &[Filter],
+    secondary: &[Filter],
+) -> Result<(FlexCanModel, Can<RX, TX>), BeginError> {
+    let model = model_for(target.board);
+    model.scramble_ram(0x5EED);
+    let controller =
+        FlexCan::begin(model.clone(), &mut HostSystem::new(), target, settings, primary, secondary)?;
+    Ok((model, Driver::new(controller)))
+}
+
+/// `begin` on can0 of a Teensy 3.2.
+pub fn begin<const RX: usize, const TX: usize>(
+    settings: &Settings,
+    primary: &[Filter],
+    secondary: &[Filter],
+) -> Result<(FlexCanModel, Can<RX, TX>), BeginError> {
+    begin_on(Target::new(Board::Teensy32, Instance::Can0), settings, primary, secondary)
+}
+
+/// ACAN §4's settings: loop-back and self reception.
+pub fn loop_back(bit_rate: u32) -> Settings {
+    let mut s = Settings::new(bit_rate);
+    s.loop_back = true;
+    s.self_reception = true;
+    s
+}
+
+/// Something whose interrupt the test services.
+pub trait Service {
+    /// Calls `on_interrupt` if the model raises an interrupt line.
+    fn service(&mut self);
+}
+
+impl<const RX: usize, const TX: usize> Service for Can<RX, TX> {
+    fn service(&mut self) {
+        if self.controller().registers().irq_pending() {
+            self.on_interrupt();
+        }
+    }
+}
+
+/// A bus with the given models attached in order.
+pub fn bus_with(bit_rate: u32, models: &[&FlexCanModel]) -> Bus {
+    let mut bus = Bus::new(bit_rate).expect("bus");
+    for (i, m) in models.iter().enumerate() {
+        bus.attach(&format!("can{i}"), (*m).clone());
+    }
+    bus
+}
+
+/// Runs the bus for `bits` bit times, servicing every driver after each event.
+pub fn run(bus: &mut Bus, nodes: &mut [&mut dyn Service], bits: u64) {
+    let until = bus.now() + bits;
+    loop {
+        for n in nodes.iter_mut() {
+            n.service();
+        }
+        if bus.step_until(until).is_none() {
+            break;
+        }
+    }
+    for n in nodes.iter_mut() {
+        n.service();
+    }
+}
+
+/// Runs one driver's bus for `bits` bit times.
+pub fn run1<const RX: usize, const TX: usize>(bus: &mut Bus, can: &mut Can<RX, TX>, bits: u64) {
+    run(bus, &mut [can], bits);
+}
+
+/// Every frame in the receive ring.
+pub fn drain<const RX: usize, const TX: usize>(can: &mut Can<RX, TX>) -> Vec<RxFrame> {
+    core::iter::from_fn(|| can.receive().ok()).collect()
+}
+
+/// A standard data frame.
+pub fn std_data(id: u16, data: &[u8]) -> Frame {
+    Frame::standard(id, data).unwrap()
+}
+
+/// An extended data frame.
+pub fn ext_data(id: u32, data: &[u8]) -> Frame {
+    Frame::extended(id, data).unwrap()
+}
+
+/// A remote frame.
+pub fn remote(id: u32, extended: bool) -> Frame {
+    Frame::remote(id, extended, 0).unwrap()
+}
+
+/// Sends each frame alone and gives the filter index it was received with, or `None`
+/// if the filters rejected it.
+pub fn indices(settings: &Settings, primary: &[Filter], secondary: &[Filter], frames: &[Frame]) -> Vec<Option<u16>> {
+    let (model, mut can) = begin::<32, 16>(settings, primary, secondary).expect("begin");
+    let mut bus = bus_with(125_000, &[&model]);
+    frames
+        .iter()
+        .map(|f| {
+            can.try_send(f).unwrap();
+            run1(&mut bus, &mut can, 1_000);
+            let got = drain(&mut can);
+            assert!(got.len() <= 1, "{got:?}");
+            got.first().map(|rx| {
+                assert_eq!(rx.frame, *f);
+                rx.filter
+            })
+        })
+        .collect()
+}

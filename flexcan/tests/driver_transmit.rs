@@ -1,0 +1,195 @@
+//! ACAN §3 "sequentiality", §8, §9: data frames through the transmit ring and the one
+//! data mailbox leave strictly in order; remote frames use the remote-frame mailboxes
+//! of the configuration; abort; mailbox states.
+#![cfg(feature = "model")]
+
+mod common;
+
+use common::*;
+use twocan_core::sim::SimNode;
+use twocan_core::{Controller, Error, Frame, MailboxId, MailboxState, TxPolicy};
+use twocan_flexcan::regs::{self, code, cs};
+use twocan_flexcan::{Configuration, Settings};
+
+/// Identifiers that a priority-ordered transmitter would reorder.
+fn scrambled_id(i: u32) -> u16 {
+    ((i.wrapping_mul(7919) + 13) % 0x800) as u16
+}
+
+#[test]
+fn strict_order_across_10_000_frames() {
+    const N: u32 = 10_000;
+    let (model, mut can) = begin::<64, 16>(&loop_back(1_000_000), &[], &[]).unwrap();
+    assert_eq!(can.tx_policy(), TxPolicy::Fifo);
+    let mut bus = bus_with(1_000_000, &[&model]);
+    let mut next = 0u32;
+    let mut expected = 0u32;
+    let mut rejected = 0u32;
+    while expected < N {
+        // Fill the transmit ring until it is full.
+        while next < N {
+            let f = if next % 3 == 0 {
+                ext_data(0x1000 + scrambled_id(next) as u32, &next.to_le_bytes())
+            } else {
+                std_data(scrambled_id(next), &next.to_le_bytes())
+            };
+            match can.try_send(&f) {
+                Ok(()) => next += 1,
+                Err(nb::Error::WouldBlock) => {
+                    rejected += 1;
+                    break;
+                }
+                Err(e) => panic!("{e:?}"),
+            }
+        }
+        run1(&mut bus, &mut can, 200);
+        for rx in drain(&mut can) {
+            let seq = u32::from_le_bytes(rx.frame.data().try_into().unwrap());
+            assert_eq!(seq, expected, "frame {expected} overtaken");
+            expected += 1;
+        }
+    }
+    let t = can.traffic();
+    assert_eq!((t.queued, t.sent, t.received), (N, N, N));
+    assert!(rejected > 0);
+    assert_eq!(can.tx_stats().peak, 17, "ACAN §8.5: size + 1 after a full buffer");
+    assert_eq!(can.rx_stats().overflows, 0);
+}
+
+#[test]
+fn strict_order_between_two_nodes() {
+    // can0 sends 500 frames to can1 of a Teensy 3.6 over the simulated bus.
+    let t36 = |i| twocan_flexcan::Target::new(twocan_flexcan::Board::Teensy36, i);
+    let s = Settings::new(500_000);
+    let (m0, mut can0) = begin_on::<32, 8>(t36(twocan_flexcan::Instance::Can0), &s, &[], &[]).unwrap();
+    let (m1, mut can1) = begin_on::<600, 8>(t36(twocan_flexcan::Instance::Can1), &s, &[], &[]).unwrap();
+    let mut bus = bus_with(500_000, &[&m0, &m1]);
+    let mut next = 0u32;
+    while next < 500 {
+        while next < 500 && can0.try_send(&std_data(scrambled_id(next), &next.to_le_bytes())).is_ok() {
+            next += 1;
+        }
+        run(&mut bus, &mut [&mut can0, &mut can1], 400);
+    }
+    run(&mut bus, &mut [&mut can0, &mut can1], 20_000);
+    let seqs: Vec<u32> = drain(&mut can1).iter().map(|rx| u32::from_le_bytes(rx.frame.data().try_into().unwrap())).collect();
+    assert_eq!(seqs, (0..500).collect::<Vec<u32>>());
+    assert_eq!(can0.traffic().sent, 500);
+    assert!(drain(&mut can0).is_empty(), "no self reception by default");
+}
+
+#[test]
+fn remote_mailboxes_per_configuration_9() {
+    for c in Configuration::ALL {
+        let mut s = loop_back(500_000);
+        s.configuration = c;
+        let (model, mut can) = begin::<32, 16>(&s, &[], &[]).unwrap();
+        let r = c.remote_mailbox_count();
+        assert_eq!(can.controller().mailbox_count(), 1 + r);
+        // Straight to the remote-frame mailboxes (ACAN: remote frames are not queued).
+        for i in 0..r {
+            can.controller_mut().transmit(&remote(0x500 + i as u32, false)).unwrap();
+            assert_eq!(can.mailbox_state(MailboxId(1 + i)), MailboxState::Pending);
+        }
+        assert!(matches!(can.controller_mut().transmit(&remote(0x5FF, false)), Err(nb::Error::WouldBlock)), "{c:?}");
+        // The data mailbox is independent of them.
+        assert_eq!(can.mailbox_state(MailboxId(0)), MailboxState::Empty);
+        can.controller_mut().transmit(&std_data(0x10, &[1])).unwrap();
+        assert!(matches!(can.controller_mut().transmit(&std_data(0x11, &[])), Err(nb::Error::WouldBlock)));
+        let mut bus = bus_with(500_000, &[&model]);
+        run1(&mut bus, &mut can, 2_000);
+        let got = drain(&mut can);
+        assert_eq!(got.len(), r as usize + 1, "{c:?}");
+        assert_eq!(can.traffic().sent, r as u32 + 1);
+        // Remote frames came back as remote frames, the data frame as data.
+        assert_eq!(got.iter().filter(|rx| rx.frame.is_remote()).count(), r as usize);
+        for i in 0..=r {
+            assert_eq!(can.mailbox_state(MailboxId(i)), MailboxState::Empty);
+        }
+        // After its remote frame, each mailbox is left inactive (not an Rx mailbox).
+        for mb in c.first_remote_mailbox()..15 {
+            assert_eq!(cs::CODE.get(model.peek32(regs::mb_cs(mb as usize))), code::TX_INACTIVE, "MB{mb}");
+        }
+    }
+}
+
+#[test]
+fn remote_frames_through_the_driver_queue() {
+    let (model, mut can) = begin::<32, 16>(&loop_back(500_000), &[], &[]).unwrap();
+    let mut bus = bus_with(500_000, &[&model]);
+    let frames: Vec<Frame> = vec![
+        std_data(0x300, &[0]),
+        remote(0x100, false),
+        std_data(0x200, &[1]),
+        remote(0x050, true),
+        std_data(0x100, &[2]),
+    ];
+    for f in &frames {
+        can.try_send(f).unwrap();
+    }
+    run1(&mut bus, &mut can, 5_000);
+    let got: Vec<Frame> = drain(&mut can).iter().map(|rx| rx.frame).collect();
+    assert_eq!(got.len(), frames.len());
+    // Data frames keep their order whatever the remote frames do.
+    let data: Vec<Frame> = got.iter().filter(|f| !f.is_remote()).copied().collect();
+    assert_eq!(data, vec![frames[0], frames[2], frames[4]]);
+}
+
+#[test]
+fn abort_a_pending_data_frame() {
+    // Normal mode, alone on the bus: before any bus time, nothing has left MB15.
+    let (_model, mut can) = begin::<32, 16>(&Settings::new(500_000), &[], &[]).unwrap();
+    can.try_send(&std_data(0x123, &[1])).unwrap();
+    assert_eq!(can.mailbox_state(MailboxId(0)), MailboxState::Pending);
+    assert!(can.abort(MailboxId(0)));
+    assert_eq!(can.mailbox_state(MailboxId(0)), MailboxState::Empty);
+    assert!(!can.abort(MailboxId(0)), "nothing pending any more");
+    assert!(!can.abort(MailboxId(9)), "no such mailbox");
+    can.on_interrupt();
+    assert_eq!((can.traffic().aborted, can.traffic().sent), (1, 0));
+    // The mailbox is usable again.
+    can.try_send(&std_data(0x124, &[])).unwrap();
+    assert_eq!(can.mailbox_state(MailboxId(0)), MailboxState::Pending);
+}
+
+#[test]
+fn abort_all_drops_the_ring_and_the_mailboxes() {
+    let (_model, mut can) = begin::<32, 16>(&Settings::new(500_000), &[], &[]).unwrap();
+    for i in 0..5 {
+        can.try_send(&std_data(i, &[])).unwrap();
+    }
+    can.controller_mut().transmit(&remote(0x42, false)).unwrap();
+    assert_eq!(can.abort_all(), 4);
+    can.on_interrupt();
+    assert_eq!(can.traffic().aborted, 4 + 2);
+    for m in 0..can.controller().mailbox_count() {
+        assert_eq!(can.mailbox_state(MailboxId(m)), MailboxState::Empty);
+    }
+}
+
+#[test]
+fn frames_reach_a_plain_iso_node() {
+    let (model, mut can) = begin::<32, 16>(&Settings::new(250_000), &[], &[]).unwrap();
+    let other = SimNode::new().shared();
+    let mut bus = bus_with(250_000, &[&model]);
+    bus.attach("other", other.clone());
+    let frames = [std_data(0x7FF, &[1, 2, 3]), ext_data(0x1FFF_FFFF, &[8; 8]), remote(0x12, false), remote(0x345678, true)];
+    for f in &frames {
+        can.try_send(f).unwrap();
+    }
+    run1(&mut bus, &mut can, 3_000);
+    let got = other.borrow().received_frames();
+    assert_eq!(got.len(), 4);
+    for f in &frames {
+        assert!(got.contains(f), "{f:?}");
+    }
+}
+
+#[test]
+fn listen_only_does_not_transmit() {
+    let mut s = Settings::new(500_000);
+    s.listen_only = true;
+    let (_model, mut can) = begin::<32, 16>(&s, &[], &[]).unwrap();
+    assert_eq!(can.try_send(&std_data(1, &[])), Err(nb::Error::Other(Error::WrongMode)));
+    assert_eq!(can.controller_mut().transmit(&remote(1, false)), Err(nb::Error::Other(Error::WrongMode)));
+}

@@ -1,0 +1,3 @@
+//! (being written)
+#[path = "model_support.rs"]
+mod support;
