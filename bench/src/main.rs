@@ -1,2 +1,236 @@
-//! can-bench (being written).
-fn main() {}
+//! `can-bench`: the benchmark command of twocan.
+//!
+//! ```sh
+//! cargo run --release --bin can-bench
+//! ```
+//!
+//! It measures, in one run, and writes `docs/benchmarks.md` (also printed):
+//!
+//! 1. flash and RAM of the firmware examples and of a minimal loop-back firmware built
+//!    with our bxCAN backend and with the `bxcan` crate 0.8 ([`sizes`], [`firmware`]);
+//! 2. instructions per frame on a Cortex-M4 under QEMU, counted by the TCG plugin
+//!    `bench/plugin/insn_count.c` ([`qemu`]);
+//! 3. the bit-timing solver against an exhaustive search ([`timing`]);
+//! 4. the simulator's speed ([`simspeed`], [`models`]).
+//!
+//! Any step that cannot run ends the command with an error and a non-zero exit code,
+//! without touching `docs/benchmarks.md`. `--skip STEP` (sizes, examples, qemu, timing,
+//! sim; repeatable) leaves a step out for a quicker look: the tables are printed, the
+//! document is not written.
+
+mod cmd;
+mod firmware;
+mod models;
+mod qemu;
+mod report;
+mod simspeed;
+mod sizes;
+mod timing;
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::time::Instant;
+
+use cmd::{Context, Error, Result};
+use firmware::Paths;
+use report::{ExampleBuild, ExampleSection, InsnSection, Report, SizeSection};
+
+/// The steps, for `--skip`.
+const STEPS: [&str; 5] = ["sizes", "examples", "qemu", "timing", "sim"];
+
+/// Profiles of the bench firmware for the instruction counts: (cargo profile, opt-level).
+const COUNT_PROFILES: [(&str, &str); 2] = [("release", "s"), ("release-speed", "3")];
+
+fn main() -> ExitCode {
+    match run() {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("can-bench: error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn parse_args() -> Result<Vec<String>> {
+    let mut skip = Vec::new();
+    let mut args = std::env::args().skip(1);
+    while let Some(a) = args.next() {
+        match a.as_str() {
+            "--skip" => {
+                let step = args
+                    .next()
+                    .ok_or_else(|| Error::new("--skip needs a step name"))?;
+                if !STEPS.contains(&step.as_str()) {
+                    return Err(Error::new(format!(
+                        "unknown step `{step}` (steps: {})",
+                        STEPS.join(", ")
+                    )));
+                }
+                skip.push(step);
+            }
+            "-h" | "--help" => {
+                println!(
+                    "can-bench: measures twocan and writes docs/benchmarks.md\n\n\
+                     usage: cargo run --release --bin can-bench [-- --skip STEP ...]\n\
+                     steps: {} (a run with --skip does not write the document)",
+                    STEPS.join(", ")
+                );
+                std::process::exit(0);
+            }
+            other => return Err(Error::new(format!("unknown argument `{other}` (try --help)"))),
+        }
+    }
+    Ok(skip)
+}
+
+fn step(name: &str) {
+    eprintln!("\ncan-bench: ==> {name}");
+}
+
+fn run() -> Result<()> {
+    let skip = parse_args()?;
+    let skipped = |s: &str| skip.iter().any(|k| k == s);
+    let started = Instant::now();
+    let paths = Paths::discover()?;
+    let mut report = Report::new(&paths);
+
+    if !skipped("timing") {
+        step("bit-timing quality (solver against exhaustive search)");
+        report.timing = Some(vec![
+            timing::run("FlexCAN", &twocan_core::timing::Limits::FLEXCAN),
+            timing::run("bxCAN", &twocan_core::timing::Limits::BXCAN),
+        ]);
+    }
+
+    if !skipped("sim") {
+        step("simulator speed");
+        let mut speeds = Vec::new();
+        for (senders, tracing) in [(1, false), (1, true), (4, false)] {
+            let s = simspeed::bare_bus(senders, tracing)?;
+            simspeed::check(&s)?;
+            eprintln!("can-bench: {}: {:.0} frames/s", s.scenario, s.frames_per_sec());
+            speeds.push(s);
+        }
+        let s = models::two_drivers()?;
+        simspeed::check(&s)?;
+        eprintln!("can-bench: {}: {:.0} frames/s", s.scenario, s.frames_per_sec());
+        speeds.push(s);
+        report.sim = Some(speeds);
+    }
+
+    let need_firmware = !skipped("sizes") || !skipped("qemu");
+    let mut firmware_dirs: Vec<(String, PathBuf)> = Vec::new();
+    if need_firmware || !skipped("examples") {
+        firmware::ensure_target()?;
+    }
+    if need_firmware {
+        step("bench firmware (bench/firmware)");
+        for (profile, _) in COUNT_PROFILES {
+            firmware_dirs.push((profile.to_string(), firmware::bench_firmware(&paths, profile)?));
+        }
+    }
+
+    if !skipped("sizes") {
+        step("flash and RAM of the loop-back firmwares");
+        let dir = &firmware_dirs[0].1;
+        let ours = sizes::measure(&dir.join("loopback-twocan"))?;
+        let theirs = sizes::measure(&dir.join("loopback-bxcan"))?;
+        report.sizes = Some(SizeSection { ours, theirs });
+    }
+
+    if !skipped("examples") {
+        step("flash and RAM of the firmware examples");
+        report.examples = Some(examples(&paths)?);
+    }
+
+    if !skipped("qemu") {
+        step("instructions per frame under QEMU");
+        let tools = qemu::tools()?;
+        let plugin = qemu::build_plugin(&paths, &tools)?;
+        let mut runs = Vec::new();
+        for ((profile, opt), (_, dir)) in COUNT_PROFILES.iter().zip(&firmware_dirs) {
+            let elf = dir.join("insn-count");
+            let counts = qemu::run(&paths, &tools, &plugin, &elf, profile)
+                .context(format!("instruction counts ({profile} profile)"))?;
+            runs.push((opt.to_string(), counts));
+        }
+        let window = sizes::read_u32_symbol(
+            &firmware_dirs[0].1.join("insn-count"),
+            "BENCH_MARKER_WINDOW",
+        )?;
+        report.insn = Some(InsnSection {
+            tools,
+            runs,
+            window,
+        });
+    }
+
+    report.elapsed_secs = started.elapsed().as_secs_f64();
+    let text = report.render()?;
+    println!("{text}");
+    if skip.is_empty() {
+        let path = paths.root.join("docs").join("benchmarks.md");
+        std::fs::write(&path, &text).context(format!("writing {}", path.display()))?;
+        eprintln!(
+            "can-bench: wrote {} ({:.0} s)",
+            path.display(),
+            report.elapsed_secs
+        );
+    } else {
+        eprintln!(
+            "can-bench: steps skipped ({}): docs/benchmarks.md not written",
+            skip.join(", ")
+        );
+    }
+    Ok(())
+}
+
+/// Features that select something other than a board.
+const NOT_BOARDS: [&str; 5] = ["defmt", "std", "log", "model", "mock"];
+
+fn examples(paths: &Paths) -> Result<ExampleSection> {
+    let packages = firmware::example_packages(paths)?;
+    if packages.is_empty() {
+        eprintln!("can-bench: no firmware example with binaries under examples/ yet");
+        return Ok(ExampleSection {
+            builds: Vec::new(),
+        });
+    }
+    let mut builds = Vec::new();
+    for p in &packages {
+        let boards: Vec<Option<String>> = {
+            let b: Vec<_> = p
+                .features
+                .iter()
+                .filter(|f| !NOT_BOARDS.contains(&f.as_str()))
+                .cloned()
+                .map(Some)
+                .collect();
+            if b.is_empty() {
+                vec![None]
+            } else {
+                b
+            }
+        };
+        for board in boards {
+            let features: Vec<String> = board.iter().cloned().collect();
+            let dir = firmware::example(paths, &p.name, &features)?;
+            for (bin, required) in &p.bins {
+                if !required.iter().all(|r| features.contains(r)) {
+                    continue;
+                }
+                let elf = dir.join(bin);
+                let size = sizes::measure(&elf)
+                    .context(format!("{} {bin} ({})", p.name, features.join(",")))?;
+                builds.push(ExampleBuild {
+                    package: p.name.clone(),
+                    dir: p.dir.clone(),
+                    board: board.clone(),
+                    bin: bin.clone(),
+                    size,
+                });
+            }
+        }
+    }
+    Ok(ExampleSection { builds })
+}

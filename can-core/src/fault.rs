@@ -115,14 +115,14 @@ impl FaultConfinement {
         false
     }
 
-    /// Rule 1: a receiver detects an error, REC += 1; rule 2 (a dominant bit right after
-    /// its own error flag) adds 8 instead. REC saturates at 255 (a receiver never goes
-    /// bus-off).
+    /// Rule 1: a receiver detects an error, REC += 1; rule 2, a dominant bit as the first
+    /// bit after its own error flag, adds 8 more (both rules apply to the same error:
+    /// +9 in all). REC saturates at 255 (a receiver never goes bus-off).
     pub fn receive_error(&mut self, dominant_after_flag: bool) {
         if self.bus_off {
             return;
         }
-        let add = if dominant_after_flag { 8 } else { 1 };
+        let add = if dominant_after_flag { 9 } else { 1 };
         self.rec = (self.rec + add).min(255);
     }
 
@@ -148,6 +148,15 @@ impl FaultConfinement {
             self.recovery_sequences = done as u16;
             false
         }
+    }
+
+    /// Recessive bits still needed (at best, with no dominant bit in between) before the
+    /// bus-off recovery condition is met; 0 when not bus-off or already met.
+    pub const fn recovery_remaining_bits(&self) -> u64 {
+        if !self.bus_off || self.recovery_sequences >= BUS_OFF_RECOVERY_SEQUENCES {
+            return 0;
+        }
+        (BUS_OFF_RECOVERY_SEQUENCES - self.recovery_sequences) as u64 * 11 - self.recessive_run as u64
     }
 
     /// A dominant bit seen while bus-off interrupts the current run of recessive bits.
@@ -189,8 +198,11 @@ mod tests {
         }
         assert_eq!(f.state(), ErrorState::BusOff);
         assert_eq!(f.counters().tec, 256);
+        assert_eq!(f.recovery_remaining_bits(), 128 * 11);
         assert!(!f.idle_bits(11 * 127 + 10));
+        assert_eq!(f.recovery_remaining_bits(), 1);
         f.dominant_bit();
+        assert_eq!(f.recovery_remaining_bits(), 11);
         assert!(!f.idle_bits(10));
         assert!(f.idle_bits(1));
         assert!(f.recovery_condition_met());
@@ -204,9 +216,9 @@ mod tests {
         let mut f = FaultConfinement::new();
         f.receive_error(false);
         f.receive_error(true);
-        assert_eq!(f.counters().rec, 9);
+        assert_eq!(f.counters().rec, 10);
         f.receive_succeeded();
-        assert_eq!(f.counters().rec, 8);
+        assert_eq!(f.counters().rec, 9);
         for _ in 0..40 {
             f.receive_error(true);
         }

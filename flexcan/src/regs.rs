@@ -37,7 +37,11 @@ impl Field {
 
     /// The field's bits in place within the register.
     pub const fn mask(self) -> u32 {
-        let ones = if self.width >= 32 { u32::MAX } else { (1u32 << self.width) - 1 };
+        let ones = if self.width >= 32 {
+            u32::MAX
+        } else {
+            (1u32 << self.width) - 1
+        };
         ones << self.shift
     }
 
@@ -664,7 +668,12 @@ pub mod pins {
     }
 
     const fn alt2(teensy_pin: u8, port: Port, pin: u8) -> CanPin {
-        CanPin { teensy_pin, port, pin, alt: 2 }
+        CanPin {
+            teensy_pin,
+            port,
+            pin,
+            alt: 2,
+        }
     }
 
     /// Teensy 3.1/3.2 CAN0_TX default: pin 3 = PTA12 ALT2.

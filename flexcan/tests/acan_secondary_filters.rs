@@ -88,10 +88,10 @@ fn every_slot_of_the_largest_configuration() {
     settings.configuration = Configuration::Filters14_18;
     let primary: Vec<Filter> = (0..14u16).map(|i| Filter::standard(0x100 + i)).collect();
     let secondary: Vec<Filter> = (0..18u32)
-        .map(|i| if i % 2 == 0 { Filter::extended(0x10000 + i) } else { Filter::exact(FrameKind::Remote, Format::Standard, 0x300 + i) })
+        .map(|i| if i.is_multiple_of(2) { Filter::extended(0x10000 + i) } else { Filter::exact(FrameKind::Remote, Format::Standard, 0x300 + i) })
         .collect();
     let mut frames: Vec<Frame> = (0..14u16).map(|i| std_data(0x100 + i, &[])).collect();
-    frames.extend((0..18u32).map(|i| if i % 2 == 0 { ext_data(0x10000 + i, &[]) } else { remote(0x300 + i, false) }));
+    frames.extend((0..18u32).map(|i| if i.is_multiple_of(2) { ext_data(0x10000 + i, &[]) } else { remote(0x300 + i, false) }));
     frames.push(std_data(0x300 + 1, &[]));
     frames.push(remote(0x10000, true));
     let got = indices(&settings, &primary, &secondary, &frames);

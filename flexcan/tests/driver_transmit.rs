@@ -28,7 +28,7 @@ fn strict_order_across_10_000_frames() {
     while expected < N {
         // Fill the transmit ring until it is full.
         while next < N {
-            let f = if next % 3 == 0 {
+            let f = if next.is_multiple_of(3) {
                 ext_data(0x1000 + scrambled_id(next) as u32, &next.to_le_bytes())
             } else {
                 std_data(scrambled_id(next), &next.to_le_bytes())

@@ -83,7 +83,10 @@ fn local_priority_goes_before_the_id() {
 fn lost_arbitration_and_errors_retry() {
     let mut r = rig();
     r.load_mb(4, &std(0x123, &[1]), code::TX_DATA);
-    assert_eq!(r.transmit(TxResult::ArbitrationLost), Some(std(0x123, &[1])));
+    assert_eq!(
+        r.transmit(TxResult::ArbitrationLost),
+        Some(std(0x123, &[1]))
+    );
     assert_eq!(r.code(4), code::TX_DATA);
     assert_eq!(r.rd(regs::IFLAG1), 0);
     r.transmit(TxResult::Error(twocan_core::LastErrorCode::Stuff));
@@ -190,13 +193,20 @@ fn receive_queue_overrun_and_masks() {
     r.deliver(&std(0x55, &[2]));
     assert_eq!((r.code(3), r.code(9)), (code::RX_FULL, code::RX_FULL));
     r.deliver(&std(0x55, &[3]));
-    assert_eq!(r.code(9), code::RX_OVERRUN, "IRMQ: the last matching mailbox is overrun");
+    assert_eq!(
+        r.code(9),
+        code::RX_OVERRUN,
+        "IRMQ: the last matching mailbox is overrun"
+    );
     assert_eq!(r.read_mb(3).0, std(0x55, &[1]));
     assert_eq!(r.read_mb(9).0, std(0x55, &[3]));
     assert_eq!(r.m.mailbox_overruns(), 1);
     // Serviced: FULL again on the next frame, first free mailbox first.
     r.deliver(&std(0x55, &[4]));
-    assert_eq!(r.read_mb(3), (std(0x55, &[4]), code::RX_FULL, r.read_mb(3).2));
+    assert_eq!(
+        r.read_mb(3),
+        (std(0x55, &[4]), code::RX_FULL, r.read_mb(3).2)
+    );
     assert_eq!(r.code(10), code::RX_EMPTY, "IDE must match");
     // Masks: individual mask of MB 10 ignores the low ID bits.
     r.freeze();
@@ -204,7 +214,11 @@ fn receive_queue_overrun_and_masks() {
     r.clear_bits(regs::MCR, mcr::HALT);
     r.idle(11);
     r.deliver(&ext(0xAB, &[]));
-    assert_eq!(r.read_mb(10).0, ext(0xAB, &[]), "received ID replaces the filter ID");
+    assert_eq!(
+        r.read_mb(10).0,
+        ext(0xAB, &[]),
+        "received ID replaces the filter ID"
+    );
     // IRMQ = 0: RXMGMASK, RX14MASK and RX15MASK.
     r.freeze();
     r.clear_bits(regs::MCR, mcr::IRMQ);
@@ -220,7 +234,11 @@ fn receive_queue_overrun_and_masks() {
     r.deliver(&std(0x66, &[7]));
     assert_eq!(r.read_mb(4).0, std(0x66, &[7]), "RXMGMASK = 0 accepts all");
     r.deliver(&std(0x66, &[8]));
-    assert_eq!(r.code(4), code::RX_FULL, "IRMQ = 0: the first match, serviced");
+    assert_eq!(
+        r.code(4),
+        code::RX_FULL,
+        "IRMQ = 0: the first match, serviced"
+    );
     r.wr(regs::mb_cs(4), 0);
     r.deliver(&std(0x67, &[]));
     assert_eq!(r.code(14), code::RX_EMPTY, "RX14MASK checks every bit");
@@ -258,7 +276,11 @@ fn a_locked_mailbox_receives_after_unlock() {
     let _ = r.rd(regs::mb_cs(3)); // lock
     assert_eq!(r.m.locked_mailbox(), Some(3));
     r.deliver(&std(0x10, &[1]));
-    assert_eq!(r.code(3), code::RX_EMPTY, "held in the serial message buffer");
+    assert_eq!(
+        r.code(3),
+        code::RX_EMPTY,
+        "held in the serial message buffer"
+    );
     let _ = r.rd(regs::TIMER); // global unlock
     assert_eq!(r.m.locked_mailbox(), None);
     assert_eq!(r.code(3), code::RX_FULL);
@@ -305,7 +327,10 @@ fn time_stamps_come_from_the_free_running_timer() {
     r.rx_mb(0, 0x30, false);
     r.deliver(&std(0x30, &[]));
     let after = r.rd(regs::TIMER);
-    assert_eq!(after, 3, "reset at the end of the frame, then the intermission");
+    assert_eq!(
+        after, 3,
+        "reset at the end of the frame, then the intermission"
+    );
 }
 
 #[test]
@@ -333,7 +358,10 @@ fn maxmb_limits_the_active_mailboxes() {
     r.load_mb(5, &std(0x5, &[]), code::TX_DATA);
     r.load_mb(3, &std(0x3, &[]), code::TX_DATA);
     assert_eq!(r.transmit_all(), vec![std(0x3, &[])]);
-    let t = BusTime { sof: r.now, now: r.now };
+    let t = BusTime {
+        sof: r.now,
+        now: r.now,
+    };
     r.m.tx_result(&std(0x5, &[]), TxResult::Acked, t); // a stray report changes nothing
     assert_eq!(r.code(5), code::TX_DATA);
 }

@@ -13,7 +13,11 @@ use twocan_flexcan::regs::{self, code, ctrl1, ctrl2, ecr, esr1, mcr};
 
 #[test]
 fn reset_state_is_disabled_with_freeze_requested() {
-    for m in [FlexCanModel::mk20dx256(), FlexCanModel::mk64fx512(), FlexCanModel::mk66fx1m0()] {
+    for m in [
+        FlexCanModel::mk20dx256(),
+        FlexCanModel::mk64fx512(),
+        FlexCanModel::mk66fx1m0(),
+    ] {
         assert_eq!(m.read32(regs::MCR), mcr::RESET);
         assert_eq!(m.read32(regs::MCR), 0xD890_000F);
         assert_eq!(m.read32(regs::CTRL1), 0);
@@ -43,7 +47,11 @@ fn enable_enters_freeze_then_normal_after_eleven_recessive_bits() {
 
     r.clear_bits(regs::MCR, mcr::HALT);
     let v = r.rd(regs::MCR);
-    assert_eq!(v & (mcr::FRZACK | mcr::NOTRDY), 0, "NOTRDY negated once freeze is left");
+    assert_eq!(
+        v & (mcr::FRZACK | mcr::NOTRDY),
+        0,
+        "NOTRDY negated once freeze is left"
+    );
     assert_eq!(r.m.mode(), ModelMode::Normal);
     // Not yet synchronised: ESR1[SYNCH] clear, no part in bus traffic.
     assert_eq!(r.rd(regs::ESR1) & esr1::SYNCH, 0);
@@ -75,11 +83,19 @@ fn freeze_needs_both_frz_and_halt() {
     r.start();
     r.set_bits(regs::MCR, mcr::HALT);
     r.clear_bits(regs::MCR, mcr::FRZ);
-    assert_eq!(r.rd(regs::MCR) & mcr::FRZACK, 0, "HALT without FRZ does not freeze");
+    assert_eq!(
+        r.rd(regs::MCR) & mcr::FRZACK,
+        0,
+        "HALT without FRZ does not freeze"
+    );
     r.set_bits(regs::MCR, mcr::FRZ);
     assert_ne!(r.rd(regs::MCR) & mcr::FRZACK, 0);
     r.clear_bits(regs::MCR, mcr::FRZ);
-    assert_eq!(r.rd(regs::MCR) & mcr::FRZACK, 0, "negating FRZ leaves freeze");
+    assert_eq!(
+        r.rd(regs::MCR) & mcr::FRZACK,
+        0,
+        "negating FRZ leaves freeze"
+    );
 }
 
 #[test]
@@ -89,10 +105,23 @@ fn freeze_only_fields_ignore_writes_outside_freeze() {
     r.start();
     // Normal mode: protected fields keep their values.
     let before = r.rd(regs::MCR);
-    r.wr(regs::MCR, before | mcr::RFEN | mcr::IRMQ | mcr::AEN | mcr::SRXDIS);
-    assert_eq!(r.rd(regs::MCR) & (mcr::RFEN | mcr::IRMQ | mcr::AEN | mcr::SRXDIS), 0);
-    r.wr(regs::CTRL1, ctrl1::PRESDIV.val(3) | ctrl1::LPB | ctrl1::LOM | ctrl1::BOFFMSK | ctrl1::BOFFREC);
-    assert_eq!(r.rd(regs::CTRL1), ctrl1::BOFFMSK | ctrl1::BOFFREC, "only the any-time bits");
+    r.wr(
+        regs::MCR,
+        before | mcr::RFEN | mcr::IRMQ | mcr::AEN | mcr::SRXDIS,
+    );
+    assert_eq!(
+        r.rd(regs::MCR) & (mcr::RFEN | mcr::IRMQ | mcr::AEN | mcr::SRXDIS),
+        0
+    );
+    r.wr(
+        regs::CTRL1,
+        ctrl1::PRESDIV.val(3) | ctrl1::LPB | ctrl1::LOM | ctrl1::BOFFMSK | ctrl1::BOFFREC,
+    );
+    assert_eq!(
+        r.rd(regs::CTRL1),
+        ctrl1::BOFFMSK | ctrl1::BOFFREC,
+        "only the any-time bits"
+    );
     r.wr(regs::CTRL2, ctrl2::RFFN.val(3) | ctrl2::RRS);
     assert_eq!(r.rd(regs::CTRL2), ctrl2::RESET);
     r.wr(regs::RXMGMASK, 0x1234);
@@ -108,16 +137,26 @@ fn freeze_only_fields_ignore_writes_outside_freeze() {
     r.set_bits(regs::CTRL1, ctrl1::CLKSRC);
     assert_eq!(r.rd(regs::CTRL1) & ctrl1::CLKSRC, 0);
     // Freeze mode: writable.
-    r.wr(regs::MCR, r.rd(regs::MCR) | mcr::RFEN | mcr::IRMQ | mcr::AEN);
+    r.wr(
+        regs::MCR,
+        r.rd(regs::MCR) | mcr::RFEN | mcr::IRMQ | mcr::AEN,
+    );
     assert_ne!(r.rd(regs::MCR) & mcr::RFEN, 0);
     r.wr(regs::CTRL1, ctrl1::PRESDIV.val(3) | ctrl1::LPB);
     assert_eq!(r.rd(regs::CTRL1), ctrl1::PRESDIV.val(3) | ctrl1::LPB);
     r.wr(regs::CTRL2, ctrl2::RFFN.val(3) | ctrl2::RRS | 0x0000_FFFF);
-    assert_eq!(r.rd(regs::CTRL2), ctrl2::RFFN.val(3) | ctrl2::RRS, "reserved bits read 0");
+    assert_eq!(
+        r.rd(regs::CTRL2),
+        ctrl2::RFFN.val(3) | ctrl2::RRS,
+        "reserved bits read 0"
+    );
     r.wr(regs::rximr(3), 0x1234);
     assert_eq!(r.rd(regs::rximr(3)), 0x1234);
     r.wr(regs::ECR, ecr::TXERRCNT.val(100) | ecr::RXERRCNT.val(7));
-    assert_eq!(r.rd(regs::ECR), ecr::TXERRCNT.val(100) | ecr::RXERRCNT.val(7));
+    assert_eq!(
+        r.rd(regs::ECR),
+        ecr::TXERRCNT.val(100) | ecr::RXERRCNT.val(7)
+    );
     // Disable mode: CLKSRC.
     r.set_bits(regs::MCR, mcr::MDIS);
     r.set_bits(regs::CTRL1, ctrl1::CLKSRC);
@@ -128,7 +167,10 @@ fn freeze_only_fields_ignore_writes_outside_freeze() {
 fn status_bits_are_read_only_and_k20_has_no_waksrc() {
     let mut r = Rig::new();
     r.enable_into_freeze();
-    r.wr(regs::MCR, r.rd(regs::MCR) & !(mcr::FRZACK | mcr::NOTRDY) | mcr::LPMACK | mcr::WAKSRC);
+    r.wr(
+        regs::MCR,
+        r.rd(regs::MCR) & !(mcr::FRZACK | mcr::NOTRDY) | mcr::LPMACK | mcr::WAKSRC,
+    );
     let v = r.rd(regs::MCR);
     assert_ne!(v & mcr::FRZACK, 0);
     assert_eq!(v & (mcr::LPMACK | mcr::WAKSRC), 0);
@@ -142,8 +184,14 @@ fn status_bits_are_read_only_and_k20_has_no_waksrc() {
 fn soft_reset_resets_the_listed_registers_only() {
     let mut r = Rig::new();
     r.enable_into_freeze();
-    r.wr(regs::MCR, r.rd(regs::MCR) | mcr::RFEN | mcr::SRXDIS | mcr::AEN);
-    r.wr(regs::CTRL1, ctrl1::PRESDIV.val(4) | ctrl1::LPB | ctrl1::ERRMSK);
+    r.wr(
+        regs::MCR,
+        r.rd(regs::MCR) | mcr::RFEN | mcr::SRXDIS | mcr::AEN,
+    );
+    r.wr(
+        regs::CTRL1,
+        ctrl1::PRESDIV.val(4) | ctrl1::LPB | ctrl1::ERRMSK,
+    );
     r.wr(regs::CTRL2, ctrl2::RFFN.val(2));
     r.wr(regs::RXMGMASK, 0x55);
     r.wr(regs::RXFGMASK, 0x66);
@@ -154,12 +202,18 @@ fn soft_reset_resets_the_listed_registers_only() {
     r.wr(regs::TIMER, 1234);
     r.wr(regs::MCR, r.rd(regs::MCR) | mcr::SOFTRST);
     assert_eq!(r.rd(regs::MCR) & mcr::SOFTRST, 0, "self-clearing");
-    assert_eq!(r.rd(regs::MCR), mcr::RESET & !(mcr::MDIS | mcr::LPMACK) | mcr::FRZACK);
+    assert_eq!(
+        r.rd(regs::MCR),
+        mcr::RESET & !(mcr::MDIS | mcr::LPMACK) | mcr::FRZACK
+    );
     assert_eq!(r.rd(regs::IMASK1), 0);
     assert_eq!(r.rd(regs::ECR), 0);
     assert_eq!(r.rd(regs::TIMER), 0);
     // Not affected.
-    assert_eq!(r.rd(regs::CTRL1), ctrl1::PRESDIV.val(4) | ctrl1::LPB | ctrl1::ERRMSK);
+    assert_eq!(
+        r.rd(regs::CTRL1),
+        ctrl1::PRESDIV.val(4) | ctrl1::LPB | ctrl1::ERRMSK
+    );
     assert_eq!(r.rd(regs::CTRL2), ctrl2::RFFN.val(2));
     assert_eq!(r.rd(regs::RXMGMASK), 0x55);
     assert_eq!(r.rd(regs::RXFGMASK), 0x66);
@@ -171,7 +225,11 @@ fn soft_reset_resets_the_listed_registers_only() {
 fn soft_reset_requested_while_disabled_completes_when_enabled() {
     let mut r = Rig::new();
     r.set_bits(regs::MCR, mcr::SOFTRST);
-    assert_ne!(r.rd(regs::MCR) & mcr::SOFTRST, 0, "pending while the clocks are off");
+    assert_ne!(
+        r.rd(regs::MCR) & mcr::SOFTRST,
+        0,
+        "pending while the clocks are off"
+    );
     r.clear_bits(regs::MCR, mcr::MDIS);
     assert_eq!(r.rd(regs::MCR) & mcr::SOFTRST, 0);
     assert_eq!(r.m.mode(), ModelMode::Freeze);
@@ -185,7 +243,11 @@ fn stuck_freeze_acknowledge_never_comes() {
     for _ in 0..1000 {
         assert_eq!(r.rd(regs::MCR) & mcr::FRZACK, 0);
     }
-    assert_ne!(r.rd(regs::MCR) & mcr::LPMACK, 0, "no clock: nothing acknowledges");
+    assert_ne!(
+        r.rd(regs::MCR) & mcr::LPMACK,
+        0,
+        "no clock: nothing acknowledges"
+    );
     r.m.set_freeze_ack_stuck(false);
     assert_ne!(r.rd(regs::MCR) & mcr::FRZACK, 0);
     // Stuck in freeze: leaving is never acknowledged either.

@@ -18,7 +18,11 @@ fn loop_back_data_and_remote_frames_through_the_fifo() {
     let sent = r.transmit_all();
     assert_eq!(sent, vec![data, rtr], "data frame first (lower ID wins)");
     assert_eq!(r.code(8), code::TX_INACTIVE);
-    assert_eq!(r.code(9), code::RX_EMPTY, "a sent remote frame turns into an Rx mailbox");
+    assert_eq!(
+        r.code(9),
+        code::RX_EMPTY,
+        "a sent remote frame turns into an Rx mailbox"
+    );
     assert_eq!(r.rd(regs::IFLAG1) & 0x300, 0x300);
     let got = r.drain_fifo();
     assert_eq!(got, vec![(data, 0), (rtr, 0)]);
@@ -78,14 +82,26 @@ fn filter_table_split_for_each_rffn() {
         r.clear_bits(regs::MCR, mcr::HALT);
         r.idle(11);
         r.deliver(&std(0x456, &[]));
-        let expect = if elements > individual { Some(individual as u32) } else { None };
-        assert_eq!(r.pop_fifo().map(|(_, h, _)| h), expect, "rffn {rffn} IRMQ=0");
+        let expect = if elements > individual {
+            Some(individual as u32)
+        } else {
+            None
+        };
+        assert_eq!(
+            r.pop_fifo().map(|(_, h, _)| h),
+            expect,
+            "rffn {rffn} IRMQ=0"
+        );
         r.freeze();
         r.wr(regs::RXMGMASK, 0);
         r.clear_bits(regs::MCR, mcr::HALT);
         r.idle(11);
         r.deliver(&std(0x456, &[]));
-        assert_eq!(r.pop_fifo().map(|(_, h, _)| h), Some(0), "rffn {rffn} RXMGMASK = 0");
+        assert_eq!(
+            r.pop_fifo().map(|(_, h, _)| h),
+            Some(0),
+            "rffn {rffn} RXMGMASK = 0"
+        );
     }
 }
 
@@ -94,7 +110,13 @@ fn idhit_numbers_every_element_of_the_14_18_table() {
     let mut r = Rig::new();
     r.enable_into_freeze();
     let table: Vec<u32> = (0..32).map(|k| elem_a(0x100 + k, false, false)).collect();
-    r.setup_fifo(3, true, &table, &[exact_mask_a(false); 16], exact_mask_a(false));
+    r.setup_fifo(
+        3,
+        true,
+        &table,
+        &[exact_mask_a(false); 16],
+        exact_mask_a(false),
+    );
     r.start();
     for k in (0..32u16).rev() {
         r.deliver(&std(0x100 + k, &[k as u8]));
@@ -102,7 +124,10 @@ fn idhit_numbers_every_element_of_the_14_18_table() {
         assert_eq!((f, hit), (std(0x100 + k, &[k as u8]), k as u32));
     }
     r.deliver(&std(0x200, &[]));
-    assert!(r.pop_fifo().is_none(), "a frame matching nothing is discarded");
+    assert!(
+        r.pop_fifo().is_none(),
+        "a frame matching nothing is discarded"
+    );
     assert_eq!(r.m.frames_discarded(), 1);
     // MB14 and MB15 are the remaining mailboxes.
     r.freeze();
@@ -151,7 +176,11 @@ fn rtr_and_ide_bits_of_format_a_elements() {
         (std(0x0BF, &[]), None),
     ] {
         r.deliver(&frame);
-        assert_eq!(r.pop_fifo().map(|(f, h, _)| (f, h)), hit.map(|h| (frame, h)), "{frame:?}");
+        assert_eq!(
+            r.pop_fifo().map(|(f, h, _)| (f, h)),
+            hit.map(|h| (frame, h)),
+            "{frame:?}"
+        );
     }
 }
 
@@ -169,7 +198,11 @@ fn fifo_is_six_deep_warns_at_five_and_overflows() {
     assert_eq!(r.rd(regs::IFLAG1) & 0xE0, iflag1::BUF5I);
     assert!(r.m.irq().message_buffer);
     r.deliver(&std(4, &[4]));
-    assert_eq!(r.rd(regs::IFLAG1) & 0xE0, iflag1::BUF5I | iflag1::BUF6I, "warning at 5");
+    assert_eq!(
+        r.rd(regs::IFLAG1) & 0xE0,
+        iflag1::BUF5I | iflag1::BUF6I,
+        "warning at 5"
+    );
     r.deliver(&std(5, &[5]));
     assert_eq!(r.m.fifo_len(), 6);
     assert_eq!(r.rd(regs::IFLAG1) & iflag1::BUF7I, 0);
@@ -231,7 +264,11 @@ fn mailbox_reception_priority_against_the_fifo() {
     assert_eq!(r.m.fifo_overflows(), 0);
     // FIFO full and the mailbox not free: IRMQ = 1 overruns the last matching mailbox.
     r.deliver(&std(0x321, &[5]));
-    assert_eq!(r.code(8), code::RX_FULL, "serviced mailbox is free: plain FULL");
+    assert_eq!(
+        r.code(8),
+        code::RX_FULL,
+        "serviced mailbox is free: plain FULL"
+    );
     r.deliver(&std(0x321, &[6]));
     assert_eq!(r.code(8), code::RX_OVERRUN);
     assert_eq!(r.m.mailbox_overruns(), 1);
@@ -246,7 +283,10 @@ fn format_b_and_c_and_d() {
     r.enable_into_freeze();
     r.setup_fifo(0, true, &[], &[u32::MAX; 8], u32::MAX);
     // Format B: element 0 = {std data 0x123, std remote 0x456}; element 1 = {ext 14 MSBs}.
-    r.wr(regs::MCR, mcr::IDAM.replace(r.rd(regs::MCR), mcr::IDAM_FORMAT_B));
+    r.wr(
+        regs::MCR,
+        mcr::IDAM.replace(r.rd(regs::MCR), mcr::IDAM_FORMAT_B),
+    );
     let e0 = (0x123 << 19) | (1 << 15) | (0x456 << 3);
     let ext_id = 0x1555_4321u32;
     let e1 = (1 << 30) | (((ext_id >> 15) & 0x3FFF) << 16);
@@ -266,7 +306,10 @@ fn format_b_and_c_and_d() {
 
     // Format C: 8 MSBs of the ID, four filters per element, remote frames accepted.
     r.freeze();
-    r.wr(regs::MCR, mcr::IDAM.replace(r.rd(regs::MCR), mcr::IDAM_FORMAT_C));
+    r.wr(
+        regs::MCR,
+        mcr::IDAM.replace(r.rd(regs::MCR), mcr::IDAM_FORMAT_C),
+    );
     r.wr(regs::rx_fifo_filter(0), 0x0102_0304);
     r.wr(regs::rx_fifo_filter(1), 0x0506_0708);
     r.clear_bits(regs::MCR, mcr::HALT);
@@ -278,7 +321,10 @@ fn format_b_and_c_and_d() {
 
     // Format D: everything rejected.
     r.freeze();
-    r.wr(regs::MCR, mcr::IDAM.replace(r.rd(regs::MCR), mcr::IDAM_FORMAT_D));
+    r.wr(
+        regs::MCR,
+        mcr::IDAM.replace(r.rd(regs::MCR), mcr::IDAM_FORMAT_D),
+    );
     r.clear_bits(regs::MCR, mcr::HALT);
     r.idle(11);
     r.deliver(&std(0x123, &[]));

@@ -23,7 +23,10 @@ pub struct Rig {
 impl Rig {
     /// A K20 module straight from reset.
     pub fn new() -> Self {
-        Rig { m: FlexCanModel::mk20dx256(), now: 0 }
+        Rig {
+            m: FlexCanModel::mk20dx256(),
+            now: 0,
+        }
     }
 
     /// Reads a register as software does.
@@ -92,7 +95,10 @@ impl Rig {
     pub fn transmit(&mut self, result: TxResult) -> Option<Frame> {
         let req = self.m.poll_tx(self.now)?;
         if req.internal {
-            let t = BusTime { sof: self.now, now: self.now };
+            let t = BusTime {
+                sof: self.now,
+                now: self.now,
+            };
             self.m.tx_result(&req.frame, result, t);
             if result == TxResult::Acked {
                 self.m.rx(&req.frame, true, t);
@@ -130,11 +136,21 @@ impl Rig {
     pub fn load_mb_prio(&mut self, n: usize, frame: &Frame, code: u32, prio: u32) {
         let ext = frame.is_extended();
         let idw = id::PRIO.val(prio)
-            | if ext { id::EXT_ID.val(frame.raw_id()) } else { id::STD.val(frame.raw_id()) };
+            | if ext {
+                id::EXT_ID.val(frame.raw_id())
+            } else {
+                id::STD.val(frame.raw_id())
+            };
         let d = frame.data_padded();
         self.wr(regs::mb_id(n), idw);
-        self.wr(regs::mb_word0(n), u32::from_be_bytes([d[0], d[1], d[2], d[3]]));
-        self.wr(regs::mb_word1(n), u32::from_be_bytes([d[4], d[5], d[6], d[7]]));
+        self.wr(
+            regs::mb_word0(n),
+            u32::from_be_bytes([d[0], d[1], d[2], d[3]]),
+        );
+        self.wr(
+            regs::mb_word1(n),
+            u32::from_be_bytes([d[4], d[5], d[6], d[7]]),
+        );
         let mut c = cs::CODE.val(code) | cs::DLC.val(u32::from(frame.dlc()));
         if ext {
             c |= cs::SRR | cs::IDE;
@@ -147,7 +163,11 @@ impl Rig {
 
     /// Configures a receive mailbox for `id` (standard unless `ext`).
     pub fn rx_mb(&mut self, n: usize, raw_id: u32, ext: bool) {
-        let idw = if ext { id::EXT_ID.val(raw_id) } else { id::STD.val(raw_id) };
+        let idw = if ext {
+            id::EXT_ID.val(raw_id)
+        } else {
+            id::STD.val(raw_id)
+        };
         self.wr(regs::mb_id(n), idw);
         let ide = if ext { cs::IDE } else { 0 };
         self.wr(regs::mb_cs(n), cs::CODE.val(code::RX_EMPTY) | ide);
@@ -166,7 +186,11 @@ impl Rig {
         let w0 = self.rd(regs::mb_word0(n));
         let w1 = self.rd(regs::mb_word1(n));
         self.rd(regs::TIMER);
-        (decode(c, idw, w0, w1), cs::CODE.get(c), cs::TIME_STAMP.get(c) as u16)
+        (
+            decode(c, idw, w0, w1),
+            cs::CODE.get(c),
+            cs::TIME_STAMP.get(c) as u16,
+        )
     }
 
     /// Pops the Rx FIFO output as software does: frame, IDHIT, time stamp.
@@ -194,7 +218,14 @@ impl Rig {
 
     /// Freeze-mode setup of the Rx FIFO: RFEN, IDAM format A, RFFN, IRMQ, filter elements
     /// (written from element 0), individual masks and global mask.
-    pub fn setup_fifo(&mut self, rffn: u32, irmq: bool, elements: &[u32], individual: &[u32], global: u32) {
+    pub fn setup_fifo(
+        &mut self,
+        rffn: u32,
+        irmq: bool,
+        elements: &[u32],
+        individual: &[u32],
+        global: u32,
+    ) {
         let mut m = self.rd(regs::MCR) | mcr::RFEN;
         m = mcr::IDAM.replace(m, mcr::IDAM_FORMAT_A);
         m = if irmq { m | mcr::IRMQ } else { m & !mcr::IRMQ };
@@ -237,7 +268,11 @@ impl Default for Rig {
 /// The frame that message-buffer words describe.
 pub fn decode(c: u32, idw: u32, w0: u32, w1: u32) -> Frame {
     let ext = c & cs::IDE != 0;
-    let raw = if ext { id::EXT_ID.get(idw) } else { id::STD.get(idw) };
+    let raw = if ext {
+        id::EXT_ID.get(idw)
+    } else {
+        id::STD.get(idw)
+    };
     let a = w0.to_be_bytes();
     let b = w1.to_be_bytes();
     Frame::from_registers(

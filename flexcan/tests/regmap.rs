@@ -60,7 +60,14 @@ macro_rules! bit {
     ($rb:expr, $ty:ty, $reg:ident . $f:ident, $bit:expr) => {{
         let off = offset_of!($ty, $reg);
         let m = field_mask($rb, off, || u32::from($rb.$reg.read().$f().bit()));
-        assert_eq!(m, $bit, "{}.{} (PAC mask {:#010x})", stringify!($reg), stringify!($f), m);
+        assert_eq!(
+            m,
+            $bit,
+            "{}.{} (PAC mask {:#010x})",
+            stringify!($reg),
+            stringify!($f),
+            m
+        );
     }};
 }
 
@@ -70,7 +77,14 @@ macro_rules! field {
         let off = offset_of!($ty, $reg);
         let m = field_mask($rb, off, || $rb.$reg.read().$f().bits() as u32);
         let ours: Field = $field;
-        assert_eq!(m, ours.mask(), "{}.{} (PAC mask {:#010x})", stringify!($reg), stringify!($f), m);
+        assert_eq!(
+            m,
+            ours.mask(),
+            "{}.{} (PAC mask {:#010x})",
+            stringify!($reg),
+            stringify!($f),
+            m
+        );
     }};
 }
 
@@ -313,7 +327,10 @@ fn port_pin_control_matches_the_svd() {
 
     type P20 = mk20d7::porta::RegisterBlock;
     for n in 0..32u8 {
-        assert_eq!(Port::A.base() + offset_of!(P20, pcr) + 4 * n as usize, Port::A.pcr(n));
+        assert_eq!(
+            Port::A.base() + offset_of!(P20, pcr) + 4 * n as usize,
+            Port::A.pcr(n)
+        );
     }
     type P66 = mk66f18::porte::RegisterBlock;
     assert_eq!(offset_of!(P66, pcr24), 4 * 24);
@@ -323,11 +340,15 @@ fn port_pin_control_matches_the_svd() {
     let p20: &P20 = host_block::<P20>();
     macro_rules! pcr20 {
         ($f:ident, bit $ours:expr) => {{
-            let m = field_mask(p20, offset_of!(P20, pcr), || u32::from(p20.pcr[0].read().$f().bit()));
+            let m = field_mask(p20, offset_of!(P20, pcr), || {
+                u32::from(p20.pcr[0].read().$f().bit())
+            });
             assert_eq!(m, $ours, stringify!($f));
         }};
         ($f:ident, field $ours:expr) => {{
-            let m = field_mask(p20, offset_of!(P20, pcr), || p20.pcr[0].read().$f().bits() as u32);
+            let m = field_mask(p20, offset_of!(P20, pcr), || {
+                p20.pcr[0].read().$f().bits() as u32
+            });
             assert_eq!(m, ($ours as Field).mask(), stringify!($f));
         }};
     }
@@ -382,14 +403,27 @@ fn field_helpers_and_geometry() {
     assert_eq!(f.val(9), 0x10);
     assert_eq!(f.replace(0xFFFF_FFFF, 0), 0xFFFF_FF8F);
     assert_eq!(Field::new(0, 32).mask(), u32::MAX);
-    assert_eq!(mcr::RESET, mcr::MDIS | mcr::FRZ | mcr::HALT | mcr::NOTRDY | mcr::SUPV | mcr::LPMACK | mcr::MAXMB.val(15));
+    assert_eq!(
+        mcr::RESET,
+        mcr::MDIS
+            | mcr::FRZ
+            | mcr::HALT
+            | mcr::NOTRDY
+            | mcr::SUPV
+            | mcr::LPMACK
+            | mcr::MAXMB.val(15)
+    );
     assert_eq!(ctrl2::TASD.get(ctrl2::RESET), 0x16);
     // RFFN → elements and occupied MBs (ACAN's 8/0, 10/6, 12/12, 14/18 configurations).
-    let table: Vec<(usize, usize)> =
-        (0..4).map(|r| (regs::rx_fifo_filter_count(r), regs::rx_fifo_occupied_mbs(r))).collect();
+    let table: Vec<(usize, usize)> = (0..4)
+        .map(|r| (regs::rx_fifo_filter_count(r), regs::rx_fifo_occupied_mbs(r)))
+        .collect();
     assert_eq!(table, vec![(8, 8), (16, 10), (24, 12), (32, 14)]);
     assert_eq!(code::TX_DATA, code::TX_REMOTE);
     assert_eq!(regs::filter_a::RXIDA.mask(), 0x3FFF_FFFE);
     assert_eq!(regs::filter_a::RXIDA_STD.mask(), 0x3FF8_0000);
-    assert_eq!(regs::filter_b::RXIDB_0.mask() | regs::filter_b::RXIDB_1.mask(), 0x3FFF_3FFF);
+    assert_eq!(
+        regs::filter_b::RXIDB_0.mask() | regs::filter_b::RXIDB_1.mask(),
+        0x3FFF_3FFF
+    );
 }

@@ -61,7 +61,11 @@ const RXIMR_END: usize = RXIMR_BASE + 4 * NUM_MB;
 impl State {
     /// MCR bits writable in Freeze mode only, for this chip.
     fn mcr_freeze_bits(&self) -> u32 {
-        let waksrc = if self.chip == Chip::Mk20dx256 { mcr::WAKSRC } else { 0 };
+        let waksrc = if self.chip == Chip::Mk20dx256 {
+            mcr::WAKSRC
+        } else {
+            0
+        };
         MCR_STORED & !MCR_ANY_TIME & !waksrc
     }
 

@@ -40,7 +40,11 @@ impl State {
         }
         let frame = self.mb_tx_frame(self.select_tx()?)?;
         let lpb = self.lpb();
-        Some(TxRequest { frame, self_ack: lpb, internal: lpb })
+        Some(TxRequest {
+            frame,
+            self_ack: lpb,
+            internal: lpb,
+        })
     }
 
     /// Drives a dominant ACK for correctly received frames.

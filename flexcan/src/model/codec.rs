@@ -20,7 +20,11 @@ pub(crate) fn encode(frame: &Frame, stamp: u16, code: u32, prio: u32) -> [u32; 4
         c |= cs::RTR;
     }
     let idw = id::PRIO.val(prio)
-        | if ext { id::EXT_ID.val(frame.raw_id()) } else { id::STD.val(frame.raw_id()) };
+        | if ext {
+            id::EXT_ID.val(frame.raw_id())
+        } else {
+            id::STD.val(frame.raw_id())
+        };
     let d = frame.data_padded();
     let w0 = u32::from_be_bytes([d[0], d[1], d[2], d[3]]);
     let w1 = u32::from_be_bytes([d[4], d[5], d[6], d[7]]);
@@ -35,7 +39,11 @@ pub(crate) fn decode(words: [u32; 4]) -> Option<Frame> {
     let ext = c & cs::IDE != 0;
     let remote = c & cs::RTR != 0;
     let dlc = cs::DLC.get(c).min(8) as u8;
-    let raw = if ext { id::EXT_ID.get(idw) } else { id::STD.get(idw) };
+    let raw = if ext {
+        id::EXT_ID.get(idw)
+    } else {
+        id::STD.get(idw)
+    };
     let a = w0.to_be_bytes();
     let b = w1.to_be_bytes();
     let data = [a[0], a[1], a[2], a[3], b[0], b[1], b[2], b[3]];

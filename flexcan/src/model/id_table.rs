@@ -26,7 +26,8 @@ use crate::regs::{self, mcr, NUM_MB};
 use super::state::State;
 
 /// Elements that fit in the message-buffer RAM after MB5.
-const TABLE_CAPACITY: usize = (NUM_MB * regs::MB_STRIDE - (regs::RX_FIFO_FILTER_BASE - regs::MB_BASE)) / 4;
+const TABLE_CAPACITY: usize =
+    (NUM_MB * regs::MB_STRIDE - (regs::RX_FIFO_FILTER_BASE - regs::MB_BASE)) / 4;
 
 impl State {
     /// Number of filter elements in use.
@@ -67,8 +68,12 @@ impl State {
             let mask = self.filter_mask(n);
             let hit = match idam {
                 mcr::IDAM_FORMAT_A => match_a(frame, elem, mask).then_some(n),
-                mcr::IDAM_FORMAT_B => (0..2).find(|&h| match_b(frame, elem, mask, h)).map(|h| 2 * n + h),
-                mcr::IDAM_FORMAT_C => (0..4).find(|&q| match_c(frame, elem, mask, q)).map(|q| 4 * n + q),
+                mcr::IDAM_FORMAT_B => (0..2)
+                    .find(|&h| match_b(frame, elem, mask, h))
+                    .map(|h| 2 * n + h),
+                mcr::IDAM_FORMAT_C => (0..4)
+                    .find(|&q| match_c(frame, elem, mask, q))
+                    .map(|q| 4 * n + q),
                 _ => return None,
             };
             if let Some(idaf) = hit {
@@ -86,7 +91,11 @@ fn masked_equal(a: u32, b: u32, mask: u32) -> bool {
 
 fn match_a(frame: &Frame, elem: u32, mask: u32) -> bool {
     let ext = frame.is_extended();
-    let mut word = if ext { frame.raw_id() << 1 } else { frame.raw_id() << 19 };
+    let mut word = if ext {
+        frame.raw_id() << 1
+    } else {
+        frame.raw_id() << 19
+    };
     if frame.is_remote() {
         word |= 1 << 31;
     }
@@ -103,7 +112,11 @@ fn match_b(frame: &Frame, elem: u32, mask: u32, h: usize) -> bool {
     let e = (elem >> shift) & 0xFFFF;
     let m = (mask >> shift) & 0xFFFF;
     let ext = frame.is_extended();
-    let mut word = if ext { (frame.raw_id() >> 15) & 0x3FFF } else { frame.raw_id() << 3 };
+    let mut word = if ext {
+        (frame.raw_id() >> 15) & 0x3FFF
+    } else {
+        frame.raw_id() << 3
+    };
     if frame.is_remote() {
         word |= 1 << 15;
     }
@@ -119,6 +132,10 @@ fn match_c(frame: &Frame, elem: u32, mask: u32, q: usize) -> bool {
     let shift = 24 - 8 * q as u32;
     let e = (elem >> shift) & 0xFF;
     let m = (mask >> shift) & 0xFF;
-    let msbs = if frame.is_extended() { frame.raw_id() >> 21 } else { frame.raw_id() >> 3 };
+    let msbs = if frame.is_extended() {
+        frame.raw_id() >> 21
+    } else {
+        frame.raw_id() >> 3
+    };
     masked_equal(msbs & 0xFF, e, m)
 }

@@ -90,7 +90,9 @@ impl State {
     /// frame (the bus arbitration order, [`Priority`]), preceded by ID[PRIO] when
     /// MCR[LPRIOEN] = 1, ties going to the lowest-numbered mailbox.
     pub fn select_tx(&self) -> Option<usize> {
-        let pending = self.active_mbs().filter(|&n| is_tx_pending(self.mb_code(n)));
+        let pending = self
+            .active_mbs()
+            .filter(|&n| is_tx_pending(self.mb_code(n)));
         if self.ctrl1_bit(ctrl1::LBUF) {
             return pending.into_iter().find(|&n| self.mb_tx_frame(n).is_some());
         }
@@ -98,7 +100,11 @@ impl State {
         pending
             .filter_map(|n| {
                 let frame = self.mb_tx_frame(n)?;
-                let prio = if lprio { id::PRIO.get(self.mb_word(n, 1)) } else { 0 };
+                let prio = if lprio {
+                    id::PRIO.get(self.mb_word(n, 1))
+                } else {
+                    0
+                };
                 Some(((prio, Priority::of(&frame), n), n))
             })
             .min()
@@ -111,7 +117,9 @@ impl State {
         let holds = |n: usize| self.mb_tx_frame(n).is_some_and(|f| f == *frame);
         match self.select_tx() {
             Some(n) if holds(n) => Some(n),
-            _ => self.active_mbs().find(|&n| is_tx_pending(self.mb_code(n)) && holds(n)),
+            _ => self
+                .active_mbs()
+                .find(|&n| is_tx_pending(self.mb_code(n)) && holds(n)),
         }
     }
 
@@ -158,7 +166,11 @@ impl State {
             let csw = self.mb_word(n, 0);
             let idw = self.mb_word(n, 1);
             let ext = csw & cs::IDE != 0;
-            let raw = if ext { id::EXT_ID.get(idw) } else { id::STD.get(idw) };
+            let raw = if ext {
+                id::EXT_ID.get(idw)
+            } else {
+                id::STD.get(idw)
+            };
             ext == frame.is_extended() && raw == frame.raw_id()
         })
     }
@@ -249,7 +261,11 @@ impl State {
     /// buffer while the mailbox is locked (a second frame there replaces the first).
     pub fn mb_store(&mut self, n: usize, frame: &Frame, stamp: u16) {
         if self.mbx.locked == Some(n) {
-            let old = self.mbx.smb.replace(Pending { mb: n, frame: *frame, stamp });
+            let old = self.mbx.smb.replace(Pending {
+                mb: n,
+                frame: *frame,
+                stamp,
+            });
             if old.is_some() {
                 self.mbx.overruns += 1;
             }

@@ -100,7 +100,9 @@ impl FlexCanModel {
     /// and RXIMR are undefined after reset on the real part; the model starts them at 0
     /// (see [`FlexCanModel::scramble_ram`]).
     pub fn new(chip: Chip) -> Self {
-        FlexCanModel { inner: Rc::new(RefCell::new(State::new(chip))) }
+        FlexCanModel {
+            inner: Rc::new(RefCell::new(State::new(chip))),
+        }
     }
 
     /// FlexCAN0 of the MK20DX256 (Teensy 3.1/3.2).
@@ -288,7 +290,9 @@ impl BusNode for FlexCanModel {
     }
 
     fn rx_error(&mut self, code: LastErrorCode, dominant_after_flag: bool, time: BusTime) {
-        self.inner.borrow_mut().rx_error(code, dominant_after_flag, time);
+        self.inner
+            .borrow_mut()
+            .rx_error(code, dominant_after_flag, time);
     }
 
     fn advance(&mut self, bits: u64, idle: bool, now: u64) {

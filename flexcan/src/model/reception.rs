@@ -59,7 +59,11 @@ impl State {
 
         let scan = self.rx_scan(frame);
         let irmq = self.irmq();
-        let mb_winner = if irmq { scan.first_free.or(scan.last) } else { scan.first };
+        let mb_winner = if irmq {
+            scan.first_free.or(scan.last)
+        } else {
+            scan.first
+        };
         let to_fifo = |s: &mut State| match fifo {
             FifoHit::NotFull(idhit) => s.fifo_store(frame, stamp, idhit),
             // `fifo_store` on a full FIFO counts the overflow.

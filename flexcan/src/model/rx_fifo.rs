@@ -69,7 +69,11 @@ impl State {
             self.iflag1 |= iflag1::BUF7I;
             return;
         }
-        self.fifo.entries.push_back(FifoEntry { frame: *frame, stamp, idhit });
+        self.fifo.entries.push_back(FifoEntry {
+            frame: *frame,
+            stamp,
+            idhit,
+        });
         if self.fifo.entries.len() == 5 {
             self.iflag1 |= iflag1::BUF6I;
         }
@@ -92,6 +96,8 @@ impl State {
 
     /// RXFIR as read.
     pub fn rxfir_value(&self) -> u32 {
-        self.fifo.output().map_or(0, |e| rxfir::IDHIT.val(u32::from(e.idhit)))
+        self.fifo
+            .output()
+            .map_or(0, |e| rxfir::IDHIT.val(u32::from(e.idhit)))
     }
 }

@@ -159,7 +159,12 @@ impl State {
 
     /// The four words of message buffer `n`.
     pub fn mb_words(&self, n: usize) -> [u32; 4] {
-        [self.ram[4 * n], self.ram[4 * n + 1], self.ram[4 * n + 2], self.ram[4 * n + 3]]
+        [
+            self.ram[4 * n],
+            self.ram[4 * n + 1],
+            self.ram[4 * n + 2],
+            self.ram[4 * n + 3],
+        ]
     }
 
     /// Writes the four words of message buffer `n`.

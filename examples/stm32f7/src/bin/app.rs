@@ -1,0 +1,109 @@
+//! The portable application (`twocan_app::App`, the same module as the host demo) on
+//! CAN1 at 500 kbit/s, as node 2 talking with node 1 — the Teensy `app` example is
+//! node 1 — over a bus with transceivers (NUCLEO-F767ZI: CAN1 on PD0 = RX, PD1 = TX;
+//! 32F746G-DISCO: PB8 = RX (Arduino D15), PB9 = TX (D14); 120 Ω at each end).
+//!
+//! The application's portable filters are compiled by the bxCAN planner into FIFO 0
+//! (one FIFO keeps the frames in arrival order). It runs every 10 ms; the LED toggles
+//! every 50 heartbeats from the peer. `STATS` mirrors the counters for a debugger.
+//!
+//! Without a transceiver (or with CANRX not recessive) `enable` times out waiting for 11
+//! recessive bits (RM0410 §40.4.1): blink code 5. 6: panic.
+#![cfg_attr(target_os = "none", no_std, no_main)]
+
+#[cfg(target_os = "none")]
+mod firmware {
+    use core::cell::RefCell;
+
+    use critical_section::Mutex;
+    use stm32f7xx_hal::pac::interrupt;
+    use twocan_app::{App, AppStats};
+    use twocan_bxcan::{regs, Can, Config, FifoPolicy, Recovery};
+    use twocan_core::{Driver, Mmio};
+    use twocan_stm32f7::board::BIT_RATE;
+    use twocan_stm32f7::rt::{self, CAN_BLINKS};
+    use twocan_stm32f7::shared::SharedDriver;
+    use twocan_stm32f7::time::{self, Every};
+
+    /// This node and its peer.
+    const NODE: u8 = 2;
+    const PEER: u8 = 1;
+
+    static CAN1: SharedDriver<Can<Mmio>, 32, 16> = SharedDriver::new();
+
+    /// The application's counters, copied after each step.
+    pub static STATS: Mutex<RefCell<AppStats>> = Mutex::new(RefCell::new(AppStats {
+        sent: 0,
+        tx_full: 0,
+        heartbeats: 0,
+        heartbeat_gaps: 0,
+        measurements: 0,
+        requests: 0,
+        answers: 0,
+        unhandled: 0,
+    }));
+
+    #[interrupt]
+    fn CAN1_TX() {
+        CAN1.on_interrupt();
+    }
+    #[interrupt]
+    fn CAN1_RX0() {
+        CAN1.on_interrupt();
+    }
+    #[interrupt]
+    fn CAN1_RX1() {
+        CAN1.on_interrupt();
+    }
+    #[interrupt]
+    fn CAN1_SCE() {
+        CAN1.on_interrupt();
+    }
+
+    #[cortex_m_rt::entry]
+    fn main() -> ! {
+        let mut boot = rt::boot();
+        let mut app = App::new(NODE, PEER);
+        // The bit timing is solved for the APB1 frequency the HAL reports.
+        let apb1 = boot.clocks.pclk1().raw();
+        let config = Config::from_bitrate(apb1, BIT_RATE)
+            .unwrap_or_else(|_| rt::halt(CAN_BLINKS))
+            .recovery(Recovery::Automatic);
+        // SAFETY: `boot` clocked CAN1 and dropped its PAC singleton; this is the only
+        // access to CAN1's registers.
+        let regs = unsafe { Mmio::new(regs::CAN1_BASE) };
+        let mut init = Can::can1(regs, &config).unwrap_or_else(|_| rt::halt(CAN_BLINKS));
+        let plan = init
+            .can()
+            .plan(&app.filters(), FifoPolicy::Fifo0)
+            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
+        if init.set_filters(&plan).is_err() {
+            rt::halt(CAN_BLINKS);
+        }
+        let can = init.enable().unwrap_or_else(|_| rt::halt(CAN_BLINKS));
+        if CAN1.install(Driver::new(can)).is_err() {
+            rt::halt(CAN_BLINKS);
+        }
+        rt::unmask(rt::CAN1_IRQS);
+
+        let mut period = Every::new(time::millis(), 10);
+        let mut shown = 0;
+        loop {
+            if period.due(time::millis()) {
+                CAN1.with(|d| app.step(d));
+                let stats = app.stats();
+                critical_section::with(|cs| *STATS.borrow_ref_mut(cs) = stats);
+                if stats.heartbeats >= shown + 50 {
+                    shown = stats.heartbeats;
+                    boot.led.toggle();
+                }
+            }
+            cortex_m::asm::wfi();
+        }
+    }
+}
+
+#[cfg(not(target_os = "none"))]
+fn main() {
+    eprintln!("{}", twocan_stm32f7::host_stub("app"));
+}

@@ -1,0 +1,155 @@
+//! NUCLEO-F767ZI only: CAN1 and CAN2 talking to each other through their transceivers,
+//! each running the portable application (`twocan_app::App`): CAN1 is node 1, CAN2
+//! node 2, at 500 kbit/s.
+//!
+//! Wiring: a transceiver on CAN1 (PD0 = RX, PD1 = TX) and one on CAN2 (PB5 = RX,
+//! PB6 = TX), CANH to CANH and CANL to CANL, 120 Ω at each end.
+//!
+//! CAN2 has no filter banks of its own (RM0410 §40.3 "dual CAN"): CAN1 is configured
+//! with `CAN2SB = 14` (banks 0–13 for CAN1, 14–27 for CAN2), and CAN2's filters are
+//! written through CAN1's register block. Each node's portable filter list is planned
+//! for its own banks; the match indices come back as each node's own filter indices.
+//!
+//! The LED toggles every 50 heartbeats each node got from the other; `STATS` holds both
+//! nodes' counters. Blink codes: 5 bxCAN configuration (or no transceiver: `enable`
+//! waits for 11 recessive bits), 6 panic.
+#![cfg_attr(target_os = "none", no_std, no_main)]
+
+#[cfg(target_os = "none")]
+mod firmware {
+    use core::cell::RefCell;
+
+    use critical_section::Mutex;
+    use stm32f7xx_hal::pac::interrupt;
+    use twocan_app::{App, AppStats};
+    use twocan_bxcan::{regs, Can, Config, FifoPolicy, Recovery};
+    use twocan_core::{Driver, Mmio};
+    use twocan_stm32f7::board::BIT_RATE;
+    use twocan_stm32f7::rt::{self, CAN_BLINKS};
+    use twocan_stm32f7::shared::SharedDriver;
+    use twocan_stm32f7::time::{self, Every};
+
+    static CAN1: SharedDriver<Can<Mmio>, 32, 16> = SharedDriver::new();
+    static CAN2: SharedDriver<Can<Mmio, Mmio>, 32, 16> = SharedDriver::new();
+
+    const NO_STATS: AppStats = AppStats {
+        sent: 0,
+        tx_full: 0,
+        heartbeats: 0,
+        heartbeat_gaps: 0,
+        measurements: 0,
+        requests: 0,
+        answers: 0,
+        unhandled: 0,
+    };
+
+    /// The counters of node 1 (CAN1) and node 2 (CAN2), copied after each step.
+    pub static STATS: Mutex<RefCell<[AppStats; 2]>> =
+        Mutex::new(RefCell::new([NO_STATS, NO_STATS]));
+
+    #[interrupt]
+    fn CAN1_TX() {
+        CAN1.on_interrupt();
+    }
+    #[interrupt]
+    fn CAN1_RX0() {
+        CAN1.on_interrupt();
+    }
+    #[interrupt]
+    fn CAN1_RX1() {
+        CAN1.on_interrupt();
+    }
+    #[interrupt]
+    fn CAN1_SCE() {
+        CAN1.on_interrupt();
+    }
+    #[interrupt]
+    fn CAN2_TX() {
+        CAN2.on_interrupt();
+    }
+    #[interrupt]
+    fn CAN2_RX0() {
+        CAN2.on_interrupt();
+    }
+    #[interrupt]
+    fn CAN2_RX1() {
+        CAN2.on_interrupt();
+    }
+    #[interrupt]
+    fn CAN2_SCE() {
+        CAN2.on_interrupt();
+    }
+
+    #[cortex_m_rt::entry]
+    fn main() -> ! {
+        let mut boot = rt::boot();
+        let apb1 = boot.clocks.pclk1().raw();
+        let base = Config::from_bitrate(apb1, BIT_RATE)
+            .unwrap_or_else(|_| rt::halt(CAN_BLINKS))
+            .recovery(Recovery::Automatic);
+        let config1 = base
+            .can2_start_bank(14)
+            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
+        let mut node1 = App::new(1, 2);
+        let mut node2 = App::new(2, 1);
+
+        // SAFETY: `boot` clocked CAN1 and CAN2 and dropped their PAC singletons. CAN1's
+        // block is reached twice: by CAN1's controller, and by CAN2's for the shared
+        // filter registers only; filters are written here, one controller after the
+        // other, before any interrupt is unmasked.
+        let (can1_regs, can2_regs, can2_filters) = unsafe {
+            (
+                Mmio::new(regs::CAN1_BASE),
+                Mmio::new(regs::CAN2_BASE),
+                Mmio::new(regs::CAN1_BASE),
+            )
+        };
+        let mut init1 = Can::can1(can1_regs, &config1).unwrap_or_else(|_| rt::halt(CAN_BLINKS));
+        let plan1 = init1
+            .can()
+            .plan(&node1.filters(), FifoPolicy::Fifo0)
+            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
+        if init1.set_filters(&plan1).is_err() {
+            rt::halt(CAN_BLINKS);
+        }
+        let mut init2 = Can::can2(can2_regs, can2_filters, &base)
+            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
+        let plan2 = init2
+            .can()
+            .plan(&node2.filters(), FifoPolicy::Fifo1)
+            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
+        if init2.set_filters(&plan2).is_err() {
+            rt::halt(CAN_BLINKS);
+        }
+        let can1 = init1.enable().unwrap_or_else(|_| rt::halt(CAN_BLINKS));
+        let can2 = init2.enable().unwrap_or_else(|_| rt::halt(CAN_BLINKS));
+        if CAN1.install(Driver::new(can1)).is_err() || CAN2.install(Driver::new(can2)).is_err()
+        {
+            rt::halt(CAN_BLINKS);
+        }
+        rt::unmask(rt::CAN1_IRQS);
+        rt::unmask(rt::CAN2_IRQS);
+
+        let mut period = Every::new(time::millis(), 10);
+        let mut shown = 0;
+        loop {
+            if period.due(time::millis()) {
+                CAN1.with(|d| node1.step(d));
+                CAN2.with(|d| node2.step(d));
+                let stats = [node1.stats(), node2.stats()];
+                critical_section::with(|cs| *STATS.borrow_ref_mut(cs) = stats);
+                let both = stats[0].heartbeats.min(stats[1].heartbeats);
+                if both >= shown + 50 {
+                    shown = both;
+                    boot.led.toggle();
+                }
+            }
+            cortex_m::asm::wfi();
+        }
+    }
+}
+
+#[cfg(not(target_os = "none"))]
+fn main() {
+    eprintln!("{}", twocan_stm32f7::host_stub("can1-can2"));
+}

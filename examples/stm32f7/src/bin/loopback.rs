@@ -1,0 +1,90 @@
+//! ACAN's `LoopBackDemo` (ACAN manual §4) on bxCAN: CAN1 in loop-back mode (RM0410
+//! §40.5.1 "Loop back mode": frames are received back internally, no transceiver
+//! needed), one pass-all filter bank, one standard data frame (identifier 0x542) every
+//! second; every frame received toggles the LED. `SENT` and `RECEIVED` can be read with
+//! a debugger (`probe-rs run` shows nothing else).
+//!
+//! Blink codes when it stops: 5 bxCAN configuration, 6 panic.
+#![cfg_attr(target_os = "none", no_std, no_main)]
+
+#[cfg(target_os = "none")]
+mod firmware {
+    use core::sync::atomic::{AtomicU32, Ordering};
+
+    use stm32f7xx_hal::pac::interrupt;
+    use twocan_bxcan::{regs, Can, Config, FifoPolicy};
+    use twocan_core::{Driver, Filter, Frame, Mmio};
+    use twocan_stm32f7::rt::{self, CAN_BLINKS};
+    use twocan_stm32f7::shared::SharedDriver;
+    use twocan_stm32f7::time::{self, Every};
+
+    static CAN1: SharedDriver<Can<Mmio>, 32, 16> = SharedDriver::new();
+
+    /// Frames handed to the driver.
+    pub static SENT: AtomicU32 = AtomicU32::new(0);
+    /// Frames received back.
+    pub static RECEIVED: AtomicU32 = AtomicU32::new(0);
+
+    #[interrupt]
+    fn CAN1_TX() {
+        CAN1.on_interrupt();
+    }
+    #[interrupt]
+    fn CAN1_RX0() {
+        CAN1.on_interrupt();
+    }
+    #[interrupt]
+    fn CAN1_RX1() {
+        CAN1.on_interrupt();
+    }
+    #[interrupt]
+    fn CAN1_SCE() {
+        CAN1.on_interrupt();
+    }
+
+    #[cortex_m_rt::entry]
+    fn main() -> ! {
+        let mut boot = rt::boot();
+        let apb1 = boot.clocks.pclk1().raw();
+        let config = Config::from_bitrate(apb1, 125_000)
+            .unwrap_or_else(|_| rt::halt(CAN_BLINKS))
+            .loopback(true);
+        // SAFETY: `boot` clocked CAN1 and dropped its PAC singleton; this is the only
+        // access to CAN1's registers.
+        let regs = unsafe { Mmio::new(regs::CAN1_BASE) };
+        let mut init = Can::can1(regs, &config).unwrap_or_else(|_| rt::halt(CAN_BLINKS));
+        let plan = init
+            .can()
+            .plan(&[Filter::pass_all()], FifoPolicy::Fifo0)
+            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
+        if init.set_filters(&plan).is_err() {
+            rt::halt(CAN_BLINKS);
+        }
+        let can = init.enable().unwrap_or_else(|_| rt::halt(CAN_BLINKS));
+        if CAN1.install(Driver::new(can)).is_err() {
+            rt::halt(CAN_BLINKS);
+        }
+        rt::unmask(rt::CAN1_IRQS);
+
+        let message = Frame::standard(0x542, &[]).unwrap_or_else(|_| rt::halt(CAN_BLINKS));
+        let mut send = Every::new(time::millis(), 1000);
+        let mut due = false;
+        loop {
+            due |= send.due(time::millis());
+            if due && CAN1.with(|d| d.try_send(&message).is_ok()) == Some(true) {
+                due = false;
+                SENT.fetch_add(1, Ordering::Relaxed);
+            }
+            while let Some(Ok(_frame)) = CAN1.with(|d| d.receive()) {
+                RECEIVED.fetch_add(1, Ordering::Relaxed);
+                boot.led.toggle();
+            }
+            cortex_m::asm::wfi();
+        }
+    }
+}
+
+#[cfg(not(target_os = "none"))]
+fn main() {
+    eprintln!("{}", twocan_stm32f7::host_stub("loopback"));
+}
