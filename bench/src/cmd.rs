@@ -16,11 +16,6 @@ impl Error {
     pub fn new(msg: impl Into<String>) -> Self {
         Error(msg.into())
     }
-
-    /// The same error, preceded by what was being done.
-    pub fn context(self, what: impl fmt::Display) -> Self {
-        Error(format!("{what}: {}", self.0))
-    }
 }
 
 impl fmt::Display for Error {

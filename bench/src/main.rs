@@ -34,6 +34,7 @@ use std::time::Instant;
 use cmd::{Context, Error, Result};
 use firmware::Paths;
 use report::{ExampleBuild, ExampleSection, InsnSection, Report, SizeSection};
+use simspeed::Trials;
 
 /// The steps, for `--skip`.
 const STEPS: [&str; 5] = ["sizes", "examples", "qemu", "timing", "sim"];
@@ -106,15 +107,17 @@ fn run() -> Result<()> {
         step("simulator speed");
         let mut speeds = Vec::new();
         for (senders, tracing) in [(1, false), (1, true), (4, false)] {
-            let s = simspeed::bare_bus(senders, tracing)?;
-            simspeed::check(&s)?;
-            eprintln!("can-bench: {}: {:.0} frames/s", s.scenario, s.frames_per_sec());
-            speeds.push(s);
+            speeds.push(Trials::run(|| simspeed::bare_bus(senders, tracing))?);
         }
-        let s = models::two_drivers()?;
-        simspeed::check(&s)?;
-        eprintln!("can-bench: {}: {:.0} frames/s", s.scenario, s.frames_per_sec());
-        speeds.push(s);
+        speeds.push(Trials::run(models::two_drivers)?);
+        for t in &speeds {
+            eprintln!(
+                "can-bench: {}: {:.0} frames/s (median of {})",
+                t.scenario(),
+                t.median().frames_per_sec(),
+                t.runs.len()
+            );
+        }
         report.sim = Some(speeds);
     }
 

@@ -18,14 +18,19 @@ use crate::simspeed::{Speed, BITRATE, MIN_SECS};
 
 /// The APB1 clock of the bxCAN side (only for its bit timing).
 const APB1_HZ: u32 = 54_000_000;
-/// Bus events between two looks at the clock.
-const EVENTS_PER_CHECK: u32 = 1_000;
+/// Frames each side queues per round (the transmit rings hold 16).
+const ROUND: usize = 8;
+/// Bus events allowed for one round before the run is declared stuck.
+const MAX_EVENTS_PER_ROUND: u32 = 10_000;
 /// Bit times one `step_until` may cover when nothing is sent.
 const MAX_IDLE_BITS: u64 = 1_000;
 
-fn bxcan_driver(model: &BxCanModel) -> Result<Driver<Can<BxCanModel>, 32, 16>> {
+/// Configures the bxCAN side. Leaving initialization mode takes 11 recessive bits on the
+/// bus (RM0410 §40.4.2), so the bus runs a few bit times between bounded tries.
+fn bxcan_driver(model: &BxCanModel, bus: &mut Bus) -> Result<Driver<Can<BxCanModel>, 32, 16>> {
     let config = Config::from_bitrate(APB1_HZ, BITRATE)
-        .map_err(|e| Error::new(format!("bxCAN configuration: {e:?}")))?;
+        .map_err(|e| Error::new(format!("bxCAN configuration: {e:?}")))?
+        .wait_iterations(4);
     let mut init = Can::can1(model.clone(), &config)
         .map_err(|e| Error::new(format!("bxCAN can1: {:?}", e.error)))?;
     let mut plan = FilterPlan::manual();
@@ -35,10 +40,16 @@ fn bxcan_driver(model: &BxCanModel) -> Result<Driver<Can<BxCanModel>, 32, 16>> {
         .map_err(|e| Error::new(format!("bxCAN filters: {e:?}")))?;
     init.set_filters(&plan)
         .map_err(|e| Error::new(format!("bxCAN filters: {e:?}")))?;
-    let can = init
-        .enable()
-        .map_err(|e| Error::new(format!("bxCAN enable: {:?}", e.error)))?;
-    Ok(Driver::new(can))
+    for _ in 0..100 {
+        match init.enable() {
+            Ok(can) => return Ok(Driver::new(can)),
+            Err(failed) => {
+                init = failed.value;
+                bus.run_for(4);
+            }
+        }
+    }
+    Err(Error::new("bxCAN model: no INAK = 0 after 400 bit times of idle bus"))
 }
 
 fn flexcan_driver(model: &FlexCanModel) -> Result<AcanDriver<FlexCanModel>> {
@@ -60,65 +71,60 @@ fn flexcan_driver(model: &FlexCanModel) -> Result<AcanDriver<FlexCanModel>> {
 pub fn two_drivers() -> Result<Speed> {
     let bx_model = BxCanModel::can1();
     let fx_model = FlexCanModel::mk20dx256();
-    let mut bx = bxcan_driver(&bx_model)?;
-    let mut fx = flexcan_driver(&fx_model)?;
     let mut bus = Bus::new(BITRATE).context("Bus::new")?;
     bus.set_tracing(false);
     bus.attach("bxcan", bx_model.clone());
     bus.attach("flexcan", fx_model.clone());
+    let mut fx = flexcan_driver(&fx_model)?;
+    let mut bx = bxcan_driver(&bx_model, &mut bus)?;
 
-    let mut sent = [0u64; 2];
+    // Rounds: each side queues ROUND frames, then the bus runs until both receivers have
+    // them all (bxCAN's identifiers win arbitration, so without rounds it would starve the
+    // FlexCAN side).
+    let mut sent = 0u64;
     let mut delivered = [0u64; 2];
     let start = Instant::now();
-    let mut events = 0u32;
-    loop {
-        // Keep both transmit queues full.
-        loop {
-            let n = sent[0];
-            let f = Frame::standard(0x100 + (n % 0x100) as u16, &n.to_le_bytes())
-                .context("frame")?;
-            if bx.try_send(&f).is_err() {
-                break;
+    while start.elapsed().as_secs_f64() < MIN_SECS {
+        for _ in 0..ROUND {
+            let data = sent.to_le_bytes();
+            let id = (sent % 0x100) as u16;
+            let a = Frame::standard(0x100 + id, &data);
+            let b = Frame::standard(0x300 + id, &data);
+            let (a, b) = match (a, b) {
+                (Ok(a), Ok(b)) => (a, b),
+                _ => return Err(Error::new("building a frame")),
+            };
+            if bx.try_send(&a).is_err() || fx.try_send(&b).is_err() {
+                return Err(Error::new("a transmit queue refused a frame of the round"));
             }
-            sent[0] += 1;
+            sent += 1;
         }
-        loop {
-            let n = sent[1];
-            let f = Frame::standard(0x300 + (n % 0x100) as u16, &n.to_le_bytes())
-                .context("frame")?;
-            if fx.try_send(&f).is_err() {
-                break;
+        let mut events = 0u32;
+        while delivered[0] < sent || delivered[1] < sent {
+            bus.step_until(bus.now() + MAX_IDLE_BITS);
+            if bx_model.irq_lines().any() {
+                bx.on_interrupt();
             }
-            sent[1] += 1;
-        }
-        bus.step_until(bus.now() + MAX_IDLE_BITS);
-        if bx_model.irq_lines().any() {
-            bx.on_interrupt();
-        }
-        while bx.receive().is_ok() {
-            delivered[0] += 1;
-        }
-        if fx_model.irq_pending() {
-            fx.on_interrupt();
-        }
-        while fx.receive().is_ok() {
-            delivered[1] += 1;
-        }
-        events += 1;
-        if events >= EVENTS_PER_CHECK {
-            events = 0;
-            if start.elapsed().as_secs_f64() >= MIN_SECS {
-                break;
+            while bx.receive().is_ok() {
+                delivered[0] += 1;
+            }
+            if fx_model.irq_pending() {
+                fx.on_interrupt();
+            }
+            while fx.receive().is_ok() {
+                delivered[1] += 1;
+            }
+            events += 1;
+            if events > MAX_EVENTS_PER_ROUND {
+                return Err(Error::new(format!(
+                    "the drivers over their models stopped exchanging frames (sent {sent} \
+                     each way, received: bxCAN {}, FlexCAN {})",
+                    delivered[0], delivered[1]
+                )));
             }
         }
     }
     let secs = start.elapsed().as_secs_f64();
-    if delivered[0] == 0 || delivered[1] == 0 {
-        return Err(Error::new(format!(
-            "the drivers over their models exchanged no frames (received: bxCAN {}, FlexCAN {})",
-            delivered[0], delivered[1]
-        )));
-    }
     let lost = bx.traffic().rx_ring_overflows + fx.traffic().rx_ring_overflows;
     if lost != 0 {
         return Err(Error::new(format!("{lost} frames lost to full receive rings")));

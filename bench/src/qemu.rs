@@ -137,8 +137,6 @@ pub fn build_plugin(paths: &Paths, tools: &Tools) -> Result<PathBuf> {
 /// One measured region.
 #[derive(Debug, Clone)]
 pub struct Region {
-    /// Its key (`twocan.try_send.direct`, ...), as the firmware names it.
-    pub key: String,
     /// Raw counts of each measurement (marker overhead included).
     pub raw: Vec<u64>,
 }
@@ -146,7 +144,7 @@ pub struct Region {
 /// The outcome of one firmware run.
 #[derive(Debug, Clone)]
 pub struct Counts {
-    /// Regions by key.
+    /// Regions by key (`twocan.try_send.direct`, ... as the firmware names them).
     pub regions: BTreeMap<String, Region>,
     /// Instructions of an empty region (the end marker store), subtracted from the others.
     pub overhead: u64,
@@ -260,10 +258,7 @@ pub fn run(paths: &Paths, tools: &Tools, plugin: &Path, elf: &Path, tag: &str) -
                 })?;
                 regions
                     .entry(key.clone())
-                    .or_insert_with(|| Region {
-                        key: key.clone(),
-                        raw: Vec::new(),
-                    })
+                    .or_insert_with(|| Region { raw: Vec::new() })
                     .raw
                     .push(count);
             }

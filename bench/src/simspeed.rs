@@ -11,14 +11,16 @@ use twocan_core::Frame;
 
 use crate::cmd::{Context, Error, Result};
 
-/// Host time each scenario runs for at least.
-pub const MIN_SECS: f64 = 1.5;
+/// Host time each trial of a scenario runs for at least.
+pub const MIN_SECS: f64 = 0.5;
+/// Trials of each scenario (the report gives the median and the range).
+pub const TRIALS: usize = 3;
 /// Frames per batch and node.
 const BATCH: usize = 2_000;
 /// The simulated bit rate (it only converts bit times to seconds).
 pub const BITRATE: u32 = 500_000;
 
-/// The result of one scenario.
+/// The result of one trial of a scenario.
 #[derive(Debug, Clone)]
 pub struct Speed {
     /// What ran.
@@ -44,7 +46,7 @@ impl Speed {
 }
 
 fn frame(id: u16, n: u64) -> Result<Frame> {
-    Frame::standard(id, &n.to_le_bytes()).context("building a frame")
+    Frame::standard(id, &n.to_le_bytes()).map_err(|e| Error::new(format!("building a frame: {e:?}")))
 }
 
 /// `senders` SimNodes (identifiers 0x100 + node) each sending 8-byte frames, one more
@@ -100,10 +102,47 @@ pub fn bare_bus(senders: usize, tracing: bool) -> Result<Speed> {
     })
 }
 
-/// Makes sure a scenario is not optimised away and reports a too-short run.
-pub fn check(s: &Speed) -> Result<()> {
-    if s.frames == 0 || s.secs < Duration::from_millis(100).as_secs_f64() {
-        return Err(Error::new(format!("scenario `{}` did not run", s.scenario)));
+/// The trials of one scenario.
+#[derive(Debug, Clone)]
+pub struct Trials {
+    /// Each trial, in the order run.
+    pub runs: Vec<Speed>,
+}
+
+impl Trials {
+    /// Runs `trial` [`TRIALS`] times.
+    pub fn run(mut trial: impl FnMut() -> Result<Speed>) -> Result<Trials> {
+        let mut runs = Vec::new();
+        for _ in 0..TRIALS {
+            let s = trial()?;
+            if s.frames == 0 || s.secs < Duration::from_millis(100).as_secs_f64() {
+                return Err(Error::new(format!("scenario `{}` did not run", s.scenario)));
+            }
+            runs.push(s);
+        }
+        Ok(Trials { runs })
     }
-    Ok(())
+
+    /// The scenario's description.
+    pub fn scenario(&self) -> &str {
+        self.runs.first().map(|s| s.scenario.as_str()).unwrap_or("")
+    }
+
+    fn sorted(&self) -> Vec<&Speed> {
+        let mut v: Vec<&Speed> = self.runs.iter().collect();
+        v.sort_by(|a, b| a.frames_per_sec().total_cmp(&b.frames_per_sec()));
+        v
+    }
+
+    /// The trial with the median frames per second.
+    pub fn median(&self) -> &Speed {
+        let v = self.sorted();
+        v[v.len() / 2]
+    }
+
+    /// The slowest and fastest trials' frames per second.
+    pub fn range(&self) -> (f64, f64) {
+        let v = self.sorted();
+        (v[0].frames_per_sec(), v[v.len() - 1].frames_per_sec())
+    }
 }

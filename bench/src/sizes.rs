@@ -115,8 +115,8 @@ pub fn measure(path: &Path) -> Result<Size> {
     let mut sections = Vec::new();
     for section in elf.sections() {
         let header = section.elf_section_header();
-        let flags = u64::from(header.sh_flags(endian));
-        if flags & u64::from(SHF_ALLOC) == 0 {
+        let flags = header.sh_flags(endian).0;
+        if flags & SHF_ALLOC.0 == 0 {
             continue;
         }
         let size = u64::from(header.sh_size(endian));
@@ -125,7 +125,7 @@ pub fn measure(path: &Path) -> Result<Size> {
         }
         let class = if header.sh_type(endian) == SHT_NOBITS {
             Class::Bss
-        } else if flags & u64::from(SHF_WRITE) != 0 {
+        } else if flags & SHF_WRITE.0 != 0 {
             Class::Data
         } else {
             Class::Code

@@ -78,11 +78,13 @@ fn receive_errors_and_last_error_code() {
     let (mut m, mut bus) = started(BxCanModel::can1());
     m.write32(regs::ESR, esr::LEC.val(esr::LEC_SOFTWARE));
     assert_eq!(esr::LEC.get(esr_of(&m)), 7, "software may set LEC to 7");
-    for _ in 0..16 {
+    // ISO 11898-1 rules 1 and 2 together: +1 for the error, +8 for the dominant bit
+    // after the error flag.
+    for _ in 0..15 {
         bus.inject_rx_error(LastErrorCode::Stuff, true);
     }
     let e = esr_of(&m);
-    assert_eq!(esr::REC.get(e), 128);
+    assert_eq!(esr::REC.get(e), 135);
     assert_eq!(esr::LEC.get(e), esr::LEC_STUFF);
     assert_eq!(e & (esr::EWGF | esr::EPVF), esr::EWGF | esr::EPVF);
     bus.inject(&std_frame(0x1, &[]));

@@ -146,10 +146,11 @@ fn received_frames_count_down_rec() {
     let (mut m, mut bus) = started(BxCanModel::can1());
     bus.inject_rx_error(twocan_core::LastErrorCode::Crc, false);
     bus.inject_rx_error(twocan_core::LastErrorCode::Crc, true);
-    assert_eq!(twocan_bxcan::regs::esr::REC.get(m.read32(regs::ESR)), 9);
+    // +1, then +1 and +8 (ISO 11898-1 rules 1 and 2)
+    assert_eq!(twocan_bxcan::regs::esr::REC.get(m.read32(regs::ESR)), 10);
     bus.inject(&std_frame(0x1, &[]));
     let e = m.read32(regs::ESR);
-    assert_eq!(twocan_bxcan::regs::esr::REC.get(e), 8);
+    assert_eq!(twocan_bxcan::regs::esr::REC.get(e), 9);
     assert_eq!(
         twocan_bxcan::regs::esr::LEC.get(e),
         0,

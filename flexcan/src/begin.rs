@@ -44,7 +44,12 @@ struct Plan {
 }
 
 /// The checks of ACAN table 5, all of them, then the register values.
-fn plan(target: Target, settings: &Settings, primary: &[Filter], secondary: &[Filter]) -> Result<Plan, ConfigErrors> {
+fn plan(
+    target: Target,
+    settings: &Settings,
+    primary: &[Filter],
+    secondary: &[Filter],
+) -> Result<Plan, ConfigErrors> {
     let mut errors = ConfigErrors::NONE;
 
     if !settings.bit_rate_close_to_wished() {
@@ -52,7 +57,10 @@ fn plan(target: Target, settings: &Settings, primary: &[Filter], secondary: &[Fi
     }
     // The table-6 rules, the register widths, and the clock the counts were made for.
     let timing_bits = settings.timing.flexcan_ctrl1();
-    if !settings.consistency().is_ok() || timing_bits.is_err() || settings.timing.clock_hz != CAN_CLOCK_HZ {
+    if !settings.consistency().is_ok()
+        || timing_bits.is_err()
+        || settings.timing.clock_hz != CAN_CLOCK_HZ
+    {
         errors |= ConfigErrors::BIT_TIMING_INCONSISTENT;
     }
 
@@ -66,7 +74,11 @@ fn plan(target: Target, settings: &Settings, primary: &[Filter], secondary: &[Fi
             errors |= ConfigErrors::NO_SUCH_INSTANCE;
             None
         }
-        Some(pins) => match choose_pins(pins, settings.use_alternate_tx_pin, settings.use_alternate_rx_pin) {
+        Some(pins) => match choose_pins(
+            pins,
+            settings.use_alternate_tx_pin,
+            settings.use_alternate_rx_pin,
+        ) {
             Ok(chosen) => Some(chosen),
             Err((no_tx, no_rx)) => {
                 if no_tx {
@@ -110,7 +122,13 @@ fn plan(target: Target, settings: &Settings, primary: &[Filter], secondary: &[Fi
                 ctrl1 |= ctrl1::ERRMSK | ctrl1::BOFFMSK | ctrl1::TWRNMSK | ctrl1::RWRNMSK;
                 mcr |= mcr::WRNEN;
             }
-            Ok(Plan { system, mcr, ctrl1, configuration: settings.configuration, table })
+            Ok(Plan {
+                system,
+                mcr,
+                ctrl1,
+                configuration: settings.configuration,
+                table,
+            })
         }
         _ => Err(errors),
     }
@@ -152,7 +170,12 @@ fn configure<R: Registers>(regs: &mut R, plan: &Plan, polls: u32) -> Result<(), 
 
 /// Every error `begin` would report for these arguments (ACAN table 5), found
 /// without touching any register. [`ConfigErrors::NONE`] when `begin` would proceed.
-pub fn check(target: Target, settings: &Settings, primary: &[Filter], secondary: &[Filter]) -> ConfigErrors {
+pub fn check(
+    target: Target,
+    settings: &Settings,
+    primary: &[Filter],
+    secondary: &[Filter],
+) -> ConfigErrors {
     match plan(target, settings, primary, secondary) {
         Ok(_) => ConfigErrors::NONE,
         Err(e) => e,
@@ -190,7 +213,10 @@ impl<R: Registers> FlexCan<R> {
     }
 }
 
-#[cfg(all(target_os = "none", any(feature = "teensy32", feature = "teensy35", feature = "teensy36")))]
+#[cfg(all(
+    target_os = "none",
+    any(feature = "teensy32", feature = "teensy35", feature = "teensy36")
+))]
 mod firmware {
     use twocan_core::{Filter, Mmio};
 
@@ -220,7 +246,8 @@ mod firmware {
             // SAFETY: the token is unique (taken once) and consumed here, so this is
             // the only access to FlexCAN0, at its reference-manual base address.
             let regs = unsafe { Mmio::new(target.instance.base()) };
-            FlexCan::begin(regs, &mut system(), target, settings, primary, secondary).map_err(|e| (self, e))
+            FlexCan::begin(regs, &mut system(), target, settings, primary, secondary)
+                .map_err(|e| (self, e))
         }
     }
 
@@ -236,7 +263,8 @@ mod firmware {
             let target = self.target();
             // SAFETY: as for `Can0::begin`, for FlexCAN1.
             let regs = unsafe { Mmio::new(target.instance.base()) };
-            FlexCan::begin(regs, &mut system(), target, settings, primary, secondary).map_err(|e| (self, e))
+            FlexCan::begin(regs, &mut system(), target, settings, primary, secondary)
+                .map_err(|e| (self, e))
         }
     }
 }

@@ -187,11 +187,20 @@ mod tests {
         assert_eq!(ConfigErrors::NO_ALTERNATE_TX_PIN.bits(), 0x40);
         assert_eq!(ConfigErrors::NO_ALTERNATE_RX_PIN.bits(), 0x80);
         let e = ConfigErrors::NO_ALTERNATE_RX_PIN | ConfigErrors::BIT_RATE_TOO_FAR;
-        assert_eq!(format!("{e:?}"), "ConfigErrors(BIT_RATE_TOO_FAR | NO_ALTERNATE_RX_PIN)");
+        assert_eq!(
+            format!("{e:?}"),
+            "ConfigErrors(BIT_RATE_TOO_FAR | NO_ALTERNATE_RX_PIN)"
+        );
         assert_eq!(format!("{:?}", ConfigErrors::NONE), "ConfigErrors(NONE)");
-        assert_eq!(ConfigErrors::from_bits_truncate(u32::MAX), ConfigErrors::ALL);
+        assert_eq!(
+            ConfigErrors::from_bits_truncate(u32::MAX),
+            ConfigErrors::ALL
+        );
         assert_eq!(ConfigErrors::ALL.count(), 9);
         assert_eq!(BeginError::Config(e).flags(), e);
-        assert_eq!(BeginError::from(twocan_core::Error::Timeout).flags(), ConfigErrors::NONE);
+        assert_eq!(
+            BeginError::from(twocan_core::Error::Timeout).flags(),
+            ConfigErrors::NONE
+        );
     }
 }

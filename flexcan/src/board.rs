@@ -3,7 +3,7 @@
 //!
 //! The board is a runtime value ([`Board`]), so the host tests check every board in
 //! one build; the cargo features `teensy32` (Teensy 3.1 and 3.2), `teensy35` and
-//! `teensy36` choose [`Board::DEFAULT`] for firmware. With several board features at
+//! `teensy36` choose `Board::DEFAULT` for firmware. With several board features at
 //! once (as in an `--all-features` build) the last in that list wins.
 //!
 //! Pin numbers and port pins come from [`crate::regs::pins`].
@@ -59,7 +59,10 @@ impl Board {
     #[cfg(all(feature = "teensy35", not(feature = "teensy36")))]
     pub const DEFAULT: Board = Board::Teensy35;
     /// The board the cargo features select.
-    #[cfg(all(feature = "teensy32", not(any(feature = "teensy35", feature = "teensy36"))))]
+    #[cfg(all(
+        feature = "teensy32",
+        not(any(feature = "teensy35", feature = "teensy36"))
+    ))]
     pub const DEFAULT: Board = Board::Teensy32;
 
     /// The board's microcontroller.
@@ -121,10 +124,22 @@ mod tests {
                 p.alternate_rx.map(|p| p.teensy_pin),
             )
         };
-        assert_eq!(teensy(Board::Teensy32, Instance::Can0), (3, Some(32), 4, Some(25)));
-        assert_eq!(teensy(Board::Teensy35, Instance::Can0), (3, Some(29), 4, Some(30)));
-        assert_eq!(teensy(Board::Teensy36, Instance::Can0), (3, Some(29), 4, Some(30)));
-        assert_eq!(teensy(Board::Teensy36, Instance::Can1), (33, None, 34, None));
+        assert_eq!(
+            teensy(Board::Teensy32, Instance::Can0),
+            (3, Some(32), 4, Some(25))
+        );
+        assert_eq!(
+            teensy(Board::Teensy35, Instance::Can0),
+            (3, Some(29), 4, Some(30))
+        );
+        assert_eq!(
+            teensy(Board::Teensy36, Instance::Can0),
+            (3, Some(29), 4, Some(30))
+        );
+        assert_eq!(
+            teensy(Board::Teensy36, Instance::Can1),
+            (33, None, 34, None)
+        );
         assert!(Board::Teensy32.pins(Instance::Can1).is_none());
         assert!(Board::Teensy35.pins(Instance::Can1).is_none());
         for b in Board::ALL {

@@ -118,7 +118,10 @@ mod tests {
             assert_eq!(c.primary_filter_capacity(), p);
             assert_eq!(c.secondary_filter_capacity(), s);
             assert_eq!(c.remote_mailbox_count(), r);
-            assert_eq!(c.first_remote_mailbox() + c.remote_mailbox_count(), DATA_MAILBOX);
+            assert_eq!(
+                c.first_remote_mailbox() + c.remote_mailbox_count(),
+                DATA_MAILBOX
+            );
             assert!(c.table_elements() <= MAX_TABLE_ELEMENTS);
             assert!(p <= MAX_PRIMARY_FILTERS && s <= MAX_SECONDARY_FILTERS);
         }

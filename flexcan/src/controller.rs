@@ -37,8 +37,8 @@
 use core::cell::Cell;
 
 use twocan_core::{
-    Controller, Error, ErrorCounters, ErrorState, ErrorStatus, Events, Frame, LastErrorCode, MailboxId,
-    MailboxState, Mode, Registers, RxFrame, TxPolicy,
+    Controller, Error, ErrorCounters, ErrorState, ErrorStatus, Events, Frame, LastErrorCode,
+    MailboxId, MailboxState, Mode, Registers, RxFrame, TxPolicy,
 };
 
 use crate::configuration::{Configuration, DATA_MAILBOX};
@@ -46,7 +46,7 @@ use crate::filters::FilterTable;
 use crate::handshake;
 use crate::instance::Target;
 use crate::message_buffer::MbWords;
-use crate::regs::{self, code, cs, esr1, iflag1, rxfir, ESR1, ECR, IFLAG1, RXFIR, TIMER};
+use crate::regs::{self, code, cs, esr1, iflag1, rxfir, ECR, ESR1, IFLAG1, RXFIR, TIMER};
 use crate::status;
 
 /// What settling a mailbox found.
@@ -87,7 +87,14 @@ pub struct FlexCan<R: Registers> {
 }
 
 impl<R: Registers> FlexCan<R> {
-    pub(crate) fn configured(regs: R, target: Target, table: FilterTable, listen_only: bool, polls: u32, irq_priority: u8) -> Self {
+    pub(crate) fn configured(
+        regs: R,
+        target: Target,
+        table: FilterTable,
+        listen_only: bool,
+        polls: u32,
+        irq_priority: u8,
+    ) -> Self {
         FlexCan {
             regs,
             target,
@@ -188,7 +195,8 @@ impl<R: Registers> FlexCan<R> {
         // A remote-frame mailbox is now an Rx mailbox (or an aborted one shows ABORT):
         // deactivate it.
         if !matches!(code, code::TX_INACTIVE | code::TX_DATA | code::TX_TANSWER) {
-            self.regs.write32(regs::mb_cs(mb), cs::CODE.val(code::TX_INACTIVE));
+            self.regs
+                .write32(regs::mb_cs(mb), cs::CODE.val(code::TX_INACTIVE));
         }
         outcome
     }
@@ -203,7 +211,8 @@ impl<R: Registers> FlexCan<R> {
     /// (reference manual "Transmit process": ID and data, then the control word).
     fn load(&mut self, mb: usize, frame: &Frame) {
         if cs::CODE.get(self.regs.read32(regs::mb_cs(mb))) != code::TX_INACTIVE {
-            self.regs.write32(regs::mb_cs(mb), cs::CODE.val(code::TX_INACTIVE));
+            self.regs
+                .write32(regs::mb_cs(mb), cs::CODE.val(code::TX_INACTIVE));
         }
         MbWords::transmit(frame).write(&mut self.regs, mb);
         self.in_flight |= 1 << mb;
@@ -237,7 +246,8 @@ impl<R: Registers> Controller for FlexCan<R> {
     /// Rewrites the ID filter table and masks in freeze mode, then restores the mode.
     /// The table must be compiled for the controller's [`Configuration`]
     /// ([`Error::InvalidArgument`] otherwise): the partition of the message buffers is
-    /// fixed by `begin`.
+    /// fixed by `begin`. Frames already in the Rx FIFO carry the `IDHIT` of the old
+    /// table: service the interrupt before, for exact indices.
     fn install_filters(&mut self, filters: &FilterTable) -> Result<(), Error> {
         if filters.configuration() != self.configuration() {
             return Err(Error::InvalidArgument);
@@ -282,7 +292,9 @@ impl<R: Registers> Controller for FlexCan<R> {
 
     /// `Empty` or `Pending`: FlexCAN does not tell which loaded mailbox is on the bus.
     fn mailbox_state(&self, mailbox: MailboxId) -> MailboxState {
-        let Some(mb) = self.mailbox(mailbox) else { return MailboxState::Empty };
+        let Some(mb) = self.mailbox(mailbox) else {
+            return MailboxState::Empty;
+        };
         let done = self.regs.read32(IFLAG1) & iflag1::buf(mb) != 0;
         if self.in_flight & (1 << mb) == 0 || done {
             MailboxState::Empty
@@ -296,12 +308,15 @@ impl<R: Registers> Controller for FlexCan<R> {
     /// meanwhile, or is still on the bus when the bound expires (its end is then
     /// accounted by [`Controller::take_events`]).
     fn abort(&mut self, mailbox: MailboxId) -> bool {
-        let Some(mb) = self.mailbox(mailbox) else { return false };
+        let Some(mb) = self.mailbox(mailbox) else {
+            return false;
+        };
         if self.mode == Mode::Sleep || self.is_free(mb) {
             return false;
         }
         let control = self.regs.read32(regs::mb_cs(mb));
-        self.regs.write32(regs::mb_cs(mb), cs::CODE.replace(control, code::TX_ABORT));
+        self.regs
+            .write32(regs::mb_cs(mb), cs::CODE.replace(control, code::TX_ABORT));
         for _ in 0..self.polls.max(1) {
             match self.settle(mb) {
                 Settled::Aborted => return true,
@@ -319,9 +334,15 @@ impl<R: Registers> Controller for FlexCan<R> {
         let words = MbWords::read(&self.regs, 0);
         let hit = rxfir::IDHIT.get(self.regs.read32(RXFIR)) as usize;
         self.regs.write32(IFLAG1, iflag1::BUF5I);
-        let frame = words.frame().map_err(|e| nb::Error::Other(Error::Frame(e)))?;
+        let frame = words
+            .frame()
+            .map_err(|e| nb::Error::Other(Error::Frame(e)))?;
         let filter = self.table.filter_index(hit, &frame);
-        Ok(RxFrame { frame, filter, timestamp: Some(words.timestamp()) })
+        Ok(RxFrame {
+            frame,
+            filter,
+            timestamp: Some(words.timestamp()),
+        })
     }
 
     fn take_events(&mut self) -> Events {
@@ -369,8 +390,16 @@ impl<R: Registers> Controller for FlexCan<R> {
         }
         let esr = self.read_esr1();
         let (state, counters) = status::decode(esr, self.regs.read32(ECR));
-        let state = if self.mode == Mode::Stopped { ErrorState::Stopped } else { state };
-        ErrorStatus { state, counters, last_error: self.last_error.get() }
+        let state = if self.mode == Mode::Stopped {
+            ErrorState::Stopped
+        } else {
+            state
+        };
+        ErrorStatus {
+            state,
+            counters,
+            last_error: self.last_error.get(),
+        }
     }
 
     /// `Normal`: on the bus. `Stopped`: freeze mode. `Sleep`: module disabled

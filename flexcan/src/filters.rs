@@ -7,7 +7,7 @@
 //! - **primary filters** use the table elements matched with an individual mask
 //!   (`RXIMRn`): kind, format, identifier, or mask + acceptance, or pass-all
 //!   (§12.1–12.3). Their conformance is [`Filter::check`] (§12.4); a filter of
-//!   kind [`FrameKind::Any`](twocan_core::FrameKind::Any) (not in ACAN) works too.
+//!   kind [`FrameKind::Any`] (not in ACAN) works too.
 //! - **secondary filters** share the one global mask `RXFGMASK`: each names a single
 //!   identifier with a data or remote kind and a standard or extended format, or is
 //!   the pass-all filter (§13, §13.4). Anything else is a secondary conformance error.
@@ -47,7 +47,9 @@
 use twocan_core::{Filter, Format, Frame, FrameKind};
 
 use crate::begin_error::ConfigErrors;
-use crate::configuration::{Configuration, MAX_PRIMARY_FILTERS, MAX_SECONDARY_FILTERS, MAX_TABLE_ELEMENTS};
+use crate::configuration::{
+    Configuration, MAX_PRIMARY_FILTERS, MAX_SECONDARY_FILTERS, MAX_TABLE_ELEMENTS,
+};
 
 /// Format A element / mask bit 31: remote frame.
 pub const ELEMENT_RTR: u32 = 1 << 31;
@@ -89,13 +91,16 @@ pub struct FilterTable {
 
 /// Whether `f` conforms as a secondary filter (ACAN §13.4).
 pub fn secondary_conforms(f: &Filter) -> bool {
-    f.check().is_ok()
-        && (f.is_pass_all() || (f.is_exact() && !matches!(f.kind, FrameKind::Any)))
+    f.check().is_ok() && (f.is_pass_all() || (f.is_exact() && !matches!(f.kind, FrameKind::Any)))
 }
 
 /// The format A element of a filter.
 pub const fn element_of(f: &Filter) -> u32 {
-    let rtr = if matches!(f.kind, FrameKind::Remote) { ELEMENT_RTR } else { 0 };
+    let rtr = if matches!(f.kind, FrameKind::Remote) {
+        ELEMENT_RTR
+    } else {
+        0
+    };
     let (ide, id) = match f.format {
         Format::Standard => (0, f.id << ELEMENT_STD_SHIFT),
         Format::Extended => (ELEMENT_IDE, f.id << ELEMENT_EXT_SHIFT),
@@ -106,7 +111,11 @@ pub const fn element_of(f: &Filter) -> u32 {
 
 /// The format A individual mask of a primary filter.
 pub const fn mask_of(f: &Filter) -> u32 {
-    let rtr = if matches!(f.kind, FrameKind::Any) { 0 } else { ELEMENT_RTR };
+    let rtr = if matches!(f.kind, FrameKind::Any) {
+        0
+    } else {
+        ELEMENT_RTR
+    };
     let (ide, id) = match f.format {
         Format::Standard => (ELEMENT_IDE, f.mask << ELEMENT_STD_SHIFT),
         Format::Extended => (ELEMENT_IDE, f.mask << ELEMENT_EXT_SHIFT),
@@ -145,7 +154,11 @@ impl FilterTable {
     /// Builds a table from lists already checked.
     fn build(configuration: Configuration, primary: &[Filter], secondary: &[Filter]) -> Self {
         const PASS_ALL: [Filter; 1] = [Filter::pass_all()];
-        let primary = if primary.is_empty() && secondary.is_empty() { &PASS_ALL[..] } else { primary };
+        let primary = if primary.is_empty() && secondary.is_empty() {
+            &PASS_ALL[..]
+        } else {
+            primary
+        };
         let p = primary.len();
         let s = secondary.len();
         let capacity_p = configuration.primary_filter_capacity();
@@ -153,13 +166,23 @@ impl FilterTable {
         let scan = secondary.iter().any(Filter::is_pass_all);
         let global_mask = if scan {
             0
-        } else if secondary.iter().any(|f| matches!(f.format, Format::Extended)) || s == 0 {
+        } else if secondary
+            .iter()
+            .any(|f| matches!(f.format, Format::Extended))
+            || s == 0
+        {
             FULL_MASK
         } else {
             // Only standard identifiers: the extended bits need no comparison.
             ELEMENT_RTR | ELEMENT_IDE | (0x7FF << ELEMENT_STD_SHIFT)
         };
-        let secondary_hit = |j: usize| if scan { Hit::ScanSecondary } else { Hit::Filter((p + j) as u16) };
+        let secondary_hit = |j: usize| {
+            if scan {
+                Hit::ScanSecondary
+            } else {
+                Hit::Filter((p + j) as u16)
+            }
+        };
 
         let mut t = FilterTable {
             configuration,
@@ -176,7 +199,9 @@ impl FilterTable {
         for i in 0..capacity_p {
             let (element, mask, hit) = match (primary.get(i), primary.last(), secondary.first()) {
                 (Some(f), _, _) => (element_of(f), mask_of(f), Hit::Filter(i as u16)),
-                (None, Some(last), _) => (element_of(last), mask_of(last), Hit::Filter((p - 1) as u16)),
+                (None, Some(last), _) => {
+                    (element_of(last), mask_of(last), Hit::Filter((p - 1) as u16))
+                }
                 (None, None, Some(first)) => (element_of(first), global_mask, secondary_hit(0)),
                 // Not reachable: an empty pair of lists became one pass-all filter.
                 (None, None, None) => (0, 0, Hit::Filter(0)),
@@ -279,7 +304,11 @@ mod tests {
         } | if frame.is_remote() { ELEMENT_RTR } else { 0 };
         let p = t.configuration().primary_filter_capacity();
         t.elements().iter().enumerate().position(|(i, e)| {
-            let m = if i < p { t.individual_masks()[i] } else { t.global_mask() };
+            let m = if i < p {
+                t.individual_masks()[i]
+            } else {
+                t.global_mask()
+            };
             (word ^ e) & m == 0
         })
     }
@@ -288,17 +317,35 @@ mod tests {
         if primary.is_empty() && secondary.is_empty() {
             return Some(0);
         }
-        primary.iter().chain(secondary).position(|f| f.matches(frame)).map(|i| i as u16)
+        primary
+            .iter()
+            .chain(secondary)
+            .position(|f| f.matches(frame))
+            .map(|i| i as u16)
     }
 
     fn frames() -> impl Iterator<Item = Frame> {
         let ids = [0u32, 1, 0x234, 0x540, 0x541, 0x542, 0x543, 0x544, 0x7FF];
-        let ext = [0u32, 0x234, 0x542, 0x123456, 0x123457, 0x1FFF_FFFF, 0x234 << 18];
+        let ext = [
+            0u32,
+            0x234,
+            0x542,
+            0x123456,
+            0x123457,
+            0x1FFF_FFFF,
+            0x234 << 18,
+        ];
         let std_frames = ids.into_iter().flat_map(|id| {
-            [Frame::standard(id as u16, &[1]).unwrap(), Frame::remote(id, false, 0).unwrap()]
+            [
+                Frame::standard(id as u16, &[1]).unwrap(),
+                Frame::remote(id, false, 0).unwrap(),
+            ]
         });
         let ext_frames = ext.into_iter().flat_map(|id| {
-            [Frame::extended(id, &[1]).unwrap(), Frame::remote(id, true, 0).unwrap()]
+            [
+                Frame::extended(id, &[1]).unwrap(),
+                Frame::remote(id, true, 0).unwrap(),
+            ]
         });
         std_frames.chain(ext_frames)
     }
@@ -317,14 +364,41 @@ mod tests {
         let lists: [(&[Filter], &[Filter]); 9] = [
             (&[], &[]),
             (&[d_ext(0x123456), d_std(0x234), r_std(0x542)], &[]),
-            (&[d_ext(0x123456), d_std(0x234), r_std(0x542), d_std(0x234)], &[]),
-            (&[d_ext(0x123456), d_std(0x234), Filter::pass_all(), r_std(0x542)], &[]),
+            (
+                &[d_ext(0x123456), d_std(0x234), r_std(0x542), d_std(0x234)],
+                &[],
+            ),
+            (
+                &[
+                    d_ext(0x123456),
+                    d_std(0x234),
+                    Filter::pass_all(),
+                    r_std(0x542),
+                ],
+                &[],
+            ),
             (&[], &[d_ext(0x123456), d_std(0x234), r_std(0x542)]),
             (&[d_ext(0x123456)], &[d_std(0x234), r_std(0x542)]),
-            (&[], &[d_ext(0x123456), d_std(0x234), r_std(0x542), Filter::pass_all()]),
-            (&[d_std(0x234)], &[d_std(0x234), Filter::pass_all(), r_std(0x542)]),
             (
-                &[Filter::masked(FrameKind::Data, Format::Standard, 0x7FC, 0x540)],
+                &[],
+                &[
+                    d_ext(0x123456),
+                    d_std(0x234),
+                    r_std(0x542),
+                    Filter::pass_all(),
+                ],
+            ),
+            (
+                &[d_std(0x234)],
+                &[d_std(0x234), Filter::pass_all(), r_std(0x542)],
+            ),
+            (
+                &[Filter::masked(
+                    FrameKind::Data,
+                    Format::Standard,
+                    0x7FC,
+                    0x540,
+                )],
                 &[d_std(0x540), r_std(0x7FF), Filter::extended(0x234 << 18)],
             ),
         ];
@@ -359,7 +433,12 @@ mod tests {
 
     #[test]
     fn numbering_and_masks() {
-        let t = FilterTable::compile(Configuration::Filters12_12, &[d_ext(0x123456)], &[d_std(0x234)]).unwrap();
+        let t = FilterTable::compile(
+            Configuration::Filters12_12,
+            &[d_ext(0x123456)],
+            &[d_std(0x234)],
+        )
+        .unwrap();
         assert_eq!(t.elements().len(), 24);
         assert_eq!(t.individual_masks().len(), 12);
         assert_eq!(t.elements()[0], ELEMENT_IDE | 0x123456 << 1);

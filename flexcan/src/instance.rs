@@ -2,8 +2,8 @@
 //!
 //! ACAN's `ACAN::can0` and `ACAN::can1` are global objects whose constructor is
 //! private, so a sketch cannot make a second driver for the same module. Here the
-//! same guarantee is a token taken at most once: [`Can0::take`] (every board) and
-//! [`Can1::take`] (Teensy 3.6) return `Some` the first time only, and `begin`
+//! same guarantee is a token taken at most once: `Can0::take` (every board) and
+//! `Can1::take` (Teensy 3.6) return `Some` the first time only, and `begin`
 //! consumes the token. The tokens need no `unsafe`: an atomic flag records the take.
 //!
 //! On the host, a controller is built over any [`twocan_core::Registers`] (the
@@ -190,10 +190,24 @@ mod tests {
 
     #[test]
     fn irq_numbers() {
-        assert_eq!(Target::new(Board::Teensy32, Instance::Can0).irqs().unwrap().message, 29);
-        assert_eq!(Target::new(Board::Teensy35, Instance::Can0).irqs().unwrap().message, 75);
+        assert_eq!(
+            Target::new(Board::Teensy32, Instance::Can0)
+                .irqs()
+                .unwrap()
+                .message,
+            29
+        );
+        assert_eq!(
+            Target::new(Board::Teensy35, Instance::Can0)
+                .irqs()
+                .unwrap()
+                .message,
+            75
+        );
         let can1 = Target::new(Board::Teensy36, Instance::Can1).irqs().unwrap();
         assert_eq!((can1.message, can1.wake_up), (94, 99));
-        assert!(Target::new(Board::Teensy35, Instance::Can1).irqs().is_none());
+        assert!(Target::new(Board::Teensy35, Instance::Can1)
+            .irqs()
+            .is_none());
     }
 }

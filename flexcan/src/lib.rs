@@ -88,11 +88,11 @@ pub mod board;
 pub mod configuration;
 pub mod controller;
 pub mod filters;
-pub mod handshake;
+mod handshake;
 pub mod instance;
-pub mod message_buffer;
+mod message_buffer;
 pub mod settings;
-pub mod status;
+mod status;
 pub mod system;
 
 pub mod regs;

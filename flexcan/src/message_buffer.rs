@@ -25,7 +25,11 @@ impl MbWords {
     /// remote frame), SRR and IDE for an extended identifier.
     pub fn transmit(frame: &Frame) -> Self {
         let extended = frame.is_extended();
-        let id = if extended { id::EXT_ID.val(frame.raw_id()) } else { id::STD.val(frame.raw_id()) };
+        let id = if extended {
+            id::EXT_ID.val(frame.raw_id())
+        } else {
+            id::STD.val(frame.raw_id())
+        };
         let mut control = cs::CODE.val(code::TX_DATA) | cs::DLC.val(frame.dlc() as u32);
         if extended {
             control |= cs::SRR | cs::IDE;
@@ -65,7 +69,11 @@ impl MbWords {
     /// The frame these words hold. A DLC of 9–15 counts as 8 (ISO 11898-1).
     pub fn frame(&self) -> Result<Frame, FrameError> {
         let extended = self.cs & cs::IDE != 0;
-        let raw = if extended { id::EXT_ID.get(self.id) } else { id::STD.get(self.id) };
+        let raw = if extended {
+            id::EXT_ID.get(self.id)
+        } else {
+            id::STD.get(self.id)
+        };
         let dlc = cs::DLC.get(self.cs).min(8) as u8;
         let w0 = self.word0.to_be_bytes();
         let w1 = self.word1.to_be_bytes();
@@ -76,11 +84,6 @@ impl MbWords {
     /// The TIME STAMP field: the free-running timer when the frame was received.
     pub const fn timestamp(&self) -> u16 {
         cs::TIME_STAMP.get(self.cs) as u16
-    }
-
-    /// The CODE field.
-    pub const fn code(&self) -> u32 {
-        cs::CODE.get(self.cs)
     }
 }
 
@@ -99,14 +102,17 @@ mod tests {
         ];
         for f in frames {
             let w = MbWords::transmit(&f);
-            assert_eq!(w.code(), code::TX_DATA);
+            assert_eq!(cs::CODE.get(w.cs), code::TX_DATA);
             assert_eq!(w.frame().unwrap(), f);
         }
         let w = MbWords::transmit(&frames[2]);
         assert_eq!(w.cs & (cs::SRR | cs::IDE), cs::SRR | cs::IDE);
         assert_eq!(w.word0, 0x0102_0304);
         assert_eq!(MbWords::transmit(&frames[0]).id, 0x542 << 18);
-        let long = MbWords { cs: cs::DLC.val(15), ..Default::default() };
+        let long = MbWords {
+            cs: cs::DLC.val(15),
+            ..Default::default()
+        };
         assert_eq!(long.frame().unwrap().dlc(), 8);
     }
 }

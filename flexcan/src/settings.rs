@@ -219,7 +219,10 @@ mod tests {
         let s = Settings::default();
         assert_eq!(s.wished_bit_rate(), 250_000);
         let t = s.timing;
-        assert_eq!((t.prescaler, t.prop_seg, t.phase_seg1, t.phase_seg2, t.sjw), (4, 5, 5, 5, 4));
+        assert_eq!(
+            (t.prescaler, t.prop_seg, t.phase_seg1, t.phase_seg2, t.sjw),
+            (4, 5, 5, 5, 4)
+        );
         assert!(!t.triple_sampling);
         assert!(s.bit_rate_close_to_wished());
         assert!(!s.listen_only && !s.self_reception && !s.loop_back);

@@ -21,7 +21,11 @@ pub const fn decode(esr1_value: u32, ecr_value: u32) -> (ErrorState, ErrorCounte
         esr1::FLTCONF_ERROR_ACTIVE => {
             let c = ErrorCounters { tec, rec };
             // Active per FLTCONF; the warning level comes from the counters.
-            let state = if tec >= 96 || rec >= 96 { ErrorState::Warning } else { ErrorState::Active };
+            let state = if tec >= 96 || rec >= 96 {
+                ErrorState::Warning
+            } else {
+                ErrorState::Active
+            };
             (state, c)
         }
         esr1::FLTCONF_ERROR_PASSIVE => (ErrorState::Passive, ErrorCounters { tec, rec }),
@@ -58,12 +62,24 @@ mod tests {
     #[test]
     fn states() {
         let fc = |v| esr1::FLTCONF.val(v);
-        assert_eq!(decode(fc(0), 0x0102), (ErrorState::Active, ErrorCounters { tec: 2, rec: 1 }));
-        assert_eq!(decode(fc(0), 96), (ErrorState::Warning, ErrorCounters { tec: 96, rec: 0 }));
+        assert_eq!(
+            decode(fc(0), 0x0102),
+            (ErrorState::Active, ErrorCounters { tec: 2, rec: 1 })
+        );
+        assert_eq!(
+            decode(fc(0), 96),
+            (ErrorState::Warning, ErrorCounters { tec: 96, rec: 0 })
+        );
         assert_eq!(decode(fc(1), 0x8000).0, ErrorState::Passive);
-        assert_eq!(decode(fc(2), 0x0305), (ErrorState::BusOff, ErrorCounters { tec: 256, rec: 3 }));
+        assert_eq!(
+            decode(fc(2), 0x0305),
+            (ErrorState::BusOff, ErrorCounters { tec: 256, rec: 3 })
+        );
         assert_eq!(decode(fc(3), 0).0, ErrorState::BusOff);
-        assert_eq!(last_error(esr1::ACKERR | esr1::STFERR), Some(LastErrorCode::Acknowledge));
+        assert_eq!(
+            last_error(esr1::ACKERR | esr1::STFERR),
+            Some(LastErrorCode::Acknowledge)
+        );
         assert_eq!(last_error(esr1::BIT1ERR), Some(LastErrorCode::BitRecessive));
         assert_eq!(last_error(esr1::IDLE), None);
     }

@@ -26,7 +26,10 @@ pub struct HostSystem {
 impl HostSystem {
     /// An empty register space.
     pub const fn new() -> Self {
-        HostSystem { cells: [(0, 0); 16], len: 0 }
+        HostSystem {
+            cells: [(0, 0); 16],
+            len: 0,
+        }
     }
 
     /// The addresses written so far, with their values, in first-write order.
@@ -37,7 +40,10 @@ impl HostSystem {
 
 impl Registers for HostSystem {
     fn read32(&self, offset: usize) -> u32 {
-        self.written().iter().find(|(a, _)| *a == offset).map_or(0, |(_, v)| *v)
+        self.written()
+            .iter()
+            .find(|(a, _)| *a == offset)
+            .map_or(0, |(_, v)| *v)
     }
 
     fn write32(&mut self, offset: usize, value: u32) {
@@ -75,8 +81,18 @@ pub struct SystemPlan {
 
 impl SystemPlan {
     /// The plan for the chosen pins.
-    pub const fn new(clock_gate: (usize, u32), tx: CanPin, rx: CanPin, open_collector: bool, pull_up: bool) -> Self {
-        SystemPlan { clock_gate, tx: (tx, tx_pcr(tx, open_collector)), rx: (rx, rx_pcr(rx, pull_up)) }
+    pub const fn new(
+        clock_gate: (usize, u32),
+        tx: CanPin,
+        rx: CanPin,
+        open_collector: bool,
+        pull_up: bool,
+    ) -> Self {
+        SystemPlan {
+            clock_gate,
+            tx: (tx, tx_pcr(tx, open_collector)),
+            rx: (rx, rx_pcr(rx, pull_up)),
+        }
     }
 
     /// Enables the clocks (ports, then the module: a FlexCAN register access with its
@@ -140,13 +156,17 @@ mod tests {
         let pins = Board::Teensy36.pins(Instance::Can1).unwrap();
         assert_eq!(choose_pins(pins, true, true), Err((true, true)));
         assert_eq!(choose_pins(pins, false, true), Err((false, true)));
-        let (tx, rx) = choose_pins(Board::Teensy32.pins(Instance::Can0).unwrap(), true, false).unwrap();
+        let (tx, rx) =
+            choose_pins(Board::Teensy32.pins(Instance::Can0).unwrap(), true, false).unwrap();
         assert_eq!((tx.teensy_pin, rx.teensy_pin), (32, 4));
         let plan = SystemPlan::new(Instance::Can0.clock_gate(), tx, rx, true, true);
         let mut sys = HostSystem::new();
         plan.apply(&mut sys);
         assert_eq!(sys.read32(sim::SIM_SCGC6), sim::SCGC6_FLEXCAN0);
-        assert_eq!(sys.read32(sim::SIM_SCGC5), sim::SCGC5_PORTA | sim::SCGC5_PORTB);
+        assert_eq!(
+            sys.read32(sim::SIM_SCGC5),
+            sim::SCGC5_PORTA | sim::SCGC5_PORTB
+        );
         assert_eq!(sys.read32(Port::B.pcr(18)), 0x200 | PCR_ODE);
         assert_eq!(sys.read32(Port::A.pcr(13)), 0x200 | PCR_PE | PCR_PS);
     }

@@ -8,25 +8,43 @@ use common::*;
 use twocan_core::{Error, Filter, Format, FrameKind};
 use twocan_flexcan::model::{FlexCanModel, ModelMode};
 use twocan_flexcan::regs::{self, mcr};
-use twocan_flexcan::{BeginError, Board, ConfigErrors, Configuration, FlexCan, HostSystem, Instance, Settings, Target};
+use twocan_flexcan::{
+    BeginError, Board, ConfigErrors, Configuration, FlexCan, HostSystem, Instance, Settings, Target,
+};
 
 const T32_CAN0: Target = Target::new(Board::Teensy32, Instance::Can0);
 const T36_CAN1: Target = Target::new(Board::Teensy36, Instance::Can1);
 
 /// Runs `begin` over a fresh model and checks that an error leaves every register
 /// untouched: the module still in reset (disabled), no SIM / PORT write.
-fn begin_error(target: Target, settings: &Settings, primary: &[Filter], secondary: &[Filter]) -> ConfigErrors {
+fn begin_error(
+    target: Target,
+    settings: &Settings,
+    primary: &[Filter],
+    secondary: &[Filter],
+) -> ConfigErrors {
     let model = model_for(target.board);
     let reset_mcr = model.peek32(regs::MCR);
     let reset_ctrl1 = model.peek32(regs::CTRL1);
     let mut sys = HostSystem::new();
     let flags = twocan_flexcan::check(target, settings, primary, secondary);
-    match FlexCan::begin(model.clone(), &mut sys, target, settings, primary, secondary) {
+    match FlexCan::begin(
+        model.clone(),
+        &mut sys,
+        target,
+        settings,
+        primary,
+        secondary,
+    ) {
         Ok(_) => panic!("begin succeeded"),
         Err(BeginError::Hardware(e)) => panic!("hardware error {e:?}"),
         Err(BeginError::Config(f)) => {
             assert_eq!(f, flags, "check() and begin() agree");
-            assert!(sys.written().is_empty(), "no SIM / PORT write: {:?}", sys.written());
+            assert!(
+                sys.written().is_empty(),
+                "no SIM / PORT write: {:?}",
+                sys.written()
+            );
             assert_eq!(model.mode(), ModelMode::Disabled);
             assert_eq!(model.peek32(regs::MCR), reset_mcr);
             assert_eq!(model.peek32(regs::CTRL1), reset_ctrl1);
@@ -54,7 +72,10 @@ fn bit_rate_too_far_15_2_1() {
 fn inconsistent_bit_configuration_15_2_2() {
     let mut s = Settings::new(500_000);
     s.timing.sjw = 0; // RJW 0: inconsistent, the bit rate is unchanged.
-    assert_eq!(begin_error(T32_CAN0, &s, &[], &[]), ConfigErrors::BIT_TIMING_INCONSISTENT);
+    assert_eq!(
+        begin_error(T32_CAN0, &s, &[], &[]),
+        ConfigErrors::BIT_TIMING_INCONSISTENT
+    );
     // §16.2's example (PS1 = 0) also moves the bit rate 45 % away: both flags.
     let mut s = Settings::new(500_000);
     s.timing.phase_seg1 = 0;
@@ -73,8 +94,14 @@ fn too_many_primary_filters_15_2_3() {
     for c in Configuration::ALL {
         let mut s = Settings::new(125_000);
         s.configuration = c;
-        let list: Vec<Filter> = (0..=c.primary_filter_capacity() as u16).map(Filter::standard).collect();
-        assert_eq!(begin_error(T32_CAN0, &s, &list, &[]), ConfigErrors::TOO_MANY_PRIMARY_FILTERS, "{c:?}");
+        let list: Vec<Filter> = (0..=c.primary_filter_capacity() as u16)
+            .map(Filter::standard)
+            .collect();
+        assert_eq!(
+            begin_error(T32_CAN0, &s, &list, &[]),
+            ConfigErrors::TOO_MANY_PRIMARY_FILTERS,
+            "{c:?}"
+        );
     }
 }
 
@@ -88,7 +115,11 @@ fn primary_filter_conformance_15_3() {
         Filter::masked(FrameKind::Data, Format::Standard, 0xFFF, 0),
     ];
     for f in not_conform {
-        assert_eq!(begin_error(T32_CAN0, &s, &[f], &[]), ConfigErrors::PRIMARY_FILTER_NOT_CONFORM, "{f:?}");
+        assert_eq!(
+            begin_error(T32_CAN0, &s, &[f], &[]),
+            ConfigErrors::PRIMARY_FILTER_NOT_CONFORM,
+            "{f:?}"
+        );
     }
 }
 
@@ -97,8 +128,14 @@ fn too_many_secondary_filters_15_3_1() {
     for c in Configuration::ALL {
         let mut s = Settings::new(125_000);
         s.configuration = c;
-        let list: Vec<Filter> = (0..=c.secondary_filter_capacity() as u16).map(Filter::standard).collect();
-        assert_eq!(begin_error(T32_CAN0, &s, &[], &list), ConfigErrors::TOO_MANY_SECONDARY_FILTERS, "{c:?}");
+        let list: Vec<Filter> = (0..=c.secondary_filter_capacity() as u16)
+            .map(Filter::standard)
+            .collect();
+        assert_eq!(
+            begin_error(T32_CAN0, &s, &[], &list),
+            ConfigErrors::TOO_MANY_SECONDARY_FILTERS,
+            "{c:?}"
+        );
     }
 }
 
@@ -114,7 +151,11 @@ fn secondary_filter_conformance_15_3_2() {
         Filter::kind_format(FrameKind::Remote, Format::Any),
     ];
     for f in not_conform {
-        assert_eq!(begin_error(T32_CAN0, &s, &[], &[f]), ConfigErrors::SECONDARY_FILTER_NOT_CONFORM, "{f:?}");
+        assert_eq!(
+            begin_error(T32_CAN0, &s, &[], &[f]),
+            ConfigErrors::SECONDARY_FILTER_NOT_CONFORM,
+            "{f:?}"
+        );
     }
 }
 
@@ -122,11 +163,20 @@ fn secondary_filter_conformance_15_3_2() {
 fn can1_has_no_alternate_pins_15_3_3_and_15_3_4() {
     let mut s = Settings::new(125_000);
     s.use_alternate_tx_pin = true;
-    assert_eq!(begin_error(T36_CAN1, &s, &[], &[]), ConfigErrors::NO_ALTERNATE_TX_PIN);
+    assert_eq!(
+        begin_error(T36_CAN1, &s, &[], &[]),
+        ConfigErrors::NO_ALTERNATE_TX_PIN
+    );
     s.use_alternate_rx_pin = true;
-    assert_eq!(begin_error(T36_CAN1, &s, &[], &[]), ConfigErrors::NO_ALTERNATE_TX_PIN | ConfigErrors::NO_ALTERNATE_RX_PIN);
+    assert_eq!(
+        begin_error(T36_CAN1, &s, &[], &[]),
+        ConfigErrors::NO_ALTERNATE_TX_PIN | ConfigErrors::NO_ALTERNATE_RX_PIN
+    );
     s.use_alternate_tx_pin = false;
-    assert_eq!(begin_error(T36_CAN1, &s, &[], &[]), ConfigErrors::NO_ALTERNATE_RX_PIN);
+    assert_eq!(
+        begin_error(T36_CAN1, &s, &[], &[]),
+        ConfigErrors::NO_ALTERNATE_RX_PIN
+    );
     assert_eq!(ConfigErrors::NO_ALTERNATE_TX_PIN.bits(), 0x40);
     assert_eq!(ConfigErrors::NO_ALTERNATE_RX_PIN.bits(), 0x80);
 }
@@ -135,7 +185,10 @@ fn can1_has_no_alternate_pins_15_3_3_and_15_3_4() {
 fn can1_only_on_teensy_36() {
     let s = Settings::new(125_000);
     for board in [Board::Teensy32, Board::Teensy35] {
-        assert_eq!(begin_error(Target::new(board, Instance::Can1), &s, &[], &[]), ConfigErrors::NO_SUCH_INSTANCE);
+        assert_eq!(
+            begin_error(Target::new(board, Instance::Can1), &s, &[], &[]),
+            ConfigErrors::NO_SUCH_INSTANCE
+        );
     }
 }
 
@@ -159,7 +212,10 @@ fn alternate_pins_accepted_on_can0() {
         let mut s = Settings::new(125_000);
         s.use_alternate_tx_pin = true;
         s.use_alternate_rx_pin = true;
-        assert_eq!(twocan_flexcan::check(Target::new(board, Instance::Can0), &s, &[], &[]), ConfigErrors::NONE);
+        assert_eq!(
+            twocan_flexcan::check(Target::new(board, Instance::Can0), &s, &[], &[]),
+            ConfigErrors::NONE
+        );
     }
 }
 
@@ -169,14 +225,33 @@ fn handshake_timeout_is_typed_and_retry_works() {
     model.set_freeze_ack_stuck(true);
     let mut s = Settings::new(125_000);
     s.handshake_polls = 1_000;
-    let e = FlexCan::begin(model.clone(), &mut HostSystem::new(), T32_CAN0, &s, &[], &[]).unwrap_err();
+    let e = FlexCan::begin(
+        model.clone(),
+        &mut HostSystem::new(),
+        T32_CAN0,
+        &s,
+        &[],
+        &[],
+    )
+    .unwrap_err();
     assert_eq!(e, BeginError::Hardware(Error::Timeout));
     assert_eq!(e.flags(), ConfigErrors::NONE);
     // Once the module acknowledges again, `begin` succeeds on the same module.
     model.set_freeze_ack_stuck(false);
-    let can = FlexCan::begin(model.clone(), &mut HostSystem::new(), T32_CAN0, &s, &[], &[]).unwrap();
+    let can = FlexCan::begin(
+        model.clone(),
+        &mut HostSystem::new(),
+        T32_CAN0,
+        &s,
+        &[],
+        &[],
+    )
+    .unwrap();
     assert_eq!(model.mode(), ModelMode::Normal);
-    assert_eq!(model.peek32(regs::MCR) & (mcr::FRZACK | mcr::LPMACK | mcr::NOTRDY), 0);
+    assert_eq!(
+        model.peek32(regs::MCR) & (mcr::FRZACK | mcr::LPMACK | mcr::NOTRDY),
+        0
+    );
     drop(can);
 }
 
@@ -184,7 +259,14 @@ fn handshake_timeout_is_typed_and_retry_works() {
 fn begin_keeps_the_model_by_reference() {
     // `regs` may be `&mut M`: the caller keeps the registers after an error.
     let mut model = FlexCanModel::mk20dx256();
-    let e = FlexCan::begin(&mut model, &mut HostSystem::new(), T32_CAN0, &Settings::new(1), &[], &[]);
+    let e = FlexCan::begin(
+        &mut model,
+        &mut HostSystem::new(),
+        T32_CAN0,
+        &Settings::new(1),
+        &[],
+        &[],
+    );
     assert!(matches!(e, Err(BeginError::Config(_))));
     assert_eq!(model.mode(), ModelMode::Disabled);
 }

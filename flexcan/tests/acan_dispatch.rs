@@ -40,7 +40,12 @@ fn setup() -> (twocan_flexcan::model::FlexCanModel, Can<32, 16>) {
 
 fn send_all(model: &twocan_flexcan::model::FlexCanModel, can: &mut Can<32, 16>) {
     let mut bus = bus_with(125_000, &[model]);
-    for f in [ext_data(0x123456, &[1]), std_data(0x234, &[2]), remote(0x542, false), std_data(0x7FF, &[])] {
+    for f in [
+        ext_data(0x123456, &[1]),
+        std_data(0x234, &[2]),
+        remote(0x542, false),
+        std_data(0x7FF, &[]),
+    ] {
         can.try_send(&f).unwrap();
         run1(&mut bus, can, 1_000);
     }
@@ -66,7 +71,10 @@ fn dispatch_with_call_backs_and_a_lost_filter() {
     assert_eq!(app.message_2, vec![0x542]);
     // Filter #1 names no call-back: its frame is lost (and counted).
     assert_eq!((d.handled(), d.unhandled()), (2, 1));
-    assert!(!can.dispatch(&mut d, &mut app), "empty receive buffer: false");
+    assert!(
+        !can.dispatch(&mut d, &mut app),
+        "empty receive buffer: false"
+    );
 }
 
 #[test]

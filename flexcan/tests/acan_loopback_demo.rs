@@ -13,7 +13,10 @@ fn loop_back_demo() {
     let settings = loop_back(125_000);
     assert_eq!(
         twocan_flexcan::check(
-            twocan_flexcan::Target::new(twocan_flexcan::Board::Teensy32, twocan_flexcan::Instance::Can0),
+            twocan_flexcan::Target::new(
+                twocan_flexcan::Board::Teensy32,
+                twocan_flexcan::Instance::Can0
+            ),
             &settings,
             &[],
             &[]

@@ -36,7 +36,20 @@ fn frames() -> Vec<Frame> {
 #[test]
 fn example_12_1_and_receive_idx_12_5() {
     let got = indices(&loop_back(125_000), &filters_0_1_2(), &[], &frames());
-    assert_eq!(got, vec![Some(0), Some(1), Some(2), None, None, None, None, None, None]);
+    assert_eq!(
+        got,
+        vec![
+            Some(0),
+            Some(1),
+            Some(2),
+            None,
+            None,
+            None,
+            None,
+            None,
+            None
+        ]
+    );
 }
 
 #[test]
@@ -59,7 +72,20 @@ fn duplicate_filter_never_matches() {
     let mut list = filters_0_1_2().to_vec();
     list.push(Filter::exact(FrameKind::Data, Format::Standard, 0x234)); // Filter #3
     let got = indices(&loop_back(125_000), &list, &[], &frames());
-    assert_eq!(got, vec![Some(0), Some(1), Some(2), None, None, None, None, None, None]);
+    assert_eq!(
+        got,
+        vec![
+            Some(0),
+            Some(1),
+            Some(2),
+            None,
+            None,
+            None,
+            None,
+            None,
+            None
+        ]
+    );
 }
 
 #[test]
@@ -67,7 +93,20 @@ fn pass_all_last_catches_the_rest_12_2() {
     let mut list = filters_0_1_2().to_vec();
     list.push(Filter::pass_all()); // Filter #3
     let got = indices(&loop_back(125_000), &list, &[], &frames());
-    assert_eq!(got, vec![Some(0), Some(1), Some(2), Some(3), Some(3), Some(3), Some(3), Some(3), Some(3)]);
+    assert_eq!(
+        got,
+        vec![
+            Some(0),
+            Some(1),
+            Some(2),
+            Some(3),
+            Some(3),
+            Some(3),
+            Some(3),
+            Some(3),
+            Some(3)
+        ]
+    );
 }
 
 #[test]
@@ -79,7 +118,20 @@ fn filters_after_pass_all_never_match_12_2() {
         Filter::exact(FrameKind::Remote, Format::Standard, 0x542),  // Filter #3
     ];
     let got = indices(&loop_back(125_000), &list, &[], &frames());
-    assert_eq!(got, vec![Some(0), Some(1), Some(2), Some(2), Some(2), Some(2), Some(2), Some(2), Some(2)]);
+    assert_eq!(
+        got,
+        vec![
+            Some(0),
+            Some(1),
+            Some(2),
+            Some(2),
+            Some(2),
+            Some(2),
+            Some(2),
+            Some(2),
+            Some(2)
+        ]
+    );
 }
 
 #[test]
@@ -98,14 +150,32 @@ fn mask_and_acceptance_12_3() {
         ext_data(0x541 << 18, &[]),
     ];
     let got = indices(&loop_back(125_000), &[f], &[], &frames);
-    assert_eq!(got, vec![Some(0), Some(0), Some(0), Some(0), None, None, None, None, None]);
+    assert_eq!(
+        got,
+        vec![
+            Some(0),
+            Some(0),
+            Some(0),
+            Some(0),
+            None,
+            None,
+            None,
+            None,
+            None
+        ]
+    );
 }
 
 #[test]
 fn extended_mask_and_kind_any() {
     // Beyond ACAN: a primary filter of kind "any" (data and remote).
     let list = [
-        Filter::masked(FrameKind::Remote, Format::Extended, 0x1FFF_FF00, 0x0ABC_DE00),
+        Filter::masked(
+            FrameKind::Remote,
+            Format::Extended,
+            0x1FFF_FF00,
+            0x0ABC_DE00,
+        ),
         Filter::exact(FrameKind::Any, Format::Standard, 0x100),
         Filter::kind_format(FrameKind::Remote, Format::Any),
     ];
@@ -119,19 +189,28 @@ fn extended_mask_and_kind_any() {
         std_data(0x101, &[]),
     ];
     let got = indices(&loop_back(125_000), &list, &[], &frames);
-    assert_eq!(got, vec![Some(0), None, Some(1), Some(1), Some(2), Some(2), None]);
+    assert_eq!(
+        got,
+        vec![Some(0), None, Some(1), Some(1), Some(2), Some(2), None]
+    );
 }
 
 #[test]
 fn every_primary_slot_of_every_configuration() {
     for c in Configuration::ALL {
         let n = c.primary_filter_capacity();
-        let list: Vec<Filter> = (0..n as u32).map(|i| Filter::standard(0x100 + i as u16)).collect();
+        let list: Vec<Filter> = (0..n as u32)
+            .map(|i| Filter::standard(0x100 + i as u16))
+            .collect();
         let mut settings = loop_back(125_000);
         settings.configuration = c;
-        let frames: Vec<Frame> = (0..n as u16 + 2).map(|i| std_data(0x100 + i, &[])).collect();
+        let frames: Vec<Frame> = (0..n as u16 + 2)
+            .map(|i| std_data(0x100 + i, &[]))
+            .collect();
         let got = indices(&settings, &list, &[], &frames);
-        let want: Vec<Option<u16>> = (0..n as u16 + 2).map(|i| (i < n as u16).then_some(i)).collect();
+        let want: Vec<Option<u16>> = (0..n as u16 + 2)
+            .map(|i| (i < n as u16).then_some(i))
+            .collect();
         assert_eq!(got, want, "{c:?}");
     }
 }
@@ -142,7 +221,13 @@ fn unused_elements_accept_nothing_extra() {
     let mut settings = loop_back(125_000);
     settings.configuration = Configuration::Filters14_18;
     let f = Filter::exact(FrameKind::Data, Format::Extended, 0x1234);
-    let frames = [ext_data(0x1234, &[]), std_data(0, &[]), ext_data(0, &[]), remote(0x1234, true), remote(0, false)];
+    let frames = [
+        ext_data(0x1234, &[]),
+        std_data(0, &[]),
+        ext_data(0, &[]),
+        remote(0x1234, true),
+        remote(0, false),
+    ];
     let got = indices(&settings, &[f], &[], &frames);
     assert_eq!(got, vec![Some(0), None, None, None, None]);
 }
@@ -152,11 +237,18 @@ fn table_and_masks_written_as_compiled() {
     let (model, can) = begin::<32, 16>(&loop_back(125_000), &filters_0_1_2(), &[]).unwrap();
     let table = can.controller().filters();
     for (i, e) in table.elements().iter().enumerate() {
-        assert_eq!(model.peek32(twocan_flexcan::regs::rx_fifo_filter(i)), *e, "element {i}");
+        assert_eq!(
+            model.peek32(twocan_flexcan::regs::rx_fifo_filter(i)),
+            *e,
+            "element {i}"
+        );
     }
     for (i, m) in table.individual_masks().iter().enumerate() {
         assert_eq!(model.peek32(twocan_flexcan::regs::rximr(i)), *m, "RXIMR{i}");
     }
-    assert_eq!(model.peek32(twocan_flexcan::regs::RXFGMASK), table.global_mask());
+    assert_eq!(
+        model.peek32(twocan_flexcan::regs::RXFGMASK),
+        table.global_mask()
+    );
     let _: &FlexCanModel = can.controller().registers();
 }

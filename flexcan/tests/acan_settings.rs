@@ -9,7 +9,9 @@ use common::*;
 use twocan_core::timing::{Consistency, Timing};
 use twocan_flexcan::regs::{self, ctrl1, mcr};
 use twocan_flexcan::settings::{DEFAULT_IRQ_PRIORITY, SAMPLE_POINT_PERMILLE};
-use twocan_flexcan::{Board, ConfigErrors, Configuration, Instance, Settings, Target, CAN_CLOCK_HZ};
+use twocan_flexcan::{
+    Board, ConfigErrors, Configuration, Instance, Settings, Target, CAN_CLOCK_HZ,
+};
 
 fn t32() -> Target {
     Target::new(Board::Teensy32, Instance::Can0)
@@ -30,7 +32,10 @@ fn bit_rate_842_kbit_16_1_and_16_4_16_5() {
     assert_eq!(s.ppm_from_wished_bit_rate(), 124);
     assert!(!s.exact_bit_rate());
     assert!(s.consistency().is_ok());
-    assert_eq!(twocan_flexcan::check(t32(), &s, &[], &[]), ConfigErrors::NONE);
+    assert_eq!(
+        twocan_flexcan::check(t32(), &s, &[], &[]),
+        ConfigErrors::NONE
+    );
 }
 
 #[test]
@@ -41,7 +46,10 @@ fn bit_rate_842_kbit_with_100_ppm_16_1() {
     assert_eq!(s.ppm_from_wished_bit_rate(), 124);
     // The tolerance changes only the acceptance, not the computation.
     assert_eq!(s.timing, Settings::new(842_000).timing);
-    assert_eq!(twocan_flexcan::check(t32(), &s, &[], &[]), ConfigErrors::BIT_RATE_TOO_FAR);
+    assert_eq!(
+        twocan_flexcan::check(t32(), &s, &[], &[]),
+        ConfigErrors::BIT_RATE_TOO_FAR
+    );
 }
 
 #[test]
@@ -94,7 +102,10 @@ fn bit_rate_440_kbit_decomposition_16_1() {
     // the printed value is that of the 500 kbit/s example (see the report).
     assert_eq!(s.sample_point_from_bit_start(), 66);
     assert_eq!(s.consistency(), Consistency::OK);
-    assert_eq!(twocan_flexcan::check(t32(), &s, &[], &[]), ConfigErrors::BIT_RATE_TOO_FAR);
+    assert_eq!(
+        twocan_flexcan::check(t32(), &s, &[], &[]),
+        ConfigErrors::BIT_RATE_TOO_FAR
+    );
 }
 
 #[test]
@@ -124,8 +135,14 @@ fn user_changed_segments_16_1() {
     assert_eq!(ctrl1::PSEG1.get(c), 5);
     assert_eq!(ctrl1::PSEG2.get(c), 3);
     assert_eq!(ctrl1::RJW.get(c), 3);
-    assert_eq!(Timing::from_flexcan_ctrl1(CAN_CLOCK_HZ, 500_000, c), s.timing);
-    assert_eq!(c & (ctrl1::CLKSRC | ctrl1::LOM | ctrl1::LPB | ctrl1::BOFFREC | ctrl1::SMP), 0);
+    assert_eq!(
+        Timing::from_flexcan_ctrl1(CAN_CLOCK_HZ, 500_000, c),
+        s.timing
+    );
+    assert_eq!(
+        c & (ctrl1::CLKSRC | ctrl1::LOM | ctrl1::LPB | ctrl1::BOFFREC | ctrl1::SMP),
+        0
+    );
 }
 
 #[test]
@@ -158,7 +175,8 @@ fn consistency_flags_16_2() {
         change(&mut s.timing);
         let c = s.consistency();
         assert!(c.bits() & (1 << bit) != 0, "table 6 bit {bit}: {c:?}");
-        assert!(twocan_flexcan::check(t32(), &s, &[], &[]).contains(ConfigErrors::BIT_TIMING_INCONSISTENT));
+        assert!(twocan_flexcan::check(t32(), &s, &[], &[])
+            .contains(ConfigErrors::BIT_TIMING_INCONSISTENT));
     }
 }
 
@@ -178,7 +196,10 @@ fn table_7_defaults() {
     let s = Settings::default();
     assert_eq!(s.wished_bit_rate(), 250_000);
     let t = s.timing;
-    assert_eq!((t.prescaler, t.prop_seg, t.phase_seg1, t.phase_seg2, t.sjw), (4, 5, 5, 5, 4));
+    assert_eq!(
+        (t.prescaler, t.prop_seg, t.phase_seg1, t.phase_seg2, t.sjw),
+        (4, 5, 5, 5, 4)
+    );
     assert!(!t.triple_sampling);
     assert!(s.bit_rate_close_to_wished());
     assert!(!s.listen_only && !s.self_reception && !s.loop_back);
@@ -186,7 +207,13 @@ fn table_7_defaults() {
     assert!(!s.use_alternate_tx_pin && !s.use_alternate_rx_pin);
     assert_eq!(s.message_irq_priority, DEFAULT_IRQ_PRIORITY);
     assert_eq!(DEFAULT_IRQ_PRIORITY, 64);
-    assert_eq!((twocan_flexcan::RECEIVE_BUFFER_SIZE, twocan_flexcan::TRANSMIT_BUFFER_SIZE), (32, 16));
+    assert_eq!(
+        (
+            twocan_flexcan::RECEIVE_BUFFER_SIZE,
+            twocan_flexcan::TRANSMIT_BUFFER_SIZE
+        ),
+        (32, 16)
+    );
     assert!(!s.tx_pin_open_collector && !s.rx_pin_pull_up);
     assert_eq!(SAMPLE_POINT_PERMILLE, 687);
     const CONST_SETTINGS: Settings = Settings::new(125_000);
@@ -195,7 +222,13 @@ fn table_7_defaults() {
 
 #[test]
 fn modes_16_7_1_to_16_7_3() {
-    let cases = [(false, false, false), (true, false, false), (false, true, false), (false, false, true), (true, true, true)];
+    let cases = [
+        (false, false, false),
+        (true, false, false),
+        (false, true, false),
+        (false, false, true),
+        (true, true, true),
+    ];
     for (listen_only, self_reception, loop_back) in cases {
         let mut s = Settings::new(250_000);
         s.listen_only = listen_only;
@@ -206,7 +239,11 @@ fn modes_16_7_1_to_16_7_3() {
         let m = model.peek32(regs::MCR);
         assert_eq!(c & ctrl1::LOM != 0, listen_only);
         assert_eq!(c & ctrl1::LPB != 0, loop_back);
-        assert_eq!(m & mcr::SRXDIS == 0, self_reception, "self reception = !SRXDIS");
+        assert_eq!(
+            m & mcr::SRXDIS == 0,
+            self_reception,
+            "self reception = !SRXDIS"
+        );
         assert_ne!(m & mcr::RFEN, 0);
         assert_ne!(m & mcr::IRMQ, 0);
         assert_eq!(mcr::MAXMB.get(m), 15);

@@ -17,7 +17,8 @@ fn flood_larger_than_the_receive_ring() {
     let mut bus = bus_with(500_000, &[&model]);
     let n = 20u16;
     for i in 0..n {
-        can.try_send(&std_data(0x100 + i, &i.to_le_bytes())).unwrap();
+        can.try_send(&std_data(0x100 + i, &i.to_le_bytes()))
+            .unwrap();
         // The interrupt moves each frame from the Rx FIFO into the ring at once, so
         // the hardware FIFO never overflows: every loss is the ring's.
         run1(&mut bus, &mut can, 300);
@@ -27,7 +28,15 @@ fn flood_larger_than_the_receive_ring() {
     assert_eq!(t.received, n as u32);
     assert_eq!(t.rx_ring_overflows, (n as usize - RX) as u32);
     // ACAN §10.4: after an overflow the peak count is size + 1.
-    assert_eq!(can.rx_stats(), BufferStats { size: RX, count: RX, peak: RX + 1, overflows: 12 });
+    assert_eq!(
+        can.rx_stats(),
+        BufferStats {
+            size: RX,
+            count: RX,
+            peak: RX + 1,
+            overflows: 12
+        }
+    );
     assert_eq!(can.error_stats().hardware_overruns, 0);
     assert_eq!(model.fifo_overflows(), 0);
     // The ring kept the oldest frames, in order.
@@ -44,7 +53,15 @@ fn receive_peak_without_overflow() {
         can.try_send(&std_data(i, &[])).unwrap();
     }
     run1(&mut bus, &mut can, 2_000);
-    assert_eq!(can.rx_stats(), BufferStats { size: 32, count: 5, peak: 5, overflows: 0 });
+    assert_eq!(
+        can.rx_stats(),
+        BufferStats {
+            size: 32,
+            count: 5,
+            peak: 5,
+            overflows: 0
+        }
+    );
     can.receive().unwrap();
     assert_eq!(can.rx_stats().count, 4);
     assert_eq!(can.rx_stats().peak, 5);
@@ -58,10 +75,29 @@ fn transmit_buffer_size_count_and_peak_8_3_to_8_5() {
     for i in 0..=TX as u16 {
         can.try_send(&std_data(i, &[])).unwrap();
     }
-    assert_eq!(can.tx_stats(), BufferStats { size: TX, count: TX, peak: TX, overflows: 0 });
+    assert_eq!(
+        can.tx_stats(),
+        BufferStats {
+            size: TX,
+            count: TX,
+            peak: TX,
+            overflows: 0
+        }
+    );
     // Full: tryToSend fails, and the peak becomes size + 1 (ACAN §8.5).
-    assert!(matches!(can.try_send(&std_data(0x7FF, &[])), Err(nb::Error::WouldBlock)));
-    assert_eq!(can.tx_stats(), BufferStats { size: TX, count: TX, peak: TX + 1, overflows: 1 });
+    assert!(matches!(
+        can.try_send(&std_data(0x7FF, &[])),
+        Err(nb::Error::WouldBlock)
+    ));
+    assert_eq!(
+        can.tx_stats(),
+        BufferStats {
+            size: TX,
+            count: TX,
+            peak: TX + 1,
+            overflows: 1
+        }
+    );
 }
 
 #[test]

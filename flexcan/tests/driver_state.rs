@@ -60,13 +60,19 @@ fn bus_off_then_automatic_recovery() {
         if can.state() == ErrorState::BusOff {
             saw_bus_off = true;
             assert_eq!(can.counters().tec, 256, "ACAN §17: 256 when bus-off");
-            assert_eq!(can.try_send(&std_data(1, &[])), Err(nb::Error::Other(Error::BusOff)));
+            assert_eq!(
+                can.try_send(&std_data(1, &[])),
+                Err(nb::Error::Other(Error::BusOff))
+            );
             break;
         }
     }
     assert!(saw_bus_off);
     assert_eq!(can.error_stats().bus_off, 1);
-    assert!(matches!(can.last_error(), LastErrorCode::BitDominant | LastErrorCode::BitRecessive));
+    assert!(matches!(
+        can.last_error(),
+        LastErrorCode::BitDominant | LastErrorCode::BitRecessive
+    ));
     // Automatic recovery after 128 × 11 recessive bits; the pending frame then goes.
     run1(&mut bus, &mut can, 128 * 11 + 500);
     assert_ne!(can.state(), ErrorState::BusOff);
@@ -88,7 +94,13 @@ fn receive_errors_count_rec() {
     bus.run_for(20);
     // Only this node sees a CRC error, on the first three attempts; the witness
     // acknowledges. Each error adds to REC, the good fourth attempt takes one off.
-    bus.inject_from(sender_id, 3, Fault::Crc { who: twocan_core::sim::Receivers::Node(me) });
+    bus.inject_from(
+        sender_id,
+        3,
+        Fault::Crc {
+            who: twocan_core::sim::Receivers::Node(me),
+        },
+    );
     sender.borrow_mut().send(std_data(0x77, &[]));
     run1(&mut bus, &mut can, 1_000);
     assert_eq!(drain(&mut can).len(), 1);
@@ -107,7 +119,10 @@ fn modes_and_bounded_waits() {
     can.set_mode(Mode::Sleep).unwrap();
     assert_eq!(model.mode(), ModelMode::Disabled);
     assert_eq!(can.state(), ErrorState::Sleeping);
-    assert_eq!(can.try_send(&std_data(1, &[])), Err(nb::Error::Other(Error::WrongMode)));
+    assert_eq!(
+        can.try_send(&std_data(1, &[])),
+        Err(nb::Error::Other(Error::WrongMode))
+    );
     can.set_mode(Mode::Normal).unwrap();
     assert_eq!(model.mode(), ModelMode::Normal);
     assert_eq!(can.state(), ErrorState::Active);
@@ -129,14 +144,22 @@ fn filters_replaced_at_run_time() {
     let s = loop_back(500_000);
     let (model, mut can) = begin::<32, 16>(&s, &[Filter::standard(0x10)], &[]).unwrap();
     let mut bus = bus_with(500_000, &[&model]);
-    let table = FilterTable::compile(s.configuration, &[Filter::standard(0x20)], &[Filter::standard(0x10)]).unwrap();
+    let table = FilterTable::compile(
+        s.configuration,
+        &[Filter::standard(0x20)],
+        &[Filter::standard(0x10)],
+    )
+    .unwrap();
     can.set_filters(&table).unwrap();
     assert_eq!(model.mode(), ModelMode::Normal);
     for id in [0x10, 0x20, 0x30] {
         can.try_send(&std_data(id, &[])).unwrap();
     }
     run1(&mut bus, &mut can, 1_000);
-    let got: Vec<(u32, u16)> = drain(&mut can).iter().map(|rx| (rx.frame.raw_id(), rx.filter)).collect();
+    let got: Vec<(u32, u16)> = drain(&mut can)
+        .iter()
+        .map(|rx| (rx.frame.raw_id(), rx.filter))
+        .collect();
     assert_eq!(got, vec![(0x10, 1), (0x20, 0)]);
     let other = FilterTable::compile(twocan_flexcan::Configuration::Filters8_0, &[], &[]).unwrap();
     assert_eq!(can.set_filters(&other), Err(Error::InvalidArgument));
@@ -166,11 +189,41 @@ fn time_stamps_follow_the_free_running_timer() {
 #[test]
 fn pins_and_clock_gates_7_16_7_5_16_7_6() {
     let cases = [
-        (Board::Teensy32, Instance::Can0, false, (Port::A, 12), (Port::A, 13)),
-        (Board::Teensy32, Instance::Can0, true, (Port::B, 18), (Port::B, 19)),
-        (Board::Teensy35, Instance::Can0, true, (Port::B, 18), (Port::B, 19)),
-        (Board::Teensy36, Instance::Can0, false, (Port::A, 12), (Port::A, 13)),
-        (Board::Teensy36, Instance::Can1, false, (Port::E, 24), (Port::E, 25)),
+        (
+            Board::Teensy32,
+            Instance::Can0,
+            false,
+            (Port::A, 12),
+            (Port::A, 13),
+        ),
+        (
+            Board::Teensy32,
+            Instance::Can0,
+            true,
+            (Port::B, 18),
+            (Port::B, 19),
+        ),
+        (
+            Board::Teensy35,
+            Instance::Can0,
+            true,
+            (Port::B, 18),
+            (Port::B, 19),
+        ),
+        (
+            Board::Teensy36,
+            Instance::Can0,
+            false,
+            (Port::A, 12),
+            (Port::A, 13),
+        ),
+        (
+            Board::Teensy36,
+            Instance::Can1,
+            false,
+            (Port::E, 24),
+            (Port::E, 25),
+        ),
     ];
     for (board, instance, alternate, (tx_port, tx_pin), (rx_port, rx_pin)) in cases {
         let mut s = Settings::new(250_000);
@@ -183,10 +236,16 @@ fn pins_and_clock_gates_7_16_7_5_16_7_6() {
         let target = Target::new(board, instance);
         let can = FlexCan::begin(model.clone(), &mut sys, target, &s, &[], &[]).unwrap();
         assert_eq!(sys.read32(tx_port.pcr(tx_pin)), PCR_MUX.val(2) | PCR_ODE);
-        assert_eq!(sys.read32(rx_port.pcr(rx_pin)), PCR_MUX.val(2) | PCR_PE | PCR_PS);
+        assert_eq!(
+            sys.read32(rx_port.pcr(rx_pin)),
+            PCR_MUX.val(2) | PCR_PE | PCR_PS
+        );
         let (gate, bit) = instance.clock_gate();
         assert_ne!(sys.read32(gate) & bit, 0);
-        assert_ne!(sys.read32(sim::SIM_SCGC5) & tx_port.scgc5_bit() & rx_port.scgc5_bit(), 0);
+        assert_ne!(
+            sys.read32(sim::SIM_SCGC5) & tx_port.scgc5_bit() & rx_port.scgc5_bit(),
+            0
+        );
         assert_eq!(can.target(), target);
         assert!(target.irqs().is_some());
         assert_eq!(can.message_irq_priority(), 64);
@@ -194,7 +253,15 @@ fn pins_and_clock_gates_7_16_7_5_16_7_6() {
     // Without open collector / pull-up: plain ALT2.
     let mut sys = HostSystem::new();
     let t = Target::new(Board::Teensy32, Instance::Can0);
-    let _can = FlexCan::begin(FlexCanModel::mk20dx256(), &mut sys, t, &Settings::new(250_000), &[], &[]).unwrap();
+    let _can = FlexCan::begin(
+        FlexCanModel::mk20dx256(),
+        &mut sys,
+        t,
+        &Settings::new(250_000),
+        &[],
+        &[],
+    )
+    .unwrap();
     assert_eq!(sys.read32(Port::A.pcr(12)), PCR_MUX.val(2));
     assert_eq!(sys.read32(Port::A.pcr(13)), PCR_MUX.val(2));
 }

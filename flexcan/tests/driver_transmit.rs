@@ -52,7 +52,11 @@ fn strict_order_across_10_000_frames() {
     let t = can.traffic();
     assert_eq!((t.queued, t.sent, t.received), (N, N, N));
     assert!(rejected > 0);
-    assert_eq!(can.tx_stats().peak, 17, "ACAN §8.5: size + 1 after a full buffer");
+    assert_eq!(
+        can.tx_stats().peak,
+        17,
+        "ACAN §8.5: size + 1 after a full buffer"
+    );
     assert_eq!(can.rx_stats().overflows, 0);
 }
 
@@ -61,18 +65,27 @@ fn strict_order_between_two_nodes() {
     // can0 sends 500 frames to can1 of a Teensy 3.6 over the simulated bus.
     let t36 = |i| twocan_flexcan::Target::new(twocan_flexcan::Board::Teensy36, i);
     let s = Settings::new(500_000);
-    let (m0, mut can0) = begin_on::<32, 8>(t36(twocan_flexcan::Instance::Can0), &s, &[], &[]).unwrap();
-    let (m1, mut can1) = begin_on::<600, 8>(t36(twocan_flexcan::Instance::Can1), &s, &[], &[]).unwrap();
+    let (m0, mut can0) =
+        begin_on::<32, 8>(t36(twocan_flexcan::Instance::Can0), &s, &[], &[]).unwrap();
+    let (m1, mut can1) =
+        begin_on::<600, 8>(t36(twocan_flexcan::Instance::Can1), &s, &[], &[]).unwrap();
     let mut bus = bus_with(500_000, &[&m0, &m1]);
     let mut next = 0u32;
     while next < 500 {
-        while next < 500 && can0.try_send(&std_data(scrambled_id(next), &next.to_le_bytes())).is_ok() {
+        while next < 500
+            && can0
+                .try_send(&std_data(scrambled_id(next), &next.to_le_bytes()))
+                .is_ok()
+        {
             next += 1;
         }
         run(&mut bus, &mut [&mut can0, &mut can1], 400);
     }
     run(&mut bus, &mut [&mut can0, &mut can1], 20_000);
-    let seqs: Vec<u32> = drain(&mut can1).iter().map(|rx| u32::from_le_bytes(rx.frame.data().try_into().unwrap())).collect();
+    let seqs: Vec<u32> = drain(&mut can1)
+        .iter()
+        .map(|rx| u32::from_le_bytes(rx.frame.data().try_into().unwrap()))
+        .collect();
     assert_eq!(seqs, (0..500).collect::<Vec<u32>>());
     assert_eq!(can0.traffic().sent, 500);
     assert!(drain(&mut can0).is_empty(), "no self reception by default");
@@ -88,27 +101,47 @@ fn remote_mailboxes_per_configuration_9() {
         assert_eq!(can.controller().mailbox_count(), 1 + r);
         // Straight to the remote-frame mailboxes (ACAN: remote frames are not queued).
         for i in 0..r {
-            can.controller_mut().transmit(&remote(0x500 + i as u32, false)).unwrap();
+            can.controller_mut()
+                .transmit(&remote(0x500 + i as u32, false))
+                .unwrap();
             assert_eq!(can.mailbox_state(MailboxId(1 + i)), MailboxState::Pending);
         }
-        assert!(matches!(can.controller_mut().transmit(&remote(0x5FF, false)), Err(nb::Error::WouldBlock)), "{c:?}");
+        assert!(
+            matches!(
+                can.controller_mut().transmit(&remote(0x5FF, false)),
+                Err(nb::Error::WouldBlock)
+            ),
+            "{c:?}"
+        );
         // The data mailbox is independent of them.
         assert_eq!(can.mailbox_state(MailboxId(0)), MailboxState::Empty);
-        can.controller_mut().transmit(&std_data(0x10, &[1])).unwrap();
-        assert!(matches!(can.controller_mut().transmit(&std_data(0x11, &[])), Err(nb::Error::WouldBlock)));
+        can.controller_mut()
+            .transmit(&std_data(0x10, &[1]))
+            .unwrap();
+        assert!(matches!(
+            can.controller_mut().transmit(&std_data(0x11, &[])),
+            Err(nb::Error::WouldBlock)
+        ));
         let mut bus = bus_with(500_000, &[&model]);
         run1(&mut bus, &mut can, 2_000);
         let got = drain(&mut can);
         assert_eq!(got.len(), r as usize + 1, "{c:?}");
         assert_eq!(can.traffic().sent, r as u32 + 1);
         // Remote frames came back as remote frames, the data frame as data.
-        assert_eq!(got.iter().filter(|rx| rx.frame.is_remote()).count(), r as usize);
+        assert_eq!(
+            got.iter().filter(|rx| rx.frame.is_remote()).count(),
+            r as usize
+        );
         for i in 0..=r {
             assert_eq!(can.mailbox_state(MailboxId(i)), MailboxState::Empty);
         }
         // After its remote frame, each mailbox is left inactive (not an Rx mailbox).
         for mb in c.first_remote_mailbox()..15 {
-            assert_eq!(cs::CODE.get(model.peek32(regs::mb_cs(mb as usize))), code::TX_INACTIVE, "MB{mb}");
+            assert_eq!(
+                cs::CODE.get(model.peek32(regs::mb_cs(mb as usize))),
+                code::TX_INACTIVE,
+                "MB{mb}"
+            );
         }
     }
 }
@@ -173,7 +206,12 @@ fn frames_reach_a_plain_iso_node() {
     let other = SimNode::new().shared();
     let mut bus = bus_with(250_000, &[&model]);
     bus.attach("other", other.clone());
-    let frames = [std_data(0x7FF, &[1, 2, 3]), ext_data(0x1FFF_FFFF, &[8; 8]), remote(0x12, false), remote(0x345678, true)];
+    let frames = [
+        std_data(0x7FF, &[1, 2, 3]),
+        ext_data(0x1FFF_FFFF, &[8; 8]),
+        remote(0x12, false),
+        remote(0x345678, true),
+    ];
     for f in &frames {
         can.try_send(f).unwrap();
     }
@@ -190,6 +228,12 @@ fn listen_only_does_not_transmit() {
     let mut s = Settings::new(500_000);
     s.listen_only = true;
     let (_model, mut can) = begin::<32, 16>(&s, &[], &[]).unwrap();
-    assert_eq!(can.try_send(&std_data(1, &[])), Err(nb::Error::Other(Error::WrongMode)));
-    assert_eq!(can.controller_mut().transmit(&remote(1, false)), Err(nb::Error::Other(Error::WrongMode)));
+    assert_eq!(
+        can.try_send(&std_data(1, &[])),
+        Err(nb::Error::Other(Error::WrongMode))
+    );
+    assert_eq!(
+        can.controller_mut().transmit(&remote(1, false)),
+        Err(nb::Error::Other(Error::WrongMode))
+    );
 }

@@ -121,9 +121,15 @@ fn receive_errors_warning_and_passive() {
         sof: r.now,
         now: r.now,
     };
-    for _ in 0..12 {
-        r.m.rx_error(LastErrorCode::Form, true, t); // rule 2: +8
+    for _ in 0..10 {
+        r.m.rx_error(LastErrorCode::Form, true, t); // rules 1 and 2: +9
     }
+    for _ in 0..5 {
+        r.m.rx_error(LastErrorCode::Stuff, false, t); // rule 1: +1
+    }
+    assert_eq!(ecr::RXERRCNT.get(r.rd(regs::ECR)), 95);
+    assert!(!r.m.irq().warning);
+    r.m.rx_error(LastErrorCode::Stuff, false, t);
     assert_eq!(ecr::RXERRCNT.get(r.rd(regs::ECR)), 96);
     let v = r.m.peek32(regs::ESR1);
     assert_ne!(v & (esr1::RXWRN | esr1::RWRNINT), 0);

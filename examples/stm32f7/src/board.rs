@@ -123,7 +123,11 @@ mod tests {
             assert!(b.apb1_hz <= 54_000_000, "RM0410 §5: APB1 ≤ 54 MHz");
             assert_eq!(b.sysclk_hz % b.apb1_hz, 0);
             for rate in [125_000, 250_000, BIT_RATE, 1_000_000] {
-                assert!(Config::from_bitrate(b.apb1_hz, rate).is_ok(), "{} {rate}", b.name);
+                assert!(
+                    Config::from_bitrate(b.apb1_hz, rate).is_ok(),
+                    "{} {rate}",
+                    b.name
+                );
             }
             assert_eq!(b.can1.af, 9);
         }

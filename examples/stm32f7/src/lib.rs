@@ -28,9 +28,9 @@ pub mod shared;
 #[path = "../../teensy/src/time.rs"]
 pub mod time;
 
+pub use board::Board;
 #[cfg(any(feature = "nucleo-f767zi", feature = "disco-f746g"))]
 pub use board::BOARD;
-pub use board::Board;
 
 /// What the host build of a firmware example does: say how to build the real thing.
 pub fn host_stub(example: &str) -> &'static str {

@@ -91,7 +91,8 @@ pub fn boot() -> Boot {
     // CAN1, so CAN1 is clocked whenever CAN2 is used.
     pac::CAN1::enable(&mut rcc.apb1);
     pac::CAN1::reset(&mut rcc.apb1);
-    drop(dp.CAN1);
+    // The PAC singleton is consumed: CAN1's registers belong to the bxCAN driver now.
+    let _can1: pac::CAN1 = dp.CAN1;
 
     // Pins in AF9 (the pin objects are not needed afterwards: the mode stays).
     #[cfg(feature = "nucleo-f767zi")]
@@ -103,7 +104,7 @@ pub fn boot() -> Boot {
         );
         pac::CAN2::enable(&mut rcc.apb1);
         pac::CAN2::reset(&mut rcc.apb1);
-        drop(dp.CAN2);
+        let _can2: pac::CAN2 = dp.CAN2;
     }
     #[cfg(feature = "disco-f746g")]
     {

@@ -129,7 +129,10 @@ mod tests {
                 let base = b.can_irq_base(i).unwrap();
                 assert!(base as usize + CAN_VECTORS_PER_INSTANCE <= b.irq_count);
                 let irqs = i.irqs(b.can.chip()).unwrap();
-                assert_eq!(irqs.wake_up as usize, base as usize + CAN_VECTORS_PER_INSTANCE - 1);
+                assert_eq!(
+                    irqs.wake_up as usize,
+                    base as usize + CAN_VECTORS_PER_INSTANCE - 1
+                );
             }
             assert_eq!(b.stack_top() % 8, 0);
         }

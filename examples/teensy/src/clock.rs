@@ -94,6 +94,9 @@ pub const FBE_CLOCKS: Clocks = Clocks {
 // FlexCAN's engine clock must be the 16 MHz the backend's bit timings are computed for.
 const _: () = assert!(FBE_CLOCKS.can_hz == twocan_flexcan::CAN_CLOCK_HZ);
 
+/// A condition on `MCG_S`.
+type StatusTest = fn(u8) -> bool;
+
 /// Polls `MCG_S` until `done` holds, at most `polls` times.
 fn wait<I: Io>(io: &mut I, polls: u32, done: impl Fn(u8) -> bool) -> bool {
     (0..polls).any(|_| done(io.read8(MCG_S)))
@@ -110,10 +113,16 @@ pub fn init<I: Io>(io: &mut I, polls: u32) -> Result<Clocks, ClockError> {
     io.write8(MCG_C2, (c2 & MCG_C2_FCFTRIM) | MCG_C2_VALUE);
     io.write8(MCG_C1, MCG_C1_FBE);
 
-    let steps: [(fn(u8) -> bool, ClockError); 3] = [
+    let steps: [(StatusTest, ClockError); 3] = [
         (|s| s & MCG_S_OSCINIT0 != 0, ClockError::OscillatorTimeout),
-        (|s| s & MCG_S_IREFST == 0, ClockError::ReferenceSwitchTimeout),
-        (|s| (s >> MCG_S_CLKST_SHIFT) & 0b11 == 2, ClockError::ClockSwitchTimeout),
+        (
+            |s| s & MCG_S_IREFST == 0,
+            ClockError::ReferenceSwitchTimeout,
+        ),
+        (
+            |s| (s >> MCG_S_CLKST_SHIFT) & 0b11 == 2,
+            ClockError::ClockSwitchTimeout,
+        ),
     ];
     for (done, error) in steps {
         if !wait(io, polls, done) {
@@ -204,7 +213,11 @@ mod tests {
         let mut io = FakeMcg::new(true);
         assert_eq!(init(&mut io, 10), Ok(FBE_CLOCKS));
         assert_eq!(io.reg(OSC0_CR), 0x8A);
-        assert_eq!(io.reg(MCG_C2), 0x24 | MCG_C2_FCFTRIM as u32, "LOCRE0 off, trim kept");
+        assert_eq!(
+            io.reg(MCG_C2),
+            0x24 | MCG_C2_FCFTRIM as u32,
+            "LOCRE0 off, trim kept"
+        );
         assert_eq!(io.reg(MCG_C1), 0xA0);
         assert_eq!(io.reg(SIM_CLKDIV1), 0);
     }

@@ -142,9 +142,17 @@ mod tests {
     fn fields() {
         let f = FlashConfig::TEENSY;
         assert_eq!(f.fsec & FSEC_SEC_MASK, FSEC_SEC_UNSECURE);
-        assert_eq!((f.fsec >> FSEC_FSLACC_SHIFT) & 3, 0b11, "factory access granted");
+        assert_eq!(
+            (f.fsec >> FSEC_FSLACC_SHIFT) & 3,
+            0b11,
+            "factory access granted"
+        );
         assert_eq!((f.fsec >> FSEC_MEEN_SHIFT) & 3, 0b11, "mass erase enabled");
-        assert_eq!((f.fsec >> FSEC_KEYEN_SHIFT) & 3, 0b11, "backdoor key disabled");
+        assert_eq!(
+            (f.fsec >> FSEC_KEYEN_SHIFT) & 3,
+            0b11,
+            "backdoor key disabled"
+        );
         assert_ne!(f.fopt & FOPT_LPBOOT, 0, "normal boot");
         assert_eq!(f.fopt & FOPT_EZPORT_DIS, 0, "EzPort disabled");
         assert_eq!(f.fopt & FOPT_NMI_DIS, 0, "NMI disabled");

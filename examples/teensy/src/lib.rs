@@ -43,9 +43,9 @@ pub mod rt;
 pub mod shared;
 pub mod time;
 
+pub use board::Board;
 #[cfg(any(feature = "teensy32", feature = "teensy35", feature = "teensy36"))]
 pub use board::BOARD;
-pub use board::Board;
 
 /// What the host build of a firmware example does: say how to build the real thing.
 pub fn host_stub(example: &str) -> &'static str {

@@ -3,7 +3,9 @@
 //! SysTick handler and the panic handler. Built only for the target (`target_os = "none"`).
 
 use crate::board::{BOARD, CAN_VECTORS_PER_INSTANCE};
-use crate::regs::{WDOG_STCTRLH, WDOG_STCTRLH_DISABLED, WDOG_UNLOCK, WDOG_UNLOCK_KEY1, WDOG_UNLOCK_KEY2};
+use crate::regs::{
+    WDOG_STCTRLH, WDOG_STCTRLH_DISABLED, WDOG_UNLOCK, WDOG_UNLOCK_KEY1, WDOG_UNLOCK_KEY2,
+};
 
 // The watchdog runs out of reset with a ~1 s (LPO clock) time-out, and its control
 // registers can only be written inside a window after an unlock (WDOG chapter,

@@ -64,8 +64,12 @@ mod tests {
         static SHARED: SharedDriver<Mock, 8, 4> = SharedDriver::new();
         assert!(!SHARED.on_interrupt());
         assert_eq!(SHARED.with(|_| ()), None);
-        assert!(SHARED.install(Driver::new(Mock::new(TxPolicy::Fifo))).is_ok());
-        assert!(SHARED.install(Driver::new(Mock::new(TxPolicy::Fifo))).is_err());
+        assert!(SHARED
+            .install(Driver::new(Mock::new(TxPolicy::Fifo)))
+            .is_ok());
+        assert!(SHARED
+            .install(Driver::new(Mock::new(TxPolicy::Fifo)))
+            .is_err());
         assert!(SHARED.on_interrupt());
         assert_eq!(SHARED.with(|d| d.traffic().sent), Some(0));
     }

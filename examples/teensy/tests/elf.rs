@@ -66,7 +66,10 @@ fn firmware_images() {
     let require = std::env::var_os("TWOCAN_REQUIRE_ELF").is_some();
     let dir = firmware_dir();
     let mut checked = 0;
-    println!("{:<10} {:<10} {:>8} {:>8}", "board", "example", "flash", "ram");
+    println!(
+        "{:<10} {:<10} {:>8} {:>8}",
+        "board", "example", "flash", "ram"
+    );
     for bin in bins(&board) {
         let path = dir.join(bin);
         let Ok(data) = std::fs::read(&path) else {
@@ -99,8 +102,7 @@ fn firmware_images() {
 mod elf {
     use object::{Object, ObjectSection, ObjectSegment, ObjectSymbol, SectionFlags};
     use twocan_teensy::flash_config::{
-        FLASH_CONFIG_BYTES, FSEC_FIELD_DISABLED, FSEC_MEEN_SHIFT, FSEC_SEC_MASK,
-        FSEC_SEC_UNSECURE,
+        FLASH_CONFIG_BYTES, FSEC_FIELD_DISABLED, FSEC_MEEN_SHIFT, FSEC_SEC_MASK, FSEC_SEC_UNSECURE,
     };
     use twocan_teensy::regs::{WDOG_STCTRLH, WDOG_UNLOCK};
     use twocan_teensy::Board;
@@ -184,7 +186,8 @@ mod elf {
             }
             // Only `.flash_config` may cover 0x400..0x410.
             for s in self.file.sections() {
-                let alloc = matches!(s.flags(), SectionFlags::Elf { sh_flags, .. } if sh_flags.0 & 2 != 0);
+                let alloc =
+                    matches!(s.flags(), SectionFlags::Elf { sh_flags, .. } if sh_flags.0 & 2 != 0);
                 let (a, n) = (s.address(), s.size());
                 if alloc && n > 0 && a < 0x410 && a + n > 0x400 {
                     let name = s.name().unwrap_or("?");
@@ -237,7 +240,9 @@ mod elf {
             }
             let reset_addr = reset & !1;
             if reset_addr < 0x410 || reset_addr >= flash0 + flash_len {
-                return Err(format!("reset vector {reset:#x} is not in flash after 0x410"));
+                return Err(format!(
+                    "reset vector {reset:#x} is not in flash after 0x410"
+                ));
             }
             if u64::from(reset_addr) != self.symbol_address("Reset")? {
                 return Err(format!("reset vector {reset:#x} is not the Reset handler"));
@@ -295,7 +300,8 @@ mod elf {
             let (mut flash, mut ram) = (0, 0);
             let (ram0, ram_len) = board.ram;
             for s in self.file.sections() {
-                let alloc = matches!(s.flags(), SectionFlags::Elf { sh_flags, .. } if sh_flags.0 & 2 != 0);
+                let alloc =
+                    matches!(s.flags(), SectionFlags::Elf { sh_flags, .. } if sh_flags.0 & 2 != 0);
                 if !alloc {
                     continue;
                 }

@@ -29,7 +29,10 @@ fn k20_interrupt_numbers() {
         I::CAN0_WAKE_UP,
     ];
     for (i, irq) in can0.iter().enumerate() {
-        assert_eq!(irq.nr() as u16, Board::TEENSY32.can_irq_base(Instance::Can0).unwrap() + i as u16);
+        assert_eq!(
+            irq.nr() as u16,
+            Board::TEENSY32.can_irq_base(Instance::Can0).unwrap() + i as u16
+        );
     }
     // PORTE is the last vector of the MK20D7 SVD.
     assert_eq!(I::PORTE.nr() as usize + 1, Board::TEENSY32.irq_count);
@@ -40,8 +43,14 @@ fn k20_register_addresses() {
     use mk20d7 as pac;
     let at = |p: *const (), off: usize| p as usize + off;
     let wdog = pac::WDOG::ptr() as *const ();
-    assert_eq!(at(wdog, offset_of!(pac::wdog::RegisterBlock, stctrlh)), WDOG_STCTRLH);
-    assert_eq!(at(wdog, offset_of!(pac::wdog::RegisterBlock, unlock)), WDOG_UNLOCK);
+    assert_eq!(
+        at(wdog, offset_of!(pac::wdog::RegisterBlock, stctrlh)),
+        WDOG_STCTRLH
+    );
+    assert_eq!(
+        at(wdog, offset_of!(pac::wdog::RegisterBlock, unlock)),
+        WDOG_UNLOCK
+    );
     let mcg = pac::MCG::ptr() as *const ();
     assert_eq!(at(mcg, offset_of!(pac::mcg::RegisterBlock, c1)), MCG_C1);
     assert_eq!(at(mcg, offset_of!(pac::mcg::RegisterBlock, c2)), MCG_C2);
@@ -50,16 +59,37 @@ fn k20_register_addresses() {
     let osc = pac::OSC::ptr() as *const ();
     assert_eq!(at(osc, offset_of!(pac::osc::RegisterBlock, cr)), OSC0_CR);
     let sim = pac::SIM::ptr() as *const ();
-    assert_eq!(at(sim, offset_of!(pac::sim::RegisterBlock, scgc5)), SIM_SCGC5);
-    assert_eq!(at(sim, offset_of!(pac::sim::RegisterBlock, clkdiv1)), SIM_CLKDIV1);
+    assert_eq!(
+        at(sim, offset_of!(pac::sim::RegisterBlock, scgc5)),
+        SIM_SCGC5
+    );
+    assert_eq!(
+        at(sim, offset_of!(pac::sim::RegisterBlock, clkdiv1)),
+        SIM_CLKDIV1
+    );
     let portc = pac::PORTC::ptr() as *const ();
-    assert_eq!(at(portc, offset_of!(pac::portc::RegisterBlock, pcr)), PORTC_PCR0);
+    assert_eq!(
+        at(portc, offset_of!(pac::portc::RegisterBlock, pcr)),
+        PORTC_PCR0
+    );
     let ptc = pac::PTC::ptr() as *const ();
     assert_eq!(at(ptc, 0), GPIOC_BASE);
-    assert_eq!(at(ptc, offset_of!(pac::ptc::RegisterBlock, psor)), GPIOC_PSOR);
-    assert_eq!(at(ptc, offset_of!(pac::ptc::RegisterBlock, pcor)), GPIOC_PCOR);
-    assert_eq!(at(ptc, offset_of!(pac::ptc::RegisterBlock, ptor)), GPIOC_PTOR);
-    assert_eq!(at(ptc, offset_of!(pac::ptc::RegisterBlock, pddr)), GPIOC_PDDR);
+    assert_eq!(
+        at(ptc, offset_of!(pac::ptc::RegisterBlock, psor)),
+        GPIOC_PSOR
+    );
+    assert_eq!(
+        at(ptc, offset_of!(pac::ptc::RegisterBlock, pcor)),
+        GPIOC_PCOR
+    );
+    assert_eq!(
+        at(ptc, offset_of!(pac::ptc::RegisterBlock, ptor)),
+        GPIOC_PTOR
+    );
+    assert_eq!(
+        at(ptc, offset_of!(pac::ptc::RegisterBlock, pddr)),
+        GPIOC_PDDR
+    );
     let fc = pac::FTFL_FLASHCONFIG::ptr() as *const ();
     use pac::ftfl_flash_config::RegisterBlock as Fc;
     assert_eq!(at(fc, 0), 0x400);
@@ -68,4 +98,3 @@ fn k20_register_addresses() {
     assert_eq!(at(fc, offset_of!(Fc, feprot)), 0x40E);
     assert_eq!(at(fc, offset_of!(Fc, fdprot)), 0x40F);
 }
-

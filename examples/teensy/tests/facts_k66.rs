@@ -53,8 +53,14 @@ fn k66_register_addresses() {
     use mk66f18 as pac;
     let at = |p: *const (), off: usize| p as usize + off;
     let wdog = pac::WDOG::ptr() as *const ();
-    assert_eq!(at(wdog, offset_of!(pac::wdog::RegisterBlock, stctrlh)), WDOG_STCTRLH);
-    assert_eq!(at(wdog, offset_of!(pac::wdog::RegisterBlock, unlock)), WDOG_UNLOCK);
+    assert_eq!(
+        at(wdog, offset_of!(pac::wdog::RegisterBlock, stctrlh)),
+        WDOG_STCTRLH
+    );
+    assert_eq!(
+        at(wdog, offset_of!(pac::wdog::RegisterBlock, unlock)),
+        WDOG_UNLOCK
+    );
     let mcg = pac::MCG::ptr() as *const ();
     assert_eq!(at(mcg, offset_of!(pac::mcg::RegisterBlock, c1)), MCG_C1);
     assert_eq!(at(mcg, offset_of!(pac::mcg::RegisterBlock, c2)), MCG_C2);
@@ -63,18 +69,36 @@ fn k66_register_addresses() {
     let osc = pac::OSC::ptr() as *const ();
     assert_eq!(at(osc, offset_of!(pac::osc::RegisterBlock, cr)), OSC0_CR);
     let sim = pac::SIM::ptr() as *const ();
-    assert_eq!(at(sim, offset_of!(pac::sim::RegisterBlock, scgc5)), SIM_SCGC5);
-    assert_eq!(at(sim, offset_of!(pac::sim::RegisterBlock, clkdiv1)), SIM_CLKDIV1);
+    assert_eq!(
+        at(sim, offset_of!(pac::sim::RegisterBlock, scgc5)),
+        SIM_SCGC5
+    );
+    assert_eq!(
+        at(sim, offset_of!(pac::sim::RegisterBlock, clkdiv1)),
+        SIM_CLKDIV1
+    );
     let portc = pac::PORTC::ptr() as *const ();
     assert_eq!(
         at(portc, offset_of!(pac::portc::RegisterBlock, pcr5)),
         PORTC_PCR0 + 4 * 5
     );
     let gpioc = pac::GPIOC::ptr() as *const ();
-    assert_eq!(at(gpioc, offset_of!(pac::gpioc::RegisterBlock, psor)), GPIOC_PSOR);
-    assert_eq!(at(gpioc, offset_of!(pac::gpioc::RegisterBlock, pcor)), GPIOC_PCOR);
-    assert_eq!(at(gpioc, offset_of!(pac::gpioc::RegisterBlock, ptor)), GPIOC_PTOR);
-    assert_eq!(at(gpioc, offset_of!(pac::gpioc::RegisterBlock, pddr)), GPIOC_PDDR);
+    assert_eq!(
+        at(gpioc, offset_of!(pac::gpioc::RegisterBlock, psor)),
+        GPIOC_PSOR
+    );
+    assert_eq!(
+        at(gpioc, offset_of!(pac::gpioc::RegisterBlock, pcor)),
+        GPIOC_PCOR
+    );
+    assert_eq!(
+        at(gpioc, offset_of!(pac::gpioc::RegisterBlock, ptor)),
+        GPIOC_PTOR
+    );
+    assert_eq!(
+        at(gpioc, offset_of!(pac::gpioc::RegisterBlock, pddr)),
+        GPIOC_PDDR
+    );
     let fc = pac::FTFE_FLASHCONFIG::ptr() as *const ();
     use pac::ftfe_flash_config::RegisterBlock as Fc;
     assert_eq!(at(fc, 0), 0x400);
@@ -97,10 +121,14 @@ fn k66_bit_positions() {
     use twocan_teensy::flash_config::FLASH_CONFIG_BYTES;
 
     let wdog = block::<pac::wdog::RegisterBlock>();
-    wdog.stctrlh.write(|w| unsafe { w.bits(WDOG_STCTRLH_DISABLED) });
+    wdog.stctrlh
+        .write(|w| unsafe { w.bits(WDOG_STCTRLH_DISABLED) });
     let r = wdog.stctrlh.read();
     assert!(r.wdogen().bit_is_clear() && r.allowupdate().bit_is_set());
-    assert_eq!(r.bits() & !(WDOG_STCTRLH_WDOGEN | WDOG_STCTRLH_ALLOWUPDATE), 0);
+    assert_eq!(
+        r.bits() & !(WDOG_STCTRLH_WDOGEN | WDOG_STCTRLH_ALLOWUPDATE),
+        0
+    );
 
     let osc = block::<pac::osc::RegisterBlock>();
     osc.cr.write(|w| unsafe { w.bits(OSC_CR_VALUE) });
@@ -109,7 +137,8 @@ fn k66_bit_positions() {
     assert!(r.sc4p().bit_is_clear() && r.sc16p().bit_is_clear() && r.erefsten().bit_is_clear());
 
     let mcg = block::<pac::mcg::RegisterBlock>();
-    mcg.c2.write(|w| unsafe { w.bits(MCG_C2_VALUE | MCG_C2_FCFTRIM) });
+    mcg.c2
+        .write(|w| unsafe { w.bits(MCG_C2_VALUE | MCG_C2_FCFTRIM) });
     let r = mcg.c2.read();
     assert_eq!(r.range().bits(), 2, "very high frequency range");
     assert!(r.erefs().bit_is_set() && r.hgo().bit_is_clear() && r.lp().bit_is_clear());
@@ -133,13 +162,23 @@ fn k66_bit_positions() {
     sim.clkdiv1.write(|w| unsafe { w.bits(SIM_CLKDIV1_FBE) });
     let r = sim.clkdiv1.read();
     assert_eq!(
-        [r.outdiv1().bits(), r.outdiv2().bits(), r.outdiv3().bits(), r.outdiv4().bits()],
+        [
+            r.outdiv1().bits(),
+            r.outdiv2().bits(),
+            r.outdiv3().bits(),
+            r.outdiv4().bits()
+        ],
         [0; 4]
     );
     sim.clkdiv1.write(|w| unsafe { w.bits(0x1234_0000) });
     let r = sim.clkdiv1.read();
     assert_eq!(
-        [r.outdiv1().bits(), r.outdiv2().bits(), r.outdiv3().bits(), r.outdiv4().bits()],
+        [
+            r.outdiv1().bits(),
+            r.outdiv2().bits(),
+            r.outdiv3().bits(),
+            r.outdiv4().bits()
+        ],
         [1, 2, 3, 4],
         "OUTDIV1 is bits 31:28 ... OUTDIV4 bits 19:16"
     );

@@ -29,10 +29,6 @@ pub(crate) struct Errors {
     pub fc: FaultConfinement,
     /// ESR1 error bits and write-1-to-clear interrupt flags.
     pub flags: u32,
-    /// Recessive bits of the current run while bus-off (mirror for ECR display).
-    boff_run: u64,
-    /// Completed 11-recessive-bit sequences while bus-off (mirror for ECR display).
-    boff_sequences: u16,
     /// CTRL1[BOFFREC] as it was when bus-off was entered (manual recovery requested).
     pub boffrec_latched: bool,
     rxwrn: bool,
@@ -60,8 +56,6 @@ impl Errors {
         Errors {
             fc: FaultConfinement::new(),
             flags: 0,
-            boff_run: 0,
-            boff_sequences: 0,
             boffrec_latched: false,
             rxwrn: false,
             txwrn: false,
@@ -70,18 +64,13 @@ impl Errors {
 
     fn bus_off_entered(&mut self, boffrec: bool) {
         self.flags |= esr1::BOFFINT;
-        self.boff_run = 0;
-        self.boff_sequences = 0;
         self.boffrec_latched = boffrec;
     }
 
-    /// Counts `bits` recessive bits toward recovery (mirror of the fault-confinement count).
-    fn recessive(&mut self, bits: u64) {
-        let total = self.boff_run + bits;
-        let seqs = (u64::from(self.boff_sequences) + total / 11)
-            .min(u64::from(BUS_OFF_RECOVERY_SEQUENCES));
-        self.boff_sequences = seqs as u16;
-        self.boff_run = total % 11;
+    /// Completed sequences of 11 recessive bits since bus-off was entered (0..=128).
+    fn recovery_sequences(&self) -> u64 {
+        let total = u64::from(BUS_OFF_RECOVERY_SEQUENCES) * 11;
+        (total - self.fc.recovery_remaining_bits().min(total)) / 11
     }
 }
 
@@ -150,7 +139,6 @@ impl State {
     pub fn bus_off_dominant(&mut self) {
         if self.bus_off() {
             self.errors.fc.dominant_bit();
-            self.errors.boff_run = 0;
         }
     }
 
@@ -161,7 +149,6 @@ impl State {
             return;
         }
         self.errors.fc.idle_bits(bits);
-        self.errors.recessive(bits);
         if self.errors.fc.recovery_condition_met() && !self.errors.boffrec_latched {
             self.recover_from_bus_off();
         }
@@ -169,8 +156,6 @@ impl State {
 
     fn recover_from_bus_off(&mut self) {
         self.errors.fc.recover();
-        self.errors.boff_run = 0;
-        self.errors.boff_sequences = 0;
         self.errors.boffrec_latched = false;
         self.update_warnings();
     }
@@ -189,18 +174,15 @@ impl State {
 
     /// Bit times of recessive bus still needed before bus-off recovery can complete.
     pub fn bus_off_bits_left(&self) -> Option<u64> {
-        if !self.bus_off() {
-            return None;
-        }
-        let done = u64::from(self.errors.boff_sequences) * 11 + self.errors.boff_run;
-        Some((u64::from(BUS_OFF_RECOVERY_SEQUENCES) * 11).saturating_sub(done))
+        self.bus_off()
+            .then(|| self.errors.fc.recovery_remaining_bits())
     }
 
     /// ECR as read: the 8-bit counters; while bus-off TXERRCNT counts recovery sequences.
     pub fn ecr_value(&self) -> u32 {
         let fc = &self.errors.fc;
         let tx = if fc.is_bus_off() {
-            u32::from(self.errors.boff_sequences)
+            self.errors.recovery_sequences() as u32
         } else {
             u32::from(fc.tec_register())
         };

@@ -28,8 +28,14 @@ pub fn begin_on<const RX: usize, const TX: usize>(
 ) -> Result<(FlexCanModel, Can<RX, TX>), BeginError> {
     let model = model_for(target.board);
     model.scramble_ram(0x5EED);
-    let controller =
-        FlexCan::begin(model.clone(), &mut HostSystem::new(), target, settings, primary, secondary)?;
+    let controller = FlexCan::begin(
+        model.clone(),
+        &mut HostSystem::new(),
+        target,
+        settings,
+        primary,
+        secondary,
+    )?;
     Ok((model, Driver::new(controller)))
 }
 
@@ -39,7 +45,12 @@ pub fn begin<const RX: usize, const TX: usize>(
     primary: &[Filter],
     secondary: &[Filter],
 ) -> Result<(FlexCanModel, Can<RX, TX>), BeginError> {
-    begin_on(Target::new(Board::Teensy32, Instance::Can0), settings, primary, secondary)
+    begin_on(
+        Target::new(Board::Teensy32, Instance::Can0),
+        settings,
+        primary,
+        secondary,
+    )
 }
 
 /// ACAN §4's settings: loop-back and self reception.
@@ -116,7 +127,12 @@ pub fn remote(id: u32, extended: bool) -> Frame {
 
 /// Sends each frame alone and gives the filter index it was received with, or `None`
 /// if the filters rejected it.
-pub fn indices(settings: &Settings, primary: &[Filter], secondary: &[Filter], frames: &[Frame]) -> Vec<Option<u16>> {
+pub fn indices(
+    settings: &Settings,
+    primary: &[Filter],
+    secondary: &[Filter],
+    frames: &[Frame],
+) -> Vec<Option<u16>> {
     let (model, mut can) = begin::<32, 16>(settings, primary, secondary).expect("begin");
     let mut bus = bus_with(125_000, &[&model]);
     frames

@@ -112,8 +112,8 @@ mod firmware {
         if init1.set_filters(&plan1).is_err() {
             rt::halt(CAN_BLINKS);
         }
-        let mut init2 = Can::can2(can2_regs, can2_filters, &base)
-            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
+        let mut init2 =
+            Can::can2(can2_regs, can2_filters, &base).unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         let plan2 = init2
             .can()
             .plan(&node2.filters(), FifoPolicy::Fifo1)
@@ -123,8 +123,7 @@ mod firmware {
         }
         let can1 = init1.enable().unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         let can2 = init2.enable().unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        if CAN1.install(Driver::new(can1)).is_err() || CAN2.install(Driver::new(can2)).is_err()
-        {
+        if CAN1.install(Driver::new(can1)).is_err() || CAN2.install(Driver::new(can2)).is_err() {
             rt::halt(CAN_BLINKS);
         }
         rt::unmask(rt::CAN1_IRQS);

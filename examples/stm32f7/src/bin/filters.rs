@@ -87,7 +87,7 @@ mod firmware {
         if index < FILTERS {
             HITS[index].fetch_add(1, Ordering::Relaxed);
         }
-        let expected = frames().get(index).and_then(|f| f.clone().ok());
+        let expected = frames().get(index).and_then(|f| f.ok());
         if index >= FILTERS || expected.as_ref() != Some(&rx.frame) {
             ERRORS.fetch_add(1, Ordering::Relaxed);
         }
