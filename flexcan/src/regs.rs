@@ -153,14 +153,14 @@ pub const fn rx_fifo_filter(n: usize) -> usize {
 /// Rx FIFO depth in frames ("Rx FIFO": six frames deep).
 pub const RX_FIFO_DEPTH: usize = 6;
 
-/// Number of Rx FIFO ID filter table elements for CTRL2[RFFN] = `rffn`: 8 × (RFFN + 1)
+/// Number of Rx FIFO ID filter table elements for CTRL2\[RFFN\] = `rffn`: 8 × (RFFN + 1)
 /// ("Control 2 register (CTRL2)", table "Rx FIFO filter: possible structures").
 pub const fn rx_fifo_filter_count(rffn: u32) -> usize {
     8 * (rffn as usize + 1)
 }
 
 /// Number of message buffers occupied by the Rx FIFO and its ID filter table for
-/// CTRL2[RFFN] = `rffn` (the FIFO engine takes MB0–MB5, each 8 filters take two MBs).
+/// CTRL2\[RFFN\] = `rffn` (the FIFO engine takes MB0–MB5, each 8 filters take two MBs).
 pub const fn rx_fifo_occupied_mbs(rffn: u32) -> usize {
     6 + 2 * (rffn as usize + 1)
 }
@@ -406,7 +406,7 @@ pub mod crcr {
 pub mod rxfir {
     use super::Field;
     /// Identifier Acceptance Filter Hit Indicator: the lowest-numbered filter that matched
-    /// the frame at the FIFO output (valid while IFLAG1[BUF5I] is set).
+    /// the frame at the FIFO output (valid while IFLAG1\[BUF5I\] is set).
     pub const IDHIT: Field = Field::new(0, 9);
 }
 
@@ -430,7 +430,7 @@ pub mod cs {
 /// Message buffer identifier word ("Message buffer structure").
 pub mod id {
     use super::Field;
-    /// Local priority (used for Tx arbitration when MCR[LPRIOEN] = 1; not transmitted).
+    /// Local priority (used for Tx arbitration when MCR\[LPRIOEN\] = 1; not transmitted).
     pub const PRIO: Field = Field::new(29, 3);
     /// Standard identifier, bits 28–18.
     pub const STD: Field = Field::new(18, 11);
@@ -477,13 +477,13 @@ pub mod code {
     pub const RX_FULL: u32 = 0b0010;
     /// Rx: a frame was overwritten into a full buffer.
     pub const RX_OVERRUN: u32 = 0b0110;
-    /// Rx: MB recognises a remote request frame and transmits a response (CTRL2[RRS] = 0).
+    /// Rx: MB recognises a remote request frame and transmits a response (CTRL2\[RRS\] = 0).
     pub const RX_RANSWER: u32 = 0b1010;
     /// Rx: BUSY bit, FlexCAN is updating the MB (code bit 0).
     pub const RX_BUSY: u32 = 0b0001;
     /// Tx: MB does not participate in arbitration.
     pub const TX_INACTIVE: u32 = 0b1000;
-    /// Tx: transmission aborted (MCR[AEN] = 1).
+    /// Tx: transmission aborted (MCR\[AEN\] = 1).
     pub const TX_ABORT: u32 = 0b1001;
     /// Tx: transmit a data frame once (RTR = 0), then INACTIVE.
     pub const TX_DATA: u32 = 0b1100;
@@ -493,7 +493,7 @@ pub mod code {
     pub const TX_TANSWER: u32 = 0b1110;
 }
 
-/// Rx FIFO ID filter table element, format A ("Rx FIFO structure", MCR[IDAM] = 0).
+/// Rx FIFO ID filter table element, format A ("Rx FIFO structure", MCR\[IDAM\] = 0).
 pub mod filter_a {
     use super::Field;
     /// Remote frame: 1 accepts remote frames and rejects data frames.
@@ -506,7 +506,7 @@ pub mod filter_a {
     pub const RXIDA_STD: Field = Field::new(19, 11);
 }
 
-/// Rx FIFO ID filter table element, format B (MCR[IDAM] = 1): two filters per element.
+/// Rx FIFO ID filter table element, format B (MCR\[IDAM\] = 1): two filters per element.
 pub mod filter_b {
     use super::Field;
     /// RTR of filter 0.
@@ -523,7 +523,7 @@ pub mod filter_b {
     pub const RXIDB_1: Field = Field::new(0, 14);
 }
 
-/// Rx FIFO ID filter table element, format C (MCR[IDAM] = 2): four 8-bit ID slices (the 8
+/// Rx FIFO ID filter table element, format C (MCR\[IDAM\] = 2): four 8-bit ID slices (the 8
 /// most significant bits of the identifier).
 pub mod filter_c {
     use super::Field;
@@ -656,7 +656,7 @@ pub mod pins {
         pub port: Port,
         /// The pin number within the port (PCR index).
         pub pin: u8,
-        /// The PORTx_PCRn[MUX] alternative selecting the CAN signal.
+        /// The PORTx_PCRn\[MUX\] alternative selecting the CAN signal.
         pub alt: u32,
     }
 

@@ -3,12 +3,12 @@
 //!
 //! - The module takes part in bus traffic when enabled, out of freeze and synchronised
 //!   (11 recessive bits), and not bus-off.
-//! - Listen-only (CTRL1[LOM]): receives, never acknowledges, never transmits, and behaves
+//! - Listen-only (CTRL1\[LOM\]): receives, never acknowledges, never transmits, and behaves
 //!   as error passive ("Listen-only mode").
-//! - Loop-back (CTRL1[LPB]): the transmitted bit stream is fed back internally, the Tx pin
+//! - Loop-back (CTRL1\[LPB\]): the transmitted bit stream is fed back internally, the Tx pin
 //!   stays recessive and the bus is not sampled; the acknowledge slot is ignored
 //!   ("Loop-back mode"). Requests are made with `internal` and `self_ack` set.
-//! - Self reception (MCR[SRXDIS] = 0): the module receives its own frames if they match a
+//! - Self reception (MCR\[SRXDIS\] = 0): the module receives its own frames if they match a
 //!   filter. The simulated bus reports a node's own frame through `rx(.., own = true, ..)`
 //!   and the model drops it when SRXDIS = 1.
 //! - Time stamps are the TIMER value at the bit after SOF (the identifier's start).

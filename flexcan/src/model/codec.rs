@@ -6,8 +6,8 @@ use twocan_core::frame::Frame;
 use crate::regs::{cs, id};
 
 /// The four words a received frame occupies in a message buffer (or the FIFO output):
-/// `code` in CS[CODE], SRR set for extended frames (received recessive), `prio` kept in
-/// ID[PRIO] (not transmitted, so it survives a move-in).
+/// `code` in CS\[CODE\], SRR set for extended frames (received recessive), `prio` kept in
+/// ID\[PRIO\] (not transmitted, so it survives a move-in).
 pub(crate) fn encode(frame: &Frame, stamp: u16, code: u32, prio: u32) -> [u32; 4] {
     let ext = frame.is_extended();
     let mut c = cs::CODE.val(code)

@@ -1,16 +1,16 @@
 //! Error counters, ESR1 and bus-off recovery ("Error Counter (CANx_ECR)", "Error and
-//! Status 1 register (CANx_ESR1)", CTRL1[BOFFREC]).
+//! Status 1 register (CANx_ESR1)", CTRL1\[BOFFREC\]).
 //!
 //! The counter rules are ISO 11898-1's, implemented once in
 //! [`twocan_core::fault::FaultConfinement`]; this file adds what FlexCAN shows of them:
 //! - ESR1 error bits STFERR..BIT1ERR record errors since ESR1 was last read and are
 //!   cleared by the read; ERRINT (set with any of them), BOFFINT (bus-off entered),
-//!   RWRNINT/TWRNINT (RXWRN/TXWRN went 0 → 1, only with MCR[WRNEN]) are write-1-to-clear;
-//! - while bus-off, ECR[TXERRCNT] counts the sequences of 11 recessive bits toward the
+//!   RWRNINT/TWRNINT (RXWRN/TXWRN went 0 → 1, only with MCR\[WRNEN\]) are write-1-to-clear;
+//! - while bus-off, ECR\[TXERRCNT\] counts the sequences of 11 recessive bits toward the
 //!   128 needed for recovery ("If FlexCAN is in Bus Off state, then TXERRCNT is cascaded
 //!   together with another internal counter to count the 128th occurrences of 11
 //!   consecutive recessive bits");
-//! - CTRL1[BOFFREC] = 0 recovers automatically once the 128 × 11 bits are seen; with
+//! - CTRL1\[BOFFREC\] = 0 recovers automatically once the 128 × 11 bits are seen; with
 //!   BOFFREC = 1 (as it was when bus-off was entered) the module stays bus-off until
 //!   software negates BOFFREC: before the condition is met recovery then proceeds as if
 //!   automatic, after it the module recovers at once and re-synchronises (11 recessive
@@ -29,7 +29,7 @@ pub(crate) struct Errors {
     pub fc: FaultConfinement,
     /// ESR1 error bits and write-1-to-clear interrupt flags.
     pub flags: u32,
-    /// CTRL1[BOFFREC] as it was when bus-off was entered (manual recovery requested).
+    /// CTRL1\[BOFFREC\] as it was when bus-off was entered (manual recovery requested).
     pub boffrec_latched: bool,
     rxwrn: bool,
     txwrn: bool,
@@ -84,7 +84,7 @@ impl State {
     }
 
     /// Re-evaluates RXWRN/TXWRN and raises RWRNINT/TWRNINT on a 0 → 1 transition when
-    /// MCR[WRNEN] is set.
+    /// MCR\[WRNEN\] is set.
     pub fn update_warnings(&mut self) {
         let c = self.errors.fc.counters();
         let rxwrn = c.rec >= 96;

@@ -1,11 +1,11 @@
-//! Rx FIFO ID filter table matching ("Rx FIFO structure", MCR[IDAM], CTRL2[RFFN], RXIMR,
+//! Rx FIFO ID filter table matching ("Rx FIFO structure", MCR\[IDAM\], CTRL2\[RFFN\], RXIMR,
 //! RXMGMASK and RXFGMASK field descriptions, table "Rx FIFO filter: possible structures").
 //!
 //! - The table holds 8 × (RFFN + 1) elements from MB6 on (element n at 0xE0 + 4·n); on
 //!   these 16-MB parts only 40 elements fit, elements beyond never match.
 //! - The first elements, as many as the message buffers the FIFO and table occupy
 //!   (RFFN 0 → 8, 1 → 10, 2 → 12, 3 → 14, at most 16), are masked by the individual masks
-//!   RXIMR[n] when MCR[IRMQ] = 1, by RXMGMASK when IRMQ = 0; the remaining elements are
+//!   RXIMR\[n\] when MCR\[IRMQ\] = 1, by RXMGMASK when IRMQ = 0; the remaining elements are
 //!   masked by RXFGMASK. Masks align bit for bit with the element ("in a perfect
 //!   alignment"); a mask bit 1 means the bit is checked.
 //! - Format A (IDAM = 0): RTR bit 31, IDE bit 30, RXIDA bits 29–1 (standard ID in 29–19;
@@ -16,7 +16,7 @@
 //!   of the identifier; remote frames are always accepted.
 //! - Format D (IDAM = 3): all frames rejected.
 //! - "If multiple filters match the incoming message ID, then the first matching IDAF found
-//!   (lowest number) by the matching process is indicated" in RXFIR[IDHIT]; IDAF numbers
+//!   (lowest number) by the matching process is indicated" in RXFIR\[IDHIT\]; IDAF numbers
 //!   count filters, so format B element n holds filters 2n, 2n+1 and format C 4n..4n+3.
 
 use twocan_core::frame::Frame;

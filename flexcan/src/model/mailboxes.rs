@@ -69,7 +69,7 @@ fn is_rx_active(c: u32) -> bool {
 }
 
 impl State {
-    /// CS[CODE] of mailbox `n`.
+    /// CS\[CODE\] of mailbox `n`.
     pub fn mb_code(&self, n: usize) -> u32 {
         cs::CODE.get(self.mb_word(n, 0))
     }
@@ -86,9 +86,9 @@ impl State {
     }
 
     /// The mailbox that wins the internal arbitration ("Arbitration process"): with
-    /// CTRL1[LBUF] = 1 the lowest-numbered pending mailbox; otherwise the highest-priority
-    /// frame (the bus arbitration order, [`Priority`]), preceded by ID[PRIO] when
-    /// MCR[LPRIOEN] = 1, ties going to the lowest-numbered mailbox.
+    /// CTRL1\[LBUF\] = 1 the lowest-numbered pending mailbox; otherwise the highest-priority
+    /// frame (the bus arbitration order, [`Priority`]), preceded by ID\[PRIO\] when
+    /// MCR\[LPRIOEN\] = 1, ties going to the lowest-numbered mailbox.
     pub fn select_tx(&self) -> Option<usize> {
         let pending = self
             .active_mbs()
@@ -138,7 +138,7 @@ impl State {
         self.iflag1 |= 1 << n;
     }
 
-    /// Software wrote the C/S word of mailbox `n`. With MCR[AEN] = 1, writing ABORT over a
+    /// Software wrote the C/S word of mailbox `n`. With MCR\[AEN\] = 1, writing ABORT over a
     /// pending transmission aborts it ("Transmission abort mechanism"): the model's frames
     /// are atomic, so the mailbox is never caught mid-transmission and the abort always
     /// succeeds: the code stays ABORT and IFLAG is set. Without AEN the write simply
@@ -183,7 +183,7 @@ impl State {
 
     // --- receive -------------------------------------------------------------------------
 
-    /// The acceptance mask of mailbox `n`: RXIMR[n] with MCR[IRMQ] = 1; otherwise
+    /// The acceptance mask of mailbox `n`: RXIMR\[n\] with MCR\[IRMQ\] = 1; otherwise
     /// RX14MASK/RX15MASK for MB14/MB15 and RXMGMASK for the others.
     fn mb_mask(&self, n: usize) -> u32 {
         if self.irmq() {
@@ -198,7 +198,7 @@ impl State {
     }
 
     /// Whether receive mailbox `n` accepts `frame`. The ID is compared under the mask
-    /// (bits 28–0; standard frames bits 28–18). With CTRL2[EACEN] = 0 IDE is always
+    /// (bits 28–0; standard frames bits 28–18). With CTRL2\[EACEN\] = 0 IDE is always
     /// compared and RTR never; with EACEN = 1 mask bit 31 checks RTR and bit 30 checks IDE
     /// ("the two most significant mask bits affect the fields RTR and IDE").
     fn mb_accepts(&self, n: usize, frame: &Frame) -> bool {

@@ -51,16 +51,16 @@ pub enum Chip {
     Mk20dx256,
     /// MK64FX512 (Teensy 3.5): FlexCAN0.
     Mk64fx512,
-    /// MK66FX1M0 (Teensy 3.6): FlexCAN0 and FlexCAN1 (MCR[WAKSRC] exists).
+    /// MK66FX1M0 (Teensy 3.6): FlexCAN0 and FlexCAN1 (MCR\[WAKSRC\] exists).
     Mk66fx1m0,
 }
 
 /// The module's mode as the acknowledge bits show it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum ModelMode {
-    /// Module Disable mode (MCR[LPMACK] = 1).
+    /// Module Disable mode (MCR\[LPMACK\] = 1).
     Disabled,
-    /// Freeze mode (MCR[FRZACK] = 1).
+    /// Freeze mode (MCR\[FRZACK\] = 1).
     Freeze,
     /// Normal mode (maybe not yet synchronised, maybe bus-off).
     Normal,
@@ -73,11 +73,11 @@ pub enum ModelMode {
 pub struct FlexCanIrq {
     /// IFLAG1 & IMASK1 ≠ 0.
     pub message_buffer: bool,
-    /// ESR1[ERRINT] with CTRL1[ERRMSK].
+    /// ESR1\[ERRINT\] with CTRL1\[ERRMSK\].
     pub error: bool,
-    /// ESR1[BOFFINT] with CTRL1[BOFFMSK].
+    /// ESR1\[BOFFINT\] with CTRL1\[BOFFMSK\].
     pub bus_off: bool,
-    /// ESR1[TWRNINT] with CTRL1[TWRNMSK], or ESR1[RWRNINT] with CTRL1[RWRNMSK].
+    /// ESR1\[TWRNINT\] with CTRL1\[TWRNMSK\], or ESR1\[RWRNINT\] with CTRL1\[RWRNMSK\].
     pub warning: bool,
 }
 
@@ -202,7 +202,7 @@ impl FlexCanModel {
         }
     }
 
-    /// Whether the module is synchronised to the bus (ESR1[SYNCH]).
+    /// Whether the module is synchronised to the bus (ESR1\[SYNCH\]).
     pub fn is_synchronised(&self) -> bool {
         self.inner.borrow().on_bus()
     }

@@ -6,7 +6,7 @@
 //!   with FRZ and HALT set the module then enters Freeze mode (FRZACK asserted).
 //! - Freeze mode is requested by FRZ = 1 and HALT = 1 and acknowledged by FRZACK; it is left
 //!   when either is negated (FRZACK negated). Out of freeze (or disable) the module must
-//!   see 11 consecutive recessive bits to synchronise (ESR1[SYNCH]) before it takes part in
+//!   see 11 consecutive recessive bits to synchronise (ESR1\[SYNCH\]) before it takes part in
 //!   bus traffic.
 //! - NOTRDY "indicates that FlexCAN is either in Disable mode, Stop mode or Freeze mode.
 //!   It is negated once FlexCAN has exited these modes."

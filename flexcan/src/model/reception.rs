@@ -1,7 +1,7 @@
 //! Where a received frame goes ("Matching process", table "Matching possibilities and
-//! resulting reception structures"; "Remote frames"; CTRL2[MRP], CTRL2[RRS], MCR[IRMQ]).
+//! resulting reception structures"; "Remote frames"; CTRL2\[MRP\], CTRL2\[RRS\], MCR\[IRMQ\]).
 //!
-//! - A remote request with CTRL2[RRS] = 0 is not stored in a mailbox: if it matches a FIFO
+//! - A remote request with CTRL2\[RRS\] = 0 is not stored in a mailbox: if it matches a FIFO
 //!   filter it goes to the FIFO ("FlexCAN will not generate an automatic response for
 //!   remote request frames that match the FIFO filtering criteria"), otherwise it turns a
 //!   RANSWER mailbox with the same identifier into TANSWER, otherwise it is dropped. With

@@ -1,14 +1,14 @@
 //! The Rx FIFO ("Rx FIFO structure", "Rx FIFO" in the functional description, IFLAG1
 //! bits 5–7, RXFIR).
 //!
-//! With MCR[RFEN] = 1 the storage of MB0–MB5 is the FIFO engine: six frames deep, the
+//! With MCR\[RFEN\] = 1 the storage of MB0–MB5 is the FIFO engine: six frames deep, the
 //! oldest presented at the MB0 window (0x80–0x8F), 0x90–0xDF reserved to the engine.
-//! - IFLAG1[BUF5I] "frames available" is set while the FIFO holds a frame; writing 1 to it
+//! - IFLAG1\[BUF5I\] "frames available" is set while the FIFO holds a frame; writing 1 to it
 //!   releases the output, and the next frame (if any) is presented.
-//! - IFLAG1[BUF6I] "warning" is set when the number of unread frames goes from 4 to 5.
-//! - IFLAG1[BUF7I] "overflow" is set when a frame that passed the filters is lost because
+//! - IFLAG1\[BUF6I\] "warning" is set when the number of unread frames goes from 4 to 5.
+//! - IFLAG1\[BUF7I\] "overflow" is set when a frame that passed the filters is lost because
 //!   the FIFO already holds six frames.
-//! - RXFIR[IDHIT] is the filter that accepted the frame at the output.
+//! - RXFIR\[IDHIT\] is the filter that accepted the frame at the output.
 
 use super::std::collections::VecDeque;
 use twocan_core::frame::Frame;
@@ -79,7 +79,7 @@ impl State {
         }
     }
 
-    /// Software wrote 1 to IFLAG1[BUF5I]: the output is released.
+    /// Software wrote 1 to IFLAG1\[BUF5I\]: the output is released.
     pub fn fifo_pop(&mut self) {
         if let Some(e) = self.fifo.entries.pop_front() {
             self.fifo.stale = Some(e);

@@ -39,7 +39,7 @@ pub(crate) struct State {
     pub softrst_pending: bool,
     /// Fault injection: the module has no clock, no mode handshake completes.
     pub clock_stuck: bool,
-    /// Synchronised to the bus (ESR1[SYNCH]).
+    /// Synchronised to the bus (ESR1\[SYNCH\]).
     pub synched: bool,
     /// Consecutive recessive bits seen while waiting for synchronisation.
     pub sync_run: u64,
@@ -130,7 +130,7 @@ impl State {
         ctrl2::RFFN.get(self.ctrl2)
     }
 
-    /// The last message buffer taking part in matching and arbitration: MCR[MAXMB], limited
+    /// The last message buffer taking part in matching and arbitration: MCR\[MAXMB\], limited
     /// to the 16 MBs that exist ("MAXMB must be programmed with a value smaller than the
     /// number of available MBs").
     pub fn last_mb(&self) -> usize {
