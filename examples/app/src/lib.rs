@@ -46,6 +46,9 @@ pub struct AppStats {
     pub heartbeats: u32,
     /// Heartbeats whose counter skipped values (frames lost between the peers).
     pub heartbeat_gaps: u32,
+    /// Heartbeats received twice (CAN's double reception: an error in the last-but-one
+    /// bit of end-of-frame makes receivers keep a frame its transmitter sends again).
+    pub heartbeat_duplicates: u32,
     /// Measurements received.
     pub measurements: u32,
     /// Remote status requests received.
@@ -195,10 +198,13 @@ impl App {
 fn on_heartbeat(s: &mut AppState, rx: &RxFrame) {
     s.stats.heartbeats += 1;
     if let Some(n) = rx.frame.data_u32(0) {
-        if let Some(expected) = s.expected {
-            if n != expected {
-                s.stats.heartbeat_gaps += 1;
+        match s.expected {
+            Some(expected) if n.wrapping_add(1) == expected => {
+                s.stats.heartbeat_duplicates += 1;
+                return;
             }
+            Some(expected) if n != expected => s.stats.heartbeat_gaps += 1,
+            _ => {}
         }
         s.expected = Some(n.wrapping_add(1));
     }

@@ -1,0 +1,333 @@
+//! The host simulation: the real FlexCAN and bxCAN drivers over their behavioural models,
+//! both attached to one simulated bus, with their interrupts serviced between bus events.
+//!
+//! [`Harness`] owns the bus; [`FlexNode`] (a Teensy 3.6's can0) and [`BxNode`] (an
+//! STM32F767's CAN1) each own a model handle and the portable [`twocan_core::Driver`] over
+//! it. The demo (`can-demo`) and the cross-controller tests use it.
+//!
+//! ```
+//! use twocan_host::{Harness, FlexNode, BxNode};
+//! use twocan_core::{Filter, Frame};
+//! let mut h = Harness::new(500_000).unwrap();
+//! let mut teensy = FlexNode::teensy36_can0(&mut h, &[Filter::pass_all()]).unwrap();
+//! let mut stm32 = BxNode::stm32f767_can1(&mut h, &[Filter::pass_all()]).unwrap();
+//! teensy.driver.try_send(&Frame::standard(0x123, &[1, 2, 3]).unwrap()).unwrap();
+//! h.run_for(1_000, &mut [&mut teensy, &mut stm32]);
+//! assert_eq!(stm32.driver.receive().unwrap().frame, Frame::standard(0x123, &[1, 2, 3]).unwrap());
+//! ```
+#![deny(missing_docs)]
+
+use std::cell::RefCell;
+use std::rc::Rc;
+
+use twocan_bxcan::model::BxCanModel;
+use twocan_bxcan::{Can as BxCan, Config as BxConfig, FifoPolicy};
+use twocan_core::sim::{Bus, NodeId, SimError};
+use twocan_core::{Driver, ErrorState, Filter, Registers};
+use twocan_flexcan::model::FlexCanModel;
+use twocan_flexcan::{Board, FlexCan, HostSystem, Instance, Settings, Target};
+
+/// The simulated bus, shared with the register wrappers that let time pass while a driver
+/// waits for an acknowledge bit.
+pub type SharedBus = Rc<RefCell<Bus>>;
+
+/// Receive ring size of the simulated nodes.
+pub const RX_RING: usize = 64;
+/// Transmit queue size of the simulated nodes.
+pub const TX_RING: usize = 32;
+/// The APB1 clock of the simulated STM32F767 (216 MHz core, APB1 = /4).
+pub const STM32F767_APB1_HZ: u32 = 54_000_000;
+
+/// Why a node could not be brought up.
+#[derive(Debug)]
+pub enum SetupError {
+    /// The bus refused the bit rate.
+    Bus(SimError),
+    /// FlexCAN `begin` failed.
+    FlexCan(twocan_flexcan::BeginError),
+    /// bxCAN configuration failed.
+    BxCanConfig(twocan_bxcan::ConfigError),
+    /// bxCAN filter planning failed.
+    BxCanPlan(twocan_bxcan::PlanError),
+    /// A driver operation failed.
+    Driver(twocan_core::Error),
+}
+
+/// Something on the bus whose interrupts the harness services.
+pub trait Serviced {
+    /// Runs the driver's interrupt handler if the model raises an interrupt line;
+    /// returns whether it did.
+    fn service(&mut self) -> bool;
+}
+
+/// The simulated bus and its clock.
+pub struct Harness {
+    bus: SharedBus,
+}
+
+impl Harness {
+    /// A bus at `bit_rate`.
+    pub fn new(bit_rate: u32) -> Result<Self, SetupError> {
+        let bus = Bus::new(bit_rate).map_err(SetupError::Bus)?;
+        Ok(Harness {
+            bus: Rc::new(RefCell::new(bus)),
+        })
+    }
+
+    /// The bus (borrow it only between runs).
+    pub fn bus(&self) -> &SharedBus {
+        &self.bus
+    }
+
+    /// The current time in bit times.
+    pub fn now(&self) -> u64 {
+        self.bus.borrow().now()
+    }
+
+    /// Runs the bus for `bits` bit times, servicing every node after each bus event.
+    pub fn run_for(&mut self, bits: u64, nodes: &mut [&mut dyn Serviced]) {
+        let until = self.now() + bits;
+        self.run_until(until, nodes);
+    }
+
+    /// Runs the bus until time `until`, servicing every node after each bus event.
+    pub fn run_until(&mut self, until: u64, nodes: &mut [&mut dyn Serviced]) {
+        loop {
+            for n in nodes.iter_mut() {
+                n.service();
+            }
+            let event = self.bus.borrow_mut().step_until(until);
+            if event.is_none() {
+                break;
+            }
+        }
+        for n in nodes.iter_mut() {
+            n.service();
+        }
+    }
+}
+
+/// Register access to a model that lets one bit time pass on the bus while the driver
+/// spins on the register it polls for an acknowledge bit — as real time passes while
+/// firmware waits. Only back-to-back reads of that register count as a spin: a single
+/// read in an interrupt handler does not move time.
+#[derive(Clone)]
+pub struct Clocked<R> {
+    regs: R,
+    bus: SharedBus,
+    poll_register: usize,
+    spinning: std::cell::Cell<bool>,
+}
+
+impl<R> Clocked<R> {
+    /// Wraps `regs`; back-to-back reads of `poll_register` advance `bus` by one bit time.
+    pub fn new(regs: R, bus: &SharedBus, poll_register: usize) -> Self {
+        Clocked {
+            regs,
+            bus: bus.clone(),
+            poll_register,
+            spinning: std::cell::Cell::new(false),
+        }
+    }
+
+    /// The wrapped register access (the model handle).
+    pub fn inner(&self) -> &R {
+        &self.regs
+    }
+}
+
+impl<R: Registers> Registers for Clocked<R> {
+    fn read32(&self, offset: usize) -> u32 {
+        if offset == self.poll_register {
+            if self.spinning.replace(true) {
+                if let Ok(mut bus) = self.bus.try_borrow_mut() {
+                    bus.run_for(1);
+                }
+            }
+        } else {
+            self.spinning.set(false);
+        }
+        self.regs.read32(offset)
+    }
+    fn write32(&mut self, offset: usize, value: u32) {
+        self.spinning.set(false);
+        self.regs.write32(offset, value)
+    }
+}
+
+/// The FlexCAN driver over its model, as used by the host nodes.
+pub type FlexDriver = Driver<FlexCan<Clocked<FlexCanModel>>, RX_RING, TX_RING>;
+/// The bxCAN driver over its model, as used by the host nodes.
+pub type BxDriver = Driver<BxCan<Clocked<BxCanModel>>, RX_RING, TX_RING>;
+
+/// A Teensy 3.x FlexCAN node on the bus.
+pub struct FlexNode {
+    /// The peripheral model (for inspection and fault injection).
+    pub model: FlexCanModel,
+    /// The portable driver over the real FlexCAN backend.
+    pub driver: FlexDriver,
+    /// Its place on the bus.
+    pub id: NodeId,
+}
+
+impl FlexNode {
+    /// can0 of a Teensy 3.6 with `filters` as ACAN primary filters (up to 14 by
+    /// configuration) and the bus's bit rate.
+    pub fn teensy36_can0(h: &mut Harness, filters: &[Filter]) -> Result<Self, SetupError> {
+        let bit_rate = h.bus.borrow().bit_rate();
+        Self::begin(
+            h,
+            Target::new(Board::Teensy36, Instance::Can0),
+            &Settings::new(bit_rate),
+            filters,
+            &[],
+        )
+    }
+
+    /// Any instance with explicit settings and primary / secondary filters.
+    pub fn begin(
+        h: &mut Harness,
+        target: Target,
+        settings: &Settings,
+        primary: &[Filter],
+        secondary: &[Filter],
+    ) -> Result<Self, SetupError> {
+        let model = match target.board {
+            Board::Teensy32 => FlexCanModel::mk20dx256(),
+            Board::Teensy35 => FlexCanModel::mk64fx512(),
+            Board::Teensy36 => FlexCanModel::mk66fx1m0(),
+        };
+        let name = format!("{:?}-{:?}", target.board, target.instance).to_lowercase();
+        let id = h.bus.borrow_mut().attach(&name, model.clone());
+        let regs = Clocked::new(model.clone(), &h.bus, twocan_flexcan::regs::MCR);
+        let controller = FlexCan::begin(
+            regs,
+            &mut HostSystem::new(),
+            target,
+            settings,
+            primary,
+            secondary,
+        )
+        .map_err(SetupError::FlexCan)?;
+        Ok(FlexNode {
+            model,
+            driver: Driver::new(controller),
+            id,
+        })
+    }
+
+    /// Frames the hardware received but no filter accepted.
+    pub fn filtered_out(&self) -> u64 {
+        self.model.frames_discarded()
+    }
+
+    /// Frames lost in hardware (Rx FIFO overflow) plus in the receive ring.
+    pub fn lost(&self) -> u64 {
+        self.model.frames_lost() + self.driver.traffic().rx_ring_overflows as u64
+    }
+}
+
+impl Serviced for FlexNode {
+    fn service(&mut self) -> bool {
+        if self.model.irq_pending() {
+            self.driver.on_interrupt();
+            true
+        } else {
+            false
+        }
+    }
+}
+
+/// An STM32F7 bxCAN node on the bus.
+pub struct BxNode {
+    /// The peripheral model (for inspection and fault injection).
+    pub model: BxCanModel,
+    /// The portable driver over the real bxCAN backend.
+    pub driver: BxDriver,
+    /// Its place on the bus.
+    pub id: NodeId,
+}
+
+impl BxNode {
+    /// CAN1 of an STM32F767 (APB1 54 MHz) at the bus's bit rate, FIFO transmit order,
+    /// automatic bus-off recovery, `filters` compiled by the planner.
+    pub fn stm32f767_can1(h: &mut Harness, filters: &[Filter]) -> Result<Self, SetupError> {
+        let bit_rate = h.bus.borrow().bit_rate();
+        let config = BxConfig::from_bitrate(STM32F767_APB1_HZ, bit_rate)
+            .map_err(SetupError::BxCanConfig)?
+            .tx_policy(twocan_core::TxPolicy::Fifo)
+            .interrupts(
+                twocan_bxcan::regs::ier::TMEIE
+                    | twocan_bxcan::regs::ier::FMPIE0
+                    | twocan_bxcan::regs::ier::FMPIE1
+                    | twocan_bxcan::regs::ier::FOVIE0
+                    | twocan_bxcan::regs::ier::FOVIE1
+                    | twocan_bxcan::regs::ier::ERRIE
+                    | twocan_bxcan::regs::ier::EWGIE
+                    | twocan_bxcan::regs::ier::EPVIE
+                    | twocan_bxcan::regs::ier::BOFIE
+                    | twocan_bxcan::regs::ier::LECIE,
+            );
+        Self::with_config(h, &config, filters, FifoPolicy::Balanced)
+    }
+
+    /// CAN1 with an explicit configuration and FIFO policy for the planner.
+    pub fn with_config(
+        h: &mut Harness,
+        config: &BxConfig,
+        filters: &[Filter],
+        fifos: FifoPolicy,
+    ) -> Result<Self, SetupError> {
+        let model = BxCanModel::can1();
+        let id = h.bus.borrow_mut().attach("stm32f767-can1", model.clone());
+        let regs = Clocked::new(model.clone(), &h.bus, twocan_bxcan::regs::MSR);
+        let mut init = BxCan::can1(regs, config).map_err(|f| SetupError::Driver(f.error))?;
+        let plan = init
+            .can()
+            .plan(filters, fifos)
+            .map_err(SetupError::BxCanPlan)?;
+        init.set_filters(&plan)
+            .map_err(|f| SetupError::Driver(f.into()))?;
+        let can = init.enable().map_err(|f| SetupError::Driver(f.error))?;
+        Ok(BxNode {
+            model,
+            driver: Driver::new(can),
+            id,
+        })
+    }
+
+    /// Frames the hardware received but no filter accepted.
+    pub fn filtered_out(&self) -> u64 {
+        self.model.state().dropped
+    }
+
+    /// Frames lost in hardware (FIFO overruns) plus in the receive ring.
+    pub fn lost(&self) -> u64 {
+        let s = self.model.state();
+        s.overruns[0] + s.overruns[1] + self.driver.traffic().rx_ring_overflows as u64
+    }
+}
+
+impl Serviced for BxNode {
+    fn service(&mut self) -> bool {
+        let l = self.model.irq_lines();
+        if l.tx || l.rx0 || l.rx1 || l.sce {
+            self.driver.on_interrupt();
+            true
+        } else {
+            false
+        }
+    }
+}
+
+/// A short name for an error state, for reports.
+pub fn state_name(s: ErrorState) -> &'static str {
+    match s {
+        ErrorState::Active => "error-active",
+        ErrorState::Warning => "error-warning",
+        ErrorState::Passive => "error-passive",
+        ErrorState::BusOff => "bus-off",
+        ErrorState::Stopped => "stopped",
+        ErrorState::Sleeping => "sleeping",
+    }
+}
