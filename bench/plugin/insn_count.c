@@ -31,9 +31,10 @@
  * "qemu_plugin_version", translation-time registration of per-instruction execution and
  * memory callbacks, "qemu_plugin_outs"), because Debian 12 ships no `qemu-plugin.h`
  * (see docs/benchmarks.md). Only opaque handles, scalar typedefs, the enum values used
- * and the function prototypes called are declared. The API version declared is 1, the
- * one QEMU 6.0 .. 8.1 accept (Debian 12 has QEMU 7.2); `-DTWOCAN_QEMU_PLUGIN_VERSION=n`
- * overrides it.
+ * and the function prototypes called are declared. QEMU refuses a plugin whose declared
+ * API version lies outside its own [minimum, current] range; we declare 1, the current
+ * version of Debian 12's QEMU 7.2 (`-DTWOCAN_QEMU_PLUGIN_VERSION=n` overrides it for
+ * another QEMU whose range excludes 1, as long as the calls below keep their form).
  */
 #include <inttypes.h>
 #include <stdbool.h>

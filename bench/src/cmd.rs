@@ -77,8 +77,14 @@ pub fn run(cmd: &mut Command, limit: Duration) -> Result<Output> {
         .spawn()
         .map_err(|e| Error::new(format!("cannot start `{line}`: {e}")))?;
     // Drain both pipes on threads so that a chatty child never blocks on a full pipe.
-    let mut out = child.stdout.take().ok_or_else(|| Error::new("no stdout pipe"))?;
-    let mut err = child.stderr.take().ok_or_else(|| Error::new("no stderr pipe"))?;
+    let mut out = child
+        .stdout
+        .take()
+        .ok_or_else(|| Error::new("no stdout pipe"))?;
+    let mut err = child
+        .stderr
+        .take()
+        .ok_or_else(|| Error::new("no stderr pipe"))?;
     let out_thread = thread::spawn(move || {
         let mut s = Vec::new();
         let _ = out.read_to_end(&mut s);
@@ -140,11 +146,7 @@ pub fn tail(s: &str, n: usize) -> String {
 /// The first line a command prints on stdout, trimmed (for version strings); `None` if
 /// it cannot run.
 pub fn first_line(program: &str, args: &[&str]) -> Option<String> {
-    let out = run(
-        Command::new(program).args(args),
-        Duration::from_secs(30),
-    )
-    .ok()?;
+    let out = run(Command::new(program).args(args), Duration::from_secs(30)).ok()?;
     if out.code != Some(0) {
         return None;
     }

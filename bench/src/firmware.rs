@@ -136,8 +136,13 @@ pub struct ExamplePackage {
 /// The packages under `examples/` that have binary targets.
 pub fn example_packages(paths: &Paths) -> Result<Vec<ExamplePackage>> {
     let mut c = cargo();
-    c.current_dir(&paths.root)
-        .args(["metadata", "--no-deps", "--format-version", "1", "--offline"]);
+    c.current_dir(&paths.root).args([
+        "metadata",
+        "--no-deps",
+        "--format-version",
+        "1",
+        "--offline",
+    ]);
     let out = match cmd::run_ok(&mut c, Duration::from_secs(120)) {
         Ok(o) => o,
         // --offline fails when something is not downloaded yet; try online.

@@ -78,7 +78,11 @@ fn parse_args() -> Result<Vec<String>> {
                 );
                 std::process::exit(0);
             }
-            other => return Err(Error::new(format!("unknown argument `{other}` (try --help)"))),
+            other => {
+                return Err(Error::new(format!(
+                    "unknown argument `{other}` (try --help)"
+                )))
+            }
         }
     }
     Ok(skip)
@@ -129,7 +133,10 @@ fn run() -> Result<()> {
     if need_firmware {
         step("bench firmware (bench/firmware)");
         for (profile, _) in COUNT_PROFILES {
-            firmware_dirs.push((profile.to_string(), firmware::bench_firmware(&paths, profile)?));
+            firmware_dirs.push((
+                profile.to_string(),
+                firmware::bench_firmware(&paths, profile)?,
+            ));
         }
     }
 
@@ -195,9 +202,7 @@ fn examples(paths: &Paths) -> Result<ExampleSection> {
     let packages = firmware::example_packages(paths)?;
     if packages.is_empty() {
         eprintln!("can-bench: no firmware example with binaries under examples/ yet");
-        return Ok(ExampleSection {
-            builds: Vec::new(),
-        });
+        return Ok(ExampleSection { builds: Vec::new() });
     }
     let mut builds = Vec::new();
     for p in &packages {
@@ -223,8 +228,11 @@ fn examples(paths: &Paths) -> Result<ExampleSection> {
                     continue;
                 }
                 let elf = dir.join(bin);
-                let size = sizes::measure(&elf)
-                    .context(format!("{} {bin} ({})", p.name, features.join(",")))?;
+                let size = sizes::measure(&elf).context(format!(
+                    "{} {bin} ({})",
+                    p.name,
+                    features.join(",")
+                ))?;
                 builds.push(ExampleBuild {
                     package: p.name.clone(),
                     dir: p.dir.clone(),

@@ -49,7 +49,9 @@ fn bxcan_driver(model: &BxCanModel, bus: &mut Bus) -> Result<Driver<Can<BxCanMod
             }
         }
     }
-    Err(Error::new("bxCAN model: no INAK = 0 after 400 bit times of idle bus"))
+    Err(Error::new(
+        "bxCAN model: no INAK = 0 after 400 bit times of idle bus",
+    ))
 }
 
 fn flexcan_driver(model: &FlexCanModel) -> Result<AcanDriver<FlexCanModel>> {
@@ -127,7 +129,9 @@ pub fn two_drivers() -> Result<Speed> {
     let secs = start.elapsed().as_secs_f64();
     let lost = bx.traffic().rx_ring_overflows + fx.traffic().rx_ring_overflows;
     if lost != 0 {
-        return Err(Error::new(format!("{lost} frames lost to full receive rings")));
+        return Err(Error::new(format!(
+            "{lost} frames lost to full receive rings"
+        )));
     }
     Ok(Speed {
         scenario: "twocan bxCAN driver over the bxCAN model ⇄ twocan FlexCAN driver over the \

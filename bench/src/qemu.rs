@@ -29,6 +29,8 @@ pub struct Tools {
     pub gcc: PathBuf,
     /// Its `--version` first line.
     pub gcc_version: String,
+    /// What `dpkg -S qemu-plugin.h` says about the installed packages.
+    pub header_search: String,
 }
 
 fn is_root() -> bool {
@@ -93,7 +95,11 @@ pub fn tools() -> Result<Tools> {
         Command::new(&qemu).args(["-machine", "help"]),
         Duration::from_secs(30),
     )?;
-    if !machines.stdout.lines().any(|l| l.split_whitespace().next() == Some(MACHINE)) {
+    if !machines
+        .stdout
+        .lines()
+        .any(|l| l.split_whitespace().next() == Some(MACHINE))
+    {
         return Err(Error::new(format!(
             "{qemu_version} has no `{MACHINE}` machine (QEMU 6.0 or newer is needed)"
         )));
@@ -107,7 +113,22 @@ pub fn tools() -> Result<Tools> {
         qemu_installed_now,
         gcc,
         gcc_version,
+        header_search: header_search(),
     })
+}
+
+/// Whether an installed Debian package ships QEMU's plugin header.
+fn header_search() -> String {
+    let mut c = Command::new("dpkg");
+    c.args(["-S", "qemu-plugin.h"]);
+    match cmd::run(&mut c, Duration::from_secs(60)) {
+        Ok(o) if o.code == Some(0) => format!(
+            "`dpkg -S qemu-plugin.h` found: {}",
+            o.stdout.lines().collect::<Vec<_>>().join("; ")
+        ),
+        Ok(_) => "`dpkg -S qemu-plugin.h` finds no installed package with the header".into(),
+        Err(_) => "`dpkg` is not available to search the installed packages".into(),
+    }
 }
 
 /// The gcc command line that builds the plugin (for the report too).
@@ -180,7 +201,11 @@ impl Counts {
 
     /// Measurements per region (the same for every region).
     pub fn repeats(&self) -> usize {
-        self.regions.values().map(|r| r.raw.len()).min().unwrap_or(0)
+        self.regions
+            .values()
+            .map(|r| r.raw.len())
+            .min()
+            .unwrap_or(0)
     }
 }
 
@@ -204,7 +229,9 @@ pub fn command(tools: &Tools, elf: &Path, plugin: &Path, window: u32, out: &Path
 /// Runs the `insn-count` firmware `elf` under QEMU with the plugin and collects the counts.
 pub fn run(paths: &Paths, tools: &Tools, plugin: &Path, elf: &Path, tag: &str) -> Result<Counts> {
     let window = crate::sizes::read_u32_symbol(elf, WINDOW_SYMBOL)?;
-    let out_file = paths.scratch("bench-plugin").join(format!("counts-{tag}.txt"));
+    let out_file = paths
+        .scratch("bench-plugin")
+        .join(format!("counts-{tag}.txt"));
     let _ = std::fs::remove_file(&out_file);
     let mut c = command(tools, elf, plugin, window, &out_file);
     eprintln!("can-bench: {}", cmd::display(&c));
@@ -254,7 +281,9 @@ pub fn run(paths: &Paths, tools: &Tools, plugin: &Path, elf: &Path, tag: &str) -
                 let n: u32 = n.parse().context("plugin output")?;
                 let count: u64 = count.parse().context("plugin output")?;
                 let key = keys.get(&n).ok_or_else(|| {
-                    Error::new(format!("the plugin measured region {n}, which the firmware did not name"))
+                    Error::new(format!(
+                        "the plugin measured region {n}, which the firmware did not name"
+                    ))
                 })?;
                 regions
                     .entry(key.clone())

@@ -70,7 +70,7 @@ fn thousands(n: u64) -> String {
     let s = n.to_string();
     let mut out = String::new();
     for (i, c) in s.chars().enumerate() {
-        if i > 0 && (s.len() - i) % 3 == 0 {
+        if i > 0 && (s.len() - i).is_multiple_of(3) {
             out.push(',');
         }
         out.push(c);
@@ -87,9 +87,9 @@ fn ratio(a: u64, b: u64) -> String {
 }
 
 fn rate(r: u32) -> String {
-    if r >= 1_000_000 && r % 1_000_000 == 0 {
+    if r >= 1_000_000 && r.is_multiple_of(1_000_000) {
         format!("{} Mbit/s", r / 1_000_000)
-    } else if r % 1000 == 0 {
+    } else if r.is_multiple_of(1000) {
         format!("{} kbit/s", r / 1000)
     } else {
         format!("{} bit/s", thousands(r as u64))
@@ -178,6 +178,7 @@ impl Report {
         if let Some(sim) = &self.sim {
             render_sim(&mut s, sim);
         }
+        render_sources(&mut s);
         Ok(s)
     }
 
@@ -331,13 +332,15 @@ impl Report {
         );
         let _ = writeln!(
             s,
-            "Debian 12 ships no `qemu-plugin.h` (no package installs it: `apt-file search \
-             qemu-plugin.h` finds nothing, and `dpkg -L` of `qemu-system-arm`, \
-             `qemu-system-common` and `qemu-system-data` lists no header), so the plugin \
-             declares the few plugin API types and functions it uses itself, from the \
-             documented plugin API (`qemu_plugin_install`, `qemu_plugin_version` = 1, \
-             translation callback, per-instruction execution callback, memory callback on \
-             stores, `qemu_plugin_register_atexit_cb`, `qemu_plugin_outs`).\n"
+            "No Debian 12 package ships QEMU's plugin header `qemu-plugin.h` (checked \
+             when the bench was written: `apt-file search qemu-plugin.h` on bookworm finds \
+             nothing, and the qemu-system packages list no header; in this run, {}), so the \
+             plugin declares the few plugin API types and functions it uses itself, from \
+             the documented plugin API (`qemu_plugin_install`, `qemu_plugin_version` = 1, \
+             the translation callback, per-instruction execution callbacks, memory \
+             callbacks on stores, `qemu_plugin_register_atexit_cb`, `qemu_plugin_outs`). \
+             It copies nothing from QEMU's header.\n",
+            insn.tools.header_search
         );
         let _ = writeln!(
             s,
@@ -510,7 +513,8 @@ impl Report {
             insn.window,
             std::path::Path::new("target/bench-plugin/counts-release.txt"),
         );
-        let line = cmd::display(&example).replace(&insn.tools.qemu.display().to_string(), "qemu-system-arm");
+        let line = cmd::display(&example)
+            .replace(&insn.tools.qemu.display().to_string(), "qemu-system-arm");
         let _ = writeln!(s, "```\n{line}\n```\n");
         Ok(())
     }
@@ -558,8 +562,14 @@ fn render_timing(s: &mut String, t: &[ControllerQuality]) {
     for q in t {
         let n = q.cases.len();
         let worst_ppm = |c: Option<&Case>| {
-            c.map(|c| format!("{} ppm ({})", thousands(c.ppm().unwrap_or(0)), case_label(c)))
-                .unwrap_or_else(|| "–".into())
+            c.map(|c| {
+                format!(
+                    "{} ppm ({})",
+                    thousands(c.ppm().unwrap_or(0)),
+                    case_label(c)
+                )
+            })
+            .unwrap_or_else(|| "–".into())
         };
         let worst_sp = |c: Option<&Case>| {
             c.map(|c| {
@@ -589,8 +599,19 @@ fn render_timing(s: &mut String, t: &[ControllerQuality]) {
     let _ = writeln!(s);
     for q in t {
         let mismatches: Vec<&Case> = q.cases.iter().filter(|c| !c.matches()).collect();
-        if !mismatches.is_empty() {
-            let _ = writeln!(s, "{} cases where the solver differs from the exhaustive search:\n", q.name);
+        if mismatches.is_empty() {
+            let _ = writeln!(
+                s,
+                "{}: the solver's choice equals the exhaustive search's in every case.\n",
+                q.name
+            );
+        } else {
+            let _ = writeln!(
+                s,
+                "{} cases where the solver differs from the exhaustive search \
+                 (prescaler, tseg1, tseg2):\n",
+                q.name
+            );
             for c in mismatches {
                 let _ = writeln!(
                     s,
@@ -608,14 +629,23 @@ fn render_timing(s: &mut String, t: &[ControllerQuality]) {
             .cases
             .iter()
             .filter(|c| !c.accepted())
-            .map(|c| format!("{} ({} ppm)", case_label(c), thousands(c.ppm().unwrap_or(0))))
+            .map(|c| {
+                format!(
+                    "{} ({} ppm)",
+                    case_label(c),
+                    thousands(c.ppm().unwrap_or(0))
+                )
+            })
             .collect();
         if !refused.is_empty() {
             let _ = writeln!(
                 s,
-                "{} cases outside 1,000 ppm (no timing of the controller comes closer; the \
-                 backends refuse them): {}.\n",
+                "<details><summary>{}: the {} cases outside 1,000 ppm</summary>\n\n\
+                 The best timing the controller allows is still too far from the wished \
+                 rate (the exhaustive search finds nothing closer); the backends refuse \
+                 these: {}.\n\n</details>\n",
                 q.name,
+                refused.len(),
                 refused.join(", ")
             );
         }
@@ -671,4 +701,25 @@ fn render_sim(s: &mut String, sim: &[Trials]) {
         );
     }
     let _ = writeln!(s);
+}
+
+fn render_sources(s: &mut String) {
+    let _ = writeln!(s, "## Where the measurements come from\n");
+    let _ = writeln!(
+        s,
+        "| what | source |\n|---|---|\n\
+         | the command, the report, section sizes, bit-timing grid and exhaustive search, \
+         simulator scenarios | `bench/src/` (package `twocan-bench`, binary `can-bench`) |\n\
+         | loop-back firmwares (STM32F7) | `bench/firmware/loopback-twocan`, \
+         `bench/firmware/loopback-bxcan`, `bench/firmware/shared/stm32f7.rs` |\n\
+         | instruction-count firmware (QEMU mps2-an386) | `bench/firmware/insn-count` |\n\
+         | QEMU plugin | `bench/plugin/insn_count.c` |\n\
+         | firmware examples | `examples/*` (see `docs/firmware.md`) |\n\n\
+         The bench firmware is its own cargo workspace (`bench/firmware/Cargo.toml`, \
+         excluded from the main workspace, with its own `Cargo.lock`), built by can-bench \
+         with `cargo build --profile release|release-speed --target {TARGET} \
+         --manifest-path bench/firmware/Cargo.toml` into `target/bench-firmware/`; the \
+         examples are built into `target/bench-examples/`, the plugin into \
+         `target/bench-plugin/`.\n"
+    );
 }

@@ -46,7 +46,8 @@ impl Speed {
 }
 
 fn frame(id: u16, n: u64) -> Result<Frame> {
-    Frame::standard(id, &n.to_le_bytes()).map_err(|e| Error::new(format!("building a frame: {e:?}")))
+    Frame::standard(id, &n.to_le_bytes())
+        .map_err(|e| Error::new(format!("building a frame: {e:?}")))
 }
 
 /// `senders` SimNodes (identifiers 0x100 + node) each sending 8-byte frames, one more

@@ -156,7 +156,8 @@ impl FaultConfinement {
         if !self.bus_off || self.recovery_sequences >= BUS_OFF_RECOVERY_SEQUENCES {
             return 0;
         }
-        (BUS_OFF_RECOVERY_SEQUENCES - self.recovery_sequences) as u64 * 11 - self.recessive_run as u64
+        (BUS_OFF_RECOVERY_SEQUENCES - self.recovery_sequences) as u64 * 11
+            - self.recessive_run as u64
     }
 
     /// A dominant bit seen while bus-off interrupts the current run of recessive bits.

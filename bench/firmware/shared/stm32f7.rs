@@ -54,7 +54,10 @@ fn wait(mut done: impl FnMut() -> bool) -> Result<(), ()> {
 /// SYSCLK 108 MHz from the PLL, APB1 54 MHz, CAN1 clocked. `Err` if a clock never
 /// becomes ready.
 pub fn clocks() -> Result<(), ()> {
-    write(FLASH_ACR, (read(FLASH_ACR) & !ACR_LATENCY) | ACR_LATENCY_3WS);
+    write(
+        FLASH_ACR,
+        (read(FLASH_ACR) & !ACR_LATENCY) | ACR_LATENCY_3WS,
+    );
     wait(|| read(FLASH_ACR) & ACR_LATENCY == ACR_LATENCY_3WS)?;
     write(
         RCC_PLLCFGR,
@@ -62,7 +65,10 @@ pub fn clocks() -> Result<(), ()> {
     );
     write(RCC_CR, read(RCC_CR) | CR_PLLON);
     wait(|| read(RCC_CR) & CR_PLLRDY != 0)?;
-    write(RCC_CFGR, (read(RCC_CFGR) & !CFGR_HPRE_PPRE) | CFGR_PPRE1_DIV2);
+    write(
+        RCC_CFGR,
+        (read(RCC_CFGR) & !CFGR_HPRE_PPRE) | CFGR_PPRE1_DIV2,
+    );
     write(RCC_CFGR, (read(RCC_CFGR) & !CFGR_SW) | CFGR_SW_PLL);
     wait(|| (read(RCC_CFGR) >> CFGR_SWS_SHIFT) & 0b11 == CFGR_SW_PLL)?;
     write(RCC_APB1ENR, read(RCC_APB1ENR) | APB1ENR_CAN1EN);

@@ -32,10 +32,7 @@ pub use board::Board;
 #[cfg(any(feature = "nucleo-f767zi", feature = "disco-f746g"))]
 pub use board::BOARD;
 
-/// What the host build of a firmware example does: say how to build the real thing.
-pub fn host_stub(example: &str) -> &'static str {
-    let _ = example;
-    "this is STM32F7 firmware: cross-build it with \
+/// What the host build of a firmware example prints: how to build the real thing.
+pub const HOST_NOTE: &str = "this is STM32F7 firmware: cross-build it with \
      `cargo build --release --target thumbv7em-none-eabihf -p twocan-stm32f7 \
-     --features nucleo-f767zi --bin <example>` (or disco-f746g), see docs/firmware.md"
-}
+     --features nucleo-f767zi --bin <example>` (or disco-f746g), see docs/firmware.md";

@@ -1,8 +1,9 @@
 //! Board facts: chip, memory map and FlexCAN interrupt vectors of each Teensy 3.x.
 //!
 //! Everything here is plain data so that host tests can check it (against the vendor
-//! SVD files, `tests/facts_k20.rs`, `tests/facts_k66.rs`) and the ELF test can check a built image against it
-//! (`tests/elf.rs`). The firmware uses [`BOARD`], selected by the board feature.
+//! SVD files: `tests/facts_k20.rs`, `tests/facts_k66.rs`) and the ELF test can check a
+//! built image against it (`tests/elf.rs`). The firmware uses `BOARD`, selected by the
+//! board feature.
 
 use twocan_flexcan::Instance;
 

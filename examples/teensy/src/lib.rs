@@ -6,7 +6,7 @@
 //! `.hex` conversion and flashing.
 //!
 //! What a bare Kinetis needs before `main`, written here (no vendor start-up code):
-//! - [`rt`]: the watchdog disabled by cortex-m-rt's `__pre_init` hook, the device
+//! - `rt` (target only): the watchdog disabled by cortex-m-rt's `__pre_init` hook, the device
 //!   interrupt vectors (`__INTERRUPTS`) with the FlexCAN ones, the flash configuration
 //!   field at 0x400 ([`flash_config`]), the SysTick handler and the panic handler;
 //! - [`clock`]: the 16 MHz crystal started and the MCG switched to FBE with bounded
@@ -14,7 +14,7 @@
 //! - [`led`]: pin 13; [`time`]: a SysTick millisecond time base; [`shared`]: a driver
 //!   shared with its interrupt handler.
 //!
-//! Everything except [`rt`] is plain code over the [`io::Io`] trait, built and tested on
+//! Everything except `rt` is plain code over the [`io::Io`] trait, built and tested on
 //! the host as well.
 #![cfg_attr(not(test), no_std)]
 #![deny(missing_docs)]
@@ -47,10 +47,7 @@ pub use board::Board;
 #[cfg(any(feature = "teensy32", feature = "teensy35", feature = "teensy36"))]
 pub use board::BOARD;
 
-/// What the host build of a firmware example does: say how to build the real thing.
-pub fn host_stub(example: &str) -> &'static str {
-    let _ = example;
-    "this is Teensy firmware: cross-build it with \
+/// What the host build of a firmware example prints: how to build the real thing.
+pub const HOST_NOTE: &str = "this is Teensy firmware: cross-build it with \
      `cargo build --release --target thumbv7em-none-eabihf -p twocan-teensy \
-     --features teensy36 --bin <example>` (or teensy32 / teensy35), see docs/firmware.md"
-}
+     --features teensy36 --bin <example>` (or teensy32 / teensy35), see docs/firmware.md";

@@ -21,7 +21,9 @@ impl<C: Controller, const RX: usize, const TX: usize> SharedDriver<C, RX, TX> {
         }
     }
 
-    /// Puts the driver in place; gives it back if one is there already.
+    /// Puts the driver in place; gives it back if one is there already (the error hands
+    /// the whole driver back, so it is as large as the driver).
+    #[allow(clippy::result_large_err)]
     pub fn install(&self, driver: Driver<C, RX, TX>) -> Result<(), Driver<C, RX, TX>> {
         critical_section::with(|cs| {
             let mut slot = self.inner.borrow_ref_mut(cs);

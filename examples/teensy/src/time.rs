@@ -5,7 +5,7 @@ use core::sync::atomic::{AtomicU32, Ordering};
 
 static MILLIS: AtomicU32 = AtomicU32::new(0);
 
-/// Milliseconds since [`start`] (wraps after 49.7 days).
+/// Milliseconds since `start` (wraps after 49.7 days).
 pub fn millis() -> u32 {
     MILLIS.load(Ordering::Relaxed)
 }

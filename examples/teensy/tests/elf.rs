@@ -47,9 +47,9 @@ fn firmware_dir() -> PathBuf {
 }
 
 fn bins(board: &twocan_teensy::Board) -> Vec<&'static str> {
-    let mut v = vec!["loopback", "filters", "app"];
+    let mut v = vec!["teensy-loopback", "teensy-filters", "teensy-app"];
     if board.can_instances().len() > 1 {
-        v.push("can0-can1");
+        v.push("teensy-can0-can1");
     }
     v
 }
@@ -91,7 +91,7 @@ fn firmware_images() {
         let image = elf::Image::parse(&data).unwrap_or_else(|e| panic!("{bin}: {e}"));
         let sizes = image.check(&board).unwrap_or_else(|e| panic!("{bin}: {e}"));
         println!(
-            "{:<10} {:<10} {:>8} {:>8}",
+            "{:<10} {:<18} {:>8} {:>8}",
             board.name, bin, sizes.flash, sizes.ram
         );
         checked += 1;

@@ -157,7 +157,9 @@ fn pending(b: &mut Block, x: usize, id: u32) {
 }
 
 fn tsr_value(empty: &[usize], code: u32) -> u32 {
-    empty.iter().fold(tsr::CODE.val(code), |v, &x| v | tsr::tme(x))
+    empty
+        .iter()
+        .fold(tsr::CODE.val(code), |v, &x| v | tsr::tme(x))
 }
 
 struct Snapshots {
@@ -200,7 +202,14 @@ fn snapshots(configured: &Block) -> Snapshots {
     rx_one[regs::rdtxr(0) / 4] = rdtxr::DLC.val(8) | rdtxr::FMI.val(0) | rdtxr::TIME.val(0x1234);
     rx_one[regs::rdlxr(0) / 4] = u32::from_le_bytes([DATA[0], DATA[1], DATA[2], DATA[3]]);
     rx_one[regs::rdhxr(0) / 4] = u32::from_le_bytes([DATA[4], DATA[5], DATA[6], DATA[7]]);
-    Snapshots { tx_free, tx_one_busy, tx_full, tx_refill, tx_done, rx_one }
+    Snapshots {
+        tx_free,
+        tx_one_busy,
+        tx_full,
+        tx_refill,
+        tx_done,
+        rx_one,
+    }
 }
 
 // ------------------------------------------------------------------ mode handshake stand-in
@@ -333,12 +342,18 @@ fn run_ours(snap: &Snapshots, d: &mut Ours) {
         restore(&snap.tx_free);
         let (dd, ff) = (black_box(&mut *d), black_box(&frame));
         let ok = measure::<OURS_SEND_DIRECT, _>(|| ours_try_send(dd, ff));
-        check(ok && loaded(0) && d.tx_stats().count == 0, "twocan try_send direct");
+        check(
+            ok && loaded(0) && d.tx_stats().count == 0,
+            "twocan try_send direct",
+        );
 
         restore(&snap.tx_one_busy);
         let (dd, ff) = (black_box(&mut *d), black_box(&frame));
         let ok = measure::<OURS_SEND_ONE_BUSY, _>(|| ours_try_send(dd, ff));
-        check(ok && loaded(1) && d.tx_stats().count == 0, "twocan try_send one busy");
+        check(
+            ok && loaded(1) && d.tx_stats().count == 0,
+            "twocan try_send one busy",
+        );
 
         restore(&snap.tx_full);
         let (dd, ff) = (black_box(&mut *d), black_box(&frame));
@@ -348,7 +363,10 @@ fn run_ours(snap: &Snapshots, d: &mut Ours) {
         restore(&snap.tx_refill);
         let dd = black_box(&mut *d);
         measure::<OURS_IRQ_REFILL, _>(|| ours_on_interrupt(dd));
-        check(loaded(0) && d.tx_stats().count == 0, "twocan on_interrupt refill");
+        check(
+            loaded(0) && d.tx_stats().count == 0,
+            "twocan on_interrupt refill",
+        );
 
         restore(&snap.tx_done);
         let sent = d.traffic().sent;
@@ -359,7 +377,10 @@ fn run_ours(snap: &Snapshots, d: &mut Ours) {
         restore(&snap.rx_one);
         let dd = black_box(&mut *d);
         measure::<OURS_IRQ_RX, _>(|| ours_on_interrupt(dd));
-        check(released() && d.rx_stats().count == 1, "twocan on_interrupt rx");
+        check(
+            released() && d.rx_stats().count == 1,
+            "twocan on_interrupt rx",
+        );
 
         let dd = black_box(&mut *d);
         let rx = measure::<OURS_RECEIVE, _>(|| ours_receive(dd));
@@ -396,7 +417,10 @@ fn configure_theirs() -> Theirs {
         .leave_disabled();
     can.modify_filters()
         .enable_bank(0, bxcan::Fifo::Fifo0, Mask32::accept_all());
-    check(nb::block!(can.enable_non_blocking()).is_ok(), "bxcan enable");
+    check(
+        nb::block!(can.enable_non_blocking()).is_ok(),
+        "bxcan enable",
+    );
     can
 }
 
@@ -443,7 +467,8 @@ fn main() -> ! {
     let mut ours = configure_ours();
     responder_off(&mut core.SYST);
     run_ours(&snapshots(&save()), &mut ours);
-    drop(ours.release().release());
+    // Our driver gives the register block up before the `bxcan` crate takes it.
+    let _ = ours.release().release();
 
     // Theirs: the same from a fresh reset block.
     reset_block();
@@ -459,6 +484,8 @@ fn main() -> ! {
     }
 }
 
+/// Reports a fault and fails the run (cortex-m-rt requires the handler to be an
+/// `unsafe fn`; it touches no memory through the frame beyond reading the stacked PC).
 #[exception]
 unsafe fn HardFault(frame: &ExceptionFrame) -> ! {
     hprintln!("FAIL hard fault at {:#010x}", frame.pc());

@@ -42,7 +42,8 @@ fn start() -> Result<(), Error> {
     let regs = unsafe { Mmio::new(CAN1_BASE) };
     let mut init = Can::can1(regs, &CONFIG)?;
     let mut filters = FilterPlan::manual();
-    let bank = Bank::mask32(&Filter::pass_all(), Fifo::Fifo0).map_err(|_| Error::InvalidArgument)?;
+    let bank =
+        Bank::mask32(&Filter::pass_all(), Fifo::Fifo0).map_err(|_| Error::InvalidArgument)?;
     filters.set_bank(0, bank)?;
     init.set_filters(&filters)?;
     let can = init.enable()?;

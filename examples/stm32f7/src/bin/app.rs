@@ -105,5 +105,5 @@ mod firmware {
 
 #[cfg(not(target_os = "none"))]
 fn main() {
-    eprintln!("{}", twocan_stm32f7::host_stub("app"));
+    eprintln!("stm32f7-app: {}", twocan_stm32f7::HOST_NOTE);
 }

@@ -150,5 +150,5 @@ mod firmware {
 
 #[cfg(not(target_os = "none"))]
 fn main() {
-    eprintln!("{}", twocan_stm32f7::host_stub("can1-can2"));
+    eprintln!("stm32f7-can1-can2: {}", twocan_stm32f7::HOST_NOTE);
 }

@@ -157,5 +157,5 @@ mod firmware {
 
 #[cfg(not(target_os = "none"))]
 fn main() {
-    eprintln!("{}", twocan_stm32f7::host_stub("filters"));
+    eprintln!("stm32f7-filters: {}", twocan_stm32f7::HOST_NOTE);
 }

@@ -86,5 +86,5 @@ mod firmware {
 
 #[cfg(not(target_os = "none"))]
 fn main() {
-    eprintln!("{}", twocan_stm32f7::host_stub("loopback"));
+    eprintln!("stm32f7-loopback: {}", twocan_stm32f7::HOST_NOTE);
 }

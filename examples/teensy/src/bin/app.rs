@@ -85,5 +85,5 @@ mod firmware {
 
 #[cfg(not(target_os = "none"))]
 fn main() {
-    eprintln!("{}", twocan_teensy::host_stub("app"));
+    eprintln!("teensy-app: {}", twocan_teensy::HOST_NOTE);
 }

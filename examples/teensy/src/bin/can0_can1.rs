@@ -99,5 +99,5 @@ mod firmware {
 
 #[cfg(not(target_os = "none"))]
 fn main() {
-    eprintln!("{}", twocan_teensy::host_stub("can0-can1"));
+    eprintln!("teensy-can0-can1: {}", twocan_teensy::HOST_NOTE);
 }

@@ -149,5 +149,5 @@ mod firmware {
 
 #[cfg(not(target_os = "none"))]
 fn main() {
-    eprintln!("{}", twocan_teensy::host_stub("filters"));
+    eprintln!("teensy-filters: {}", twocan_teensy::HOST_NOTE);
 }

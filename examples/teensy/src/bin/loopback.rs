@@ -68,5 +68,5 @@ mod firmware {
 
 #[cfg(not(target_os = "none"))]
 fn main() {
-    eprintln!("{}", twocan_teensy::host_stub("loopback"));
+    eprintln!("teensy-loopback: {}", twocan_teensy::HOST_NOTE);
 }
