@@ -287,7 +287,7 @@ impl BxNode {
             .plan(filters, fifos)
             .map_err(SetupError::BxCanPlan)?;
         init.set_filters(&plan)
-            .map_err(|f| SetupError::Driver(f))?;
+            .map_err(SetupError::Driver)?;
         let can = init.enable().map_err(|f| SetupError::Driver(f.error))?;
         Ok(BxNode {
             model,
