@@ -146,9 +146,9 @@ fn run(o: &Options) -> Result<(), String> {
     for p in 0..periods {
         teensy_app.step(&mut teensy.driver);
         stm32_app.step(&mut stm32.driver);
-        if p % 5 == 0 {
+        if p.is_multiple_of(5) {
             let k = (p / 5) as u32;
-            let f = if k % 2 == 0 {
+            let f = if k.is_multiple_of(2) {
                 Frame::standard(0x300 + (k % 16) as u16, &k.to_le_bytes())
             } else {
                 Frame::extended(0x0CF0_0400 | (k % 8), &k.to_be_bytes())
@@ -161,7 +161,7 @@ fn run(o: &Options) -> Result<(), String> {
             start + (p + 1) * period,
             &mut [&mut teensy as &mut dyn Serviced, &mut stm32],
         );
-        if (p + 1) % progress_every == 0 {
+        if (p + 1).is_multiple_of(progress_every) {
             let bus = h.bus().borrow();
             println!(
                 "  t = {:>7.3} s  frames on bus {:>7}  load {:>5.1} %  teensy {} / stm32 {}",
