@@ -60,7 +60,7 @@ pub enum ClockError {
 }
 
 impl ClockError {
-    /// The number of blinks the examples show for this error (see `crate::halt`).
+    /// The number of blinks the examples show for this error (see `rt::halt`).
     pub const fn blink_code(self) -> u8 {
         match self {
             ClockError::OscillatorTimeout => 2,

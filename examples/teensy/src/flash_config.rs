@@ -18,12 +18,16 @@
 //!   mass-erased again — it is lost. `0xFE` keeps every other field at its erased,
 //!   permissive value, so the chip can always be mass-erased and reprogrammed (the Teensy
 //!   loader chip programs over the debug port).
-//! - `FOPT = 0xF9` is what PJRC ships on every Teensy 3.x. `EZPORT_DIS = 0` stops a low
-//!   level on the EZP_CS pin at reset from entering EzPort mode instead of running the
-//!   program; `NMI_DIS = 0` stops a low level on the NMI pin (a user pin on the Teensy
-//!   headers) from raising NMIs; `LPBOOT = 1` selects the normal-boot reset values of the
+//! - `FOPT = 0xF9` is the value of PJRC's current Teensyduino start-up code (the early
+//!   Teensy 3.0 code left it erased, `0xFF`). `EZPORT_DIS = 0` stops a low level on the
+//!   EZP_CS pin at reset from entering EzPort mode instead of running the program;
+//!   `NMI_DIS = 0` stops a low level on the NMI pin (a user pin on the Teensy headers)
+//!   from raising NMIs; `LPBOOT = 1` selects the normal-boot reset values of the
 //!   `SIM_CLKDIV1` dividers (the core clock is not divided by 8), so the start-up code
 //!   runs at full speed.
+//! - PJRC's current code uses `FSEC = 0xDE`, the early code `0xFE`: they differ only in
+//!   `MEEN` (`0b01` / `0b11`), and both mean "mass erase enabled". `0xFE` is the
+//!   erased value in every field but `SEC`.
 //!
 //! The constants are checked at compile time here ([`FlashConfig::check`]), and on the
 //! linked ELF by `tests/elf.rs`.

@@ -1,8 +1,8 @@
 //! Addresses and bits of the Kinetis system registers the start-up code touches.
 //!
 //! The addresses and bit positions are the same on the K20 (K20P64M72SF1RM), the K64
-//! (K64P144M120SF5RM) and the K66 (K66P144M180SF5RMV2); `tests/facts.rs` checks each one
-//! against the MK20D7 and MK66F18 SVD files. Chapter names below are those of the
+//! (K64P144M120SF5RM) and the K66 (K66P144M180SF5RMV2); `tests/facts_k20.rs` and
+//! `tests/facts_k66.rs` check each one against the MK20D7 and MK66F18 SVD files. Chapter names below are those of the
 //! reference manuals ("WDOG", "MCG", "OSC", "SIM", "PORT", "GPIO").
 
 /// Watchdog (WDOG chapter, "Memory map and register definition"): base address.

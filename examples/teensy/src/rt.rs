@@ -7,16 +7,16 @@ use crate::regs::{
     WDOG_STCTRLH, WDOG_STCTRLH_DISABLED, WDOG_UNLOCK, WDOG_UNLOCK_KEY1, WDOG_UNLOCK_KEY2,
 };
 
-// The watchdog runs out of reset with a ~1 s (LPO clock) time-out, and its control
-// registers can only be written inside a window after an unlock (WDOG chapter,
+// The watchdog is enabled out of reset, and its control registers can only be written
+// inside a window after an unlock (WDOG chapter,
 // "Unlocking and updating the watchdog"): the two unlock words must be written within
 // 20 bus clocks of each other, and the new control value within the WCT window (256 bus
 // clocks) that follows. That is why this runs as cortex-m-rt's `__pre_init` — the first
 // code after reset, before `.bss`/`.data` are initialised — and why it is assembly:
 // cortex-m-rt 0.7.6 deprecated `#[pre_init]` because Rust code must not run before RAM
 // is initialised, and recommends a `__pre_init` symbol written with `global_asm!`.
-// Between the unlock and the write there are two `nop`s (the unlock completes one bus
-// clock after the second word) and a literal load: about six core clocks, far inside
+// Between the unlock and the write there are two `nop`s (the manual asks for at least
+// one bus clock between the second unlock word and the update) and a literal load: about six core clocks, far inside
 // the window. Only r0 and r1 are used, which the AAPCS lets a callee clobber.
 core::arch::global_asm!(
     ".section .text.__pre_init,\"ax\",%progbits",

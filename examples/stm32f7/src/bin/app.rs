@@ -31,17 +31,8 @@ mod firmware {
 
     static CAN1: SharedDriver<Can<Mmio>, 32, 16> = SharedDriver::new();
 
-    /// The application's counters, copied after each step.
-    pub static STATS: Mutex<RefCell<AppStats>> = Mutex::new(RefCell::new(AppStats {
-        sent: 0,
-        tx_full: 0,
-        heartbeats: 0,
-        heartbeat_gaps: 0,
-        measurements: 0,
-        requests: 0,
-        answers: 0,
-        unhandled: 0,
-    }));
+    /// The application's counters, copied after each step (`None` before the first).
+    pub static STATS: Mutex<RefCell<Option<AppStats>>> = Mutex::new(RefCell::new(None));
 
     #[interrupt]
     fn CAN1_TX() {
@@ -92,7 +83,7 @@ mod firmware {
             if period.due(time::millis()) {
                 CAN1.with(|d| app.step(d));
                 let stats = app.stats();
-                critical_section::with(|cs| *STATS.borrow_ref_mut(cs) = stats);
+                critical_section::with(|cs| *STATS.borrow_ref_mut(cs) = Some(stats));
                 if stats.heartbeats >= shown + 50 {
                     shown = stats.heartbeats;
                     boot.led.toggle();

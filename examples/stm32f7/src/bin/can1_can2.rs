@@ -32,20 +32,9 @@ mod firmware {
     static CAN1: SharedDriver<Can<Mmio>, 32, 16> = SharedDriver::new();
     static CAN2: SharedDriver<Can<Mmio, Mmio>, 32, 16> = SharedDriver::new();
 
-    const NO_STATS: AppStats = AppStats {
-        sent: 0,
-        tx_full: 0,
-        heartbeats: 0,
-        heartbeat_gaps: 0,
-        measurements: 0,
-        requests: 0,
-        answers: 0,
-        unhandled: 0,
-    };
-
-    /// The counters of node 1 (CAN1) and node 2 (CAN2), copied after each step.
-    pub static STATS: Mutex<RefCell<[AppStats; 2]>> =
-        Mutex::new(RefCell::new([NO_STATS, NO_STATS]));
+    /// The counters of node 1 (CAN1) and node 2 (CAN2), copied after each step
+    /// (`None` before the first).
+    pub static STATS: Mutex<RefCell<Option<[AppStats; 2]>>> = Mutex::new(RefCell::new(None));
 
     #[interrupt]
     fn CAN1_TX() {
@@ -136,7 +125,7 @@ mod firmware {
                 CAN1.with(|d| node1.step(d));
                 CAN2.with(|d| node2.step(d));
                 let stats = [node1.stats(), node2.stats()];
-                critical_section::with(|cs| *STATS.borrow_ref_mut(cs) = stats);
+                critical_section::with(|cs| *STATS.borrow_ref_mut(cs) = Some(stats));
                 let both = stats[0].heartbeats.min(stats[1].heartbeats);
                 if both >= shown + 50 {
                     shown = both;

@@ -33,17 +33,11 @@ mod firmware {
     static CAN0: SharedDriver<FlexCan<Mmio>, RECEIVE_BUFFER_SIZE, TRANSMIT_BUFFER_SIZE> =
         SharedDriver::new();
 
-    /// The application's counters, copied after each step.
-    pub static STATS: Mutex<RefCell<AppStats>> = Mutex::new(RefCell::new(AppStats {
-        sent: 0,
-        tx_full: 0,
-        heartbeats: 0,
-        heartbeat_gaps: 0,
-        measurements: 0,
-        requests: 0,
-        answers: 0,
-        unhandled: 0,
-    }));
+    /// The application's counters, copied after each step (`None` before the first).
+    pub static STATS: Mutex<RefCell<Option<AppStats>>> = Mutex::new(RefCell::new(None));
+
+    /// 500 kbit/s, computed at compile time (the bit-timing solver is `const`).
+    const SETTINGS: Settings = Settings::new(500_000);
 
     #[no_mangle]
     extern "C" fn CAN0_ORED_MESSAGE_BUFFER() {
@@ -54,11 +48,10 @@ mod firmware {
     fn main() -> ! {
         let mut boot = rt::boot();
         let mut app = App::new(NODE, PEER);
-        let settings = Settings::new(500_000);
         let token = Can0::take().unwrap_or_else(|| rt::halt(CAN_BLINKS));
         // The application's portable filter list, as primary filters.
         let can = token
-            .begin(&settings, &app.filters(), &[])
+            .begin(&SETTINGS, &app.filters(), &[])
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         rt::enable_can_irq(&mut boot.core.NVIC, &can);
         let driver: AcanDriver<Mmio> = AcanDriver::new(can);
@@ -72,7 +65,7 @@ mod firmware {
             if period.due(time::millis()) {
                 CAN0.with(|d| app.step(d));
                 let stats = app.stats();
-                critical_section::with(|cs| *STATS.borrow_ref_mut(cs) = stats);
+                critical_section::with(|cs| *STATS.borrow_ref_mut(cs) = Some(stats));
                 if stats.heartbeats >= shown + 50 {
                     shown = stats.heartbeats;
                     boot.led.toggle();

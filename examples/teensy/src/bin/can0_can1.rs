@@ -30,20 +30,12 @@ mod firmware {
     static CAN1: SharedDriver<FlexCan<Mmio>, RECEIVE_BUFFER_SIZE, TRANSMIT_BUFFER_SIZE> =
         SharedDriver::new();
 
-    const NO_STATS: AppStats = AppStats {
-        sent: 0,
-        tx_full: 0,
-        heartbeats: 0,
-        heartbeat_gaps: 0,
-        measurements: 0,
-        requests: 0,
-        answers: 0,
-        unhandled: 0,
-    };
+    /// The counters of node 1 (CAN0) and node 2 (CAN1), copied after each step
+    /// (`None` before the first).
+    pub static STATS: Mutex<RefCell<Option<[AppStats; 2]>>> = Mutex::new(RefCell::new(None));
 
-    /// The counters of node 1 (CAN0) and node 2 (CAN1), copied after each step.
-    pub static STATS: Mutex<RefCell<[AppStats; 2]>> =
-        Mutex::new(RefCell::new([NO_STATS, NO_STATS]));
+    /// 500 kbit/s, computed at compile time (the bit-timing solver is `const`).
+    const SETTINGS: Settings = Settings::new(500_000);
 
     #[no_mangle]
     extern "C" fn CAN0_ORED_MESSAGE_BUFFER() {
@@ -58,17 +50,16 @@ mod firmware {
     #[cortex_m_rt::entry]
     fn main() -> ! {
         let mut boot = rt::boot();
-        let settings = Settings::new(500_000);
         let mut node1 = App::new(1, 2);
         let mut node2 = App::new(2, 1);
 
         let can0 = Can0::take()
             .unwrap_or_else(|| rt::halt(CAN_BLINKS))
-            .begin(&settings, &node1.filters(), &[])
+            .begin(&SETTINGS, &node1.filters(), &[])
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         let can1 = Can1::take()
             .unwrap_or_else(|| rt::halt(CAN_BLINKS))
-            .begin(&settings, &node2.filters(), &[])
+            .begin(&SETTINGS, &node2.filters(), &[])
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         rt::enable_can_irq(&mut boot.core.NVIC, &can0);
         rt::enable_can_irq(&mut boot.core.NVIC, &can1);
@@ -85,7 +76,7 @@ mod firmware {
                 CAN0.with(|d| node1.step(d));
                 CAN1.with(|d| node2.step(d));
                 let stats = [node1.stats(), node2.stats()];
-                critical_section::with(|cs| *STATS.borrow_ref_mut(cs) = stats);
+                critical_section::with(|cs| *STATS.borrow_ref_mut(cs) = Some(stats));
                 let both = stats[0].heartbeats.min(stats[1].heartbeats);
                 if both >= shown + 50 {
                     shown = both;

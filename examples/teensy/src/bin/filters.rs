@@ -40,6 +40,15 @@ mod firmware {
     /// call-back are counted by the dispatcher).
     pub static ERRORS: AtomicU32 = AtomicU32::new(0);
 
+    /// ACAN §4: 125 kbit/s, loop-back and self reception. Computed at compile time
+    /// (the bit-timing solver is `const`), so the solver is not in the image.
+    const SETTINGS: Settings = {
+        let mut s = Settings::new(125_000);
+        s.loop_back = true;
+        s.self_reception = true;
+        s
+    };
+
     #[no_mangle]
     extern "C" fn CAN0_ORED_MESSAGE_BUFFER() {
         CAN0.on_interrupt();
@@ -88,9 +97,6 @@ mod firmware {
     #[cortex_m_rt::entry]
     fn main() -> ! {
         let mut boot = rt::boot();
-        let mut settings = Settings::new(125_000);
-        settings.loop_back = true;
-        settings.self_reception = true;
         let primary = [
             Filter::exact(FrameKind::Data, Format::Extended, 0x12_3456),
             Filter::exact(FrameKind::Data, Format::Standard, 0x234),
@@ -102,7 +108,7 @@ mod firmware {
         ];
         let token = Can0::take().unwrap_or_else(|| rt::halt(CAN_BLINKS));
         let can = token
-            .begin(&settings, &primary, &secondary)
+            .begin(&SETTINGS, &primary, &secondary)
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         rt::enable_can_irq(&mut boot.core.NVIC, &can);
         let driver: AcanDriver<Mmio> = AcanDriver::new(can);
