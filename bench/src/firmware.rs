@@ -133,7 +133,8 @@ pub struct ExamplePackage {
     pub features: Vec<String>,
 }
 
-/// The packages under `examples/` that have binary targets.
+/// The firmware packages under `examples/`: those with binary targets and a dependency on
+/// `cortex-m-rt` (host examples there, such as a simulation, have none).
 pub fn example_packages(paths: &Paths) -> Result<Vec<ExamplePackage>> {
     let mut c = cargo();
     c.current_dir(&paths.root).args([
@@ -184,7 +185,12 @@ pub fn example_packages(paths: &Paths) -> Result<Vec<ExamplePackage>> {
                 (t["name"].as_str().unwrap_or("?").to_string(), req)
             })
             .collect();
-        if bins.is_empty() {
+        let firmware = p["dependencies"]
+            .as_array()
+            .into_iter()
+            .flatten()
+            .any(|d| d["name"] == "cortex-m-rt");
+        if bins.is_empty() || !firmware {
             continue;
         }
         let features = p["features"]

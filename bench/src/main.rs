@@ -33,13 +33,13 @@ use std::time::Instant;
 
 use cmd::{Context, Error, Result};
 use firmware::Paths;
-use report::{ExampleBuild, ExampleSection, InsnSection, Report, SizeSection};
+use report::{ExampleBuild, ExampleSection, InsnSection, Report, SizeBuild, SizeSection};
 use simspeed::Trials;
 
 /// The steps, for `--skip`.
 const STEPS: [&str; 5] = ["sizes", "examples", "qemu", "timing", "sim"];
 
-/// Profiles of the bench firmware for the instruction counts: (cargo profile, opt-level).
+/// Profiles of the bench firmware (sizes and instruction counts): (cargo profile, opt-level).
 const COUNT_PROFILES: [(&str, &str); 2] = [("release", "s"), ("release-speed", "3")];
 
 fn main() -> ExitCode {
@@ -92,14 +92,29 @@ fn step(name: &str) {
     eprintln!("\ncan-bench: ==> {name}");
 }
 
+/// Prints how long the steps so far took.
+fn lap(started: Instant) {
+    eprintln!("can-bench: ({:.1} s)", started.elapsed().as_secs_f64());
+}
+
 fn run() -> Result<()> {
     let skip = parse_args()?;
     let skipped = |s: &str| skip.iter().any(|k| k == s);
     let started = Instant::now();
     let paths = Paths::discover()?;
     let mut report = Report::new(&paths);
+    // QEMU and gcc first: a missing tool should stop the command before the long builds.
+    let tools = if skipped("qemu") {
+        None
+    } else {
+        step("tools for the instruction counts (QEMU, gcc)");
+        let t = qemu::tools()?;
+        eprintln!("can-bench: {}; {}", t.qemu_version, t.gcc_version);
+        Some(t)
+    };
 
     if !skipped("timing") {
+        lap(started);
         step("bit-timing quality (solver against exhaustive search)");
         report.timing = Some(vec![
             timing::run("FlexCAN", &twocan_core::timing::Limits::FLEXCAN),
@@ -108,12 +123,14 @@ fn run() -> Result<()> {
     }
 
     if !skipped("sim") {
+        lap(started);
         step("simulator speed");
         let mut speeds = Vec::new();
         for (senders, tracing) in [(1, false), (1, true), (4, false)] {
             speeds.push(Trials::run(|| simspeed::bare_bus(senders, tracing))?);
         }
         speeds.push(Trials::run(models::two_drivers)?);
+        speeds.push(Trials::run(models::harness)?);
         for t in &speeds {
             eprintln!(
                 "can-bench: {}: {:.0} frames/s (median of {})",
@@ -131,31 +148,42 @@ fn run() -> Result<()> {
         firmware::ensure_target()?;
     }
     if need_firmware {
+        lap(started);
         step("bench firmware (bench/firmware)");
         for (profile, _) in COUNT_PROFILES {
-            firmware_dirs.push((
-                profile.to_string(),
-                firmware::bench_firmware(&paths, profile)?,
-            ));
+            let t = Instant::now();
+            let dir = firmware::bench_firmware(&paths, profile)?;
+            report.build_secs += t.elapsed().as_secs_f64();
+            firmware_dirs.push((profile.to_string(), dir));
         }
     }
 
     if !skipped("sizes") {
+        lap(started);
         step("flash and RAM of the loop-back firmwares");
-        let dir = &firmware_dirs[0].1;
-        let ours = sizes::measure(&dir.join("loopback-twocan"))?;
-        let theirs = sizes::measure(&dir.join("loopback-bxcan"))?;
-        report.sizes = Some(SizeSection { ours, theirs });
+        let mut builds = Vec::new();
+        for ((profile, opt), (_, dir)) in COUNT_PROFILES.iter().zip(&firmware_dirs) {
+            builds.push(SizeBuild {
+                profile: profile.to_string(),
+                opt: opt.to_string(),
+                ours: sizes::measure(&dir.join("loopback-twocan"))?,
+                theirs: sizes::measure(&dir.join("loopback-bxcan"))?,
+            });
+        }
+        report.sizes = Some(SizeSection { builds });
     }
 
     if !skipped("examples") {
+        lap(started);
         step("flash and RAM of the firmware examples");
+        let t = Instant::now();
         report.examples = Some(examples(&paths)?);
+        report.build_secs += t.elapsed().as_secs_f64();
     }
 
-    if !skipped("qemu") {
+    if let Some(tools) = tools {
+        lap(started);
         step("instructions per frame under QEMU");
-        let tools = qemu::tools()?;
         let plugin = qemu::build_plugin(&paths, &tools)?;
         let mut runs = Vec::new();
         for ((profile, opt), (_, dir)) in COUNT_PROFILES.iter().zip(&firmware_dirs) {
@@ -175,6 +203,7 @@ fn run() -> Result<()> {
         });
     }
 
+    lap(started);
     report.elapsed_secs = started.elapsed().as_secs_f64();
     let text = report.render()?;
     println!("{text}");
@@ -201,7 +230,10 @@ const NOT_BOARDS: [&str; 5] = ["defmt", "std", "log", "model", "mock"];
 fn examples(paths: &Paths) -> Result<ExampleSection> {
     let packages = firmware::example_packages(paths)?;
     if packages.is_empty() {
-        eprintln!("can-bench: no firmware example with binaries under examples/ yet");
+        eprintln!(
+            "can-bench: no firmware example under examples/ yet (no package with binaries \
+             and a cortex-m-rt dependency): nothing to measure there"
+        );
         return Ok(ExampleSection { builds: Vec::new() });
     }
     let mut builds = Vec::new();

@@ -1,8 +1,15 @@
-//! Simulator speed with the two real drivers over their behavioural models: our bxCAN
+//! Simulator speed with the two real drivers over their behavioural models.
+//!
+//! [`two_drivers`]: our bxCAN
 //! backend over `twocan_bxcan::model::BxCanModel` (CAN1) and our FlexCAN backend over
 //! `twocan_flexcan::model::FlexCanModel` (Teensy 3.2's FlexCAN0), on one simulated bus,
 //! each sending 8-byte frames to the other. The "interrupt handler" (`on_interrupt`) of a
 //! driver runs whenever its model raises an interrupt line, between bus events.
+//!
+//! [`harness`]: the same traffic through `twocan_host::Harness` (the cross-controller
+//! harness of `can-demo` and the cross-backend tests: a Teensy 3.6's FlexCAN0 and an
+//! STM32F767's CAN1, register access that lets bus time pass while a driver spins on an
+//! acknowledge bit, every node serviced after each bus event).
 
 use std::time::Instant;
 
@@ -12,6 +19,7 @@ use twocan_core::sim::Bus;
 use twocan_core::{Driver, Filter, Frame};
 use twocan_flexcan::model::FlexCanModel;
 use twocan_flexcan::{AcanDriver, Board, FlexCan, HostSystem, Instance, Settings, Target};
+use twocan_host::{BxNode, FlexNode, Harness};
 
 use crate::cmd::{Context, Error, Result};
 use crate::simspeed::{Speed, BITRATE, MIN_SECS};
@@ -141,5 +149,70 @@ pub fn two_drivers() -> Result<Speed> {
         frames: delivered[0] + delivered[1],
         secs,
         bus_secs: bus.now() as f64 / BITRATE as f64,
+    })
+}
+
+/// Bit times the harness runs between two looks at the receive rings (about one frame).
+const HARNESS_STEP_BITS: u64 = 150;
+
+/// The same traffic as [`two_drivers`] through the `twocan-host` harness.
+pub fn harness() -> Result<Speed> {
+    let mut h = Harness::new(BITRATE).map_err(|e| Error::new(format!("harness: {e:?}")))?;
+    h.bus().borrow_mut().set_tracing(false);
+    let mut teensy = FlexNode::teensy36_can0(&mut h, &[Filter::pass_all()])
+        .map_err(|e| Error::new(format!("harness FlexCAN node: {e:?}")))?;
+    let mut stm32 = BxNode::stm32f767_can1(&mut h, &[Filter::pass_all()])
+        .map_err(|e| Error::new(format!("harness bxCAN node: {e:?}")))?;
+    let start_bits = h.now();
+    let mut sent = 0u64;
+    let mut delivered = [0u64; 2];
+    let start = Instant::now();
+    while start.elapsed().as_secs_f64() < MIN_SECS {
+        for _ in 0..ROUND {
+            let data = sent.to_le_bytes();
+            let id = (sent % 0x100) as u16;
+            let (a, b) = match (
+                Frame::standard(0x100 + id, &data),
+                Frame::standard(0x300 + id, &data),
+            ) {
+                (Ok(a), Ok(b)) => (a, b),
+                _ => return Err(Error::new("building a frame")),
+            };
+            if stm32.driver.try_send(&a).is_err() || teensy.driver.try_send(&b).is_err() {
+                return Err(Error::new("a transmit queue refused a frame of the round"));
+            }
+            sent += 1;
+        }
+        let mut steps = 0u32;
+        while delivered[0] < sent || delivered[1] < sent {
+            h.run_for(HARNESS_STEP_BITS, &mut [&mut teensy, &mut stm32]);
+            while teensy.driver.receive().is_ok() {
+                delivered[0] += 1;
+            }
+            while stm32.driver.receive().is_ok() {
+                delivered[1] += 1;
+            }
+            steps += 1;
+            if steps > MAX_EVENTS_PER_ROUND {
+                return Err(Error::new(format!(
+                    "the harness stopped exchanging frames (sent {sent} each way, received: \
+                     FlexCAN {}, bxCAN {})",
+                    delivered[0], delivered[1]
+                )));
+            }
+        }
+    }
+    let secs = start.elapsed().as_secs_f64();
+    if teensy.lost() + stm32.lost() != 0 {
+        return Err(Error::new("the harness nodes lost frames"));
+    }
+    Ok(Speed {
+        scenario: "the same through `twocan_host::Harness` (can-demo's harness: Teensy 3.6 \
+                   FlexCAN0 ⇄ STM32F767 CAN1, clocked register access, every node serviced \
+                   after each bus event), trace off"
+            .into(),
+        frames: delivered[0] + delivered[1],
+        secs,
+        bus_secs: (h.now() - start_bits) as f64 / BITRATE as f64,
     })
 }

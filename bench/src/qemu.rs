@@ -169,8 +169,6 @@ pub struct Counts {
     pub regions: BTreeMap<String, Region>,
     /// Instructions of an empty region (the end marker store), subtracted from the others.
     pub overhead: u64,
-    /// Instructions the guest executed in the whole run.
-    pub total: u64,
 }
 
 impl Counts {
@@ -246,9 +244,17 @@ pub fn run(paths: &Paths, tools: &Tools, plugin: &Path, elf: &Path, tag: &str) -
             cmd::tail(&out.stderr, 20)
         )));
     }
-    // The firmware names its regions; the plugin counts them.
+    let counts = std::fs::read_to_string(&out_file).context(format!(
+        "reading the plugin output {} (did the plugin load?)",
+        out_file.display()
+    ))?;
+    parse(&out.stdout, &counts, window)
+}
+
+/// Pairs the firmware's region names (its semihosting output) with the plugin's counts.
+fn parse(stdout: &str, counts: &str, window: u32) -> Result<Counts> {
     let mut keys = BTreeMap::new();
-    for line in out.stdout.lines() {
+    for line in stdout.lines() {
         let mut w = line.split_whitespace();
         match (w.next(), w.next(), w.next()) {
             (Some("window"), Some(addr), None) => {
@@ -268,12 +274,8 @@ pub fn run(paths: &Paths, tools: &Tools, plugin: &Path, elf: &Path, tag: &str) -
             _ => {}
         }
     }
-    let counts = std::fs::read_to_string(&out_file).context(format!(
-        "reading the plugin output {} (did the plugin load?)",
-        out_file.display()
-    ))?;
     let mut regions: BTreeMap<String, Region> = BTreeMap::new();
-    let mut total = None;
+    let mut finished = false;
     for line in counts.lines() {
         let w: Vec<&str> = line.split_whitespace().collect();
         match w.as_slice() {
@@ -297,14 +299,17 @@ pub fn run(paths: &Paths, tools: &Tools, plugin: &Path, elf: &Path, tag: &str) -
                         "the plugin saw {u} end markers without a start"
                     )));
                 }
-                total = Some(t.parse::<u64>().context("plugin output")?);
+                t.parse::<u64>().context("plugin output")?;
+                finished = true;
             }
             _ => {}
         }
     }
-    let total = total.ok_or_else(|| {
-        Error::new("the plugin output has no `total` line (QEMU did not exit normally)")
-    })?;
+    if !finished {
+        return Err(Error::new(
+            "the plugin output has no `total` line (QEMU did not exit normally)",
+        ));
+    }
     for key in keys.values() {
         if !regions.contains_key(key) {
             return Err(Error::new(format!("region `{key}` was never measured")));
@@ -320,9 +325,45 @@ pub fn run(paths: &Paths, tools: &Tools, plugin: &Path, elf: &Path, tag: &str) -
             empty.raw
         )));
     }
-    Ok(Counts {
-        regions,
-        overhead,
-        total,
-    })
+    Ok(Counts { regions, overhead })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const STDOUT: &str = "window 0x20110000\nregion 0 empty\nregion 1 a.b\nregion 2 c\ndone\n";
+
+    #[test]
+    fn pairs_names_and_counts_and_subtracts_the_empty_region() {
+        let plugin = "window 0x20110000\nregion 0 1\nregion 1 11\nregion 0 1\nregion 1 11\n\
+                      region 2 7\nregion 2 9\ntotal 500 completed 6 unmatched 0\n";
+        let c = parse(STDOUT, plugin, 0x2011_0000).unwrap();
+        assert_eq!(c.overhead, 1);
+        assert_eq!(c.exact("a.b").unwrap(), 10);
+        assert_eq!(c.net("c").unwrap(), (6, 8));
+        assert!(c.exact("c").is_err(), "differing measurements are refused");
+        assert_eq!(c.repeats(), 2);
+        assert!(c.net("missing").is_err());
+    }
+
+    #[test]
+    fn refuses_incomplete_or_inconsistent_output() {
+        let complete = "region 0 1\nregion 1 5\nregion 2 5\n";
+        // QEMU did not exit through the plugin's exit callback.
+        assert!(parse(STDOUT, complete, 0x2011_0000).is_err());
+        let done = format!("{complete}total 9 completed 3 unmatched 0\n");
+        assert!(parse(STDOUT, &done, 0x2011_0000).is_ok());
+        // Another window than the ELF symbol says.
+        assert!(parse(STDOUT, &done, 0x2012_0000).is_err());
+        // An end marker without a start.
+        let unmatched = format!("{complete}total 9 completed 3 unmatched 1\n");
+        assert!(parse(STDOUT, &unmatched, 0x2011_0000).is_err());
+        // A named region that was never measured.
+        let partial = "region 0 1\nregion 1 5\ntotal 9 completed 2 unmatched 0\n";
+        assert!(parse(STDOUT, partial, 0x2011_0000).is_err());
+        // A calibration region that varies.
+        let varying = format!("region 0 2\n{done}");
+        assert!(parse(STDOUT, &varying, 0x2011_0000).is_err());
+    }
 }

@@ -215,3 +215,66 @@ pub fn run(name: &'static str, limits: &Limits) -> ControllerQuality {
         solver_secs,
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn pick(clock: u32, rate: u32, limits: &Limits) -> (u64, u64, u64) {
+        let p = exhaustive(clock, rate, limits, cia_sample_point(rate)).unwrap();
+        (p.prescaler, p.tseg1, p.tseg2)
+    }
+
+    #[test]
+    fn exhaustive_search_gives_the_documented_examples() {
+        // docs/bit-timing.md, bxCAN table: 54 MHz / 500 kbit/s → prescaler 6, 18 quanta
+        // (TS1 15, TS2 2); 45 MHz / 1 Mbit/s → 3, 10 + 4; 54 MHz / 1 Mbit/s → 3, 12 + 5.
+        assert_eq!(pick(54_000_000, 500_000, &Limits::BXCAN), (6, 15, 2));
+        assert_eq!(pick(45_000_000, 1_000_000, &Limits::BXCAN), (3, 10, 4));
+        assert_eq!(pick(54_000_000, 1_000_000, &Limits::BXCAN), (3, 12, 5));
+        // FlexCAN at 16 MHz: 1 Mbit/s → 1 × 16 quanta, tseg1 11, tseg2 4; 842 kbit/s →
+        // prescaler 1, 19 quanta.
+        assert_eq!(pick(16_000_000, 1_000_000, &Limits::FLEXCAN), (1, 11, 4));
+        let (p, t1, t2) = pick(16_000_000, 842_000, &Limits::FLEXCAN);
+        assert_eq!((p, 1 + t1 + t2), (1, 19));
+    }
+
+    #[test]
+    fn ranking_follows_the_objective_order() {
+        let a = Pick {
+            prescaler: 1,
+            tseg1: 13,
+            tseg2: 2,
+        }; // 16 quanta, 875 ‰
+        let b = Pick {
+            prescaler: 2,
+            tseg1: 6,
+            tseg2: 1,
+        }; // 8 quanta, 875 ‰
+           // Same error (both exact at 16 MHz / 1 Mbit/s... here 16 MHz / 1 MHz = 16 clocks),
+           // same sample point: more quanta wins.
+        assert_eq!(rank(a, b, 16_000_000, 1_000_000, 875), Ordering::Less);
+        // A smaller error beats everything else.
+        let c = Pick {
+            prescaler: 1,
+            tseg1: 12,
+            tseg2: 2,
+        }; // 15 quanta: not exact
+        assert_eq!(rank(a, c, 16_000_000, 1_000_000, 875), Ordering::Less);
+    }
+
+    #[test]
+    fn a_case_matches_when_both_agree() {
+        let limits = Limits::BXCAN;
+        let clock = 54_000_000;
+        let rate = 500_000;
+        let case = Case {
+            clock,
+            bitrate: rate,
+            solved: solve(clock, rate, &limits, cia_sample_point(rate)).ok(),
+            best: exhaustive(clock, rate, &limits, cia_sample_point(rate)),
+        };
+        assert!(case.matches() && case.accepted());
+        assert_eq!(case.ppm(), Some(0));
+    }
+}

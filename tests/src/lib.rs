@@ -1,1 +1,16 @@
 //! Shared support for the workspace integration tests.
+//!
+//! - [`app_bus`]: the portable application on a FlexCAN and a bxCAN node on one bus;
+//! - [`backend`]: one trait ([`backend::Backend`], [`backend::Dut`]) over a FlexCAN node
+//!   and a bxCAN node of the host harness, so that the cross-controller suites are written
+//!   once and run on both controllers;
+//! - [`load`]: the full-load runner (back-to-back frames, interrupt serviced after a
+//!   random latency, losses predicted from the FIFO depth and checked exactly);
+//! - [`rng`]: a tiny seeded generator;
+//! - [`support`]: frame sets, the reference filter semantics, running the bus.
+
+pub mod app_bus;
+pub mod backend;
+pub mod load;
+pub mod rng;
+pub mod support;

@@ -22,7 +22,7 @@ use std::rc::Rc;
 
 use twocan_bxcan::model::BxCanModel;
 use twocan_bxcan::{Can as BxCan, Config as BxConfig, FifoPolicy};
-use twocan_core::sim::{Bus, NodeId, SimError};
+use twocan_core::sim::{Bus, BusNode, NodeId, SimError};
 use twocan_core::{Driver, ErrorState, Filter, Registers};
 use twocan_flexcan::model::FlexCanModel;
 use twocan_flexcan::{Board, FlexCan, HostSystem, Instance, Settings, Target};
@@ -134,6 +134,19 @@ impl<R> Clocked<R> {
     pub fn inner(&self) -> &R {
         &self.regs
     }
+
+    /// Lets time pass on `bus` from now on: for a model moved to another bus (a new bus
+    /// at another bit rate, brought to the same time, with the model attached to it).
+    pub fn set_bus(&mut self, bus: &SharedBus) {
+        self.bus = bus.clone();
+        self.spinning.set(false);
+    }
+}
+
+/// Attaches a node as it is (the default of [`FlexNode::begin_via`] and
+/// [`BxNode::with_config_via`]).
+pub fn attach_plain(bus: &mut Bus, name: &str, node: Box<dyn BusNode>) -> NodeId {
+    bus.attach_boxed(name, node)
 }
 
 impl<R: Registers> Registers for Clocked<R> {
@@ -192,13 +205,27 @@ impl FlexNode {
         primary: &[Filter],
         secondary: &[Filter],
     ) -> Result<Self, SetupError> {
+        Self::begin_via(h, target, settings, primary, secondary, attach_plain)
+    }
+
+    /// Like [`FlexNode::begin`], but `attach` puts the model on the bus: a test can wrap
+    /// the model in its own [`BusNode`] (to watch or act on every bus event) before it
+    /// attaches it. `attach` gets the bus, the node's name and the model handle.
+    pub fn begin_via(
+        h: &mut Harness,
+        target: Target,
+        settings: &Settings,
+        primary: &[Filter],
+        secondary: &[Filter],
+        attach: impl FnOnce(&mut Bus, &str, Box<dyn BusNode>) -> NodeId,
+    ) -> Result<Self, SetupError> {
         let model = match target.board {
             Board::Teensy32 => FlexCanModel::mk20dx256(),
             Board::Teensy35 => FlexCanModel::mk64fx512(),
             Board::Teensy36 => FlexCanModel::mk66fx1m0(),
         };
         let name = format!("{:?}-{:?}", target.board, target.instance).to_lowercase();
-        let id = h.bus.borrow_mut().attach(&name, model.clone());
+        let id = attach(&mut h.bus.borrow_mut(), &name, Box::new(model.clone()));
         let regs = Clocked::new(model.clone(), &h.bus, twocan_flexcan::regs::MCR);
         let controller = FlexCan::begin(
             regs,
@@ -278,16 +305,31 @@ impl BxNode {
         filters: &[Filter],
         fifos: FifoPolicy,
     ) -> Result<Self, SetupError> {
+        Self::with_config_via(h, config, filters, fifos, attach_plain)
+    }
+
+    /// Like [`BxNode::with_config`], but `attach` puts the model on the bus (see
+    /// [`FlexNode::begin_via`]).
+    pub fn with_config_via(
+        h: &mut Harness,
+        config: &BxConfig,
+        filters: &[Filter],
+        fifos: FifoPolicy,
+        attach: impl FnOnce(&mut Bus, &str, Box<dyn BusNode>) -> NodeId,
+    ) -> Result<Self, SetupError> {
         let model = BxCanModel::can1();
-        let id = h.bus.borrow_mut().attach("stm32f767-can1", model.clone());
+        let id = attach(
+            &mut h.bus.borrow_mut(),
+            "stm32f767-can1",
+            Box::new(model.clone()),
+        );
         let regs = Clocked::new(model.clone(), &h.bus, twocan_bxcan::regs::MSR);
         let mut init = BxCan::can1(regs, config).map_err(|f| SetupError::Driver(f.error))?;
         let plan = init
             .can()
             .plan(filters, fifos)
             .map_err(SetupError::BxCanPlan)?;
-        init.set_filters(&plan)
-            .map_err(SetupError::Driver)?;
+        init.set_filters(&plan).map_err(SetupError::Driver)?;
         let can = init.enable().map_err(|f| SetupError::Driver(f.error))?;
         Ok(BxNode {
             model,

@@ -1,0 +1,511 @@
+//! One trait over both controllers, so that the conformance suite, the fault scenarios
+//! and the full-load test are written once and run on FlexCAN and on bxCAN.
+//!
+//! [`Backend`] brings a node of one controller up on the host harness's bus (the real
+//! driver over its peripheral model, see `twocan-host`) from backend-neutral
+//! [`NodeOptions`]; [`Dut`] is what a test needs from the node afterwards: the portable
+//! driver, its interrupt line and the model's own counters (lost and filtered frames),
+//! which are counted by the model, independently of the driver.
+//!
+//! The constants of each implementation are facts of the hardware manuals (FIFO depth,
+//! filter capacity, overrun policy, clock), not values read back from the drivers.
+
+use twocan_bxcan::model::BxCanModel;
+use twocan_bxcan::{
+    Config as BxConfig, ConfigError, FifoPolicy, PlanError, Recovery as BxRecovery,
+};
+use twocan_core::sim::{Bus, BusNode, NodeId};
+use twocan_core::timing::{solve, Limits, TimingError, DEFAULT_TOLERANCE_PPM};
+use twocan_core::{Controller, Driver, Filter, Registers, TxPolicy};
+use twocan_flexcan::model::FlexCanModel;
+use twocan_flexcan::{
+    BeginError, Board, ConfigErrors, Configuration, FlexCan, HostSystem, Instance, Settings,
+    Target, CAN_CLOCK_HZ,
+};
+use twocan_host::{
+    attach_plain, BxNode, FlexNode, Harness, Serviced, SetupError, RX_RING, STM32F767_APB1_HZ,
+    TX_RING,
+};
+
+/// How a node leaves bus-off.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Recovery {
+    /// By itself after 128 × 11 recessive bits.
+    Automatic,
+    /// Only when software asks (`Driver::recover`), then after 128 × 11 recessive bits.
+    Manual,
+}
+
+/// What a receive FIFO does with a valid frame that arrives while it is full.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum OverrunPolicy {
+    /// The new frame is lost; the stored ones stay (FlexCAN Rx FIFO; bxCAN with RFLM = 1).
+    DiscardNew,
+    /// The new frame replaces the newest stored one (bxCAN with RFLM = 0).
+    OverwriteNewest,
+}
+
+/// Backend-neutral node options.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NodeOptions {
+    /// The portable filter list (empty: receive everything).
+    pub filters: Vec<Filter>,
+    /// Bus-off recovery.
+    pub recovery: Recovery,
+}
+
+impl NodeOptions {
+    /// `filters`, automatic recovery.
+    pub fn filters(filters: &[Filter]) -> Self {
+        NodeOptions {
+            filters: filters.to_vec(),
+            recovery: Recovery::Automatic,
+        }
+    }
+
+    /// Receive everything, automatic recovery.
+    pub fn pass_all() -> Self {
+        Self::filters(&[Filter::pass_all()])
+    }
+
+    /// With another recovery mode.
+    pub fn recovery(mut self, recovery: Recovery) -> Self {
+        self.recovery = recovery;
+        self
+    }
+}
+
+/// Why a backend refused to bring a node up, in backend-neutral terms.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Refused {
+    /// A filter of the list does not conform (bxCAN says which; FlexCAN's `begin` reports
+    /// a flag for the whole list: `None`).
+    FilterNotConform {
+        /// The filter's index in the user's list, when the backend tells.
+        index: Option<usize>,
+    },
+    /// The list needs more hardware filters than the controller has.
+    TooManyFilters,
+    /// The backend offers no such option.
+    Unsupported(&'static str),
+    /// Anything else (the backend's error, printed).
+    Other(String),
+}
+
+/// Why a bit timing was refused, in backend-neutral terms.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum TimingRefused {
+    /// 0 bit/s.
+    Zero,
+    /// Faster than clock / fewest quanta per bit.
+    TooHigh,
+    /// No timing within the tolerance of the wished rate.
+    TooFar,
+    /// The sample point is not strictly between 50 % and 100 %.
+    SamplePoint,
+    /// Another reason.
+    Other,
+}
+
+/// How a backend changed its bit rate.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum BitrateChange {
+    /// The controller was reconfigured and kept its installed filters (bxCAN
+    /// `Can::reconfigure`).
+    FiltersKept,
+    /// The backend has no way to change the bit rate of a running controller: it was
+    /// configured again from scratch (FlexCAN `begin`) and the filters were installed
+    /// again from the lists the application kept.
+    FiltersReinstalledFromLists,
+}
+
+/// A node of one backend on the harness bus (the device under test).
+pub trait Dut: Serviced {
+    /// The backend's controller.
+    type C: Controller;
+    /// The portable driver.
+    fn driver(&mut self) -> &mut Driver<Self::C, RX_RING, TX_RING>;
+    /// The portable driver, shared.
+    fn driver_ref(&self) -> &Driver<Self::C, RX_RING, TX_RING>;
+    /// The node's place on the bus.
+    fn bus_id(&self) -> NodeId;
+    /// Whether the model raises an interrupt line the driver services.
+    fn irq_pending(&self) -> bool;
+    /// Frames lost in the hardware receive FIFOs, as the model counts them.
+    fn hw_lost(&self) -> u64;
+    /// Valid frames no filter accepted, as the model counts them.
+    fn filtered_out(&self) -> u64;
+    /// The bit rate the timing registers give with the chip's CAN clock (decoded from the
+    /// raw register bits with the reference manual's formula).
+    fn bitrate_in_registers(&self) -> u32;
+}
+
+/// A controller backend, as the cross-controller tests see it.
+pub trait Backend {
+    /// The node type.
+    type Node: Dut + 'static;
+    /// For messages.
+    const NAME: &'static str;
+    /// Frames one receive FIFO holds (Kinetis RM "Rx FIFO": 6; RM0410 §40.7.5: 3).
+    const RX_FIFO_DEPTH: usize;
+    /// What the receive FIFO used by [`Backend::attach`] does when full.
+    const OVERRUN: OverrunPolicy;
+    /// Most distinct exact standard-identifier data filters the controller holds
+    /// (ACAN table 4: 14 primary + 18 secondary; RM0410: 28 banks × 4 16-bit list ids).
+    const MAX_EXACT_STD_FILTERS: usize;
+    /// Whether software-started bus-off recovery is offered.
+    const MANUAL_RECOVERY: bool;
+    /// The CAN clock the bit timing is made from (FlexCAN: 16 MHz oscillator; bxCAN:
+    /// APB1 of the STM32F767 at 216 MHz, 54 MHz).
+    const CLOCK_HZ: u32;
+    /// The bit-timing register ranges.
+    const LIMITS: Limits;
+
+    /// Brings a node up on `h`'s bus at its bit rate.
+    fn attach(h: &mut Harness, opts: &NodeOptions) -> Result<Self::Node, Refused> {
+        Self::attach_via(h, opts, attach_plain)
+    }
+
+    /// Like [`Backend::attach`]; `attach` puts the model on the bus (to wrap it).
+    fn attach_via(
+        h: &mut Harness,
+        opts: &NodeOptions,
+        attach: impl FnOnce(&mut Bus, &str, Box<dyn BusNode>) -> NodeId,
+    ) -> Result<Self::Node, Refused>;
+
+    /// Checks a bit timing the way an application would configure it: the wished rate
+    /// with a sample point in per mille. Gives the actual bit rate.
+    fn check_timing(bitrate: u32, sample_point_permille: u16) -> Result<u32, TimingRefused>;
+
+    /// Moves `node` to the new bus of `h` (at another bit rate, brought to the old bus's
+    /// time, `node`'s old bus no longer used) and changes its bit rate to `h`'s.
+    fn change_bitrate(
+        node: Self::Node,
+        opts: &NodeOptions,
+        h: &mut Harness,
+    ) -> Result<(Self::Node, BitrateChange), Refused>;
+}
+
+fn timing_refused(e: TimingError) -> TimingRefused {
+    match e {
+        TimingError::BitrateZero => TimingRefused::Zero,
+        TimingError::BitrateTooHigh => TimingRefused::TooHigh,
+        TimingError::TooFarFromWishedBitrate => TimingRefused::TooFar,
+        TimingError::SamplePointOutOfRange => TimingRefused::SamplePoint,
+        _ => TimingRefused::Other,
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// FlexCAN: can0 of a Teensy 3.6.
+
+/// FlexCAN can0 of a Teensy 3.6 through ACAN's `begin`.
+pub struct FlexCanBackend;
+
+/// The Teensy 3.6 can0 target.
+pub fn teensy36_can0() -> Target {
+    Target::new(Board::Teensy36, Instance::Can0)
+}
+
+/// ACAN settings for `bit_rate` holding `filters`: up to 12 primary filters in ACAN's
+/// default 12/12 configuration, more in the 14/18 configuration (14 primary, the rest
+/// secondary). Gives the settings and the two lists.
+pub fn flexcan_lists(bit_rate: u32, filters: &[Filter]) -> (Settings, Vec<Filter>, Vec<Filter>) {
+    let mut s = Settings::new(bit_rate);
+    if filters.len() <= Configuration::Filters12_12.primary_filter_capacity() {
+        (s, filters.to_vec(), Vec::new())
+    } else {
+        s.configuration = Configuration::Filters14_18;
+        let n = Configuration::Filters14_18.primary_filter_capacity();
+        (s, filters[..n].to_vec(), filters[n..].to_vec())
+    }
+}
+
+fn flexcan_refused(e: SetupError) -> Refused {
+    match e {
+        SetupError::FlexCan(BeginError::Config(flags)) => {
+            if flags.contains(ConfigErrors::TOO_MANY_PRIMARY_FILTERS)
+                || flags.contains(ConfigErrors::TOO_MANY_SECONDARY_FILTERS)
+            {
+                Refused::TooManyFilters
+            } else if flags.contains(ConfigErrors::PRIMARY_FILTER_NOT_CONFORM)
+                || flags.contains(ConfigErrors::SECONDARY_FILTER_NOT_CONFORM)
+            {
+                Refused::FilterNotConform { index: None }
+            } else {
+                Refused::Other(format!("{flags:?}"))
+            }
+        }
+        other => Refused::Other(format!("{other:?}")),
+    }
+}
+
+/// Bit rate of FlexCAN `CTRL1` timing bits (Kinetis RM, CTRL1: PRESDIV 31–24, PSEG1 21–19,
+/// PSEG2 18–16, PROPSEG 2–0; "Protocol timing": Sclock = clock / (PRESDIV + 1), bit =
+/// 1 + (PROPSEG + 1) + (PSEG1 + 1) + (PSEG2 + 1) quanta).
+pub fn flexcan_ctrl1_bitrate(ctrl1: u32, clock_hz: u32) -> u32 {
+    let presdiv = (ctrl1 >> 24) & 0xFF;
+    let pseg1 = (ctrl1 >> 19) & 0x7;
+    let pseg2 = (ctrl1 >> 16) & 0x7;
+    let propseg = ctrl1 & 0x7;
+    let quanta = 1 + (propseg + 1) + (pseg1 + 1) + (pseg2 + 1);
+    clock_hz / ((presdiv + 1) * quanta)
+}
+
+/// Bit rate of a bxCAN `CAN_BTR` value (RM0410 §40.7.7: tq = (BRP + 1) tPCLK, bit =
+/// 1 + (TS1 + 1) + (TS2 + 1) quanta; BRP 9–0, TS1 19–16, TS2 22–20).
+pub fn bxcan_btr_bitrate(btr: u32, clock_hz: u32) -> u32 {
+    let brp = btr & 0x3FF;
+    let ts1 = (btr >> 16) & 0xF;
+    let ts2 = (btr >> 20) & 0x7;
+    clock_hz / ((brp + 1) * (3 + ts1 + ts2))
+}
+
+impl Dut for FlexNode {
+    type C = FlexCan<twocan_host::Clocked<FlexCanModel>>;
+    fn driver(&mut self) -> &mut Driver<Self::C, RX_RING, TX_RING> {
+        &mut self.driver
+    }
+    fn driver_ref(&self) -> &Driver<Self::C, RX_RING, TX_RING> {
+        &self.driver
+    }
+    fn bus_id(&self) -> NodeId {
+        self.id
+    }
+    fn irq_pending(&self) -> bool {
+        self.model.irq_pending()
+    }
+    fn hw_lost(&self) -> u64 {
+        self.model.frames_lost()
+    }
+    fn filtered_out(&self) -> u64 {
+        self.model.frames_discarded()
+    }
+    fn bitrate_in_registers(&self) -> u32 {
+        flexcan_ctrl1_bitrate(self.model.peek32(twocan_flexcan::regs::CTRL1), CAN_CLOCK_HZ)
+    }
+}
+
+impl Backend for FlexCanBackend {
+    type Node = FlexNode;
+    const NAME: &'static str = "FlexCAN (Teensy 3.6 can0)";
+    const RX_FIFO_DEPTH: usize = 6;
+    const OVERRUN: OverrunPolicy = OverrunPolicy::DiscardNew;
+    const MAX_EXACT_STD_FILTERS: usize = 14 + 18;
+    const MANUAL_RECOVERY: bool = false;
+    const CLOCK_HZ: u32 = 16_000_000;
+    const LIMITS: Limits = Limits::FLEXCAN;
+
+    fn attach_via(
+        h: &mut Harness,
+        opts: &NodeOptions,
+        attach: impl FnOnce(&mut Bus, &str, Box<dyn BusNode>) -> NodeId,
+    ) -> Result<FlexNode, Refused> {
+        if opts.recovery == Recovery::Manual {
+            return Err(Refused::Unsupported(
+                "FlexCAN: the driver leaves CTRL1.BOFFREC = 0, recovery is automatic (ACAN)",
+            ));
+        }
+        let rate = h.bus().borrow().bit_rate();
+        let (s, primary, secondary) = flexcan_lists(rate, &opts.filters);
+        FlexNode::begin_via(h, teensy36_can0(), &s, &primary, &secondary, attach)
+            .map_err(flexcan_refused)
+    }
+
+    fn check_timing(bitrate: u32, sample_point_permille: u16) -> Result<u32, TimingRefused> {
+        let t = solve(
+            CAN_CLOCK_HZ,
+            bitrate,
+            &Limits::FLEXCAN,
+            sample_point_permille,
+        )
+        .map_err(timing_refused)?;
+        let mut s = Settings::new(bitrate);
+        s.timing = t;
+        let flags = twocan_flexcan::check(teensy36_can0(), &s, &[], &[]);
+        if flags.contains(ConfigErrors::BIT_RATE_TOO_FAR) {
+            Err(TimingRefused::TooFar)
+        } else if !flags.is_empty() {
+            Err(TimingRefused::Other)
+        } else {
+            Ok(s.actual_bit_rate())
+        }
+    }
+
+    fn change_bitrate(
+        node: FlexNode,
+        opts: &NodeOptions,
+        h: &mut Harness,
+    ) -> Result<(FlexNode, BitrateChange), Refused> {
+        let FlexNode { model, driver, .. } = node;
+        let id = h
+            .bus()
+            .borrow_mut()
+            .attach("teensy36-can0-moved", model.clone());
+        let controller = driver.release();
+        let target = controller.target();
+        let mut regs = controller.into_registers();
+        regs.set_bus(h.bus());
+        let rate = h.bus().borrow().bit_rate();
+        let (s, primary, secondary) = flexcan_lists(rate, &opts.filters);
+        let controller = FlexCan::begin(
+            regs,
+            &mut HostSystem::new(),
+            target,
+            &s,
+            &primary,
+            &secondary,
+        )
+        .map_err(|e| flexcan_refused(SetupError::FlexCan(e)))?;
+        Ok((
+            FlexNode {
+                model,
+                driver: Driver::new(controller),
+                id,
+            },
+            BitrateChange::FiltersReinstalledFromLists,
+        ))
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// bxCAN: CAN1 of an STM32F767.
+
+/// bxCAN CAN1 of an STM32F767 with every filter bank (`CAN2SB = 28`), transmit FIFO
+/// order, one receive FIFO (FIFO 0), RFLM = 0, every interrupt.
+pub struct BxCanBackend;
+
+/// The bxCAN configuration [`BxCanBackend`] uses for `bit_rate`.
+pub fn bxcan_config(bit_rate: u32, recovery: Recovery) -> Result<BxConfig, ConfigError> {
+    BxConfig::from_bitrate(STM32F767_APB1_HZ, bit_rate)?
+        .tx_policy(TxPolicy::Fifo)
+        .recovery(match recovery {
+            Recovery::Automatic => BxRecovery::Automatic,
+            Recovery::Manual => BxRecovery::Manual,
+        })
+        .interrupts(twocan_bxcan::config::DEFAULT_INTERRUPTS)
+        .can2_start_bank(28)
+}
+
+fn bxcan_refused(e: SetupError) -> Refused {
+    match e {
+        SetupError::BxCanPlan(PlanError::Filter { index, .. }) => Refused::FilterNotConform {
+            index: Some(index as usize),
+        },
+        SetupError::BxCanPlan(PlanError::TooManyBanks { .. } | PlanError::TooManyFilters) => {
+            Refused::TooManyFilters
+        }
+        other => Refused::Other(format!("{other:?}")),
+    }
+}
+
+impl Dut for BxNode {
+    type C = twocan_bxcan::Can<twocan_host::Clocked<BxCanModel>>;
+    fn driver(&mut self) -> &mut Driver<Self::C, RX_RING, TX_RING> {
+        &mut self.driver
+    }
+    fn driver_ref(&self) -> &Driver<Self::C, RX_RING, TX_RING> {
+        &self.driver
+    }
+    fn bus_id(&self) -> NodeId {
+        self.id
+    }
+    fn irq_pending(&self) -> bool {
+        self.model.irq_lines().any()
+    }
+    fn hw_lost(&self) -> u64 {
+        let s = self.model.state();
+        s.overruns[0] + s.overruns[1]
+    }
+    fn filtered_out(&self) -> u64 {
+        self.model.state().dropped
+    }
+    fn bitrate_in_registers(&self) -> u32 {
+        bxcan_btr_bitrate(
+            self.model.read32(twocan_bxcan::regs::BTR),
+            STM32F767_APB1_HZ,
+        )
+    }
+}
+
+impl Backend for BxCanBackend {
+    type Node = BxNode;
+    const NAME: &'static str = "bxCAN (STM32F767 CAN1)";
+    const RX_FIFO_DEPTH: usize = 3;
+    const OVERRUN: OverrunPolicy = OverrunPolicy::OverwriteNewest;
+    const MAX_EXACT_STD_FILTERS: usize = 28 * 4;
+    const MANUAL_RECOVERY: bool = true;
+    const CLOCK_HZ: u32 = 54_000_000;
+    const LIMITS: Limits = Limits::BXCAN;
+
+    fn attach_via(
+        h: &mut Harness,
+        opts: &NodeOptions,
+        attach: impl FnOnce(&mut Bus, &str, Box<dyn BusNode>) -> NodeId,
+    ) -> Result<BxNode, Refused> {
+        let rate = h.bus().borrow().bit_rate();
+        let config =
+            bxcan_config(rate, opts.recovery).map_err(|e| Refused::Other(format!("{e:?}")))?;
+        let filters = if opts.filters.is_empty() {
+            vec![Filter::pass_all()]
+        } else {
+            opts.filters.clone()
+        };
+        BxNode::with_config_via(h, &config, &filters, FifoPolicy::Fifo0, attach)
+            .map_err(bxcan_refused)
+    }
+
+    fn check_timing(bitrate: u32, sample_point_permille: u16) -> Result<u32, TimingRefused> {
+        let c = BxConfig::from_bitrate_with(
+            STM32F767_APB1_HZ,
+            bitrate,
+            sample_point_permille,
+            DEFAULT_TOLERANCE_PPM,
+        )
+        .map_err(|e| match e {
+            ConfigError::Timing(t) => timing_refused(t),
+            _ => TimingRefused::Other,
+        })?;
+        Ok(bxcan_btr_bitrate(c.btr_value(), STM32F767_APB1_HZ))
+    }
+
+    fn change_bitrate(
+        node: BxNode,
+        opts: &NodeOptions,
+        h: &mut Harness,
+    ) -> Result<(BxNode, BitrateChange), Refused> {
+        let BxNode { model, driver, .. } = node;
+        let id = h
+            .bus()
+            .borrow_mut()
+            .attach("stm32f767-can1-moved", model.clone());
+        let mut can = driver.release();
+        can.registers_mut().set_bus(h.bus());
+        let rate = h.bus().borrow().bit_rate();
+        let config =
+            bxcan_config(rate, opts.recovery).map_err(|e| Refused::Other(format!("{e:?}")))?;
+        let init = can
+            .reconfigure(&config)
+            .map_err(|f| Refused::Other(format!("reconfigure: {:?}", f.error)))?;
+        let can = init
+            .enable()
+            .map_err(|f| Refused::Other(format!("enable: {:?}", f.error)))?;
+        Ok((
+            BxNode {
+                model,
+                driver: Driver::new(can),
+                id,
+            },
+            BitrateChange::FiltersKept,
+        ))
+    }
+}
+
+/// A new harness at `bit_rate` whose bus time is already `now` (nothing attached yet),
+/// to move nodes onto.
+pub fn harness_at(bit_rate: u32, now: u64) -> Harness {
+    let h = Harness::new(bit_rate).expect("bus");
+    h.bus().borrow_mut().run_until(now);
+    assert_eq!(h.now(), now);
+    h
+}

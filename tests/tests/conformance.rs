@@ -1,0 +1,598 @@
+//! Issue 6, item 2: one conformance suite, run on both controllers.
+//!
+//! Every test is a generic function over [`Backend`] (FlexCAN can0 of a Teensy 3.6 and
+//! bxCAN CAN1 of an STM32F767, each the real driver over its peripheral model on the
+//! simulated bus); the `suite!` macro at the end instantiates each for both. The other
+//! side of the bus is a plain ISO node ([`SimNode`]), which counts on its own what it sent
+//! and received. Expected values come from the CAN rules (ISO 11898-1 counters, frame
+//! format), from the hardware manuals (FIFO depth, filter capacity) or from a hand-written
+//! table cross-checked with the reference filter semantics — never from the drivers.
+
+use twocan_core::sim::{Fault, NodeId, Receivers, SimNode};
+use twocan_core::timing::Limits;
+use twocan_core::{
+    ErrorCounters, ErrorState, Filter, FilterError, Format, Frame, FrameError, FrameKind,
+    LastErrorCode, Mode,
+};
+use twocan_host::Harness;
+use twocan_tests::backend::{
+    harness_at, Backend, BitrateChange, BxCanBackend, Dut, FlexCanBackend, NodeOptions, Refused,
+    TimingRefused,
+};
+use twocan_tests::support::{
+    attach_peer, attach_sim, bytes, drain, ext_frame, first_match, frame_zoo, remote_frame, run,
+    settle, std_frame, Peer,
+};
+
+const RATE: u32 = 500_000;
+
+fn setup<B: Backend>(opts: &NodeOptions) -> (Harness, B::Node, Peer) {
+    let (h, dut, peer, _) = setup_with_id::<B>(opts);
+    (h, dut, peer)
+}
+
+fn setup_with_id<B: Backend>(opts: &NodeOptions) -> (Harness, B::Node, Peer, NodeId) {
+    let mut h = Harness::new(RATE).unwrap();
+    let dut = B::attach(&mut h, opts).unwrap_or_else(|e| panic!("{}: {e:?}", B::NAME));
+    let (peer, id) = attach_peer(&h, "peer");
+    // Let the node synchronise to the idle bus (11 recessive bits) before traffic: the
+    // FlexCAN driver returns from `begin` before it has (see
+    // `flexcan_is_on_the_bus_when_set_mode_returns`).
+    let mut dut = dut;
+    run(&mut h, &mut dut, 20);
+    (h, dut, peer, id)
+}
+
+// ---------------------------------------------------------------------------------------
+
+fn data_frames_both_ways<B: Backend>() {
+    let (mut h, mut dut, peer) = setup::<B>(&NodeOptions::pass_all());
+    let frames: Vec<Frame> = frame_zoo().into_iter().filter(|f| !f.is_remote()).collect();
+    assert!(frames.len() > 16);
+    // Out: in the order handed to try_send (both backends are set up for FIFO order).
+    for f in &frames {
+        dut.driver().try_send(f).unwrap();
+    }
+    settle(&mut h, &mut dut, &[&peer], 100_000);
+    assert_eq!(peer.borrow().received_frames(), frames, "{}", B::NAME);
+    let t = dut.driver_ref().traffic();
+    assert_eq!(
+        (t.queued, t.sent),
+        (frames.len() as u32, frames.len() as u32)
+    );
+    // In: every identifier, format, DLC and byte intact, in order, filter 0.
+    for f in &frames {
+        peer.borrow_mut().send(*f);
+    }
+    settle(&mut h, &mut dut, &[&peer], 100_000);
+    let got = drain(&mut dut);
+    assert_eq!(
+        got.iter().map(|r| r.frame).collect::<Vec<_>>(),
+        frames,
+        "{}",
+        B::NAME
+    );
+    assert!(got.iter().all(|r| r.filter == 0));
+    for (r, f) in got.iter().zip(&frames) {
+        assert_eq!(r.frame.data(), f.data());
+        assert_eq!(r.frame.is_extended(), f.is_extended());
+    }
+    assert_eq!(dut.hw_lost(), 0);
+    assert_eq!(dut.driver_ref().traffic().received, frames.len() as u32);
+}
+
+fn remote_frames_both_ways<B: Backend>() {
+    let (mut h, mut dut, peer) = setup::<B>(&NodeOptions::pass_all());
+    let remotes: Vec<Frame> = frame_zoo().into_iter().filter(|f| f.is_remote()).collect();
+    assert_eq!(remotes.len(), 18);
+    // Out, one at a time (FlexCAN sends remote frames from their own mailboxes, which
+    // compete by identifier: ACAN keeps no order between them).
+    for f in &remotes {
+        dut.driver().try_send(f).unwrap();
+        settle(&mut h, &mut dut, &[&peer], 20_000);
+    }
+    let seen = peer.borrow().received_frames();
+    assert_eq!(seen, remotes, "{}", B::NAME);
+    assert!(seen.iter().all(|f| f.is_remote() && f.data().is_empty()));
+    // In: the DLC of the request comes through, no data.
+    for f in &remotes {
+        peer.borrow_mut().send(*f);
+    }
+    settle(&mut h, &mut dut, &[&peer], 100_000);
+    let got: Vec<Frame> = drain(&mut dut).iter().map(|r| r.frame).collect();
+    assert_eq!(got, remotes, "{}", B::NAME);
+    for (g, f) in got.iter().zip(&remotes) {
+        assert!(g.is_remote());
+        assert_eq!(g.dlc(), f.dlc());
+        assert!(g.data().is_empty());
+    }
+}
+
+/// The filter list of the filter tests: exact and masked, both formats, data, remote and
+/// any kind, with an overlap (filter 5 contains 0x123 of filter 0).
+fn filter_list() -> Vec<Filter> {
+    vec![
+        Filter::standard(0x123),
+        Filter::masked(FrameKind::Data, Format::Standard, 0x7F0, 0x340),
+        Filter::extended(0x0123_4567),
+        Filter::masked(FrameKind::Any, Format::Extended, 0x1FFF_FF00, 0x0ABC_DE00),
+        Filter::exact(FrameKind::Remote, Format::Standard, 0x555),
+        Filter::masked(FrameKind::Data, Format::Standard, 0x700, 0x100),
+    ]
+}
+
+/// Frames sent at [`filter_list`] with the filter that must take each (first match in
+/// list order), written by hand from the filter definitions.
+fn filter_cases() -> Vec<(Frame, Option<u16>)> {
+    vec![
+        (std_frame(0x123, &[1]), Some(0)),
+        (remote_frame(0x123, false, 1), None), // data-only filters refuse remote frames
+        (ext_frame(0x123, &[2]), None),        // wrong format
+        (std_frame(0x124, &[3]), Some(5)),     // 0x124 & 0x700 == 0x100
+        (std_frame(0x223, &[4]), None),
+        (std_frame(0x340, &[5]), Some(1)),
+        (std_frame(0x34F, &[6, 6]), Some(1)),
+        (std_frame(0x350, &[7]), None),
+        (std_frame(0x33F, &[8]), None),
+        (remote_frame(0x345, false, 2), None),
+        (ext_frame(0x0123_4567, &bytes(8, 9)), Some(2)),
+        (ext_frame(0x0123_4566, &[10]), None),
+        (remote_frame(0x0123_4567, true, 8), None),
+        (std_frame(0x567, &[11]), None),
+        (ext_frame(0x0ABC_DE00, &[12]), Some(3)),
+        (ext_frame(0x0ABC_DEFF, &[13]), Some(3)),
+        (remote_frame(0x0ABC_DE42, true, 3), Some(3)),
+        (ext_frame(0x0ABC_DF00, &[14]), None),
+        (std_frame(0x0DE, &[15]), None),
+        (remote_frame(0x555, false, 0), Some(4)),
+        (std_frame(0x555, &[16]), None), // remote-only filter refuses data frames
+        (remote_frame(0x555, true, 0), None),
+        (std_frame(0x1FF, &[17]), Some(5)),
+        (std_frame(0x200, &[18]), None),
+    ]
+}
+
+/// Sends `cases` from the peer and gives what the node received, with filter indices,
+/// and how many frames its hardware refused. The application drains the receive ring
+/// as it goes (every 100 bit times).
+fn run_cases<N: Dut>(
+    h: &mut Harness,
+    dut: &mut N,
+    peer: &Peer,
+    cases: &[(Frame, Option<u16>)],
+) -> (Vec<(Frame, u16)>, u64) {
+    let refused_before = dut.filtered_out();
+    for (f, _) in cases {
+        peer.borrow_mut().send(*f);
+    }
+    let mut got = Vec::new();
+    let end = h.now() + 200_000;
+    while h.now() < end && peer.borrow().pending() > 0 {
+        run(h, dut, 100);
+        got.extend(drain(dut).iter().map(|r| (r.frame, r.filter)));
+    }
+    run(h, dut, 200);
+    got.extend(drain(dut).iter().map(|r| (r.frame, r.filter)));
+    assert_eq!(dut.driver_ref().traffic().rx_ring_overflows, 0);
+    assert_eq!(dut.hw_lost(), 0);
+    (got, dut.filtered_out() - refused_before)
+}
+
+fn expected_cases(cases: &[(Frame, Option<u16>)]) -> (Vec<(Frame, u16)>, u64) {
+    let accepted = cases
+        .iter()
+        .filter_map(|(f, i)| i.map(|i| (*f, i)))
+        .collect();
+    let refused = cases.iter().filter(|(_, i)| i.is_none()).count() as u64;
+    (accepted, refused)
+}
+
+fn filters_accept_exactly_their_frames<B: Backend>() {
+    let filters = filter_list();
+    let cases = filter_cases();
+    // The table agrees with the reference semantics (Filter::matches, first match).
+    for (f, i) in &cases {
+        assert_eq!(first_match(&filters, f), *i, "{f:?}");
+    }
+    let (mut h, mut dut, peer) = setup::<B>(&NodeOptions::filters(&filters));
+    let got = run_cases(&mut h, &mut dut, &peer, &cases);
+    assert_eq!(got, expected_cases(&cases), "{}", B::NAME);
+    // The peer's frames were all acknowledged (by the node under test: refusing a frame
+    // in the filters does not refuse it on the bus).
+    assert_eq!(peer.borrow().pending(), 0);
+}
+
+fn invalid_filters_are_refused<B: Backend>() {
+    let bad = [
+        (Filter::standard(0x800), FilterError::IdOutOfRange),
+        (
+            Filter::masked(FrameKind::Data, Format::Standard, 0x7F0, 0x001),
+            FilterError::AcceptanceOutsideMask,
+        ),
+        (
+            Filter::masked(FrameKind::Data, Format::Extended, 0x3FFF_FFFF, 0),
+            FilterError::MaskOutOfRange,
+        ),
+        (
+            Filter::masked(FrameKind::Any, Format::Any, 1, 1),
+            FilterError::AnyFormatWithIdentifier,
+        ),
+    ];
+    for (f, why) in bad {
+        assert_eq!(f.check(), Err(why));
+        let list = [Filter::standard(0x10), Filter::extended(0x20), f];
+        let mut h = Harness::new(RATE).unwrap();
+        match B::attach(&mut h, &NodeOptions::filters(&list)) {
+            Err(Refused::FilterNotConform { index }) => {
+                assert!(
+                    index.is_none() || index == Some(2),
+                    "{}: {index:?}",
+                    B::NAME
+                )
+            }
+            Err(e) => panic!("{}: {f:?}: {e:?}", B::NAME),
+            Ok(_) => panic!("{}: {f:?} accepted", B::NAME),
+        }
+    }
+}
+
+fn filter_capacity<B: Backend>() {
+    let n = B::MAX_EXACT_STD_FILTERS;
+    let filters: Vec<Filter> = (0..n).map(|i| Filter::standard(0x100 + i as u16)).collect();
+    let (mut h, mut dut, peer) = setup::<B>(&NodeOptions::filters(&filters));
+    // Every one of them is live and reports its own index; others are refused.
+    let mut cases: Vec<(Frame, Option<u16>)> = (0..n)
+        .rev()
+        .map(|i| (std_frame(0x100 + i as u16, &[i as u8]), Some(i as u16)))
+        .collect();
+    cases.push((std_frame(0x100 + n as u16, &[]), None));
+    cases.push((std_frame(0x0FF, &[]), None));
+    cases.push((remote_frame(0x100, false, 0), None));
+    let (got, refused) = run_cases(&mut h, &mut dut, &peer, &cases);
+    let (want, want_refused) = expected_cases(&cases);
+    for (k, (g, w)) in got.iter().zip(&want).enumerate() {
+        assert_eq!(g, w, "{}: frame {k}", B::NAME);
+    }
+    assert_eq!(
+        (got.len(), refused),
+        (want.len(), want_refused),
+        "{}",
+        B::NAME
+    );
+    // One more does not fit: a typed error, not a silently dropped filter.
+    let more: Vec<Filter> = (0..=n)
+        .map(|i| Filter::standard(0x100 + i as u16))
+        .collect();
+    let mut h = Harness::new(RATE).unwrap();
+    assert_eq!(
+        B::attach(&mut h, &NodeOptions::filters(&more)).err(),
+        Some(Refused::TooManyFilters),
+        "{}",
+        B::NAME
+    );
+}
+
+fn bit_rate_limits<B: Backend>() {
+    let l: Limits = B::LIMITS;
+    // Fastest: prescaler 1 and the fewest quanta (1 + tseg1 min + tseg2 min).
+    let fastest = B::CLOCK_HZ / l.min_quanta();
+    assert_eq!(B::check_timing(fastest, 750), Ok(fastest), "{}", B::NAME);
+    assert_eq!(
+        B::check_timing(fastest + 1, 750),
+        Err(TimingRefused::TooHigh),
+        "{}",
+        B::NAME
+    );
+    // Slowest: the largest prescaler and the most quanta; half of it is out of reach.
+    let slowest = B::CLOCK_HZ / (u32::from(l.prescaler.max) * l.max_quanta());
+    assert_eq!(
+        B::check_timing(slowest / 2, 750),
+        Err(TimingRefused::TooFar),
+        "{}",
+        B::NAME
+    );
+    assert_eq!(B::check_timing(0, 750), Err(TimingRefused::Zero));
+    // The sample point must lie strictly between 50 % and 100 % of the bit.
+    for sp in [0, 500, 1000, 1200] {
+        assert_eq!(
+            B::check_timing(500_000, sp),
+            Err(TimingRefused::SamplePoint),
+            "{} {sp}",
+            B::NAME
+        );
+    }
+    // The usual rates are exact from both clocks.
+    for rate in [125_000, 250_000, 500_000, 1_000_000] {
+        assert_eq!(B::check_timing(rate, 875), Ok(rate), "{} {rate}", B::NAME);
+    }
+}
+
+/// Steps the bus one event at a time, servicing the node, until `done` or `max_bits`;
+/// gives (TEC, REC, state) after every event that changed them.
+fn watch<N: Dut>(
+    h: &mut Harness,
+    dut: &mut N,
+    max_bits: u64,
+    mut done: impl FnMut(&mut N) -> bool,
+) -> Vec<(u16, u16, ErrorState)> {
+    let end = h.now() + max_bits;
+    let c = dut.driver_ref().counters();
+    let mut seen = vec![(c.tec, c.rec, dut.driver().state())];
+    while h.now() < end && !done(dut) {
+        run(h, dut, 1);
+        let c = dut.driver_ref().counters();
+        let s = dut.driver().state();
+        if seen.last() != Some(&(c.tec, c.rec, s)) {
+            seen.push((c.tec, c.rec, s));
+        }
+    }
+    seen
+}
+
+fn state_and_counters_follow_iso_rules<B: Backend>() {
+    let (mut h, mut dut, peer, peer_bus_id) = setup_with_id::<B>(&NodeOptions::pass_all());
+    assert_eq!(dut.driver().state(), ErrorState::Active);
+    assert_eq!(
+        dut.driver_ref().counters(),
+        ErrorCounters { tec: 0, rec: 0 }
+    );
+    assert_eq!(dut.driver_ref().last_error(), LastErrorCode::None);
+    // Twelve bit errors on our transmissions: TEC + 8 each (ISO 11898-1 rule 3) up to 96,
+    // the warning level; the thirteenth attempt succeeds: TEC - 1 (rule 7).
+    let me = dut.bus_id();
+    h.bus()
+        .borrow_mut()
+        .inject_from(me, 12, Fault::Bit { at: None });
+    let f = std_frame(0x2A0, &[0xAA]);
+    dut.driver().try_send(&f).unwrap();
+    let seen = watch(&mut h, &mut dut, 20_000, |d| {
+        d.driver_ref().traffic().sent == 1
+    });
+    let mut expected: Vec<(u16, u16, ErrorState)> = (0..=12u16)
+        .map(|k| {
+            let tec = 8 * k;
+            let state = if tec >= 96 {
+                ErrorState::Warning
+            } else {
+                ErrorState::Active
+            };
+            (tec, 0, state)
+        })
+        .collect();
+    expected.push((95, 0, ErrorState::Active));
+    assert_eq!(seen, expected, "{}", B::NAME);
+    assert_eq!(dut.driver_ref().error_stats().bit, 12, "{}", B::NAME);
+    assert!(dut.driver_ref().traffic().state_changes >= 2);
+    assert_eq!(peer.borrow().received_frames(), vec![f]);
+    // Receive errors: the node alone detects a CRC error in the peer's next three frames
+    // (REC + 1 each, rule 1; its error flag starts after the ACK delimiter, so the next
+    // bit is not dominant and rule 2's + 8 does not apply); a witness acknowledges.
+    let (witness, _) = attach_sim(&h, "witness", SimNode::new());
+    h.bus().borrow_mut().inject_from(
+        peer_bus_id,
+        3,
+        Fault::Crc {
+            who: Receivers::Node(me),
+        },
+    );
+    peer.borrow_mut().send(std_frame(0x2B0, &[1, 2]));
+    settle(&mut h, &mut dut, &[&peer], 20_000);
+    let got: Vec<Frame> = drain(&mut dut).iter().map(|r| r.frame).collect();
+    assert_eq!(got, vec![std_frame(0x2B0, &[1, 2])], "{}", B::NAME);
+    assert_eq!(witness.borrow().received_frames().len(), 1);
+    // REC: per attempt + 1 for the CRC error (rule 1) and + 8 for the dominant bit that
+    // follows its own error flag (rule 2: the other nodes see the flag as a form error in
+    // EOF and start theirs one bit later); then - 1 for the good frame (rule 8):
+    // 3 × 9 - 1 = 26.
+    assert_eq!(
+        dut.driver_ref().counters().rec,
+        3 * (1 + 8) - 1,
+        "{}",
+        B::NAME
+    );
+    assert_eq!(dut.driver_ref().error_stats().crc, 3, "{}", B::NAME);
+}
+
+fn last_error_survives_the_interrupt<B: Backend>() {
+    // `Driver::last_error` is "the last error code the controller latched": after an
+    // acknowledge error has been serviced, thread code must still be able to read it.
+    let mut h = Harness::new(RATE).unwrap();
+    let mut dut = B::attach(&mut h, &NodeOptions::pass_all()).unwrap();
+    dut.driver().try_send(&std_frame(0x10, &[])).unwrap();
+    run(&mut h, &mut dut, 2_000); // alone: acknowledge errors, serviced
+    assert!(dut.driver_ref().error_stats().acknowledge > 0);
+    assert_eq!(
+        dut.driver_ref().last_error(),
+        LastErrorCode::Acknowledge,
+        "{}",
+        B::NAME
+    );
+}
+
+fn filters_survive_stop_and_start<B: Backend>() {
+    let filters = filter_list();
+    let cases = filter_cases();
+    let (mut h, mut dut, peer) = setup::<B>(&NodeOptions::filters(&filters));
+    let (witness, _) = attach_sim(&h, "witness", SimNode::new());
+    let before = run_cases(&mut h, &mut dut, &peer, &cases);
+    assert_eq!(before, expected_cases(&cases));
+    dut.driver().set_mode(Mode::Stopped).unwrap();
+    assert_eq!(dut.driver().state(), ErrorState::Stopped);
+    // Stopped: off the bus, nothing received (the witness acknowledges).
+    let received = dut.driver_ref().traffic().received;
+    let refused = dut.filtered_out();
+    peer.borrow_mut().send(std_frame(0x123, &[9]));
+    settle(&mut h, &mut dut, &[&peer], 10_000);
+    assert_eq!(
+        witness.borrow().received_frames().last(),
+        Some(&std_frame(0x123, &[9]))
+    );
+    assert_eq!(dut.driver_ref().traffic().received, received, "{}", B::NAME);
+    assert_eq!(dut.filtered_out(), refused);
+    assert!(drain(&mut dut).is_empty());
+    dut.driver().set_mode(Mode::Normal).unwrap();
+    assert_eq!(dut.driver().state(), ErrorState::Active);
+    run(&mut h, &mut dut, 20); // synchronise (see `flexcan_is_on_the_bus_when_set_mode_returns`)
+    let after = run_cases(&mut h, &mut dut, &peer, &cases);
+    assert_eq!(after, before, "{}", B::NAME);
+}
+
+fn filters_survive_a_bit_rate_change<B: Backend>() {
+    let filters = filter_list();
+    let cases = filter_cases();
+    let opts = NodeOptions::filters(&filters);
+    let (mut h, mut dut, peer) = setup::<B>(&opts);
+    assert_eq!(dut.bitrate_in_registers(), RATE, "{}", B::NAME);
+    let before = run_cases(&mut h, &mut dut, &peer, &cases);
+    assert_eq!(before, expected_cases(&cases));
+    // A new bus at 250 kbit/s at the same time; the peer and the node move to it.
+    let mut h2 = harness_at(250_000, h.now());
+    h2.bus().borrow_mut().attach("peer", peer.clone());
+    drop(h);
+    let (mut dut, how) = B::change_bitrate(dut, &opts, &mut h2).unwrap();
+    assert_eq!(dut.bitrate_in_registers(), 250_000, "{}", B::NAME);
+    run(&mut h2, &mut dut, 20); // synchronise
+    println!("{}: bit rate change: {how:?}", B::NAME);
+    let after = run_cases(&mut h2, &mut dut, &peer, &cases);
+    assert_eq!(after, before, "{}", B::NAME);
+    let _ = BitrateChange::FiltersKept;
+}
+
+// ---------------------------------------------------------------------------------------
+
+#[test]
+fn frames_that_break_the_format_are_typed_errors() {
+    assert_eq!(
+        Frame::standard(0x800, &[]),
+        Err(FrameError::StandardIdOutOfRange(0x800))
+    );
+    assert_eq!(
+        Frame::extended(0x2000_0000, &[]),
+        Err(FrameError::ExtendedIdOutOfRange(0x2000_0000))
+    );
+    assert_eq!(
+        Frame::standard(0x7FF, &[0; 9]),
+        Err(FrameError::TooMuchData(9))
+    );
+    assert_eq!(
+        Frame::remote(0x10, false, 9),
+        Err(FrameError::DlcTooLarge(9))
+    );
+    let mut r = remote_frame(0x10, false, 4);
+    assert_eq!(r.set_data(&[1]), Err(FrameError::DataOnRemoteFrame));
+    // The largest legal values are accepted.
+    assert!(Frame::standard(0x7FF, &[0; 8]).is_ok());
+    assert!(Frame::extended(0x1FFF_FFFF, &[0; 8]).is_ok());
+    assert!(Frame::remote(0x1FFF_FFFF, true, 8).is_ok());
+}
+
+#[test]
+fn bit_rate_changes_as_each_backend_offers_them() {
+    // bxCAN reconfigures a running controller and keeps its filter banks; FlexCAN has no
+    // such operation (ACAN neither): `begin` again, with the lists the application kept.
+    let opts = NodeOptions::filters(&filter_list());
+    let mut h = Harness::new(RATE).unwrap();
+    let bx = BxCanBackend::attach(&mut h, &opts).unwrap();
+    let flex = FlexCanBackend::attach(&mut h, &opts).unwrap();
+    let mut h2 = harness_at(250_000, h.now());
+    let (_, how) = BxCanBackend::change_bitrate(bx, &opts, &mut h2).unwrap();
+    assert_eq!(how, BitrateChange::FiltersKept);
+    let (_, how) = FlexCanBackend::change_bitrate(flex, &opts, &mut h2).unwrap();
+    assert_eq!(how, BitrateChange::FiltersReinstalledFromLists);
+}
+
+#[test]
+fn flexcan_last_error_survives_the_interrupt() {
+    last_error_survives_the_interrupt::<FlexCanBackend>();
+}
+
+#[test]
+#[ignore = "BUG: bxcan/src/controller.rs take_events() writes LEC = 0b111 after reading it \
+            and error_status() reads LEC live, so Driver::last_error() is None after every \
+            on_interrupt (FlexCAN keeps the last error); the portable last error is lost"]
+fn bxcan_last_error_survives_the_interrupt() {
+    last_error_survives_the_interrupt::<BxCanBackend>();
+}
+
+/// `set_mode(Normal)` promises "on the bus": a frame the peer starts right after it
+/// returns must be received (a witness acknowledges it, so the peer does not retry).
+fn on_the_bus_when_set_mode_returns<B: Backend>() {
+    let (mut h, mut dut, peer) = setup::<B>(&NodeOptions::pass_all());
+    let (witness, _) = attach_sim(&h, "witness", SimNode::new());
+    dut.driver().set_mode(Mode::Stopped).unwrap();
+    run(&mut h, &mut dut, 100);
+    dut.driver().set_mode(Mode::Normal).unwrap();
+    let f = std_frame(0x321, &[3, 2, 1]);
+    peer.borrow_mut().send(f);
+    settle(&mut h, &mut dut, &[&peer], 10_000);
+    assert_eq!(witness.borrow().received_frames(), vec![f]);
+    let got: Vec<Frame> = drain(&mut dut).iter().map(|r| r.frame).collect();
+    assert_eq!(
+        got,
+        vec![f],
+        "{}: frame missed right after set_mode(Normal)",
+        B::NAME
+    );
+}
+
+#[test]
+fn bxcan_is_on_the_bus_when_set_mode_returns() {
+    on_the_bus_when_set_mode_returns::<BxCanBackend>();
+}
+
+#[test]
+#[ignore = "BUG: flexcan/src/handshake.rs unfreeze() (used by set_mode(Normal) and begin) \
+            returns once FRZACK and NOTRDY are 0, before the module has synchronised to the \
+            bus (ESR1.SYNCH, 11 recessive bits): a frame starting in that window is missed \
+            and counted nowhere; bxCAN's set_mode waits for INAK, which includes the 11 bits"]
+fn flexcan_is_on_the_bus_when_set_mode_returns() {
+    on_the_bus_when_set_mode_returns::<FlexCanBackend>();
+}
+
+macro_rules! suite {
+    ($module:ident, $backend:ty) => {
+        mod $module {
+            use super::*;
+
+            #[test]
+            fn data_frames_both_ways() {
+                super::data_frames_both_ways::<$backend>();
+            }
+            #[test]
+            fn remote_frames_both_ways() {
+                super::remote_frames_both_ways::<$backend>();
+            }
+            #[test]
+            fn filters_accept_exactly_their_frames() {
+                super::filters_accept_exactly_their_frames::<$backend>();
+            }
+            #[test]
+            fn invalid_filters_are_refused() {
+                super::invalid_filters_are_refused::<$backend>();
+            }
+            #[test]
+            fn filter_capacity() {
+                super::filter_capacity::<$backend>();
+            }
+            #[test]
+            fn bit_rate_limits() {
+                super::bit_rate_limits::<$backend>();
+            }
+            #[test]
+            fn state_and_counters_follow_iso_rules() {
+                super::state_and_counters_follow_iso_rules::<$backend>();
+            }
+            #[test]
+            fn filters_survive_stop_and_start() {
+                super::filters_survive_stop_and_start::<$backend>();
+            }
+            #[test]
+            fn filters_survive_a_bit_rate_change() {
+                super::filters_survive_a_bit_rate_change::<$backend>();
+            }
+        }
+    };
+}
+
+suite!(flexcan, FlexCanBackend);
+suite!(bxcan, BxCanBackend);
