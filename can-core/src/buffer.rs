@@ -293,6 +293,11 @@ impl<const N: usize> TxQueue<N> {
         self.len() == 0
     }
 
+    /// Whether the queue is full.
+    pub fn is_full(&self) -> bool {
+        self.len() == N
+    }
+
     /// Drops every queued frame, returning how many were dropped.
     pub fn clear(&self) -> usize {
         critical_section::with(|cs| {

@@ -57,6 +57,12 @@ pub struct Driver<C: Controller, const RX: usize, const TX: usize> {
 impl<C: Controller, const RX: usize, const TX: usize> Driver<C, RX, TX> {
     /// Wraps a configured controller; the transmit queue takes the controller's policy.
     pub fn new(controller: C) -> Self {
+        const {
+            assert!(
+                RX > 0 && TX > 0,
+                "the receive and transmit rings need room for a frame"
+            )
+        };
         let state = controller.error_status().state;
         Driver {
             tx: TxQueue::new(controller.tx_policy()),
@@ -90,7 +96,12 @@ impl<C: Controller, const RX: usize, const TX: usize> Driver<C, RX, TX> {
     /// [`Driver::tx_stats`] (`overflows`, and `peak` becomes size + 1).
     pub fn try_send(&mut self, frame: &Frame) -> nb::Result<(), Error> {
         if self.state == ErrorState::BusOff {
-            return Err(nb::Error::Other(Error::BusOff));
+            // Recovery (automatic, or by another path) raises no interrupt on every
+            // controller: read the state again before refusing.
+            self.track_state();
+            if self.state == ErrorState::BusOff {
+                return Err(nb::Error::Other(Error::BusOff));
+            }
         }
         if self.tx.is_empty() {
             match self.controller.transmit(frame) {
@@ -105,6 +116,12 @@ impl<C: Controller, const RX: usize, const TX: usize> Driver<C, RX, TX> {
                 Err(nb::Error::WouldBlock) => {}
                 Err(nb::Error::Other(e)) => return Err(nb::Error::Other(e)),
             }
+        }
+        if self.tx.is_full() {
+            // Make what progress the hardware allows without waiting for the interrupt
+            // (completed mailboxes refilled from the queue), so that polling `try_send`
+            // with interrupts off, as `nb::block!` does, cannot spin for ever.
+            self.on_interrupt();
         }
         match self.tx.push(*frame) {
             Ok(()) => {

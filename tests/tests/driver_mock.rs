@@ -251,3 +251,32 @@ fn blocking_can_round_trip() {
     let got = embedded_can::blocking::Can::receive(&mut d).unwrap();
     assert_eq!(got, frame(0x42, 7));
 }
+
+#[test]
+fn try_send_sees_a_recovery_that_raised_no_interrupt() {
+    let mut d: Driver<Mock, 8, 8> = Driver::new(Mock::new(TxPolicy::Fifo));
+    d.controller_mut()
+        .set_status(ErrorState::BusOff, 256, 0, LastErrorCode::BitDominant);
+    d.on_interrupt();
+    assert_eq!(
+        d.try_send(&frame(1, 1)),
+        Err(nb::Error::Other(Error::BusOff))
+    );
+    // The controller recovers by itself; no interrupt is serviced.
+    d.controller_mut()
+        .set_status(ErrorState::Active, 0, 0, LastErrorCode::None);
+    assert_eq!(d.try_send(&frame(1, 1)), Ok(()));
+}
+
+#[test]
+fn polling_try_send_progresses_without_interrupts() {
+    let mut d: Driver<Mock, 8, 8> = Driver::new(Mock::new(TxPolicy::Fifo));
+    for i in 0..11 {
+        d.try_send(&frame(0x100, i)).unwrap();
+    }
+    assert_eq!(d.try_send(&frame(0x100, 11)), Err(nb::Error::WouldBlock));
+    // The bus sends one mailbox; nobody runs the interrupt handler.
+    d.controller_mut().complete();
+    assert_eq!(d.try_send(&frame(0x100, 11)), Ok(()));
+    assert_eq!(d.tx_stats().overflows, 1);
+}

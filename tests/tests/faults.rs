@@ -555,10 +555,6 @@ suite!(flexcan, FlexCanBackend);
 suite!(bxcan, BxCanBackend);
 
 #[test]
-#[ignore = "BUG: examples/host/src/lib.rs BxNode::stm32f767_can1 documents \"automatic bus-off \
-            recovery\" but never calls Config::recovery(Recovery::Automatic); the bxCAN \
-            Config default is Recovery::Manual (ABOM = 0), so the demo's STM32 node stays \
-            bus-off for ever"]
 fn harness_stm32_node_recovers_from_bus_off_by_itself() {
     let mut h = Harness::new(RATE).unwrap();
     let mut dut = BxNode::stm32f767_can1(&mut h, &[Filter::pass_all()]).unwrap();

@@ -283,6 +283,7 @@ impl BxNode {
         let config = BxConfig::from_bitrate(STM32F767_APB1_HZ, bit_rate)
             .map_err(SetupError::BxCanConfig)?
             .tx_policy(twocan_core::TxPolicy::Fifo)
+            .recovery(twocan_bxcan::Recovery::Automatic)
             .interrupts(
                 twocan_bxcan::regs::ier::TMEIE
                     | twocan_bxcan::regs::ier::FMPIE0
