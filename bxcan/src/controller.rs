@@ -2,6 +2,8 @@
 //! [`Can::can3`]), the initialization-mode value [`Init`], and the
 //! [`twocan_core::Controller`] implementation the portable [`twocan_core::Driver`] uses.
 
+use core::cell::Cell;
+
 use twocan_core::{
     Controller, Error, ErrorCounters, ErrorState, ErrorStatus, Events, Frame, LastErrorCode,
     MailboxId, MailboxState, Mode, Priority, Registers, RxFrame, TxPolicy,
@@ -57,6 +59,11 @@ pub struct Can<R: Registers, F: Registers = R> {
     /// Completions noticed outside `take_events` (a reload clears RQCP), reported next.
     pending: Events,
     last_state: ErrorState,
+    /// The last error code the hardware latched (`CAN_ESR.LEC`), kept after
+    /// `take_events` sets LEC to 0b111 so [`Controller::error_status`] still reports it
+    /// until a newer error replaces it (as the FlexCAN backend does). A `Cell` because
+    /// `error_status` takes `&self` and may observe a newer LEC first.
+    last_error: Cell<LastErrorCode>,
 }
 
 /// A controller in initialization mode (RM0410 §40.4.1), configured but off the bus.
@@ -115,6 +122,7 @@ impl<R: Registers, F: Registers> Can<R, F> {
             displaced: [None; TX_MAILBOXES],
             pending: Events::default(),
             last_state: ErrorState::Stopped,
+            last_error: Cell::new(LastErrorCode::None),
         }
     }
 
@@ -195,9 +203,21 @@ impl<R: Registers, F: Registers> Can<R, F> {
     }
 
     /// Clears the last error code by software (`CAN_ESR.LEC = 0b111`, "set by software":
-    /// the hardware overwrites it with the next bus event).
+    /// the hardware overwrites it with the next bus event); the driver's sticky copy
+    /// ([`Controller::error_status`]'s `last_error`) reads [`LastErrorCode::None`] too.
     pub fn clear_last_error(&mut self) {
         self.regs.write32(ESR, esr::LEC.val(esr::LEC_SOFTWARE));
+        self.last_error.set(LastErrorCode::None);
+    }
+
+    /// Reads `CAN_ESR.LEC`; a latched error code replaces the sticky copy. Returns the
+    /// code just latched (`None` when LEC holds no new error).
+    fn latch_last_error(&self, esr_value: u32) -> LastErrorCode {
+        let code = lec(esr::LEC.get(esr_value));
+        if code != LastErrorCode::None {
+            self.last_error.set(code);
+        }
+        code
     }
 
     fn bound(&self) -> u32 {
@@ -283,10 +303,11 @@ impl<R: Registers, F: Registers> Can<R, F> {
         } else {
             ErrorState::from_counters(counters)
         };
+        self.latch_last_error(e);
         ErrorStatus {
             state,
             counters,
-            last_error: lec(esr::LEC.get(e)),
+            last_error: self.last_error.get(),
         }
     }
 }
@@ -503,7 +524,8 @@ impl<R: Registers, F: Registers> Controller for Can<R, F> {
     /// Reads and acknowledges (write 1 to clear): RQCPx (with TXOKx/ALSTx/TERRx) →
     /// sent / failed / aborted; FULLx, FOVRx → one overrun per FOVR occurrence (the
     /// hardware does not count lost frames); ERRI, WKUI, SLAKI; LEC (reported, then set
-    /// to 0b111 by software so the next error is seen as new).
+    /// to 0b111 by software so the next error is seen as new; the code stays readable from
+    /// [`Controller::error_status`] until a newer one replaces it).
     fn take_events(&mut self) -> Events {
         let t = self.regs.read32(TSR);
         for x in 0..TX_MAILBOXES {
@@ -530,10 +552,11 @@ impl<R: Registers, F: Registers> Controller for Can<R, F> {
             self.regs.write32(MSR, ack);
         }
         ev.wakeup = m & msr::WKUI != 0;
-        let code = lec(esr::LEC.get(self.regs.read32(ESR)));
+        let code = self.latch_last_error(self.regs.read32(ESR));
         if code != LastErrorCode::None {
             ev.bus_error = Some(code);
-            self.clear_last_error();
+            // LEC = 0b111 so the next error is seen as new; the sticky copy stays.
+            self.regs.write32(ESR, esr::LEC.val(esr::LEC_SOFTWARE));
         }
         let state = self.state_now().state;
         ev.state_changed = m & msr::ERRI != 0 || state != self.last_state;
@@ -542,7 +565,9 @@ impl<R: Registers, F: Registers> Controller for Can<R, F> {
     }
 
     /// From `CAN_ESR` and `CAN_MSR`: sleeping (SLAK), stopped (INAK), bus-off (BOFF; TEC
-    /// reported as 256), passive (EPVF), warning (EWGF), active; LEC as last error.
+    /// reported as 256), passive (EPVF), warning (EWGF), active; last error: the last
+    /// code `CAN_ESR.LEC` latched, kept after `take_events` acknowledges it (sticky until
+    /// a newer error or [`Can::clear_last_error`]).
     fn error_status(&self) -> ErrorStatus {
         self.state_now()
     }

@@ -507,9 +507,6 @@ fn flexcan_last_error_survives_the_interrupt() {
 }
 
 #[test]
-#[ignore = "BUG: bxcan/src/controller.rs take_events() writes LEC = 0b111 after reading it \
-            and error_status() reads LEC live, so Driver::last_error() is None after every \
-            on_interrupt (FlexCAN keeps the last error); the portable last error is lost"]
 fn bxcan_last_error_survives_the_interrupt() {
     last_error_survives_the_interrupt::<BxCanBackend>();
 }
