@@ -312,6 +312,12 @@ impl<R: Registers, F: Registers> Can<R, F> {
     }
 }
 
+/// Whether 16-bit time stamp `a` is not later than `b`, wrap-aware (the timer wraps
+/// every 65,536 ticks: stamps less than half a period apart compare correctly).
+fn older_or_same(a: u16, b: u16) -> bool {
+    b.wrapping_sub(a) < 0x8000
+}
+
 /// `CAN_ESR.LEC` as a last-error code (notes "Error management": 0 none, 1 stuff, 2 form,
 /// 3 acknowledgment, 4 bit recessive, 5 bit dominant, 6 CRC, 7 set by software).
 pub fn lec(code: u32) -> LastErrorCode {
@@ -477,12 +483,30 @@ impl<R: Registers, F: Registers> Controller for Can<R, F> {
     /// Sets `CAN_TSR.ABRQx` and waits [`ABORT_WAIT_ITERATIONS`] reads for TMEx: `true`
     /// when the mailbox emptied without TXOK (it was pending or scheduled). The abort is
     /// counted in [`Events::aborted`]. An index ≥ 3 returns `false`.
+    ///
+    /// A displacement of mailbox `x` still in flight or parked (its abort ended, the
+    /// frame read back not yet handed back by [`Controller::transmit`]) is dropped: the
+    /// frame is never handed back nor sent, and counts as aborted.
     fn abort(&mut self, mailbox: MailboxId) -> bool {
         let x = mailbox.0 as usize;
         if x >= TX_MAILBOXES {
             return false;
         }
         let t = self.regs.read32(TSR);
+        // A displacement of this mailbox under way or parked: the abort wins, the frame
+        // read back is dropped (not handed back to a later `transmit`), and it is counted
+        // as aborted like any other aborted mailbox.
+        if self.displaced[x].take().is_some() && t & tsr::tme(x) != 0 {
+            if t & tsr::rqcp(x) != 0 {
+                // Ended but not yet seen by `take_events`: sent, or now aborted.
+                let _ = self.complete(x, t);
+                return t & tsr::txok(x) == 0;
+            }
+            // Parked (RQCPx already acknowledged by `take_events`).
+            self.abort_requested &= !(1 << x);
+            self.pending.aborted = self.pending.aborted.saturating_add(1);
+            return true;
+        }
         if t & tsr::tme(x) != 0 {
             return false;
         }
@@ -497,28 +521,51 @@ impl<R: Registers, F: Registers> Controller for Can<R, F> {
         false
     }
 
-    /// FIFO 0 first, then FIFO 1: reads the output mailbox, releases it (`RFOMx`), maps
-    /// the FMI to the user's filter index ([`crate::filters::NO_FILTER`] if the installed
-    /// plan has none) and adds the time stamp when TTCM is on.
+    /// Takes the frame at the head of one receive FIFO: reads the output mailbox,
+    /// releases it (`RFOMx`), maps the FMI to the user's filter index
+    /// ([`crate::filters::NO_FILTER`] if the installed plan has none) and adds the time
+    /// stamp when TTCM is on.
+    ///
+    /// Order: frames of one FIFO come in arrival order (the hardware's). Across the two
+    /// FIFOs:
+    /// - with time stamps on ([`Config::timestamps`], `CAN_MCR.TTCM`), the older of the
+    ///   two heads by `CAN_RDTxR.TIME` (16-bit, compared wrap-aware: heads less than
+    ///   32,768 timer ticks apart; ties go to FIFO 0) — arrival order is kept across FIFOs;
+    /// - without, FIFO 0 first, then FIFO 1: arrival order across FIFOs is **not**
+    ///   preserved (the hardware records none). Keep frames whose relative order matters
+    ///   in one FIFO (`FifoPolicy::Fifo0`/`Fifo1`); `FifoPolicy::Balanced` trades that
+    ///   order for more room before an overrun.
     fn receive(&mut self) -> nb::Result<RxFrame, Error> {
-        for (x, fifo) in [(0, Fifo::Fifo0), (1, Fifo::Fifo1)] {
-            if rfxr::FMP.get(self.regs.read32(crate::regs::rfxr(x))) == 0 {
-                continue;
-            }
-            let got = mailbox::read_rx(&self.regs, x);
-            self.regs.write32(crate::regs::rfxr(x), rfxr::RFOM);
-            let frame = got.frame.map_err(|e| nb::Error::Other(Error::Frame(e)))?;
-            return Ok(RxFrame {
-                frame,
-                filter: self.fmi.get(fifo, got.fmi),
-                timestamp: if self.config.get_timestamps() {
-                    Some(got.time)
+        let pending = |regs: &R, x: usize| rfxr::FMP.get(regs.read32(crate::regs::rfxr(x))) != 0;
+        let (p0, p1) = (pending(&self.regs, 0), pending(&self.regs, 1));
+        let x = match (p0, p1) {
+            (false, false) => return Err(nb::Error::WouldBlock),
+            (true, false) => 0,
+            (false, true) => 1,
+            (true, true) if self.config.get_timestamps() => {
+                let t0 = mailbox::read_rx_time(&self.regs, 0);
+                let t1 = mailbox::read_rx_time(&self.regs, 1);
+                if older_or_same(t0, t1) {
+                    0
                 } else {
-                    None
-                },
-            });
-        }
-        Err(nb::Error::WouldBlock)
+                    1
+                }
+            }
+            (true, true) => 0,
+        };
+        let fifo = if x == 0 { Fifo::Fifo0 } else { Fifo::Fifo1 };
+        let got = mailbox::read_rx(&self.regs, x);
+        self.regs.write32(crate::regs::rfxr(x), rfxr::RFOM);
+        let frame = got.frame.map_err(|e| nb::Error::Other(Error::Frame(e)))?;
+        Ok(RxFrame {
+            frame,
+            filter: self.fmi.get(fifo, got.fmi),
+            timestamp: if self.config.get_timestamps() {
+                Some(got.time)
+            } else {
+                None
+            },
+        })
     }
 
     /// Reads and acknowledges (write 1 to clear): RQCPx (with TXOKx/ALSTx/TERRx) →
@@ -529,9 +576,16 @@ impl<R: Registers, F: Registers> Controller for Can<R, F> {
     fn take_events(&mut self) -> Events {
         let t = self.regs.read32(TSR);
         for x in 0..TX_MAILBOXES {
-            // An ended displacement abort is left for `transmit`, which hands the frame back.
-            let parked = self.displaced[x].is_some() && t & tsr::txok(x) == 0;
-            if !parked {
+            // An ended displacement abort: the frame stays parked for `transmit`, which
+            // hands it back (or for `abort`, which drops it). RQCPx is acknowledged now
+            // all the same, so the transmit interrupt line (TMEIE) is not left asserted
+            // while no transmit comes for it.
+            let parked =
+                self.displaced[x].is_some() && t & tsr::rqcp(x) != 0 && t & tsr::txok(x) == 0;
+            if parked {
+                self.abort_requested &= !(1 << x);
+                self.regs.write32(TSR, tsr::rqcp(x));
+            } else {
                 let _ = self.complete(x, t);
             }
         }
@@ -598,4 +652,18 @@ impl<R: Registers, F: Registers> Controller for Can<R, F> {
 /// builds its own `CAN_IER` value).
 pub const fn fifo_interrupts(fifo: Fifo) -> u32 {
     ier::fmpie(fifo.index()) | ier::fovie(fifo.index())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::older_or_same;
+
+    #[test]
+    fn time_stamps_compare_across_the_wrap() {
+        assert!(older_or_same(10, 20));
+        assert!(!older_or_same(20, 10));
+        assert!(older_or_same(7, 7));
+        assert!(older_or_same(0xFFF0, 0x0010), "0x0010 is after the wrap");
+        assert!(!older_or_same(0x0010, 0xFFF0));
+    }
 }

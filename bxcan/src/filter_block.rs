@@ -7,6 +7,16 @@
 //! 3. write `FSCi`, `FBMi`, `FFAi` and `FiR1`/`FiR2` of every bank of the plan;
 //! 4. activate the plan's active banks; the instance's other banks stay deactivated;
 //! 5. `FINIT = 0`.
+//!
+//! **Shared registers.** On F76x/F77x the filter block of CAN1 also serves CAN2 (its
+//! banks `CAN2SB..28`): `CAN_FMR`, `CAN_FM1R`, `CAN_FS1R`, `CAN_FFA1R` and `CAN_FA1R`
+//! hold bits of both instances, and the drivers of CAN1 and CAN2 may run in different
+//! execution contexts (thread and interrupt, or two interrupt priorities). Every
+//! read-modify-write of them — the whole FINIT section of `program` and the `CAN2SB`
+//! write of `set_can2sb` — runs inside [`critical_section::with`], so that one
+//! instance's programming cannot interleave with the other's and write back stale bits
+//! (or clear `FINIT` while the other is still configuring its banks). The sections are
+//! short: a fixed number of register accesses, no waiting.
 
 use twocan_core::Registers;
 
@@ -24,20 +34,33 @@ pub(crate) fn banks_of<F: Registers>(regs: &F, instance: Instance) -> (usize, us
     bank_range(instance, can2sb(regs))
 }
 
-/// Sets `CAN2SB` (in filter initialization mode, as RM0410 requires).
+/// Sets `CAN2SB` (in filter initialization mode, as RM0410 requires), in a critical
+/// section (`CAN_FMR` is shared with CAN2's driver, see the module notes).
 pub(crate) fn set_can2sb<F: Registers>(regs: &mut F, start: u8) {
-    let fmr_value = regs.read32(FMR);
-    regs.write32(FMR, fmr_value | fmr::FINIT);
-    let with = fmr::CAN2SB.set(fmr_value | fmr::FINIT, start as u32);
-    regs.write32(FMR, with);
-    regs.write32(FMR, with & !fmr::FINIT);
+    critical_section::with(|_| {
+        let fmr_value = regs.read32(FMR);
+        regs.write32(FMR, fmr_value | fmr::FINIT);
+        let with = fmr::CAN2SB.set(fmr_value | fmr::FINIT, start as u32);
+        regs.write32(FMR, with);
+        regs.write32(FMR, with & !fmr::FINIT);
+    })
 }
 
 /// Error: the plan has more banks than the instance owns.
 pub(crate) struct TooManyBanks;
 
-/// Writes `plan` to the banks `instance` owns.
+/// Writes `plan` to the banks `instance` owns, in a critical section (the registers are
+/// shared with the other instance's driver, see the module notes; `CAN2SB` is read
+/// inside it too, so the bank range cannot change under the programming).
 pub(crate) fn program<F: Registers>(
+    regs: &mut F,
+    instance: Instance,
+    plan: &FilterPlan,
+) -> Result<(), TooManyBanks> {
+    critical_section::with(|_| program_locked(regs, instance, plan))
+}
+
+fn program_locked<F: Registers>(
     regs: &mut F,
     instance: Instance,
     plan: &FilterPlan,

@@ -606,12 +606,16 @@ impl FilterPlan {
     /// filters that accept it, a 32-bit filter wins over a 16-bit one, then list over
     /// mask, then the lower filter number. `None`: the frame is discarded.
     ///
-    /// The notes do not say how filters of different FIFOs compare; here FIFO 0 wins a
-    /// tie of class. Plans made by the planner never let one frame match filters of both
-    /// FIFOs, so the question does not arise for them.
+    /// The notes and RM0410 do not say how filters of different FIFOs compare (filter
+    /// numbers are per FIFO); here, as in the behavioural model, a tie of class goes to
+    /// the lower bank number (then the lower position in the bank, which within one FIFO
+    /// is the lower filter number). Plans made by the planner never let one frame match
+    /// filters of both FIFOs (overlapping filters share a FIFO), so the question only
+    /// arises for manual plans; check it on silicon before relying on it.
     pub fn evaluate(&self, frame: &Frame) -> Option<Acceptance> {
         let (id, ext, rtr) = (frame.raw_id(), frame.is_extended(), frame.is_remote());
-        let mut best: Option<(u8, Fifo, u8, u16)> = None;
+        // (class, bank, slot, FIFO, FMI, user index)
+        let mut best: Option<(u8, usize, usize, Fifo, u8, u16)> = None;
         for (i, b) in self.banks().iter().enumerate() {
             if !b.active {
                 continue;
@@ -623,7 +627,14 @@ impl FilterPlan {
                 let Some((fifo, fmi)) = self.fmi_of(i, slot) else {
                     continue;
                 };
-                let key = (b.kind.priority_class(), fifo, fmi, self.users[i][slot]);
+                let key = (
+                    b.kind.priority_class(),
+                    i,
+                    slot,
+                    fifo,
+                    fmi,
+                    self.users[i][slot],
+                );
                 let better = match best {
                     None => true,
                     Some(bk) => (key.0, key.1, key.2) < (bk.0, bk.1, bk.2),
@@ -633,7 +644,7 @@ impl FilterPlan {
                 }
             }
         }
-        best.map(|(_, fifo, fmi, filter)| Acceptance { fifo, fmi, filter })
+        best.map(|(_, _, _, fifo, fmi, filter)| Acceptance { fifo, fmi, filter })
     }
 
     /// Whether any bank of the plan sends frames to `fifo`.

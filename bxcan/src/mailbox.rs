@@ -83,6 +83,11 @@ pub(crate) fn read_rx<R: Registers>(regs: &R, x: usize) -> Received {
     }
 }
 
+/// The time stamp (`CAN_RDTxR.TIME`) of the output mailbox of FIFO `x`.
+pub(crate) fn read_rx_time<R: Registers>(regs: &R, x: usize) -> u16 {
+    rdtxr::TIME.get(regs.read32(rdtxr(x))) as u16
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -7,9 +7,12 @@ mod common;
 
 use common::*;
 use twocan_bxcan::model::BxCanModel;
+use twocan_bxcan::regs::{esr, ESR};
 use twocan_bxcan::{Can, Recovery};
 use twocan_core::sim::{Fault, NodeId, SimNode};
-use twocan_core::{Controller, Driver, Error, ErrorState, LastErrorCode, Mode, TxPolicy};
+use twocan_core::{
+    Controller, Driver, Error, ErrorState, LastErrorCode, Mode, Registers, TxPolicy,
+};
 
 fn bus_off_setup(recovery: Recovery) -> (Driver<Can<Clocked>, 8, 8>, Clocked, SharedBus, NodeId) {
     let bus = new_bus();
@@ -127,14 +130,25 @@ fn last_error_code_is_reported_then_cleared_by_software() {
     let ev = can.take_events();
     assert_eq!(ev.bus_error, Some(status.last_error));
     assert!(ev.state_changed || status.state == ErrorState::Active);
+    // The register holds 0b111 ("set by software") so the next error is seen as new...
     assert_eq!(
-        can.error_status().last_error,
-        LastErrorCode::None,
-        "LEC = 0b111 reads as none"
+        esr::LEC.get(regs.model.read32(ESR)),
+        esr::LEC_SOFTWARE,
+        "LEC = 0b111 after the event was taken"
     );
-    assert_eq!(can.take_events().bus_error, None);
+    // ...but the last error the hardware latched stays readable (sticky).
+    assert_eq!(can.error_status().last_error, status.last_error);
+    assert_eq!(can.take_events().bus_error, None, "reported once");
+    assert_eq!(can.error_status().last_error, status.last_error);
     settle(&bus);
     assert_eq!(can.take_events().sent, 1);
+    assert_eq!(
+        can.error_status().last_error,
+        status.last_error,
+        "a success does not replace the last error"
+    );
+    can.clear_last_error();
+    assert_eq!(can.error_status().last_error, LastErrorCode::None);
 }
 
 #[test]

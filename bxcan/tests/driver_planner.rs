@@ -485,3 +485,21 @@ fn large_overlapping_lists_are_planned_quickly_and_exactly() {
     }
     assert!(planned >= 2);
 }
+
+#[test]
+fn evaluate_breaks_cross_fifo_ties_by_bank_number() {
+    // Two 32-bit mask banks accepting the same frames, in different FIFOs: equal scale
+    // and mode, so the lower bank number wins (RM0410 is silent; the model does so too,
+    // see `driver_rx.rs`).
+    for (low, high) in [(Fifo::Fifo1, Fifo::Fifo0), (Fifo::Fifo0, Fifo::Fifo1)] {
+        let mut p = FilterPlan::manual();
+        p.set_bank(0, Bank::mask32(&Filter::pass_all(), low).unwrap())
+            .unwrap();
+        p.set_bank(1, Bank::mask32(&Filter::pass_all(), high).unwrap())
+            .unwrap();
+        let frame = Frame::standard(0x123, &[]).unwrap();
+        let a = p.evaluate(&frame).unwrap();
+        assert_eq!((a.fifo, a.fmi), (low, 0));
+        assert_eq!(a.filter, p.user_index(low, 0));
+    }
+}

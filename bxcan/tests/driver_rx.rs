@@ -39,6 +39,59 @@ fn fifo0_first_and_order_within_each_fifo() {
     assert_eq!(got, [(2, 4), (4, 4), (1, 0), (3, 0), (5, 0)]);
 }
 
+fn odd_fifo1_even_fifo0() -> FilterPlan {
+    let mut p = FilterPlan::manual();
+    let odd = Filter::masked(
+        twocan_core::FrameKind::Data,
+        twocan_core::Format::Standard,
+        1,
+        1,
+    );
+    let even = Filter::masked(
+        twocan_core::FrameKind::Data,
+        twocan_core::Format::Standard,
+        1,
+        0,
+    );
+    p.set_bank(0, Bank::mask32(&odd, Fifo::Fifo1).unwrap())
+        .unwrap();
+    p.set_bank(1, Bank::mask32(&even, Fifo::Fifo0).unwrap())
+        .unwrap();
+    p
+}
+
+#[test]
+fn time_stamps_keep_arrival_order_across_fifos() {
+    // TTCM on: the older FIFO head (by CAN_RDTxR.TIME) is taken first.
+    let cfg = loopback_config(TxPolicy::Fifo).timestamps(true);
+    let (mut can, _regs, bus) = can1_with(&cfg, &odd_fifo1_even_fifo0());
+    let sent = [1, 3, 2, 5, 4, 6];
+    for id in sent {
+        can.transmit(&std(id)).unwrap();
+        settle(&bus);
+    }
+    let got = drain(&mut can);
+    let ids: Vec<u32> = got.iter().map(|r| r.frame.raw_id()).collect();
+    assert_eq!(ids, sent.map(u32::from), "arrival order across both FIFOs");
+    let filters: Vec<u16> = got.iter().map(|r| r.filter).collect();
+    assert_eq!(filters, [0, 0, 4, 0, 4, 4]);
+    let stamps: Vec<u16> = got.iter().map(|r| r.timestamp.unwrap()).collect();
+    assert!(stamps.windows(2).all(|w| w[0] < w[1]), "{stamps:?}");
+}
+
+#[test]
+fn without_time_stamps_fifo0_goes_first() {
+    // Documented: no time stamps, no order across FIFOs (FIFO 0 first).
+    let (mut can, _regs, bus) =
+        can1_with(&loopback_config(TxPolicy::Fifo), &odd_fifo1_even_fifo0());
+    for id in [1, 2] {
+        can.transmit(&std(id)).unwrap();
+        settle(&bus);
+    }
+    let got: Vec<u32> = drain(&mut can).iter().map(|r| r.frame.raw_id()).collect();
+    assert_eq!(got, [2, 1]);
+}
+
 fn overrun(lock: bool) -> Vec<u32> {
     let cfg = loopback_config(TxPolicy::Fifo).rx_fifo_lock(lock);
     let (mut can, _regs, bus) = can1_with(&cfg, &pass_all());
@@ -85,4 +138,24 @@ fn driver_counts_hardware_overruns() {
     d.on_interrupt();
     assert_eq!(d.error_stats().hardware_overruns, 1);
     assert_eq!(d.traffic().received, 3);
+}
+
+#[test]
+fn cross_fifo_tie_goes_to_the_lower_bank_in_the_model_and_in_evaluate() {
+    for (low, high) in [(Fifo::Fifo1, Fifo::Fifo0), (Fifo::Fifo0, Fifo::Fifo1)] {
+        let mut p = FilterPlan::manual();
+        p.set_bank(0, Bank::mask32(&Filter::pass_all(), low).unwrap())
+            .unwrap();
+        p.set_bank(1, Bank::mask32(&Filter::pass_all(), high).unwrap())
+            .unwrap();
+        let a = p.evaluate(&std(0x123)).unwrap();
+        assert_eq!(a.fifo, low);
+        let (mut can, _regs, bus) = can1_with(&loopback_config(TxPolicy::Fifo), &p);
+        can.transmit(&std(0x123)).unwrap();
+        settle(&bus);
+        let got = drain(&mut can);
+        assert_eq!(got.len(), 1);
+        assert_eq!(got[0].filter, a.filter, "evaluate agrees with the model");
+        assert_ne!(a.filter, p.user_index(high, 0), "the banks are told apart");
+    }
 }

@@ -129,3 +129,82 @@ fn one_shot_failure_is_reported() {
     assert!(order(&peer).is_empty(), "not retransmitted");
     assert_eq!(can.mailbox_state(MailboxId(0)), MailboxState::Empty);
 }
+
+/// Puts the scheduled mailbox of `regs` in transmit state, as the bus does when it
+/// offers the frame (the abort of a mailbox in transmit state must wait for the bus).
+fn offer(regs: &Clocked, bus: &SharedBus) {
+    use twocan_core::sim::BusNode;
+    let now = bus.borrow().now();
+    let mut model = regs.model.clone();
+    assert!(model.poll_tx(now).is_some(), "a frame is offered");
+}
+
+#[test]
+fn abort_all_drops_an_in_flight_displacement() {
+    let cfg = config().tx_policy(TxPolicy::Priority); // TMEIE on (default interrupts)
+    let (can, regs, bus, peer) = can1_and_peer(&cfg, &pass_all());
+    regs.ticking.set(false);
+    let mut d: Driver<_, 8, 8> = Driver::new(can);
+    d.try_send(&std(0x700)).unwrap(); // mailbox 0
+    offer(&regs, &bus); // 0x700 in transmit state: its abort must wait for the bus
+    d.try_send(&std(0x600)).unwrap();
+    d.try_send(&std(0x650)).unwrap();
+    // 0x100 displaces the lowest (0x700, on the bus): the abort is in flight.
+    d.try_send(&std(0x100)).unwrap();
+    assert_eq!(d.tx_stats().count, 1, "0x100 waits for the displacement");
+    assert_eq!(d.abort_all(), 1, "0x100 dropped from the queue");
+    // The bus resolves the abort of the offered mailbox (not started: aborted).
+    regs.ticking.set(true);
+    for _ in 0..5 {
+        run(&bus, 100);
+        d.on_interrupt();
+    }
+    assert!(
+        !regs.model.irq_lines().tx,
+        "the transmit line is not left asserted"
+    );
+    for m in 0..3 {
+        assert_eq!(d.mailbox_state(MailboxId(m)), MailboxState::Empty);
+    }
+    // A new frame goes alone: nothing aborted comes back.
+    d.try_send(&std(0x050)).unwrap();
+    for _ in 0..10 {
+        run(&bus, 100);
+        d.on_interrupt();
+    }
+    settle(&bus);
+    d.on_interrupt();
+    assert_eq!(order(&peer), [0x050]);
+    let t = d.traffic();
+    assert_eq!((t.sent, t.aborted, t.failed), (1, 4, 0));
+    assert_eq!(d.tx_stats().count, 0);
+    assert!(!regs.model.irq_lines().tx);
+}
+
+#[test]
+fn a_parked_displacement_does_not_hold_the_transmit_line() {
+    // The displacement ends while no transmit is waiting for it: RQCPx is acknowledged
+    // at once, the frame read back stays parked and comes back from the next transmit.
+    let cfg = config().tx_policy(TxPolicy::Priority);
+    let (mut can, regs, bus, _peer) = can1_and_peer(&cfg, &pass_all());
+    regs.ticking.set(false);
+    can.transmit(&std(0x700)).unwrap();
+    offer(&regs, &bus);
+    can.transmit(&std(0x600)).unwrap();
+    can.transmit(&std(0x650)).unwrap();
+    assert_eq!(can.transmit(&std(0x100)), Err(nb::Error::WouldBlock));
+    // The next bus poll finds the offered frame not started: the abort takes effect.
+    {
+        use twocan_core::sim::BusNode;
+        let mut model = regs.model.clone();
+        let now = bus.borrow().now();
+        let _ = model.poll_tx(now);
+    }
+    assert_eq!(can.mailbox_state(MailboxId(0)), MailboxState::Empty);
+    let ev = can.take_events();
+    assert_eq!((ev.sent, ev.aborted, ev.failed), (0, 0, 0));
+    assert!(!regs.model.irq_lines().tx);
+    // Handed back, not lost, not counted as aborted.
+    assert_eq!(can.transmit(&std(0x100)), Ok(Some(std(0x700))));
+    assert_eq!(can.take_events().aborted, 0);
+}
