@@ -18,7 +18,9 @@ use twocan_bxcan::{Bank, Can, Config, Fifo, FilterPlan};
 use twocan_core::sim::Bus;
 use twocan_core::{Driver, Filter, Frame};
 use twocan_flexcan::model::FlexCanModel;
-use twocan_flexcan::{AcanDriver, Board, FlexCan, HostSystem, Instance, Settings, Target};
+use twocan_flexcan::{
+    AcanDriver, Board, FlexCan, HostSystem, IdleClocked, Instance, Settings, Target,
+};
 use twocan_host::{BxNode, FlexNode, Harness};
 
 use crate::cmd::{Context, Error, Result};
@@ -62,11 +64,12 @@ fn bxcan_driver(model: &BxCanModel, bus: &mut Bus) -> Result<Driver<Can<BxCanMod
     ))
 }
 
-fn flexcan_driver(model: &FlexCanModel) -> Result<AcanDriver<FlexCanModel>> {
+fn flexcan_driver(model: &FlexCanModel) -> Result<AcanDriver<IdleClocked>> {
     let settings = Settings::new(BITRATE);
     let target = Target::new(Board::Teensy32, Instance::Can0);
+    // `begin` waits for ESR1.SYNCH: let idle bus time pass while it polls.
     let controller = FlexCan::begin(
-        model.clone(),
+        IdleClocked::new(model.clone()),
         &mut HostSystem::new(),
         target,
         &settings,

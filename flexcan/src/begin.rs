@@ -16,7 +16,9 @@
 //!    automatic bus-off recovery, error interrupt masks), `CTRL2` (`RFFN`, remote frames stored), the ID filter
 //!    table, `RXIMR`, `RXFGMASK`, the transmit mailboxes inactive, flags cleared,
 //!    `IMASK1` (FIFO frames available and overflow, every transmit mailbox);
-//! 5. leave freeze (wait `FRZACK` and `NOTRDY` to clear).
+//! 5. leave freeze (wait `FRZACK` and `NOTRDY` to clear), then wait until the module
+//!    is synchronised to the bus (`ESR1.SYNCH`, 11 recessive bits; internal in
+//!    loop-back mode): when `begin` returns, a frame starting on the bus is received.
 //!
 //! Every wait is bounded by [`Settings::handshake_polls`]; a missing acknowledge is
 //! [`BeginError::Hardware`]`(`[`Error::Timeout`]`)`.

@@ -4,7 +4,10 @@
 //! The board is a runtime value ([`Board`]), so the host tests check every board in
 //! one build; the cargo features `teensy32` (Teensy 3.1 and 3.2), `teensy35` and
 //! `teensy36` choose `Board::DEFAULT` for firmware. With several board features at
-//! once (as in an `--all-features` build) the last in that list wins.
+//! once (as in an `--all-features` build, or by feature unification) the last in that
+//! list wins, silently: `teensy36` over `teensy35` over `teensy32` (see the crate
+//! documentation, "Board features"). This is deliberately not a compile error, so that
+//! `--all-features` builds keep working.
 //!
 //! Pin numbers and port pins come from [`crate::regs::pins`].
 
@@ -52,7 +55,8 @@ impl Board {
     /// Every board.
     pub const ALL: [Board; 3] = [Board::Teensy32, Board::Teensy35, Board::Teensy36];
 
-    /// The board the cargo features select.
+    /// The board the cargo features select. Precedence when several are enabled:
+    /// `teensy36`, then `teensy35`, then `teensy32` (not an error).
     #[cfg(feature = "teensy36")]
     pub const DEFAULT: Board = Board::Teensy36;
     /// The board the cargo features select.

@@ -30,7 +30,9 @@
 //! [`Controller::receive`] reads the Rx FIFO output (MB0), the `RXFIR.IDHIT` of the
 //! element that accepted it, then pops the FIFO by writing 1 to `IFLAG1.BUF5I` (the
 //! reading order of the reference manual). `IDHIT` becomes the user's filter index
-//! through [`FilterTable::filter_index`]; the TIME STAMP field becomes
+//! through [`FilterTable::filter_index`] (an `IDHIT` that maps to no filter gives
+//! [`crate::UNKNOWN_FILTER`] and is counted, see [`FlexCan::unresolved_filter_hits`]);
+//! the TIME STAMP field becomes
 //! [`RxFrame::timestamp`]. A FIFO overflow (`IFLAG1.BUF7I`: at least one frame lost,
 //! the hardware does not count them) is reported as one overrun.
 
@@ -42,7 +44,7 @@ use twocan_core::{
 };
 
 use crate::configuration::{Configuration, DATA_MAILBOX};
-use crate::filters::FilterTable;
+use crate::filters::{FilterTable, UNKNOWN_FILTER};
 use crate::handshake;
 use crate::instance::Target;
 use crate::message_buffer::MbWords;
@@ -84,6 +86,8 @@ pub struct FlexCan<R: Registers> {
     unreported_error: Cell<Option<LastErrorCode>>,
     /// `ESR1.FLTCONF` as `take_events` last saw it.
     fault: u32,
+    /// Frames received with an `IDHIT` that maps to no filter.
+    unresolved_hits: u32,
 }
 
 impl<R: Registers> FlexCan<R> {
@@ -108,6 +112,7 @@ impl<R: Registers> FlexCan<R> {
             last_error: Cell::new(LastErrorCode::None),
             unreported_error: Cell::new(None),
             fault: esr1::FLTCONF_ERROR_ACTIVE,
+            unresolved_hits: 0,
         }
     }
 
@@ -144,6 +149,13 @@ impl<R: Registers> FlexCan<R> {
     /// The registers, mutably (for the model's bus and fault-injection methods).
     pub fn registers_mut(&mut self) -> &mut R {
         &mut self.regs
+    }
+
+    /// Frames received whose `RXFIR.IDHIT` maps to none of the installed filters (beyond
+    /// the table, which the hardware does not produce): they were handed out with
+    /// filter index [`crate::UNKNOWN_FILTER`] rather than a wrong index. Saturates.
+    pub const fn unresolved_filter_hits(&self) -> u32 {
+        self.unresolved_hits
     }
 
     /// Gives the registers back.
@@ -337,7 +349,10 @@ impl<R: Registers> Controller for FlexCan<R> {
         let frame = words
             .frame()
             .map_err(|e| nb::Error::Other(Error::Frame(e)))?;
-        let filter = self.table.filter_index(hit, &frame);
+        let filter = self.table.filter_index(hit, &frame).unwrap_or_else(|| {
+            self.unresolved_hits = self.unresolved_hits.saturating_add(1);
+            UNKNOWN_FILTER
+        });
         Ok(RxFrame {
             frame,
             filter,
@@ -402,10 +417,14 @@ impl<R: Registers> Controller for FlexCan<R> {
         }
     }
 
-    /// `Normal`: on the bus. `Stopped`: freeze mode. `Sleep`: module disabled
-    /// (`MDIS`, low-power acknowledge). Each step waits, bounded, for its
-    /// acknowledge bit ([`Error::Timeout`]); asking again for the same mode repeats
-    /// the request, so a change that timed out can be retried.
+    /// `Normal`: on the bus — out of freeze and synchronised to it (`ESR1.SYNCH`, 11
+    /// recessive bits; internal in loop-back mode), so a frame starting after the
+    /// return is received. If the module leaves freeze but does not synchronise within
+    /// the bound (a bus stuck dominant), the mode is `Normal` and the result
+    /// [`Error::Timeout`]; errors `ESR1` reports meanwhile are kept. `Stopped`: freeze
+    /// mode. `Sleep`: module disabled (`MDIS`, low-power acknowledge). Each step
+    /// waits, bounded, for its acknowledge bit ([`Error::Timeout`]); asking again for
+    /// the same mode repeats the request, so a change that timed out can be retried.
     fn set_mode(&mut self, mode: Mode) -> Result<(), Error> {
         let polls = self.polls;
         // From the hardware, not from the last request: a timed-out change may have
@@ -415,7 +434,18 @@ impl<R: Registers> Controller for FlexCan<R> {
             handshake::enable(&mut self.regs, polls)?;
         }
         match mode {
-            Mode::Normal => handshake::unfreeze(&mut self.regs, polls)?,
+            Mode::Normal => {
+                handshake::leave_freeze(&mut self.regs, polls)?;
+                // Out of freeze: the module runs, even if it does not synchronise in time.
+                self.mode = mode;
+                let (last, unreported) = (&self.last_error, &self.unreported_error);
+                return handshake::wait_synch(&self.regs, polls, |esr| {
+                    if let Some(code) = status::last_error(esr) {
+                        last.set(code);
+                        unreported.set(Some(code));
+                    }
+                });
+            }
             Mode::Stopped => handshake::freeze(&mut self.regs, polls)?,
             Mode::Sleep => handshake::disable(&mut self.regs, polls)?,
         }

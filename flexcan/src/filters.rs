@@ -266,19 +266,27 @@ impl FilterTable {
     /// The user's filter index for a frame the hardware accepted with `RXFIR.IDHIT`
     /// = `element` (ACAN §12.5, §13.5).
     ///
-    /// An `IDHIT` beyond the table (which the hardware does not produce) is resolved
-    /// like a zero-mask hit, by the first secondary filter that matches; failing that
-    /// it gives index 0.
-    pub fn filter_index(&self, element: usize, frame: &Frame) -> u16 {
-        match self.hit(element) {
-            Some(Hit::Filter(i)) => i,
-            Some(Hit::ScanSecondary) | None => self.secondary[..self.secondary_count()]
+    /// `None` when `element` is beyond the table, or is a zero-mask hit that no
+    /// secondary filter matches: neither is produced by the hardware for this table
+    /// (a frame read with a stale or corrupted `IDHIT`), and no filter index can be
+    /// told — the controller reports such a frame with [`UNKNOWN_FILTER`].
+    pub fn filter_index(&self, element: usize, frame: &Frame) -> Option<u16> {
+        match self.hit(element)? {
+            Hit::Filter(i) => Some(i),
+            Hit::ScanSecondary => self.secondary[..self.secondary_count()]
                 .iter()
                 .position(|f| f.matches(frame))
-                .map_or(0, |j| self.secondary_index(j) as u16),
+                .map(|j| self.secondary_index(j) as u16),
         }
     }
 }
+
+/// The filter index of a received frame whose `RXFIR.IDHIT` does not map back to any
+/// of the user's filters ([`FilterTable::filter_index`] gives `None`): distinct from
+/// every real index (a list has at most a few hundred filters). The controller counts
+/// such frames ([`crate::FlexCan::unresolved_filter_hits`]); a
+/// [`twocan_core::Dispatcher`] counts them as unhandled.
+pub const UNKNOWN_FILTER: u16 = u16::MAX;
 
 #[cfg(test)]
 mod tests {
@@ -354,7 +362,7 @@ mod tests {
         let t = FilterTable::compile(c, primary, secondary).unwrap();
         for frame in frames() {
             let want = reference(primary, secondary, &frame);
-            let got = hw_match(&t, &frame).map(|e| t.filter_index(e, &frame));
+            let got = hw_match(&t, &frame).and_then(|e| t.filter_index(e, &frame));
             assert_eq!(got, want, "{c:?} {frame:?}");
         }
     }
@@ -447,6 +455,10 @@ mod tests {
         assert_eq!(t.hit(12), Some(Hit::Filter(1)));
         assert_eq!(t.hit(24), None);
         let remote = Frame::new_remote(standard_id(0x234).unwrap(), 0).unwrap();
-        assert_eq!(t.filter_index(99, &remote), 0);
+        // An IDHIT beyond the table is no filter 0: no index at all.
+        assert_eq!(t.filter_index(99, &remote), None);
+        assert_eq!(t.filter_index(24, &remote), None);
+        let data = Frame::new_data(standard_id(0x234).unwrap(), &[]).unwrap();
+        assert_eq!(t.filter_index(12, &data), Some(1));
     }
 }

@@ -7,15 +7,24 @@
 //! | `MCR.MDIS = 0` (enable) | `MCR.LPMACK` becomes 0 |
 //! | `MCR.SOFTRST = 1` | `MCR.SOFTRST` returns to 0 |
 //! | `MCR.FRZ = HALT = 1` (freeze) | `MCR.FRZACK` becomes 1 |
-//! | `MCR.FRZ = HALT = 0` (leave freeze) | `MCR.FRZACK` becomes 0, then `MCR.NOTRDY` 0 |
+//! | `MCR.FRZ = HALT = 0` (leave freeze) | `MCR.FRZACK` becomes 0, then `MCR.NOTRDY` 0, then `ESR1.SYNCH` 1 |
 //!
-//! Every wait polls `MCR` at most `polls` times (at least once) and ends in
-//! [`Error::Timeout`]: a module with no clock or no transceiver never hangs the
-//! firmware.
+//! Leaving freeze is only complete once the module is synchronised to the bus
+//! (`ESR1.SYNCH`: 11 consecutive recessive bits seen after Freeze or Disable mode).
+//! Before that the module does not take part in bus traffic, so a frame starting in
+//! that window would be missed without any trace. In loop-back mode (`CTRL1.LPB`) the
+//! receiver sees the module's own, recessive, Tx output instead of the bus ("Loop-back
+//! mode": the Rx pin is ignored), so the module synchronises internally after 11 bit
+//! times whatever the bus does; in listen-only mode (`CTRL1.LOM`) it synchronises to the
+//! bus like in normal mode.
+//!
+//! Every wait polls its register (`MCR`, or `ESR1` for `SYNCH`) at most `polls` times
+//! (at least once) and ends in [`Error::Timeout`]: a module with no clock, no
+//! transceiver or a bus stuck dominant never hangs the firmware.
 
 use twocan_core::{Error, Registers};
 
-use crate::regs::{mcr, MCR};
+use crate::regs::{esr1, mcr, ESR1, MCR};
 
 /// Polls `MCR` until `bit` reads `set`, at most `polls` times (at least once).
 pub fn wait_mcr<R: Registers>(regs: &R, bit: u32, set: bool, polls: u32) -> Result<(), Error> {
@@ -52,11 +61,39 @@ pub fn freeze<R: Registers>(regs: &mut R, polls: u32) -> Result<(), Error> {
 }
 
 /// Leaves freeze mode (clears `FRZ` and `HALT`, waits for `FRZACK` and then `NOTRDY`
-/// to clear).
-pub fn unfreeze<R: Registers>(regs: &mut R, polls: u32) -> Result<(), Error> {
+/// to clear). The module is then running but maybe not yet synchronised: see
+/// [`wait_synch`], or [`unfreeze`] for both steps.
+pub fn leave_freeze<R: Registers>(regs: &mut R, polls: u32) -> Result<(), Error> {
     regs.modify32(MCR, |v| v & !(mcr::FRZ | mcr::HALT));
     wait_mcr(regs, mcr::FRZACK, false, polls)?;
     wait_mcr(regs, mcr::NOTRDY, false, polls)
+}
+
+/// Polls `ESR1` until `SYNCH` is set, at most `polls` times (at least once).
+///
+/// Reading `ESR1` clears its error bits (`BIT1ERR` … `STFERR`): every value read is
+/// handed to `seen`, so that a caller keeping the last error loses none.
+pub fn wait_synch<R: Registers>(
+    regs: &R,
+    polls: u32,
+    mut seen: impl FnMut(u32),
+) -> Result<(), Error> {
+    for _ in 0..polls.max(1) {
+        let value = regs.read32(ESR1);
+        seen(value);
+        if value & esr1::SYNCH != 0 {
+            return Ok(());
+        }
+    }
+    Err(Error::Timeout)
+}
+
+/// Leaves freeze mode ([`leave_freeze`]) and waits until the module is synchronised to
+/// the bus ([`wait_synch`]): when it returns `Ok`, a frame starting on the bus is
+/// received.
+pub fn unfreeze<R: Registers>(regs: &mut R, polls: u32) -> Result<(), Error> {
+    leave_freeze(regs, polls)?;
+    wait_synch(regs, polls, |_| {})
 }
 
 #[cfg(test)]
@@ -82,5 +119,35 @@ mod tests {
         assert_eq!(soft_reset(&mut r, 3), Err(Error::Timeout));
         assert_eq!(unfreeze(&mut r, 3), Err(Error::Timeout));
         assert_eq!(freeze(&mut r, 1), Ok(()));
+    }
+
+    /// Out of freeze at once, but never synchronised (a bus stuck dominant).
+    struct NeverSynch;
+    impl Registers for NeverSynch {
+        fn read32(&self, offset: usize) -> u32 {
+            if offset == ESR1 {
+                esr1::BIT0ERR
+            } else {
+                0
+            }
+        }
+        fn write32(&mut self, _: usize, _: u32) {}
+    }
+
+    #[test]
+    fn synch_wait_is_bounded_and_reports_every_read() {
+        let mut r = NeverSynch;
+        assert_eq!(leave_freeze(&mut r, 3), Ok(()));
+        assert_eq!(unfreeze(&mut r, 3), Err(Error::Timeout));
+        let mut reads = 0;
+        assert_eq!(
+            wait_synch(&r, 5, |v| {
+                assert_eq!(v, esr1::BIT0ERR);
+                reads += 1;
+            }),
+            Err(Error::Timeout)
+        );
+        assert_eq!(reads, 5);
+        assert_eq!(wait_synch(&Deaf(esr1::SYNCH), 0, |_| {}), Ok(()));
     }
 }

@@ -10,7 +10,9 @@
 //! use twocan_core::sim::Bus;
 //! use twocan_core::{Filter, Format, Frame, FrameKind};
 //! use twocan_flexcan::model::FlexCanModel;
-//! use twocan_flexcan::{AcanDriver, Board, FlexCan, HostSystem, Instance, Settings, Target};
+//! use twocan_flexcan::{
+//!     AcanDriver, Board, FlexCan, HostSystem, IdleClocked, Instance, Settings, Target,
+//! };
 //!
 //! // ACAN §4, §16: 125 kbit/s from the 16 MHz clock, loop-back, self reception.
 //! let mut settings = Settings::new(125_000);
@@ -23,13 +25,16 @@
 //! let secondary = [Filter::exact(FrameKind::Remote, Format::Extended, 0x1234)];
 //!
 //! // The model stands for FlexCAN0 of a Teensy 3.2 (firmware: `Can0::take()`).
+//! // `begin` waits for the module to synchronise (11 recessive bits): `IdleClocked`
+//! // lets idle bus time pass while the driver polls.
 //! let model = FlexCanModel::mk20dx256();
 //! let target = Target::new(Board::Teensy32, Instance::Can0);
+//! let regs = IdleClocked::new(model.clone());
 //! let controller =
-//!     FlexCan::begin(model.clone(), &mut HostSystem::new(), target, &settings, &primary, &secondary)
+//!     FlexCan::begin(regs, &mut HostSystem::new(), target, &settings, &primary, &secondary)
 //!         .expect("begin: no error of ACAN table 5");
 //! // ACAN's buffers: receive 32, transmit 16.
-//! let mut can: AcanDriver<FlexCanModel> = AcanDriver::new(controller);
+//! let mut can: AcanDriver<IdleClocked> = AcanDriver::new(controller);
 //!
 //! can.try_send(&Frame::standard(0x542, &[1, 2]).unwrap()).unwrap(); // tryToSend
 //! can.try_send(&Frame::remote(0x1234, true, 0).unwrap()).unwrap();
@@ -64,6 +69,27 @@
 //! // Put `can` in a critical_section::Mutex<RefCell<Option<_>>>, call `on_interrupt`
 //! // from the CAN interrupt handler, `try_send` / `receive` / `dispatch` from thread code.
 //! ```
+//!
+//! # Board features
+//!
+//! Exactly one of `teensy32` (Teensy 3.1 / 3.2), `teensy35` or `teensy36` should be
+//! enabled for firmware: it selects `Board::DEFAULT`, the board of `Can0::take()`
+//! (its pins, SIM gates and chip), and `teensy36` alone also provides `Can1`.
+//! Conflicting board features are **not** an error (so that `cargo clippy
+//! --all-features` and feature unification across a workspace keep building); the
+//! precedence is fixed and silent:
+//!
+//! | features enabled | `Board::DEFAULT` | `Can1` |
+//! |---|---|---|
+//! | `teensy36` (with or without the others) | `Teensy36` | yes |
+//! | `teensy35`, maybe `teensy32`, not `teensy36` | `Teensy35` | no |
+//! | `teensy32` alone | `Teensy32` | no |
+//!
+//! So `teensy32` + `teensy36` builds for a Teensy 3.6: firmware for a Teensy 3.2 linked
+//! that way would drive the wrong pins. Check `Board::DEFAULT` (or `cargo tree -e
+//! features -i twocan-flexcan`) when another crate of the build may enable a board
+//! feature. The host build (no board feature) has no `Board::DEFAULT`; pass a
+//! [`Target`] to [`FlexCan::begin`] instead.
 //!
 //! # Map of the ACAN manual
 //!
@@ -100,12 +126,17 @@ pub mod regs;
 #[cfg(feature = "model")]
 pub mod model;
 
+#[cfg(feature = "model")]
+mod idle_clock;
+#[cfg(feature = "model")]
+pub use idle_clock::IdleClocked;
+
 pub use begin::check;
 pub use begin_error::{BeginError, ConfigErrors};
 pub use board::{Board, Chip, InstancePins};
 pub use configuration::Configuration;
 pub use controller::FlexCan;
-pub use filters::FilterTable;
+pub use filters::{FilterTable, UNKNOWN_FILTER};
 #[cfg(any(feature = "teensy32", feature = "teensy35", feature = "teensy36"))]
 pub use instance::Can0;
 #[cfg(feature = "teensy36")]

@@ -40,9 +40,10 @@ pub const TRANSMIT_BUFFER_SIZE: usize = 16;
 pub const DEFAULT_IRQ_PRIORITY: u8 = 64;
 
 /// Default bound of every acknowledge wait (`FRZACK`, `LPMACK`, `NOTRDY`,
-/// `SOFTRST`), in register polls. At 180 MHz one poll is a few tens of
-/// nanoseconds; the longest legitimate wait (freeze at the end of a frame at
-/// 2.5 kbit/s, about 60 ms) is covered with margin.
+/// `SOFTRST`, and `ESR1.SYNCH` after leaving freeze), in register polls. At 180 MHz
+/// one poll is a few tens of nanoseconds; the longest legitimate wait (freeze at the
+/// end of a frame, or synchronisation after one, at 2.5 kbit/s, about 60 ms) is
+/// covered with margin.
 pub const DEFAULT_HANDSHAKE_POLLS: u32 = 2_000_000;
 
 /// The driver settings (ACAN `ACANSettings`, §16; table 7 gives the defaults).
@@ -83,7 +84,8 @@ pub struct Settings {
     /// Default `false`.
     pub rx_pin_pull_up: bool,
     /// Bound of every acknowledge wait, in register polls (not in ACAN: a controller
-    /// that never acknowledges ends in [`twocan_core::Error::Timeout`]).
+    /// that never acknowledges, or never synchronises to the bus, ends in
+    /// [`twocan_core::Error::Timeout`]).
     pub handshake_polls: u32,
     /// Also interrupt on bus errors, bus-off and the warning levels (`CTRL1.ERRMSK`,
     /// `BOFFMSK`, `TWRNMSK`, `RWRNMSK`, `MCR.WRNEN`), so that the driver's error

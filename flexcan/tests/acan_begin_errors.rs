@@ -239,7 +239,7 @@ fn handshake_timeout_is_typed_and_retry_works() {
     // Once the module acknowledges again, `begin` succeeds on the same module.
     model.set_freeze_ack_stuck(false);
     let can = FlexCan::begin(
-        model.clone(),
+        Ticking::new(model.clone()),
         &mut HostSystem::new(),
         T32_CAN0,
         &s,
@@ -252,6 +252,9 @@ fn handshake_timeout_is_typed_and_retry_works() {
         model.peek32(regs::MCR) & (mcr::FRZACK | mcr::LPMACK | mcr::NOTRDY),
         0
     );
+    // `begin` returned once the module was synchronised to the (idle) bus.
+    assert!(model.is_synchronised());
+    assert_ne!(model.peek32(regs::ESR1) & regs::esr1::SYNCH, 0);
     drop(can);
 }
 

@@ -252,3 +252,59 @@ fn table_and_masks_written_as_compiled() {
     );
     let _: &FlexCanModel = can.controller().registers();
 }
+
+/// Register access that reports an `RXFIR.IDHIT` beyond the table (the hardware never
+/// does; a stale or corrupted value).
+#[derive(Debug)]
+struct IdhitBeyondTable(Ticking);
+
+impl twocan_core::Registers for IdhitBeyondTable {
+    fn read32(&self, offset: usize) -> u32 {
+        if offset == twocan_flexcan::regs::RXFIR {
+            0x1FF
+        } else {
+            self.0.read32(offset)
+        }
+    }
+    fn write32(&mut self, offset: usize, value: u32) {
+        self.0.write32(offset, value);
+    }
+}
+
+#[test]
+fn unreachable_idhit_is_no_filter_and_is_counted() {
+    let model = model_for(twocan_flexcan::Board::Teensy32);
+    let controller = twocan_flexcan::FlexCan::begin(
+        IdhitBeyondTable(Ticking::new(model.clone())),
+        &mut twocan_flexcan::HostSystem::new(),
+        twocan_flexcan::Target::new(
+            twocan_flexcan::Board::Teensy32,
+            twocan_flexcan::Instance::Can0,
+        ),
+        &loop_back(125_000),
+        &filters_0_1_2(),
+        &[],
+    )
+    .unwrap();
+    let mut can: twocan_core::Driver<_, 8, 8> = twocan_core::Driver::new(controller);
+    let mut bus = bus_with(125_000, &[&model]);
+    let f = Frame::standard(0x234, &[1]).unwrap();
+    can.try_send(&f).unwrap();
+    for _ in 0..1_000 {
+        if model.irq_pending() {
+            can.on_interrupt();
+        }
+        if bus.step_until(bus.now() + 1_000).is_none() {
+            break;
+        }
+    }
+    if model.irq_pending() {
+        can.on_interrupt();
+    }
+    let rx = can.receive().unwrap();
+    assert_eq!(rx.frame, f);
+    // Not filter #0 (the old fallback): the distinct "no filter" index, counted.
+    assert_eq!(rx.filter, twocan_flexcan::UNKNOWN_FILTER);
+    assert_eq!(can.controller().unresolved_filter_hits(), 1);
+    assert!(can.receive().is_err());
+}

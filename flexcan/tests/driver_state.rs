@@ -234,7 +234,8 @@ fn pins_and_clock_gates_7_16_7_5_16_7_6() {
         let mut sys = HostSystem::new();
         let model = model_for(board);
         let target = Target::new(board, instance);
-        let can = FlexCan::begin(model.clone(), &mut sys, target, &s, &[], &[]).unwrap();
+        let can =
+            FlexCan::begin(Ticking::new(model.clone()), &mut sys, target, &s, &[], &[]).unwrap();
         assert_eq!(sys.read32(tx_port.pcr(tx_pin)), PCR_MUX.val(2) | PCR_ODE);
         assert_eq!(
             sys.read32(rx_port.pcr(rx_pin)),
@@ -254,7 +255,7 @@ fn pins_and_clock_gates_7_16_7_5_16_7_6() {
     let mut sys = HostSystem::new();
     let t = Target::new(Board::Teensy32, Instance::Can0);
     let _can = FlexCan::begin(
-        FlexCanModel::mk20dx256(),
+        Ticking::new(FlexCanModel::mk20dx256()),
         &mut sys,
         t,
         &Settings::new(250_000),

@@ -218,3 +218,55 @@ fn a_lone_module_stops_at_error_passive_on_the_simulated_bus() {
     assert_ne!(a.read32(regs::ESR1) & regs::esr1::ACKERR, 0);
     assert_eq!(r.code(8), code::TX_DATA);
 }
+
+#[test]
+fn extreme_bus_times_do_not_overflow() {
+    use twocan_core::sim::BusTime;
+    let end = BusTime {
+        sof: u64::MAX,
+        now: u64::MAX,
+    };
+    // Received and transmitted frames stamped at the very end of time.
+    let mut r = rig(false, 0);
+    r.m.rx(&std(0x10, &[1]), false, end);
+    assert_eq!(r.m.fifo_len(), 1);
+    let frame = std(0x11, &[2]);
+    r.load_mb(8, &frame, code::TX_DATA);
+    r.m.tx_result(&frame, TxResult::Acked, end);
+    assert_eq!(r.code(8), code::TX_INACTIVE);
+    r.m.advance(u64::MAX, true, u64::MAX);
+    // Waiting for synchronisation with a frame pending: the wake-up saturates.
+    let mut r = rig(false, 0);
+    r.freeze();
+    r.clear_bits(regs::MCR, mcr::HALT);
+    assert!(!r.m.is_synchronised());
+    r.load_mb(8, &frame, code::TX_DATA);
+    assert_eq!(r.m.next_wakeup(u64::MAX - 1), Some(u64::MAX));
+    assert_eq!(r.m.next_wakeup(u64::MAX), Some(u64::MAX));
+    // Bus-off with a frame pending: the recovery wake-up saturates too.
+    let mut r = rig(false, 0);
+    r.load_mb(8, &frame, code::TX_DATA);
+    for _ in 0..32 {
+        r.m.tx_result(
+            &frame,
+            TxResult::Error(twocan_core::error::LastErrorCode::BitDominant),
+            BusTime {
+                sof: r.now,
+                now: r.now,
+            },
+        );
+    }
+    assert_eq!(
+        twocan_flexcan::regs::esr1::FLTCONF.get(r.m.peek32(regs::ESR1)),
+        twocan_flexcan::regs::esr1::FLTCONF_BUS_OFF
+    );
+    assert_eq!(r.m.next_wakeup(u64::MAX), Some(u64::MAX));
+    r.m.rx_error(
+        twocan_core::error::LastErrorCode::Crc,
+        false,
+        BusTime {
+            sof: u64::MAX,
+            now: u64::MAX,
+        },
+    );
+}

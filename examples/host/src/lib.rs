@@ -108,25 +108,32 @@ impl Harness {
 }
 
 /// Register access to a model that lets one bit time pass on the bus while the driver
-/// spins on the register it polls for an acknowledge bit — as real time passes while
-/// firmware waits. Only back-to-back reads of that register count as a spin: a single
-/// read in an interrupt handler does not move time.
+/// spins on a register it polls for an acknowledge bit — as real time passes while
+/// firmware waits. Only back-to-back reads of the same poll register count as a spin: a
+/// single read in an interrupt handler does not move time.
 #[derive(Clone)]
 pub struct Clocked<R> {
     regs: R,
     bus: SharedBus,
-    poll_register: usize,
-    spinning: std::cell::Cell<bool>,
+    poll_registers: Vec<usize>,
+    /// The poll register read last, if the last access was such a read.
+    spinning: std::cell::Cell<Option<usize>>,
 }
 
 impl<R> Clocked<R> {
     /// Wraps `regs`; back-to-back reads of `poll_register` advance `bus` by one bit time.
     pub fn new(regs: R, bus: &SharedBus, poll_register: usize) -> Self {
+        Self::with_poll_registers(regs, bus, &[poll_register])
+    }
+
+    /// Wraps `regs`; back-to-back reads of any one of `poll_registers` advance `bus` by
+    /// one bit time (FlexCAN: `MCR` for the mode acknowledges, `ESR1` for `SYNCH`).
+    pub fn with_poll_registers(regs: R, bus: &SharedBus, poll_registers: &[usize]) -> Self {
         Clocked {
             regs,
             bus: bus.clone(),
-            poll_register,
-            spinning: std::cell::Cell::new(false),
+            poll_registers: poll_registers.to_vec(),
+            spinning: std::cell::Cell::new(None),
         }
     }
 
@@ -139,7 +146,7 @@ impl<R> Clocked<R> {
     /// at another bit rate, brought to the same time, with the model attached to it).
     pub fn set_bus(&mut self, bus: &SharedBus) {
         self.bus = bus.clone();
-        self.spinning.set(false);
+        self.spinning.set(None);
     }
 }
 
@@ -151,19 +158,19 @@ pub fn attach_plain(bus: &mut Bus, name: &str, node: Box<dyn BusNode>) -> NodeId
 
 impl<R: Registers> Registers for Clocked<R> {
     fn read32(&self, offset: usize) -> u32 {
-        if offset == self.poll_register {
-            if self.spinning.replace(true) {
+        if self.poll_registers.contains(&offset) {
+            if self.spinning.replace(Some(offset)) == Some(offset) {
                 if let Ok(mut bus) = self.bus.try_borrow_mut() {
                     bus.run_for(1);
                 }
             }
         } else {
-            self.spinning.set(false);
+            self.spinning.set(None);
         }
         self.regs.read32(offset)
     }
     fn write32(&mut self, offset: usize, value: u32) {
-        self.spinning.set(false);
+        self.spinning.set(None);
         self.regs.write32(offset, value)
     }
 }
@@ -226,7 +233,12 @@ impl FlexNode {
         };
         let name = format!("{:?}-{:?}", target.board, target.instance).to_lowercase();
         let id = attach(&mut h.bus.borrow_mut(), &name, Box::new(model.clone()));
-        let regs = Clocked::new(model.clone(), &h.bus, twocan_flexcan::regs::MCR);
+        // MCR for the mode acknowledges, ESR1 for the synchronisation after freeze.
+        let regs = Clocked::with_poll_registers(
+            model.clone(),
+            &h.bus,
+            &[twocan_flexcan::regs::MCR, twocan_flexcan::regs::ESR1],
+        );
         let controller = FlexCan::begin(
             regs,
             &mut HostSystem::new(),

@@ -72,7 +72,7 @@ impl State {
         match result {
             TxResult::Acked => {
                 if let Some(n) = self.tx_mb_of(frame) {
-                    let stamp = self.timer.value_at(time.sof + 1);
+                    let stamp = self.timer.value_at(time.sof.saturating_add(1));
                     self.tx_done(n, stamp);
                 }
                 self.transmit_ok();
@@ -100,7 +100,7 @@ impl State {
             }
             self.receive_ok();
         }
-        let stamp = self.timer.value_at(time.sof + 1);
+        let stamp = self.timer.value_at(time.sof.saturating_add(1));
         self.accept_frame(frame, stamp);
     }
 
@@ -128,10 +128,10 @@ impl State {
             if self.errors.boffrec_latched {
                 return None;
             }
-            return Some(now + left.max(1));
+            return Some(now.saturating_add(left.max(1)));
         }
         if !self.synched {
-            return Some(now + 11u64.saturating_sub(self.sync_run).max(1));
+            return Some(now.saturating_add(11u64.saturating_sub(self.sync_run).max(1)));
         }
         None
     }

@@ -7,8 +7,12 @@ use twocan_core::{Driver, Filter, Frame, RxFrame};
 use twocan_flexcan::model::FlexCanModel;
 use twocan_flexcan::{BeginError, Board, FlexCan, HostSystem, Instance, Settings, Target};
 
+/// The model as the driver sees it: back-to-back reads of `MCR` or `ESR1` (a mode
+/// acknowledge or `SYNCH` wait) let one bit time of idle bus pass for the module.
+pub use twocan_flexcan::IdleClocked as Ticking;
+
 /// The driver over the model with receive ring `RX` and transmit ring `TX`.
-pub type Can<const RX: usize, const TX: usize> = Driver<FlexCan<FlexCanModel>, RX, TX>;
+pub type Can<const RX: usize, const TX: usize> = Driver<FlexCan<Ticking>, RX, TX>;
 
 /// A fresh model of the board's chip.
 pub fn model_for(board: Board) -> FlexCanModel {
@@ -29,7 +33,7 @@ pub fn begin_on<const RX: usize, const TX: usize>(
     let model = model_for(target.board);
     model.scramble_ram(0x5EED);
     let controller = FlexCan::begin(
-        model.clone(),
+        Ticking::new(model.clone()),
         &mut HostSystem::new(),
         target,
         settings,
