@@ -206,11 +206,7 @@ fn narrow(f: Filter, earlier: &[Filter]) -> Option<Filter> {
                 kind: FrameKind::Remote,
                 ..f
             };
-            if covered(&data) {
-                f = remote;
-            } else if covered(&remote) {
-                f = data;
-            }
+            f = keep_uncovered_half(f, data, remote, &covered);
         }
         if f.format == Format::Any {
             let std = Filter {
@@ -221,17 +217,30 @@ fn narrow(f: Filter, earlier: &[Filter]) -> Option<Filter> {
                 format: Format::Extended,
                 ..f
             };
-            if covered(&std) {
-                f = ext;
-            } else if covered(&ext) {
-                f = std;
-            }
+            f = keep_uncovered_half(f, std, ext, &covered);
         }
     }
     if covered(&f) {
         None
     } else {
         Some(f)
+    }
+}
+
+/// `f` split into halves `a` and `b` (by kind or by format): if earlier filters take one
+/// half, only the other is left; otherwise `f` stays whole.
+fn keep_uncovered_half(
+    f: Filter,
+    a: Filter,
+    b: Filter,
+    covered: &impl Fn(&Filter) -> bool,
+) -> Filter {
+    if covered(&a) {
+        b
+    } else if covered(&b) {
+        a
+    } else {
+        f
     }
 }
 
