@@ -71,38 +71,38 @@ pub const fn id_is_extended(id: &Id) -> bool {
     matches!(id, Id::Extended(_))
 }
 
-/// A classical CAN frame (data or remote).
+/// Bit of [`Frame`]'s identifier word marking an extended (29-bit) identifier.
+const EXTENDED_BIT: u32 = 1 << 31;
+/// Bit of [`Frame`]'s identifier word marking a remote frame.
+const REMOTE_BIT: u32 = 1 << 30;
+/// The identifier bits of [`Frame`]'s identifier word.
+const ID_BITS: u32 = 0x1FFF_FFFF;
+
+/// A classical CAN frame (data or remote), 16 bytes: one identifier word (29-bit
+/// identifier, format and kind flags), the DLC and eight data bytes, so copies stay a
+/// few word loads and stores.
 ///
-/// Equality compares identifier, kind, DLC and the first `dlc` data bytes only.
-#[derive(Debug, Clone, Copy)]
+/// Invariants kept by every constructor and setter: the identifier is in range for its
+/// format, the DLC is `0..=8`, data bytes beyond the DLC (and all bytes of a remote
+/// frame) are zero — so the derived equality compares identifier, kind, DLC and data.
+///
+/// `Frame::default()` is a standard data frame with identifier 0 and no data.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[repr(C)]
 pub struct Frame {
-    id: Id,
-    /// `id` as a number, kept beside it so that const code can read it.
-    raw_id: u32,
-    remote: bool,
+    word: u32,
     dlc: u8,
     data: [u8; 8],
 }
 
-impl PartialEq for Frame {
-    fn eq(&self, other: &Self) -> bool {
-        self.raw_id == other.raw_id
-            && self.id == other.id
-            && self.remote == other.remote
-            && self.dlc == other.dlc
-            && self.data() == other.data()
-    }
-}
-impl Eq for Frame {}
-
 #[cfg(feature = "defmt")]
 impl defmt::Format for Frame {
     fn format(&self, f: defmt::Formatter) {
-        if self.remote {
+        if self.is_remote() {
             defmt::write!(
                 f,
                 "Frame {{ id: {:x}, ext: {}, remote, dlc: {} }}",
-                id_raw(&self.id),
+                self.raw_id(),
                 self.is_extended(),
                 self.dlc
             )
@@ -110,7 +110,7 @@ impl defmt::Format for Frame {
             defmt::write!(
                 f,
                 "Frame {{ id: {:x}, ext: {}, data: {=[u8]:x} }}",
-                id_raw(&self.id),
+                self.raw_id(),
                 self.is_extended(),
                 self.data()
             )
@@ -135,9 +135,7 @@ impl Frame {
             i += 1;
         }
         Ok(Frame {
-            id,
-            raw_id,
-            remote: false,
+            word: Self::id_word(raw_id, id_is_extended(&id), false),
             dlc: data.len() as u8,
             data: bytes,
         })
@@ -149,9 +147,7 @@ impl Frame {
             return Err(FrameError::DlcTooLarge(dlc));
         }
         Ok(Frame {
-            id,
-            raw_id: id_raw(&id),
-            remote: true,
+            word: Self::id_word(id_raw(&id), id_is_extended(&id), true),
             dlc,
             data: [0; 8],
         })
@@ -159,17 +155,14 @@ impl Frame {
 
     /// A remote frame with a raw identifier (`extended` selects 29 bits).
     pub const fn remote(raw_id: u32, extended: bool, dlc: u8) -> Result<Self, FrameError> {
-        let id = match raw_to_id(raw_id, extended) {
-            Ok(id) => id,
-            Err(e) => return Err(e),
-        };
+        if let Err(e) = raw_to_id(raw_id, extended) {
+            return Err(e);
+        }
         if dlc > MAX_DLC {
             return Err(FrameError::DlcTooLarge(dlc));
         }
         Ok(Frame {
-            id,
-            raw_id,
-            remote: true,
+            word: Self::id_word(raw_id, extended, true),
             dlc,
             data: [0; 8],
         })
@@ -214,10 +207,9 @@ impl Frame {
         dlc: u8,
         data: [u8; 8],
     ) -> Result<Self, FrameError> {
-        let id = match raw_to_id(raw_id, extended) {
-            Ok(id) => id,
-            Err(e) => return Err(e),
-        };
+        if let Err(e) = raw_to_id(raw_id, extended) {
+            return Err(e);
+        }
         if dlc > MAX_DLC {
             return Err(FrameError::DlcTooLarge(dlc));
         }
@@ -230,32 +222,83 @@ impl Frame {
             }
         }
         Ok(Frame {
-            id,
-            raw_id,
-            remote,
+            word: Self::id_word(raw_id, extended, remote),
             dlc,
             data: bytes,
         })
     }
 
+    /// Builds a frame from an identifier word as [`Frame::id_word`] packs it, a DLC and
+    /// the eight data bytes, without re-checking the identifier: the fast path of a
+    /// backend decoding its registers. The identifier bits are masked to 29 bits (11
+    /// for a standard identifier), the DLC is clamped to 8 (ISO 11898-1: DLC codes
+    /// 9..=15 mean 8 bytes), bytes beyond the DLC (all of them for a remote frame)
+    /// are cleared, so every invariant holds whatever the inputs.
+    #[inline]
+    pub const fn from_words(word: u32, dlc: u8, data: [u8; 8]) -> Self {
+        let extended = word & EXTENDED_BIT != 0;
+        let id_mask = if extended { ID_BITS } else { 0x7FF };
+        let word = word & (EXTENDED_BIT | REMOTE_BIT | id_mask);
+        let dlc = if dlc > MAX_DLC { MAX_DLC } else { dlc };
+        let mut bytes = data;
+        let keep = if word & REMOTE_BIT != 0 { 0 } else { dlc as usize };
+        let mut i = keep;
+        while i < 8 {
+            bytes[i] = 0;
+            i += 1;
+        }
+        Frame {
+            word,
+            dlc,
+            data: bytes,
+        }
+    }
+
+    /// The identifier word of a frame: the raw identifier in bits 28..0, bit 31 set
+    /// for an extended identifier, bit 30 for a remote frame.
+    #[inline]
+    pub const fn id_word(raw_id: u32, extended: bool, remote: bool) -> u32 {
+        (raw_id & ID_BITS)
+            | if extended { EXTENDED_BIT } else { 0 }
+            | if remote { REMOTE_BIT } else { 0 }
+    }
+
+    /// This frame's identifier word (see [`Frame::id_word`]).
+    #[inline]
+    pub const fn word(&self) -> u32 {
+        self.word
+    }
+
     /// The identifier.
     pub const fn id(&self) -> Id {
-        self.id
+        let raw = self.raw_id();
+        if self.is_extended() {
+            // SAFETY: every constructor keeps an extended identifier within 29 bits
+            // (`from_words` masks it), the range `ExtendedId` requires.
+            Id::Extended(unsafe { ExtendedId::new_unchecked(raw) })
+        } else {
+            // SAFETY: every constructor keeps a standard identifier within 11 bits
+            // (`from_words` masks it), the range `StandardId` requires.
+            Id::Standard(unsafe { StandardId::new_unchecked(raw as u16) })
+        }
     }
 
     /// The raw identifier value (11 or 29 bits).
+    #[inline]
     pub const fn raw_id(&self) -> u32 {
-        self.raw_id
+        self.word & ID_BITS
     }
 
     /// Whether the identifier is extended.
+    #[inline]
     pub const fn is_extended(&self) -> bool {
-        id_is_extended(&self.id)
+        self.word & EXTENDED_BIT != 0
     }
 
     /// Whether this is a remote frame.
+    #[inline]
     pub const fn is_remote(&self) -> bool {
-        self.remote
+        self.word & REMOTE_BIT != 0
     }
 
     /// The data length code, `0..=8`.
@@ -265,7 +308,7 @@ impl Frame {
 
     /// The data bytes (empty for a remote frame).
     pub fn data(&self) -> &[u8] {
-        if self.remote {
+        if self.is_remote() {
             &[]
         } else {
             &self.data[..self.dlc as usize]
@@ -284,7 +327,7 @@ impl Frame {
 
     /// Sets data byte `index` (within the DLC of a data frame).
     pub fn set_byte(&mut self, index: usize, value: u8) -> Result<(), FrameError> {
-        if self.remote {
+        if self.is_remote() {
             return Err(FrameError::DataOnRemoteFrame);
         }
         if index >= self.dlc as usize {
@@ -296,14 +339,14 @@ impl Frame {
 
     /// Replaces the payload (and DLC) of a data frame.
     pub fn set_data(&mut self, data: &[u8]) -> Result<(), FrameError> {
-        if self.remote {
+        if self.is_remote() {
             return Err(FrameError::DataOnRemoteFrame);
         }
-        *self = Self::new_data(self.id, data)?;
+        *self = Self::new_data(self.id(), data)?;
         Ok(())
     }
 
-    fn word<const W: usize>(&self, index: usize) -> Option<[u8; W]> {
+    fn data_word<const W: usize>(&self, index: usize) -> Option<[u8; W]> {
         let start = index.checked_mul(W)?;
         let end = start.checked_add(W)?;
         let bytes = self.data().get(start..end)?;
@@ -313,7 +356,7 @@ impl Frame {
     }
 
     fn set_word<const W: usize>(&mut self, index: usize, bytes: [u8; W]) -> Result<(), FrameError> {
-        if self.remote {
+        if self.is_remote() {
             return Err(FrameError::DataOnRemoteFrame);
         }
         let start = index.checked_mul(W).ok_or(FrameError::OutOfBounds)?;
@@ -327,17 +370,17 @@ impl Frame {
 
     /// Little-endian 16-bit word `index` (bytes `2*index..2*index+2`), if within the DLC.
     pub fn data_u16(&self, index: usize) -> Option<u16> {
-        self.word::<2>(index).map(u16::from_le_bytes)
+        self.data_word::<2>(index).map(u16::from_le_bytes)
     }
 
     /// Little-endian 32-bit word `index` (bytes `4*index..4*index+4`), if within the DLC.
     pub fn data_u32(&self, index: usize) -> Option<u32> {
-        self.word::<4>(index).map(u32::from_le_bytes)
+        self.data_word::<4>(index).map(u32::from_le_bytes)
     }
 
     /// The eight bytes as one little-endian 64-bit word, if the DLC is 8.
     pub fn data_u64(&self) -> Option<u64> {
-        self.word::<8>(0).map(u64::from_le_bytes)
+        self.data_word::<8>(0).map(u64::from_le_bytes)
     }
 
     /// Writes little-endian 16-bit word `index` (must lie within the DLC).
@@ -378,11 +421,11 @@ impl embedded_can::Frame for Frame {
     }
 
     fn is_remote_frame(&self) -> bool {
-        self.remote
+        self.is_remote()
     }
 
     fn id(&self) -> Id {
-        self.id
+        Frame::id(self)
     }
 
     fn dlc(&self) -> usize {

@@ -13,14 +13,20 @@ pub mod error;
 pub mod fault;
 pub mod filter;
 pub mod frame;
+pub mod hardware;
 pub mod mailbox;
 #[cfg(any(test, feature = "mock"))]
 pub mod mock;
+#[cfg(any(test, feature = "mock"))]
+pub mod mock_hw;
 pub mod priority;
 pub mod registers;
 #[cfg(feature = "sim")]
 pub mod sim;
+pub mod spsc;
+pub mod split;
 pub mod timing;
+pub mod txqueue;
 
 pub use buffer::{BufferStats, Ring, TxQueue};
 pub use controller::{Controller, ErrorStatus, Events, Mode};
@@ -30,6 +36,10 @@ pub use embedded_can::{ExtendedId, Id, StandardId};
 pub use error::{Error, ErrorCounters, ErrorState, ErrorStatistics, LastErrorCode};
 pub use filter::{Filter, FilterError, Format, FrameKind};
 pub use frame::{Frame, FrameError, RxFrame};
+pub use hardware::{Completion, Hardware, Settled, StatusEvents, Token, TxFailure};
+pub use split::{AbortRequest, Parts, StateChange};
+pub use spsc::SpscRing;
+pub use txqueue::{AnyQueue, FifoQueue, PriorityQueue};
 pub use mailbox::{MailboxId, MailboxState, TxOutcome, TxPolicy};
 pub use priority::Priority;
 pub use registers::{Mmio, Registers};

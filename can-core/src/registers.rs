@@ -7,11 +7,13 @@
 pub trait Registers {
     /// Reads the register at `offset`.
     fn read32(&self, offset: usize) -> u32;
-    /// Writes `value` to the register at `offset`.
-    fn write32(&mut self, offset: usize, value: u32);
+    /// Writes `value` to the register at `offset`. Takes `&self`: a register write needs
+    /// no exclusive borrow (volatile access; models use interior mutability), so the
+    /// split driver's contexts can share one register handle.
+    fn write32(&self, offset: usize, value: u32);
 
-    /// Read-modify-write (not atomic: callers hold the peripheral exclusively).
-    fn modify32(&mut self, offset: usize, f: impl FnOnce(u32) -> u32) {
+    /// Read-modify-write (not atomic: callers hold the register exclusively).
+    fn modify32(&self, offset: usize, f: impl FnOnce(u32) -> u32) {
         let v = self.read32(offset);
         self.write32(offset, f(v));
     }
@@ -21,7 +23,16 @@ impl<R: Registers + ?Sized> Registers for &mut R {
     fn read32(&self, offset: usize) -> u32 {
         (**self).read32(offset)
     }
-    fn write32(&mut self, offset: usize, value: u32) {
+    fn write32(&self, offset: usize, value: u32) {
+        (**self).write32(offset, value)
+    }
+}
+
+impl<R: Registers + ?Sized> Registers for &R {
+    fn read32(&self, offset: usize) -> u32 {
+        (**self).read32(offset)
+    }
+    fn write32(&self, offset: usize, value: u32) {
         (**self).write32(offset, value)
     }
 }
@@ -58,7 +69,7 @@ impl Registers for Mmio {
     }
 
     #[inline(always)]
-    fn write32(&mut self, offset: usize, value: u32) {
+    fn write32(&self, offset: usize, value: u32) {
         // SAFETY: as for `read32`; writes go to a register of the owned peripheral.
         unsafe { core::ptr::write_volatile((self.base + offset) as *mut u32, value) }
     }

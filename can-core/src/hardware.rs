@@ -1,0 +1,184 @@
+//! The seam between the portable split driver ([`crate::split`]) and a controller
+//! backend, by execution context.
+//!
+//! A backend implements [`Hardware`] on one value that every half of the driver shares
+//! by reference (it is `Sync`). Each method says which context calls it; the backend
+//! guarantees that calls from different contexts touch disjoint registers, or only
+//! write-1-to-clear bits of a shared status register, so they never need a lock:
+//!
+//! | context | methods |
+//! |---|---|
+//! | transmit half (thread/task) | [`Hardware::free_mailbox`], [`Hardware::load`] (queue empty), [`Hardware::request_abort`] |
+//! | transmit interrupt (inside the driver's one critical section) | [`Hardware::settle`], [`Hardware::free_mailbox`], [`Hardware::load`], [`Hardware::displace`] |
+//! | receive interrupt of queue `q` | [`Hardware::read_rx`] |
+//! | receive half (thread/task) | [`Hardware::decode`], [`Hardware::install_filters`] |
+//! | status interrupt | [`Hardware::take_status`] |
+//! | any (reads only) | [`Hardware::error_status`], [`Hardware::tx_policy`], [`Hardware::on_bus`] |
+//! | control (thread, with the halves idle or tolerant) | [`Hardware::set_mode`], [`Hardware::recover`] |
+
+use crate::controller::{ErrorStatus, Mode};
+use crate::error::{Error, LastErrorCode};
+use crate::frame::{Frame, RxFrame};
+use crate::mailbox::{TxOutcome, TxPolicy};
+
+/// Identifies one frame accepted by [`crate::split::Tx::try_send`]: its sequence number
+/// (wrapping at `u32::MAX`), in acceptance order.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Token(pub u32);
+
+/// How one accepted frame ended, delivered in order to the transmit half.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Completion {
+    /// The frame's token.
+    pub token: Token,
+    /// Sent, failed (one-shot), or aborted.
+    pub outcome: TxOutcome,
+    /// Why a one-shot transmission failed, where the hardware says.
+    pub cause: Option<TxFailure>,
+    /// The transmit time stamp where the hardware has one (16-bit timer).
+    pub timestamp: Option<u16>,
+}
+
+/// Why a transmission failed without retry (one-shot mode).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum TxFailure {
+    /// Arbitration lost (bxCAN `ALSTx`).
+    ArbitrationLost,
+    /// A transmit error (bxCAN `TERRx`).
+    Error,
+}
+
+/// What [`Hardware::settle`] found in one mailbox.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Settled {
+    /// The mailbox's frame ended: report it.
+    Done(Completion),
+    /// The mailbox was emptied to make room for a higher-priority frame
+    /// ([`Hardware::displace`]): queue this frame again, under its token.
+    Displaced(Token, Frame),
+}
+
+/// What the status interrupt found.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct StatusEvents {
+    /// Bus errors latched, by code (each reported error counted once).
+    pub bus_error: Option<LastErrorCode>,
+    /// The error status now.
+    pub status: ErrorStatus,
+    /// The controller woke up from sleep.
+    pub wakeup: bool,
+}
+
+/// A CAN controller as the split driver uses it. See the [module docs](self) for who
+/// calls what.
+///
+/// # Safety
+/// Implementations promise the table of the [module docs](self): calls made from
+/// different contexts as listed there may overlap in time (an interrupt preempting the
+/// thread, or two host threads) and must stay correct. The methods marked `unsafe` may
+/// rely on their context being exclusive, as their `# Safety` sections say.
+pub unsafe trait Hardware {
+    /// One received frame as the receive interrupt copies it out of the hardware (raw
+    /// register words and the hardware match index); decoded on the thread side.
+    type Raw: Copy + Send;
+    /// The thread side's map from hardware match index to the user's filter index.
+    type FilterMap: Send;
+    /// A compiled filter list for [`Hardware::install_filters`].
+    type Filters;
+
+    /// Transmit order of the loaded mailboxes (and so of the driver's queue).
+    fn tx_policy(&self) -> TxPolicy;
+
+    /// A mailbox that is empty and settled (its last completion taken by
+    /// [`Hardware::settle`]) and may carry `frame`. Reads the status register once.
+    /// `Err` when the controller cannot send now or ever in its mode (listen-only,
+    /// sleep): the frame is then not accepted.
+    fn free_mailbox(&self, frame: &Frame) -> Result<Option<u8>, Error>;
+
+    /// Loads `frame` into `mailbox` (returned by [`Hardware::free_mailbox`]), remembers
+    /// `token` for its completion, and requests transmission.
+    ///
+    /// # Safety
+    /// Called from this method's one context only (see the [module docs](self)).
+    unsafe fn load(&self, mailbox: u8, frame: &Frame, token: Token);
+
+    /// Transmit interrupt: acknowledges every ended mailbox and reports it to `f`.
+    ///
+    /// # Safety
+    /// Called from this method's one context only (see the [module docs](self)).
+    unsafe fn settle<F: FnMut(Settled)>(&self, f: F);
+
+    /// Transmit interrupt, [`TxPolicy::Priority`] only: when every mailbox is busy and
+    /// `frame` beats the lowest-priority pending one, requests that mailbox's abort so
+    /// `frame` can take it; the displaced frame comes back through
+    /// [`Settled::Displaced`]. Returns whether an abort was requested.
+    ///
+    /// # Safety
+    /// Called from this method's one context only (see the [module docs](self)).
+    unsafe fn displace(&self, frame: &Frame) -> bool {
+        let _ = frame;
+        false
+    }
+
+    /// Transmit half: requests the abort of the mailbox holding `token`, if one does.
+    /// Returns whether it did; the outcome arrives through [`Hardware::settle`].
+    ///
+    /// # Safety
+    /// Called from this method's one context only (see the [module docs](self)).
+    unsafe fn request_abort(&self, token: Token) -> bool;
+
+    /// Transmit half: requests the abort of every loaded mailbox.
+    ///
+    /// # Safety
+    /// Called from this method's one context only (see the [module docs](self)).
+    unsafe fn abort_all_mailboxes(&self);
+
+    /// Receive interrupt of queue `queue`: copies the head of that hardware FIFO out and
+    /// releases it. `overrun` is set when the hardware reported lost frames (its flag is
+    /// acknowledged).
+    ///
+    /// # Safety
+    /// Called from this method's one context only (see the [module docs](self)).
+    unsafe fn read_rx(&self, queue: usize, overrun: &mut bool) -> Option<Self::Raw>;
+
+    /// Receive half: the frame, its user filter index and time stamp. `None` when the
+    /// frame must be dropped (the filter map has no user filter for it).
+    fn decode(&self, raw: &Self::Raw, map: &Self::FilterMap) -> Option<RxFrame>;
+
+    /// The 16-bit receive time stamp of a raw frame, if the hardware records one (to
+    /// keep arrival order across several receive queues).
+    fn raw_timestamp(&self, raw: &Self::Raw) -> Option<u16> {
+        let _ = raw;
+        None
+    }
+
+    /// Receive half: writes `filters` into the hardware and returns their map.
+    ///
+    /// # Safety
+    /// Called from this method's one context only (see the [module docs](self)).
+    unsafe fn install_filters(&self, filters: &Self::Filters) -> Result<Self::FilterMap, Error>;
+
+    /// The map of the filters installed now (read at split time).
+    fn filter_map(&self) -> Self::FilterMap;
+
+    /// Status interrupt: reads and acknowledges error and wake-up causes.
+    ///
+    /// # Safety
+    /// Called from this method's one context only (see the [module docs](self)).
+    unsafe fn take_status(&self) -> StatusEvents;
+
+    /// The error status, read now.
+    fn error_status(&self) -> ErrorStatus;
+
+    /// Whether the controller is on the bus (not stopped, not asleep).
+    fn on_bus(&self) -> bool;
+
+    /// Changes the operating mode (bounded wait on the acknowledge bit).
+    fn set_mode(&self, mode: Mode) -> Result<(), Error>;
+
+    /// Starts bus-off recovery by software.
+    fn recover(&self) -> Result<(), Error>;
+}

@@ -1,0 +1,892 @@
+//! The split driver: one shared [`State`] that a `static` holds, and handles taken from
+//! it once — the transmit half [`Tx`], the receive half [`Rx`] (thread or task
+//! context) and one handler per interrupt line ([`TxIrq`], [`RxIrq`], [`StatusIrq`]).
+//!
+//! ```text
+//!  thread / tasks                         interrupt lines
+//!  Tx::try_send ─ queue empty & mailbox free ──► mailbox (no lock)
+//!      └─ otherwise ─► [transmit queue] ◄── critical section ──► TxIrq::on_interrupt
+//!  Tx::take_completion ◄────── completion ring (lock-free) ◄───────┘ (settles, refills)
+//!  Rx::receive (decode, user index) ◄─ raw ring per FIFO (lock-free) ◄─ RxIrq::on_interrupt
+//!  Rx::take_state_change ◄──── state-change ring (lock-free) ◄──────── StatusIrq::on_interrupt
+//! ```
+//!
+//! Who owns what: each ring has one producer handle and one consumer handle, so the
+//! per-frame path needs no critical section. The transmit queue is the only structure
+//! two contexts modify; it is touched inside a critical section only when a frame cannot
+//! go straight into a free mailbox, and by the transmit interrupt (settling ended
+//! mailboxes and refilling them: a bounded loop over the mailboxes). The interrupt
+//! handlers can only exist once [`State::split`] has stored the controller: an
+//! interrupt that fires before its handler is installed must stay masked (enable the
+//! interrupt lines after the split).
+//!
+//! ```
+//! use twocan_core::mock_hw::MockHardware;
+//! use twocan_core::split::State;
+//! use twocan_core::{FifoQueue, Frame, TxOutcome};
+//!
+//! static CAN: State<MockHardware, 8, FifoQueue<4>> = State::new();
+//!
+//! let mut parts = CAN.split(MockHardware::new(3)).expect("taken once");
+//! assert!(CAN.split(MockHardware::new(3)).is_err(), "a second split is refused");
+//! let frame = Frame::standard(0x123, &[1, 2])?;
+//! let token = nb::block!(parts.tx.try_send(&frame))?;
+//! CAN.hardware().unwrap().complete_all();   // the mock "sends" its mailboxes
+//! parts.tx_irq.on_interrupt();              // in the transmit interrupt handler
+//! let done = parts.tx.take_completion().unwrap();
+//! assert_eq!((done.token, done.outcome), (token, TxOutcome::Sent));
+//! # Ok::<(), twocan_core::Error>(())
+//! ```
+
+use core::cell::UnsafeCell;
+use core::mem::MaybeUninit;
+use core::sync::atomic::{AtomicBool, AtomicU32, AtomicU8, Ordering};
+
+use crate::controller::{ErrorStatus, Mode};
+use crate::dispatch::Dispatcher;
+use crate::error::{Error, ErrorCounters, ErrorState, ErrorStatistics, LastErrorCode};
+use crate::frame::{Frame, RxFrame};
+use crate::hardware::{Completion, Hardware, Settled, Token};
+use crate::mailbox::{TxOutcome, TxPolicy};
+use crate::spsc::{BufferStats, Counter, SpscRing};
+use crate::txqueue::{FifoQueue, Queued, TxQueue};
+
+/// Capacity of the error-state change ring.
+pub const STATE_CHANGES: usize = 8;
+
+/// One error-state change, with the counters read at the change.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct StateChange {
+    /// The new state.
+    pub state: ErrorState,
+    /// TEC (256 while bus-off) and REC when the change was seen.
+    pub counters: ErrorCounters,
+}
+
+/// Traffic counters (saturating), each written by one context.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct TrafficStats {
+    /// Frames accepted by `try_send` (each has a token and gets one completion).
+    pub queued: u32,
+    /// Completions: sent.
+    pub sent: u32,
+    /// Completions: failed (one-shot mode).
+    pub failed: u32,
+    /// Completions: aborted (queued frames dropped, mailboxes aborted).
+    pub aborted: u32,
+    /// Frames taken from the hardware by the receive handlers.
+    pub received: u32,
+    /// Frames lost because a receive ring was full.
+    pub rx_ring_overflows: u32,
+    /// Frames the hardware accepted that no user filter claims (dropped on the thread
+    /// side, e.g. the extra identifiers of a superset filter plan).
+    pub rx_dropped: u32,
+    /// Completions lost because the completion ring was full.
+    pub completion_overflows: u32,
+    /// Error-state transitions observed.
+    pub state_changes: u32,
+}
+
+const STATE_UNKNOWN: u8 = 0xFF;
+
+fn state_code(s: ErrorState) -> u8 {
+    match s {
+        ErrorState::Active => 0,
+        ErrorState::Warning => 1,
+        ErrorState::Passive => 2,
+        ErrorState::BusOff => 3,
+        ErrorState::Stopped => 4,
+        ErrorState::Sleeping => 5,
+    }
+}
+
+/// Error statistics as atomics, written by the status handler only.
+struct ErrorCounts {
+    stuff: Counter,
+    form: Counter,
+    ack: Counter,
+    bit: Counter,
+    crc: Counter,
+    bus_off: Counter,
+    overruns: Counter,
+    wakeups: Counter,
+}
+
+impl ErrorCounts {
+    const fn new() -> Self {
+        ErrorCounts {
+            stuff: Counter::new(),
+            form: Counter::new(),
+            ack: Counter::new(),
+            bit: Counter::new(),
+            crc: Counter::new(),
+            bus_off: Counter::new(),
+            overruns: Counter::new(),
+            wakeups: Counter::new(),
+        }
+    }
+
+    fn record(&self, code: LastErrorCode) {
+        match code {
+            LastErrorCode::None => {}
+            LastErrorCode::Stuff => self.stuff.inc(),
+            LastErrorCode::Form => self.form.inc(),
+            LastErrorCode::Acknowledge => self.ack.inc(),
+            LastErrorCode::BitRecessive | LastErrorCode::BitDominant => self.bit.inc(),
+            LastErrorCode::Crc => self.crc.inc(),
+        }
+    }
+}
+
+/// Everything the halves and handlers share. A `static` holds it (`State::new` is a
+/// `const fn` of zeros: no flash image); [`State::split`] stores the controller and
+/// hands out the handles once.
+///
+/// - `H`: the controller ([`Hardware`]).
+/// - `RX`: receive ring capacity (frames) of the first receive queue (bxCAN FIFO 0,
+///   FlexCAN Rx FIFO).
+/// - `Q`: the transmit queue, which fixes the transmit order and its capacity
+///   ([`FifoQueue`] or [`crate::PriorityQueue`]); the completion ring has the same
+///   capacity.
+/// - `RX1`: receive ring capacity of the second queue (bxCAN FIFO 1; 0 when unused —
+///   frames arriving there are then counted as ring overflows).
+/// - `DONE`: completion ring capacity (a completion that finds it full is counted in
+///   [`TrafficStats::completion_overflows`]; 0 turns completions off).
+pub struct State<
+    H: Hardware,
+    const RX: usize,
+    Q: TxQueue = FifoQueue<8>,
+    const RX1: usize = 0,
+    const DONE: usize = 8,
+> {
+    taken: AtomicBool,
+    hw: UnsafeCell<MaybeUninit<H>>,
+    rx0: SpscRing<H::Raw, RX>,
+    rx1: SpscRing<H::Raw, RX1>,
+    queue: critical_section::Mutex<UnsafeCell<Q>>,
+    /// Entries in `queue` plus displaced frames on their way back into it.
+    queue_len: AtomicU32,
+    queue_peak: AtomicU32,
+    queue_overflows: Counter,
+    done: SpscRing<Completion, DONE>,
+    changes: SpscRing<StateChange, STATE_CHANGES>,
+    state: AtomicU8,
+    queued: Counter,
+    sent: Counter,
+    failed: Counter,
+    aborted: Counter,
+    received: Counter,
+    dropped: Counter,
+    state_changes: Counter,
+    errors: ErrorCounts,
+    _q: core::marker::PhantomData<Q>,
+}
+
+// SAFETY: the controller is written once by `split` before `taken` is published and
+// only read afterwards (`H: Sync` makes sharing it sound); the rings follow the SPSC
+// contract through the unique handles; the queue is only touched inside a critical
+// section.
+unsafe impl<H: Hardware + Sync, const RX: usize, Q: TxQueue + Send, const RX1: usize, const DONE: usize> Sync
+    for State<H, RX, Q, RX1, DONE>
+where
+    H::Raw: Send,
+{
+}
+
+impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize> Default
+    for State<H, RX, Q, RX1, DONE>
+{
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+/// The handles [`State::split`] hands out, each for one context.
+pub struct Parts<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize> {
+    /// Transmit half (thread/task).
+    pub tx: Tx<'a, H, RX, Q, RX1, DONE>,
+    /// Receive half (thread/task).
+    pub rx: Rx<'a, H, RX, Q, RX1, DONE>,
+    /// Transmit interrupt handler (bxCAN TX line; FlexCAN message-buffer line).
+    pub tx_irq: TxIrq<'a, H, RX, Q, RX1, DONE>,
+    /// Receive interrupt handler of queue 0 (bxCAN RX0; FlexCAN message-buffer line).
+    pub rx0_irq: RxIrq<'a, H, RX, Q, RX1, DONE>,
+    /// Receive interrupt handler of queue 1 (bxCAN RX1; unused on FlexCAN).
+    pub rx1_irq: RxIrq<'a, H, RX, Q, RX1, DONE>,
+    /// Status interrupt handler (bxCAN SCE; FlexCAN bus-off, error, warning, wake-up).
+    pub status_irq: StatusIrq<'a, H, RX, Q, RX1, DONE>,
+}
+
+impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize> State<H, RX, Q, RX1, DONE> {
+    /// Empty, with no controller yet: all zeros.
+    pub const fn new() -> Self {
+        State {
+            taken: AtomicBool::new(false),
+            hw: UnsafeCell::new(MaybeUninit::uninit()),
+            rx0: SpscRing::new(),
+            rx1: SpscRing::new(),
+            queue: critical_section::Mutex::new(UnsafeCell::new(Q::EMPTY)),
+            queue_len: AtomicU32::new(0),
+            queue_peak: AtomicU32::new(0),
+            queue_overflows: Counter::new(),
+            done: SpscRing::new(),
+            changes: SpscRing::new(),
+            state: AtomicU8::new(STATE_UNKNOWN),
+            queued: Counter::new(),
+            sent: Counter::new(),
+            failed: Counter::new(),
+            aborted: Counter::new(),
+            received: Counter::new(),
+            dropped: Counter::new(),
+            state_changes: Counter::new(),
+            errors: ErrorCounts::new(),
+            _q: core::marker::PhantomData,
+        }
+    }
+
+    /// Stores `hardware` and hands out the handles; once only. A second call gives
+    /// `hardware` back. The controller's transmit order must be `Q`'s
+    /// ([`Error::InvalidArgument`] otherwise, with the controller given back).
+    #[allow(clippy::type_complexity)]
+    pub fn split(&self, hardware: H) -> Result<Parts<'_, H, RX, Q, RX1, DONE>, (Error, H)> {
+                if self.taken.load(Ordering::Acquire) {
+            return Err((Error::WrongMode, hardware));
+        }
+        let adopted = critical_section::with(|cs| {
+            // SAFETY: the queue is only touched inside a critical section.
+            unsafe { &mut *self.queue.borrow(cs).get() }.adopt(hardware.tx_policy())
+        });
+        if !adopted {
+            return Err((Error::InvalidArgument, hardware));
+        }
+        if self.taken.swap(true, Ordering::AcqRel) {
+            return Err((Error::WrongMode, hardware));
+        }
+        // SAFETY: `taken` was false: no handle exists, so nothing reads `hw` yet, and
+        // the swap above makes this the only writer ever.
+        unsafe { (*self.hw.get()).write(hardware) };
+        // SAFETY: written just above.
+        let hw = unsafe { (*self.hw.get()).assume_init_ref() };
+        let map = hw.filter_map();
+        let status = hw.error_status();
+        self.state.store(state_code(status.state), Ordering::Release);
+        Ok(Parts {
+            tx: Tx {
+                s: self,
+                next: 0,
+                last_error: None,
+            },
+            rx: Rx {
+                s: self,
+                map,
+                last_from: 0,
+            },
+            tx_irq: TxIrq { s: self },
+            rx0_irq: RxIrq { s: self, queue: 0 },
+            rx1_irq: RxIrq { s: self, queue: 1 },
+            status_irq: StatusIrq {
+                s: self,
+                last: status.state,
+            },
+        })
+    }
+
+    /// The controller, once [`State::split`] stored it.
+    pub fn hardware(&self) -> Option<&H> {
+        if self.taken.load(Ordering::Acquire) {
+            // SAFETY: `taken` is set only after `hw` was written (release/acquire).
+            Some(unsafe { (*self.hw.get()).assume_init_ref() })
+        } else {
+            None
+        }
+    }
+
+    #[inline(always)]
+    fn hw(&self) -> &H {
+        // SAFETY: only handles call this, and handles exist only after `split` wrote
+        // `hw`.
+        unsafe { (*self.hw.get()).assume_init_ref() }
+    }
+
+    /// Traffic counters.
+    pub fn traffic(&self) -> TrafficStats {
+        TrafficStats {
+            queued: self.queued.get(),
+            sent: self.sent.get(),
+            failed: self.failed.get(),
+            aborted: self.aborted.get(),
+            received: self.received.get(),
+            rx_ring_overflows: self.rx0.stats().overflows + self.rx1.stats().overflows,
+            rx_dropped: self.dropped.get(),
+            completion_overflows: self.done.stats().overflows,
+            state_changes: self.state_changes.get(),
+        }
+    }
+
+    /// Error statistics (bus errors by kind, bus-off count, hardware overruns).
+    pub fn error_stats(&self) -> ErrorStatistics {
+        let e = &self.errors;
+        ErrorStatistics {
+            stuff: e.stuff.get(),
+            form: e.form.get(),
+            acknowledge: e.ack.get(),
+            bit: e.bit.get(),
+            crc: e.crc.get(),
+            bus_off: e.bus_off.get(),
+            hardware_overruns: e.overruns.get(),
+        }
+    }
+
+    /// Wake-up events seen by the status handler.
+    pub fn wakeups(&self) -> u32 {
+        self.errors.wakeups.get()
+    }
+
+    /// Receive ring figures (queue 0, and queue 1 added when it has room).
+    pub fn rx_stats(&self) -> BufferStats {
+        let (a, b) = (self.rx0.stats(), self.rx1.stats());
+        BufferStats {
+            size: a.size + b.size,
+            count: a.count + b.count,
+            peak: if RX1 == 0 { a.peak } else { a.peak + b.peak },
+            overflows: a.overflows + b.overflows,
+        }
+    }
+
+    /// Transmit queue figures.
+    pub fn tx_stats(&self) -> BufferStats {
+        BufferStats {
+            size: Q::CAPACITY,
+            count: self.queue_len.load(Ordering::Relaxed) as usize,
+            peak: self.queue_peak.load(Ordering::Relaxed) as usize,
+            overflows: self.queue_overflows.get(),
+        }
+    }
+
+    /// Sets both rings' peaks back to their counts.
+    pub fn reset_peaks(&self) {
+        self.rx0.reset_peak();
+        self.rx1.reset_peak();
+        self.queue_peak
+            .store(self.queue_len.load(Ordering::Relaxed), Ordering::Relaxed);
+    }
+
+    fn record(&self, done: Completion) {
+        match done.outcome {
+            TxOutcome::Sent => self.sent.inc(),
+            TxOutcome::Failed => self.failed.inc(),
+            TxOutcome::Aborted => self.aborted.inc(),
+        }
+        // SAFETY: completions are produced only inside the critical section (transmit
+        // interrupt, transmit half's slow path), so producers never overlap.
+        let _ = unsafe { self.done.push(done) };
+    }
+
+    /// The transmit interrupt's work, inside the critical section `cs`: settle ended
+    /// mailboxes, put displaced frames back, refill free mailboxes from the queue.
+    fn service_tx(&self, q: &mut Q) {
+        let hw = self.hw();
+        // SAFETY: the caller holds the critical section, the transmit interrupt's
+        // context for `settle`/`load`/`displace`.
+        unsafe {
+            hw.settle(|s| match s {
+                Settled::Done(c) => self.record(c),
+                Settled::Displaced(token, frame) => {
+                    // Room was reserved when the displacement was requested.
+                    let _ = q.push(Queued { token, frame });
+                }
+            });
+            while let Some(next) = q.peek() {
+                match hw.free_mailbox(&next.frame) {
+                    Ok(Some(m)) => {
+                        let e = *next;
+                        q.pop();
+                        self.queue_len.fetch_sub(1, Ordering::Relaxed);
+                        hw.load(m, &e.frame, e.token);
+                    }
+                    Ok(None) => {
+                        if q.policy() == TxPolicy::Priority && hw.displace(&next.frame) {
+                            // The displaced frame comes back through `settle`: its
+                            // room in the queue stays counted in `queue_len`.
+                            self.queue_len.fetch_add(1, Ordering::Relaxed);
+                        }
+                        break;
+                    }
+                    Err(_) => break,
+                }
+            }
+        }
+    }
+
+    fn note_queue_peak(&self, len: u32) {
+        if len > self.queue_peak.load(Ordering::Relaxed) {
+            self.queue_peak.store(len, Ordering::Relaxed);
+        }
+    }
+}
+
+/// The transmit half: send frames, take their completions, abort them.
+pub struct Tx<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize> {
+    s: &'a State<H, RX, Q, RX1, DONE>,
+    next: u32,
+    last_error: Option<Error>,
+}
+
+/// What [`Tx::abort`] did.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum AbortRequest {
+    /// The frame was still queued: it was removed; its `Aborted` completion is in the
+    /// completion ring already.
+    Dequeued,
+    /// The frame is in a mailbox: its abort was requested; the completion (aborted, or
+    /// sent if the abort came too late) follows.
+    Requested,
+    /// No frame with this token is queued or in a mailbox (it completed already).
+    NotFound,
+}
+
+impl<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize> Tx<'a, H, RX, Q, RX1, DONE> {
+    /// Accepts `frame` for transmission and returns its token; exactly one
+    /// [`Completion`] with that token follows.
+    ///
+    /// When nothing is queued and a mailbox is free, the frame goes straight into it
+    /// (no lock). Otherwise it joins the queue (a short critical section, in which the
+    /// transmit interrupt's refill also runs, so a mailbox freed meanwhile is used at
+    /// once). `WouldBlock` when the queue is full (counted in [`Tx::stats`]). An error
+    /// means the frame was **not** accepted: [`Error::BusOff`] while bus-off,
+    /// [`Error::WrongMode`] when the controller cannot send in its mode.
+    #[inline]
+    pub fn try_send(&mut self, frame: &Frame) -> nb::Result<Token, Error> {
+        let s = self.s;
+        let hw = s.hw();
+        if s.state.load(Ordering::Relaxed) == state_code(ErrorState::BusOff)
+            && hw.error_status().state == ErrorState::BusOff
+        {
+            return Err(nb::Error::Other(Error::BusOff));
+        }
+        let token = Token(self.next);
+        if s.queue_len.load(Ordering::Acquire) == 0 {
+            match hw.free_mailbox(frame) {
+                Ok(Some(m)) => {
+                    // SAFETY: the transmit half's direct path: the queue is empty and only
+                    // this half fills it, so the interrupt's refill loads nothing and
+                    // `m` (empty and settled) is this call's alone.
+                    unsafe { hw.load(m, frame, token) };
+                    return Ok(self.accept(token));
+                }
+                Ok(None) => {}
+                Err(e) => return Err(nb::Error::Other(e)),
+            }
+        }
+        critical_section::with(|cs| {
+            // SAFETY: the queue is only touched inside a critical section.
+            let q = unsafe { &mut *s.queue.borrow(cs).get() };
+            let len = s.queue_len.load(Ordering::Relaxed);
+            if len as usize >= Q::CAPACITY {
+                // Make what progress the hardware allows (useful when polled with the
+                // interrupt masked), then try once more.
+                s.service_tx(q);
+                if s.queue_len.load(Ordering::Relaxed) as usize >= Q::CAPACITY {
+                    s.queue_overflows.inc();
+                    s.queue_peak
+                        .store(Q::CAPACITY as u32 + 1, Ordering::Relaxed);
+                    return Err(nb::Error::WouldBlock);
+                }
+            }
+            if let Err(e) = hw.free_mailbox(frame) {
+                return Err(nb::Error::Other(e));
+            }
+            if q.push(Queued {
+                token,
+                frame: *frame,
+            })
+            .is_err()
+            {
+                s.queue_overflows.inc();
+                return Err(nb::Error::WouldBlock);
+            }
+            let len = s.queue_len.fetch_add(1, Ordering::Relaxed) + 1;
+            s.note_queue_peak(len);
+            s.service_tx(q);
+            Ok(self.accept(token))
+        })
+    }
+
+    #[inline(always)]
+    fn accept(&mut self, token: Token) -> Token {
+        self.next = self.next.wrapping_add(1);
+        self.s.queued.inc();
+        token
+    }
+
+    /// The next completion, in the order the controller reported them.
+    pub fn take_completion(&mut self) -> Option<Completion> {
+        // SAFETY: the transmit half is the completion ring's only consumer.
+        unsafe { self.s.done.pop() }
+    }
+
+    /// Aborts the frame of `token`, queued or in a mailbox.
+    pub fn abort(&mut self, token: Token) -> AbortRequest {
+        let s = self.s;
+        critical_section::with(|cs| {
+            // SAFETY: the queue is only touched inside a critical section.
+            let q = unsafe { &mut *s.queue.borrow(cs).get() };
+            if q.remove(token) {
+                s.queue_len.fetch_sub(1, Ordering::Relaxed);
+                s.record(Completion {
+                    token,
+                    outcome: TxOutcome::Aborted,
+                    cause: None,
+                    timestamp: None,
+                });
+                AbortRequest::Dequeued
+            } else {
+                // SAFETY: inside the critical section, exclusive with the interrupt's
+                // settle, as `request_abort` needs.
+                if unsafe { s.hw().request_abort(token) } {
+                    AbortRequest::Requested
+                } else {
+                    AbortRequest::NotFound
+                }
+            }
+        })
+    }
+
+    /// Drops every queued frame (each gets an `Aborted` completion) and requests the
+    /// abort of every mailbox. Returns the number of queued frames dropped.
+    pub fn abort_all(&mut self) -> usize {
+        let s = self.s;
+        critical_section::with(|cs| {
+            // SAFETY: the queue is only touched inside a critical section.
+            let q = unsafe { &mut *s.queue.borrow(cs).get() };
+            let mut dropped = 0;
+            while let Some(e) = q.pop() {
+                s.queue_len.fetch_sub(1, Ordering::Relaxed);
+                s.record(Completion {
+                    token: e.token,
+                    outcome: TxOutcome::Aborted,
+                    cause: None,
+                    timestamp: None,
+                });
+                dropped += 1;
+            }
+            // SAFETY: inside the critical section, as `abort_all_mailboxes` needs.
+            unsafe { s.hw().abort_all_mailboxes() };
+            dropped
+        })
+    }
+
+    /// Runs the transmit interrupt's work from here (for polling code with the transmit
+    /// interrupt off).
+    pub fn poll(&mut self) {
+        let s = self.s;
+        critical_section::with(|cs| {
+            // SAFETY: the queue is only touched inside a critical section.
+            s.service_tx(unsafe { &mut *s.queue.borrow(cs).get() })
+        })
+    }
+
+    /// Transmit queue figures.
+    pub fn stats(&self) -> BufferStats {
+        self.s.tx_stats()
+    }
+
+    /// The token the next accepted frame will get.
+    pub fn next_token(&self) -> Token {
+        Token(self.next)
+    }
+
+    /// The shared state (statistics, the controller).
+    pub fn state(&self) -> &'a State<H, RX, Q, RX1, DONE> {
+        self.s
+    }
+
+    /// The controller.
+    pub fn hardware(&self) -> &'a H {
+        self.s.hw()
+    }
+
+    /// The last error of a blocking operation, if any.
+    pub fn last_error(&self) -> Option<Error> {
+        self.last_error
+    }
+}
+
+/// The receive half: take frames with their user filter index, dispatch them, follow
+/// the error state.
+pub struct Rx<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize> {
+    s: &'a State<H, RX, Q, RX1, DONE>,
+    map: H::FilterMap,
+    last_from: u8,
+}
+
+impl<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize> Rx<'a, H, RX, Q, RX1, DONE> {
+    fn pop_raw(&mut self) -> Option<H::Raw> {
+        let s = self.s;
+        // SAFETY: the receive half is the only consumer of both receive rings.
+        unsafe {
+            if RX1 == 0 {
+                return s.rx0.pop();
+            }
+            match (s.rx0.peek(), s.rx1.peek()) {
+                (Some(a), Some(b)) => {
+                    let hw = s.hw();
+                    let first = match (hw.raw_timestamp(&a), hw.raw_timestamp(&b)) {
+                        (Some(ta), Some(tb)) => tb.wrapping_sub(ta) < 0x8000,
+                        _ => true,
+                    };
+                    self.last_from = if first { 0 } else { 1 };
+                    if first {
+                        s.rx0.pop()
+                    } else {
+                        s.rx1.pop()
+                    }
+                }
+                (Some(_), None) => s.rx0.pop(),
+                (None, Some(_)) => s.rx1.pop(),
+                (None, None) => None,
+            }
+        }
+    }
+
+    /// Takes the oldest received frame, decoded, with the index of the user's filter
+    /// that accepted it and its time stamp. `WouldBlock` when none is waiting.
+    #[inline]
+    pub fn receive(&mut self) -> nb::Result<RxFrame, Error> {
+        loop {
+            let raw = self.pop_raw().ok_or(nb::Error::WouldBlock)?;
+            match self.s.hw().decode(&raw, &self.map) {
+                Some(frame) => return Ok(frame),
+                None => self.s.dropped.inc(),
+            }
+        }
+    }
+
+    /// Frames waiting in the receive ring(s) (ACAN `available()`).
+    pub fn available(&self) -> usize {
+        self.s.rx0.len() + self.s.rx1.len()
+    }
+
+    /// Takes one frame and hands it to its filter's call-back (ACAN
+    /// `dispatchReceivedMessage`). Returns whether a frame was taken.
+    pub fn dispatch<Ctx, const N: usize>(
+        &mut self,
+        dispatcher: &mut Dispatcher<Ctx, N>,
+        ctx: &mut Ctx,
+    ) -> bool {
+        match self.receive() {
+            Ok(frame) => {
+                dispatcher.dispatch(ctx, &frame);
+                true
+            }
+            Err(_) => false,
+        }
+    }
+
+    /// The next error-state change, in order, with the counters at the change.
+    pub fn take_state_change(&mut self) -> Option<StateChange> {
+        // SAFETY: the receive half is the state-change ring's only consumer.
+        unsafe { self.s.changes.pop() }
+    }
+
+    /// Installs a new compiled filter list. Frames still in the ring that the old list
+    /// accepted are decoded with the new map: drain the ring first where that matters.
+    pub fn set_filters(&mut self, filters: &H::Filters) -> Result<(), Error> {
+        // SAFETY: the receive half is the context of `install_filters`.
+        self.map = unsafe { self.s.hw().install_filters(filters)? };
+        Ok(())
+    }
+
+    /// Receive ring figures.
+    pub fn stats(&self) -> BufferStats {
+        self.s.rx_stats()
+    }
+
+    /// The shared state (statistics, the controller).
+    pub fn state(&self) -> &'a State<H, RX, Q, RX1, DONE> {
+        self.s
+    }
+
+    /// The controller.
+    pub fn hardware(&self) -> &'a H {
+        self.s.hw()
+    }
+
+    /// The map from hardware match index to user filter index in force.
+    pub fn filter_map(&self) -> &H::FilterMap {
+        &self.map
+    }
+}
+
+/// The transmit interrupt handler.
+pub struct TxIrq<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize> {
+    s: &'a State<H, RX, Q, RX1, DONE>,
+}
+
+impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize> TxIrq<'_, H, RX, Q, RX1, DONE> {
+    /// Settles ended mailboxes (completions in order, with their tokens) and refills
+    /// free mailboxes from the queue, in one critical section.
+    pub fn on_interrupt(&mut self) {
+        let s = self.s;
+        critical_section::with(|cs| {
+            // SAFETY: the queue is only touched inside a critical section.
+            s.service_tx(unsafe { &mut *s.queue.borrow(cs).get() })
+        })
+    }
+}
+
+/// The receive interrupt handler of one hardware receive queue.
+pub struct RxIrq<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize> {
+    s: &'a State<H, RX, Q, RX1, DONE>,
+    queue: u8,
+}
+
+impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize> RxIrq<'_, H, RX, Q, RX1, DONE> {
+    /// Moves every frame of the hardware queue into its ring as raw words and releases
+    /// the hardware; a full ring counts the frame as an overflow. No decoding here.
+    #[inline]
+    pub fn on_interrupt(&mut self) {
+        let s = self.s;
+        let hw = s.hw();
+        let mut overrun = false;
+        let q = self.queue as usize;
+        // SAFETY: this handle is the only caller of `read_rx` for its queue and the only
+        // producer of its ring.
+        unsafe {
+            while let Some(raw) = hw.read_rx(q, &mut overrun) {
+                s.received.inc();
+                let _ = if q == 0 {
+                    s.rx0.push(raw)
+                } else {
+                    s.rx1.push(raw)
+                };
+            }
+        }
+        if overrun {
+            overrun_counter(s).inc();
+        }
+    }
+
+    /// Which hardware queue this handler drains.
+    pub fn queue(&self) -> usize {
+        self.queue as usize
+    }
+}
+
+fn overrun_counter<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize>(
+    s: &State<H, RX, Q, RX1, DONE>,
+) -> &Counter {
+    &s.errors.overruns
+}
+
+/// The status (error, bus-off, wake-up) interrupt handler.
+pub struct StatusIrq<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize> {
+    s: &'a State<H, RX, Q, RX1, DONE>,
+    last: ErrorState,
+}
+
+impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize> StatusIrq<'_, H, RX, Q, RX1, DONE> {
+    /// Reads and acknowledges the error and wake-up causes: counts the bus error by
+    /// kind, records a state change (with the counters) when the state moved.
+    pub fn on_interrupt(&mut self) {
+        let s = self.s;
+        // SAFETY: this handle is the only caller of `take_status`.
+        let ev = unsafe { s.hw().take_status() };
+        if let Some(code) = ev.bus_error {
+            s.errors.record(code);
+        }
+        if ev.wakeup {
+            s.errors.wakeups.inc();
+        }
+        self.note(ev.status);
+    }
+
+    fn note(&mut self, now: ErrorStatus) {
+        let s = self.s;
+        if now.state != self.last {
+            if now.state == ErrorState::BusOff {
+                s.errors.bus_off.inc();
+            }
+            self.last = now.state;
+            s.state.store(state_code(now.state), Ordering::Relaxed);
+            s.state_changes.inc();
+            // SAFETY: this handle is the state-change ring's only producer.
+            let _ = unsafe {
+                s.changes.push(StateChange {
+                    state: now.state,
+                    counters: now.counters,
+                })
+            };
+        }
+    }
+
+    /// Reads the error state without an interrupt (controllers that recover from
+    /// bus-off raise none) and records a change.
+    pub fn poll_state(&mut self) {
+        let now = self.s.hw().error_status();
+        self.note(now);
+    }
+
+    /// The state last recorded.
+    pub fn last_state(&self) -> ErrorState {
+        self.last
+    }
+}
+
+// SAFETY (all handles): a handle is a shared reference to a `Sync` state plus data
+// owned by its context; moving it to another context is what it is for.
+unsafe impl<H: Hardware + Sync, const RX: usize, Q: TxQueue + Send, const RX1: usize, const DONE: usize> Send
+    for Tx<'_, H, RX, Q, RX1, DONE>
+where
+    H::Raw: Send,
+{
+}
+// SAFETY: as for `Tx`; the filter map is `Send`.
+unsafe impl<H: Hardware + Sync, const RX: usize, Q: TxQueue + Send, const RX1: usize, const DONE: usize> Send
+    for Rx<'_, H, RX, Q, RX1, DONE>
+where
+    H::Raw: Send,
+{
+}
+// SAFETY: as for `Tx`.
+unsafe impl<H: Hardware + Sync, const RX: usize, Q: TxQueue + Send, const RX1: usize, const DONE: usize> Send
+    for TxIrq<'_, H, RX, Q, RX1, DONE>
+where
+    H::Raw: Send,
+{
+}
+// SAFETY: as for `Tx`.
+unsafe impl<H: Hardware + Sync, const RX: usize, Q: TxQueue + Send, const RX1: usize, const DONE: usize> Send
+    for RxIrq<'_, H, RX, Q, RX1, DONE>
+where
+    H::Raw: Send,
+{
+}
+// SAFETY: as for `Tx`.
+unsafe impl<H: Hardware + Sync, const RX: usize, Q: TxQueue + Send, const RX1: usize, const DONE: usize> Send
+    for StatusIrq<'_, H, RX, Q, RX1, DONE>
+where
+    H::Raw: Send,
+{
+}
+
+/// Errors of the control operations shared by both halves.
+impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize> State<H, RX, Q, RX1, DONE> {
+    /// The controller's error status, read now.
+    pub fn error_status(&self) -> Option<ErrorStatus> {
+        self.hardware().map(|h| h.error_status())
+    }
+
+    /// Changes the operating mode.
+    pub fn set_mode(&self, mode: Mode) -> Result<(), Error> {
+        self.hardware().ok_or(Error::WrongMode)?.set_mode(mode)
+    }
+
+    /// Starts bus-off recovery by software.
+    pub fn recover(&self) -> Result<(), Error> {
+        self.hardware().ok_or(Error::WrongMode)?.recover()
+    }
+}
