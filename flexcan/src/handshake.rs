@@ -106,7 +106,7 @@ mod tests {
         fn read32(&self, _: usize) -> u32 {
             self.0
         }
-        fn write32(&mut self, _: usize, _: u32) {}
+        fn write32(&self, _: usize, _: u32) {}
     }
 
     #[test]
@@ -131,7 +131,7 @@ mod tests {
                 0
             }
         }
-        fn write32(&mut self, _: usize, _: u32) {}
+        fn write32(&self, _: usize, _: u32) {}
     }
 
     #[test]

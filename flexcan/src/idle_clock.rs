@@ -69,7 +69,7 @@ impl Registers for IdleClocked {
         self.model.read32(offset)
     }
 
-    fn write32(&mut self, offset: usize, value: u32) {
+    fn write32(&self, offset: usize, value: u32) {
         self.spinning.set(None);
         self.model.write32(offset, value);
     }

@@ -7,6 +7,8 @@
 //! [`HostSystem`] stands in and remembers what was written, so tests can check the
 //! pin set-up.
 
+use core::cell::{Ref, RefCell};
+
 use twocan_core::Registers;
 
 use crate::board::InstancePins;
@@ -19,22 +21,20 @@ use crate::regs::sim;
 /// beyond are dropped, which `begin` (5 addresses) never reaches.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct HostSystem {
-    cells: [(usize, u32); 16],
-    len: usize,
+    cells: RefCell<([(usize, u32); 16], usize)>,
 }
 
 impl HostSystem {
     /// An empty register space.
     pub const fn new() -> Self {
         HostSystem {
-            cells: [(0, 0); 16],
-            len: 0,
+            cells: RefCell::new(([(0, 0); 16], 0)),
         }
     }
 
     /// The addresses written so far, with their values, in first-write order.
-    pub fn written(&self) -> &[(usize, u32)] {
-        &self.cells[..self.len]
+    pub fn written(&self) -> Ref<'_, [(usize, u32)]> {
+        Ref::map(self.cells.borrow(), |(cells, len)| &cells[..*len])
     }
 }
 
@@ -46,13 +46,14 @@ impl Registers for HostSystem {
             .map_or(0, |(_, v)| *v)
     }
 
-    fn write32(&mut self, offset: usize, value: u32) {
-        let len = self.len;
-        if let Some(cell) = self.cells[..len].iter_mut().find(|(a, _)| *a == offset) {
+    fn write32(&self, offset: usize, value: u32) {
+        let mut guard = self.cells.borrow_mut();
+        let (cells, len) = &mut *guard;
+        if let Some(cell) = cells[..*len].iter_mut().find(|(a, _)| *a == offset) {
             cell.1 = value;
-        } else if let Some(cell) = self.cells.get_mut(len) {
+        } else if let Some(cell) = cells.get_mut(*len) {
             *cell = (offset, value);
-            self.len += 1;
+            *len += 1;
         }
     }
 }

@@ -266,7 +266,7 @@ impl twocan_core::Registers for IdhitBeyondTable {
             self.0.read32(offset)
         }
     }
-    fn write32(&mut self, offset: usize, value: u32) {
+    fn write32(&self, offset: usize, value: u32) {
         self.0.write32(offset, value);
     }
 }

@@ -206,7 +206,7 @@ impl Registers for BxCanModel {
         self.inner.borrow().read(offset)
     }
 
-    fn write32(&mut self, offset: usize, value: u32) {
+    fn write32(&self, offset: usize, value: u32) {
         self.inner.borrow_mut().write(offset, value);
     }
 }

@@ -50,7 +50,7 @@ impl Registers for Clocked {
         }
         self.model.read32(offset)
     }
-    fn write32(&mut self, offset: usize, value: u32) {
+    fn write32(&self, offset: usize, value: u32) {
         self.model.write32(offset, value)
     }
 }

@@ -169,7 +169,7 @@ impl<R: Registers> Registers for Clocked<R> {
         }
         self.regs.read32(offset)
     }
-    fn write32(&mut self, offset: usize, value: u32) {
+    fn write32(&self, offset: usize, value: u32) {
         self.spinning.set(None);
         self.regs.write32(offset, value)
     }

@@ -259,7 +259,7 @@ impl Registers for FlexCanModel {
         self.inner.borrow_mut().read(offset, true)
     }
 
-    fn write32(&mut self, offset: usize, value: u32) {
+    fn write32(&self, offset: usize, value: u32) {
         self.inner.borrow_mut().write(offset, value);
     }
 }
