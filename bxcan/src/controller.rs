@@ -44,26 +44,26 @@ impl<T> From<Failed<T>> for Error {
 /// (see [`Can::can2`]); CAN1 and CAN3 use their own registers and `F` is unused.
 #[derive(Debug)]
 pub struct Can<R: Registers, F: Registers = R> {
-    regs: R,
-    filter_regs: Option<F>,
-    instance: Instance,
-    config: Config,
-    fmi: FmiMap,
+    pub(crate) regs: R,
+    pub(crate) filter_regs: Option<F>,
+    pub(crate) instance: Instance,
+    pub(crate) config: Config,
+    pub(crate) fmi: FmiMap,
     /// Request order of each loaded mailbox (TXFP = 1 scheduling), for `mailbox_state`.
-    seq: [u32; TX_MAILBOXES],
-    next_seq: u32,
+    pub(crate) seq: [u32; TX_MAILBOXES],
+    pub(crate) next_seq: u32,
     /// Mailboxes whose abort was requested (to tell an abort from a one-shot failure).
-    abort_requested: u8,
+    pub(crate) abort_requested: u8,
     /// Frames read back from mailboxes whose displacement abort was still in flight.
-    displaced: [Option<Frame>; TX_MAILBOXES],
+    pub(crate) displaced: [Option<Frame>; TX_MAILBOXES],
     /// Completions noticed outside `take_events` (a reload clears RQCP), reported next.
-    pending: Events,
-    last_state: ErrorState,
+    pub(crate) pending: Events,
+    pub(crate) last_state: ErrorState,
     /// The last error code the hardware latched (`CAN_ESR.LEC`), kept after
     /// `take_events` sets LEC to 0b111 so [`Controller::error_status`] still reports it
     /// until a newer error replaces it (as the FlexCAN backend does). A `Cell` because
     /// `error_status` takes `&self` and may observe a newer LEC first.
-    last_error: Cell<LastErrorCode>,
+    pub(crate) last_error: Cell<LastErrorCode>,
 }
 
 /// A controller in initialization mode (RM0410 §40.4.1), configured but off the bus.

@@ -36,7 +36,7 @@ pub(crate) fn banks_of<F: Registers>(regs: &F, instance: Instance) -> (usize, us
 
 /// Sets `CAN2SB` (in filter initialization mode, as RM0410 requires), in a critical
 /// section (`CAN_FMR` is shared with CAN2's driver, see the module notes).
-pub(crate) fn set_can2sb<F: Registers>(regs: &mut F, start: u8) {
+pub(crate) fn set_can2sb<F: Registers>(regs: &F, start: u8) {
     critical_section::with(|_| {
         let fmr_value = regs.read32(FMR);
         regs.write32(FMR, fmr_value | fmr::FINIT);
@@ -53,7 +53,7 @@ pub(crate) struct TooManyBanks;
 /// shared with the other instance's driver, see the module notes; `CAN2SB` is read
 /// inside it too, so the bank range cannot change under the programming).
 pub(crate) fn program<F: Registers>(
-    regs: &mut F,
+    regs: &F,
     instance: Instance,
     plan: &FilterPlan,
 ) -> Result<(), TooManyBanks> {
@@ -61,7 +61,7 @@ pub(crate) fn program<F: Registers>(
 }
 
 fn program_locked<F: Registers>(
-    regs: &mut F,
+    regs: &F,
     instance: Instance,
     plan: &FilterPlan,
 ) -> Result<(), TooManyBanks> {

@@ -39,7 +39,7 @@
 //! - [`regs`]: the register map.
 #![cfg_attr(not(feature = "model"), no_std)]
 #![deny(missing_docs)]
-#![forbid(unsafe_code)]
+#![deny(unsafe_code)]
 
 pub mod regs;
 
@@ -54,9 +54,13 @@ pub mod instance;
 mod mailbox;
 mod mode;
 pub mod planner;
+// Interrupt-shared state: the `Hardware` contract and the per-mailbox frame cell.
+#[allow(unsafe_code)]
+pub mod split;
 
 pub use config::{Config, ConfigError, Recovery};
 pub use controller::{Can, Failed, Init};
 pub use filters::{Bank, BankError, BankKind, Fifo, FilterPlan, PlanError};
 pub use instance::Instance;
 pub use planner::{plan, FifoPolicy, PlanOptions};
+pub use split::{BxCan, RawFrame};

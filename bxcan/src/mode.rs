@@ -29,7 +29,7 @@ pub(crate) fn wait_msr<R: Registers>(
 }
 
 /// Requests `mode` and waits (bounded) for the acknowledge.
-pub(crate) fn request<R: Registers>(regs: &mut R, mode: Mode, bound: u32) -> Result<(), Error> {
+pub(crate) fn request<R: Registers>(regs: &R, mode: Mode, bound: u32) -> Result<(), Error> {
     let both = msr::INAK | msr::SLAK;
     match mode {
         Mode::Stopped => {

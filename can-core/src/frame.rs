@@ -241,7 +241,11 @@ impl Frame {
         let word = word & (EXTENDED_BIT | REMOTE_BIT | id_mask);
         let dlc = if dlc > MAX_DLC { MAX_DLC } else { dlc };
         let mut bytes = data;
-        let keep = if word & REMOTE_BIT != 0 { 0 } else { dlc as usize };
+        let keep = if word & REMOTE_BIT != 0 {
+            0
+        } else {
+            dlc as usize
+        };
         let mut i = keep;
         while i < 8 {
             bytes[i] = 0;

@@ -23,8 +23,8 @@ pub mod priority;
 pub mod registers;
 #[cfg(feature = "sim")]
 pub mod sim;
-pub mod spsc;
 pub mod split;
+pub mod spsc;
 pub mod timing;
 pub mod txqueue;
 
@@ -37,9 +37,9 @@ pub use error::{Error, ErrorCounters, ErrorState, ErrorStatistics, LastErrorCode
 pub use filter::{Filter, FilterError, Format, FrameKind};
 pub use frame::{Frame, FrameError, RxFrame};
 pub use hardware::{Completion, Hardware, Settled, StatusEvents, Token, TxFailure};
-pub use split::{AbortRequest, Parts, StateChange};
-pub use spsc::SpscRing;
-pub use txqueue::{AnyQueue, FifoQueue, PriorityQueue};
 pub use mailbox::{MailboxId, MailboxState, TxOutcome, TxPolicy};
 pub use priority::Priority;
 pub use registers::{Mmio, Registers};
+pub use split::{AbortRequest, Parts, StateChange};
+pub use spsc::SpscRing;
+pub use txqueue::{AnyQueue, FifoQueue, PriorityQueue};

@@ -220,7 +220,9 @@ unsafe impl Hardware for MockHardware {
             if m.ended.len() + m.count > m.ended.capacity() {
                 return Ok(None);
             }
-            Ok((0..m.count).find(|&i| m.mailboxes[i].is_none()).map(|i| i as u8))
+            Ok((0..m.count)
+                .find(|&i| m.mailboxes[i].is_none())
+                .map(|i| i as u8))
         })
     }
 

@@ -188,8 +188,13 @@ pub struct State<
 // only read afterwards (`H: Sync` makes sharing it sound); the rings follow the SPSC
 // contract through the unique handles; the queue is only touched inside a critical
 // section.
-unsafe impl<H: Hardware + Sync, const RX: usize, Q: TxQueue + Send, const RX1: usize, const DONE: usize> Sync
-    for State<H, RX, Q, RX1, DONE>
+unsafe impl<
+        H: Hardware + Sync,
+        const RX: usize,
+        Q: TxQueue + Send,
+        const RX1: usize,
+        const DONE: usize,
+    > Sync for State<H, RX, Q, RX1, DONE>
 where
     H::Raw: Send,
 {
@@ -204,7 +209,8 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
 }
 
 /// The handles [`State::split`] hands out, each for one context.
-pub struct Parts<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize> {
+pub struct Parts<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize>
+{
     /// Transmit half (thread/task).
     pub tx: Tx<'a, H, RX, Q, RX1, DONE>,
     /// Receive half (thread/task).
@@ -219,7 +225,9 @@ pub struct Parts<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize,
     pub status_irq: StatusIrq<'a, H, RX, Q, RX1, DONE>,
 }
 
-impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize> State<H, RX, Q, RX1, DONE> {
+impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize>
+    State<H, RX, Q, RX1, DONE>
+{
     /// Empty, with no controller yet: all zeros.
     pub const fn new() -> Self {
         State {
@@ -251,7 +259,7 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
     /// ([`Error::InvalidArgument`] otherwise, with the controller given back).
     #[allow(clippy::type_complexity)]
     pub fn split(&self, hardware: H) -> Result<Parts<'_, H, RX, Q, RX1, DONE>, (Error, H)> {
-                if self.taken.load(Ordering::Acquire) {
+        if self.taken.load(Ordering::Acquire) {
             return Err((Error::WrongMode, hardware));
         }
         let adopted = critical_section::with(|cs| {
@@ -271,7 +279,8 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
         let hw = unsafe { (*self.hw.get()).assume_init_ref() };
         let map = hw.filter_map();
         let status = hw.error_status();
-        self.state.store(state_code(status.state), Ordering::Release);
+        self.state
+            .store(state_code(status.state), Ordering::Release);
         Ok(Parts {
             tx: Tx {
                 s: self,
@@ -448,7 +457,9 @@ pub enum AbortRequest {
     NotFound,
 }
 
-impl<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize> Tx<'a, H, RX, Q, RX1, DONE> {
+impl<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize>
+    Tx<'a, H, RX, Q, RX1, DONE>
+{
     /// Accepts `frame` for transmission and returns its token; exactly one
     /// [`Completion`] with that token follows.
     ///
@@ -623,7 +634,9 @@ pub struct Rx<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, co
     last_from: u8,
 }
 
-impl<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize> Rx<'a, H, RX, Q, RX1, DONE> {
+impl<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize>
+    Rx<'a, H, RX, Q, RX1, DONE>
+{
     fn pop_raw(&mut self) -> Option<H::Raw> {
         let s = self.s;
         // SAFETY: the receive half is the only consumer of both receive rings.
@@ -722,11 +735,14 @@ impl<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE:
 }
 
 /// The transmit interrupt handler.
-pub struct TxIrq<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize> {
+pub struct TxIrq<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize>
+{
     s: &'a State<H, RX, Q, RX1, DONE>,
 }
 
-impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize> TxIrq<'_, H, RX, Q, RX1, DONE> {
+impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize>
+    TxIrq<'_, H, RX, Q, RX1, DONE>
+{
     /// Settles ended mailboxes (completions in order, with their tokens) and refills
     /// free mailboxes from the queue, in one critical section.
     pub fn on_interrupt(&mut self) {
@@ -739,12 +755,15 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
 }
 
 /// The receive interrupt handler of one hardware receive queue.
-pub struct RxIrq<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize> {
+pub struct RxIrq<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize>
+{
     s: &'a State<H, RX, Q, RX1, DONE>,
     queue: u8,
 }
 
-impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize> RxIrq<'_, H, RX, Q, RX1, DONE> {
+impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize>
+    RxIrq<'_, H, RX, Q, RX1, DONE>
+{
     /// Moves every frame of the hardware queue into its ring as raw words and releases
     /// the hardware; a full ring counts the frame as an overflow. No decoding here.
     #[inline]
@@ -776,19 +795,34 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
     }
 }
 
-fn overrun_counter<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize>(
+fn overrun_counter<
+    H: Hardware,
+    const RX: usize,
+    Q: TxQueue,
+    const RX1: usize,
+    const DONE: usize,
+>(
     s: &State<H, RX, Q, RX1, DONE>,
 ) -> &Counter {
     &s.errors.overruns
 }
 
 /// The status (error, bus-off, wake-up) interrupt handler.
-pub struct StatusIrq<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize> {
+pub struct StatusIrq<
+    'a,
+    H: Hardware,
+    const RX: usize,
+    Q: TxQueue,
+    const RX1: usize,
+    const DONE: usize,
+> {
     s: &'a State<H, RX, Q, RX1, DONE>,
     last: ErrorState,
 }
 
-impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize> StatusIrq<'_, H, RX, Q, RX1, DONE> {
+impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize>
+    StatusIrq<'_, H, RX, Q, RX1, DONE>
+{
     /// Reads and acknowledges the error and wake-up causes: counts the bus error by
     /// kind, records a state change (with the counters) when the state moved.
     pub fn on_interrupt(&mut self) {
@@ -838,43 +872,70 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
 
 // SAFETY (all handles): a handle is a shared reference to a `Sync` state plus data
 // owned by its context; moving it to another context is what it is for.
-unsafe impl<H: Hardware + Sync, const RX: usize, Q: TxQueue + Send, const RX1: usize, const DONE: usize> Send
-    for Tx<'_, H, RX, Q, RX1, DONE>
+unsafe impl<
+        H: Hardware + Sync,
+        const RX: usize,
+        Q: TxQueue + Send,
+        const RX1: usize,
+        const DONE: usize,
+    > Send for Tx<'_, H, RX, Q, RX1, DONE>
 where
     H::Raw: Send,
 {
 }
 // SAFETY: as for `Tx`; the filter map is `Send`.
-unsafe impl<H: Hardware + Sync, const RX: usize, Q: TxQueue + Send, const RX1: usize, const DONE: usize> Send
-    for Rx<'_, H, RX, Q, RX1, DONE>
+unsafe impl<
+        H: Hardware + Sync,
+        const RX: usize,
+        Q: TxQueue + Send,
+        const RX1: usize,
+        const DONE: usize,
+    > Send for Rx<'_, H, RX, Q, RX1, DONE>
 where
     H::Raw: Send,
 {
 }
 // SAFETY: as for `Tx`.
-unsafe impl<H: Hardware + Sync, const RX: usize, Q: TxQueue + Send, const RX1: usize, const DONE: usize> Send
-    for TxIrq<'_, H, RX, Q, RX1, DONE>
+unsafe impl<
+        H: Hardware + Sync,
+        const RX: usize,
+        Q: TxQueue + Send,
+        const RX1: usize,
+        const DONE: usize,
+    > Send for TxIrq<'_, H, RX, Q, RX1, DONE>
 where
     H::Raw: Send,
 {
 }
 // SAFETY: as for `Tx`.
-unsafe impl<H: Hardware + Sync, const RX: usize, Q: TxQueue + Send, const RX1: usize, const DONE: usize> Send
-    for RxIrq<'_, H, RX, Q, RX1, DONE>
+unsafe impl<
+        H: Hardware + Sync,
+        const RX: usize,
+        Q: TxQueue + Send,
+        const RX1: usize,
+        const DONE: usize,
+    > Send for RxIrq<'_, H, RX, Q, RX1, DONE>
 where
     H::Raw: Send,
 {
 }
 // SAFETY: as for `Tx`.
-unsafe impl<H: Hardware + Sync, const RX: usize, Q: TxQueue + Send, const RX1: usize, const DONE: usize> Send
-    for StatusIrq<'_, H, RX, Q, RX1, DONE>
+unsafe impl<
+        H: Hardware + Sync,
+        const RX: usize,
+        Q: TxQueue + Send,
+        const RX1: usize,
+        const DONE: usize,
+    > Send for StatusIrq<'_, H, RX, Q, RX1, DONE>
 where
     H::Raw: Send,
 {
 }
 
 /// Errors of the control operations shared by both halves.
-impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize> State<H, RX, Q, RX1, DONE> {
+impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize>
+    State<H, RX, Q, RX1, DONE>
+{
     /// The controller's error status, read now.
     pub fn error_status(&self) -> Option<ErrorStatus> {
         self.hardware().map(|h| h.error_status())

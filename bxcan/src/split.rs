@@ -1,0 +1,474 @@
+//! The bxCAN controller as the portable split driver uses it ([`twocan_core::split`]):
+//! [`BxCan`], built from an enabled [`Can`] with [`Can::into_split`].
+//!
+//! Who touches which register (RM0410 §40.9.2), so that the contexts need no lock:
+//! - transmit half (direct path) and transmit interrupt: `CAN_TSR` read, the registers
+//!   of one mailbox that is empty and settled (`TMEx` = 1, `RQCPx` = 0) — only one
+//!   context loads a given mailbox (see [`twocan_core::hardware`]);
+//! - transmit interrupt: `CAN_TSR` write-1-to-clear `RQCPx` and `ABRQx` requests;
+//! - receive interrupt x: `CAN_RFxR` (`FOVRx`, `FULLx` write-1-to-clear, `RFOMx`) and the
+//!   FIFO x output mailbox;
+//! - status interrupt: `CAN_MSR` (`ERRI`, `WKUI`, `SLAKI` write-1-to-clear) and
+//!   `CAN_ESR.LEC` (set to 0b111 after reading);
+//! - receive half: the filter registers (under `CAN_FMR.FINIT`).
+//!
+//! A raw received frame is the four output-mailbox words (`CAN_RIxR`, `CAN_RDTxR`,
+//! `CAN_RDLxR`, `CAN_RDHxR`) with the FIFO number in the reserved bits 7:4 of the
+//! second word; the thread side decodes it and maps `(FIFO, FMI)` to the user's filter.
+
+use core::cell::UnsafeCell;
+use core::sync::atomic::{AtomicU32, AtomicU8, Ordering};
+
+use twocan_core::hardware::{Completion, Settled, StatusEvents, Token, TxFailure};
+use twocan_core::{
+    Error, ErrorCounters, ErrorState, ErrorStatus, Frame, Hardware, LastErrorCode, Mode, Priority,
+    Registers, RxFrame, TxOutcome, TxPolicy,
+};
+
+use crate::config::{Config, Recovery};
+use crate::controller::{lec, Can};
+use crate::filter_block;
+use crate::filters::{Fifo, FilterPlan, FmiMap};
+use crate::instance::Instance;
+use crate::mode;
+use crate::regs::{
+    esr, msr, rdhxr, rdlxr, rdtxr, rfxr, rixr, tdhxr, tdlxr, tdtxr, tixr, tsr, ESR, MSR, TSR,
+    TX_MAILBOXES,
+};
+
+/// `CAN_TSR.TMEx` of the three mailboxes.
+const TME_ALL: u32 = tsr::TME0 | tsr::TME1 | tsr::TME2;
+
+/// One received frame as the receive interrupt copies it: `CAN_RIxR`, `CAN_RDTxR` (FIFO
+/// number in bits 7:4), `CAN_RDLxR`, `CAN_RDHxR`.
+pub type RawFrame = [u32; 4];
+
+/// A bxCAN instance shared by the halves and handlers of the split driver.
+pub struct BxCan<R: Registers, F: Registers = R> {
+    regs: R,
+    filter_regs: Option<F>,
+    instance: Instance,
+    config: Config,
+    fmi: FmiMap,
+    /// Token of the frame in each mailbox (written before `TXRQ`).
+    tokens: [AtomicU32; TX_MAILBOXES],
+    /// Mailboxes whose abort was requested to make room (displacement).
+    displacing: AtomicU8,
+    /// Mailboxes whose abort the application requested.
+    aborting: AtomicU8,
+    /// Frames read back from mailboxes being displaced: touched only by the transmit
+    /// interrupt's `displace` and `settle` (one context, see `Hardware`).
+    displaced: UnsafeCell<[Frame; TX_MAILBOXES]>,
+    /// The last error code latched (`LastErrorCode` as its index), kept after LEC is
+    /// set to 0b111.
+    last_error: AtomicU8,
+}
+
+// SAFETY: the atomics are shared; `displaced` is touched by the transmit interrupt's
+// methods only (one context at a time, the `Hardware` contract); the register handles
+// are shared as `Hardware` documents (disjoint registers or write-1-to-clear bits).
+unsafe impl<R: Registers + Sync, F: Registers + Sync> Sync for BxCan<R, F> {}
+
+impl<R: Registers, F: Registers> Can<R, F> {
+    /// The controller for the split driver (`twocan_core::split::State::split`); the
+    /// installed filters come along.
+    pub fn into_split(self) -> BxCan<R, F> {
+        BxCan {
+            regs: self.regs,
+            filter_regs: self.filter_regs,
+            instance: self.instance,
+            config: self.config,
+            fmi: self.fmi,
+            tokens: [const { AtomicU32::new(0) }; TX_MAILBOXES],
+            displacing: AtomicU8::new(0),
+            aborting: AtomicU8::new(0),
+            displaced: UnsafeCell::new([Frame::default(); TX_MAILBOXES]),
+            last_error: AtomicU8::new(0),
+        }
+    }
+}
+
+const CODES: [LastErrorCode; 7] = [
+    LastErrorCode::None,
+    LastErrorCode::Stuff,
+    LastErrorCode::Form,
+    LastErrorCode::Acknowledge,
+    LastErrorCode::BitRecessive,
+    LastErrorCode::BitDominant,
+    LastErrorCode::Crc,
+];
+
+fn code_index(c: LastErrorCode) -> u8 {
+    CODES.iter().position(|&x| x == c).unwrap_or(0) as u8
+}
+
+/// The mailbox identifier word (`CAN_TIxR` without `TXRQ`) of a frame's identifier word.
+#[inline(always)]
+fn tir_of(frame: &Frame) -> u32 {
+    let raw = frame.raw_id();
+    let rtr = if frame.is_remote() { tixr::RTR } else { 0 };
+    if frame.is_extended() {
+        (raw << 3) | tixr::IDE | rtr
+    } else {
+        (raw << 21) | rtr
+    }
+}
+
+/// The frame's identifier word from `CAN_RIxR`/`CAN_TIxR`.
+#[inline(always)]
+fn word_of(ir: u32) -> u32 {
+    let extended = ir & rixr::IDE != 0;
+    let raw = if extended { ir >> 3 } else { ir >> 21 };
+    Frame::id_word(raw, extended, ir & rixr::RTR != 0)
+}
+
+impl<R: Registers, F: Registers> BxCan<R, F> {
+    /// The instance.
+    pub fn instance(&self) -> Instance {
+        self.instance
+    }
+
+    /// The configuration in force.
+    pub fn config(&self) -> &Config {
+        &self.config
+    }
+
+    /// The registers (for inspection).
+    pub fn registers(&self) -> &R {
+        &self.regs
+    }
+
+    fn read_frame(&self, x: usize) -> Frame {
+        let lo = self.regs.read32(tdlxr(x));
+        let hi = self.regs.read32(tdhxr(x));
+        let dlc = rdtxr::DLC.get(self.regs.read32(tdtxr(x))) as u8;
+        let mut data = [0u8; 8];
+        data[..4].copy_from_slice(&lo.to_le_bytes());
+        data[4..].copy_from_slice(&hi.to_le_bytes());
+        Frame::from_words(word_of(self.regs.read32(tixr(x))), dlc, data)
+    }
+
+    fn status_now(&self) -> ErrorStatus {
+        let e = self.regs.read32(ESR);
+        let m = self.regs.read32(MSR);
+        let boff = e & esr::BOFF != 0;
+        let counters = ErrorCounters {
+            tec: if boff { 256 } else { esr::TEC.get(e) as u16 },
+            rec: esr::REC.get(e) as u16,
+        };
+        let state = if m & msr::SLAK != 0 {
+            ErrorState::Sleeping
+        } else if m & msr::INAK != 0 {
+            ErrorState::Stopped
+        } else if boff {
+            ErrorState::BusOff
+        } else if e & esr::EPVF != 0 {
+            ErrorState::Passive
+        } else if e & esr::EWGF != 0 {
+            ErrorState::Warning
+        } else {
+            ErrorState::from_counters(counters)
+        };
+        ErrorStatus {
+            state,
+            counters,
+            last_error: CODES[self.last_error.load(Ordering::Relaxed) as usize % CODES.len()],
+        }
+    }
+}
+
+// SAFETY: each method touches the registers its context owns (module docs); `displaced`
+// only from `displace`/`settle` (transmit interrupt context).
+unsafe impl<R: Registers, F: Registers> Hardware for BxCan<R, F> {
+    type Raw = RawFrame;
+    type FilterMap = FmiMap;
+    type Filters = FilterPlan;
+
+    fn tx_policy(&self) -> TxPolicy {
+        self.config.get_tx_policy()
+    }
+
+    /// Reads `CAN_TSR` once: `CODE` names an empty mailbox when `TMEx` is set (RM0410
+    /// §40.9.2); it is taken when its last completion was settled (`RQCPx` = 0).
+    #[inline(always)]
+    fn free_mailbox(&self, _frame: &Frame) -> Result<Option<u8>, Error> {
+        let t = self.regs.read32(TSR);
+        if t & TME_ALL == 0 {
+            return Ok(None);
+        }
+        let code = tsr::CODE.get(t) as usize;
+        if t & tsr::tme(code) != 0 && t & tsr::rqcp(code) == 0 {
+            return Ok(Some(code as u8));
+        }
+        Ok((0..TX_MAILBOXES)
+            .find(|&x| t & tsr::tme(x) != 0 && t & tsr::rqcp(x) == 0)
+            .map(|x| x as u8))
+    }
+
+    /// Notes "Transmission handling": DLC, data, then identifier with `TXRQ`.
+    #[inline(always)]
+    unsafe fn load(&self, mailbox: u8, frame: &Frame, token: Token) {
+        let x = mailbox as usize;
+        self.tokens[x].store(token.0, Ordering::Release);
+        let d = frame.data_padded();
+        self.regs.write32(tdtxr(x), frame.dlc() as u32);
+        self.regs
+            .write32(tdlxr(x), u32::from_le_bytes([d[0], d[1], d[2], d[3]]));
+        self.regs
+            .write32(tdhxr(x), u32::from_le_bytes([d[4], d[5], d[6], d[7]]));
+        self.regs.write32(tixr(x), tir_of(frame) | tixr::TXRQ);
+    }
+
+    /// For each `RQCPx` (RM0410 §40.9.2): `TXOKx` → sent (with `CAN_TDTxR.TIME` when
+    /// TTCM is on); an abort the application requested → aborted; a displacement abort
+    /// → the frame goes back to the queue; otherwise a one-shot failure, `ALSTx` or
+    /// `TERRx` saying why. Writing `RQCPx` clears `TXOKx`, `ALSTx` and `TERRx`.
+    unsafe fn settle<G: FnMut(Settled)>(&self, mut f: G) {
+        let t = self.regs.read32(TSR);
+        if t & (tsr::RQCP0 | tsr::RQCP1 | tsr::RQCP2) == 0 {
+            return;
+        }
+        // Several mailboxes can end between two interrupts: report them in token
+        // (acceptance) order, which is the transmit order under TXFP = 1.
+        let mut ended = [(
+            0u32,
+            Settled::Done(Completion {
+                token: Token(0),
+                outcome: TxOutcome::Sent,
+                cause: None,
+                timestamp: None,
+            }),
+        ); TX_MAILBOXES];
+        let mut n = 0;
+        for x in 0..TX_MAILBOXES {
+            if t & tsr::rqcp(x) == 0 {
+                continue;
+            }
+            let bit = 1u8 << x;
+            let token = Token(self.tokens[x].load(Ordering::Acquire));
+            let user_abort = self.aborting.fetch_and(!bit, Ordering::Relaxed) & bit != 0;
+            let displacing = self.displacing.fetch_and(!bit, Ordering::Relaxed) & bit != 0;
+            let settled = if t & tsr::txok(x) != 0 {
+                let timestamp = self
+                    .config
+                    .get_timestamps()
+                    .then(|| rdtxr::TIME.get(self.regs.read32(tdtxr(x))) as u16);
+                Settled::Done(Completion {
+                    token,
+                    outcome: TxOutcome::Sent,
+                    cause: None,
+                    timestamp,
+                })
+            } else if user_abort {
+                Settled::Done(Completion {
+                    token,
+                    outcome: TxOutcome::Aborted,
+                    cause: None,
+                    timestamp: None,
+                })
+            } else if displacing {
+                // SAFETY: transmit interrupt context, the only one touching `displaced`.
+                let frame = unsafe { (*self.displaced.get())[x] };
+                Settled::Displaced(token, frame)
+            } else {
+                let cause = if t & tsr::alst(x) != 0 {
+                    Some(TxFailure::ArbitrationLost)
+                } else if t & tsr::terr(x) != 0 {
+                    Some(TxFailure::Error)
+                } else {
+                    None
+                };
+                Settled::Done(Completion {
+                    token,
+                    outcome: TxOutcome::Failed,
+                    cause,
+                    timestamp: None,
+                })
+            };
+            self.regs.write32(TSR, tsr::rqcp(x));
+            ended[n] = (token.0, settled);
+            n += 1;
+        }
+        let ended = &mut ended[..n];
+        if n > 1 {
+            let base = ended.iter().map(|e| e.0).fold(ended[0].0, |a, b| {
+                if (b.wrapping_sub(a) as i32) < 0 {
+                    b
+                } else {
+                    a
+                }
+            });
+            ended.sort_unstable_by_key(|e| e.0.wrapping_sub(base));
+        }
+        for (_, s) in ended.iter() {
+            f(*s);
+        }
+    }
+
+    /// With all three mailboxes pending, the one lowest in the hardware's order
+    /// (largest arbitration key; ties: higher mailbox number, notes "Transmit
+    /// priority") is aborted (`ABRQx`) when `frame` beats it.
+    unsafe fn displace(&self, frame: &Frame) -> bool {
+        let t = self.regs.read32(TSR);
+        if t & TME_ALL != 0 || self.displacing.load(Ordering::Relaxed) != 0 {
+            return false;
+        }
+        let mut low = 0;
+        let mut low_frame = self.read_frame(0);
+        for x in 1..TX_MAILBOXES {
+            let f = self.read_frame(x);
+            if !Priority::of(&f).beats(Priority::of(&low_frame)) {
+                low = x;
+                low_frame = f;
+            }
+        }
+        if !Priority::of(frame).beats(Priority::of(&low_frame)) {
+            return false;
+        }
+        // SAFETY: transmit interrupt context, the only one touching `displaced`.
+        unsafe { (*self.displaced.get())[low] = low_frame };
+        self.displacing.fetch_or(1 << low, Ordering::Relaxed);
+        self.regs.write32(TSR, tsr::abrq(low));
+        true
+    }
+
+    /// `ABRQx` of the loaded mailbox holding `token` (RM0410 §40.9.2); a mailbox on the
+    /// bus finishes first, so the completion may still say sent.
+    unsafe fn request_abort(&self, token: Token) -> bool {
+        let t = self.regs.read32(TSR);
+        for x in 0..TX_MAILBOXES {
+            let loaded = t & tsr::tme(x) == 0;
+            if loaded && self.tokens[x].load(Ordering::Acquire) == token.0 {
+                self.aborting.fetch_or(1 << x, Ordering::Relaxed);
+                self.regs.write32(TSR, tsr::abrq(x));
+                return true;
+            }
+        }
+        false
+    }
+
+    unsafe fn abort_all_mailboxes(&self) {
+        let t = self.regs.read32(TSR);
+        for x in 0..TX_MAILBOXES {
+            if t & tsr::tme(x) == 0 {
+                self.aborting.fetch_or(1 << x, Ordering::Relaxed);
+                self.regs.write32(TSR, tsr::abrq(x));
+            }
+        }
+    }
+
+    /// `CAN_RFxR.FMPx` > 0: copies the output mailbox and releases it (`RFOMx`); an
+    /// overrun (`FOVRx`, frames lost in hardware) is acknowledged with `FULLx`.
+    #[inline(always)]
+    unsafe fn read_rx(&self, queue: usize, overrun: &mut bool) -> Option<RawFrame> {
+        let x = queue & 1;
+        let r = self.regs.read32(rfxr(x));
+        if r & (rfxr::FOVR | rfxr::FULL) != 0 {
+            *overrun |= r & rfxr::FOVR != 0;
+            self.regs.write32(rfxr(x), r & (rfxr::FOVR | rfxr::FULL));
+        }
+        if rfxr::FMP.get(r) == 0 {
+            return None;
+        }
+        let raw = [
+            self.regs.read32(rixr(x)),
+            self.regs.read32(rdtxr(x)) | (x as u32) << 4,
+            self.regs.read32(rdlxr(x)),
+            self.regs.read32(rdhxr(x)),
+        ];
+        self.regs.write32(rfxr(x), rfxr::RFOM);
+        Some(raw)
+    }
+
+    #[inline]
+    fn decode(&self, raw: &RawFrame, map: &FmiMap) -> Option<RxFrame> {
+        let [ir, dt, lo, hi] = *raw;
+        let mut data = [0u8; 8];
+        data[..4].copy_from_slice(&lo.to_le_bytes());
+        data[4..].copy_from_slice(&hi.to_le_bytes());
+        let frame = Frame::from_words(word_of(ir), rdtxr::DLC.get(dt) as u8, data);
+        let fifo = if (dt >> 4) & 1 == 0 {
+            Fifo::Fifo0
+        } else {
+            Fifo::Fifo1
+        };
+        Some(RxFrame {
+            frame,
+            filter: map.get(fifo, rdtxr::FMI.get(dt) as u8),
+            timestamp: self
+                .config
+                .get_timestamps()
+                .then_some(rdtxr::TIME.get(dt) as u16),
+        })
+    }
+
+    fn raw_timestamp(&self, raw: &RawFrame) -> Option<u16> {
+        self.config
+            .get_timestamps()
+            .then_some(rdtxr::TIME.get(raw[1]) as u16)
+    }
+
+    unsafe fn install_filters(&self, filters: &FilterPlan) -> Result<FmiMap, Error> {
+        let r = match &self.filter_regs {
+            Some(f) => filter_block::program(f, self.instance, filters),
+            None => filter_block::program(&self.regs, self.instance, filters),
+        };
+        r.map_err(|_| Error::InvalidArgument)?;
+        Ok(filters.fmi_map())
+    }
+
+    fn filter_map(&self) -> FmiMap {
+        self.fmi.clone()
+    }
+
+    /// `CAN_MSR`: `ERRI`, `WKUI`, `SLAKI` acknowledged; `CAN_ESR.LEC` reported and set
+    /// to 0b111 so the next error is seen as new (notes "Error management").
+    unsafe fn take_status(&self) -> StatusEvents {
+        let m = self.regs.read32(MSR);
+        let ack = m & (msr::ERRI | msr::WKUI | msr::SLAKI);
+        if ack != 0 {
+            self.regs.write32(MSR, ack);
+        }
+        let e = self.regs.read32(ESR);
+        let code = lec(esr::LEC.get(e));
+        let bus_error = if code != LastErrorCode::None {
+            self.last_error.store(code_index(code), Ordering::Relaxed);
+            self.regs.write32(ESR, esr::LEC.val(esr::LEC_SOFTWARE));
+            Some(code)
+        } else {
+            None
+        };
+        StatusEvents {
+            bus_error,
+            status: self.status_now(),
+            wakeup: m & msr::WKUI != 0,
+        }
+    }
+
+    fn error_status(&self) -> ErrorStatus {
+        self.status_now()
+    }
+
+    fn on_bus(&self) -> bool {
+        self.regs.read32(MSR) & (msr::INAK | msr::SLAK) == 0
+    }
+
+    fn set_mode(&self, mode: Mode) -> Result<(), Error> {
+        mode::request(&self.regs, mode, self.config.get_wait_iterations())
+    }
+
+    /// Manual recovery (`ABOM` = 0): when bus-off, enter and leave initialization mode;
+    /// the hardware then waits for 128 × 11 recessive bits. Refused with
+    /// [`Error::WrongMode`] when recovery is automatic (nothing to start).
+    fn recover(&self) -> Result<(), Error> {
+        if self.config.get_recovery() == Recovery::Automatic {
+            return Err(Error::WrongMode);
+        }
+        if self.regs.read32(ESR) & esr::BOFF == 0 {
+            return Ok(());
+        }
+        let bound = self.config.get_wait_iterations();
+        mode::request(&self.regs, Mode::Stopped, bound)?;
+        mode::request(&self.regs, Mode::Normal, bound)
+    }
+}
