@@ -5,7 +5,6 @@
 #[cfg(feature = "std")]
 extern crate std;
 
-pub mod buffer;
 pub mod controller;
 pub mod dispatch;
 pub mod driver;
@@ -15,8 +14,6 @@ pub mod filter;
 pub mod frame;
 pub mod hardware;
 pub mod mailbox;
-#[cfg(any(test, feature = "mock"))]
-pub mod mock;
 #[cfg(any(test, feature = "mock"))]
 pub mod mock_hw;
 pub mod priority;
@@ -28,8 +25,7 @@ pub mod spsc;
 pub mod timing;
 pub mod txqueue;
 
-pub use buffer::{BufferStats, Ring, TxQueue};
-pub use controller::{Controller, ErrorStatus, Events, Mode};
+pub use controller::{ErrorStatus, Mode};
 pub use dispatch::Dispatcher;
 pub use driver::{Driver, TrafficStats};
 pub use embedded_can::{ExtendedId, Id, StandardId};
@@ -40,6 +36,8 @@ pub use hardware::{Completion, Hardware, Settled, StatusEvents, Token, TxFailure
 pub use mailbox::{MailboxId, MailboxState, TxOutcome, TxPolicy};
 pub use priority::Priority;
 pub use registers::{Mmio, Registers};
+pub use split::State;
 pub use split::{AbortRequest, Parts, StateChange};
+pub use spsc::BufferStats;
 pub use spsc::SpscRing;
 pub use txqueue::{AnyQueue, FifoQueue, PriorityQueue};

@@ -208,6 +208,14 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
     }
 }
 
+impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize> Drop
+    for State<H, RX, Q, RX1, DONE>
+{
+    fn drop(&mut self) {
+        drop(self.uninstall());
+    }
+}
+
 /// The handles [`State::split`] hands out, each for one context.
 pub struct Parts<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize>
 {
@@ -282,16 +290,8 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
         self.state
             .store(state_code(status.state), Ordering::Release);
         Ok(Parts {
-            tx: Tx {
-                s: self,
-                next: 0,
-                last_error: None,
-            },
-            rx: Rx {
-                s: self,
-                map,
-                last_from: 0,
-            },
+            tx: Tx { s: self, next: 0 },
+            rx: Rx { s: self, map },
             tx_irq: TxIrq { s: self },
             rx0_irq: RxIrq { s: self, queue: 0 },
             rx1_irq: RxIrq { s: self, queue: 1 },
@@ -300,6 +300,30 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
                 last: status.state,
             },
         })
+    }
+
+    /// Stores `hardware` in a state owned exclusively (the one-struct
+    /// [`crate::Driver`]); returns the filter map and status for its handles.
+    pub(crate) fn install(&mut self, hardware: H) -> (H::FilterMap, ErrorStatus) {
+        let policy = hardware.tx_policy();
+        self.queue.get_mut().get_mut().adopt(policy);
+        self.hw.get_mut().write(hardware);
+        *self.taken.get_mut() = true;
+        let hw = self.hw();
+        let status = hw.error_status();
+        self.state
+            .store(state_code(status.state), Ordering::Relaxed);
+        (hw.filter_map(), status)
+    }
+
+    /// Takes the controller back out of a state owned exclusively.
+    pub(crate) fn uninstall(&mut self) -> Option<H> {
+        if !core::mem::replace(self.taken.get_mut(), false) {
+            return None;
+        }
+        // SAFETY: `taken` was set: `hw` holds a controller, moved out exactly once
+        // (the flag is cleared first).
+        Some(unsafe { self.hw.get_mut().assume_init_read() })
     }
 
     /// The controller, once [`State::split`] stored it.
@@ -429,6 +453,57 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
         }
     }
 
+    /// The consumer side of the receive rings: the oldest frame across both queues
+    /// (by time stamp when the hardware records one, else queue 0 first), decoded.
+    ///
+    /// # Safety
+    /// Called from the receive rings' one consumer context.
+    pub(crate) unsafe fn receive_with(&self, map: &H::FilterMap) -> nb::Result<RxFrame, Error> {
+        loop {
+            // SAFETY: the caller is the rings' only consumer.
+            let raw = unsafe { self.pop_raw() }.ok_or(nb::Error::WouldBlock)?;
+            match self.hw().decode(&raw, map) {
+                Some(frame) => return Ok(frame),
+                None => self.dropped.inc(),
+            }
+        }
+    }
+
+    /// # Safety
+    /// Called from the receive rings' one consumer context.
+    unsafe fn pop_raw(&self) -> Option<H::Raw> {
+        // SAFETY: the caller is the rings' only consumer.
+        unsafe {
+            if RX1 == 0 {
+                return self.rx0.pop();
+            }
+            match (self.rx0.peek(), self.rx1.peek()) {
+                (Some(a), Some(b)) => {
+                    let hw = self.hw();
+                    let first = match (hw.raw_timestamp(&a), hw.raw_timestamp(&b)) {
+                        (Some(ta), Some(tb)) => tb.wrapping_sub(ta) < 0x8000,
+                        _ => true,
+                    };
+                    if first {
+                        self.rx0.pop()
+                    } else {
+                        self.rx1.pop()
+                    }
+                }
+                (Some(_), None) => self.rx0.pop(),
+                (None, Some(_)) => self.rx1.pop(),
+                (None, None) => None,
+            }
+        }
+    }
+
+    /// # Safety
+    /// Called from the state-change ring's one consumer context.
+    pub(crate) unsafe fn pop_change(&self) -> Option<StateChange> {
+        // SAFETY: the caller is the ring's only consumer.
+        unsafe { self.changes.pop() }
+    }
+
     fn note_queue_peak(&self, len: u32) {
         if len > self.queue_peak.load(Ordering::Relaxed) {
             self.queue_peak.store(len, Ordering::Relaxed);
@@ -438,9 +513,8 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
 
 /// The transmit half: send frames, take their completions, abort them.
 pub struct Tx<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize> {
-    s: &'a State<H, RX, Q, RX1, DONE>,
-    next: u32,
-    last_error: Option<Error>,
+    pub(crate) s: &'a State<H, RX, Q, RX1, DONE>,
+    pub(crate) next: u32,
 }
 
 /// What [`Tx::abort`] did.
@@ -619,63 +693,24 @@ impl<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE:
     pub fn hardware(&self) -> &'a H {
         self.s.hw()
     }
-
-    /// The last error of a blocking operation, if any.
-    pub fn last_error(&self) -> Option<Error> {
-        self.last_error
-    }
 }
 
 /// The receive half: take frames with their user filter index, dispatch them, follow
 /// the error state.
 pub struct Rx<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize> {
-    s: &'a State<H, RX, Q, RX1, DONE>,
-    map: H::FilterMap,
-    last_from: u8,
+    pub(crate) s: &'a State<H, RX, Q, RX1, DONE>,
+    pub(crate) map: H::FilterMap,
 }
 
 impl<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize>
     Rx<'a, H, RX, Q, RX1, DONE>
 {
-    fn pop_raw(&mut self) -> Option<H::Raw> {
-        let s = self.s;
-        // SAFETY: the receive half is the only consumer of both receive rings.
-        unsafe {
-            if RX1 == 0 {
-                return s.rx0.pop();
-            }
-            match (s.rx0.peek(), s.rx1.peek()) {
-                (Some(a), Some(b)) => {
-                    let hw = s.hw();
-                    let first = match (hw.raw_timestamp(&a), hw.raw_timestamp(&b)) {
-                        (Some(ta), Some(tb)) => tb.wrapping_sub(ta) < 0x8000,
-                        _ => true,
-                    };
-                    self.last_from = if first { 0 } else { 1 };
-                    if first {
-                        s.rx0.pop()
-                    } else {
-                        s.rx1.pop()
-                    }
-                }
-                (Some(_), None) => s.rx0.pop(),
-                (None, Some(_)) => s.rx1.pop(),
-                (None, None) => None,
-            }
-        }
-    }
-
     /// Takes the oldest received frame, decoded, with the index of the user's filter
     /// that accepted it and its time stamp. `WouldBlock` when none is waiting.
     #[inline]
     pub fn receive(&mut self) -> nb::Result<RxFrame, Error> {
-        loop {
-            let raw = self.pop_raw().ok_or(nb::Error::WouldBlock)?;
-            match self.s.hw().decode(&raw, &self.map) {
-                Some(frame) => return Ok(frame),
-                None => self.s.dropped.inc(),
-            }
-        }
+        // SAFETY: the receive half is the receive rings' only consumer.
+        unsafe { self.s.receive_with(&self.map) }
     }
 
     /// Frames waiting in the receive ring(s) (ACAN `available()`).
@@ -702,7 +737,7 @@ impl<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE:
     /// The next error-state change, in order, with the counters at the change.
     pub fn take_state_change(&mut self) -> Option<StateChange> {
         // SAFETY: the receive half is the state-change ring's only consumer.
-        unsafe { self.s.changes.pop() }
+        unsafe { self.s.pop_change() }
     }
 
     /// Installs a new compiled filter list. Frames still in the ring that the old list
@@ -737,7 +772,7 @@ impl<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE:
 /// The transmit interrupt handler.
 pub struct TxIrq<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize>
 {
-    s: &'a State<H, RX, Q, RX1, DONE>,
+    pub(crate) s: &'a State<H, RX, Q, RX1, DONE>,
 }
 
 impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize>
@@ -757,8 +792,8 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
 /// The receive interrupt handler of one hardware receive queue.
 pub struct RxIrq<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize>
 {
-    s: &'a State<H, RX, Q, RX1, DONE>,
-    queue: u8,
+    pub(crate) s: &'a State<H, RX, Q, RX1, DONE>,
+    pub(crate) queue: u8,
 }
 
 impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize>
@@ -816,8 +851,8 @@ pub struct StatusIrq<
     const RX1: usize,
     const DONE: usize,
 > {
-    s: &'a State<H, RX, Q, RX1, DONE>,
-    last: ErrorState,
+    pub(crate) s: &'a State<H, RX, Q, RX1, DONE>,
+    pub(crate) last: ErrorState,
 }
 
 impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize>

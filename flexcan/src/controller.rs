@@ -69,25 +69,25 @@ enum Settled {
 /// `receive`, `dispatchReceivedMessage` and buffer statistics.
 #[derive(Debug)]
 pub struct FlexCan<R: Registers> {
-    regs: R,
-    target: Target,
-    table: FilterTable,
-    listen_only: bool,
-    polls: u32,
-    irq_priority: u8,
-    mode: Mode,
+    pub(crate) regs: R,
+    pub(crate) target: Target,
+    pub(crate) table: FilterTable,
+    pub(crate) listen_only: bool,
+    pub(crate) polls: u32,
+    pub(crate) irq_priority: u8,
+    pub(crate) mode: Mode,
     /// Mailboxes loaded for transmission whose end has not been accounted (bit n: MBn).
-    in_flight: u16,
+    pub(crate) in_flight: u16,
     /// Completions accounted outside `take_events` (when a mailbox is reused).
-    pending: Events,
+    pub(crate) pending: Events,
     /// The newest error `ESR1` reported.
-    last_error: Cell<LastErrorCode>,
+    pub(crate) last_error: Cell<LastErrorCode>,
     /// An error read from `ESR1` not yet handed out by `take_events`.
-    unreported_error: Cell<Option<LastErrorCode>>,
+    pub(crate) unreported_error: Cell<Option<LastErrorCode>>,
     /// `ESR1.FLTCONF` as `take_events` last saw it.
-    fault: u32,
+    pub(crate) fault: u32,
     /// Frames received with an `IDHIT` that maps to no filter.
-    unresolved_hits: u32,
+    pub(crate) unresolved_hits: u32,
 }
 
 impl<R: Registers> FlexCan<R> {
@@ -241,7 +241,7 @@ impl<R: Registers> FlexCan<R> {
     }
 
     /// Writes the filter table and masks (freeze mode).
-    pub(crate) fn write_filters(regs: &mut R, table: &FilterTable) {
+    pub(crate) fn write_filters(regs: &R, table: &FilterTable) {
         for (i, e) in table.elements().iter().enumerate() {
             regs.write32(regs::rx_fifo_filter(i), *e);
         }

@@ -37,25 +37,25 @@ pub fn wait_mcr<R: Registers>(regs: &R, bit: u32, set: bool, polls: u32) -> Resu
 }
 
 /// Disables the module (`MDIS`, waits for `LPMACK`).
-pub fn disable<R: Registers>(regs: &mut R, polls: u32) -> Result<(), Error> {
+pub fn disable<R: Registers>(regs: &R, polls: u32) -> Result<(), Error> {
     regs.modify32(MCR, |v| v | mcr::MDIS);
     wait_mcr(regs, mcr::LPMACK, true, polls)
 }
 
 /// Enables the module (clears `MDIS`, waits for `LPMACK` to clear).
-pub fn enable<R: Registers>(regs: &mut R, polls: u32) -> Result<(), Error> {
+pub fn enable<R: Registers>(regs: &R, polls: u32) -> Result<(), Error> {
     regs.modify32(MCR, |v| v & !mcr::MDIS);
     wait_mcr(regs, mcr::LPMACK, false, polls)
 }
 
 /// Soft reset (`SOFTRST`, waits until it clears itself).
-pub fn soft_reset<R: Registers>(regs: &mut R, polls: u32) -> Result<(), Error> {
+pub fn soft_reset<R: Registers>(regs: &R, polls: u32) -> Result<(), Error> {
     regs.modify32(MCR, |v| v | mcr::SOFTRST);
     wait_mcr(regs, mcr::SOFTRST, false, polls)
 }
 
 /// Enters freeze mode (`FRZ` and `HALT`, waits for `FRZACK`).
-pub fn freeze<R: Registers>(regs: &mut R, polls: u32) -> Result<(), Error> {
+pub fn freeze<R: Registers>(regs: &R, polls: u32) -> Result<(), Error> {
     regs.modify32(MCR, |v| v | mcr::FRZ | mcr::HALT);
     wait_mcr(regs, mcr::FRZACK, true, polls)
 }
@@ -63,7 +63,7 @@ pub fn freeze<R: Registers>(regs: &mut R, polls: u32) -> Result<(), Error> {
 /// Leaves freeze mode (clears `FRZ` and `HALT`, waits for `FRZACK` and then `NOTRDY`
 /// to clear). The module is then running but maybe not yet synchronised: see
 /// [`wait_synch`], or [`unfreeze`] for both steps.
-pub fn leave_freeze<R: Registers>(regs: &mut R, polls: u32) -> Result<(), Error> {
+pub fn leave_freeze<R: Registers>(regs: &R, polls: u32) -> Result<(), Error> {
     regs.modify32(MCR, |v| v & !(mcr::FRZ | mcr::HALT));
     wait_mcr(regs, mcr::FRZACK, false, polls)?;
     wait_mcr(regs, mcr::NOTRDY, false, polls)
@@ -91,7 +91,7 @@ pub fn wait_synch<R: Registers>(
 /// Leaves freeze mode ([`leave_freeze`]) and waits until the module is synchronised to
 /// the bus ([`wait_synch`]): when it returns `Ok`, a frame starting on the bus is
 /// received.
-pub fn unfreeze<R: Registers>(regs: &mut R, polls: u32) -> Result<(), Error> {
+pub fn unfreeze<R: Registers>(regs: &R, polls: u32) -> Result<(), Error> {
     leave_freeze(regs, polls)?;
     wait_synch(regs, polls, |_| {})
 }

@@ -119,6 +119,7 @@ pub mod instance;
 mod message_buffer;
 pub mod settings;
 mod status;
+pub mod split;
 pub mod system;
 
 pub mod regs;
@@ -136,6 +137,7 @@ pub use begin_error::{BeginError, ConfigErrors};
 pub use board::{Board, Chip, InstancePins};
 pub use configuration::Configuration;
 pub use controller::FlexCan;
+pub use split::FlexCanHw;
 pub use filters::{FilterTable, UNKNOWN_FILTER};
 #[cfg(any(feature = "teensy32", feature = "teensy35", feature = "teensy36"))]
 pub use instance::Can0;

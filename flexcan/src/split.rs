@@ -1,0 +1,466 @@
+//! The FlexCAN controller as the portable split driver uses it
+//! ([`twocan_core::split`]): [`FlexCanHw`], built from a started [`FlexCan`] with
+//! [`FlexCan::into_split`].
+//!
+//! Interrupt lines (Kinetis RM, FlexCAN "Interrupts"): the ORed message-buffer vector
+//! runs both the transmit handler ([`twocan_core::split::TxIrq`]: settle MB15 and the
+//! remote-frame mailboxes, refill) and the receive handler
+//! ([`twocan_core::split::RxIrq`] of queue 0: the Rx FIFO); the bus-off, error,
+//! Tx/Rx-warning and wake-up vectors run the status handler
+//! ([`twocan_core::split::StatusIrq`]). Who touches which register:
+//! - transmit half and transmit handler: `IFLAG1` read, the words of one transmit
+//!   mailbox that is inactive and settled (code `INACTIVE`, its `IFLAG1` bit clear);
+//! - transmit handler: `IFLAG1` write-1-to-clear of the transmit mailboxes' bits;
+//! - receive handler: MB0–MB3 (the Rx FIFO output), `RXFIR`, `IFLAG1` write-1-to-clear
+//!   of `BUF5I`/`BUF6I`/`BUF7I`;
+//! - status handler: `ESR1` write-1-to-clear of exactly the bits it read, `ECR` read.
+//!
+//! A raw received frame is the Rx FIFO output's four words (control/status,
+//! identifier, data) and `RXFIR.IDHIT`; the thread side decodes it and maps the hit
+//! to the user's filter ([`FilterTable::filter_index`]).
+
+use core::sync::atomic::{AtomicU32, AtomicU8, Ordering};
+
+use twocan_core::hardware::{Completion, Settled, StatusEvents, Token};
+use twocan_core::{
+    Error, ErrorCounters, ErrorState, ErrorStatus, Frame, Hardware, LastErrorCode, Mode,
+    Registers, RxFrame, TxOutcome, TxPolicy,
+};
+
+use crate::configuration::{Configuration, DATA_MAILBOX};
+use crate::controller::FlexCan;
+use crate::filters::{FilterTable, UNKNOWN_FILTER};
+use crate::handshake;
+use crate::instance::Target;
+use crate::regs::{self, code, cs, esr1, iflag1, rxfir, ECR, ESR1, IFLAG1, RXFIR};
+use crate::status;
+
+/// One received frame: the Rx FIFO output's control/status, identifier and two data
+/// words, and `RXFIR.IDHIT`.
+pub type RawFrame = [u32; 5];
+
+/// Transmit mailboxes at most (MB15 and up to seven remote-frame mailboxes).
+const MAX_TX: usize = 8;
+
+const MODE_NORMAL: u8 = 0;
+const MODE_STOPPED: u8 = 1;
+const MODE_SLEEP: u8 = 2;
+
+fn mode_code(m: Mode) -> u8 {
+    match m {
+        Mode::Normal => MODE_NORMAL,
+        Mode::Stopped => MODE_STOPPED,
+        Mode::Sleep => MODE_SLEEP,
+    }
+}
+
+const CODES: [LastErrorCode; 7] = [
+    LastErrorCode::None,
+    LastErrorCode::Stuff,
+    LastErrorCode::Form,
+    LastErrorCode::Acknowledge,
+    LastErrorCode::BitRecessive,
+    LastErrorCode::BitDominant,
+    LastErrorCode::Crc,
+];
+
+fn code_index(c: LastErrorCode) -> u8 {
+    CODES.iter().position(|&x| x == c).unwrap_or(0) as u8
+}
+
+/// A FlexCAN instance shared by the halves and handlers of the split driver.
+pub struct FlexCanHw<R: Registers> {
+    regs: R,
+    target: Target,
+    table: FilterTable,
+    listen_only: bool,
+    polls: u32,
+    irq_priority: u8,
+    mode: AtomicU8,
+    /// Token of the frame in each transmit mailbox, indexed by `15 - MB`.
+    tokens: [AtomicU32; MAX_TX],
+    last_error: AtomicU8,
+}
+
+impl<R: Registers> FlexCan<R> {
+    /// The controller for the split driver (`twocan_core::split::State::split`); the
+    /// installed filter table comes along.
+    pub fn into_split(self) -> FlexCanHw<R> {
+        let mode = self.mode;
+        FlexCanHw {
+            regs: self.regs,
+            target: self.target,
+            table: self.table,
+            listen_only: self.listen_only,
+            polls: self.polls,
+            irq_priority: self.irq_priority,
+            mode: AtomicU8::new(mode_code(mode)),
+            tokens: [const { AtomicU32::new(0) }; MAX_TX],
+            last_error: AtomicU8::new(code_index(self.last_error.get())),
+        }
+    }
+}
+
+impl<R: Registers> FlexCanHw<R> {
+    /// Which instance of which chip.
+    pub const fn target(&self) -> Target {
+        self.target
+    }
+
+    /// The message-buffer configuration.
+    pub const fn configuration(&self) -> Configuration {
+        self.table.configuration()
+    }
+
+    /// `mMessageIRQPriority` of the settings `begin` took.
+    pub const fn message_irq_priority(&self) -> u8 {
+        self.irq_priority
+    }
+
+    /// The registers (for inspection).
+    pub fn registers(&self) -> &R {
+        &self.regs
+    }
+
+    fn mode(&self) -> u8 {
+        self.mode.load(Ordering::Relaxed)
+    }
+
+    /// The transmit mailboxes' bits in `IFLAG1`: remote-frame mailboxes and MB15.
+    fn tx_bits(&self) -> u32 {
+        let first = self.configuration().first_remote_mailbox() as u32;
+        (0xFFFF_u32 >> first << first) & 0xFFFF
+    }
+
+    fn latch(&self, esr: u32) -> Option<LastErrorCode> {
+        let code = status::last_error(esr);
+        if let Some(c) = code {
+            self.last_error.store(code_index(c), Ordering::Relaxed);
+        }
+        code
+    }
+
+    fn last_error(&self) -> LastErrorCode {
+        CODES[self.last_error.load(Ordering::Relaxed) as usize % CODES.len()]
+    }
+
+    fn status_now(&self) -> ErrorStatus {
+        if self.mode() == MODE_SLEEP {
+            return ErrorStatus {
+                state: ErrorState::Sleeping,
+                counters: ErrorCounters::default(),
+                last_error: self.last_error(),
+            };
+        }
+        let esr = self.regs.read32(ESR1);
+        self.latch(esr);
+        let (state, counters) = status::decode(esr, self.regs.read32(ECR));
+        let state = if self.mode() == MODE_STOPPED {
+            ErrorState::Stopped
+        } else {
+            state
+        };
+        ErrorStatus {
+            state,
+            counters,
+            last_error: self.last_error(),
+        }
+    }
+
+    fn mode_change(&self, mode: Mode) -> Result<(), Error> {
+        let polls = self.polls;
+        // From the hardware, not from the last request: a timed-out change may have
+        // completed since.
+        let disabled = self.regs.read32(regs::MCR) & (regs::mcr::MDIS | regs::mcr::LPMACK) != 0;
+        if disabled && mode != Mode::Sleep {
+            handshake::enable(&self.regs, polls)?;
+        }
+        match mode {
+            Mode::Normal => {
+                handshake::leave_freeze(&self.regs, polls)?;
+                self.mode.store(MODE_NORMAL, Ordering::Relaxed);
+                return handshake::wait_synch(&self.regs, polls, |esr| {
+                    self.latch(esr);
+                });
+            }
+            Mode::Stopped => handshake::freeze(&self.regs, polls)?,
+            Mode::Sleep => handshake::disable(&self.regs, polls)?,
+        }
+        self.mode.store(mode_code(mode), Ordering::Relaxed);
+        Ok(())
+    }
+}
+
+// SAFETY: the shared fields are atomics; the register accesses of each context are
+// those listed in the module docs (disjoint registers, write-1-to-clear bits).
+unsafe impl<R: Registers + Sync> Sync for FlexCanHw<R> {}
+
+// SAFETY: as for `Sync`: each method stays within its context's registers.
+unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
+    type Raw = RawFrame;
+    type FilterMap = FilterTable;
+    type Filters = FilterTable;
+
+    /// MB15 is the one data mailbox: request order (ACAN §3 "sequentiality").
+    fn tx_policy(&self) -> TxPolicy {
+        TxPolicy::Fifo
+    }
+
+    /// Data frames: MB15; remote frames: the first free remote-frame mailbox (ACAN §9).
+    /// Free means code `INACTIVE` and its `IFLAG1` bit clear (settled). Refused with
+    /// [`Error::WrongMode`] in listen-only mode and while disabled (sleep).
+    #[inline(always)]
+    fn free_mailbox(&self, frame: &Frame) -> Result<Option<u8>, Error> {
+        if self.listen_only || self.mode() == MODE_SLEEP {
+            return Err(Error::WrongMode);
+        }
+        let flags = self.regs.read32(IFLAG1);
+        let free = |mb: usize| {
+            flags & iflag1::buf(mb) == 0
+                && cs::CODE.get(self.regs.read32(regs::mb_cs(mb))) == code::TX_INACTIVE
+        };
+        if !frame.is_remote() {
+            let mb = DATA_MAILBOX as usize;
+            return Ok(free(mb).then_some(DATA_MAILBOX));
+        }
+        let first = self.configuration().first_remote_mailbox() as usize;
+        Ok((first..DATA_MAILBOX as usize).find(|&mb| free(mb)).map(|mb| mb as u8))
+    }
+
+    /// Identifier and data first, the control word (CODE `DATA`) last (Kinetis RM,
+    /// "Transmit process").
+    #[inline(always)]
+    unsafe fn load(&self, mailbox: u8, frame: &Frame, token: Token) {
+        let mb = mailbox as usize;
+        self.tokens[DATA_MAILBOX as usize - mb].store(token.0, Ordering::Release);
+        let raw = frame.raw_id();
+        let (id, ext) = if frame.is_extended() {
+            (raw, cs::SRR | cs::IDE)
+        } else {
+            (raw << 18, 0)
+        };
+        let rtr = if frame.is_remote() { cs::RTR } else { 0 };
+        let d = frame.data_padded();
+        self.regs.write32(regs::mb_id(mb), id);
+        self.regs
+            .write32(regs::mb_word0(mb), u32::from_be_bytes([d[0], d[1], d[2], d[3]]));
+        self.regs
+            .write32(regs::mb_word1(mb), u32::from_be_bytes([d[4], d[5], d[6], d[7]]));
+        self.regs.write32(
+            regs::mb_cs(mb),
+            cs::CODE.val(code::TX_DATA) | cs::DLC.val(frame.dlc() as u32) | ext | rtr,
+        );
+    }
+
+    /// Each transmit mailbox with its `IFLAG1` bit set ended: code `ABORT` means
+    /// aborted, anything else sent (with the TIME STAMP the hardware wrote). The flag
+    /// is acknowledged and the mailbox made `INACTIVE` again (a remote-frame mailbox
+    /// became a receive mailbox for the answer; an aborted one shows `ABORT`).
+    unsafe fn settle<G: FnMut(Settled)>(&self, mut f: G) {
+        if self.mode() == MODE_SLEEP {
+            return;
+        }
+        let ended = self.regs.read32(IFLAG1) & self.tx_bits();
+        if ended == 0 {
+            return;
+        }
+        let mut out = [(0u32, Completion {
+            token: Token(0),
+            outcome: TxOutcome::Sent,
+            cause: None,
+            timestamp: None,
+        }); MAX_TX];
+        let mut n = 0;
+        for mb in (0..=DATA_MAILBOX as usize).filter(|&mb| ended & iflag1::buf(mb) != 0) {
+            let control = self.regs.read32(regs::mb_cs(mb));
+            let c = cs::CODE.get(control);
+            let token = Token(self.tokens[DATA_MAILBOX as usize - mb].load(Ordering::Acquire));
+            let (outcome, timestamp) = if c == code::TX_ABORT {
+                (TxOutcome::Aborted, None)
+            } else {
+                (TxOutcome::Sent, Some(cs::TIME_STAMP.get(control) as u16))
+            };
+            self.regs.write32(IFLAG1, iflag1::buf(mb));
+            if c != code::TX_INACTIVE {
+                self.regs
+                    .write32(regs::mb_cs(mb), cs::CODE.val(code::TX_INACTIVE));
+            }
+            out[n] = (
+                token.0,
+                Completion {
+                    token,
+                    outcome,
+                    cause: None,
+                    timestamp,
+                },
+            );
+            n += 1;
+        }
+        let out = &mut out[..n];
+        if n > 1 {
+            let base = out.iter().map(|e| e.0).fold(out[0].0, |a, b| {
+                if (b.wrapping_sub(a) as i32) < 0 {
+                    b
+                } else {
+                    a
+                }
+            });
+            out.sort_unstable_by_key(|e| e.0.wrapping_sub(base));
+        }
+        for (_, c) in out.iter() {
+            f(Settled::Done(*c));
+        }
+    }
+
+    /// Writes code `ABORT` into the loaded mailbox holding `token` (Kinetis RM,
+    /// "Transmission abort mechanism"); the outcome comes with its `IFLAG1` bit.
+    unsafe fn request_abort(&self, token: Token) -> bool {
+        if self.mode() == MODE_SLEEP {
+            return false;
+        }
+        let flags = self.regs.read32(IFLAG1);
+        let first = self.configuration().first_remote_mailbox() as usize;
+        for mb in first..=DATA_MAILBOX as usize {
+            let control = self.regs.read32(regs::mb_cs(mb));
+            let loaded = flags & iflag1::buf(mb) == 0 && cs::CODE.get(control) == code::TX_DATA;
+            if loaded && self.tokens[DATA_MAILBOX as usize - mb].load(Ordering::Acquire) == token.0
+            {
+                self.regs
+                    .write32(regs::mb_cs(mb), cs::CODE.replace(control, code::TX_ABORT));
+                return true;
+            }
+        }
+        false
+    }
+
+    unsafe fn abort_all_mailboxes(&self) {
+        if self.mode() == MODE_SLEEP {
+            return;
+        }
+        let flags = self.regs.read32(IFLAG1);
+        let first = self.configuration().first_remote_mailbox() as usize;
+        for mb in first..=DATA_MAILBOX as usize {
+            let control = self.regs.read32(regs::mb_cs(mb));
+            if flags & iflag1::buf(mb) == 0 && cs::CODE.get(control) == code::TX_DATA {
+                self.regs
+                    .write32(regs::mb_cs(mb), cs::CODE.replace(control, code::TX_ABORT));
+            }
+        }
+    }
+
+    /// `IFLAG1.BUF5I`: reads the Rx FIFO output (control/status first, Kinetis RM "Rx
+    /// FIFO"), `RXFIR.IDHIT`, then pops it (write 1 to `BUF5I`). `BUF7I` (overflow:
+    /// frames lost) and `BUF6I` (warning) are acknowledged.
+    #[inline(always)]
+    unsafe fn read_rx(&self, _queue: usize, overrun: &mut bool) -> Option<RawFrame> {
+        if self.mode() == MODE_SLEEP {
+            return None;
+        }
+        let flags = self.regs.read32(IFLAG1);
+        let fifo_acks = flags & (iflag1::BUF6I | iflag1::BUF7I);
+        if fifo_acks != 0 {
+            *overrun |= flags & iflag1::BUF7I != 0;
+            self.regs.write32(IFLAG1, fifo_acks);
+        }
+        if flags & iflag1::BUF5I == 0 {
+            return None;
+        }
+        let raw = [
+            self.regs.read32(regs::mb_cs(0)),
+            self.regs.read32(regs::mb_id(0)),
+            self.regs.read32(regs::mb_word0(0)),
+            self.regs.read32(regs::mb_word1(0)),
+            rxfir::IDHIT.get(self.regs.read32(RXFIR)),
+        ];
+        self.regs.write32(IFLAG1, iflag1::BUF5I);
+        Some(raw)
+    }
+
+    /// The frame, the user's filter for `IDHIT` ([`FilterTable::filter_index`];
+    /// [`UNKNOWN_FILTER`] when it maps to none) and the TIME STAMP.
+    #[inline]
+    fn decode(&self, raw: &RawFrame, map: &FilterTable) -> Option<RxFrame> {
+        let [control, id, w0, w1, hit] = *raw;
+        let extended = control & cs::IDE != 0;
+        let raw_id = if extended { id & 0x1FFF_FFFF } else { (id >> 18) & 0x7FF };
+        let a = w0.to_be_bytes();
+        let b = w1.to_be_bytes();
+        let frame = Frame::from_words(
+            Frame::id_word(raw_id, extended, control & cs::RTR != 0),
+            cs::DLC.get(control) as u8,
+            [a[0], a[1], a[2], a[3], b[0], b[1], b[2], b[3]],
+        );
+        Some(RxFrame {
+            frame,
+            filter: map
+                .filter_index(hit as usize, &frame)
+                .unwrap_or(UNKNOWN_FILTER),
+            timestamp: Some(cs::TIME_STAMP.get(control) as u16),
+        })
+    }
+
+    fn raw_timestamp(&self, raw: &RawFrame) -> Option<u16> {
+        Some(cs::TIME_STAMP.get(raw[0]) as u16)
+    }
+
+    /// Freeze, write the table, come back to the mode it was in (the table must be
+    /// compiled for the configuration `begin` chose).
+    unsafe fn install_filters(&self, filters: &FilterTable) -> Result<FilterTable, Error> {
+        if filters.configuration() != self.configuration() {
+            return Err(Error::InvalidArgument);
+        }
+        let previous = match self.mode() {
+            MODE_NORMAL => Mode::Normal,
+            MODE_STOPPED => Mode::Stopped,
+            _ => Mode::Sleep,
+        };
+        self.mode_change(Mode::Stopped)?;
+        FlexCan::write_filters(&self.regs, filters);
+        self.mode_change(previous)?;
+        Ok(filters.clone())
+    }
+
+    fn filter_map(&self) -> FilterTable {
+        self.table.clone()
+    }
+
+    /// `ESR1`: the error code latched, the write-1-to-clear interrupt bits read
+    /// acknowledged (exactly those), wake-up; the state from `FLTCONF` and `ECR`.
+    unsafe fn take_status(&self) -> StatusEvents {
+        if self.mode() == MODE_SLEEP {
+            return StatusEvents {
+                bus_error: None,
+                status: self.status_now(),
+                wakeup: false,
+            };
+        }
+        let esr = self.regs.read32(ESR1);
+        let bus_error = self.latch(esr);
+        if esr & esr1::W1C_BITS != 0 {
+            self.regs.write32(ESR1, esr & esr1::W1C_BITS);
+        }
+        StatusEvents {
+            bus_error,
+            status: self.status_now(),
+            wakeup: esr & esr1::WAKINT != 0,
+        }
+    }
+
+    fn error_status(&self) -> ErrorStatus {
+        self.status_now()
+    }
+
+    fn on_bus(&self) -> bool {
+        self.mode() == MODE_NORMAL
+    }
+
+    fn set_mode(&self, mode: Mode) -> Result<(), Error> {
+        self.mode_change(mode)
+    }
+
+    /// FlexCAN here recovers from bus-off automatically (`CTRL1.BOFFREC` = 0, as
+    /// ACAN): there is nothing to start, so the request is refused.
+    fn recover(&self) -> Result<(), Error> {
+        Err(Error::WrongMode)
+    }
+}
