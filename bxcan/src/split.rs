@@ -30,10 +30,10 @@ use crate::controller::{lec, Can};
 use crate::filter_block;
 use crate::filters::{Fifo, FilterPlan, FmiMap};
 use crate::instance::Instance;
+use crate::mailbox;
 use crate::mode;
 use crate::regs::{
-    esr, msr, rdhxr, rdlxr, rdtxr, rfxr, rixr, tdhxr, tdlxr, tdtxr, tixr, tsr, ESR, MSR, TSR,
-    TX_MAILBOXES,
+    esr, msr, rdhxr, rdlxr, rdtxr, rfxr, rixr, tdtxr, tsr, ESR, MSR, TSR, TX_MAILBOXES,
 };
 
 /// `CAN_TSR.TMEx` of the three mailboxes.
@@ -102,26 +102,6 @@ fn code_index(c: LastErrorCode) -> u8 {
     CODES.iter().position(|&x| x == c).unwrap_or(0) as u8
 }
 
-/// The mailbox identifier word (`CAN_TIxR` without `TXRQ`) of a frame's identifier word.
-#[inline(always)]
-fn tir_of(frame: &Frame) -> u32 {
-    let raw = frame.raw_id();
-    let rtr = if frame.is_remote() { tixr::RTR } else { 0 };
-    if frame.is_extended() {
-        (raw << 3) | tixr::IDE | rtr
-    } else {
-        (raw << 21) | rtr
-    }
-}
-
-/// The frame's identifier word from `CAN_RIxR`/`CAN_TIxR`.
-#[inline(always)]
-fn word_of(ir: u32) -> u32 {
-    let extended = ir & rixr::IDE != 0;
-    let raw = if extended { ir >> 3 } else { ir >> 21 };
-    Frame::id_word(raw, extended, ir & rixr::RTR != 0)
-}
-
 impl<R: Registers, F: Registers> BxCan<R, F> {
     /// The instance.
     pub fn instance(&self) -> Instance {
@@ -139,13 +119,7 @@ impl<R: Registers, F: Registers> BxCan<R, F> {
     }
 
     fn read_frame(&self, x: usize) -> Frame {
-        let lo = self.regs.read32(tdlxr(x));
-        let hi = self.regs.read32(tdhxr(x));
-        let dlc = rdtxr::DLC.get(self.regs.read32(tdtxr(x))) as u8;
-        let mut data = [0u8; 8];
-        data[..4].copy_from_slice(&lo.to_le_bytes());
-        data[4..].copy_from_slice(&hi.to_le_bytes());
-        Frame::from_words(word_of(self.regs.read32(tixr(x))), dlc, data)
+        mailbox::read_tx(&self.regs, x)
     }
 
     fn status_now(&self) -> ErrorStatus {
@@ -210,13 +184,7 @@ unsafe impl<R: Registers, F: Registers> Hardware for BxCan<R, F> {
     unsafe fn load(&self, mailbox: u8, frame: &Frame, token: Token) {
         let x = mailbox as usize;
         self.tokens[x].store(token.0, Ordering::Release);
-        let d = frame.data_padded();
-        self.regs.write32(tdtxr(x), frame.dlc() as u32);
-        self.regs
-            .write32(tdlxr(x), u32::from_le_bytes([d[0], d[1], d[2], d[3]]));
-        self.regs
-            .write32(tdhxr(x), u32::from_le_bytes([d[4], d[5], d[6], d[7]]));
-        self.regs.write32(tixr(x), tir_of(frame) | tixr::TXRQ);
+        mailbox::load(&self.regs, x, frame);
     }
 
     /// For each `RQCPx` (RM0410 §40.9.2): `TXOKx` → sent (with `CAN_TDTxR.TIME` when
@@ -383,10 +351,7 @@ unsafe impl<R: Registers, F: Registers> Hardware for BxCan<R, F> {
     #[inline]
     fn decode(&self, raw: &RawFrame, map: &FmiMap) -> Option<RxFrame> {
         let [ir, dt, lo, hi] = *raw;
-        let mut data = [0u8; 8];
-        data[..4].copy_from_slice(&lo.to_le_bytes());
-        data[4..].copy_from_slice(&hi.to_le_bytes());
-        let frame = Frame::from_words(word_of(ir), rdtxr::DLC.get(dt) as u8, data);
+        let frame = mailbox::frame_of(ir, rdtxr::DLC.get(dt), lo, hi);
         let fifo = if (dt >> 4) & 1 == 0 {
             Fifo::Fifo0
         } else {

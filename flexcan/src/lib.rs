@@ -118,8 +118,8 @@ mod handshake;
 pub mod instance;
 mod message_buffer;
 pub mod settings;
-mod status;
 pub mod split;
+mod status;
 pub mod system;
 
 pub mod regs;
@@ -137,7 +137,6 @@ pub use begin_error::{BeginError, ConfigErrors};
 pub use board::{Board, Chip, InstancePins};
 pub use configuration::Configuration;
 pub use controller::FlexCan;
-pub use split::FlexCanHw;
 pub use filters::{FilterTable, UNKNOWN_FILTER};
 #[cfg(any(feature = "teensy32", feature = "teensy35", feature = "teensy36"))]
 pub use instance::Can0;
@@ -145,6 +144,7 @@ pub use instance::Can0;
 pub use instance::Can1;
 pub use instance::{Instance, Irqs, Target};
 pub use settings::{Settings, CAN_CLOCK_HZ, RECEIVE_BUFFER_SIZE, TRANSMIT_BUFFER_SIZE};
+pub use split::FlexCanHw;
 pub use system::HostSystem;
 
 /// The driver with ACAN's default buffer sizes: a receive ring of 32 frames and a

@@ -3,7 +3,7 @@
 //! RTR, DLC, TIME STAMP), identifier (standard in bits 28–18, extended in 28–0), and
 //! two data words with byte 0 in the most significant byte of the first.
 
-use twocan_core::{Frame, FrameError, Registers};
+use twocan_core::{Frame, Registers};
 
 use crate::regs::{self, code, cs, id};
 
@@ -59,7 +59,7 @@ impl MbWords {
 
     /// Writes message buffer `n`: identifier and data first, the control word (which
     /// holds CODE and so activates the buffer) last.
-    pub fn write<R: Registers>(&self, regs: &mut R, n: usize) {
+    pub fn write<R: Registers>(&self, regs: &R, n: usize) {
         regs.write32(regs::mb_id(n), self.id);
         regs.write32(regs::mb_word0(n), self.word0);
         regs.write32(regs::mb_word1(n), self.word1);
@@ -67,23 +67,26 @@ impl MbWords {
     }
 
     /// The frame these words hold. A DLC of 9–15 counts as 8 (ISO 11898-1).
-    pub fn frame(&self) -> Result<Frame, FrameError> {
+    #[inline(always)]
+    pub fn frame(&self) -> Frame {
         let extended = self.cs & cs::IDE != 0;
         let raw = if extended {
             id::EXT_ID.get(self.id)
         } else {
             id::STD.get(self.id)
         };
-        let dlc = cs::DLC.get(self.cs).min(8) as u8;
         let w0 = self.word0.to_be_bytes();
         let w1 = self.word1.to_be_bytes();
-        let data = [w0[0], w0[1], w0[2], w0[3], w1[0], w1[1], w1[2], w1[3]];
-        Frame::from_registers(raw, extended, self.cs & cs::RTR != 0, dlc, data)
+        Frame::from_words(
+            Frame::id_word(raw, extended, self.cs & cs::RTR != 0),
+            cs::DLC.get(self.cs) as u8,
+            [w0[0], w0[1], w0[2], w0[3], w1[0], w1[1], w1[2], w1[3]],
+        )
     }
 
-    /// The TIME STAMP field: the free-running timer when the frame was received.
-    pub const fn timestamp(&self) -> u16 {
-        cs::TIME_STAMP.get(self.cs) as u16
+    /// The TIME STAMP field of a control/status word.
+    pub const fn timestamp_of(control: u32) -> u16 {
+        cs::TIME_STAMP.get(control) as u16
     }
 }
 
@@ -103,7 +106,8 @@ mod tests {
         for f in frames {
             let w = MbWords::transmit(&f);
             assert_eq!(cs::CODE.get(w.cs), code::TX_DATA);
-            assert_eq!(w.frame().unwrap(), f);
+            assert_eq!(w.frame(), f);
+            assert_eq!(MbWords::timestamp_of(w.cs), 0);
         }
         let w = MbWords::transmit(&frames[2]);
         assert_eq!(w.cs & (cs::SRR | cs::IDE), cs::SRR | cs::IDE);
@@ -113,6 +117,6 @@ mod tests {
             cs: cs::DLC.val(15),
             ..Default::default()
         };
-        assert_eq!(long.frame().unwrap().dlc(), 8);
+        assert_eq!(long.frame().dlc(), 8);
     }
 }

@@ -23,8 +23,8 @@ use core::sync::atomic::{AtomicU32, AtomicU8, Ordering};
 
 use twocan_core::hardware::{Completion, Settled, StatusEvents, Token};
 use twocan_core::{
-    Error, ErrorCounters, ErrorState, ErrorStatus, Frame, Hardware, LastErrorCode, Mode,
-    Registers, RxFrame, TxOutcome, TxPolicy,
+    Error, ErrorCounters, ErrorState, ErrorStatus, Frame, Hardware, LastErrorCode, Mode, Registers,
+    RxFrame, TxOutcome, TxPolicy,
 };
 
 use crate::configuration::{Configuration, DATA_MAILBOX};
@@ -32,6 +32,7 @@ use crate::controller::FlexCan;
 use crate::filters::{FilterTable, UNKNOWN_FILTER};
 use crate::handshake;
 use crate::instance::Target;
+use crate::message_buffer::MbWords;
 use crate::regs::{self, code, cs, esr1, iflag1, rxfir, ECR, ESR1, IFLAG1, RXFIR};
 use crate::status;
 
@@ -224,7 +225,9 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
             return Ok(free(mb).then_some(DATA_MAILBOX));
         }
         let first = self.configuration().first_remote_mailbox() as usize;
-        Ok((first..DATA_MAILBOX as usize).find(|&mb| free(mb)).map(|mb| mb as u8))
+        Ok((first..DATA_MAILBOX as usize)
+            .find(|&mb| free(mb))
+            .map(|mb| mb as u8))
     }
 
     /// Identifier and data first, the control word (CODE `DATA`) last (Kinetis RM,
@@ -233,23 +236,7 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
     unsafe fn load(&self, mailbox: u8, frame: &Frame, token: Token) {
         let mb = mailbox as usize;
         self.tokens[DATA_MAILBOX as usize - mb].store(token.0, Ordering::Release);
-        let raw = frame.raw_id();
-        let (id, ext) = if frame.is_extended() {
-            (raw, cs::SRR | cs::IDE)
-        } else {
-            (raw << 18, 0)
-        };
-        let rtr = if frame.is_remote() { cs::RTR } else { 0 };
-        let d = frame.data_padded();
-        self.regs.write32(regs::mb_id(mb), id);
-        self.regs
-            .write32(regs::mb_word0(mb), u32::from_be_bytes([d[0], d[1], d[2], d[3]]));
-        self.regs
-            .write32(regs::mb_word1(mb), u32::from_be_bytes([d[4], d[5], d[6], d[7]]));
-        self.regs.write32(
-            regs::mb_cs(mb),
-            cs::CODE.val(code::TX_DATA) | cs::DLC.val(frame.dlc() as u32) | ext | rtr,
-        );
+        MbWords::transmit(frame).write(&self.regs, mb);
     }
 
     /// Each transmit mailbox with its `IFLAG1` bit set ended: code `ABORT` means
@@ -264,12 +251,15 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
         if ended == 0 {
             return;
         }
-        let mut out = [(0u32, Completion {
-            token: Token(0),
-            outcome: TxOutcome::Sent,
-            cause: None,
-            timestamp: None,
-        }); MAX_TX];
+        let mut out = [(
+            0u32,
+            Completion {
+                token: Token(0),
+                outcome: TxOutcome::Sent,
+                cause: None,
+                timestamp: None,
+            },
+        ); MAX_TX];
         let mut n = 0;
         for mb in (0..=DATA_MAILBOX as usize).filter(|&mb| ended & iflag1::buf(mb) != 0) {
             let control = self.regs.read32(regs::mb_cs(mb));
@@ -365,11 +355,12 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
         if flags & iflag1::BUF5I == 0 {
             return None;
         }
+        let w = MbWords::read(&self.regs, 0);
         let raw = [
-            self.regs.read32(regs::mb_cs(0)),
-            self.regs.read32(regs::mb_id(0)),
-            self.regs.read32(regs::mb_word0(0)),
-            self.regs.read32(regs::mb_word1(0)),
+            w.cs,
+            w.id,
+            w.word0,
+            w.word1,
             rxfir::IDHIT.get(self.regs.read32(RXFIR)),
         ];
         self.regs.write32(IFLAG1, iflag1::BUF5I);
@@ -380,27 +371,25 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
     /// [`UNKNOWN_FILTER`] when it maps to none) and the TIME STAMP.
     #[inline]
     fn decode(&self, raw: &RawFrame, map: &FilterTable) -> Option<RxFrame> {
-        let [control, id, w0, w1, hit] = *raw;
-        let extended = control & cs::IDE != 0;
-        let raw_id = if extended { id & 0x1FFF_FFFF } else { (id >> 18) & 0x7FF };
-        let a = w0.to_be_bytes();
-        let b = w1.to_be_bytes();
-        let frame = Frame::from_words(
-            Frame::id_word(raw_id, extended, control & cs::RTR != 0),
-            cs::DLC.get(control) as u8,
-            [a[0], a[1], a[2], a[3], b[0], b[1], b[2], b[3]],
-        );
+        let [control, id, word0, word1, hit] = *raw;
+        let frame = MbWords {
+            cs: control,
+            id,
+            word0,
+            word1,
+        }
+        .frame();
         Some(RxFrame {
             frame,
             filter: map
                 .filter_index(hit as usize, &frame)
                 .unwrap_or(UNKNOWN_FILTER),
-            timestamp: Some(cs::TIME_STAMP.get(control) as u16),
+            timestamp: Some(MbWords::timestamp_of(control)),
         })
     }
 
     fn raw_timestamp(&self, raw: &RawFrame) -> Option<u16> {
-        Some(cs::TIME_STAMP.get(raw[0]) as u16)
+        Some(MbWords::timestamp_of(raw[0]))
     }
 
     /// Freeze, write the table, come back to the mode it was in (the table must be

@@ -141,7 +141,7 @@ mod tests {
 
     #[test]
     fn host_system_remembers() {
-        let mut s = HostSystem::new();
+        let s = HostSystem::new();
         assert_eq!(s.read32(0x10), 0);
         s.write32(0x10, 5);
         s.modify32(0x10, |v| v | 2);
