@@ -13,6 +13,8 @@ pub mod fault;
 pub mod filter;
 pub mod frame;
 pub mod hardware;
+pub mod io;
+pub mod irq_cell;
 pub mod mailbox;
 #[cfg(any(test, feature = "mock"))]
 pub mod mock_hw;
@@ -32,6 +34,7 @@ pub use embedded_can::{ExtendedId, Id, StandardId};
 pub use error::{Error, ErrorCounters, ErrorState, ErrorStatistics, LastErrorCode};
 pub use filter::{Filter, FilterError, Format, FrameKind};
 pub use frame::{Frame, FrameError, RxFrame};
+pub use io::{CanRx, CanTx};
 pub use hardware::{Completion, Hardware, Settled, StatusEvents, Token, TxFailure};
 pub use mailbox::{MailboxId, MailboxState, TxOutcome, TxPolicy};
 pub use priority::Priority;

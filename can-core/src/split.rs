@@ -769,6 +769,22 @@ impl<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE:
     }
 }
 
+impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize>
+    crate::io::CanTx for Tx<'_, H, RX, Q, RX1, DONE>
+{
+    fn try_send(&mut self, frame: &Frame) -> nb::Result<Token, Error> {
+        Tx::try_send(self, frame)
+    }
+}
+
+impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize>
+    crate::io::CanRx for Rx<'_, H, RX, Q, RX1, DONE>
+{
+    fn receive(&mut self) -> nb::Result<RxFrame, Error> {
+        Rx::receive(self)
+    }
+}
+
 /// The transmit interrupt handler.
 pub struct TxIrq<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize>
 {

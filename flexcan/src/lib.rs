@@ -1,6 +1,9 @@
 //! FlexCAN backend of twocan: the ACAN driver's feature set for Teensy 3.1/3.2, 3.5 and
 //! 3.6 (ACAN 1.0.5 manual, Pierre Molinaro), in Rust over twocan-core's
-//! [`Controller`](twocan_core::Controller) seam.
+//! [`Hardware`](twocan_core::Hardware) seam: [`FlexCan::begin`] configures the module,
+//! [`FlexCan::into_split`] hands it to the portable driver — the split halves and
+//! interrupt handlers of [`twocan_core::split`] in firmware, or the one-struct
+//! [`twocan_core::Driver`] for polling code.
 //!
 //! ACAN §4's LoopBackDemo, on the host over the behavioural model of the module
 //! (feature `model`) and twocan-core's simulated bus:
@@ -34,7 +37,7 @@
 //!     FlexCan::begin(regs, &mut HostSystem::new(), target, &settings, &primary, &secondary)
 //!         .expect("begin: no error of ACAN table 5");
 //! // ACAN's buffers: receive 32, transmit 16.
-//! let mut can: AcanDriver<IdleClocked> = AcanDriver::new(controller);
+//! let mut can: AcanDriver<IdleClocked> = AcanDriver::new(controller.into_split());
 //!
 //! can.try_send(&Frame::standard(0x542, &[1, 2]).unwrap()).unwrap(); // tryToSend
 //! can.try_send(&Frame::remote(0x1234, true, 0).unwrap()).unwrap();
@@ -61,13 +64,16 @@
 //! `thumbv7em-none-eabihf`), the singleton token gives the controller:
 //!
 //! ```ignore
-//! use twocan_flexcan::{AcanDriver, Can0, Settings};
+//! use twocan_core::{irq_cell::IrqCell, split::State, FifoQueue, Mmio};
+//! use twocan_flexcan::{Can0, FlexCanHw, Settings};
+//! static CAN0: State<FlexCanHw<Mmio>, 32, FifoQueue<16>> = State::new();
 //! let settings = Settings::new(500_000);
 //! let controller = Can0::take().unwrap().begin(&settings, &[], &[]).map_err(|(_, e)| e)?;
-//! let irqs = controller.target().irqs().unwrap(); // enable irqs.message in the NVIC
-//! let can: AcanDriver<_> = AcanDriver::new(controller);
-//! // Put `can` in a critical_section::Mutex<RefCell<Option<_>>>, call `on_interrupt`
-//! // from the CAN interrupt handler, `try_send` / `receive` / `dispatch` from thread code.
+//! let irqs = controller.target().irqs().unwrap();
+//! let parts = CAN0.split(controller.into_split()).ok().unwrap();
+//! // Put parts.tx_irq and parts.rx0_irq in an IrqCell run by the irqs.message vector,
+//! // parts.status_irq in one run by the bus-off/error/warning vectors, *then* unmask
+//! // those vectors; use parts.tx / parts.rx from thread code or tasks.
 //! ```
 //!
 //! # Board features
@@ -149,5 +155,6 @@ pub use system::HostSystem;
 
 /// The driver with ACAN's default buffer sizes: a receive ring of 32 frames and a
 /// transmit ring of 16 (ACAN table 7, §8.2, §10.1). Choose other sizes with
-/// `twocan_core::Driver<FlexCan<R>, RX, TX>`.
-pub type AcanDriver<R> = twocan_core::Driver<FlexCan<R>, RECEIVE_BUFFER_SIZE, TRANSMIT_BUFFER_SIZE>;
+/// `twocan_core::Driver<FlexCanHw<R>, RX, TX>`.
+pub type AcanDriver<R> =
+    twocan_core::Driver<FlexCanHw<R>, RECEIVE_BUFFER_SIZE, TRANSMIT_BUFFER_SIZE>;

@@ -21,7 +21,7 @@
 #![no_std]
 #![deny(missing_docs)]
 
-use twocan_core::{Controller, Dispatcher, Driver, Filter, Format, Frame, FrameKind, RxFrame};
+use twocan_core::{CanRx, CanTx, Dispatcher, Filter, Format, Frame, FrameKind, RxFrame};
 
 /// Number of filters of the application's list.
 pub const FILTER_COUNT: usize = 4;
@@ -121,14 +121,24 @@ impl App {
         ]
     }
 
-    /// Runs one period of the application: handle what was received, answer requests,
-    /// publish. Call it from the main loop (on the host: every simulated millisecond).
-    pub fn step<C: Controller, const RX: usize, const TX: usize>(
-        &mut self,
-        driver: &mut Driver<C, RX, TX>,
-    ) {
-        while driver.dispatch(&mut self.dispatcher, &mut self.state) {}
+    /// Runs one period of the application with a one-struct driver (something that both
+    /// sends and receives): [`App::handle`], then [`App::publish`]. Call it from the main
+    /// loop (on the host: every simulated millisecond).
+    pub fn step<C: CanTx + CanRx>(&mut self, driver: &mut C) {
+        self.handle(driver);
+        self.publish(driver);
+    }
+
+    /// Handles every frame waiting in `rx` through the dispatcher (by filter index).
+    pub fn handle<R: CanRx>(&mut self, rx: &mut R) {
+        while let Ok(frame) = rx.receive() {
+            self.dispatcher.dispatch(&mut self.state, &frame);
+        }
         self.state.stats.unhandled = self.dispatcher.unhandled();
+    }
+
+    /// Answers requests and publishes this period's frames through `driver`.
+    pub fn publish<T: CanTx>(&mut self, driver: &mut T) {
         self.tick = self.tick.wrapping_add(1);
         // A frame refused earlier goes first, so that the heartbeat counter stays in order.
         if let Some(f) = self.pending.take() {
@@ -171,13 +181,9 @@ impl App {
     }
 
     /// Queues `frame`; if the queue is full keeps it for the next step and returns false.
-    fn send<C: Controller, const RX: usize, const TX: usize>(
-        &mut self,
-        driver: &mut Driver<C, RX, TX>,
-        frame: Frame,
-    ) -> bool {
+    fn send<T: CanTx>(&mut self, driver: &mut T, frame: Frame) -> bool {
         match driver.try_send(&frame) {
-            Ok(()) => {
+            Ok(_) => {
                 self.state.stats.sent += 1;
                 true
             }

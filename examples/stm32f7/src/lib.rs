@@ -5,9 +5,9 @@
 //! - [`board`]: the board facts (oscillator, CAN pins, LED), plain data;
 //! - `rt` (target only): clocks with `stm32f7xx-hal` after a bounded probe of the
 //!   external oscillator, CAN peripheral clocks and pins, SysTick, the panic handler;
-//! - [`time`], [`shared`]: the SysTick time base and the driver shared with its
-//!   interrupt handlers — the very files of `twocan-teensy` (nothing in them is
-//!   chip-specific).
+//! - [`can`]: the split driver's state and its interrupt vectors' handles;
+//! - [`time`]: the SysTick time base — the very file of `twocan-teensy` (nothing in it
+//!   is chip-specific).
 #![cfg_attr(not(test), no_std)]
 #![deny(missing_docs)]
 
@@ -21,10 +21,9 @@ compile_error!("choose the board: --features nucleo-f767zi or disco-f746g");
 compile_error!("choose one board feature only");
 
 pub mod board;
+pub mod can;
 #[cfg(target_os = "none")]
 pub mod rt;
-#[path = "../../teensy/src/shared.rs"]
-pub mod shared;
 #[path = "../../teensy/src/time.rs"]
 pub mod time;
 

@@ -137,13 +137,12 @@ pub fn boot() -> Boot {
     }
 }
 
-/// Unmasks the four bxCAN interrupts of an instance (TX, RX0, RX1, SCE: the driver's
-/// `on_interrupt` services them all). The handlers must be defined by the example.
+/// Unmasks the four bxCAN interrupts of an instance (TX, RX0, RX1, SCE), after the
+/// handles their vectors run are in place ([`crate::can::start`]).
 pub fn unmask(interrupts: [pac::Interrupt; 4]) {
     for irq in interrupts {
         // SAFETY: this crate's critical sections mask every interrupt
-        // (`critical-section-single-core`), and the handlers reach the driver only
-        // through its `critical_section::Mutex`.
+        // (`critical-section-single-core`); the vectors run handles put in place before.
         unsafe { cortex_m::peripheral::NVIC::unmask(irq) };
     }
 }

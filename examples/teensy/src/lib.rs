@@ -11,8 +11,8 @@
 //!   field at 0x400 ([`flash_config`]), the SysTick handler and the panic handler;
 //! - [`clock`]: the 16 MHz crystal started and the MCG switched to FBE with bounded
 //!   waits; OSCERCLK, FlexCAN's clock, enabled;
-//! - [`led`]: pin 13; [`time`]: a SysTick millisecond time base; [`shared`]: a driver
-//!   shared with its interrupt handler.
+//! - [`led`]: pin 13; [`time`]: a SysTick millisecond time base; [`can`]: the split
+//!   driver's state, its interrupt vectors' handles and their start-up order.
 //!
 //! Everything except `rt` is plain code over the [`io::Io`] trait, built and tested on
 //! the host as well.
@@ -33,14 +33,15 @@ compile_error!("choose the board: --features teensy32, teensy35 or teensy36");
 compile_error!("choose one board feature only");
 
 pub mod board;
+pub mod can;
 pub mod clock;
+pub mod filters_example;
 pub mod flash_config;
 pub mod io;
 pub mod led;
 pub mod regs;
 #[cfg(target_os = "none")]
 pub mod rt;
-pub mod shared;
 pub mod time;
 
 pub use board::Board;

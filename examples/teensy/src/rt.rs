@@ -57,45 +57,29 @@ extern "C" {
     // cortex-m-rt's default handler (an infinite loop unless the application defines
     // `DefaultHandler`).
     fn DefaultHandler();
-    // FlexCAN vectors, weakly aliased to `DefaultHandler` by the `device.x` build.rs
-    // writes; an example overrides one by defining a `#[no_mangle] extern "C" fn` of the
-    // same name.
-    fn CAN0_ORED_MESSAGE_BUFFER();
-    fn CAN0_BUS_OFF();
-    fn CAN0_ERROR();
-    fn CAN0_TX_WARNING();
-    fn CAN0_RX_WARNING();
+    // The FlexCAN wake-up vectors, weakly aliased to `DefaultHandler` by the `device.x`
+    // build.rs writes (the examples never enable them).
     fn CAN0_WAKE_UP();
-    #[cfg(feature = "teensy36")]
-    fn CAN1_ORED_MESSAGE_BUFFER();
-    #[cfg(feature = "teensy36")]
-    fn CAN1_BUS_OFF();
-    #[cfg(feature = "teensy36")]
-    fn CAN1_ERROR();
-    #[cfg(feature = "teensy36")]
-    fn CAN1_TX_WARNING();
-    #[cfg(feature = "teensy36")]
-    fn CAN1_RX_WARNING();
     #[cfg(feature = "teensy36")]
     fn CAN1_WAKE_UP();
 }
 
 const CAN0: [Vector; CAN_VECTORS_PER_INSTANCE] = [
-    CAN0_ORED_MESSAGE_BUFFER,
-    CAN0_BUS_OFF,
-    CAN0_ERROR,
-    CAN0_TX_WARNING,
-    CAN0_RX_WARNING,
+    can0_message,
+    can0_bus_off,
+    can0_error,
+    can0_tx_warning,
+    can0_rx_warning,
     CAN0_WAKE_UP,
 ];
 
 #[cfg(feature = "teensy36")]
 const CAN1: [Vector; CAN_VECTORS_PER_INSTANCE] = [
-    CAN1_ORED_MESSAGE_BUFFER,
-    CAN1_BUS_OFF,
-    CAN1_ERROR,
-    CAN1_TX_WARNING,
-    CAN1_RX_WARNING,
+    can1_message,
+    can1_bus_off,
+    can1_error,
+    can1_tx_warning,
+    can1_rx_warning,
     CAN1_WAKE_UP,
 ];
 
@@ -218,21 +202,73 @@ unsafe impl cortex_m::interrupt::InterruptNumber for Irq {
     }
 }
 
-/// Sets the priority of a FlexCAN controller's message interrupt from its settings
-/// (ACAN §16.7.4; the Kinetis NVIC keeps the 4 upper bits) and unmasks it. The
-/// `CANn_ORED_MESSAGE_BUFFER` handler must be defined by the example.
-pub fn enable_can_irq<R: twocan_core::Registers>(
+/// Sets the priority of a FlexCAN controller's interrupts from its settings
+/// (`mMessageIRQPriority`, ACAN §16.7.4; the Kinetis NVIC keeps the 4 upper bits) and
+/// unmasks the message, bus-off, error and warning lines. Call it after the handles the
+/// vectors run are in place ([`crate::can::start`] does).
+pub fn enable_can_irqs(
     nvic: &mut cortex_m::peripheral::NVIC,
-    can: &twocan_flexcan::FlexCan<R>,
+    irqs: twocan_flexcan::Irqs,
+    priority: u8,
 ) {
-    let Some(irqs) = can.target().irqs() else {
-        halt(CAN_BLINKS)
-    };
-    let irq = Irq(irqs.message);
-    // SAFETY: changing a priority is only unsound under priority-based critical sections;
-    // this crate's critical sections mask all interrupts (`critical-section-single-core`).
-    unsafe { nvic.set_priority(irq, can.message_irq_priority()) };
-    // SAFETY: as above; the handler only touches the driver through its
-    // `critical_section::Mutex`.
-    unsafe { cortex_m::peripheral::NVIC::unmask(irq) };
+    for n in [
+        irqs.message,
+        irqs.bus_off,
+        irqs.error,
+        irqs.tx_warning,
+        irqs.rx_warning,
+    ] {
+        let irq = Irq(n);
+        // SAFETY: changing a priority is only unsound under priority-based critical
+        // sections; this crate's critical sections mask all interrupts
+        // (`critical-section-single-core`).
+        unsafe { nvic.set_priority(irq, priority) };
+        // SAFETY: as above; the vectors run handles that were put in place before.
+        unsafe { cortex_m::peripheral::NVIC::unmask(irq) };
+    }
+}
+
+extern "C" fn can0_message() {
+    crate::can::CAN0_VECTORS.on_message();
+}
+
+extern "C" fn can0_bus_off() {
+    crate::can::CAN0_VECTORS.on_status();
+}
+
+extern "C" fn can0_error() {
+    crate::can::CAN0_VECTORS.on_status();
+}
+
+extern "C" fn can0_tx_warning() {
+    crate::can::CAN0_VECTORS.on_status();
+}
+
+extern "C" fn can0_rx_warning() {
+    crate::can::CAN0_VECTORS.on_status();
+}
+
+#[cfg(feature = "teensy36")]
+extern "C" fn can1_message() {
+    crate::can::CAN1_VECTORS.on_message();
+}
+
+#[cfg(feature = "teensy36")]
+extern "C" fn can1_bus_off() {
+    crate::can::CAN1_VECTORS.on_status();
+}
+
+#[cfg(feature = "teensy36")]
+extern "C" fn can1_error() {
+    crate::can::CAN1_VECTORS.on_status();
+}
+
+#[cfg(feature = "teensy36")]
+extern "C" fn can1_tx_warning() {
+    crate::can::CAN1_VECTORS.on_status();
+}
+
+#[cfg(feature = "teensy36")]
+extern "C" fn can1_rx_warning() {
+    crate::can::CAN1_VECTORS.on_status();
 }

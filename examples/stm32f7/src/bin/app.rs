@@ -19,36 +19,37 @@ mod firmware {
     use stm32f7xx_hal::pac::interrupt;
     use twocan_app::{App, AppStats};
     use twocan_bxcan::{regs, Can, Config, FifoPolicy, Recovery};
-    use twocan_core::{Driver, Mmio};
+    use twocan_core::Mmio;
     use twocan_stm32f7::board::BIT_RATE;
+    use twocan_stm32f7::can::{self, CanState, Vectors};
     use twocan_stm32f7::rt::{self, CAN_BLINKS};
-    use twocan_stm32f7::shared::SharedDriver;
     use twocan_stm32f7::time::{self, Every};
 
     /// This node and its peer.
     const NODE: u8 = 2;
     const PEER: u8 = 1;
 
-    static CAN1: SharedDriver<Can<Mmio>, 32, 16> = SharedDriver::new();
+    static CAN1: CanState = CanState::new();
+    static CAN1_VECTORS: Vectors = Vectors::new();
 
     /// The application's counters, copied after each step (`None` before the first).
     pub static STATS: Mutex<RefCell<Option<AppStats>>> = Mutex::new(RefCell::new(None));
 
     #[interrupt]
     fn CAN1_TX() {
-        CAN1.on_interrupt();
+        CAN1_VECTORS.on_tx();
     }
     #[interrupt]
     fn CAN1_RX0() {
-        CAN1.on_interrupt();
+        CAN1_VECTORS.on_rx0();
     }
     #[interrupt]
     fn CAN1_RX1() {
-        CAN1.on_interrupt();
+        CAN1_VECTORS.on_rx1();
     }
     #[interrupt]
     fn CAN1_SCE() {
-        CAN1.on_interrupt();
+        CAN1_VECTORS.on_sce();
     }
 
     #[cortex_m_rt::entry]
@@ -72,16 +73,16 @@ mod firmware {
             rt::halt(CAN_BLINKS);
         }
         let can = init.enable().unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        if CAN1.install(Driver::new(can)).is_err() {
-            rt::halt(CAN_BLINKS);
-        }
-        rt::unmask(rt::CAN1_IRQS);
+        let (mut tx, mut rx) = can::start(&CAN1, &CAN1_VECTORS, can.into_split(), rt::CAN1_IRQS)
+            .unwrap_or_else(|| rt::halt(CAN_BLINKS));
 
         let mut period = Every::new(time::millis(), 10);
         let mut shown = 0;
         loop {
             if period.due(time::millis()) {
-                CAN1.with(|d| app.step(d));
+                app.handle(&mut rx);
+                app.publish(&mut tx);
+                while tx.take_completion().is_some() {}
                 let stats = app.stats();
                 critical_section::with(|cs| *STATS.borrow_ref_mut(cs) = Some(stats));
                 if stats.heartbeats >= shown + 50 {

@@ -23,14 +23,16 @@ mod firmware {
     use stm32f7xx_hal::pac::interrupt;
     use twocan_app::{App, AppStats};
     use twocan_bxcan::{regs, Can, Config, FifoPolicy, Recovery};
-    use twocan_core::{Driver, Mmio};
+    use twocan_core::Mmio;
     use twocan_stm32f7::board::BIT_RATE;
+    use twocan_stm32f7::can::{self, CanState, Vectors};
     use twocan_stm32f7::rt::{self, CAN_BLINKS};
-    use twocan_stm32f7::shared::SharedDriver;
     use twocan_stm32f7::time::{self, Every};
 
-    static CAN1: SharedDriver<Can<Mmio>, 32, 16> = SharedDriver::new();
-    static CAN2: SharedDriver<Can<Mmio, Mmio>, 32, 16> = SharedDriver::new();
+    static CAN1: CanState = CanState::new();
+    static CAN1_VECTORS: Vectors = Vectors::new();
+    static CAN2: CanState = CanState::new();
+    static CAN2_VECTORS: Vectors = Vectors::new();
 
     /// The counters of node 1 (CAN1) and node 2 (CAN2), copied after each step
     /// (`None` before the first).
@@ -38,35 +40,35 @@ mod firmware {
 
     #[interrupt]
     fn CAN1_TX() {
-        CAN1.on_interrupt();
+        CAN1_VECTORS.on_tx();
     }
     #[interrupt]
     fn CAN1_RX0() {
-        CAN1.on_interrupt();
+        CAN1_VECTORS.on_rx0();
     }
     #[interrupt]
     fn CAN1_RX1() {
-        CAN1.on_interrupt();
+        CAN1_VECTORS.on_rx1();
     }
     #[interrupt]
     fn CAN1_SCE() {
-        CAN1.on_interrupt();
+        CAN1_VECTORS.on_sce();
     }
     #[interrupt]
     fn CAN2_TX() {
-        CAN2.on_interrupt();
+        CAN2_VECTORS.on_tx();
     }
     #[interrupt]
     fn CAN2_RX0() {
-        CAN2.on_interrupt();
+        CAN2_VECTORS.on_rx0();
     }
     #[interrupt]
     fn CAN2_RX1() {
-        CAN2.on_interrupt();
+        CAN2_VECTORS.on_rx1();
     }
     #[interrupt]
     fn CAN2_SCE() {
-        CAN2.on_interrupt();
+        CAN2_VECTORS.on_sce();
     }
 
     #[cortex_m_rt::entry]
@@ -112,18 +114,21 @@ mod firmware {
         }
         let can1 = init1.enable().unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         let can2 = init2.enable().unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        if CAN1.install(Driver::new(can1)).is_err() || CAN2.install(Driver::new(can2)).is_err() {
-            rt::halt(CAN_BLINKS);
-        }
-        rt::unmask(rt::CAN1_IRQS);
-        rt::unmask(rt::CAN2_IRQS);
+        let (mut tx1, mut rx1) = can::start(&CAN1, &CAN1_VECTORS, can1.into_split(), rt::CAN1_IRQS)
+            .unwrap_or_else(|| rt::halt(CAN_BLINKS));
+        let (mut tx2, mut rx2) = can::start(&CAN2, &CAN2_VECTORS, can2.into_split(), rt::CAN2_IRQS)
+            .unwrap_or_else(|| rt::halt(CAN_BLINKS));
 
         let mut period = Every::new(time::millis(), 10);
         let mut shown = 0;
         loop {
             if period.due(time::millis()) {
-                CAN1.with(|d| node1.step(d));
-                CAN2.with(|d| node2.step(d));
+                node1.handle(&mut rx1);
+                node1.publish(&mut tx1);
+                node2.handle(&mut rx2);
+                node2.publish(&mut tx2);
+                while tx1.take_completion().is_some() {}
+                while tx2.take_completion().is_some() {}
                 let stats = [node1.stats(), node2.stats()];
                 critical_section::with(|cs| *STATS.borrow_ref_mut(cs) = Some(stats));
                 let both = stats[0].heartbeats.min(stats[1].heartbeats);

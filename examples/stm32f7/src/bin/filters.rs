@@ -25,14 +25,15 @@ mod firmware {
 
     use stm32f7xx_hal::pac::interrupt;
     use twocan_bxcan::{regs, Can, Config, FifoPolicy};
-    use twocan_core::{Dispatcher, Driver, Filter, Format, Frame, FrameKind, Mmio, RxFrame};
+    use twocan_core::{Dispatcher, Filter, Format, Frame, FrameKind, Mmio, RxFrame};
+    use twocan_stm32f7::can::{self, CanState, Vectors};
     use twocan_stm32f7::rt::{self, CAN_BLINKS};
-    use twocan_stm32f7::shared::SharedDriver;
     use twocan_stm32f7::time::{self, Every};
 
     const FILTERS: usize = 6;
 
-    static CAN1: SharedDriver<Can<Mmio>, 32, 16> = SharedDriver::new();
+    static CAN1: CanState = CanState::new();
+    static CAN1_VECTORS: Vectors = Vectors::new();
 
     /// Frames per filter index.
     pub static HITS: [AtomicU32; FILTERS] = [const { AtomicU32::new(0) }; FILTERS];
@@ -43,19 +44,19 @@ mod firmware {
 
     #[interrupt]
     fn CAN1_TX() {
-        CAN1.on_interrupt();
+        CAN1_VECTORS.on_tx();
     }
     #[interrupt]
     fn CAN1_RX0() {
-        CAN1.on_interrupt();
+        CAN1_VECTORS.on_rx0();
     }
     #[interrupt]
     fn CAN1_RX1() {
-        CAN1.on_interrupt();
+        CAN1_VECTORS.on_rx1();
     }
     #[interrupt]
     fn CAN1_SCE() {
-        CAN1.on_interrupt();
+        CAN1_VECTORS.on_sce();
     }
 
     fn filters() -> [Filter; FILTERS] {
@@ -115,10 +116,8 @@ mod firmware {
             rt::halt(CAN_BLINKS);
         }
         let can = init.enable().unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        if CAN1.install(Driver::new(can)).is_err() {
-            rt::halt(CAN_BLINKS);
-        }
-        rt::unmask(rt::CAN1_IRQS);
+        let (mut tx, mut rx) = can::start(&CAN1, &CAN1_VECTORS, can.into_split(), rt::CAN1_IRQS)
+            .unwrap_or_else(|| rt::halt(CAN_BLINKS));
 
         let mut dispatcher: Dispatcher<(), FILTERS> = Dispatcher::new();
         for i in 0..FILTERS {
@@ -134,12 +133,13 @@ mod firmware {
         loop {
             if send.due(time::millis()) {
                 if let Ok(frame) = &list[next] {
-                    if CAN1.with(|d| d.try_send(frame).is_ok()) == Some(true) {
+                    if tx.try_send(frame).is_ok() {
                         next = (next + 1) % list.len();
                     }
                 }
             }
-            while CAN1.with(|d| d.dispatch(&mut dispatcher, &mut ())) == Some(true) {}
+            while tx.take_completion().is_some() {}
+            while rx.dispatch(&mut dispatcher, &mut ()) {}
             let rounds = HITS
                 .iter()
                 .map(|h| h.load(Ordering::Relaxed))

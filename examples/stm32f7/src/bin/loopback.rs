@@ -13,12 +13,13 @@ mod firmware {
 
     use stm32f7xx_hal::pac::interrupt;
     use twocan_bxcan::{regs, Can, Config, FifoPolicy};
-    use twocan_core::{Driver, Filter, Frame, Mmio};
+    use twocan_core::{Filter, Frame, Mmio};
+    use twocan_stm32f7::can::{self, CanState, Vectors};
     use twocan_stm32f7::rt::{self, CAN_BLINKS};
-    use twocan_stm32f7::shared::SharedDriver;
     use twocan_stm32f7::time::{self, Every};
 
-    static CAN1: SharedDriver<Can<Mmio>, 32, 16> = SharedDriver::new();
+    static CAN1: CanState = CanState::new();
+    static CAN1_VECTORS: Vectors = Vectors::new();
 
     /// Frames handed to the driver.
     pub static SENT: AtomicU32 = AtomicU32::new(0);
@@ -27,19 +28,19 @@ mod firmware {
 
     #[interrupt]
     fn CAN1_TX() {
-        CAN1.on_interrupt();
+        CAN1_VECTORS.on_tx();
     }
     #[interrupt]
     fn CAN1_RX0() {
-        CAN1.on_interrupt();
+        CAN1_VECTORS.on_rx0();
     }
     #[interrupt]
     fn CAN1_RX1() {
-        CAN1.on_interrupt();
+        CAN1_VECTORS.on_rx1();
     }
     #[interrupt]
     fn CAN1_SCE() {
-        CAN1.on_interrupt();
+        CAN1_VECTORS.on_sce();
     }
 
     #[cortex_m_rt::entry]
@@ -61,21 +62,20 @@ mod firmware {
             rt::halt(CAN_BLINKS);
         }
         let can = init.enable().unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        if CAN1.install(Driver::new(can)).is_err() {
-            rt::halt(CAN_BLINKS);
-        }
-        rt::unmask(rt::CAN1_IRQS);
+        let (mut tx, mut rx) = can::start(&CAN1, &CAN1_VECTORS, can.into_split(), rt::CAN1_IRQS)
+            .unwrap_or_else(|| rt::halt(CAN_BLINKS));
 
         let message = Frame::standard(0x542, &[]).unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         let mut send = Every::new(time::millis(), 1000);
         let mut due = false;
         loop {
             due |= send.due(time::millis());
-            if due && CAN1.with(|d| d.try_send(&message).is_ok()) == Some(true) {
+            if due && tx.try_send(&message).is_ok() {
                 due = false;
                 SENT.fetch_add(1, Ordering::Relaxed);
             }
-            while let Some(Ok(_frame)) = CAN1.with(|d| d.receive()) {
+            while tx.take_completion().is_some() {}
+            while rx.receive().is_ok() {
                 RECEIVED.fetch_add(1, Ordering::Relaxed);
                 boot.led.toggle();
             }

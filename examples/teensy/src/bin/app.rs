@@ -18,31 +18,22 @@ mod firmware {
 
     use critical_section::Mutex;
     use twocan_app::{App, AppStats};
-    use twocan_core::Mmio;
-    use twocan_flexcan::{
-        AcanDriver, Can0, FlexCan, Settings, RECEIVE_BUFFER_SIZE, TRANSMIT_BUFFER_SIZE,
-    };
+    use twocan_flexcan::{Can0, Settings};
+    use twocan_teensy::can::{self, CanState, CAN0_VECTORS};
     use twocan_teensy::rt::{self, CAN_BLINKS};
-    use twocan_teensy::shared::SharedDriver;
     use twocan_teensy::time::{self, Every};
 
     /// This node and its peer.
     const NODE: u8 = 1;
     const PEER: u8 = 2;
 
-    static CAN0: SharedDriver<FlexCan<Mmio>, RECEIVE_BUFFER_SIZE, TRANSMIT_BUFFER_SIZE> =
-        SharedDriver::new();
+    static CAN0: CanState = CanState::new();
 
     /// The application's counters, copied after each step (`None` before the first).
     pub static STATS: Mutex<RefCell<Option<AppStats>>> = Mutex::new(RefCell::new(None));
 
     /// 500 kbit/s, computed at compile time (the bit-timing solver is `const`).
     const SETTINGS: Settings = Settings::new(500_000);
-
-    #[no_mangle]
-    extern "C" fn CAN0_ORED_MESSAGE_BUFFER() {
-        CAN0.on_interrupt();
-    }
 
     #[cortex_m_rt::entry]
     fn main() -> ! {
@@ -53,17 +44,17 @@ mod firmware {
         let can = token
             .begin(&SETTINGS, &app.filters(), &[])
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        rt::enable_can_irq(&mut boot.core.NVIC, &can);
-        let driver: AcanDriver<Mmio> = AcanDriver::new(can);
-        if CAN0.install(driver).is_err() {
-            rt::halt(CAN_BLINKS);
-        }
+        let (mut tx, mut rx) =
+            can::start(&CAN0, &CAN0_VECTORS, can.into_split(), &mut boot.core.NVIC)
+                .unwrap_or_else(|| rt::halt(CAN_BLINKS));
 
         let mut period = Every::new(time::millis(), 10);
         let mut shown = 0;
         loop {
             if period.due(time::millis()) {
-                CAN0.with(|d| app.step(d));
+                app.handle(&mut rx);
+                app.publish(&mut tx);
+                while tx.take_completion().is_some() {}
                 let stats = app.stats();
                 critical_section::with(|cs| *STATS.borrow_ref_mut(cs) = Some(stats));
                 if stats.heartbeats >= shown + 50 {

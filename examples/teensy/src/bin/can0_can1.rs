@@ -17,18 +17,13 @@ mod firmware {
 
     use critical_section::Mutex;
     use twocan_app::{App, AppStats};
-    use twocan_core::Mmio;
-    use twocan_flexcan::{
-        AcanDriver, Can0, Can1, FlexCan, Settings, RECEIVE_BUFFER_SIZE, TRANSMIT_BUFFER_SIZE,
-    };
+    use twocan_flexcan::{Can0, Can1, Settings};
+    use twocan_teensy::can::{self, CanState, CAN0_VECTORS, CAN1_VECTORS};
     use twocan_teensy::rt::{self, CAN_BLINKS};
-    use twocan_teensy::shared::SharedDriver;
     use twocan_teensy::time::{self, Every};
 
-    static CAN0: SharedDriver<FlexCan<Mmio>, RECEIVE_BUFFER_SIZE, TRANSMIT_BUFFER_SIZE> =
-        SharedDriver::new();
-    static CAN1: SharedDriver<FlexCan<Mmio>, RECEIVE_BUFFER_SIZE, TRANSMIT_BUFFER_SIZE> =
-        SharedDriver::new();
+    static CAN0: CanState = CanState::new();
+    static CAN1: CanState = CanState::new();
 
     /// The counters of node 1 (CAN0) and node 2 (CAN1), copied after each step
     /// (`None` before the first).
@@ -36,16 +31,6 @@ mod firmware {
 
     /// 500 kbit/s, computed at compile time (the bit-timing solver is `const`).
     const SETTINGS: Settings = Settings::new(500_000);
-
-    #[no_mangle]
-    extern "C" fn CAN0_ORED_MESSAGE_BUFFER() {
-        CAN0.on_interrupt();
-    }
-
-    #[no_mangle]
-    extern "C" fn CAN1_ORED_MESSAGE_BUFFER() {
-        CAN1.on_interrupt();
-    }
 
     #[cortex_m_rt::entry]
     fn main() -> ! {
@@ -61,20 +46,22 @@ mod firmware {
             .unwrap_or_else(|| rt::halt(CAN_BLINKS))
             .begin(&SETTINGS, &node2.filters(), &[])
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        rt::enable_can_irq(&mut boot.core.NVIC, &can0);
-        rt::enable_can_irq(&mut boot.core.NVIC, &can1);
-        let d0: AcanDriver<Mmio> = AcanDriver::new(can0);
-        let d1: AcanDriver<Mmio> = AcanDriver::new(can1);
-        if CAN0.install(d0).is_err() || CAN1.install(d1).is_err() {
-            rt::halt(CAN_BLINKS);
-        }
+        let nvic = &mut boot.core.NVIC;
+        let (mut tx0, mut rx0) = can::start(&CAN0, &CAN0_VECTORS, can0.into_split(), nvic)
+            .unwrap_or_else(|| rt::halt(CAN_BLINKS));
+        let (mut tx1, mut rx1) = can::start(&CAN1, &CAN1_VECTORS, can1.into_split(), nvic)
+            .unwrap_or_else(|| rt::halt(CAN_BLINKS));
 
         let mut period = Every::new(time::millis(), 10);
         let mut shown = 0;
         loop {
             if period.due(time::millis()) {
-                CAN0.with(|d| node1.step(d));
-                CAN1.with(|d| node2.step(d));
+                node1.handle(&mut rx0);
+                node1.publish(&mut tx0);
+                node2.handle(&mut rx1);
+                node2.publish(&mut tx1);
+                while tx0.take_completion().is_some() {}
+                while tx1.take_completion().is_some() {}
                 let stats = [node1.stats(), node2.stats()];
                 critical_section::with(|cs| *STATS.borrow_ref_mut(cs) = Some(stats));
                 let both = stats[0].heartbeats.min(stats[1].heartbeats);

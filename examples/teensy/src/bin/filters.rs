@@ -1,12 +1,14 @@
 //! Primary and secondary filters with call-backs (ACAN manual §12–§14) on FlexCAN0, in
 //! loop-back with self reception (no transceiver needed).
 //!
-//! Filters, numbered as ACAN numbers them (primary first, then secondary):
-//! - #0 primary: extended data frame 0x123456 (ACAN §12.1);
-//! - #1 primary: standard data frame 0x234;
-//! - #2 primary: standard remote frame 0x542;
-//! - #3 secondary: standard data frames 0x300–0x30F (ACAN §13.2, with a mask);
-//! - #4 secondary: any extended data frame 0x18FF_xx00 (a masked extended filter).
+//! Filters, numbered as ACAN numbers them (primary first, then secondary). A secondary
+//! filter shares the global mask, so it must be exact or pass-all (ACAN §13.4): masked
+//! filters are primary.
+//! - #0 primary: standard data frames 0x300–0x30F (with a mask, ACAN §12.2);
+//! - #1 primary: any extended data frame 0x18FF_xx00 (a masked extended filter);
+//! - #2 primary: standard data frame 0x234;
+//! - #3 secondary: extended data frame 0x123456 (ACAN §13.2);
+//! - #4 secondary: standard remote frame 0x542.
 //!
 //! Every 100 ms the example sends the next frame of a list that hits each filter once and
 //! one frame (0x777) that no filter accepts; each filter's call-back counts its frames
@@ -21,18 +23,14 @@
 mod firmware {
     use core::sync::atomic::{AtomicU32, Ordering};
 
-    use twocan_core::{Dispatcher, Filter, Format, Frame, FrameKind, Mmio, RxFrame};
-    use twocan_flexcan::{
-        AcanDriver, Can0, FlexCan, Settings, RECEIVE_BUFFER_SIZE, TRANSMIT_BUFFER_SIZE,
-    };
+    use twocan_core::{Dispatcher, Frame, RxFrame};
+    use twocan_flexcan::{Can0, Settings};
+    use twocan_teensy::can::{self, CanState, CAN0_VECTORS};
+    use twocan_teensy::filters_example::{self, FILTERS};
     use twocan_teensy::rt::{self, CAN_BLINKS};
-    use twocan_teensy::shared::SharedDriver;
     use twocan_teensy::time::{self, Every};
 
-    const FILTERS: usize = 5;
-
-    static CAN0: SharedDriver<FlexCan<Mmio>, RECEIVE_BUFFER_SIZE, TRANSMIT_BUFFER_SIZE> =
-        SharedDriver::new();
+    static CAN0: CanState = CanState::new();
 
     /// Frames per filter index.
     pub static HITS: [AtomicU32; FILTERS] = [const { AtomicU32::new(0) }; FILTERS];
@@ -40,31 +38,12 @@ mod firmware {
     /// call-back are counted by the dispatcher).
     pub static ERRORS: AtomicU32 = AtomicU32::new(0);
 
-    /// ACAN §4: 125 kbit/s, loop-back and self reception. Computed at compile time
-    /// (the bit-timing solver is `const`), so the solver is not in the image.
-    const SETTINGS: Settings = {
-        let mut s = Settings::new(125_000);
-        s.loop_back = true;
-        s.self_reception = true;
-        s
-    };
+    /// Computed at compile time (the bit-timing solver is `const`), so the solver is
+    /// not in the image.
+    const SETTINGS: Settings = filters_example::SETTINGS;
 
-    #[no_mangle]
-    extern "C" fn CAN0_ORED_MESSAGE_BUFFER() {
-        CAN0.on_interrupt();
-    }
-
-    /// The frames sent, in order, with the filter index each must arrive through
-    /// (`None`: rejected by every filter).
     fn frames() -> [(Result<Frame, twocan_core::FrameError>, Option<usize>); 6] {
-        [
-            (Frame::extended(0x12_3456, &[0]), Some(0)),
-            (Frame::standard(0x234, &[1, 2]), Some(1)),
-            (Frame::remote(0x542, false, 0), Some(2)),
-            (Frame::standard(0x305, &[3]), Some(3)),
-            (Frame::extended(0x18FF_2A00, &[4; 8]), Some(4)),
-            (Frame::standard(0x777, &[5]), None),
-        ]
+        filters_example::frames()
     }
 
     fn check(expected: usize, rx: &RxFrame) {
@@ -97,24 +76,15 @@ mod firmware {
     #[cortex_m_rt::entry]
     fn main() -> ! {
         let mut boot = rt::boot();
-        let primary = [
-            Filter::exact(FrameKind::Data, Format::Extended, 0x12_3456),
-            Filter::exact(FrameKind::Data, Format::Standard, 0x234),
-            Filter::exact(FrameKind::Remote, Format::Standard, 0x542),
-        ];
-        let secondary = [
-            Filter::masked(FrameKind::Data, Format::Standard, 0x7F0, 0x300),
-            Filter::masked(FrameKind::Data, Format::Extended, 0x1FFF_00FF, 0x18FF_0000),
-        ];
+        let primary = filters_example::primary();
+        let secondary = filters_example::secondary();
         let token = Can0::take().unwrap_or_else(|| rt::halt(CAN_BLINKS));
         let can = token
             .begin(&SETTINGS, &primary, &secondary)
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        rt::enable_can_irq(&mut boot.core.NVIC, &can);
-        let driver: AcanDriver<Mmio> = AcanDriver::new(can);
-        if CAN0.install(driver).is_err() {
-            rt::halt(CAN_BLINKS);
-        }
+        let (mut tx, mut rx) =
+            can::start(&CAN0, &CAN0_VECTORS, can.into_split(), &mut boot.core.NVIC)
+                .unwrap_or_else(|| rt::halt(CAN_BLINKS));
 
         let mut dispatcher: Dispatcher<(), FILTERS> = Dispatcher::new();
         let callbacks: [fn(&mut (), &RxFrame); FILTERS] = [on_0, on_1, on_2, on_3, on_4];
@@ -131,12 +101,13 @@ mod firmware {
         loop {
             if send.due(time::millis()) {
                 if let (Ok(frame), _) = &list[next] {
-                    if CAN0.with(|d| d.try_send(frame).is_ok()) == Some(true) {
+                    if tx.try_send(frame).is_ok() {
                         next = (next + 1) % list.len();
                     }
                 }
             }
-            while CAN0.with(|d| d.dispatch(&mut dispatcher, &mut ())) == Some(true) {}
+            while tx.take_completion().is_some() {}
+            while rx.dispatch(&mut dispatcher, &mut ()) {}
             // A round is complete when every filter saw one more frame.
             let rounds = HITS
                 .iter()

@@ -10,16 +10,13 @@
 mod firmware {
     use core::sync::atomic::{AtomicU32, Ordering};
 
-    use twocan_core::{Frame, Mmio};
-    use twocan_flexcan::{
-        AcanDriver, Can0, FlexCan, Settings, RECEIVE_BUFFER_SIZE, TRANSMIT_BUFFER_SIZE,
-    };
+    use twocan_core::Frame;
+    use twocan_flexcan::{Can0, Settings};
+    use twocan_teensy::can::{self, CanState, CAN0_VECTORS};
     use twocan_teensy::rt::{self, CAN_BLINKS};
-    use twocan_teensy::shared::SharedDriver;
     use twocan_teensy::time::{self, Every};
 
-    static CAN0: SharedDriver<FlexCan<Mmio>, RECEIVE_BUFFER_SIZE, TRANSMIT_BUFFER_SIZE> =
-        SharedDriver::new();
+    static CAN0: CanState = CanState::new();
 
     /// Frames handed to the driver.
     pub static SENT: AtomicU32 = AtomicU32::new(0);
@@ -35,11 +32,6 @@ mod firmware {
         s
     };
 
-    #[no_mangle]
-    extern "C" fn CAN0_ORED_MESSAGE_BUFFER() {
-        CAN0.on_interrupt();
-    }
-
     #[cortex_m_rt::entry]
     fn main() -> ! {
         let mut boot = rt::boot();
@@ -47,22 +39,21 @@ mod firmware {
         let can = token
             .begin(&SETTINGS, &[], &[])
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        rt::enable_can_irq(&mut boot.core.NVIC, &can);
-        let driver: AcanDriver<Mmio> = AcanDriver::new(can);
-        if CAN0.install(driver).is_err() {
-            rt::halt(CAN_BLINKS);
-        }
+        let (mut tx, mut rx) =
+            can::start(&CAN0, &CAN0_VECTORS, can.into_split(), &mut boot.core.NVIC)
+                .unwrap_or_else(|| rt::halt(CAN_BLINKS));
 
         let message = Frame::standard(0x542, &[]).unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         let mut send = Every::new(time::millis(), 1000);
         let mut due = false;
         loop {
             due |= send.due(time::millis());
-            if due && CAN0.with(|d| d.try_send(&message).is_ok()) == Some(true) {
+            if due && tx.try_send(&message).is_ok() {
                 due = false;
                 SENT.fetch_add(1, Ordering::Relaxed);
             }
-            while let Some(Ok(_frame)) = CAN0.with(|d| d.receive()) {
+            while tx.take_completion().is_some() {}
+            while rx.receive().is_ok() {
                 RECEIVED.fetch_add(1, Ordering::Relaxed);
                 boot.led.toggle();
             }

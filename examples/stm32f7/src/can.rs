@@ -1,0 +1,93 @@
+//! The split driver of a bxCAN instance as the examples use it: its shared state in a
+//! `static` ([`CanState`]), its interrupt handles in the instance's [`Vectors`], which
+//! the example's four vectors run (TX, RX0, RX1, SCE: one handler per line, RM0410
+//! §40.8), and `start`, which puts the handles in place **before** it unmasks the lines.
+
+use twocan_bxcan::BxCan;
+use twocan_core::irq_cell::IrqCell;
+use twocan_core::split::{Rx, RxIrq, State, StatusIrq, Tx, TxIrq};
+use twocan_core::{FifoQueue, Mmio};
+
+/// Receive ring per FIFO, transmit queue and completion ring sizes of the examples.
+pub const RX: usize = 32;
+/// See [`RX`].
+pub const TX: usize = 16;
+/// See [`RX`].
+pub const COMPLETIONS: usize = 8;
+
+/// A transmit queue in request order (`TXFP = 1`, the driver's default).
+pub type Queue = FifoQueue<TX>;
+/// The shared state of an instance with registers `R` and filter registers `F`.
+pub type CanState<F = Mmio> = State<BxCan<Mmio, F>, RX, Queue, RX, COMPLETIONS>;
+/// The transmit half.
+pub type CanTxHalf<F = Mmio> = Tx<'static, BxCan<Mmio, F>, RX, Queue, RX, COMPLETIONS>;
+/// The receive half.
+pub type CanRxHalf<F = Mmio> = Rx<'static, BxCan<Mmio, F>, RX, Queue, RX, COMPLETIONS>;
+
+/// The interrupt handles of one bxCAN instance.
+pub struct Vectors<F: twocan_core::Registers + 'static = Mmio> {
+    tx: IrqCell<TxIrq<'static, BxCan<Mmio, F>, RX, Queue, RX, COMPLETIONS>>,
+    rx0: IrqCell<RxIrq<'static, BxCan<Mmio, F>, RX, Queue, RX, COMPLETIONS>>,
+    rx1: IrqCell<RxIrq<'static, BxCan<Mmio, F>, RX, Queue, RX, COMPLETIONS>>,
+    sce: IrqCell<StatusIrq<'static, BxCan<Mmio, F>, RX, Queue, RX, COMPLETIONS>>,
+}
+
+impl<F: twocan_core::Registers + 'static> Default for Vectors<F> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<F: twocan_core::Registers + 'static> Vectors<F> {
+    /// Empty: the vectors do nothing until `start` fills them.
+    pub const fn new() -> Self {
+        Vectors {
+            tx: IrqCell::new(),
+            rx0: IrqCell::new(),
+            rx1: IrqCell::new(),
+            sce: IrqCell::new(),
+        }
+    }
+
+    /// The TX line: settle ended mailboxes, refill them.
+    pub fn on_tx(&self) -> bool {
+        self.tx.run(|h| h.on_interrupt())
+    }
+
+    /// The RX0 line: FIFO 0 into its ring.
+    pub fn on_rx0(&self) -> bool {
+        self.rx0.run(|h| h.on_interrupt())
+    }
+
+    /// The RX1 line: FIFO 1 into its ring.
+    pub fn on_rx1(&self) -> bool {
+        self.rx1.run(|h| h.on_interrupt())
+    }
+
+    /// The SCE line: errors, state changes, wake-up.
+    pub fn on_sce(&self) -> bool {
+        self.sce.run(|h| h.on_interrupt())
+    }
+}
+
+/// Splits `state` over `hw`, puts the interrupt handles in `vectors`, then unmasks
+/// `irqs` (TX, RX0, RX1, SCE). Returns the thread-side halves; `None` when `state` was
+/// split already.
+#[cfg(target_os = "none")]
+pub fn start<F: twocan_core::Registers + Sync + 'static>(
+    state: &'static CanState<F>,
+    vectors: &'static Vectors<F>,
+    hw: BxCan<Mmio, F>,
+    irqs: [stm32f7xx_hal::pac::Interrupt; 4],
+) -> Option<(CanTxHalf<F>, CanRxHalf<F>)> {
+    let parts = state.split(hw).ok()?;
+    let put = vectors.tx.put(parts.tx_irq).is_ok()
+        && vectors.rx0.put(parts.rx0_irq).is_ok()
+        && vectors.rx1.put(parts.rx1_irq).is_ok()
+        && vectors.sce.put(parts.status_irq).is_ok();
+    if !put {
+        return None;
+    }
+    crate::rt::unmask(irqs);
+    Some((parts.tx, parts.rx))
+}
