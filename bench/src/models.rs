@@ -14,7 +14,7 @@
 use std::time::Instant;
 
 use twocan_bxcan::model::BxCanModel;
-use twocan_bxcan::{Bank, Can, Config, Fifo, FilterPlan};
+use twocan_bxcan::{Bank, BxCan, Can, Config, Fifo, FilterPlan};
 use twocan_core::sim::Bus;
 use twocan_core::{Driver, Filter, Frame};
 use twocan_flexcan::model::FlexCanModel;
@@ -37,7 +37,7 @@ const MAX_IDLE_BITS: u64 = 1_000;
 
 /// Configures the bxCAN side. Leaving initialization mode takes 11 recessive bits on the
 /// bus (RM0410 §40.4.2), so the bus runs a few bit times between bounded tries.
-fn bxcan_driver(model: &BxCanModel, bus: &mut Bus) -> Result<Driver<Can<BxCanModel>, 32, 16>> {
+fn bxcan_driver(model: &BxCanModel, bus: &mut Bus) -> Result<Driver<BxCan<BxCanModel>, 32, 16>> {
     let config = Config::from_bitrate(APB1_HZ, BITRATE)
         .map_err(|e| Error::new(format!("bxCAN configuration: {e:?}")))?
         .wait_iterations(4);
@@ -52,7 +52,7 @@ fn bxcan_driver(model: &BxCanModel, bus: &mut Bus) -> Result<Driver<Can<BxCanMod
         .map_err(|e| Error::new(format!("bxCAN filters: {e:?}")))?;
     for _ in 0..100 {
         match init.enable() {
-            Ok(can) => return Ok(Driver::new(can)),
+            Ok(can) => return Ok(Driver::new(can.into_split())),
             Err(failed) => {
                 init = failed.value;
                 bus.run_for(4);
@@ -77,7 +77,7 @@ fn flexcan_driver(model: &FlexCanModel) -> Result<AcanDriver<IdleClocked>> {
         &[],
     )
     .map_err(|e| Error::new(format!("FlexCAN begin: {e:?}")))?;
-    Ok(AcanDriver::new(controller))
+    Ok(AcanDriver::new(controller.into_split()))
 }
 
 /// Runs the two drivers against each other; frames delivered per host second.

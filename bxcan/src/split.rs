@@ -24,6 +24,7 @@ use twocan_core::{
     Error, ErrorCounters, ErrorState, ErrorStatus, Frame, Hardware, LastErrorCode, Mode, Priority,
     Registers, RxFrame, TxOutcome, TxPolicy,
 };
+use twocan_core::{MailboxId, MailboxState};
 
 use crate::config::{Config, Recovery};
 use crate::controller::{lec, Can};
@@ -103,6 +104,19 @@ fn code_index(c: LastErrorCode) -> u8 {
 }
 
 impl<R: Registers, F: Registers> BxCan<R, F> {
+    /// Back to the configuration-level controller (for [`Can::reconfigure`]); the
+    /// filters installed (and their map) come along. Transmit bookkeeping is dropped:
+    /// take it back only when no frame is in flight.
+    pub fn into_can(self) -> Can<R, F> {
+        Can {
+            regs: self.regs,
+            filter_regs: self.filter_regs,
+            instance: self.instance,
+            config: self.config,
+            fmi: self.fmi,
+        }
+    }
+
     /// The instance.
     pub fn instance(&self) -> Instance {
         self.instance
@@ -157,6 +171,7 @@ unsafe impl<R: Registers, F: Registers> Hardware for BxCan<R, F> {
     type Raw = RawFrame;
     type FilterMap = FmiMap;
     type Filters = FilterPlan;
+    const RX_QUEUES: usize = 2;
 
     fn tx_policy(&self) -> TxPolicy {
         self.config.get_tx_policy()
@@ -298,6 +313,47 @@ unsafe impl<R: Registers, F: Registers> Hardware for BxCan<R, F> {
         self.displacing.fetch_or(1 << low, Ordering::Relaxed);
         self.regs.write32(TSR, tsr::abrq(low));
         true
+    }
+
+    fn mailbox_count(&self) -> u8 {
+        TX_MAILBOXES as u8
+    }
+
+    /// `Empty` when `CAN_TSR.TMEx`; otherwise the mailbox first in the hardware's
+    /// transmit order is `Transmitting` while `CAN_MSR.TXM` is set and `Scheduled`
+    /// before, the others `Pending` (notes "Transmit mailbox states"). The order: the
+    /// identifier priority (ties: lower mailbox number) under `TXFP = 0`, the request
+    /// order (tokens) under `TXFP = 1`.
+    fn mailbox_state(&self, mailbox: MailboxId) -> MailboxState {
+        let x = mailbox.0 as usize;
+        let t = self.regs.read32(TSR);
+        if x >= TX_MAILBOXES || t & tsr::tme(x) != 0 {
+            return MailboxState::Empty;
+        }
+        let token = |y: usize| self.tokens[y].load(Ordering::Acquire);
+        let mut first = x;
+        for y in (0..TX_MAILBOXES).filter(|&y| y != x && t & tsr::tme(y) == 0) {
+            let ahead = match self.config.get_tx_policy() {
+                TxPolicy::Fifo => (token(y).wrapping_sub(token(first)) as i32) < 0,
+                TxPolicy::Priority => {
+                    let (a, b) = (
+                        Priority::of(&self.read_frame(y)),
+                        Priority::of(&self.read_frame(first)),
+                    );
+                    a.beats(b) || (a == b && y < first)
+                }
+            };
+            if ahead {
+                first = y;
+            }
+        }
+        if first != x {
+            MailboxState::Pending
+        } else if self.regs.read32(MSR) & msr::TXM != 0 {
+            MailboxState::Transmitting
+        } else {
+            MailboxState::Scheduled
+        }
     }
 
     /// `ABRQx` of the loaded mailbox holding `token` (RM0410 §40.9.2); a mailbox on the

@@ -150,10 +150,36 @@ impl<H: Hardware, const RX: usize, const TX: usize, const RX1: usize> Driver<H, 
         let s = &self.state;
         TxIrq { s }.on_interrupt();
         RxIrq { s, queue: 0 }.on_interrupt();
-        if RX1 > 0 {
+        if RX1 > 0 && H::RX_QUEUES > 1 {
             RxIrq { s, queue: 1 }.on_interrupt();
         }
         let mut status = StatusIrq { s, last: self.last };
+        status.on_interrupt();
+        status.poll_state();
+        self.last = status.last;
+    }
+
+    /// The transmit line's handler ([`TxIrq::on_interrupt`]).
+    pub fn on_tx(&mut self) {
+        TxIrq { s: &self.state }.on_interrupt();
+    }
+
+    /// The receive handler of hardware queue `queue` ([`RxIrq::on_interrupt`]).
+    pub fn on_rx(&mut self, queue: u8) {
+        RxIrq {
+            s: &self.state,
+            queue,
+        }
+        .on_interrupt();
+    }
+
+    /// The status line's handler ([`StatusIrq::on_interrupt`]), then a read of the
+    /// error state (a controller leaving bus-off raises no interrupt).
+    pub fn on_status(&mut self) {
+        let mut status = StatusIrq {
+            s: &self.state,
+            last: self.last,
+        };
         status.on_interrupt();
         status.poll_state();
         self.last = status.last;
@@ -214,6 +240,14 @@ impl<H: Hardware, const RX: usize, const TX: usize, const RX1: usize> Driver<H, 
     /// Sets the peaks of both rings back to their counts.
     pub fn reset_peaks(&self) {
         self.state.reset_peaks()
+    }
+
+    /// State of one transmit mailbox, read now.
+    pub fn mailbox_state(
+        &self,
+        mailbox: crate::mailbox::MailboxId,
+    ) -> crate::mailbox::MailboxState {
+        self.hardware().mailbox_state(mailbox)
     }
 
     /// The transmit order.

@@ -19,7 +19,7 @@
 use crate::controller::{ErrorStatus, Mode};
 use crate::error::{Error, LastErrorCode};
 use crate::frame::{Frame, RxFrame};
-use crate::mailbox::{TxOutcome, TxPolicy};
+use crate::mailbox::{MailboxId, MailboxState, TxOutcome, TxPolicy};
 
 /// Identifies one frame accepted by [`crate::split::Tx::try_send`]: its sequence number
 /// (wrapping at `u32::MAX`), in acceptance order.
@@ -88,6 +88,9 @@ pub unsafe trait Hardware {
     type FilterMap: Send;
     /// A compiled filter list for [`Hardware::install_filters`].
     type Filters;
+    /// Number of hardware receive queues (1 or 2: bxCAN FIFO 0 and FIFO 1), each with
+    /// its own receive line and ring.
+    const RX_QUEUES: usize = 1;
 
     /// Transmit order of the loaded mailboxes (and so of the driver's queue).
     fn tx_policy(&self) -> TxPolicy;
@@ -122,6 +125,13 @@ pub unsafe trait Hardware {
         let _ = frame;
         false
     }
+
+    /// Number of transmit mailboxes.
+    fn mailbox_count(&self) -> u8;
+
+    /// State of one transmit mailbox, read now (any context; an index beyond the
+    /// mailboxes reads [`MailboxState::Empty`]).
+    fn mailbox_state(&self, mailbox: MailboxId) -> MailboxState;
 
     /// Transmit half: requests the abort of the mailbox holding `token`, if one does.
     /// Returns whether it did; the outcome arrives through [`Hardware::settle`].

@@ -16,7 +16,7 @@ use crate::error::{Error, ErrorCounters, ErrorState, LastErrorCode};
 use crate::filter::Filter;
 use crate::frame::{Frame, RxFrame};
 use crate::hardware::{Completion, Hardware, Settled, StatusEvents, Token};
-use crate::mailbox::{TxOutcome, TxPolicy};
+use crate::mailbox::{MailboxId, MailboxState, TxOutcome, TxPolicy};
 
 /// Mock filter list: portable filters matched in order (the first match gives the index).
 pub type MockFilterList = Vec<Filter, 16>;
@@ -242,6 +242,17 @@ unsafe impl Hardware for MockHardware {
         while let Some(c) = self.with(|m| m.ended.pop_front()) {
             f(Settled::Done(c));
         }
+    }
+
+    fn mailbox_count(&self) -> u8 {
+        self.with(|m| m.count as u8)
+    }
+
+    fn mailbox_state(&self, mailbox: MailboxId) -> MailboxState {
+        self.with(|m| match m.mailboxes.get(mailbox.0 as usize) {
+            Some(Some(_)) if (mailbox.0 as usize) < m.count => MailboxState::Pending,
+            _ => MailboxState::Empty,
+        })
     }
 
     unsafe fn request_abort(&self, token: Token) -> bool {

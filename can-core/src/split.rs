@@ -379,7 +379,11 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
 
     /// Receive ring figures (queue 0, and queue 1 added when it has room).
     pub fn rx_stats(&self) -> BufferStats {
-        let (a, b) = (self.rx0.stats(), self.rx1.stats());
+        let a = self.rx0.stats();
+        if H::RX_QUEUES < 2 {
+            return a;
+        }
+        let b = self.rx1.stats();
         BufferStats {
             size: a.size + b.size,
             count: a.count + b.count,
@@ -769,16 +773,16 @@ impl<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE:
     }
 }
 
-impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize>
-    crate::io::CanTx for Tx<'_, H, RX, Q, RX1, DONE>
+impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize> crate::io::CanTx
+    for Tx<'_, H, RX, Q, RX1, DONE>
 {
     fn try_send(&mut self, frame: &Frame) -> nb::Result<Token, Error> {
         Tx::try_send(self, frame)
     }
 }
 
-impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize>
-    crate::io::CanRx for Rx<'_, H, RX, Q, RX1, DONE>
+impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize> crate::io::CanRx
+    for Rx<'_, H, RX, Q, RX1, DONE>
 {
     fn receive(&mut self) -> nb::Result<RxFrame, Error> {
         Rx::receive(self)

@@ -26,6 +26,7 @@ use twocan_core::{
     Error, ErrorCounters, ErrorState, ErrorStatus, Frame, Hardware, LastErrorCode, Mode, Registers,
     RxFrame, TxOutcome, TxPolicy,
 };
+use twocan_core::{MailboxId, MailboxState};
 
 use crate::configuration::{Configuration, DATA_MAILBOX};
 use crate::controller::FlexCan;
@@ -121,6 +122,11 @@ impl<R: Registers> FlexCanHw<R> {
     /// The registers (for inspection).
     pub fn registers(&self) -> &R {
         &self.regs
+    }
+
+    /// The register handle back (to run `begin` again).
+    pub fn into_registers(self) -> R {
+        self.regs
     }
 
     fn mode(&self) -> u8 {
@@ -302,6 +308,33 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
         }
     }
 
+    /// MB15 (data) and the remote-frame mailboxes.
+    fn mailbox_count(&self) -> u8 {
+        1 + self.configuration().remote_mailbox_count()
+    }
+
+    /// `MailboxId(0)` is MB15 (data), `MailboxId(1..=n)` the remote-frame mailboxes in
+    /// increasing MB order: `Pending` while loaded (code `DATA`, flag clear), else
+    /// `Empty` (FlexCAN shows no scheduled or transmitting state per mailbox).
+    fn mailbox_state(&self, mailbox: MailboxId) -> MailboxState {
+        let c = self.configuration();
+        let mb = match mailbox.0 {
+            0 => DATA_MAILBOX as usize,
+            k if k <= c.remote_mailbox_count() => (c.first_remote_mailbox() + k - 1) as usize,
+            _ => return MailboxState::Empty,
+        };
+        if self.mode() == MODE_SLEEP {
+            return MailboxState::Empty;
+        }
+        let done = self.regs.read32(IFLAG1) & iflag1::buf(mb) != 0;
+        let code = cs::CODE.get(self.regs.read32(regs::mb_cs(mb)));
+        if !done && code == code::TX_DATA {
+            MailboxState::Pending
+        } else {
+            MailboxState::Empty
+        }
+    }
+
     /// Writes code `ABORT` into the loaded mailbox holding `token` (Kinetis RM,
     /// "Transmission abort mechanism"); the outcome comes with its `IFLAG1` bit.
     unsafe fn request_abort(&self, token: Token) -> bool {
@@ -342,8 +375,8 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
     /// FIFO"), `RXFIR.IDHIT`, then pops it (write 1 to `BUF5I`). `BUF7I` (overflow:
     /// frames lost) and `BUF6I` (warning) are acknowledged.
     #[inline(always)]
-    unsafe fn read_rx(&self, _queue: usize, overrun: &mut bool) -> Option<RawFrame> {
-        if self.mode() == MODE_SLEEP {
+    unsafe fn read_rx(&self, queue: usize, overrun: &mut bool) -> Option<RawFrame> {
+        if queue != 0 || self.mode() == MODE_SLEEP {
             return None;
         }
         let flags = self.regs.read32(IFLAG1);

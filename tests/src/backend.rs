@@ -16,11 +16,11 @@ use twocan_bxcan::{
 };
 use twocan_core::sim::{Bus, BusNode, NodeId};
 use twocan_core::timing::{solve, Limits, TimingError, DEFAULT_TOLERANCE_PPM};
-use twocan_core::{Controller, Driver, Filter, Registers, TxPolicy};
+use twocan_core::{Driver, Filter, Hardware, Registers, TxPolicy};
 use twocan_flexcan::model::FlexCanModel;
 use twocan_flexcan::{
-    BeginError, Board, ConfigErrors, Configuration, FlexCan, HostSystem, Instance, Settings,
-    Target, CAN_CLOCK_HZ,
+    BeginError, Board, ConfigErrors, Configuration, FlexCan, FlexCanHw, HostSystem, Instance,
+    Settings, Target, CAN_CLOCK_HZ,
 };
 use twocan_host::{
     attach_plain, BxNode, FlexNode, Harness, Serviced, SetupError, RX_RING, STM32F767_APB1_HZ,
@@ -122,11 +122,11 @@ pub enum BitrateChange {
 /// A node of one backend on the harness bus (the device under test).
 pub trait Dut: Serviced {
     /// The backend's controller.
-    type C: Controller;
+    type C: Hardware;
     /// The portable driver.
-    fn driver(&mut self) -> &mut Driver<Self::C, RX_RING, TX_RING>;
+    fn driver(&mut self) -> &mut Driver<Self::C, RX_RING, TX_RING, RX_RING>;
     /// The portable driver, shared.
-    fn driver_ref(&self) -> &Driver<Self::C, RX_RING, TX_RING>;
+    fn driver_ref(&self) -> &Driver<Self::C, RX_RING, TX_RING, RX_RING>;
     /// The node's place on the bus.
     fn bus_id(&self) -> NodeId;
     /// Whether the model raises an interrupt line the driver services.
@@ -262,11 +262,11 @@ pub fn bxcan_btr_bitrate(btr: u32, clock_hz: u32) -> u32 {
 }
 
 impl Dut for FlexNode {
-    type C = FlexCan<twocan_host::Clocked<FlexCanModel>>;
-    fn driver(&mut self) -> &mut Driver<Self::C, RX_RING, TX_RING> {
+    type C = FlexCanHw<twocan_host::Clocked<FlexCanModel>>;
+    fn driver(&mut self) -> &mut Driver<Self::C, RX_RING, TX_RING, RX_RING> {
         &mut self.driver
     }
-    fn driver_ref(&self) -> &Driver<Self::C, RX_RING, TX_RING> {
+    fn driver_ref(&self) -> &Driver<Self::C, RX_RING, TX_RING, RX_RING> {
         &self.driver
     }
     fn bus_id(&self) -> NodeId {
@@ -360,7 +360,7 @@ impl Backend for FlexCanBackend {
         Ok((
             FlexNode {
                 model,
-                driver: Driver::new(controller),
+                driver: Driver::new(controller.into_split()),
                 id,
             },
             BitrateChange::FiltersReinstalledFromLists,
@@ -400,11 +400,11 @@ fn bxcan_refused(e: SetupError) -> Refused {
 }
 
 impl Dut for BxNode {
-    type C = twocan_bxcan::Can<twocan_host::Clocked<BxCanModel>>;
-    fn driver(&mut self) -> &mut Driver<Self::C, RX_RING, TX_RING> {
+    type C = twocan_bxcan::BxCan<twocan_host::Clocked<BxCanModel>>;
+    fn driver(&mut self) -> &mut Driver<Self::C, RX_RING, TX_RING, RX_RING> {
         &mut self.driver
     }
-    fn driver_ref(&self) -> &Driver<Self::C, RX_RING, TX_RING> {
+    fn driver_ref(&self) -> &Driver<Self::C, RX_RING, TX_RING, RX_RING> {
         &self.driver
     }
     fn bus_id(&self) -> NodeId {
@@ -479,7 +479,7 @@ impl Backend for BxCanBackend {
             .bus()
             .borrow_mut()
             .attach("stm32f767-can1-moved", model.clone());
-        let mut can = driver.release();
+        let mut can = driver.release().into_can();
         can.registers_mut().set_bus(h.bus());
         let rate = h.bus().borrow().bit_rate();
         let config =
@@ -493,7 +493,7 @@ impl Backend for BxCanBackend {
         Ok((
             BxNode {
                 model,
-                driver: Driver::new(can),
+                driver: Driver::new(can.into_split()),
                 id,
             },
             BitrateChange::FiltersKept,

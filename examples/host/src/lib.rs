@@ -3,7 +3,8 @@
 //!
 //! [`Harness`] owns the bus; [`FlexNode`] (a Teensy 3.6's can0) and [`BxNode`] (an
 //! STM32F767's CAN1) each own a model handle and the portable [`twocan_core::Driver`] over
-//! it. The demo (`can-demo`) and the cross-controller tests use it.
+//! it (its per-line handlers run when the model raises that line). The demo (`can-demo`)
+//! and the cross-controller tests use it.
 //!
 //! ```
 //! use twocan_host::{Harness, FlexNode, BxNode};
@@ -21,11 +22,11 @@ use std::cell::RefCell;
 use std::rc::Rc;
 
 use twocan_bxcan::model::BxCanModel;
-use twocan_bxcan::{Can as BxCan, Config as BxConfig, FifoPolicy};
+use twocan_bxcan::{BxCan, Can, Config as BxConfig, FifoPolicy};
 use twocan_core::sim::{Bus, BusNode, NodeId, SimError};
 use twocan_core::{Driver, ErrorState, Filter, Registers};
 use twocan_flexcan::model::FlexCanModel;
-use twocan_flexcan::{Board, FlexCan, HostSystem, Instance, Settings, Target};
+use twocan_flexcan::{Board, FlexCan, FlexCanHw, HostSystem, Instance, Settings, Target};
 
 /// The simulated bus, shared with the register wrappers that let time pass while a driver
 /// waits for an acknowledge bit.
@@ -176,9 +177,10 @@ impl<R: Registers> Registers for Clocked<R> {
 }
 
 /// The FlexCAN driver over its model, as used by the host nodes.
-pub type FlexDriver = Driver<FlexCan<Clocked<FlexCanModel>>, RX_RING, TX_RING>;
-/// The bxCAN driver over its model, as used by the host nodes.
-pub type BxDriver = Driver<BxCan<Clocked<BxCanModel>>, RX_RING, TX_RING>;
+pub type FlexDriver = Driver<FlexCanHw<Clocked<FlexCanModel>>, RX_RING, TX_RING, RX_RING>;
+/// The bxCAN driver over its model, as used by the host nodes (a receive ring per
+/// FIFO; the FlexCAN one has the same shape, its second ring stays unused).
+pub type BxDriver = Driver<BxCan<Clocked<BxCanModel>>, RX_RING, TX_RING, RX_RING>;
 
 /// A Teensy 3.x FlexCAN node on the bus.
 pub struct FlexNode {
@@ -250,7 +252,7 @@ impl FlexNode {
         .map_err(SetupError::FlexCan)?;
         Ok(FlexNode {
             model,
-            driver: Driver::new(controller),
+            driver: Driver::new(controller.into_split()),
             id,
         })
     }
@@ -337,7 +339,7 @@ impl BxNode {
             Box::new(model.clone()),
         );
         let regs = Clocked::new(model.clone(), &h.bus, twocan_bxcan::regs::MSR);
-        let mut init = BxCan::can1(regs, config).map_err(|f| SetupError::Driver(f.error))?;
+        let mut init = Can::can1(regs, config).map_err(|f| SetupError::Driver(f.error))?;
         let plan = init
             .can()
             .plan(filters, fifos)
@@ -346,7 +348,7 @@ impl BxNode {
         let can = init.enable().map_err(|f| SetupError::Driver(f.error))?;
         Ok(BxNode {
             model,
-            driver: Driver::new(can),
+            driver: Driver::new(can.into_split()),
             id,
         })
     }
@@ -365,13 +367,21 @@ impl BxNode {
 
 impl Serviced for BxNode {
     fn service(&mut self) -> bool {
+        // One handler per line, as the four vectors of the chip run them.
         let l = self.model.irq_lines();
-        if l.tx || l.rx0 || l.rx1 || l.sce {
-            self.driver.on_interrupt();
-            true
-        } else {
-            false
+        if l.tx {
+            self.driver.on_tx();
         }
+        if l.rx0 {
+            self.driver.on_rx(0);
+        }
+        if l.rx1 {
+            self.driver.on_rx(1);
+        }
+        if l.sce {
+            self.driver.on_status();
+        }
+        l.tx || l.rx0 || l.rx1 || l.sce
     }
 }
 
