@@ -231,19 +231,26 @@ unsafe impl<R: Registers, F: Registers> Hardware for BxCan<R, F> {
             let token = Token(self.tokens[x].load(Ordering::Acquire));
             let user_abort = self.aborting.fetch_and(!bit, Ordering::Relaxed) & bit != 0;
             let displacing = self.displacing.fetch_and(!bit, Ordering::Relaxed) & bit != 0;
+            let done = |c: Completion| {
+                if displacing {
+                    Settled::DoneDisplacing(c)
+                } else {
+                    Settled::Done(c)
+                }
+            };
             let settled = if t & tsr::txok(x) != 0 {
                 let timestamp = self
                     .config
                     .get_timestamps()
                     .then(|| rdtxr::TIME.get(self.regs.read32(tdtxr(x))) as u16);
-                Settled::Done(Completion {
+                done(Completion {
                     token,
                     outcome: TxOutcome::Sent,
                     cause: None,
                     timestamp,
                 })
             } else if user_abort {
-                Settled::Done(Completion {
+                done(Completion {
                     token,
                     outcome: TxOutcome::Aborted,
                     cause: None,

@@ -59,6 +59,10 @@ pub enum Settled {
     /// The mailbox was emptied to make room for a higher-priority frame
     /// ([`Hardware::displace`]): queue this frame again, under its token.
     Displaced(Token, Frame),
+    /// A mailbox whose displacement was requested ended otherwise (sent before the
+    /// abort took effect, or aborted at the application's request): report it, and the
+    /// room kept for the displaced frame is free again.
+    DoneDisplacing(Completion),
 }
 
 /// What the status interrupt found.

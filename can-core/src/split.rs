@@ -425,35 +425,57 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
     /// mailboxes, put displaced frames back, refill free mailboxes from the queue.
     fn service_tx(&self, q: &mut Q) {
         let hw = self.hw();
-        // SAFETY: the caller holds the critical section, the transmit interrupt's
-        // context for `settle`/`load`/`displace`.
-        unsafe {
-            hw.settle(|s| match s {
-                Settled::Done(c) => self.record(c),
-                Settled::Displaced(token, frame) => {
-                    // Room was reserved when the displacement was requested.
-                    let _ = q.push(Queued { token, frame });
+        // SAFETY (every block below): the caller holds the critical section, the
+        // transmit interrupt's context for `settle`/`load`/`displace`.
+        unsafe { self.settle_into(q) };
+        let mut displaced = false;
+        while let Some(next) = q.peek() {
+            match hw.free_mailbox(&next.frame) {
+                Ok(Some(m)) => {
+                    let e = *next;
+                    q.pop();
+                    self.queue_len.fetch_sub(1, Ordering::Relaxed);
+                    unsafe { hw.load(m, &e.frame, e.token) };
                 }
-            });
-            while let Some(next) = q.peek() {
-                match hw.free_mailbox(&next.frame) {
-                    Ok(Some(m)) => {
-                        let e = *next;
-                        q.pop();
-                        self.queue_len.fetch_sub(1, Ordering::Relaxed);
-                        hw.load(m, &e.frame, e.token);
-                    }
-                    Ok(None) => {
-                        if q.policy() == TxPolicy::Priority && hw.displace(&next.frame) {
-                            // The displaced frame comes back through `settle`: its
-                            // room in the queue stays counted in `queue_len`.
-                            self.queue_len.fetch_add(1, Ordering::Relaxed);
-                        }
+                Ok(None) => {
+                    if displaced
+                        || q.policy() != TxPolicy::Priority
+                        || !unsafe { hw.displace(&next.frame) }
+                    {
                         break;
                     }
-                    Err(_) => break,
+                    // The displaced frame comes back through `settle`: its room in the
+                    // queue is kept from now on. An abort of a pending mailbox ends at
+                    // once: settle again so the frame takes the mailbox now; otherwise
+                    // the abort's completion interrupt does it.
+                    self.queue_len.fetch_add(1, Ordering::Relaxed);
+                    displaced = true;
+                    unsafe { self.settle_into(q) };
                 }
+                Err(_) => break,
             }
+        }
+    }
+
+    /// Settles ended mailboxes into the completion ring and the queue.
+    ///
+    /// # Safety
+    /// Called inside the critical section (the transmit interrupt's context).
+    unsafe fn settle_into(&self, q: &mut Q) {
+        // SAFETY: the caller's contract.
+        unsafe {
+            self.hw().settle(|s| match s {
+                Settled::Done(c) => self.record(c),
+                Settled::Displaced(token, frame) => {
+                    // Room was reserved when the displacement was requested (and stays
+                    // counted in `queue_len`, now by the frame itself).
+                    let _ = q.push(Queued { token, frame });
+                }
+                Settled::DoneDisplacing(c) => {
+                    self.queue_len.fetch_sub(1, Ordering::Relaxed);
+                    self.record(c);
+                }
+            })
         }
     }
 

@@ -10,7 +10,8 @@ use twocan_bxcan::model::BxCanModel;
 use twocan_bxcan::regs::MSR;
 use twocan_bxcan::{Can, Config, FilterPlan, Recovery};
 use twocan_core::sim::{Bus, SimNode};
-use twocan_core::{Controller, Filter, Frame, Registers, RxFrame, TxPolicy};
+use twocan_bxcan::BxCan;
+use twocan_core::{Driver, Filter, Frame, Registers, RxFrame, TxPolicy};
 
 pub type SharedBus = Rc<RefCell<Bus>>;
 
@@ -115,10 +116,19 @@ pub fn settle(bus: &SharedBus) {
     let _ = bus.borrow_mut().run_until_idle(200_000);
 }
 
-/// Everything the controller has received, in order.
-pub fn drain<C: Controller>(c: &mut C) -> Vec<RxFrame> {
+/// The one-struct driver over CAN1 used by the driver tests (a receive ring per FIFO).
+pub type Drv = Driver<BxCan<Clocked>, 16, 8, 16>;
+
+/// The driver over an enabled controller.
+pub fn driver(can: Can<Clocked>) -> Drv {
+    Driver::new(can.into_split())
+}
+
+/// Runs every handler, then takes everything received, in order.
+pub fn drain(d: &mut Drv) -> Vec<RxFrame> {
+    d.on_interrupt();
     let mut v = Vec::new();
-    while let Ok(f) = c.receive() {
+    while let Ok(f) = d.receive() {
         v.push(f);
     }
     v
