@@ -117,6 +117,41 @@ impl<R: Registers, F: Registers> BxCan<R, F> {
         }
     }
 
+    /// Clears the last error code by software (`CAN_ESR.LEC = 0b111`, "set by
+    /// software": the hardware overwrites it with the next bus event); the sticky copy
+    /// the error status reports reads [`LastErrorCode::None`] too.
+    pub fn clear_last_error(&self) {
+        self.regs.write32(ESR, esr::LEC.val(esr::LEC_SOFTWARE));
+        self.last_error.store(0, Ordering::Relaxed);
+    }
+
+    /// The operating mode the acknowledge bits (`CAN_MSR.INAK`, `SLAK`) show now.
+    pub fn mode(&self) -> Mode {
+        mode::current(&self.regs)
+    }
+
+    /// The banks (`start..end`, hardware numbering) this instance owns now.
+    pub fn bank_range(&self) -> (usize, usize) {
+        match &self.filter_regs {
+            Some(f) => filter_block::banks_of(f, self.instance),
+            None => filter_block::banks_of(&self.regs, self.instance),
+        }
+    }
+
+    /// Compiles `filters` for this instance's banks ([`crate::planner::plan`]), to
+    /// install with the receive half's `set_filters`.
+    pub fn plan(
+        &self,
+        filters: &[twocan_core::Filter],
+        fifo: crate::planner::FifoPolicy,
+    ) -> Result<FilterPlan, crate::filters::PlanError> {
+        let (s, e) = self.bank_range();
+        crate::planner::plan(
+            filters,
+            crate::planner::PlanOptions::new((e - s) as u8).fifo(fifo),
+        )
+    }
+
     /// The instance.
     pub fn instance(&self) -> Instance {
         self.instance
@@ -157,6 +192,12 @@ impl<R: Registers, F: Registers> BxCan<R, F> {
         } else {
             ErrorState::from_counters(counters)
         };
+        // A code latched since the status handler last ran counts as the last error
+        // (the handler reports and clears it; reading it here changes nothing).
+        let code = lec(esr::LEC.get(e));
+        if code != LastErrorCode::None {
+            self.last_error.store(code_index(code), Ordering::Relaxed);
+        }
         ErrorStatus {
             state,
             counters,

@@ -7,7 +7,7 @@ mod common;
 use common::*;
 use twocan_bxcan::model::BxCanModel;
 use twocan_bxcan::{Can, FifoPolicy};
-use twocan_core::{Controller, Driver, Filter, Frame, TxPolicy};
+use twocan_core::{Driver, Filter, Frame, TxPolicy};
 
 #[test]
 fn can2_uses_can1_banks_from_the_start_bank() {
@@ -48,8 +48,8 @@ fn can2_uses_can1_banks_from_the_start_bank() {
     init2.set_filters(&p2).unwrap();
     let can1 = init1.enable().map_err(|f| f.error).unwrap();
     let can2 = init2.enable().map_err(|f| f.error).unwrap();
-    let mut d1: Driver<_, 16, 8> = Driver::new(can1);
-    let mut d2: Driver<_, 16, 8> = Driver::new(can2);
+    let mut d1: Driver<_, 16, 8, 16> = Driver::new(can1.into_split());
+    let mut d2: Driver<_, 16, 8, 16> = Driver::new(can2.into_split());
 
     let probe = [
         Frame::standard(0x100, &[]).unwrap(),
@@ -88,5 +88,7 @@ fn can2_uses_can1_banks_from_the_start_bank() {
             while d2.receive().is_ok() {}
         }
     }
-    let _ = d1.controller_mut().take_events();
+    let (t1, t2) = (d1.traffic(), d2.traffic());
+    assert_eq!((t1.queued, t1.sent), (7, 7));
+    assert_eq!((t2.queued, t2.sent), (7, 7));
 }

@@ -10,11 +10,9 @@ use twocan_bxcan::model::BxCanModel;
 use twocan_bxcan::regs::{esr, ESR};
 use twocan_bxcan::{Can, Recovery};
 use twocan_core::sim::{Fault, NodeId, SimNode};
-use twocan_core::{
-    Controller, Driver, Error, ErrorState, LastErrorCode, Mode, Registers, TxPolicy,
-};
+use twocan_core::{Error, ErrorState, LastErrorCode, Mode, Registers, TxOutcome, TxPolicy};
 
-fn bus_off_setup(recovery: Recovery) -> (Driver<Can<Clocked>, 8, 8>, Clocked, SharedBus, NodeId) {
+fn bus_off_setup(recovery: Recovery) -> (Drv, Clocked, SharedBus, NodeId) {
     let bus = new_bus();
     let model = BxCanModel::can1();
     let me = bus.borrow_mut().attach("can1", model.clone());
@@ -24,11 +22,11 @@ fn bus_off_setup(recovery: Recovery) -> (Driver<Can<Clocked>, 8, 8>, Clocked, Sh
     let mut init = Can::can1(regs.clone(), &cfg).map_err(|f| f.error).unwrap();
     init.set_filters(&pass_all()).unwrap();
     let can = init.enable().map_err(|f| f.error).unwrap();
-    (Driver::new(can), regs, bus, me)
+    (driver(can), regs, bus, me)
 }
 
 /// 32 bit errors on our transmissions: TEC + 8 each → 256 → bus-off.
-fn drive_to_bus_off(d: &mut Driver<Can<Clocked>, 8, 8>, bus: &SharedBus, me: NodeId) {
+fn drive_to_bus_off(d: &mut Drv, bus: &SharedBus, me: NodeId) {
     bus.borrow_mut()
         .inject_from(me, 32, Fault::Bit { at: None });
     d.try_send(&std(0x123)).unwrap();
@@ -44,6 +42,15 @@ fn drive_to_bus_off(d: &mut Driver<Can<Clocked>, 8, 8>, bus: &SharedBus, me: Nod
     assert_eq!(d.error_stats().bus_off, 1);
     assert!(d.error_stats().bit >= 1);
     assert_eq!(d.try_send(&std(1)), Err(nb::Error::Other(Error::BusOff)));
+    // In order, with the counters at each change.
+    let changes: Vec<_> = std::iter::from_fn(|| d.take_state_change()).collect();
+    let states: Vec<_> = changes.iter().map(|c| c.state).collect();
+    assert_eq!(
+        states,
+        [ErrorState::Warning, ErrorState::Passive, ErrorState::BusOff],
+        "{changes:?}"
+    );
+    assert_eq!(changes[2].counters.tec, 256);
 }
 
 #[test]
@@ -54,7 +61,11 @@ fn bus_off_with_automatic_recovery() {
     run(&bus, 128 * 11 + 100);
     d.on_interrupt();
     assert_eq!(d.state(), ErrorState::Active);
-    assert_eq!(d.recover(), Ok(()), "a no-op with ABOM");
+    assert_eq!(
+        d.recover(),
+        Err(Error::WrongMode),
+        "refused: recovery is automatic (ABOM)"
+    );
     // The pending frame goes out after recovery.
     settle(&bus);
     d.on_interrupt();
@@ -106,82 +117,114 @@ fn a_controller_that_never_acknowledges_times_out() {
     let failed = init.enable().unwrap_err();
     assert_eq!(failed.error, Error::Timeout);
     model.set_ack_stuck(false);
-    let mut can = failed.value.enable().map_err(|f| f.error).unwrap();
+    let can = failed.value.enable().map_err(|f| f.error).unwrap();
     assert_eq!(can.mode(), Mode::Normal);
+    let mut d = driver(can);
 
     // Mode changes are bounded too.
     model.set_ack_stuck(true);
-    assert_eq!(can.set_mode(Mode::Sleep), Err(Error::Timeout));
-    assert_eq!(can.set_mode(Mode::Stopped), Err(Error::Timeout));
+    assert_eq!(d.set_mode(Mode::Sleep), Err(Error::Timeout));
+    assert_eq!(d.set_mode(Mode::Stopped), Err(Error::Timeout));
     model.set_ack_stuck(false);
-    assert_eq!(can.set_mode(Mode::Normal), Ok(()));
+    assert_eq!(d.set_mode(Mode::Normal), Ok(()));
 }
 
 #[test]
 fn last_error_code_is_reported_then_cleared_by_software() {
-    let (mut can, regs, bus, _peer) = can1_and_peer(&config(), &pass_all());
+    let (can, regs, bus, _peer) = can1_and_peer(&config(), &pass_all());
     regs.ticking.set(false);
+    let mut d = driver(can);
     bus.borrow_mut().inject_next(Fault::Bit { at: None });
-    can.transmit(&std(0x10)).unwrap();
+    d.try_send(&std(0x10)).unwrap();
     bus.borrow_mut().step(); // the failed attempt only
-    let status = can.error_status();
+    let status = d.error_status();
     assert_ne!(status.last_error, LastErrorCode::None);
     assert_eq!(status.counters.tec, 8);
-    let ev = can.take_events();
-    assert_eq!(ev.bus_error, Some(status.last_error));
-    assert!(ev.state_changed || status.state == ErrorState::Active);
+    d.on_status();
+    assert_eq!(d.error_stats().bit, 1, "counted once, by kind");
     // The register holds 0b111 ("set by software") so the next error is seen as new...
     assert_eq!(
         esr::LEC.get(regs.model.read32(ESR)),
         esr::LEC_SOFTWARE,
-        "LEC = 0b111 after the event was taken"
+        "LEC = 0b111 after the status handler took it"
     );
     // ...but the last error the hardware latched stays readable (sticky).
-    assert_eq!(can.error_status().last_error, status.last_error);
-    assert_eq!(can.take_events().bus_error, None, "reported once");
-    assert_eq!(can.error_status().last_error, status.last_error);
+    assert_eq!(d.error_status().last_error, status.last_error);
+    d.on_status();
+    assert_eq!(d.error_stats().bit, 1, "reported once");
+    assert_eq!(d.error_status().last_error, status.last_error);
     settle(&bus);
-    assert_eq!(can.take_events().sent, 1);
+    d.on_interrupt();
+    assert_eq!(d.traffic().sent, 1);
     assert_eq!(
-        can.error_status().last_error,
+        d.error_status().last_error,
         status.last_error,
         "a success does not replace the last error"
     );
-    can.clear_last_error();
-    assert_eq!(can.error_status().last_error, LastErrorCode::None);
+    d.hardware().clear_last_error();
+    assert_eq!(d.error_status().last_error, LastErrorCode::None);
 }
 
 #[test]
 fn acknowledge_error_is_reported() {
-    let (mut can, regs, bus, _peer) = can1_and_peer(&config(), &pass_all());
+    let (can, regs, bus, _peer) = can1_and_peer(&config(), &pass_all());
     regs.ticking.set(false);
+    let mut d = driver(can);
     bus.borrow_mut().inject_next(Fault::Ack);
-    can.transmit(&std(0x10)).unwrap();
+    d.try_send(&std(0x10)).unwrap();
     bus.borrow_mut().step();
-    assert_eq!(
-        can.take_events().bus_error,
-        Some(LastErrorCode::Acknowledge)
-    );
+    d.on_status();
+    assert_eq!(d.error_stats().acknowledge, 1);
+    assert_eq!(d.last_error(), LastErrorCode::Acknowledge);
 }
 
 #[test]
 fn sleep_and_wake_up() {
     let cfg = config().auto_wakeup(true);
-    let (mut can, _regs, bus, peer) = can1_and_peer(&cfg, &pass_all());
-    can.set_mode(Mode::Sleep).unwrap();
-    assert_eq!(can.mode(), Mode::Sleep);
-    assert_eq!(can.error_status().state, ErrorState::Sleeping);
-    let _ = can.take_events();
+    let (can, _regs, bus, peer) = can1_and_peer(&cfg, &pass_all());
+    let mut d = driver(can);
+    d.set_mode(Mode::Sleep).unwrap();
+    assert_eq!(d.hardware().mode(), Mode::Sleep);
+    assert_eq!(d.error_status().state, ErrorState::Sleeping);
+    d.on_interrupt();
     // Bus activity wakes it (AWUM): WKUI, then normal mode after the bus is idle.
     peer.borrow_mut().send(std(0x77));
     settle(&bus);
     run(&bus, 100);
-    let ev = can.take_events();
-    assert!(ev.wakeup);
-    assert_ne!(can.mode(), Mode::Sleep);
-    can.set_mode(Mode::Sleep).unwrap();
-    can.set_mode(Mode::Normal).unwrap();
-    assert_eq!(can.mode(), Mode::Normal);
-    can.set_mode(Mode::Stopped).unwrap();
-    assert_eq!(can.error_status().state, ErrorState::Stopped);
+    d.on_status();
+    assert_eq!(d.shared_state().wakeups(), 1);
+    assert_ne!(d.hardware().mode(), Mode::Sleep);
+    d.set_mode(Mode::Sleep).unwrap();
+    d.set_mode(Mode::Normal).unwrap();
+    assert_eq!(d.hardware().mode(), Mode::Normal);
+    d.set_mode(Mode::Stopped).unwrap();
+    assert_eq!(d.error_status().state, ErrorState::Stopped);
+}
+
+#[test]
+fn blocking_transmit_fails_off_the_bus_instead_of_spinning() {
+    use embedded_can::blocking::Can as _;
+    let (can, _regs, _bus, _peer) = can1_and_peer(&config(), &pass_all());
+    let mut d: twocan_core::Driver<twocan_bxcan::BxCan<Clocked>, 8, 2> =
+        twocan_core::Driver::new(can.into_split());
+    d.set_mode(Mode::Stopped).unwrap();
+    // Three mailboxes and two queue slots take frames while stopped...
+    for id in 0..5 {
+        assert!(d.try_send(&std(id)).is_ok(), "frame {id} accepted");
+    }
+    // ...the sixth would wait for ever: the blocking call says why instead.
+    assert_eq!(d.transmit(&std(9)), Err(Error::WrongMode));
+    assert_eq!(d.traffic().queued, 5, "the refused frame was not accepted");
+    // Back on the bus, the five go and complete once each.
+    d.set_mode(Mode::Normal).unwrap();
+    let done = (0..200)
+        .map(|_| {
+            _bus.borrow_mut().run_for(100);
+            d.on_interrupt();
+            std::iter::from_fn(|| d.take_completion()).count()
+        })
+        .sum::<usize>();
+    assert_eq!(done, 5);
+    assert_eq!(d.traffic().sent, 5);
+    let _ = TxOutcome::Sent;
 }

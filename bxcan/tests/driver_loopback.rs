@@ -8,14 +8,12 @@ mod common;
 use common::*;
 use twocan_bxcan::filters::NO_FILTER;
 use twocan_bxcan::{plan, Bank, Can, Fifo, FifoPolicy, FilterPlan, PlanOptions};
-use twocan_core::{
-    Controller, Driver, ErrorState, Filter, Format, Frame, FrameKind, Mode, TxPolicy,
-};
+use twocan_core::{Driver, ErrorState, Filter, Format, Frame, FrameKind, Mode, TxPolicy};
 
 #[test]
 fn loopback_standard_extended_remote_through_the_driver() {
     let (can, _regs, bus) = can1_with(&loopback_config(TxPolicy::Fifo), &pass_all());
-    let mut d: Driver<_, 16, 8> = Driver::new(can);
+    let mut d: Driver<_, 16, 8, 16> = Driver::new(can.into_split());
     assert_eq!(d.state(), ErrorState::Active);
     let frames = [
         Frame::standard(0x123, &[1, 2, 3]).unwrap(),
@@ -49,7 +47,7 @@ fn embedded_can_blocking_traits_work_over_the_driver() {
     let (can, regs, _bus) = can1_with(&cfg, &pass_all());
     // Time passes while the driver polls (reads of CAN_MSR in on_interrupt).
     let _ = regs;
-    let mut d: Driver<_, 8, 8> = Driver::new(can);
+    let mut d: Driver<_, 8, 8, 8> = Driver::new(can.into_split());
     let f = Frame::extended(0x42, &[9, 8, 7]).unwrap();
     d.transmit(&f).unwrap();
     assert_eq!(embedded_can::blocking::Can::receive(&mut d).unwrap(), f);
@@ -58,11 +56,12 @@ fn embedded_can_blocking_traits_work_over_the_driver() {
 #[test]
 fn time_stamps_with_ttcm() {
     let cfg = loopback_config(TxPolicy::Fifo).timestamps(true);
-    let (mut can, _regs, bus) = can1_with(&cfg, &pass_all());
-    can.transmit(&std(1)).unwrap();
+    let (can, _regs, bus) = can1_with(&cfg, &pass_all());
+    let mut can = driver(can);
+    can.try_send(&std(1)).unwrap();
     settle(&bus);
     run(&bus, 1000);
-    can.transmit(&std(2)).unwrap();
+    can.try_send(&std(2)).unwrap();
     settle(&bus);
     let rx = drain(&mut can);
     assert_eq!(rx.len(), 2);
@@ -97,7 +96,8 @@ fn each_bank_mode_end_to_end() {
     p.set_bank(4, Bank::list32(&g, &g, Fifo::Fifo1).unwrap())
         .unwrap();
     let cfg = loopback_config(TxPolicy::Fifo);
-    let (mut can, _regs, bus) = can1_with(&cfg, &p);
+    let (can, _regs, bus) = can1_with(&cfg, &p);
+    let mut can = driver(can);
     let frames = [
         Frame::standard(0x10, &[]).unwrap(),         // bank 0 slot 0
         Frame::remote(0x1_0000, true, 2).unwrap(),   // bank 0 slot 1
@@ -111,7 +111,7 @@ fn each_bank_mode_end_to_end() {
     ];
     let mut got = Vec::new();
     for f in &frames {
-        can.transmit(f).unwrap();
+        can.try_send(f).unwrap();
         settle(&bus);
         got.extend(drain(&mut can).into_iter().map(|r| (r.frame, r.filter)));
     }
@@ -129,9 +129,10 @@ fn each_bank_mode_end_to_end() {
 fn end_to_end(filters: &[Filter], fifo: FifoPolicy, frames: &[Frame]) {
     let p = plan(filters, PlanOptions::new(14).fifo(fifo)).unwrap();
     let cfg = loopback_config(TxPolicy::Fifo);
-    let (mut can, _regs, bus) = can1_with(&cfg, &p);
+    let (can, _regs, bus) = can1_with(&cfg, &p);
+    let mut can = driver(can);
     for f in frames {
-        can.transmit(f).unwrap();
+        can.try_send(f).unwrap();
         settle(&bus);
         let rx = drain(&mut can);
         let want = filters.iter().position(|x| x.matches(f)).map(|i| i as u16);
@@ -221,13 +222,14 @@ fn nine_ids_in_three_banks_end_to_end() {
 #[test]
 fn install_filters_keeps_the_operating_mode() {
     let cfg = loopback_config(TxPolicy::Fifo);
-    let (mut can, _regs, bus) = can1_with(&cfg, &pass_all());
-    assert_eq!(can.mode(), Mode::Normal);
+    let (can, _regs, bus) = can1_with(&cfg, &pass_all());
+    let mut can = driver(can);
+    assert_eq!(can.hardware().mode(), Mode::Normal);
     let only = plan(&[Filter::standard(0x55)], PlanOptions::new(14)).unwrap();
-    can.install_filters(&only).unwrap();
-    assert_eq!(can.mode(), Mode::Normal);
-    can.transmit(&std(0x54)).unwrap();
-    can.transmit(&std(0x55)).unwrap();
+    can.set_filters(&only).unwrap();
+    assert_eq!(can.hardware().mode(), Mode::Normal);
+    can.try_send(&std(0x54)).unwrap();
+    can.try_send(&std(0x55)).unwrap();
     settle(&bus);
     let rx = drain(&mut can);
     assert_eq!(rx.len(), 1);
@@ -238,11 +240,11 @@ fn install_filters_keeps_the_operating_mode() {
         .collect();
     let p = plan(&big, PlanOptions::new(28)).unwrap();
     assert_eq!(
-        can.install_filters(&p),
+        can.set_filters(&p),
         Err(twocan_core::Error::InvalidArgument)
     );
     assert_eq!(
-        can.plan(&big, FifoPolicy::Fifo0).unwrap_err(),
+        can.hardware().plan(&big, FifoPolicy::Fifo0).unwrap_err(),
         twocan_bxcan::PlanError::TooManyBanks {
             needed: 15,
             available: 14
@@ -266,9 +268,9 @@ fn can3_has_fourteen_banks_of_its_own() {
         .plan(&[Filter::extended(7)], FifoPolicy::Fifo0)
         .unwrap();
     init.set_filters(&p).unwrap();
-    let mut can = init.enable().map_err(|f| f.error).unwrap();
-    can.transmit(&Frame::extended(7, &[]).unwrap()).unwrap();
-    can.transmit(&Frame::extended(8, &[]).unwrap()).unwrap();
+    let mut can = driver(init.enable().map_err(|f| f.error).unwrap());
+    can.try_send(&Frame::extended(7, &[]).unwrap()).unwrap();
+    can.try_send(&Frame::extended(8, &[]).unwrap()).unwrap();
     settle(&bus);
     let rx = drain(&mut can);
     assert_eq!(rx.len(), 1);

@@ -62,7 +62,11 @@ fn priority_policy_has_no_priority_inversion() {
     // All three pending: the high-priority frame displaces the lowest (0x502): the
     // abort of a pending mailbox ends at once, 0x100 takes it, 0x502 waits.
     d.try_send(&std(0x100)).unwrap();
-    assert_eq!(d.tx_stats().count, 1, "the displaced frame waits in the queue");
+    assert_eq!(
+        d.tx_stats().count,
+        1,
+        "the displaced frame waits in the queue"
+    );
     // A frame lower than all three pending waits in the queue.
     d.try_send(&std(0x600)).unwrap();
     for _ in 0..30 {
@@ -72,7 +76,11 @@ fn priority_policy_has_no_priority_inversion() {
     assert_eq!(order(&peer), [0x100, 0x500, 0x501, 0x502, 0x600]);
     let t = d.traffic();
     assert_eq!((t.sent, t.aborted, t.failed), (5, 0, 0));
-    assert_eq!(completions(&mut d).len(), 5, "the displaced frame completes once");
+    assert_eq!(
+        completions(&mut d).len(),
+        5,
+        "the displaced frame completes once"
+    );
 }
 
 #[test]
