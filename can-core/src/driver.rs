@@ -102,6 +102,12 @@ impl<H: Hardware, const RX: usize, const TX: usize, const RX1: usize> Driver<H, 
         self.with_tx(|tx| tx.try_send(frame))
     }
 
+    /// Loads `frame` into a free mailbox now or `WouldBlock`, never queued
+    /// ([`Tx::try_send_now`]).
+    pub fn try_send_now(&mut self, frame: &Frame) -> nb::Result<Token, Error> {
+        self.with_tx(|tx| tx.try_send_now(frame))
+    }
+
     /// The next completion, in order.
     pub fn take_completion(&mut self) -> Option<Completion> {
         self.with_tx(|tx| tx.take_completion())

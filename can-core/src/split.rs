@@ -626,6 +626,39 @@ impl<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE:
         })
     }
 
+    /// Loads `frame` into a free mailbox now, or `WouldBlock`: never queued. Unlike
+    /// [`Tx::try_send`] it does not wait behind queued frames, so it may overtake them
+    /// when it needs another kind of mailbox — ACAN's remote frames, which go straight
+    /// to FlexCAN's remote-frame mailboxes while data frames wait for MB15. (On bxCAN
+    /// all mailboxes are alike: it overtakes the queue whenever a mailbox is free.)
+    pub fn try_send_now(&mut self, frame: &Frame) -> nb::Result<Token, Error> {
+        let s = self.s;
+        let hw = s.hw();
+        if s.state.load(Ordering::Relaxed) == state_code(ErrorState::BusOff)
+            && hw.error_status().state == ErrorState::BusOff
+        {
+            return Err(nb::Error::Other(Error::BusOff));
+        }
+        let token = Token(self.next);
+        let load = || match hw.free_mailbox(frame) {
+            Ok(Some(m)) => {
+                // SAFETY: either the queue is empty (the direct path of `try_send`), or
+                // the caller holds the critical section, which keeps the interrupt's
+                // refill from taking `m` meanwhile.
+                unsafe { hw.load(m, frame, token) };
+                Ok(())
+            }
+            Ok(None) => Err(nb::Error::WouldBlock),
+            Err(e) => Err(nb::Error::Other(e)),
+        };
+        let r = if s.queue_len.load(Ordering::Acquire) == 0 {
+            load()
+        } else {
+            critical_section::with(|_| load())
+        };
+        r.map(|()| self.accept(token))
+    }
+
     #[inline(always)]
     fn accept(&mut self, token: Token) -> Token {
         self.next = self.next.wrapping_add(1);

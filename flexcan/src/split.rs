@@ -82,6 +82,11 @@ pub struct FlexCanHw<R: Registers> {
     /// Token of the frame in each transmit mailbox, indexed by `15 - MB`.
     tokens: [AtomicU32; MAX_TX],
     last_error: AtomicU8,
+    /// Written by the receive half's `decode` only.
+    unresolved: AtomicU32,
+    /// Transmit mailboxes loaded and not settled yet (bit per MB): a flag raised by a
+    /// remote-frame mailbox that became a receive mailbox is not a completion.
+    loaded: AtomicU32,
 }
 
 impl<R: Registers> FlexCan<R> {
@@ -99,6 +104,8 @@ impl<R: Registers> FlexCan<R> {
             mode: AtomicU8::new(mode_code(mode)),
             tokens: [const { AtomicU32::new(0) }; MAX_TX],
             last_error: AtomicU8::new(code_index(self.last_error.get())),
+            unresolved: AtomicU32::new(0),
+            loaded: AtomicU32::new(0),
         }
     }
 }
@@ -122,6 +129,23 @@ impl<R: Registers> FlexCanHw<R> {
     /// The registers (for inspection).
     pub fn registers(&self) -> &R {
         &self.regs
+    }
+
+    /// The free-running timer (`TIMER`, one tick per bit time).
+    pub fn timer(&self) -> u16 {
+        regs::timer::TIMER.get(self.regs.read32(regs::TIMER)) as u16
+    }
+
+    /// The filter table installed at split time (the receive half keeps the one in
+    /// force).
+    pub fn filters(&self) -> &FilterTable {
+        &self.table
+    }
+
+    /// Frames whose `RXFIR.IDHIT` mapped to no filter (reported with
+    /// [`UNKNOWN_FILTER`]); the hardware never produces one for the installed table.
+    pub fn unresolved_filter_hits(&self) -> u32 {
+        self.unresolved.load(Ordering::Relaxed)
     }
 
     /// The register handle back (to run `begin` again).
@@ -242,6 +266,7 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
     unsafe fn load(&self, mailbox: u8, frame: &Frame, token: Token) {
         let mb = mailbox as usize;
         self.tokens[DATA_MAILBOX as usize - mb].store(token.0, Ordering::Release);
+        self.loaded.fetch_or(1 << mb, Ordering::Relaxed);
         MbWords::transmit(frame).write(&self.regs, mb);
     }
 
@@ -270,6 +295,17 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
         for mb in (0..=DATA_MAILBOX as usize).filter(|&mb| ended & iflag1::buf(mb) != 0) {
             let control = self.regs.read32(regs::mb_cs(mb));
             let c = cs::CODE.get(control);
+            let was_loaded = self.loaded.fetch_and(!(1 << mb), Ordering::Relaxed) & (1 << mb) != 0;
+            if !was_loaded {
+                // A flag without a frame of ours (an answer caught by a remote-frame
+                // mailbox turned receive mailbox): acknowledge, deactivate, no completion.
+                self.regs.write32(IFLAG1, iflag1::buf(mb));
+                if c != code::TX_INACTIVE {
+                    self.regs
+                        .write32(regs::mb_cs(mb), cs::CODE.val(code::TX_INACTIVE));
+                }
+                continue;
+            }
             let token = Token(self.tokens[DATA_MAILBOX as usize - mb].load(Ordering::Acquire));
             let (outcome, timestamp) = if c == code::TX_ABORT {
                 (TxOutcome::Aborted, None)
@@ -414,9 +450,12 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
         .frame();
         Some(RxFrame {
             frame,
-            filter: map
-                .filter_index(hit as usize, &frame)
-                .unwrap_or(UNKNOWN_FILTER),
+            filter: map.filter_index(hit as usize, &frame).unwrap_or_else(|| {
+                let n = self.unresolved.load(Ordering::Relaxed);
+                self.unresolved
+                    .store(n.saturating_add(1), Ordering::Relaxed);
+                UNKNOWN_FILTER
+            }),
             timestamp: Some(MbWords::timestamp_of(control)),
         })
     }

@@ -235,7 +235,7 @@ fn unused_elements_accept_nothing_extra() {
 #[test]
 fn table_and_masks_written_as_compiled() {
     let (model, can) = begin::<32, 16>(&loop_back(125_000), &filters_0_1_2(), &[]).unwrap();
-    let table = can.controller().filters();
+    let table = can.hardware().filters();
     for (i, e) in table.elements().iter().enumerate() {
         assert_eq!(
             model.peek32(twocan_flexcan::regs::rx_fifo_filter(i)),
@@ -250,7 +250,7 @@ fn table_and_masks_written_as_compiled() {
         model.peek32(twocan_flexcan::regs::RXFGMASK),
         table.global_mask()
     );
-    let _: &FlexCanModel = can.controller().registers();
+    let _: &FlexCanModel = can.hardware().registers();
 }
 
 /// Register access that reports an `RXFIR.IDHIT` beyond the table (the hardware never
@@ -286,7 +286,7 @@ fn unreachable_idhit_is_no_filter_and_is_counted() {
         &[],
     )
     .unwrap();
-    let mut can: twocan_core::Driver<_, 8, 8> = twocan_core::Driver::new(controller);
+    let mut can: twocan_core::Driver<_, 8, 8> = twocan_core::Driver::new(controller.into_split());
     let mut bus = bus_with(125_000, &[&model]);
     let f = Frame::standard(0x234, &[1]).unwrap();
     can.try_send(&f).unwrap();
@@ -305,6 +305,6 @@ fn unreachable_idhit_is_no_filter_and_is_counted() {
     assert_eq!(rx.frame, f);
     // Not filter #0 (the old fallback): the distinct "no filter" index, counted.
     assert_eq!(rx.filter, twocan_flexcan::UNKNOWN_FILTER);
-    assert_eq!(can.controller().unresolved_filter_hits(), 1);
+    assert_eq!(can.hardware().unresolved_filter_hits(), 1);
     assert!(can.receive().is_err());
 }

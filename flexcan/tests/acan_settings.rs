@@ -258,6 +258,6 @@ fn configuration_sets_rffn_11() {
         s.configuration = *c;
         let (model, can) = begin::<32, 16>(&s, &[], &[]).unwrap();
         assert_eq!(regs::ctrl2::RFFN.get(model.peek32(regs::CTRL2)), rffn);
-        assert_eq!(can.controller().configuration(), *c);
+        assert_eq!(can.hardware().configuration(), *c);
     }
 }

@@ -7,7 +7,9 @@ mod common;
 
 use common::*;
 use twocan_core::sim::SimNode;
-use twocan_core::{Controller, Error, Frame, MailboxId, MailboxState, TxPolicy};
+use twocan_core::{
+    AbortRequest, Error, Frame, Hardware, MailboxId, MailboxState, TxOutcome, TxPolicy,
+};
 use twocan_flexcan::regs::{self, code, cs};
 use twocan_flexcan::{Configuration, Settings};
 
@@ -34,7 +36,7 @@ fn strict_order_across_10_000_frames() {
                 std_data(scrambled_id(next), &next.to_le_bytes())
             };
             match can.try_send(&f) {
-                Ok(()) => next += 1,
+                Ok(_) => next += 1,
                 Err(nb::Error::WouldBlock) => {
                     rejected += 1;
                     break;
@@ -98,30 +100,27 @@ fn remote_mailboxes_per_configuration_9() {
         s.configuration = c;
         let (model, mut can) = begin::<32, 16>(&s, &[], &[]).unwrap();
         let r = c.remote_mailbox_count();
-        assert_eq!(can.controller().mailbox_count(), 1 + r);
+        assert_eq!(can.hardware().mailbox_count(), 1 + r);
         // Straight to the remote-frame mailboxes (ACAN: remote frames are not queued).
         for i in 0..r {
-            can.controller_mut()
-                .transmit(&remote(0x500 + i as u32, false))
-                .unwrap();
+            can.try_send_now(&remote(0x500 + i as u32, false)).unwrap();
             assert_eq!(can.mailbox_state(MailboxId(1 + i)), MailboxState::Pending);
         }
         assert!(
             matches!(
-                can.controller_mut().transmit(&remote(0x5FF, false)),
+                can.try_send_now(&remote(0x5FF, false)),
                 Err(nb::Error::WouldBlock)
             ),
             "{c:?}"
         );
         // The data mailbox is independent of them.
         assert_eq!(can.mailbox_state(MailboxId(0)), MailboxState::Empty);
-        can.controller_mut()
-            .transmit(&std_data(0x10, &[1]))
-            .unwrap();
+        can.try_send_now(&std_data(0x10, &[1])).unwrap();
         assert!(matches!(
-            can.controller_mut().transmit(&std_data(0x11, &[])),
+            can.try_send_now(&std_data(0x11, &[])),
             Err(nb::Error::WouldBlock)
         ));
+        assert_eq!(can.tx_stats().count, 0, "nothing queued");
         let mut bus = bus_with(500_000, &[&model]);
         run1(&mut bus, &mut can, 2_000);
         let got = drain(&mut can);
@@ -169,17 +168,47 @@ fn remote_frames_through_the_driver_queue() {
 }
 
 #[test]
+fn remote_frames_overtake_queued_data_frames_through_their_own_mailboxes() {
+    // ACAN: data frames wait for MB15 in order; a remote frame goes straight to a
+    // remote-frame mailbox (`try_send_now`), never behind them.
+    let (model, mut can) = begin::<32, 16>(&loop_back(500_000), &[], &[]).unwrap();
+    for i in 0..4 {
+        can.try_send(&std_data(0x300 + i, &[])).unwrap();
+    }
+    assert_eq!(can.tx_stats().count, 3);
+    let t = can.try_send_now(&remote(0x100, false)).unwrap();
+    assert_eq!(can.tx_stats().count, 3, "not queued");
+    assert_eq!(can.mailbox_state(MailboxId(1)), MailboxState::Pending);
+    let mut bus = bus_with(500_000, &[&model]);
+    run1(&mut bus, &mut can, 5_000);
+    let got: Vec<Frame> = drain(&mut can).iter().map(|rx| rx.frame).collect();
+    assert_eq!(got.len(), 5);
+    // 0x100 wins arbitration against the data frame pending in MB15.
+    assert!(got[0].is_remote() || got[1].is_remote(), "{got:?}");
+    let done: Vec<_> = std::iter::from_fn(|| can.take_completion()).collect();
+    assert_eq!(done.len(), 5);
+    assert!(done
+        .iter()
+        .any(|c| c.token == t && c.outcome == TxOutcome::Sent));
+}
+
+#[test]
 fn abort_a_pending_data_frame() {
     // Normal mode, alone on the bus: before any bus time, nothing has left MB15.
     let (_model, mut can) = begin::<32, 16>(&Settings::new(500_000), &[], &[]).unwrap();
-    can.try_send(&std_data(0x123, &[1])).unwrap();
+    let t = can.try_send(&std_data(0x123, &[1])).unwrap();
     assert_eq!(can.mailbox_state(MailboxId(0)), MailboxState::Pending);
-    assert!(can.abort(MailboxId(0)));
+    assert_eq!(can.abort(t), AbortRequest::Requested);
     assert_eq!(can.mailbox_state(MailboxId(0)), MailboxState::Empty);
-    assert!(!can.abort(MailboxId(0)), "nothing pending any more");
-    assert!(!can.abort(MailboxId(9)), "no such mailbox");
+    assert_eq!(
+        can.abort(t),
+        AbortRequest::NotFound,
+        "nothing pending any more"
+    );
     can.on_interrupt();
     assert_eq!((can.traffic().aborted, can.traffic().sent), (1, 0));
+    let c = can.take_completion().unwrap();
+    assert_eq!((c.token, c.outcome), (t, TxOutcome::Aborted));
     // The mailbox is usable again.
     can.try_send(&std_data(0x124, &[])).unwrap();
     assert_eq!(can.mailbox_state(MailboxId(0)), MailboxState::Pending);
@@ -191,13 +220,16 @@ fn abort_all_drops_the_ring_and_the_mailboxes() {
     for i in 0..5 {
         can.try_send(&std_data(i, &[])).unwrap();
     }
-    can.controller_mut().transmit(&remote(0x42, false)).unwrap();
+    can.try_send_now(&remote(0x42, false)).unwrap();
     assert_eq!(can.abort_all(), 4);
     can.on_interrupt();
     assert_eq!(can.traffic().aborted, 4 + 2);
-    for m in 0..can.controller().mailbox_count() {
+    for m in 0..can.hardware().mailbox_count() {
         assert_eq!(can.mailbox_state(MailboxId(m)), MailboxState::Empty);
     }
+    let done: Vec<_> = std::iter::from_fn(|| can.take_completion()).collect();
+    assert_eq!(done.len(), 6, "one completion per accepted frame");
+    assert!(done.iter().all(|c| c.outcome == TxOutcome::Aborted));
 }
 
 #[test]
@@ -233,7 +265,8 @@ fn listen_only_does_not_transmit() {
         Err(nb::Error::Other(Error::WrongMode))
     );
     assert_eq!(
-        can.controller_mut().transmit(&remote(1, false)),
+        can.try_send_now(&remote(1, false)),
         Err(nb::Error::Other(Error::WrongMode))
     );
+    assert_eq!(can.traffic().queued, 0, "an error means not accepted");
 }

@@ -5,14 +5,16 @@
 use twocan_core::sim::Bus;
 use twocan_core::{Driver, Filter, Frame, RxFrame};
 use twocan_flexcan::model::FlexCanModel;
-use twocan_flexcan::{BeginError, Board, FlexCan, HostSystem, Instance, Settings, Target};
+use twocan_flexcan::{
+    BeginError, Board, FlexCan, FlexCanHw, HostSystem, Instance, Settings, Target,
+};
 
 /// The model as the driver sees it: back-to-back reads of `MCR` or `ESR1` (a mode
 /// acknowledge or `SYNCH` wait) let one bit time of idle bus pass for the module.
 pub use twocan_flexcan::IdleClocked as Ticking;
 
 /// The driver over the model with receive ring `RX` and transmit ring `TX`.
-pub type Can<const RX: usize, const TX: usize> = Driver<FlexCan<Ticking>, RX, TX>;
+pub type Can<const RX: usize, const TX: usize> = Driver<FlexCanHw<Ticking>, RX, TX>;
 
 /// A fresh model of the board's chip.
 pub fn model_for(board: Board) -> FlexCanModel {
@@ -40,7 +42,7 @@ pub fn begin_on<const RX: usize, const TX: usize>(
         primary,
         secondary,
     )?;
-    Ok((model, Driver::new(controller)))
+    Ok((model, Driver::new(controller.into_split())))
 }
 
 /// `begin` on can0 of a Teensy 3.2.
@@ -73,7 +75,7 @@ pub trait Service {
 
 impl<const RX: usize, const TX: usize> Service for Can<RX, TX> {
     fn service(&mut self) {
-        if self.controller().registers().irq_pending() {
+        if self.hardware().registers().irq_pending() {
             self.on_interrupt();
         }
     }
