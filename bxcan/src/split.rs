@@ -172,8 +172,8 @@ impl<R: Registers, F: Registers> BxCan<R, F> {
     }
 
     fn status_now(&self) -> ErrorStatus {
-        let e = self.regs.read32(ESR);
         let m = self.regs.read32(MSR);
+        let e = self.regs.read32(ESR);
         let boff = e & esr::BOFF != 0;
         let counters = ErrorCounters {
             tec: if boff { 256 } else { esr::TEC.get(e) as u16 },
@@ -493,6 +493,8 @@ unsafe impl<R: Registers, F: Registers> Hardware for BxCan<R, F> {
     /// `CAN_MSR`: `ERRI`, `WKUI`, `SLAKI` acknowledged; `CAN_ESR.LEC` reported and set
     /// to 0b111 so the next error is seen as new (notes "Error management").
     unsafe fn take_status(&self) -> StatusEvents {
+        // Acknowledge first, then read the error register: an error latched after the
+        // acknowledge raises ERRI again instead of being lost.
         let m = self.regs.read32(MSR);
         let ack = m & (msr::ERRI | msr::WKUI | msr::SLAKI);
         if ack != 0 {

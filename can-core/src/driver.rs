@@ -3,7 +3,7 @@
 //! `static` and no interrupt. Firmware that takes interrupts uses the split handles.
 //!
 //! ```
-//! use twocan_core::mock_hw::MockHardware;
+//! use twocan_core::mock::MockHardware;
 //! use twocan_core::{Driver, Frame, TxOutcome};
 //!
 //! let mut can: Driver<MockHardware, 8, 4> = Driver::new(MockHardware::new(3).with_loopback(true));

@@ -17,7 +17,7 @@ pub mod io;
 pub mod irq_cell;
 pub mod mailbox;
 #[cfg(any(test, feature = "mock"))]
-pub mod mock_hw;
+pub mod mock;
 pub mod priority;
 pub mod registers;
 #[cfg(feature = "sim")]

@@ -21,7 +21,7 @@
 //! interrupt lines after the split).
 //!
 //! ```
-//! use twocan_core::mock_hw::MockHardware;
+//! use twocan_core::mock::MockHardware;
 //! use twocan_core::split::State;
 //! use twocan_core::{FifoQueue, Frame, TxOutcome};
 //!

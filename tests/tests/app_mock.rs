@@ -1,16 +1,13 @@
 //! The portable application over two mock controllers wired back to back.
 
 use twocan_app::App;
-use twocan_core::mock::{MockController, MockFilters};
-use twocan_core::{Driver, TxPolicy};
+use twocan_core::mock::MockHardware;
+use twocan_core::Driver;
 
-type Node = Driver<MockController<1, 6>, 16, 16>;
+type Node = Driver<MockHardware, 16, 16>;
 
 fn node(app: &App) -> Node {
-    let mut c = MockController::new(TxPolicy::Fifo);
-    let filters: MockFilters = app.filters().into_iter().collect();
-    c.install_filters_for_test(&filters);
-    Driver::new(c)
+    Driver::new(MockHardware::new(1).with_filters(&app.filters()))
 }
 
 #[test]
@@ -23,11 +20,11 @@ fn two_apps_exchange_every_frame_kind() {
         b.step(&mut db);
         // Play a bus: every pending frame of each node reaches the other.
         for _ in 0..8 {
-            if let Some(f) = da.controller_mut().complete() {
-                db.controller_mut().deliver(f);
+            if let Some(f) = da.hardware().complete() {
+                db.hardware().deliver(f);
             }
-            if let Some(f) = db.controller_mut().complete() {
-                da.controller_mut().deliver(f);
+            if let Some(f) = db.hardware().complete() {
+                da.hardware().deliver(f);
             }
             da.on_interrupt();
             db.on_interrupt();

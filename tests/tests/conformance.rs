@@ -321,6 +321,9 @@ fn watch<N: Dut>(
     while h.now() < end && !done(dut) {
         run(h, dut, 1);
         let c = dut.driver_ref().counters();
+        if std::env::var("DBG").is_ok() {
+            eprintln!("{} {:?}", h.now(), c);
+        }
         let s = dut.driver().state();
         if seen.last() != Some(&(c.tec, c.rec, s)) {
             seen.push((c.tec, c.rec, s));

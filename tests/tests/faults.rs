@@ -155,7 +155,11 @@ fn bus_off_then_manual_recovery<B: Backend>() {
         let mut dut = node::<B>(&mut h, &NodeOptions::pass_all());
         let (_peer, _) = attach_peer(&h, "peer");
         drive_to_bus_off(&mut h, &mut dut, &std_frame(0x77, &[]));
-        assert_eq!(dut.driver().recover(), Ok(()), "a no-op");
+        assert_eq!(
+            dut.driver().recover(),
+            Err(twocan_core::Error::WrongMode),
+            "refused: nothing to start, recovery is automatic"
+        );
         let (back, _) = run_until(&mut h, &mut dut, RECOVERY_BITS + 100, |d| {
             d.driver().state() == ErrorState::Active
         });
@@ -367,7 +371,7 @@ fn bxcan_sleep_then_wake_up_on_bus_activity() {
     dut.driver.set_mode(Mode::Sleep).unwrap();
     assert_eq!(dut.driver.state(), ErrorState::Sleeping);
     dut.driver.on_interrupt(); // SLAKI acknowledged
-    let _ = dut.driver.take_state_change();
+    while dut.driver.take_state_change().is_some() {}
     run(&mut h, &mut dut, 500);
     assert_eq!(
         dut.driver.state(),
@@ -383,7 +387,11 @@ fn bxcan_sleep_then_wake_up_on_bus_activity() {
     // Serviced: WKUI acknowledged, the driver sees sleeping → active.
     settle(&mut h, &mut dut, &[&peer], 10_000);
     assert_eq!(dut.model.read32(MSR) & msr::WKUI, 0);
-    assert_eq!(dut.driver.take_state_change(), Some(ErrorState::Active));
+    assert_eq!(
+        dut.driver.take_state_change().map(|c| c.state),
+        Some(ErrorState::Active)
+    );
+    assert_eq!(dut.driver.shared_state().wakeups(), 1);
     assert_eq!(witness.borrow().received_frames(), vec![a]);
     assert!(
         drain(&mut dut).is_empty(),

@@ -24,13 +24,17 @@ use std::rc::Rc;
 use twocan_bxcan::model::BxCanModel;
 use twocan_bxcan::{BxCan, Can, Config as BxConfig, FifoPolicy};
 use twocan_core::sim::{Bus, BusNode, NodeId, SimError};
-use twocan_core::{Driver, ErrorState, Filter, Registers};
+use twocan_core::{Driver, ErrorState, Filter};
 use twocan_flexcan::model::FlexCanModel;
 use twocan_flexcan::{Board, FlexCan, FlexCanHw, HostSystem, Instance, Settings, Target};
 
 /// The simulated bus, shared with the register wrappers that let time pass while a driver
 /// waits for an acknowledge bit.
-pub type SharedBus = Rc<RefCell<Bus>>;
+pub use twocan_core::sim::SharedBus;
+
+/// Register access to a model that lets bus time pass while a driver spins on a poll
+/// register ([`twocan_core::sim::PollClock`]).
+pub type Clocked<R> = twocan_core::sim::PollClock<R>;
 
 /// Receive ring size of the simulated nodes.
 pub const RX_RING: usize = 64;
@@ -108,72 +112,10 @@ impl Harness {
     }
 }
 
-/// Register access to a model that lets one bit time pass on the bus while the driver
-/// spins on a register it polls for an acknowledge bit — as real time passes while
-/// firmware waits. Only back-to-back reads of the same poll register count as a spin: a
-/// single read in an interrupt handler does not move time.
-#[derive(Clone)]
-pub struct Clocked<R> {
-    regs: R,
-    bus: SharedBus,
-    poll_registers: Vec<usize>,
-    /// The poll register read last, if the last access was such a read.
-    spinning: std::cell::Cell<Option<usize>>,
-}
-
-impl<R> Clocked<R> {
-    /// Wraps `regs`; back-to-back reads of `poll_register` advance `bus` by one bit time.
-    pub fn new(regs: R, bus: &SharedBus, poll_register: usize) -> Self {
-        Self::with_poll_registers(regs, bus, &[poll_register])
-    }
-
-    /// Wraps `regs`; back-to-back reads of any one of `poll_registers` advance `bus` by
-    /// one bit time (FlexCAN: `MCR` for the mode acknowledges, `ESR1` for `SYNCH`).
-    pub fn with_poll_registers(regs: R, bus: &SharedBus, poll_registers: &[usize]) -> Self {
-        Clocked {
-            regs,
-            bus: bus.clone(),
-            poll_registers: poll_registers.to_vec(),
-            spinning: std::cell::Cell::new(None),
-        }
-    }
-
-    /// The wrapped register access (the model handle).
-    pub fn inner(&self) -> &R {
-        &self.regs
-    }
-
-    /// Lets time pass on `bus` from now on: for a model moved to another bus (a new bus
-    /// at another bit rate, brought to the same time, with the model attached to it).
-    pub fn set_bus(&mut self, bus: &SharedBus) {
-        self.bus = bus.clone();
-        self.spinning.set(None);
-    }
-}
-
 /// Attaches a node as it is (the default of [`FlexNode::begin_via`] and
 /// [`BxNode::with_config_via`]).
 pub fn attach_plain(bus: &mut Bus, name: &str, node: Box<dyn BusNode>) -> NodeId {
     bus.attach_boxed(name, node)
-}
-
-impl<R: Registers> Registers for Clocked<R> {
-    fn read32(&self, offset: usize) -> u32 {
-        if self.poll_registers.contains(&offset) {
-            if self.spinning.replace(Some(offset)) == Some(offset) {
-                if let Ok(mut bus) = self.bus.try_borrow_mut() {
-                    bus.run_for(1);
-                }
-            }
-        } else {
-            self.spinning.set(None);
-        }
-        self.regs.read32(offset)
-    }
-    fn write32(&self, offset: usize, value: u32) {
-        self.spinning.set(None);
-        self.regs.write32(offset, value)
-    }
 }
 
 /// The FlexCAN driver over its model, as used by the host nodes.

@@ -36,7 +36,7 @@ struct Inner {
     policy: TxPolicy,
     count: usize,
     mailboxes: [Option<Mailbox>; 8],
-    ended: Deque<Completion, 16>,
+    ended: Deque<Settled, 16>,
     seq: u64,
     fifo: Deque<Frame, MOCK_FIFO_DEPTH>,
     overrun: bool,
@@ -85,6 +85,17 @@ impl MockHardware {
         }
     }
 
+    /// The same with `filters` installed (the first match gives the index).
+    pub fn with_filters(self, filters: &[Filter]) -> Self {
+        self.with(|m| m.filters = filters.iter().copied().take(16).collect());
+        self
+    }
+
+    /// Forgets the frames sent so far.
+    pub fn clear_sent(&self) {
+        self.with(|m| m.sent.clear());
+    }
+
     /// The same with identifier-priority transmit order.
     pub fn with_policy(self, policy: TxPolicy) -> Self {
         self.with(|m| m.policy = policy);
@@ -127,12 +138,12 @@ impl MockHardware {
             } else {
                 TxOutcome::Sent
             };
-            let _ = m.ended.push_back(Completion {
+            let _ = m.ended.push_back(Settled::Done(Completion {
                 token: mb.token,
                 outcome,
                 cause: None,
                 timestamp: None,
-            });
+            }));
             if outcome == TxOutcome::Sent {
                 let _ = m.sent.push(mb.frame);
                 if m.loopback {
@@ -239,19 +250,66 @@ unsafe impl Hardware for MockHardware {
     }
 
     unsafe fn settle<F: FnMut(Settled)>(&self, mut f: F) {
-        while let Some(c) = self.with(|m| m.ended.pop_front()) {
-            f(Settled::Done(c));
+        while let Some(s) = self.with(|m| m.ended.pop_front()) {
+            f(s);
         }
+    }
+
+    /// Under the priority order, with every mailbox loaded: the lowest-priority one is
+    /// emptied at once when `frame` beats it, and its frame handed back.
+    unsafe fn displace(&self, frame: &Frame) -> bool {
+        self.with(|m| {
+            if m.policy != TxPolicy::Priority || m.mailboxes[..m.count].iter().any(|x| x.is_none())
+            {
+                return false;
+            }
+            let mut low = 0;
+            for i in 1..m.count {
+                let (a, b) = (m.mailboxes[i], m.mailboxes[low]);
+                if let (Some(a), Some(b)) = (a, b) {
+                    if !a.frame.priority().beats(b.frame.priority()) {
+                        low = i;
+                    }
+                }
+            }
+            let Some(victim) = m.mailboxes[low] else {
+                return false;
+            };
+            if !frame.priority().beats(victim.frame.priority()) {
+                return false;
+            }
+            m.mailboxes[low] = None;
+            let _ = m
+                .ended
+                .push_back(Settled::Displaced(victim.token, victim.frame));
+            true
+        })
     }
 
     fn mailbox_count(&self) -> u8 {
         self.with(|m| m.count as u8)
     }
 
+    /// `Scheduled` for the loaded mailbox the policy sends next, `Pending` for the
+    /// other loaded ones.
     fn mailbox_state(&self, mailbox: MailboxId) -> MailboxState {
-        self.with(|m| match m.mailboxes.get(mailbox.0 as usize) {
-            Some(Some(_)) if (mailbox.0 as usize) < m.count => MailboxState::Pending,
-            _ => MailboxState::Empty,
+        let i = mailbox.0 as usize;
+        self.with(|m| {
+            let Some(Some(me)) = m.mailboxes.get(i).filter(|_| i < m.count) else {
+                return MailboxState::Empty;
+            };
+            let ahead = m.mailboxes[..m.count]
+                .iter()
+                .flatten()
+                .any(|o| match m.policy {
+                    TxPolicy::Fifo => o.seq < me.seq,
+                    TxPolicy::Priority => o.frame.priority().beats(me.frame.priority()),
+                });
+            if ahead {
+                MailboxState::Pending
+            } else {
+                MailboxState::Scheduled
+            }
         })
     }
 
@@ -261,12 +319,12 @@ unsafe impl Hardware for MockHardware {
                 if let Some(mb) = m.mailboxes[i] {
                     if mb.token == token {
                         m.mailboxes[i] = None;
-                        let _ = m.ended.push_back(Completion {
+                        let _ = m.ended.push_back(Settled::Done(Completion {
                             token,
                             outcome: TxOutcome::Aborted,
                             cause: None,
                             timestamp: None,
-                        });
+                        }));
                         return true;
                     }
                 }
@@ -279,12 +337,12 @@ unsafe impl Hardware for MockHardware {
         self.with(|m| {
             for i in 0..m.count {
                 if let Some(mb) = m.mailboxes[i].take() {
-                    let _ = m.ended.push_back(Completion {
+                    let _ = m.ended.push_back(Settled::Done(Completion {
                         token: mb.token,
                         outcome: TxOutcome::Aborted,
                         cause: None,
                         timestamp: None,
-                    });
+                    }));
                 }
             }
         })

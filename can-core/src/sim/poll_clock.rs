@@ -1,0 +1,83 @@
+//! [`PollClock`]: register access to a peripheral model that lets bus time pass while
+//! a driver spins on a register — as real time passes while firmware waits for an
+//! acknowledge bit. Only back-to-back reads of the same poll register count as a spin:
+//! a single read (in an interrupt handler) does not move time.
+
+use std::cell::{Cell, RefCell};
+use std::rc::Rc;
+use std::vec::Vec;
+
+use crate::registers::Registers;
+use crate::sim::Bus;
+
+/// The simulated bus, shared with the register wrappers that let time pass.
+pub type SharedBus = Rc<RefCell<Bus>>;
+
+/// A register handle whose back-to-back reads of a poll register advance the bus by
+/// one bit time (see the [module docs](self)).
+#[derive(Clone)]
+pub struct PollClock<R> {
+    regs: R,
+    bus: SharedBus,
+    poll_registers: Vec<usize>,
+    /// The poll register read last, if the last access was such a read.
+    spinning: Cell<Option<usize>>,
+}
+
+impl<R> core::fmt::Debug for PollClock<R> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("PollClock")
+            .field("poll_registers", &self.poll_registers)
+            .finish_non_exhaustive()
+    }
+}
+
+impl<R> PollClock<R> {
+    /// Wraps `regs`; back-to-back reads of `poll_register` advance `bus` by one bit time.
+    pub fn new(regs: R, bus: &SharedBus, poll_register: usize) -> Self {
+        Self::with_poll_registers(regs, bus, &[poll_register])
+    }
+
+    /// Wraps `regs`; back-to-back reads of any one of `poll_registers` advance `bus` by
+    /// one bit time (FlexCAN: `MCR` for the mode acknowledges, `ESR1` for `SYNCH`).
+    pub fn with_poll_registers(regs: R, bus: &SharedBus, poll_registers: &[usize]) -> Self {
+        PollClock {
+            regs,
+            bus: bus.clone(),
+            poll_registers: poll_registers.to_vec(),
+            spinning: Cell::new(None),
+        }
+    }
+
+    /// The wrapped register access (the model handle).
+    pub fn inner(&self) -> &R {
+        &self.regs
+    }
+
+    /// Lets time pass on `bus` from now on: for a model moved to another bus (a new bus
+    /// at another bit rate, brought to the same time, with the model attached to it).
+    pub fn set_bus(&mut self, bus: &SharedBus) {
+        self.bus = bus.clone();
+        self.spinning.set(None);
+    }
+}
+
+impl<R: Registers> Registers for PollClock<R> {
+    fn read32(&self, offset: usize) -> u32 {
+        if self.poll_registers.contains(&offset) {
+            if self.spinning.replace(Some(offset)) == Some(offset) {
+                if let Ok(mut bus) = self.bus.try_borrow_mut() {
+                    bus.run_for(1);
+                }
+            }
+        } else {
+            self.spinning.set(None);
+        }
+        self.regs.read32(offset)
+    }
+
+    fn write32(&self, offset: usize, value: u32) {
+        self.spinning.set(None);
+        self.regs.write32(offset, value)
+    }
+}
