@@ -57,6 +57,7 @@ pub mod model;
 
 pub mod config;
 pub mod controller;
+mod error;
 pub mod filter_block;
 pub mod filters;
 pub mod instance;

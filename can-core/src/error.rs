@@ -156,9 +156,66 @@ impl From<crate::filter::FilterError> for Error {
 
 impl core::fmt::Display for Error {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        core::fmt::Debug::fmt(self, f)
+        match self {
+            Error::BusOff => f.write_str("the controller is bus-off"),
+            Error::WrongMode => f.write_str("the controller is not in a mode that allows this"),
+            Error::Timeout => f.write_str("the controller did not acknowledge in time"),
+            Error::Bus(code) => write!(f, "bus error: {code:?}"),
+            Error::Overrun => f.write_str("a receive FIFO overran: frames were lost in hardware"),
+            Error::Frame(_) => f.write_str("invalid frame"),
+            Error::Filter(_) => f.write_str("invalid filter"),
+            Error::InvalidArgument => f.write_str("argument out of range"),
+        }
     }
 }
+
+impl core::error::Error for Error {
+    fn source(&self) -> Option<&(dyn core::error::Error + 'static)> {
+        match self {
+            Error::Frame(e) => Some(e),
+            Error::Filter(e) => Some(e),
+            _ => None,
+        }
+    }
+}
+
+impl core::fmt::Display for crate::frame::FrameError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        use crate::frame::FrameError as E;
+        match self {
+            E::StandardIdOutOfRange(id) => {
+                write!(f, "standard identifier {id:#X} above 0x7FF")
+            }
+            E::ExtendedIdOutOfRange(id) => {
+                write!(f, "extended identifier {id:#X} above 0x1FFFFFFF")
+            }
+            E::DlcTooLarge(dlc) => write!(f, "data length code {dlc} above 8"),
+            E::TooMuchData(n) => write!(f, "{n} data bytes, more than 8"),
+            E::DataOnRemoteFrame => f.write_str("a remote frame carries no data"),
+            E::OutOfBounds => f.write_str("word view outside the frame's data length"),
+        }
+    }
+}
+
+impl core::error::Error for crate::frame::FrameError {}
+
+impl core::fmt::Display for crate::filter::FilterError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        use crate::filter::FilterError as E;
+        f.write_str(match self {
+            E::IdOutOfRange => "filter identifier wider than its format",
+            E::MaskOutOfRange => "filter mask wider than its format",
+            E::AcceptanceOutsideMask => {
+                "filter identifier has bits outside its mask: it never matches"
+            }
+            E::AnyFormatWithIdentifier => {
+                "an identifier comparison needs a format (not Format::Any)"
+            }
+        })
+    }
+}
+
+impl core::error::Error for crate::filter::FilterError {}
 
 #[cfg(test)]
 mod tests {
@@ -175,6 +232,24 @@ mod tests {
         assert_eq!(s(0, 128), ErrorState::Passive);
         assert_eq!(s(255, 0), ErrorState::Passive);
         assert_eq!(s(256, 0), ErrorState::BusOff);
+    }
+
+    #[test]
+    fn errors_display_and_chain() {
+        use crate::filter::FilterError;
+        use crate::frame::FrameError;
+        use core::error::Error as _;
+        let e = Error::from(FrameError::StandardIdOutOfRange(0x800));
+        assert_eq!(e.to_string(), "invalid frame");
+        let source = e.source().expect("the frame error is the source");
+        assert_eq!(source.to_string(), "standard identifier 0x800 above 0x7FF");
+        let e = Error::from(FilterError::MaskOutOfRange);
+        assert_eq!(
+            e.source().unwrap().to_string(),
+            "filter mask wider than its format"
+        );
+        assert!(Error::Timeout.source().is_none());
+        assert_eq!(Error::BusOff.to_string(), "the controller is bus-off");
     }
 
     #[test]
