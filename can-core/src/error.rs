@@ -85,7 +85,9 @@ pub struct ErrorStatistics {
     pub crc: u32,
     /// Times the controller entered bus-off.
     pub bus_off: u32,
-    /// Frames lost by a hardware receive FIFO overrun.
+    /// Hardware receive FIFO overrun occurrences seen by the interrupt handler. Neither
+    /// FlexCAN (`IFLAG1` bit 7) nor bxCAN (`FOVR`) counts the frames an overrun drops, so
+    /// this counts occurrences, not lost frames (at least one frame per occurrence).
     pub hardware_overruns: u32,
 }
 

@@ -32,7 +32,8 @@ pub struct MockController<const M: usize, const F: usize> {
     pub sent: Vec<Frame, 1024>,
     /// Whether sent frames are received back through the filters.
     pub loopback: bool,
-    /// Frames lost to FIFO overrun.
+    /// Frames dropped because the FIFO was full. The mock reports each as one overrun
+    /// event, so here frames and `ErrorStatistics::hardware_overruns` occurrences agree.
     pub overruns: u32,
 }
 
