@@ -219,6 +219,28 @@ impl core::fmt::Display for crate::filter::FilterError {
 
 impl core::error::Error for crate::filter::FilterError {}
 
+impl core::fmt::Display for crate::dispatch::NoSuchFilter {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        write!(f, "no filter with index {} in the dispatcher", self.0)
+    }
+}
+
+impl core::error::Error for crate::dispatch::NoSuchFilter {}
+
+#[cfg(feature = "sim")]
+impl core::fmt::Display for crate::sim::bus::StillBusy {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        write!(
+            f,
+            "the simulated bus was still busy at bit time {} when its budget ran out",
+            self.now
+        )
+    }
+}
+
+#[cfg(feature = "sim")]
+impl core::error::Error for crate::sim::bus::StillBusy {}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -252,6 +274,8 @@ mod tests {
         );
         assert!(Error::Timeout.source().is_none());
         assert_eq!(Error::BusOff.to_string(), "the controller is bus-off");
+        let e: &dyn core::error::Error = &crate::dispatch::NoSuchFilter(7);
+        assert_eq!(e.to_string(), "no filter with index 7 in the dispatcher");
     }
 
     #[test]
