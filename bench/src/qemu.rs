@@ -350,8 +350,7 @@ mod tests {
     #[test]
     fn a_missing_tool_is_named_not_installed_without_install() {
         let e = ensure("twocan-no-such-program", "twocan-no-such-package", false)
-            .err()
-            .expect("a missing program is an error");
+            .expect_err("a missing program is an error");
         let msg = e.to_string();
         assert!(
             msg.contains("`twocan-no-such-program` is not installed"),
