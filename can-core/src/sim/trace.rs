@@ -290,7 +290,8 @@ impl<'a, W: Write> CandumpWriter<'a, W> {
     }
 
     /// Writes every record of `trace` and clears it, so that its memory stays bounded by
-    /// what happened since the last call. On an error the records are kept.
+    /// what happened since the last call. On a write error the trace is left as it was
+    /// (a retry may write again the lines that did get out).
     pub fn drain(&mut self, trace: &mut Trace) -> io::Result<()> {
         for r in &trace.records {
             self.write_record(r)?;
