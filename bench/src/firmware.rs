@@ -78,8 +78,9 @@ pub fn cargo() -> Command {
     c
 }
 
-/// Makes sure the cross target is installed (`rustup target add` if rustup is there).
-pub fn ensure_target() -> Result<()> {
+/// Makes sure the cross target is installed; `rustup target add` only when `install`
+/// (`--install`) is set, otherwise an error says how to get it.
+pub fn ensure_target(install: bool) -> Result<()> {
     let Some(rustup) = cmd::which("rustup") else {
         // No rustup: the build itself will say whether the target's std is there.
         return Ok(());
@@ -91,7 +92,13 @@ pub fn ensure_target() -> Result<()> {
     if out.stdout.lines().any(|l| l.trim() == TARGET) {
         return Ok(());
     }
-    eprintln!("can-bench: installing the {TARGET} target (rustup target add {TARGET})");
+    if !install {
+        return Err(Error::new(format!(
+            "the {TARGET} target (needed to cross-build the firmware) is not installed: run \
+             `rustup target add {TARGET}`, or `can-bench --install` to let can-bench do it"
+        )));
+    }
+    eprintln!("can-bench: installing the {TARGET} target (rustup target add {TARGET}, --install)");
     cmd::run_ok(
         Command::new(&rustup).args(["target", "add", TARGET]),
         Duration::from_secs(600),

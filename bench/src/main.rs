@@ -17,6 +17,11 @@
 //! without touching `docs/benchmarks.md`. `--skip STEP` (sizes, examples, qemu, timing,
 //! sim; repeatable) leaves a step out for a quicker look: the tables are printed, the
 //! document is not written.
+//!
+//! can-bench installs nothing by itself: a missing tool (QEMU, gcc, the
+//! `thumbv7em-none-eabihf` target) ends it with a message naming the tool and how to get
+//! it. With `--install` it installs them (Debian packages with apt-get when run as root,
+//! the target with rustup).
 
 mod cmd;
 mod firmware;
@@ -31,13 +36,53 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
 
-use cmd::{Context, Error, Result};
+use clap::{Parser, ValueEnum};
+
+use cmd::{Context, Result};
 use firmware::Paths;
 use report::{ExampleBuild, ExampleSection, InsnSection, Report, SizeBuild, SizeSection};
 use simspeed::Trials;
 
-/// The steps, for `--skip`.
-const STEPS: [&str; 5] = ["sizes", "examples", "qemu", "timing", "sim"];
+/// A step of the command, for `--skip`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum Step {
+    /// flash and RAM of the loop-back firmwares
+    Sizes,
+    /// flash and RAM of the firmware examples
+    Examples,
+    /// instructions per frame under QEMU
+    Qemu,
+    /// bit-timing quality
+    Timing,
+    /// simulator speed
+    Sim,
+}
+
+impl Step {
+    fn name(self) -> &'static str {
+        match self {
+            Step::Sizes => "sizes",
+            Step::Examples => "examples",
+            Step::Qemu => "qemu",
+            Step::Timing => "timing",
+            Step::Sim => "sim",
+        }
+    }
+}
+
+/// can-bench: measures twocan and writes docs/benchmarks.md (a run with --skip prints the
+/// tables and does not write the document).
+#[derive(Debug, Parser)]
+#[command(name = "can-bench", version)]
+struct Args {
+    /// Leave a step out (repeatable)
+    #[arg(long, value_enum, value_name = "STEP")]
+    skip: Vec<Step>,
+    /// Install what is missing (QEMU and gcc with apt-get, as root; the
+    /// thumbv7em-none-eabihf target with rustup) instead of stopping with a message
+    #[arg(long)]
+    install: bool,
+}
 
 /// Profiles of the bench firmware (sizes and instruction counts): (cargo profile, opt-level).
 const COUNT_PROFILES: [(&str, &str); 2] = [("release", "s"), ("release-speed", "3")];
@@ -52,42 +97,6 @@ fn main() -> ExitCode {
     }
 }
 
-fn parse_args() -> Result<Vec<String>> {
-    let mut skip = Vec::new();
-    let mut args = std::env::args().skip(1);
-    while let Some(a) = args.next() {
-        match a.as_str() {
-            "--skip" => {
-                let step = args
-                    .next()
-                    .ok_or_else(|| Error::new("--skip needs a step name"))?;
-                if !STEPS.contains(&step.as_str()) {
-                    return Err(Error::new(format!(
-                        "unknown step `{step}` (steps: {})",
-                        STEPS.join(", ")
-                    )));
-                }
-                skip.push(step);
-            }
-            "-h" | "--help" => {
-                println!(
-                    "can-bench: measures twocan and writes docs/benchmarks.md\n\n\
-                     usage: cargo run --release --bin can-bench [-- --skip STEP ...]\n\
-                     steps: {} (a run with --skip does not write the document)",
-                    STEPS.join(", ")
-                );
-                std::process::exit(0);
-            }
-            other => {
-                return Err(Error::new(format!(
-                    "unknown argument `{other}` (try --help)"
-                )))
-            }
-        }
-    }
-    Ok(skip)
-}
-
 fn step(name: &str) {
     eprintln!("\ncan-bench: ==> {name}");
 }
@@ -98,8 +107,10 @@ fn lap(started: Instant) {
 }
 
 fn run() -> Result<()> {
-    let skip = parse_args()?;
-    let skipped = |s: &str| skip.iter().any(|k| k == s);
+    // Bad options: clap prints the error and a usage line and exits with status 2.
+    let args = Args::parse();
+    let skip: Vec<&str> = args.skip.iter().map(|s| s.name()).collect();
+    let skipped = |s: &str| skip.contains(&s);
     let started = Instant::now();
     let paths = Paths::discover()?;
     let mut report = Report::new(&paths);
@@ -108,7 +119,7 @@ fn run() -> Result<()> {
         None
     } else {
         step("tools for the instruction counts (QEMU, gcc)");
-        let t = qemu::tools()?;
+        let t = qemu::tools(args.install)?;
         eprintln!("can-bench: {}; {}", t.qemu_version, t.gcc_version);
         Some(t)
     };
@@ -145,7 +156,7 @@ fn run() -> Result<()> {
     let need_firmware = !skipped("sizes") || !skipped("qemu");
     let mut firmware_dirs: Vec<(String, PathBuf)> = Vec::new();
     if need_firmware || !skipped("examples") {
-        firmware::ensure_target()?;
+        firmware::ensure_target(args.install)?;
     }
     if need_firmware {
         lap(started);
@@ -276,4 +287,34 @@ fn examples(paths: &Paths) -> Result<ExampleSection> {
         }
     }
     Ok(ExampleSection { builds })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::CommandFactory;
+
+    #[test]
+    fn options() {
+        let a = Args::try_parse_from(["can-bench", "--skip", "qemu", "--skip=sim", "--install"])
+            .unwrap();
+        assert_eq!(a.skip, [Step::Qemu, Step::Sim]);
+        assert!(a.install);
+        let a = Args::try_parse_from(["can-bench"]).unwrap();
+        assert!(a.skip.is_empty() && !a.install);
+        assert!(Args::try_parse_from(["can-bench", "--skip", "frob"]).is_err());
+        assert!(Args::try_parse_from(["can-bench", "--install=yes"]).is_err());
+        assert_eq!(
+            [
+                Step::Sizes,
+                Step::Examples,
+                Step::Qemu,
+                Step::Timing,
+                Step::Sim
+            ]
+            .map(Step::name),
+            ["sizes", "examples", "qemu", "timing", "sim"]
+        );
+        Args::command().debug_assert();
+    }
 }

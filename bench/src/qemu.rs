@@ -62,20 +62,34 @@ fn apt_install(package: &str) -> Result<()> {
     Ok(())
 }
 
-/// Finds `program`, installing Debian `package` when running as root; a clear error
-/// otherwise.
-fn ensure(program: &str, package: &str) -> Result<(PathBuf, bool)> {
+/// How to get a missing Debian package, for messages.
+fn how_to_get(program: &str, package: &str) -> String {
+    format!(
+        "`{program}` is not installed: install the Debian package `{package}` \
+         (`sudo apt-get install -y {package}`), or run `can-bench --install` as root to let \
+         can-bench install it"
+    )
+}
+
+/// Finds `program`. When it is missing, installs Debian `package` only if `install` is
+/// set (`--install`) and can-bench runs as root; otherwise an error says what is missing
+/// and how to get it.
+fn ensure(program: &str, package: &str, install: bool) -> Result<(PathBuf, bool)> {
     if let Some(p) = cmd::which(program) {
         return Ok((p, false));
     }
+    if !install {
+        return Err(Error::new(how_to_get(program, package)));
+    }
     if !is_root() {
         return Err(Error::new(format!(
-            "`{program}` is not installed and can-bench does not run as root (id -u is not 0), \
-             so it cannot install it: run `sudo apt-get install -y {package}` (Debian package \
-             `{package}`) and start can-bench again"
+            "{} (--install was given, but can-bench does not run as root: id -u is not 0)",
+            how_to_get(program, package)
         )));
     }
-    eprintln!("can-bench: `{program}` not found; installing the Debian package `{package}`");
+    eprintln!(
+        "can-bench: `{program}` not found; installing the Debian package `{package}` (--install)"
+    );
     apt_install(package)?;
     let p = cmd::which(program).ok_or_else(|| {
         Error::new(format!(
@@ -85,9 +99,10 @@ fn ensure(program: &str, package: &str) -> Result<(PathBuf, bool)> {
     Ok((p, true))
 }
 
-/// QEMU (with the mps2-an386 machine) and gcc.
-pub fn tools() -> Result<Tools> {
-    let (qemu, qemu_installed_now) = ensure("qemu-system-arm", "qemu-system-arm")?;
+/// QEMU (with the mps2-an386 machine) and gcc; installed with apt-get only when `install`
+/// (`--install`) is set.
+pub fn tools(install: bool) -> Result<Tools> {
+    let (qemu, qemu_installed_now) = ensure("qemu-system-arm", "qemu-system-arm", install)?;
     let qemu_s = qemu.to_string_lossy().into_owned();
     let qemu_version = cmd::first_line(&qemu_s, &["--version"])
         .ok_or_else(|| Error::new(format!("`{qemu_s} --version` failed")))?;
@@ -104,7 +119,7 @@ pub fn tools() -> Result<Tools> {
             "{qemu_version} has no `{MACHINE}` machine (QEMU 6.0 or newer is needed)"
         )));
     }
-    let (gcc, _) = ensure("gcc", "gcc")?;
+    let (gcc, _) = ensure("gcc", "gcc", install)?;
     let gcc_version = cmd::first_line(&gcc.to_string_lossy(), &["--version"])
         .ok_or_else(|| Error::new("`gcc --version` failed"))?;
     Ok(Tools {
@@ -331,6 +346,25 @@ fn parse(stdout: &str, counts: &str, window: u32) -> Result<Counts> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_missing_tool_is_named_not_installed_without_install() {
+        let e = ensure("twocan-no-such-program", "twocan-no-such-package", false)
+            .expect_err("a missing program is an error");
+        let msg = e.to_string();
+        assert!(
+            msg.contains("`twocan-no-such-program` is not installed"),
+            "{msg}"
+        );
+        assert!(
+            msg.contains("apt-get install -y twocan-no-such-package"),
+            "{msg}"
+        );
+        assert!(msg.contains("can-bench --install"), "{msg}");
+        // A present program is found and reported as not installed by this run.
+        let (p, installed_now) = ensure("sh", "dash", false).unwrap();
+        assert!(p.ends_with("sh") && !installed_now);
+    }
 
     const STDOUT: &str = "window 0x20110000\nregion 0 empty\nregion 1 a.b\nregion 2 c\ndone\n";
 

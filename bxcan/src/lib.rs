@@ -85,7 +85,16 @@
 //!   compiled [`FilterPlan`]; [`planner`]: portable filters → fewest banks, exactly;
 //! - [`instance`]: CAN1/CAN2/CAN3 and what the firmware must do (RCC, AF9);
 //! - [`regs`]: the register map.
+//!
+//! # Critical sections
+//!
+//! Firmware must link one `critical-section` implementation: on the single-core
+//! Cortex-M4/M7 of these boards, `cortex-m`'s `critical-section-single-core` feature
+//! (otherwise linking fails on `_critical_section_1_0_acquire`); see
+//! [`twocan_core`'s crate documentation](twocan_core#critical-sections).
 #![cfg_attr(not(feature = "model"), no_std)]
+// docs.rs (nightly rustdoc): mark feature-gated items with the feature they need.
+#![cfg_attr(docsrs, feature(doc_cfg))]
 #![deny(missing_docs)]
 #![deny(unsafe_code)]
 
@@ -96,6 +105,7 @@ pub mod model;
 
 pub mod config;
 pub mod controller;
+mod error;
 pub mod filter_block;
 pub mod filters;
 pub mod instance;

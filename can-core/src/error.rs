@@ -85,7 +85,9 @@ pub struct ErrorStatistics {
     pub crc: u32,
     /// Times the controller entered bus-off.
     pub bus_off: u32,
-    /// Frames lost by a hardware receive FIFO overrun.
+    /// Hardware receive FIFO overrun occurrences seen by the interrupt handler. Neither
+    /// FlexCAN (`IFLAG1` bit 7) nor bxCAN (`FOVR`) counts the frames an overrun drops, so
+    /// this counts occurrences, not lost frames (at least one frame per occurrence).
     pub hardware_overruns: u32,
 }
 
@@ -156,9 +158,88 @@ impl From<crate::filter::FilterError> for Error {
 
 impl core::fmt::Display for Error {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        core::fmt::Debug::fmt(self, f)
+        match self {
+            Error::BusOff => f.write_str("the controller is bus-off"),
+            Error::WrongMode => f.write_str("the controller is not in a mode that allows this"),
+            Error::Timeout => f.write_str("the controller did not acknowledge in time"),
+            Error::Bus(code) => write!(f, "bus error: {code:?}"),
+            Error::Overrun => f.write_str("a receive FIFO overran: frames were lost in hardware"),
+            Error::Frame(_) => f.write_str("invalid frame"),
+            Error::Filter(_) => f.write_str("invalid filter"),
+            Error::InvalidArgument => f.write_str("argument out of range"),
+        }
     }
 }
+
+impl core::error::Error for Error {
+    fn source(&self) -> Option<&(dyn core::error::Error + 'static)> {
+        match self {
+            Error::Frame(e) => Some(e),
+            Error::Filter(e) => Some(e),
+            _ => None,
+        }
+    }
+}
+
+impl core::fmt::Display for crate::frame::FrameError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        use crate::frame::FrameError as E;
+        match self {
+            E::StandardIdOutOfRange(id) => {
+                write!(f, "standard identifier {id:#X} above 0x7FF")
+            }
+            E::ExtendedIdOutOfRange(id) => {
+                write!(f, "extended identifier {id:#X} above 0x1FFFFFFF")
+            }
+            E::DlcTooLarge(dlc) => write!(f, "data length code {dlc} above 8"),
+            E::TooMuchData(n) => write!(f, "{n} data bytes, more than 8"),
+            E::DataOnRemoteFrame => f.write_str("a remote frame carries no data"),
+            E::OutOfBounds => f.write_str("word view outside the frame's data length"),
+        }
+    }
+}
+
+impl core::error::Error for crate::frame::FrameError {}
+
+impl core::fmt::Display for crate::filter::FilterError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        use crate::filter::FilterError as E;
+        f.write_str(match self {
+            E::IdOutOfRange => "filter identifier wider than its format",
+            E::MaskOutOfRange => "filter mask wider than its format",
+            E::AcceptanceOutsideMask => {
+                "filter identifier has bits outside its mask: it never matches"
+            }
+            E::AnyFormatWithIdentifier => {
+                "an identifier comparison needs a format (not Format::Any)"
+            }
+        })
+    }
+}
+
+impl core::error::Error for crate::filter::FilterError {}
+
+impl core::fmt::Display for crate::dispatch::NoSuchFilter {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        write!(f, "no filter with index {} in the dispatcher", self.0)
+    }
+}
+
+impl core::error::Error for crate::dispatch::NoSuchFilter {}
+
+#[cfg(feature = "sim")]
+impl core::fmt::Display for crate::sim::bus::StillBusy {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        write!(
+            f,
+            "the simulated bus was still busy at bit time {} when its budget ran out",
+            self.now
+        )
+    }
+}
+
+#[cfg(feature = "sim")]
+impl core::error::Error for crate::sim::bus::StillBusy {}
 
 #[cfg(test)]
 mod tests {
@@ -175,6 +256,26 @@ mod tests {
         assert_eq!(s(0, 128), ErrorState::Passive);
         assert_eq!(s(255, 0), ErrorState::Passive);
         assert_eq!(s(256, 0), ErrorState::BusOff);
+    }
+
+    #[test]
+    fn errors_display_and_chain() {
+        use crate::filter::FilterError;
+        use crate::frame::FrameError;
+        use core::error::Error as _;
+        let e = Error::from(FrameError::StandardIdOutOfRange(0x800));
+        assert_eq!(e.to_string(), "invalid frame");
+        let source = e.source().expect("the frame error is the source");
+        assert_eq!(source.to_string(), "standard identifier 0x800 above 0x7FF");
+        let e = Error::from(FilterError::MaskOutOfRange);
+        assert_eq!(
+            e.source().unwrap().to_string(),
+            "filter mask wider than its format"
+        );
+        assert!(Error::Timeout.source().is_none());
+        assert_eq!(Error::BusOff.to_string(), "the controller is bus-off");
+        let e: &dyn core::error::Error = &crate::dispatch::NoSuchFilter(7);
+        assert_eq!(e.to_string(), "no filter with index 7 in the dispatcher");
     }
 
     #[test]

@@ -83,6 +83,23 @@ pub enum FilterError {
 ///
 /// A frame matches when its kind and format are accepted and
 /// `frame_id & mask == id`.
+///
+/// ```
+/// use twocan_core::{Filter, FilterError, Format, Frame, FrameKind};
+///
+/// // Standard data frames 0x120..=0x12F (ACAN's (kind, format, mask, acceptance) filter).
+/// const RANGE: Filter = Filter::masked(FrameKind::Data, Format::Standard, 0x7F0, 0x120);
+/// assert_eq!(RANGE.check(), Ok(()));
+/// assert!(RANGE.matches(&Frame::standard(0x12A, &[1]).unwrap()));
+/// assert!(!RANGE.matches(&Frame::standard(0x130, &[1]).unwrap()));
+/// assert!(!RANGE.matches(&Frame::extended(0x12A, &[1]).unwrap())); // other format
+/// assert!(!RANGE.matches(&Frame::remote(0x12A, false, 0).unwrap())); // other kind
+///
+/// // Bad filters are refused with a reason, never accepted silently.
+/// let never = Filter::masked(FrameKind::Data, Format::Standard, 0x700, 0x0FF);
+/// assert_eq!(never.check(), Err(FilterError::AcceptanceOutsideMask));
+/// assert_eq!(Filter::standard(0x800).check(), Err(FilterError::IdOutOfRange));
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Filter {

@@ -1,5 +1,16 @@
 //! Portable core of the `twocan` CAN drivers.
+//!
+//! # Critical sections
+//!
+//! The drivers share state between thread code and the interrupt handler through the
+//! [`critical_section`] crate, which needs exactly one implementation in the final program;
+//! without one, linking fails with an undefined `_critical_section_1_0_acquire`. Firmware
+//! on a single-core Cortex-M (Teensy 3.x, STM32F7) enables `cortex-m`'s
+//! `critical-section-single-core` feature (or uses a HAL or RTOS that provides one); host
+//! programs and tests enable `critical-section`'s `std` feature.
 #![cfg_attr(not(any(test, feature = "std")), no_std)]
+// docs.rs (nightly rustdoc): mark feature-gated items with the feature they need.
+#![cfg_attr(docsrs, feature(doc_cfg))]
 #![deny(missing_docs)]
 
 #[cfg(feature = "std")]

@@ -31,4 +31,9 @@ fn main() {
         many => panic!("twocan-stm32f7: several board features selected: {many:?}; choose one"),
     }
     println!("cargo:rustc-link-arg-bins=-Tlink.x");
+    // defmt's linker script: its interned strings go to the `.defmt` section of the ELF,
+    // which probe-rs reads to decode the RTT output.
+    if env::var_os("CARGO_FEATURE_DEFMT").is_some() {
+        println!("cargo:rustc-link-arg-bins=-Tdefmt.x");
+    }
 }

@@ -8,105 +8,62 @@
 
 use core::fmt;
 
-/// The error flags of ACAN table 5 (bits 0–7 at ACAN's positions), plus bit 8 for
-/// an instance the board does not have.
-///
-/// The table, as extracted from the manual's PDF, shows bits 1–0 as `0 0` on the
-/// rows of bits 2–7; read with the §15.2 text ("an error code could report several
-/// errors") they are "don't care": this driver reports every flag that applies, the
-/// timing flags included, in one value.
-#[derive(Clone, Copy, PartialEq, Eq, Hash, Default)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct ConfigErrors(u32);
+bitflags::bitflags! {
+    /// The error flags of ACAN table 5 (bits 0–7 at ACAN's positions), plus bit 8 for
+    /// an instance the board does not have.
+    ///
+    /// The table, as extracted from the manual's PDF, shows bits 1–0 as `0 0` on the
+    /// rows of bits 2–7; read with the §15.2 text ("an error code could report several
+    /// errors") they are "don't care": this driver reports every flag that applies, the
+    /// timing flags included, in one value.
+    ///
+    /// ```
+    /// use twocan_flexcan::ConfigErrors;
+    ///
+    /// let e = ConfigErrors::NO_ALTERNATE_RX_PIN | ConfigErrors::BIT_RATE_TOO_FAR;
+    /// assert_eq!(e.bits(), 0x81); // ACAN's error code
+    /// assert_eq!(format!("{e:?}"), "ConfigErrors(BIT_RATE_TOO_FAR | NO_ALTERNATE_RX_PIN)");
+    /// assert!(ConfigErrors::NONE.is_empty());
+    /// ```
+    #[derive(Clone, Copy, PartialEq, Eq, Hash, Default)]
+    pub struct ConfigErrors: u32 {
+        /// Bit 0: the bit timing is too far from the wished bit rate (ACAN §15.2.1,
+        /// `kCANBitConfigurationTooFarFromWishedBitRateErrorMask`).
+        const BIT_RATE_TOO_FAR = 1 << 0;
+        /// Bit 1: the bit timing is inconsistent (ACAN §15.2.2, §16.2).
+        const BIT_TIMING_INCONSISTENT = 1 << 1;
+        /// Bit 2: more primary filters than the configuration allows (ACAN §15.2.3).
+        const TOO_MANY_PRIMARY_FILTERS = 1 << 2;
+        /// Bit 3: a primary filter does not conform (ACAN §15.3, §12.4).
+        const PRIMARY_FILTER_NOT_CONFORM = 1 << 3;
+        /// Bit 4: more secondary filters than the configuration allows (ACAN §15.3.1).
+        const TOO_MANY_SECONDARY_FILTERS = 1 << 4;
+        /// Bit 5: a secondary filter does not conform (ACAN §15.3.2, §13.4).
+        const SECONDARY_FILTER_NOT_CONFORM = 1 << 5;
+        /// Bit 6: an alternate Tx pin was asked for `can1`, which has none (ACAN §15.3.3).
+        const NO_ALTERNATE_TX_PIN = 1 << 6;
+        /// Bit 7: an alternate Rx pin was asked for `can1`, which has none (ACAN §15.3.4).
+        const NO_ALTERNATE_RX_PIN = 1 << 7;
+        /// Bit 8 (not in ACAN): the board has no such FlexCAN instance (`can1` exists on
+        /// the Teensy 3.6 only, ACAN §6 table 2).
+        const NO_SUCH_INSTANCE = 1 << 8;
+    }
+}
 
 impl ConfigErrors {
     /// No error (ACAN: error code 0).
-    pub const NONE: ConfigErrors = ConfigErrors(0);
-    /// Bit 0: the bit timing is too far from the wished bit rate (ACAN §15.2.1,
-    /// `kCANBitConfigurationTooFarFromWishedBitRateErrorMask`).
-    pub const BIT_RATE_TOO_FAR: ConfigErrors = ConfigErrors(1 << 0);
-    /// Bit 1: the bit timing is inconsistent (ACAN §15.2.2, §16.2).
-    pub const BIT_TIMING_INCONSISTENT: ConfigErrors = ConfigErrors(1 << 1);
-    /// Bit 2: more primary filters than the configuration allows (ACAN §15.2.3).
-    pub const TOO_MANY_PRIMARY_FILTERS: ConfigErrors = ConfigErrors(1 << 2);
-    /// Bit 3: a primary filter does not conform (ACAN §15.3, §12.4).
-    pub const PRIMARY_FILTER_NOT_CONFORM: ConfigErrors = ConfigErrors(1 << 3);
-    /// Bit 4: more secondary filters than the configuration allows (ACAN §15.3.1).
-    pub const TOO_MANY_SECONDARY_FILTERS: ConfigErrors = ConfigErrors(1 << 4);
-    /// Bit 5: a secondary filter does not conform (ACAN §15.3.2, §13.4).
-    pub const SECONDARY_FILTER_NOT_CONFORM: ConfigErrors = ConfigErrors(1 << 5);
-    /// Bit 6: an alternate Tx pin was asked for `can1`, which has none (ACAN §15.3.3).
-    pub const NO_ALTERNATE_TX_PIN: ConfigErrors = ConfigErrors(1 << 6);
-    /// Bit 7: an alternate Rx pin was asked for `can1`, which has none (ACAN §15.3.4).
-    pub const NO_ALTERNATE_RX_PIN: ConfigErrors = ConfigErrors(1 << 7);
-    /// Bit 8 (not in ACAN): the board has no such FlexCAN instance (`can1` exists on
-    /// the Teensy 3.6 only, ACAN §6 table 2).
-    pub const NO_SUCH_INSTANCE: ConfigErrors = ConfigErrors(1 << 8);
+    pub const NONE: ConfigErrors = ConfigErrors::empty();
     /// Every flag.
-    pub const ALL: ConfigErrors = ConfigErrors((1 << 9) - 1);
-
-    const NAMES: [&'static str; 9] = [
-        "BIT_RATE_TOO_FAR",
-        "BIT_TIMING_INCONSISTENT",
-        "TOO_MANY_PRIMARY_FILTERS",
-        "PRIMARY_FILTER_NOT_CONFORM",
-        "TOO_MANY_SECONDARY_FILTERS",
-        "SECONDARY_FILTER_NOT_CONFORM",
-        "NO_ALTERNATE_TX_PIN",
-        "NO_ALTERNATE_RX_PIN",
-        "NO_SUCH_INSTANCE",
-    ];
-
-    /// The raw bits (ACAN's error code for bits 0–7).
-    pub const fn bits(self) -> u32 {
-        self.0
-    }
-
-    /// Flags from raw bits; unknown bits are dropped.
-    pub const fn from_bits_truncate(bits: u32) -> Self {
-        ConfigErrors(bits & Self::ALL.0)
-    }
-
-    /// No flag set.
-    pub const fn is_empty(self) -> bool {
-        self.0 == 0
-    }
-
-    /// Every flag of `other` is set.
-    pub const fn contains(self, other: ConfigErrors) -> bool {
-        self.0 & other.0 == other.0
-    }
-
-    /// Flags of both.
-    pub const fn union(self, other: ConfigErrors) -> Self {
-        ConfigErrors(self.0 | other.0)
-    }
+    pub const ALL: ConfigErrors = ConfigErrors::all();
 
     /// Number of flags set.
     pub const fn count(self) -> u32 {
-        self.0.count_ones()
+        self.bits().count_ones()
     }
 
     /// Names of the set flags, lowest bit first.
     pub fn names(self) -> impl Iterator<Item = &'static str> {
-        Self::NAMES
-            .iter()
-            .enumerate()
-            .filter(move |(i, _)| self.0 & (1 << i) != 0)
-            .map(|(_, n)| *n)
-    }
-}
-
-impl core::ops::BitOr for ConfigErrors {
-    type Output = ConfigErrors;
-    fn bitor(self, rhs: ConfigErrors) -> ConfigErrors {
-        self.union(rhs)
-    }
-}
-
-impl core::ops::BitOrAssign for ConfigErrors {
-    fn bitor_assign(&mut self, rhs: ConfigErrors) {
-        *self = self.union(rhs);
+        self.iter_names().map(|(name, _)| name)
     }
 }
 
@@ -129,6 +86,15 @@ impl fmt::Debug for ConfigErrors {
 impl fmt::Display for ConfigErrors {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         fmt::Debug::fmt(self, f)
+    }
+}
+
+impl core::error::Error for ConfigErrors {}
+
+#[cfg(feature = "defmt")]
+impl defmt::Format for ConfigErrors {
+    fn format(&self, f: defmt::Formatter<'_>) {
+        defmt::write!(f, "ConfigErrors({=u32:#x})", self.bits());
     }
 }
 

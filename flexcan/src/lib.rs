@@ -111,7 +111,16 @@
 //! | §14 `dispatchReceivedMessage` | [`twocan_core::Driver::dispatch`] with a [`twocan_core::Dispatcher`] |
 //! | §15 `begin`, table 5 | [`FlexCan::begin`], [`check`], [`ConfigErrors`], [`BeginError`] |
 //! | §17 controller state, REC, TEC | [`twocan_core::Driver::state`], `counters` |
+//!
+//! # Critical sections
+//!
+//! Firmware must link one `critical-section` implementation: on the single-core
+//! Cortex-M4/M7 of these boards, `cortex-m`'s `critical-section-single-core` feature
+//! (otherwise linking fails on `_critical_section_1_0_acquire`); see
+//! [`twocan_core`'s crate documentation](twocan_core#critical-sections).
 #![cfg_attr(not(any(test, feature = "model")), no_std)]
+// docs.rs (nightly rustdoc): mark feature-gated items with the feature they need.
+#![cfg_attr(docsrs, feature(doc_cfg))]
 #![deny(missing_docs)]
 
 pub mod begin;

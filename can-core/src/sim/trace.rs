@@ -200,31 +200,119 @@ impl Trace {
     }
 
     fn write(&self, w: &mut impl Write, interface: &str, errors: bool) -> io::Result<()> {
-        for r in self.records.iter().filter(|r| !r.internal) {
-            if r.delivered {
-                let us = self.micros(r.sof);
+        let mut sink = CandumpWriter::new(w, interface, self.bit_rate);
+        sink.error_frames = errors;
+        for r in &self.records {
+            sink.write_record(r)?;
+        }
+        Ok(())
+    }
+}
+
+/// Streams trace records to any [`Write`] target in `candump -l` form, so that a long run
+/// keeps only the records not yet written: call [`CandumpWriter::drain`] now and then (it
+/// writes the bus's records so far and clears them) instead of writing the whole
+/// [`Trace`] at the end.
+///
+/// ```
+/// use twocan_core::sim::{trace::CandumpWriter, Bus, SimNode};
+/// use twocan_core::Frame;
+///
+/// let mut bus = Bus::new(500_000).unwrap();
+/// let a = SimNode::new().shared();
+/// bus.attach("a", a.clone());
+/// bus.attach("b", SimNode::new().shared());
+/// let mut log = Vec::new();
+/// let mut sink = CandumpWriter::new(&mut log, "can0", bus.bit_rate());
+/// for i in 0..3u8 {
+///     a.borrow_mut().send(Frame::standard(0x100 + u16::from(i), &[i]).unwrap());
+///     bus.run_for(1_000);
+///     sink.drain(bus.trace_mut()).unwrap(); // the trace is empty again
+///     assert!(bus.trace().is_empty());
+/// }
+/// assert_eq!(sink.frames_written(), 3);
+/// let text = String::from_utf8(log).unwrap();
+/// assert!(text.lines().nth(2).unwrap().ends_with(" can0 102#02"));
+/// ```
+#[derive(Debug)]
+pub struct CandumpWriter<'a, W: Write> {
+    out: W,
+    interface: &'a str,
+    bit_rate: u32,
+    /// Also write one SocketCAN error frame per errored attempt (as
+    /// [`Trace::write_candump_with_errors`]); off by default.
+    pub error_frames: bool,
+    frames: u64,
+}
+
+impl<'a, W: Write> CandumpWriter<'a, W> {
+    /// A writer of `interface` lines for a bus running at `bit_rate` bit/s.
+    pub fn new(out: W, interface: &'a str, bit_rate: u32) -> Self {
+        CandumpWriter {
+            out,
+            interface,
+            bit_rate: bit_rate.max(1),
+            error_frames: false,
+            frames: 0,
+        }
+    }
+
+    /// Writes one record: a line if it was delivered on the wire (none for an internal
+    /// frame), and its error frame when [`CandumpWriter::error_frames`] is on.
+    pub fn write_record(&mut self, r: &TraceRecord) -> io::Result<()> {
+        if r.internal {
+            return Ok(());
+        }
+        if r.delivered {
+            let us = bits_to_micros(r.sof, self.bit_rate);
+            writeln!(
+                self.out,
+                "{} {} {}",
+                timestamp(us),
+                self.interface,
+                candump_frame(&r.frame)
+            )?;
+            self.frames += 1;
+        }
+        if self.error_frames {
+            if let Some(e) = r.first_error {
+                let us = bits_to_micros(r.sof + u64::from(e.bit), self.bit_rate);
                 writeln!(
-                    w,
+                    self.out,
                     "{} {} {}",
                     timestamp(us),
-                    interface,
-                    candump_frame(&r.frame)
+                    self.interface,
+                    candump_error(&e, &r.bits)
                 )?;
-            }
-            if errors {
-                if let Some(e) = r.first_error {
-                    let us = self.micros(r.sof + u64::from(e.bit));
-                    writeln!(
-                        w,
-                        "{} {} {}",
-                        timestamp(us),
-                        interface,
-                        candump_error(&e, &r.bits)
-                    )?;
-                }
             }
         }
         Ok(())
+    }
+
+    /// Writes every record of `trace` and clears it, so that its memory stays bounded by
+    /// what happened since the last call. On a write error the trace is left as it was
+    /// (a retry may write again the lines that did get out).
+    pub fn drain(&mut self, trace: &mut Trace) -> io::Result<()> {
+        for r in &trace.records {
+            self.write_record(r)?;
+        }
+        trace.clear();
+        Ok(())
+    }
+
+    /// Frame lines written so far (error frames not counted).
+    pub fn frames_written(&self) -> u64 {
+        self.frames
+    }
+
+    /// Flushes the target.
+    pub fn flush(&mut self) -> io::Result<()> {
+        self.out.flush()
+    }
+
+    /// The target, flushed or not.
+    pub fn into_inner(self) -> W {
+        self.out
     }
 }
 

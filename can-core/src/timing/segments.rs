@@ -11,129 +11,82 @@ use core::fmt;
 use super::error::TimingError;
 use super::limits::Limits;
 
-/// Bit flags naming every violated bit timing rule; empty means consistent
-/// (ACAN §16.2: "returns 0 if CAN bit decomposition is consistent").
-///
-/// Bits 0..=10 have the positions of ACAN table 6; each "is zero" rule there is
-/// checked here as "below the controller minimum", each "greater than" rule as
-/// "above the controller maximum" (same thing for FlexCAN except PSEG2, whose
-/// minimum is 2 per the §16.1 constraint list). Bits 11..=13 are rules the ACAN
-/// table does not list: SJW ≤ phase segment 1 (CAN rule SJW ≤ min(PS1, PS2)),
-/// and the two triple-sampling rules of §16.1.
-#[derive(Clone, Copy, PartialEq, Eq, Hash, Default)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct Consistency(u32);
+bitflags::bitflags! {
+    /// Bit flags naming every violated bit timing rule; empty means consistent
+    /// (ACAN §16.2: "returns 0 if CAN bit decomposition is consistent").
+    ///
+    /// Bits 0..=10 have the positions of ACAN table 6; each "is zero" rule there is
+    /// checked here as "below the controller minimum", each "greater than" rule as
+    /// "above the controller maximum" (same thing for FlexCAN except PSEG2, whose
+    /// minimum is 2 per the §16.1 constraint list). Bits 11..=13 are rules the ACAN
+    /// table does not list: SJW ≤ phase segment 1 (CAN rule SJW ≤ min(PS1, PS2)),
+    /// and the two triple-sampling rules of §16.1.
+    ///
+    /// ```
+    /// use twocan_core::timing::Consistency;
+    ///
+    /// let c = Consistency::SJW_TOO_LARGE | Consistency::PRESCALER_TOO_SMALL;
+    /// assert_eq!(c.bits(), 0b10_0000_0001); // ACAN table 6 bits 9 and 0
+    /// assert!(c.contains(Consistency::SJW_TOO_LARGE) && !c.is_ok());
+    /// assert_eq!(c.to_string(), "PRESCALER_TOO_SMALL, SJW_TOO_LARGE");
+    /// assert_eq!(Consistency::from_bits_truncate(u32::MAX), Consistency::ALL);
+    /// ```
+    #[derive(Clone, Copy, PartialEq, Eq, Hash, Default)]
+    pub struct Consistency: u32 {
+        /// Prescaler below minimum (ACAN table 6 bit 0, `kBitRatePrescalerIsZero`).
+        const PRESCALER_TOO_SMALL = 1 << 0;
+        /// Prescaler above maximum (bit 1, `kBitRatePrescalerIsGreaterThan256`).
+        const PRESCALER_TOO_LARGE = 1 << 1;
+        /// Propagation segment below minimum (bit 2, `kPropagationSegmentIsZero`).
+        const PROP_SEG_TOO_SMALL = 1 << 2;
+        /// Propagation segment above maximum (bit 3, `kPropagationSegmentIsGreaterThan8`;
+        /// for bxCAN any non-zero value, as TS1 has no separate propagation field).
+        const PROP_SEG_TOO_LARGE = 1 << 3;
+        /// Phase segment 1 below minimum (bit 4, `kPhaseSegment1IsZero`).
+        const PHASE_SEG1_TOO_SMALL = 1 << 4;
+        /// Phase segment 1 above maximum (bit 5, `kPhaseSegment1IsGreaterThan8`).
+        const PHASE_SEG1_TOO_LARGE = 1 << 5;
+        /// Phase segment 2 below minimum (bit 6, `kPhaseSegment2IsZero`; FlexCAN
+        /// minimum is 2).
+        const PHASE_SEG2_TOO_SMALL = 1 << 6;
+        /// Phase segment 2 above maximum (bit 7, `kPhaseSegment2IsGreaterThan8`).
+        const PHASE_SEG2_TOO_LARGE = 1 << 7;
+        /// SJW below minimum (bit 8, `kRJWIsZero`).
+        const SJW_TOO_SMALL = 1 << 8;
+        /// SJW above maximum (bit 9, `kRJWIsGreaterThan4`).
+        const SJW_TOO_LARGE = 1 << 9;
+        /// SJW greater than phase segment 2 (bit 10, `kRJWIsGreaterThanPhaseSegment2`).
+        const SJW_ABOVE_PHASE_SEG2 = 1 << 10;
+        /// SJW greater than phase segment 1 (not in ACAN table 6; checked when
+        /// [`Limits::sjw_le_phase_seg1`] is set, i.e. FlexCAN).
+        const SJW_ABOVE_PHASE_SEG1 = 1 << 11;
+        /// Triple sampling asked on a controller without it (bxCAN).
+        const TRIPLE_SAMPLING_UNSUPPORTED = 1 << 12;
+        /// Triple sampling with phase segment 1 below its triple-sampling minimum
+        /// (ACAN §16.1: "Triple sampling: 2 ≤ mPhaseSegment1 ≤ 8").
+        const TRIPLE_SAMPLING_PHASE_SEG1_TOO_SMALL = 1 << 13;
+    }
+}
 
 impl Consistency {
     /// No rule violated.
-    pub const OK: Consistency = Consistency(0);
-    /// Prescaler below minimum (ACAN table 6 bit 0, `kBitRatePrescalerIsZero`).
-    pub const PRESCALER_TOO_SMALL: Consistency = Consistency(1 << 0);
-    /// Prescaler above maximum (bit 1, `kBitRatePrescalerIsGreaterThan256`).
-    pub const PRESCALER_TOO_LARGE: Consistency = Consistency(1 << 1);
-    /// Propagation segment below minimum (bit 2, `kPropagationSegmentIsZero`).
-    pub const PROP_SEG_TOO_SMALL: Consistency = Consistency(1 << 2);
-    /// Propagation segment above maximum (bit 3, `kPropagationSegmentIsGreaterThan8`;
-    /// for bxCAN any non-zero value, as TS1 has no separate propagation field).
-    pub const PROP_SEG_TOO_LARGE: Consistency = Consistency(1 << 3);
-    /// Phase segment 1 below minimum (bit 4, `kPhaseSegment1IsZero`).
-    pub const PHASE_SEG1_TOO_SMALL: Consistency = Consistency(1 << 4);
-    /// Phase segment 1 above maximum (bit 5, `kPhaseSegment1IsGreaterThan8`).
-    pub const PHASE_SEG1_TOO_LARGE: Consistency = Consistency(1 << 5);
-    /// Phase segment 2 below minimum (bit 6, `kPhaseSegment2IsZero`; FlexCAN
-    /// minimum is 2).
-    pub const PHASE_SEG2_TOO_SMALL: Consistency = Consistency(1 << 6);
-    /// Phase segment 2 above maximum (bit 7, `kPhaseSegment2IsGreaterThan8`).
-    pub const PHASE_SEG2_TOO_LARGE: Consistency = Consistency(1 << 7);
-    /// SJW below minimum (bit 8, `kRJWIsZero`).
-    pub const SJW_TOO_SMALL: Consistency = Consistency(1 << 8);
-    /// SJW above maximum (bit 9, `kRJWIsGreaterThan4`).
-    pub const SJW_TOO_LARGE: Consistency = Consistency(1 << 9);
-    /// SJW greater than phase segment 2 (bit 10, `kRJWIsGreaterThanPhaseSegment2`).
-    pub const SJW_ABOVE_PHASE_SEG2: Consistency = Consistency(1 << 10);
-    /// SJW greater than phase segment 1 (not in ACAN table 6; checked when
-    /// [`Limits::sjw_le_phase_seg1`] is set, i.e. FlexCAN).
-    pub const SJW_ABOVE_PHASE_SEG1: Consistency = Consistency(1 << 11);
-    /// Triple sampling asked on a controller without it (bxCAN).
-    pub const TRIPLE_SAMPLING_UNSUPPORTED: Consistency = Consistency(1 << 12);
-    /// Triple sampling with phase segment 1 below its triple-sampling minimum
-    /// (ACAN §16.1: "Triple sampling: 2 ≤ mPhaseSegment1 ≤ 8").
-    pub const TRIPLE_SAMPLING_PHASE_SEG1_TOO_SMALL: Consistency = Consistency(1 << 13);
+    pub const OK: Consistency = Consistency::empty();
     /// Every flag defined above.
-    pub const ALL: Consistency = Consistency((1 << 14) - 1);
-
-    const NAMES: [&'static str; 14] = [
-        "PRESCALER_TOO_SMALL",
-        "PRESCALER_TOO_LARGE",
-        "PROP_SEG_TOO_SMALL",
-        "PROP_SEG_TOO_LARGE",
-        "PHASE_SEG1_TOO_SMALL",
-        "PHASE_SEG1_TOO_LARGE",
-        "PHASE_SEG2_TOO_SMALL",
-        "PHASE_SEG2_TOO_LARGE",
-        "SJW_TOO_SMALL",
-        "SJW_TOO_LARGE",
-        "SJW_ABOVE_PHASE_SEG2",
-        "SJW_ABOVE_PHASE_SEG1",
-        "TRIPLE_SAMPLING_UNSUPPORTED",
-        "TRIPLE_SAMPLING_PHASE_SEG1_TOO_SMALL",
-    ];
-
-    /// The raw bits (ACAN table 6 layout for bits 0..=10).
-    pub const fn bits(self) -> u32 {
-        self.0
-    }
-
-    /// Flags from raw bits; unknown bits are dropped.
-    pub const fn from_bits_truncate(bits: u32) -> Self {
-        Consistency(bits & Self::ALL.0)
-    }
+    pub const ALL: Consistency = Consistency::all();
 
     /// No rule is violated.
     pub const fn is_ok(self) -> bool {
-        self.0 == 0
-    }
-
-    /// Every flag of `other` is set in `self`.
-    pub const fn contains(self, other: Consistency) -> bool {
-        self.0 & other.0 == other.0
-    }
-
-    /// At least one flag of `other` is set in `self`.
-    pub const fn intersects(self, other: Consistency) -> bool {
-        self.0 & other.0 != 0
-    }
-
-    /// Flags of both.
-    pub const fn union(self, other: Consistency) -> Self {
-        Consistency(self.0 | other.0)
+        self.is_empty()
     }
 
     /// Number of violated rules.
     pub const fn count(self) -> u32 {
-        self.0.count_ones()
+        self.bits().count_ones()
     }
 
     /// Names of the set flags, lowest bit first (for messages).
     pub fn names(self) -> impl Iterator<Item = &'static str> {
-        Self::NAMES
-            .iter()
-            .enumerate()
-            .filter(move |(i, _)| self.0 & (1 << i) != 0)
-            .map(|(_, n)| *n)
-    }
-}
-
-impl core::ops::BitOr for Consistency {
-    type Output = Consistency;
-    fn bitor(self, rhs: Consistency) -> Consistency {
-        self.union(rhs)
-    }
-}
-
-impl core::ops::BitOrAssign for Consistency {
-    fn bitor_assign(&mut self, rhs: Consistency) {
-        *self = self.union(rhs);
+        self.iter_names().map(|(name, _)| name)
     }
 }
 
@@ -165,6 +118,13 @@ impl fmt::Display for Consistency {
             f.write_str(name)?;
         }
         Ok(())
+    }
+}
+
+#[cfg(feature = "defmt")]
+impl defmt::Format for Consistency {
+    fn format(&self, f: defmt::Formatter<'_>) {
+        defmt::write!(f, "Consistency({=u32:#x})", self.bits());
     }
 }
 
@@ -347,52 +307,52 @@ pub(crate) const fn consistency_with(t: &Timing, limits: &Limits) -> Consistency
     let mut f = 0u32;
     let l = limits;
     if t.prescaler < l.prescaler.min {
-        f |= Consistency::PRESCALER_TOO_SMALL.0;
+        f |= Consistency::PRESCALER_TOO_SMALL.bits();
     }
     if t.prescaler > l.prescaler.max {
-        f |= Consistency::PRESCALER_TOO_LARGE.0;
+        f |= Consistency::PRESCALER_TOO_LARGE.bits();
     }
     if (t.prop_seg as u16) < l.prop_seg.min {
-        f |= Consistency::PROP_SEG_TOO_SMALL.0;
+        f |= Consistency::PROP_SEG_TOO_SMALL.bits();
     }
     if (t.prop_seg as u16) > l.prop_seg.max {
-        f |= Consistency::PROP_SEG_TOO_LARGE.0;
+        f |= Consistency::PROP_SEG_TOO_LARGE.bits();
     }
     if (t.phase_seg1 as u16) < l.phase_seg1.min {
-        f |= Consistency::PHASE_SEG1_TOO_SMALL.0;
+        f |= Consistency::PHASE_SEG1_TOO_SMALL.bits();
     }
     if (t.phase_seg1 as u16) > l.phase_seg1.max {
-        f |= Consistency::PHASE_SEG1_TOO_LARGE.0;
+        f |= Consistency::PHASE_SEG1_TOO_LARGE.bits();
     }
     if (t.phase_seg2 as u16) < l.phase_seg2.min {
-        f |= Consistency::PHASE_SEG2_TOO_SMALL.0;
+        f |= Consistency::PHASE_SEG2_TOO_SMALL.bits();
     }
     if (t.phase_seg2 as u16) > l.phase_seg2.max {
-        f |= Consistency::PHASE_SEG2_TOO_LARGE.0;
+        f |= Consistency::PHASE_SEG2_TOO_LARGE.bits();
     }
     if (t.sjw as u16) < l.sjw.min {
-        f |= Consistency::SJW_TOO_SMALL.0;
+        f |= Consistency::SJW_TOO_SMALL.bits();
     }
     if (t.sjw as u16) > l.sjw.max {
-        f |= Consistency::SJW_TOO_LARGE.0;
+        f |= Consistency::SJW_TOO_LARGE.bits();
     }
     if t.sjw > t.phase_seg2 {
-        f |= Consistency::SJW_ABOVE_PHASE_SEG2.0;
+        f |= Consistency::SJW_ABOVE_PHASE_SEG2.bits();
     }
     if l.sjw_le_phase_seg1 && t.sjw > t.phase_seg1 {
-        f |= Consistency::SJW_ABOVE_PHASE_SEG1.0;
+        f |= Consistency::SJW_ABOVE_PHASE_SEG1.bits();
     }
     if t.triple_sampling {
         match l.triple_sampling_min_phase_seg1 {
-            None => f |= Consistency::TRIPLE_SAMPLING_UNSUPPORTED.0,
+            None => f |= Consistency::TRIPLE_SAMPLING_UNSUPPORTED.bits(),
             Some(min) => {
                 if t.phase_seg1 < min {
-                    f |= Consistency::TRIPLE_SAMPLING_PHASE_SEG1_TOO_SMALL.0;
+                    f |= Consistency::TRIPLE_SAMPLING_PHASE_SEG1_TOO_SMALL.bits();
                 }
             }
         }
     }
-    Consistency(f)
+    Consistency::from_bits_retain(f)
 }
 
 #[cfg(test)]

@@ -145,6 +145,25 @@ pub(crate) const fn check_inputs(
 /// rate below the slowest possible one is not an error: as in ACAN §15.2.1
 /// (1 bit/s), the closest timing is returned and fails
 /// [`Timing::within_tolerance`].
+///
+/// ```
+/// use twocan_core::timing::{solve, Limits, Timing, TimingError};
+///
+/// // bxCAN on a 54 MHz APB1, 500 kbit/s, 87.5 % asked: solved at compile time, and a
+/// // `CAN_BTR` value as a constant.
+/// const T: Timing = match solve(54_000_000, 500_000, &Limits::BXCAN, 875) {
+///     Ok(t) => t,
+///     Err(_) => panic!("no timing"),
+/// };
+/// assert!(T.is_exact());
+/// assert_eq!((T.prescaler, T.quanta()), (6, 18));
+/// assert_eq!(T.bxcan_btr(), Ok(0x011E_0005));
+///
+/// // Bad input is a typed error.
+/// assert_eq!(solve(0, 500_000, &Limits::BXCAN, 875), Err(TimingError::ClockZero));
+/// assert_eq!(solve(54_000_000, 500_000, &Limits::BXCAN, 500), Err(TimingError::SamplePointOutOfRange));
+/// assert_eq!(solve(16_000_000, 4_000_000, &Limits::FLEXCAN, 750), Err(TimingError::BitrateTooHigh));
+/// ```
 pub const fn solve(
     clock_hz: u32,
     bitrate: u32,

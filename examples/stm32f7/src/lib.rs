@@ -20,6 +20,10 @@ compile_error!("choose the board: --features nucleo-f767zi or disco-f746g");
 #[cfg(all(feature = "nucleo-f767zi", feature = "disco-f746g"))]
 compile_error!("choose one board feature only");
 
+// `--features defmt`: the RTT transport of the defmt logger (docs/firmware.md, runners).
+#[cfg(all(target_os = "none", feature = "defmt"))]
+use defmt_rtt as _;
+
 pub mod board;
 pub mod can;
 #[cfg(target_os = "none")]

@@ -8,31 +8,67 @@
 //! Exit status: 0 timing found within tolerance, 1 timing printed but outside the
 //! tolerance (ACAN "too far from wished bit rate"), 2 bad options or input.
 
-use std::fmt::Write as _;
 use std::process::ExitCode;
 
+use clap::error::ErrorKind;
+use clap::{CommandFactory, Parser, ValueEnum};
+use serde::ser::{SerializeMap, Serializer};
+use serde::Serialize;
 use twocan_core::timing::{
     cia_sample_point, solve, Controller, Limits, Solutions, Timing, DEFAULT_TOLERANCE_PPM,
     FLEXCAN_CTRL1_TIMING_MASK,
 };
 
-const USAGE: &str = "\
-usage: can-timing --controller flexcan|bxcan [--clock HZ] --bitrate BPS
-                  [--sample-point PCT] [--tolerance PPM] [--json] [--all]
+/// The controller whose bit timing register is computed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum ControllerArg {
+    /// NXP FlexCAN (CTRL1)
+    Flexcan,
+    /// STM32 bxCAN (CAN_BTR)
+    Bxcan,
+}
 
-  --controller     flexcan (NXP FlexCAN, CTRL1) or bxcan (STM32 bxCAN, CAN_BTR)
-  --clock HZ       CAN clock in Hz (flexcan default 16000000, ACAN's CAN clock;
-                   bxcan: required, the APB1 clock, e.g. 54000000)
-  --bitrate BPS    wished bit rate in bit/s
-  --sample-point   target sample point in per cent, e.g. 87.5 (default: CiA,
-                   87.5 up to 500 kbit/s, 80 up to 800 kbit/s, 75 above)
-  --tolerance PPM  accepted distance from the wished bit rate (default 1000,
-                   0 = exact only)
-  --json           print one JSON object
-  --all            also list every timing within the tolerance
-  -h, --help       this text
+impl From<ControllerArg> for Controller {
+    fn from(c: ControllerArg) -> Self {
+        match c {
+            ControllerArg::Flexcan => Controller::FlexCan,
+            ControllerArg::Bxcan => Controller::BxCan,
+        }
+    }
+}
 
-exit status: 0 ok, 1 outside tolerance, 2 bad options";
+/// CAN bit timing calculator for FlexCAN and bxCAN.
+#[derive(Debug, Parser)]
+#[command(
+    name = "can-timing",
+    version,
+    after_help = "exit status: 0 ok, 1 outside tolerance, 2 bad options"
+)]
+struct Args {
+    /// The controller
+    #[arg(long, value_enum, ignore_case = true)]
+    controller: ControllerArg,
+    /// CAN clock in Hz (flexcan default 16000000, ACAN's CAN clock; bxcan: required, the
+    /// APB1 clock, e.g. 54000000)
+    #[arg(long, value_name = "HZ", value_parser = parse_u32)]
+    clock: Option<u32>,
+    /// Wished bit rate in bit/s
+    #[arg(long, value_name = "BPS", value_parser = parse_u32)]
+    bitrate: u32,
+    /// Target sample point in per cent, e.g. 87.5 (default: CiA, 87.5 up to 500 kbit/s,
+    /// 80 up to 800 kbit/s, 75 above)
+    #[arg(long, value_name = "PCT", value_parser = parse_percent)]
+    sample_point: Option<u16>,
+    /// Accepted distance from the wished bit rate (0 = exact only)
+    #[arg(long, value_name = "PPM", value_parser = parse_u32, default_value_t = DEFAULT_TOLERANCE_PPM)]
+    tolerance: u32,
+    /// Print one JSON object
+    #[arg(long)]
+    json: bool,
+    /// Also list every timing within the tolerance
+    #[arg(long)]
+    all: bool,
+}
 
 struct Options {
     controller: Controller,
@@ -44,19 +80,46 @@ struct Options {
     all: bool,
 }
 
-fn parse_u32(name: &str, text: &str) -> Result<u32, String> {
+impl Args {
+    /// The options, with the clock defaulted per controller.
+    fn options(&self) -> Result<Options, clap::Error> {
+        let controller = Controller::from(self.controller);
+        let clock = match (self.clock, controller) {
+            (Some(c), _) => c,
+            (None, Controller::FlexCan) => 16_000_000,
+            (None, Controller::BxCan) => {
+                return Err(Args::command().error(
+                    ErrorKind::MissingRequiredArgument,
+                    "--clock is required for bxcan (the APB1 clock in Hz)",
+                ))
+            }
+        };
+        Ok(Options {
+            controller,
+            clock,
+            bitrate: self.bitrate,
+            sample_point: self.sample_point,
+            tolerance: self.tolerance,
+            json: self.json,
+            all: self.all,
+        })
+    }
+}
+
+/// A whole number, `_` allowed as a digit separator (`54_000_000`).
+fn parse_u32(text: &str) -> Result<u32, String> {
     let digits: String = text.chars().filter(|&c| c != '_').collect();
     if digits.is_empty() || !digits.bytes().all(|b| b.is_ascii_digit()) {
-        return Err(format!("{name}: '{text}' is not a whole number"));
+        return Err(format!("'{text}' is not a whole number"));
     }
     digits
         .parse::<u32>()
-        .map_err(|_| format!("{name}: '{text}' is too large (max {})", u32::MAX))
+        .map_err(|_| format!("'{text}' is too large (max {})", u32::MAX))
 }
 
 /// "87.5" or "87.5%" → 875 per mille (at most one decimal).
 fn parse_percent(text: &str) -> Result<u16, String> {
-    let bad = || format!("--sample-point: '{text}' is not a percentage like 87.5");
+    let bad = || format!("'{text}' is not a percentage like 87.5");
     let t = text.strip_suffix('%').unwrap_or(text);
     let (int, frac) = match t.split_once('.') {
         Some((i, f)) => (i, f),
@@ -67,7 +130,7 @@ fn parse_percent(text: &str) -> Result<u16, String> {
     }
     if frac.len() > 1 || !frac.bytes().all(|b| b.is_ascii_digit()) {
         return Err(format!(
-            "--sample-point: '{text}': at most one decimal (per mille resolution)"
+            "'{text}': at most one decimal (per mille resolution)"
         ));
     }
     let int: u16 = int.parse().map_err(|_| bad())?;
@@ -77,72 +140,6 @@ fn parse_percent(text: &str) -> Result<u16, String> {
         frac.parse().map_err(|_| bad())?
     };
     Ok(int * 10 + frac)
-}
-
-fn parse_args(args: &[String]) -> Result<Option<Options>, String> {
-    let mut controller = None;
-    let mut clock = None;
-    let mut bitrate = None;
-    let mut sample_point = None;
-    let mut tolerance = DEFAULT_TOLERANCE_PPM;
-    let mut json = false;
-    let mut all = false;
-    let mut it = args.iter();
-    while let Some(arg) = it.next() {
-        let (name, inline) = match arg.split_once('=') {
-            Some((n, v)) if n.starts_with("--") => (n, Some(v.to_string())),
-            _ => (arg.as_str(), None),
-        };
-        let mut value = || -> Result<String, String> {
-            match inline.clone() {
-                Some(v) => Ok(v),
-                None => it
-                    .next()
-                    .cloned()
-                    .ok_or_else(|| format!("{name} needs a value")),
-            }
-        };
-        match name {
-            "-h" | "--help" => return Ok(None),
-            "--controller" => {
-                controller = Some(match value()?.to_ascii_lowercase().as_str() {
-                    "flexcan" => Controller::FlexCan,
-                    "bxcan" => Controller::BxCan,
-                    other => {
-                        return Err(format!(
-                            "--controller: unknown controller '{other}' (flexcan or bxcan)"
-                        ))
-                    }
-                })
-            }
-            "--clock" => clock = Some(parse_u32(name, &value()?)?),
-            "--bitrate" => bitrate = Some(parse_u32(name, &value()?)?),
-            "--sample-point" => sample_point = Some(parse_percent(&value()?)?),
-            "--tolerance" => tolerance = parse_u32(name, &value()?)?,
-            "--json" | "--all" if inline.is_some() => return Err(format!("{name} takes no value")),
-            "--json" => json = true,
-            "--all" => all = true,
-            other => return Err(format!("unknown option '{other}'")),
-        }
-    }
-    let controller = controller.ok_or("--controller is required (flexcan or bxcan)")?;
-    let clock = match (clock, controller) {
-        (Some(c), _) => c,
-        (None, Controller::FlexCan) => 16_000_000,
-        (None, Controller::BxCan) => {
-            return Err("--clock is required for bxcan (the APB1 clock in Hz)".into())
-        }
-    };
-    let bitrate = bitrate.ok_or("--bitrate is required")?;
-    Ok(Some(Options {
-        controller,
-        clock,
-        bitrate,
-        sample_point,
-        tolerance,
-        json,
-        all,
-    }))
 }
 
 fn permille(v: u16) -> String {
@@ -177,73 +174,110 @@ fn registers(t: &Timing) -> Vec<(&'static str, u32)> {
     }
 }
 
-fn json_timing(out: &mut String, t: &Timing, tolerance: u32) {
-    let ok = t.consistency().is_ok() && t.within_tolerance(tolerance);
-    let _ = write!(
-        out,
-        "\"actual_bitrate\":{},\"ppm\":{},\"exact\":{},\"ok\":{},\"sample_point_permille\":{},\
-         \"prescaler\":{},\"quanta\":{},\"tseg1\":{},\"tseg2\":{},\"prop_seg\":{},\
-         \"phase_seg1\":{},\"phase_seg2\":{},\"sjw\":{},\"triple_sampling\":{},\
-         \"oscillator_tolerance_ppm\":{},\"registers\":{{",
-        t.actual_bitrate(),
-        t.ppm_from_wished(),
-        t.is_exact(),
-        ok,
-        t.sample_point(),
-        t.prescaler,
-        t.quanta(),
-        t.tseg1(),
-        t.tseg2(),
-        t.prop_seg,
-        t.phase_seg1,
-        t.phase_seg2,
-        t.sjw,
-        t.triple_sampling,
-        t.oscillator_tolerance_ppm(),
-    );
-    for (i, (name, value)) in registers(t).iter().enumerate() {
-        if i == 0 {
-            let _ = write!(out, "\"{name}\":{value},\"{name}_hex\":\"0x{value:08X}\"");
-            if t.limits.controller == Controller::FlexCan {
-                let _ = write!(
-                    out,
-                    ",\"{name}_mask_hex\":\"0x{FLEXCAN_CTRL1_TIMING_MASK:08X}\""
-                );
+/// The register values of a timing in JSON: the whole register (decimal and hex, plus
+/// the CTRL1 timing mask for FlexCAN) first, then its fields, in that order.
+struct RegistersJson {
+    controller: Controller,
+    values: Vec<(&'static str, u32)>,
+}
+
+impl Serialize for RegistersJson {
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        let mut map = serializer.serialize_map(None)?;
+        for (i, (name, value)) in self.values.iter().enumerate() {
+            map.serialize_entry(name, value)?;
+            if i == 0 {
+                map.serialize_entry(&format!("{name}_hex"), &format!("0x{value:08X}"))?;
+                if self.controller == Controller::FlexCan {
+                    map.serialize_entry(
+                        &format!("{name}_mask_hex"),
+                        &format!("0x{FLEXCAN_CTRL1_TIMING_MASK:08X}"),
+                    )?;
+                }
             }
-        } else {
-            let _ = write!(out, ",\"{name}\":{value}");
+        }
+        map.end()
+    }
+}
+
+/// One timing in JSON (field names are the interface: scripts read them).
+#[derive(Serialize)]
+struct TimingJson {
+    actual_bitrate: u32,
+    ppm: u64,
+    exact: bool,
+    ok: bool,
+    sample_point_permille: u16,
+    prescaler: u16,
+    quanta: u32,
+    tseg1: u32,
+    tseg2: u32,
+    prop_seg: u8,
+    phase_seg1: u8,
+    phase_seg2: u8,
+    sjw: u8,
+    triple_sampling: bool,
+    oscillator_tolerance_ppm: u32,
+    registers: RegistersJson,
+}
+
+impl TimingJson {
+    fn new(t: &Timing, tolerance: u32) -> Self {
+        TimingJson {
+            actual_bitrate: t.actual_bitrate(),
+            ppm: t.ppm_from_wished(),
+            exact: t.is_exact(),
+            ok: t.consistency().is_ok() && t.within_tolerance(tolerance),
+            sample_point_permille: t.sample_point(),
+            prescaler: t.prescaler,
+            quanta: t.quanta(),
+            tseg1: t.tseg1(),
+            tseg2: t.tseg2(),
+            prop_seg: t.prop_seg,
+            phase_seg1: t.phase_seg1,
+            phase_seg2: t.phase_seg2,
+            sjw: t.sjw,
+            triple_sampling: t.triple_sampling,
+            oscillator_tolerance_ppm: t.oscillator_tolerance_ppm(),
+            registers: RegistersJson {
+                controller: t.limits.controller,
+                values: registers(t),
+            },
         }
     }
-    out.push('}');
+}
+
+/// The whole `--json` answer: the request, the chosen timing, and with `--all` every
+/// timing within the tolerance.
+#[derive(Serialize)]
+struct Answer {
+    controller: &'static str,
+    clock: u32,
+    bitrate: u32,
+    tolerance_ppm: u32,
+    sample_point_target_permille: u16,
+    #[serde(flatten)]
+    chosen: TimingJson,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    solutions: Option<Vec<TimingJson>>,
 }
 
 fn json(o: &Options, target: u16, t: &Timing, all: &[Timing]) -> String {
-    let mut out = String::new();
-    let _ = write!(
-        out,
-        "{{\"controller\":\"{}\",\"clock\":{},\"bitrate\":{},\"tolerance_ppm\":{},\
-         \"sample_point_target_permille\":{},",
-        o.controller.name(),
-        o.clock,
-        o.bitrate,
-        o.tolerance,
-        target
-    );
-    json_timing(&mut out, t, o.tolerance);
-    if o.all {
-        out.push_str(",\"solutions\":[");
-        for (i, s) in all.iter().enumerate() {
-            if i > 0 {
-                out.push(',');
-            }
-            out.push('{');
-            json_timing(&mut out, s, o.tolerance);
-            out.push('}');
-        }
-        out.push(']');
-    }
-    out.push('}');
-    out
+    let answer = Answer {
+        controller: o.controller.name(),
+        clock: o.clock,
+        bitrate: o.bitrate,
+        tolerance_ppm: o.tolerance,
+        sample_point_target_permille: target,
+        chosen: TimingJson::new(t, o.tolerance),
+        solutions: o.all.then(|| {
+            all.iter()
+                .map(|s| TimingJson::new(s, o.tolerance))
+                .collect()
+        }),
+    };
+    // Only strings, numbers and booleans: serialisation cannot fail.
+    serde_json::to_string(&answer).unwrap_or_default()
 }
 
 fn print_text(o: &Options, target: u16, t: &Timing, all: &[Timing]) {
@@ -330,17 +364,10 @@ fn print_text(o: &Options, target: u16, t: &Timing, all: &[Timing]) {
 }
 
 fn main() -> ExitCode {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    let o = match parse_args(&args) {
-        Ok(Some(o)) => o,
-        Ok(None) => {
-            println!("{USAGE}");
-            return ExitCode::SUCCESS;
-        }
-        Err(msg) => {
-            eprintln!("can-timing: error: {msg}\n(see can-timing --help)");
-            return ExitCode::from(2);
-        }
+    // Bad options: clap prints the error with a usage line and exits with status 2.
+    let o = match Args::parse().options() {
+        Ok(o) => o,
+        Err(e) => e.exit(),
     };
     let limits: Limits = o.controller.limits();
     let target = o.sample_point.unwrap_or(cia_sample_point(o.bitrate));
@@ -381,12 +408,13 @@ fn main() -> ExitCode {
 mod tests {
     use super::*;
 
-    fn args(s: &str) -> Vec<String> {
-        s.split_whitespace().map(String::from).collect()
+    fn parse_args(line: &str) -> Result<Options, clap::Error> {
+        let argv = std::iter::once("can-timing").chain(line.split_whitespace());
+        Args::try_parse_from(argv)?.options()
     }
 
     fn run_json(line: &str) -> String {
-        let o = parse_args(&args(line)).unwrap().unwrap();
+        let o = parse_args(line).unwrap();
         let limits = o.controller.limits();
         let target = o.sample_point.unwrap_or(cia_sample_point(o.bitrate));
         let t = solve(o.clock, o.bitrate, &limits, target).unwrap();
@@ -438,23 +466,72 @@ mod tests {
 
     #[test]
     fn option_parsing() {
-        let o = parse_args(&args("--controller flexcan --bitrate 842000"))
-            .unwrap()
-            .unwrap();
+        let o = parse_args("--controller flexcan --bitrate 842000").unwrap();
         assert_eq!(o.clock, 16_000_000);
         assert_eq!(o.tolerance, 1000);
-        let o = parse_args(&args(
-            "--controller=bxcan --clock=54_000_000 --bitrate 500000 --json",
-        ))
-        .unwrap()
-        .unwrap();
-        assert_eq!((o.clock, o.json), (54_000_000, true));
-        assert!(parse_args(&args("--controller bxcan --bitrate 500000")).is_err());
-        assert!(parse_args(&args("--controller can --bitrate 5")).is_err());
-        assert!(parse_args(&args("--controller flexcan")).is_err());
-        assert!(parse_args(&args("--controller flexcan --bitrate")).is_err());
-        assert!(parse_args(&args("--controller flexcan --bitrate 99999999999")).is_err());
-        assert!(parse_args(&args("--controller flexcan --bitrate 1 --frob")).is_err());
-        assert!(parse_args(&args("--help")).unwrap().is_none());
+        let o =
+            parse_args("--controller=bxcan --clock=54_000_000 --bitrate 500000 --json").unwrap();
+        assert_eq!((o.clock, o.json, o.bitrate), (54_000_000, true, 500_000));
+        // `--x=v` and `--x v` alike, controller names in any case.
+        let o =
+            parse_args("--controller BxCAN --clock 8000000 --bitrate=250000 --sample-point=75%")
+                .unwrap();
+        assert_eq!(
+            (o.controller, o.clock, o.bitrate, o.sample_point),
+            (Controller::BxCan, 8_000_000, 250_000, Some(750))
+        );
+        let kind = |line: &str| parse_args(line).err().map(|e| e.kind());
+        assert_eq!(
+            kind("--controller bxcan --bitrate 500000"),
+            Some(ErrorKind::MissingRequiredArgument)
+        );
+        assert_eq!(
+            kind("--controller can --bitrate 5"),
+            Some(ErrorKind::InvalidValue)
+        );
+        assert_eq!(
+            kind("--controller flexcan"),
+            Some(ErrorKind::MissingRequiredArgument)
+        );
+        assert_eq!(
+            kind("--controller flexcan --bitrate"),
+            Some(ErrorKind::InvalidValue)
+        );
+        assert_eq!(
+            kind("--controller flexcan --bitrate 99999999999"),
+            Some(ErrorKind::ValueValidation)
+        );
+        assert_eq!(
+            kind("--controller flexcan --bitrate 1 --frob"),
+            Some(ErrorKind::UnknownArgument)
+        );
+        assert_eq!(
+            kind("--controller flexcan --bitrate 1 --json=yes"),
+            Some(ErrorKind::TooManyValues)
+        );
+        assert_eq!(kind("--help"), Some(ErrorKind::DisplayHelp));
+        // Every bad input exits with status 2 (clap's usage-error status).
+        let e = parse_args("--controller flexcan --bitrate x")
+            .err()
+            .unwrap();
+        assert_eq!(e.exit_code(), 2);
+        Args::command().debug_assert();
+    }
+
+    #[test]
+    fn json_is_valid_and_ordered() {
+        let j = run_json("--controller flexcan --bitrate 500000 --json --all");
+        let v: serde_json::Value = serde_json::from_str(&j).unwrap();
+        assert_eq!(v["controller"], "flexcan");
+        assert_eq!(v["clock"], 16_000_000);
+        assert_eq!(v["registers"]["CTRL1_mask_hex"], "0xFFFF0087");
+        assert!(v["solutions"].as_array().is_some_and(|s| !s.is_empty()));
+        // The register comes before its fields, as before.
+        let at = |k: &str| j.find(k).unwrap();
+        assert!(at("\"CTRL1\"") < at("\"CTRL1_hex\"") && at("\"CTRL1_hex\"") < at("\"PRESDIV\""));
+        assert!(
+            at("\"controller\"") < at("\"actual_bitrate\"")
+                && at("\"registers\"") < at("\"solutions\"")
+        );
     }
 }

@@ -7,105 +7,118 @@
 //! ```
 
 use std::fs::File;
-use std::io::{BufWriter, Write};
+use std::io::BufWriter;
+use std::path::PathBuf;
 use std::process::ExitCode;
 
+use clap::error::ErrorKind;
+use clap::{CommandFactory, Parser};
 use twocan_app::App;
+use twocan_core::sim::bits::{max_stuff_bits, INTERMISSION_BITS};
+use twocan_core::sim::trace::CandumpWriter;
 use twocan_core::sim::{RandomFaults, SimNode};
 use twocan_core::Frame;
 use twocan_host::{state_name, BxNode, FlexNode, Harness, Serviced};
 
-const USAGE: &str =
-    "usage: can-demo [--bitrate BPS] [--seconds S] [--error-rate R] [--seed N] [--trace FILE]
-  --bitrate BPS     bus bit rate, 10000..=1000000 (default 500000)
-  --seconds S       simulated time to run, > 0 (default 2)
-  --error-rate R    probability in [0, 1) that a frame on the bus is hit by an error (default 0)
-  --seed N          seed of the error injection (default 1)
-  --trace FILE      write every frame on the bus in the candump log format";
-
-#[derive(Debug)]
-struct Options {
+/// A simulated Teensy 3.6 (FlexCAN can0) and a simulated STM32F767 (bxCAN CAN1) on one
+/// bus, both running the portable application of `twocan-app`.
+#[derive(Debug, Parser)]
+#[command(name = "can-demo", version)]
+struct Args {
+    /// Bus bit rate in bit/s, 10000..=1000000
+    #[arg(long, value_name = "BPS", default_value_t = 500_000,
+          value_parser = clap::value_parser!(u32).range(10_000..=1_000_000))]
     bitrate: u32,
+    /// Simulated time to run in seconds, up to 3600; at least one frame time and one
+    /// application period (1 ms)
+    #[arg(long, value_name = "S", default_value_t = 2.0, value_parser = parse_seconds)]
     seconds: f64,
+    /// Probability in [0, 1) that a frame on the bus is hit by an error
+    #[arg(long, value_name = "R", default_value_t = 0.0, value_parser = parse_error_rate)]
     error_rate: f64,
+    /// Seed of the error injection
+    #[arg(long, value_name = "N", default_value_t = 1)]
     seed: u64,
-    trace: Option<String>,
+    /// Write every frame on the bus to FILE in the candump log format, as the run goes
+    #[arg(long, value_name = "FILE")]
+    trace: Option<PathBuf>,
 }
 
-fn parse(args: &[String]) -> Result<Options, String> {
-    let mut o = Options {
-        bitrate: 500_000,
-        seconds: 2.0,
-        error_rate: 0.0,
-        seed: 1,
-        trace: None,
-    };
-    let mut it = args.iter();
-    while let Some(a) = it.next() {
-        let mut value = |name: &str| {
-            it.next()
-                .cloned()
-                .ok_or_else(|| format!("{name} needs a value"))
-        };
-        match a.as_str() {
-            "--bitrate" => {
-                let v = value("--bitrate")?;
-                o.bitrate = v
-                    .parse()
-                    .map_err(|_| format!("--bitrate: not a number: {v}"))?;
-                if !(10_000..=1_000_000).contains(&o.bitrate) {
-                    return Err(format!(
-                        "--bitrate: {} is outside 10000..=1000000",
-                        o.bitrate
-                    ));
-                }
-            }
-            "--seconds" => {
-                let v = value("--seconds")?;
-                o.seconds = v
-                    .parse()
-                    .map_err(|_| format!("--seconds: not a number: {v}"))?;
-                if !(o.seconds > 0.0 && o.seconds <= 3600.0) {
-                    return Err(format!("--seconds: {v} is outside (0, 3600]"));
-                }
-            }
-            "--error-rate" => {
-                let v = value("--error-rate")?;
-                o.error_rate = v
-                    .parse()
-                    .map_err(|_| format!("--error-rate: not a number: {v}"))?;
-                if !(0.0..1.0).contains(&o.error_rate) {
-                    return Err(format!("--error-rate: {v} is outside [0, 1)"));
-                }
-            }
-            "--seed" => {
-                let v = value("--seed")?;
-                o.seed = v
-                    .parse()
-                    .map_err(|_| format!("--seed: not a number: {v}"))?;
-            }
-            "--trace" => o.trace = Some(value("--trace")?),
-            "-h" | "--help" => return Err(String::new()),
-            other => return Err(format!("unknown option: {other}")),
-        }
+/// Bit times of the longest classical frame (extended identifier, 8 data bytes, every
+/// possible stuff bit) with its intermission: 64 + 64 + 29 + 3 = 160.
+const LONGEST_FRAME_BITS: u32 = 64 + 8 * 8 + max_stuff_bits(true, 8) + INTERMISSION_BITS;
+
+fn parse_seconds(text: &str) -> Result<f64, String> {
+    let s: f64 = text
+        .parse()
+        .map_err(|_| format!("'{text}' is not a number"))?;
+    if s > 0.0 && s <= 3600.0 {
+        Ok(s)
+    } else {
+        Err(format!("{text} is outside (0, 3600]"))
     }
-    Ok(o)
+}
+
+fn parse_error_rate(text: &str) -> Result<f64, String> {
+    let r: f64 = text
+        .parse()
+        .map_err(|_| format!("'{text}' is not a number"))?;
+    if (0.0..1.0).contains(&r) {
+        Ok(r)
+    } else {
+        Err(format!("{text} is outside [0, 1)"))
+    }
+}
+
+impl Args {
+    /// The rules between options: the run must last at least one frame time at the
+    /// chosen bit rate, and one application period (the demo steps in whole periods).
+    fn check(&self) -> Result<(), clap::Error> {
+        let frame_time = f64::from(LONGEST_FRAME_BITS) / f64::from(self.bitrate);
+        let minimum = frame_time.max(0.001);
+        if self.seconds < minimum {
+            return Err(Args::command().error(
+                ErrorKind::ValueValidation,
+                format!(
+                    "--seconds {}: shorter than {minimum} s, the longest of one frame time \
+                     ({LONGEST_FRAME_BITS} bits at {} bit/s) and one application period (1 ms)",
+                    self.seconds, self.bitrate
+                ),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// The `--trace` file, opened before the run: candump lines are written to it as the
+/// simulation goes (the bus trace is drained every application period).
+type TraceSink = CandumpWriter<'static, BufWriter<File>>;
+
+fn open_trace(path: &PathBuf, bitrate: u32) -> Result<TraceSink, String> {
+    let file = File::create(path).map_err(|e| format!("--trace {}: {e}", path.display()))?;
+    Ok(CandumpWriter::new(BufWriter::new(file), "can0", bitrate))
 }
 
 fn main() -> ExitCode {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    let o = match parse(&args) {
-        Ok(o) => o,
-        Err(msg) if msg.is_empty() => {
-            println!("{USAGE}");
-            return ExitCode::SUCCESS;
-        }
+    // Bad options: clap prints the error and a usage line and exits with status 2.
+    let args = Args::parse();
+    if let Err(e) = args.check() {
+        e.exit();
+    }
+    // A bad trace path fails at once, before any simulation.
+    let mut trace = match args
+        .trace
+        .as_ref()
+        .map(|path| open_trace(path, args.bitrate))
+        .transpose()
+    {
+        Ok(t) => t,
         Err(msg) => {
-            eprintln!("can-demo: {msg}\n{USAGE}");
+            eprintln!("can-demo: {msg}");
             return ExitCode::from(2);
         }
     };
-    match run(&o) {
+    match run(&args, trace.as_mut()) {
         Ok(()) => ExitCode::SUCCESS,
         Err(msg) => {
             eprintln!("can-demo: {msg}");
@@ -114,7 +127,7 @@ fn main() -> ExitCode {
     }
 }
 
-fn run(o: &Options) -> Result<(), String> {
+fn run(o: &Args, mut trace: Option<&mut TraceSink>) -> Result<(), String> {
     let mut h = Harness::new(o.bitrate).map_err(|e| format!("bus: {e:?}"))?;
     let mut teensy_app = App::new(1, 2);
     let mut stm32_app = App::new(2, 1);
@@ -161,6 +174,10 @@ fn run(o: &Options) -> Result<(), String> {
             start + (p + 1) * period,
             &mut [&mut teensy as &mut dyn Serviced, &mut stm32],
         );
+        if let Some(sink) = trace.as_deref_mut() {
+            sink.drain(h.bus().borrow_mut().trace_mut())
+                .map_err(|e| format!("--trace: {e}"))?;
+        }
         if (p + 1).is_multiple_of(progress_every) {
             let bus = h.bus().borrow();
             println!(
@@ -246,14 +263,14 @@ fn run(o: &Options) -> Result<(), String> {
             s.heartbeats, s.heartbeat_gaps, s.heartbeat_duplicates, s.measurements, s.requests, s.answers, s.tx_full
         );
     }
-    if let Some(path) = &o.trace {
-        let file = File::create(path).map_err(|e| format!("--trace {path}: {e}"))?;
-        let mut w = BufWriter::new(file);
-        bus.trace()
-            .write_candump(&mut w, "can0")
-            .map_err(|e| format!("--trace {path}: {e}"))?;
-        w.flush().map_err(|e| format!("--trace {path}: {e}"))?;
-        println!("trace: {} frames written to {path}", bus.trace().len());
+    if let (Some(sink), Some(path)) = (trace, &o.trace) {
+        sink.flush()
+            .map_err(|e| format!("--trace {}: {e}", path.display()))?;
+        println!(
+            "trace: {} frames written to {}",
+            sink.frames_written(),
+            path.display()
+        );
     }
     Ok(())
 }
