@@ -169,10 +169,8 @@ impl MockHardware {
     }
 
     fn receive_into(m: &mut Inner, frame: Frame) {
-        if m.filters.iter().any(|f| f.matches(&frame)) {
-            if m.fifo.push_back(frame).is_err() {
-                m.overrun = true;
-            }
+        if m.filters.iter().any(|f| f.matches(&frame)) && m.fifo.push_back(frame).is_err() {
+            m.overrun = true;
         }
     }
 
