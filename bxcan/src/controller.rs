@@ -101,7 +101,7 @@ impl<R: Registers, F: Registers> Can<R, F> {
     fn configure(mut self, config: &Config) -> Result<Init<R, F>, Failed<Can<R, F>>> {
         self.config = *config;
         let bound = config.get_wait_iterations();
-        if let Err(error) = mode::request(&mut self.regs, Mode::Stopped, bound) {
+        if let Err(error) = mode::request(&self.regs, Mode::Stopped, bound) {
             return Err(Failed { error, value: self });
         }
         let keep = mcr::INRQ;
@@ -109,7 +109,7 @@ impl<R: Registers, F: Registers> Can<R, F> {
         self.regs.write32(BTR, config.btr_value());
         self.regs.write32(IER, config.get_interrupts());
         if let (Instance::Can1, Some(start)) = (self.instance, config.get_can2_start_bank()) {
-            filter_block::set_can2sb(&mut self.regs, start);
+            filter_block::set_can2sb(&self.regs, start);
         }
         Ok(Init { can: self })
     }
@@ -181,7 +181,7 @@ impl<R: Registers, F: Registers> Can<R, F> {
         let instance = self.instance;
         let r = match &mut self.filter_regs {
             Some(f) => filter_block::program(f, instance, plan),
-            None => filter_block::program(&mut self.regs, instance, plan),
+            None => filter_block::program(&self.regs, instance, plan),
         };
         r.map_err(|_| Error::InvalidArgument)?;
         self.fmi = plan.fmi_map();
@@ -224,9 +224,9 @@ impl<R: Registers, F: Registers> Init<R, F> {
     /// hardware gives after 11 recessive bits on CANRX (RM0410 §40.4.2).
     ///
     /// Errors: [`Error::Timeout`], with this value handed back in [`Failed::value`].
-    pub fn enable(mut self) -> Result<Can<R, F>, Failed<Init<R, F>>> {
+    pub fn enable(self) -> Result<Can<R, F>, Failed<Init<R, F>>> {
         let bound = self.can.bound();
-        match mode::request(&mut self.can.regs, Mode::Normal, bound) {
+        match mode::request(&self.can.regs, Mode::Normal, bound) {
             Ok(()) => Ok(self.can),
             Err(error) => Err(Failed { error, value: self }),
         }

@@ -56,7 +56,7 @@ fn where_is(m: &mut BxCanModel) -> Option<(usize, u32)> {
 
 #[test]
 fn instances_and_filter_windows() {
-    let (mut can1, mut can2) = BxCanModel::can1_can2();
+    let (mut can1, can2) = BxCanModel::can1_can2();
     assert_eq!(
         (can1.instance(), can2.instance()),
         (Instance::Can1, Instance::Can2)

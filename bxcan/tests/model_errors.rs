@@ -75,7 +75,7 @@ fn error_passive_transmitter_acknowledge_errors_do_not_count() {
 
 #[test]
 fn receive_errors_and_last_error_code() {
-    let (mut m, mut bus) = started(BxCanModel::can1());
+    let (m, mut bus) = started(BxCanModel::can1());
     m.write32(regs::ESR, esr::LEC.val(esr::LEC_SOFTWARE));
     assert_eq!(esr::LEC.get(esr_of(&m)), 7, "software may set LEC to 7");
     // ISO 11898-1 rules 1 and 2 together: +1 for the error, +8 for the dominant bit
@@ -107,7 +107,7 @@ fn receive_errors_and_last_error_code() {
 
 #[test]
 fn erri_needs_an_enabled_error_flag_and_sce_needs_errie() {
-    let (mut m, mut bus) = started(BxCanModel::can1());
+    let (m, mut bus) = started(BxCanModel::can1());
     bus.inject_rx_error(LastErrorCode::Crc, false);
     assert_eq!(m.read32(regs::MSR) & msr::ERRI, 0, "LECIE = 0: no ERRI");
     m.write32(regs::IER, ier::LECIE);

@@ -350,7 +350,7 @@ fn filter_register_write_rules() {
 
 #[test]
 fn can3_has_14_banks_and_no_can2sb() {
-    let mut m = BxCanModel::can3();
+    let m = BxCanModel::can3();
     m.write32(regs::FA1R, u32::MAX);
     assert_eq!(m.read32(regs::FA1R), 0x3FFF);
     m.write32(regs::FA1R, 0);

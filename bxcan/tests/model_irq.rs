@@ -79,7 +79,7 @@ fn fifo_lines_follow_fmp_full_and_fovr() {
 
 #[test]
 fn status_change_line_follows_erri_wkui_slaki() {
-    let (mut m, mut bus) = started(BxCanModel::can1());
+    let (m, mut bus) = started(BxCanModel::can1());
     m.write32(regs::IER, ier::LECIE);
     bus.inject_rx_error(LastErrorCode::Form, false);
     assert_eq!(m.irq_lines(), NONE, "ERRI set, ERRIE = 0");

@@ -41,7 +41,7 @@ fn reset_values() {
 
 #[test]
 fn initialization_handshake_from_sleep() {
-    let mut m = BxCanModel::can1();
+    let m = BxCanModel::can1();
     // INRQ while SLEEP is still set: not acknowledged (Sleep → Init needs !SLEEP).
     m.write32(regs::MCR, mcr::INRQ | mcr::SLEEP);
     assert_eq!(mode_bits(&m), msr::SLAK);
@@ -75,7 +75,7 @@ fn leaving_initialization_waits_for_11_recessive_bits() {
 
 #[test]
 fn sleep_handshake_and_slaki() {
-    let (mut m, mut bus) = started(BxCanModel::can1());
+    let (m, mut bus) = started(BxCanModel::can1());
     m.write32(regs::MCR, mcr::SLEEP);
     assert_eq!(mode_bits(&m), msr::SLAK);
     assert_eq!(
@@ -145,7 +145,7 @@ fn automatic_wakeup_on_bus_activity() {
 
 #[test]
 fn wakeup_without_awum_needs_software() {
-    let (mut m, mut bus) = started(BxCanModel::can1());
+    let (m, mut bus) = started(BxCanModel::can1());
     m.write32(regs::MCR, mcr::SLEEP);
     bus.inject(&std_frame(0x10, &[1]));
     assert_ne!(m.read32(regs::MSR) & msr::WKUI, 0);
@@ -180,7 +180,7 @@ fn btr_is_writable_in_initialization_mode_only() {
 
 #[test]
 fn reserved_bits_are_ignored() {
-    let mut m = BxCanModel::can1();
+    let m = BxCanModel::can1();
     m.write32(regs::MCR, !mcr::RESET);
     assert_eq!(m.read32(regs::MCR), 0x0001_00FF);
     m.write32(regs::IER, u32::MAX);
@@ -234,7 +234,7 @@ fn master_reset() {
 
 #[test]
 fn stuck_acknowledge_never_changes_inak_or_slak() {
-    let mut m = BxCanModel::can1();
+    let m = BxCanModel::can1();
     let mut bus = TinyBus::new(&[&m]);
     m.set_ack_stuck(true);
     m.write32(regs::MCR, mcr::INRQ);
@@ -286,7 +286,7 @@ fn initialization_request_waits_for_the_end_of_a_transmission() {
 fn no_write_panics_and_reads_are_stable() {
     let values = [0, u32::MAX, 0xAAAA_AAAA, 0x5555_5555, 0x8000_0001];
     let (can1, can2) = BxCanModel::can1_can2();
-    for mut m in [BxCanModel::can1(), BxCanModel::can3(), can1, can2] {
+    for m in [BxCanModel::can1(), BxCanModel::can3(), can1, can2] {
         let mut bus = TinyBus::new(&[&m]);
         for round in 0..3 {
             for offset in 0..0x400 {

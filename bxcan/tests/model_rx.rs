@@ -59,7 +59,7 @@ fn fifo_pending_states_and_release() {
 
 #[test]
 fn overrun_with_fifo_unlocked_overwrites_the_newest() {
-    let (mut m, mut bus) = started(BxCanModel::can1());
+    let (m, mut bus) = started(BxCanModel::can1());
     m.write32(regs::IER, ier::FOVIE0);
     let f = frames(5);
     for x in &f {

@@ -53,7 +53,7 @@ fn transmitted_frames_are_stamped_in_tdtxr() {
 
 #[test]
 fn transmit_global_time_replaces_data_bytes_6_and_7() {
-    let (mut a, mut b, mut bus) = started_pair(BxCanModel::can1(), BxCanModel::can3());
+    let (a, mut b, mut bus) = started_pair(BxCanModel::can1(), BxCanModel::can3());
     a.modify32(regs::MCR, |v| v | mcr::TTCM);
     bus.idle(0x1234);
     a.write32(regs::tdtxr(0), tdtxr::DLC.val(8) | tdtxr::TGT);

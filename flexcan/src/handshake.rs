@@ -111,14 +111,14 @@ mod tests {
 
     #[test]
     fn waits_are_bounded() {
-        let mut r = Deaf(0);
-        assert_eq!(freeze(&mut r, 10), Err(Error::Timeout));
-        assert_eq!(disable(&mut r, 0), Err(Error::Timeout));
-        let mut r = Deaf(mcr::LPMACK | mcr::SOFTRST | mcr::FRZACK);
-        assert_eq!(enable(&mut r, 3), Err(Error::Timeout));
-        assert_eq!(soft_reset(&mut r, 3), Err(Error::Timeout));
-        assert_eq!(unfreeze(&mut r, 3), Err(Error::Timeout));
-        assert_eq!(freeze(&mut r, 1), Ok(()));
+        let r = Deaf(0);
+        assert_eq!(freeze(&r, 10), Err(Error::Timeout));
+        assert_eq!(disable(&r, 0), Err(Error::Timeout));
+        let r = Deaf(mcr::LPMACK | mcr::SOFTRST | mcr::FRZACK);
+        assert_eq!(enable(&r, 3), Err(Error::Timeout));
+        assert_eq!(soft_reset(&r, 3), Err(Error::Timeout));
+        assert_eq!(unfreeze(&r, 3), Err(Error::Timeout));
+        assert_eq!(freeze(&r, 1), Ok(()));
     }
 
     /// Out of freeze at once, but never synchronised (a bus stuck dominant).
@@ -136,9 +136,9 @@ mod tests {
 
     #[test]
     fn synch_wait_is_bounded_and_reports_every_read() {
-        let mut r = NeverSynch;
-        assert_eq!(leave_freeze(&mut r, 3), Ok(()));
-        assert_eq!(unfreeze(&mut r, 3), Err(Error::Timeout));
+        let r = NeverSynch;
+        assert_eq!(leave_freeze(&r, 3), Ok(()));
+        assert_eq!(unfreeze(&r, 3), Err(Error::Timeout));
         let mut reads = 0;
         assert_eq!(
             wait_synch(&r, 5, |v| {

@@ -174,7 +174,7 @@ fn status_bits_are_read_only_and_k20_has_no_waksrc() {
     let v = r.rd(regs::MCR);
     assert_ne!(v & mcr::FRZACK, 0);
     assert_eq!(v & (mcr::LPMACK | mcr::WAKSRC), 0);
-    let mut m = FlexCanModel::mk66fx1m0();
+    let m = FlexCanModel::mk66fx1m0();
     m.modify32(regs::MCR, |v| v & !mcr::MDIS);
     m.modify32(regs::MCR, |v| v | mcr::WAKSRC);
     assert_ne!(m.read32(regs::MCR) & mcr::WAKSRC, 0);
