@@ -38,7 +38,7 @@ pub enum Recovery {
     /// itself.
     Automatic,
     /// `ABOM = 0`: software starts it by entering and leaving initialization mode
-    /// ([`twocan_core::Controller::recover`]).
+    /// ([`twocan_core::Hardware::recover`]).
     #[default]
     Manual,
 }
@@ -193,7 +193,7 @@ impl Config {
 
     /// No automatic retransmission (`CAN_MCR.NART`; notes "Non automatic retransmission
     /// mode"): each frame is tried once; a failure is reported as
-    /// [`twocan_core::Events::failed`].
+    /// a `Failed` completion ([`twocan_core::TxOutcome::Failed`]).
     pub const fn one_shot(self, on: bool) -> Self {
         Config {
             one_shot: on,

@@ -1,6 +1,6 @@
 //! The bxCAN controller: configuration entry points ([`Can::can1`], [`Can::can2`],
-//! [`Can::can3`]), the initialization-mode value [`Init`], and the
-//! [`twocan_core::Controller`] implementation the portable [`twocan_core::Driver`] uses.
+//! [`Can::can3`]), the initialization-mode value [`Init`], and
+//! the configured controller that [`Can::into_split`] hands to the portable driver.
 
 use twocan_core::{Error, LastErrorCode, Mode, Registers};
 
@@ -205,7 +205,7 @@ pub fn lec(code: u32) -> LastErrorCode {
 
 #[allow(clippy::result_large_err)]
 impl<R: Registers, F: Registers> Init<R, F> {
-    /// Installs filters before going on the bus (see [`Controller::install_filters`]).
+    /// Installs filters before going on the bus (the receive half's `set_filters` installs later lists).
     pub fn set_filters(&mut self, plan: &FilterPlan) -> Result<(), Error> {
         self.can.write_filters(plan)
     }

@@ -16,7 +16,7 @@
 //! - priority ("Filter priority rules"): a 32-bit filter beats a 16-bit one, then list
 //!   beats mask, then the lower filter number wins.
 //!
-//! A bank is described by [`Bank`]; [`FilterPlan`] (the [`twocan_core::Controller::Filters`]
+//! A bank is described by [`Bank`]; [`FilterPlan`] (the [`twocan_core::Hardware::Filters`]
 //! of this backend) holds the banks of one instance and the map from each FIFO's match
 //! index back to the index the application uses ([`twocan_core::RxFrame::filter`]).
 //! The automatic planner ([`crate::planner`]) builds a plan from portable
@@ -463,7 +463,7 @@ pub struct Acceptance {
 
 /// The banks of one instance's share of the filter block, relative to its first bank,
 /// with the user index of every slot: the compiled filter list that
-/// [`twocan_core::Controller::install_filters`] writes.
+/// [`twocan_core::Hardware::install_filters`] writes.
 ///
 /// Bank `k` of a plan is written to hardware bank `first + k`, where `first` is 0 for
 /// CAN1 and CAN3 and `CAN2SB` for CAN2. Match indices are numbered from the instance's

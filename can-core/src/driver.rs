@@ -124,7 +124,7 @@ impl<H: Hardware, const RX: usize, const TX: usize, const RX1: usize> Driver<H, 
         self.with_tx(|tx| tx.abort_all())
     }
 
-    /// Takes the oldest received frame ([`Rx::receive`]).
+    /// Takes the oldest received frame ([`crate::split::Rx::receive`]).
     pub fn receive(&mut self) -> nb::Result<RxFrame, Error> {
         // SAFETY: the driver plays every role; it is the rings' only consumer.
         unsafe { self.state.receive_with(&self.map) }

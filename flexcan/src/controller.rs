@@ -112,7 +112,7 @@ impl<R: Registers> FlexCan<R> {
     }
 
     /// The free-running timer (`TIMER`, one count per bit time): the time base of
-    /// [`RxFrame::timestamp`].
+    /// [`twocan_core::RxFrame::timestamp`].
     pub fn timer(&self) -> u16 {
         regs::timer::TIMER.get(self.regs.read32(TIMER)) as u16
     }

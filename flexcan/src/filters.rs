@@ -76,7 +76,7 @@ pub enum Hit {
 /// A filter list compiled for one [`Configuration`]: the ID filter table, the masks
 /// and the map from `RXFIR.IDHIT` back to the user's filter index.
 ///
-/// This is the FlexCAN [`twocan_core::Controller::Filters`] type.
+/// This is the FlexCAN [`twocan_core::Hardware::Filters`] type.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct FilterTable {
     configuration: Configuration,
@@ -284,7 +284,7 @@ impl FilterTable {
 /// The filter index of a received frame whose `RXFIR.IDHIT` does not map back to any
 /// of the user's filters ([`FilterTable::filter_index`] gives `None`): distinct from
 /// every real index (a list has at most a few hundred filters). The controller counts
-/// such frames ([`crate::FlexCan::unresolved_filter_hits`]); a
+/// such frames ([`crate::FlexCanHw::unresolved_filter_hits`]); a
 /// [`twocan_core::Dispatcher`] counts them as unhandled.
 pub const UNKNOWN_FILTER: u16 = u16::MAX;
 

@@ -1,6 +1,6 @@
 //! The split driver of a FlexCAN instance as the examples use it: its shared state in a
 //! `static` ([`CanState`]), its interrupt handles in the instance's [`Vectors`], which
-//! the device vectors of [`crate::rt`] run, and [`start`], which puts the handles in
+//! the device vectors of `rt` run, and `start`, which puts the handles in
 //! place **before** it unmasks the interrupt lines — so an interrupt never finds a
 //! vector with nothing to run (the line would stay asserted).
 //!
@@ -48,7 +48,7 @@ impl Default for Vectors {
 }
 
 impl Vectors {
-    /// Empty: the vectors do nothing until [`start`] fills them.
+    /// Empty: the vectors do nothing until `start` fills them.
     pub const fn new() -> Self {
         Vectors {
             message: IrqCell::new(),
@@ -77,7 +77,7 @@ impl Vectors {
     }
 }
 
-/// FlexCAN0's handles, run by `CAN0_*` vectors of [`crate::rt`].
+/// FlexCAN0's handles, run by `CAN0_*` vectors of `rt`.
 pub static CAN0_VECTORS: Vectors = Vectors::new();
 /// FlexCAN1's handles (Teensy 3.6), run by its `CAN1_*` vectors.
 #[cfg(feature = "teensy36")]
