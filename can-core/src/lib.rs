@@ -16,6 +16,8 @@
 #[cfg(feature = "std")]
 extern crate std;
 
+#[cfg(feature = "async")]
+pub mod asynch;
 pub mod controller;
 pub mod dispatch;
 pub mod driver;
@@ -46,6 +48,8 @@ pub use error::{Error, ErrorCounters, ErrorState, ErrorStatistics, LastErrorCode
 pub use filter::{Filter, FilterError, Format, FrameKind};
 pub use frame::{Frame, FrameError, RxFrame};
 pub use hardware::{Completion, Hardware, Settled, StatusEvents, Token, TxFailure};
+#[cfg(feature = "async")]
+pub use io::{AsyncCanRx, AsyncCanTx};
 pub use io::{CanRx, CanTx};
 pub use mailbox::{MailboxId, MailboxState, TxOutcome, TxPolicy};
 pub use priority::Priority;

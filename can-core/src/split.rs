@@ -181,6 +181,8 @@ pub struct State<
     dropped: Counter,
     state_changes: Counter,
     errors: ErrorCounts,
+    #[cfg(feature = "async")]
+    pub(crate) wakers: crate::asynch::Wakers,
     _q: core::marker::PhantomData<Q>,
 }
 
@@ -258,6 +260,8 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
             dropped: Counter::new(),
             state_changes: Counter::new(),
             errors: ErrorCounts::new(),
+            #[cfg(feature = "async")]
+            wakers: crate::asynch::Wakers::new(),
             _q: core::marker::PhantomData,
         }
     }
@@ -857,10 +861,18 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
     /// free mailboxes from the queue, in one critical section.
     pub fn on_interrupt(&mut self) {
         let s = self.s;
+        #[cfg(feature = "async")]
+        let before = s.sent.get() + s.failed.get() + s.aborted.get();
         critical_section::with(|cs| {
             // SAFETY: the queue is only touched inside a critical section.
             s.service_tx(unsafe { &mut *s.queue.borrow(cs).get() })
-        })
+        });
+        #[cfg(feature = "async")]
+        if s.sent.get() + s.failed.get() + s.aborted.get() != before {
+            // Completions came, so mailboxes (and queue room) were freed.
+            s.wakers.tx_done.wake();
+            s.wakers.tx_room.wake();
+        }
     }
 }
 
@@ -882,6 +894,8 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
         let hw = s.hw();
         let mut overrun = false;
         let q = self.queue as usize;
+        #[cfg(feature = "async")]
+        let mut any = false;
         // SAFETY: this handle is the only caller of `read_rx` for its queue and the only
         // producer of its ring.
         unsafe {
@@ -892,10 +906,18 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
                 } else {
                     s.rx1.push(raw)
                 };
+                #[cfg(feature = "async")]
+                {
+                    any = true;
+                }
             }
         }
         if overrun {
             overrun_counter(s).inc();
+        }
+        #[cfg(feature = "async")]
+        if any {
+            s.wakers.rx.wake();
         }
     }
 
@@ -964,6 +986,8 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
                     counters: now.counters,
                 })
             };
+            #[cfg(feature = "async")]
+            s.wakers.state.wake();
         }
     }
 
