@@ -76,6 +76,19 @@ impl<R: Registers> Can<R, R> {
 
 #[allow(clippy::result_large_err)]
 impl<R: Registers, F: Registers> Can<R, F> {
+    /// Configures CAN1 as the master of a dual set-up: `regs` reach its control and
+    /// mailbox registers only ([`crate::regs::ControlRegs`] on target) and `filters`
+    /// the filter block it shares with CAN2 ([`crate::regs::FilterRegs`], lent as
+    /// `&'static` to both). So no register is owned twice: CAN1's control block by
+    /// CAN1, CAN2's by CAN2, the filter block by the shared `static`.
+    pub fn can1_dual(
+        regs: R,
+        filters: F,
+        config: &Config,
+    ) -> Result<Init<R, F>, Failed<Can<R, F>>> {
+        Can::new(regs, Some(filters), Instance::Can1, config).configure(config)
+    }
+
     /// Configures CAN2 (the slave): `regs` are CAN2's registers, `can1_filters` reaches
     /// CAN1's register block, used for the filter registers only (`CAN_FMR` ..
     /// `CAN_F27R2`, RM0410 §40.9.4: CAN2 has none of its own). CAN1 must be clocked;
@@ -109,7 +122,10 @@ impl<R: Registers, F: Registers> Can<R, F> {
         self.regs.write32(BTR, config.btr_value());
         self.regs.write32(IER, config.get_interrupts());
         if let (Instance::Can1, Some(start)) = (self.instance, config.get_can2_start_bank()) {
-            filter_block::set_can2sb(&self.regs, start);
+            match &self.filter_regs {
+                Some(f) => filter_block::set_can2sb(f, start),
+                None => filter_block::set_can2sb(&self.regs, start),
+            }
         }
         Ok(Init { can: self })
     }

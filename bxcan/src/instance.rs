@@ -19,10 +19,12 @@
 //!   PA11/PA12, PB8/PB9, PD0/PD1, PI9/PH13) and CAN2 (PB12/PB13, PB5/PB6); CAN3 (PA8/PA15,
 //!   PB3/PB4) uses **AF11** on F76x/F77x — check the data sheet's alternate-function
 //!   table for the pin chosen;
-//! - build the register access: `twocan_core::Mmio::new(regs::CAN1_BASE)` (an `unsafe`
-//!   promise that nothing else touches the peripheral). For CAN2, a second `Mmio` at
-//!   `CAN1_BASE` reaches the shared filter block; the driver only touches the filter
-//!   registers (`0x200..0x31C`) through it.
+//! - build the register access: `regs::CanRegs::new(regs::CAN1_BASE)` (an `unsafe`
+//!   promise that nothing else touches the peripheral; the handle reaches the block's
+//!   registers and nothing else). With CAN2, no register has two owners: CAN1 and CAN2
+//!   each get their control registers (`regs::ControlRegs`, `0x000..0x200`) and both
+//!   borrow one `static` `regs::FilterRegs` (CAN1's `0x200..0x320`): `Can::can1_dual`
+//!   and `Can::can2`.
 //! - CAN2 alone: CAN1 must be clocked, but need not be enabled on the bus, for its filter
 //!   block to take the configuration.
 

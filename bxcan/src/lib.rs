@@ -4,7 +4,7 @@
 //! [`twocan_core::split`] and the one-struct [`twocan_core::Driver`].
 //!
 //! Quick start on the host, over the behavioural model of CAN1 (feature `model`) in
-//! loop-back mode; firmware runs the same code over [`twocan_core::Mmio`]:
+//! loop-back mode; firmware runs the same code over [`regs::CanRegs`]:
 //!
 //! ```
 //! # #[cfg(feature = "model")] {
@@ -44,21 +44,23 @@
 //! # }
 //! ```
 //!
-//! In firmware the register handle is [`twocan_core::Mmio`] at the instance's base, the
+//! In firmware the register handle is [`regs::CanRegs`] (a [`twocan_core::Mmio`] window
+//! over the instance's block: safe code reaches no other address) at its base, the
 //! state a `static`, and the handlers go to the TX, RX0, RX1 and SCE vectors before those
 //! are unmasked (see `examples/stm32f7/src/can.rs`):
 //!
 //! ```no_run
-//! use twocan_bxcan::{regs, BxCan, Can, Config, FifoPolicy, Recovery};
+//! use twocan_bxcan::regs::{self, CanRegs};
+//! use twocan_bxcan::{BxCan, Can, Config, FifoPolicy, Recovery};
 //! use twocan_core::split::State;
-//! use twocan_core::{FifoQueue, Filter, Mmio};
+//! use twocan_core::{FifoQueue, Filter};
 //!
-//! static CAN1: State<BxCan<Mmio>, 32, FifoQueue<16>, 32> = State::new();
+//! static CAN1: State<BxCan<CanRegs>, 32, FifoQueue<16>, 32> = State::new();
 //!
 //! fn start() -> Result<(), twocan_core::Error> {
 //!     // Firmware first: RCC_APB1ENR.CAN1EN = 1, PD0/PD1 in AF9 (see `instance`).
 //!     // SAFETY: CAN1's registers, clocked, used by nothing else.
-//!     let regs = unsafe { Mmio::new(regs::CAN1_BASE) };
+//!     let regs = unsafe { CanRegs::new(regs::CAN1_BASE) };
 //!     let config = Config::from_bitrate(54_000_000, 500_000)
 //!         .map_err(|_| twocan_core::Error::InvalidArgument)?
 //!         .recovery(Recovery::Automatic);

@@ -91,6 +91,22 @@ pub const CAN2_BASE: usize = 0x4000_6800;
 /// Base address of CAN3 (single CAN with its own filters; STM32F76x/F77x only).
 pub const CAN3_BASE: usize = 0x4000_3400;
 
+/// End of an instance's registers: the last filter register (`CAN_F27R2`) is at 0x31C.
+pub const BLOCK_END: usize = 0x320;
+/// Start of the filter registers (`CAN_FMR`).
+pub const FILTERS_START: usize = 0x200;
+
+/// Volatile access to a whole bxCAN register block (CAN1 alone, CAN3): control,
+/// mailboxes and filters.
+pub type CanRegs = twocan_core::Mmio<BLOCK_END>;
+/// Volatile access to an instance's control and mailbox registers only (CAN2, which
+/// has no filters of its own; CAN1 when it shares its filters with CAN2).
+pub type ControlRegs = twocan_core::Mmio<FILTERS_START>;
+/// Volatile access to CAN1's filter registers, the block CAN1 and CAN2 share (RM0410
+/// §40.9.4): held in one `static` and lent to both (`&'static FilterRegs`), its
+/// writes made under a critical section.
+pub type FilterRegs = twocan_core::Mmio<BLOCK_END, FILTERS_START>;
+
 /// Filter banks in the dual-CAN filter block of CAN1, shared by CAN1 and CAN2
 /// (RM0410 40.2: "28 filter banks shared between CAN1 and CAN2 for dual CAN").
 pub const FILTER_BANKS: usize = 28;

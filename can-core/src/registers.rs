@@ -1,7 +1,10 @@
 //! The register seam: the only way a backend touches its peripheral.
 //!
-//! On target it is volatile memory-mapped I/O at the peripheral's base address
-//! ([`Mmio`]); on the host it is a behavioural model of the peripheral.
+//! On target it is volatile memory-mapped I/O ([`Mmio`]); on the host it is a
+//! behavioural model of the peripheral. Writes take `&self`: a register write needs no
+//! exclusive borrow (volatile access on target, interior mutability in a model), so the
+//! split driver's contexts can share one register handle, each touching only its own
+//! registers (see [`crate::hardware`]).
 
 /// 32-bit register access by byte offset from the peripheral's base.
 pub trait Registers {
@@ -37,40 +40,113 @@ impl<R: Registers + ?Sized> Registers for &R {
     }
 }
 
-/// Volatile access to a memory-mapped peripheral.
+/// Volatile access to the registers at byte offsets `START..END` from a peripheral's
+/// base address: the window of a register block that this handle owns.
+///
+/// Safe code cannot reach anything else: an offset outside the window or not 32-bit
+/// aligned is never accessed (a read gives 0, a write is dropped; debug builds assert).
+/// Backends use offsets that are constants of their register map, so the check is
+/// folded away at compile time. The one promise is made once, `unsafe`ly, in
+/// [`Mmio::new`].
+///
+/// A window can be split ([`Mmio::split`]) so that two owners hold disjoint parts of
+/// one block — bxCAN's CAN1 control registers and the filter block it shares with CAN2.
 #[derive(Debug)]
-pub struct Mmio {
+pub struct Mmio<const END: usize = 0x400, const START: usize = 0> {
     base: usize,
 }
 
-impl Mmio {
-    /// Access to the peripheral at `base`.
+impl<const END: usize, const START: usize> Mmio<END, START> {
+    /// Access to the registers `START..END` of the peripheral at `base`.
     ///
     /// # Safety
-    /// `base` must be the address of a peripheral whose registers may be read and written
-    /// at every offset the backend uses, and nothing else may access it while this value
-    /// lives (the backends' singletons take care of that).
+    /// `base + START .. base + END` must be registers of one peripheral that may be
+    /// read and written with 32-bit accesses, and nothing else may access them while
+    /// this value lives (the backends' singletons take care of that).
     pub const unsafe fn new(base: usize) -> Self {
+        const {
+            assert!(
+                START < END && START.is_multiple_of(4) && END.is_multiple_of(4),
+                "empty window"
+            )
+        };
         Mmio { base }
     }
 
-    /// The base address.
+    /// The base address (offsets count from it).
     pub const fn base(&self) -> usize {
         self.base
     }
+
+    /// Whether `offset` is an aligned register of this window.
+    #[inline(always)]
+    pub const fn owns(offset: usize) -> bool {
+        offset.is_multiple_of(4) && offset >= START && offset < END
+    }
+
+    /// Splits the window at `MID` into two owners of disjoint parts.
+    pub fn split<const MID: usize>(self) -> (Mmio<MID, START>, Mmio<END, MID>) {
+        const {
+            assert!(
+                START < MID && MID < END && MID.is_multiple_of(4),
+                "split inside the window"
+            )
+        };
+        (Mmio { base: self.base }, Mmio { base: self.base })
+    }
 }
 
-impl Registers for Mmio {
+impl<const END: usize, const START: usize> Registers for Mmio<END, START> {
     #[inline(always)]
     fn read32(&self, offset: usize) -> u32 {
-        // SAFETY: `Mmio::new`'s contract: `base + offset` is a readable, aligned register of
-        // a peripheral that this value owns.
+        if !Self::owns(offset) {
+            debug_assert!(
+                false,
+                "register offset {offset:#x} outside {START:#x}..{END:#x}"
+            );
+            return 0;
+        }
+        // SAFETY: `Mmio::new`'s contract covers every aligned offset of `START..END`,
+        // checked just above.
         unsafe { core::ptr::read_volatile((self.base + offset) as *const u32) }
     }
 
     #[inline(always)]
     fn write32(&self, offset: usize, value: u32) {
-        // SAFETY: as for `read32`; writes go to a register of the owned peripheral.
+        if !Self::owns(offset) {
+            debug_assert!(
+                false,
+                "register offset {offset:#x} outside {START:#x}..{END:#x}"
+            );
+            return;
+        }
+        // SAFETY: as for `read32`; writes go to a register of the owned window.
         unsafe { core::ptr::write_volatile((self.base + offset) as *mut u32, value) }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn only_aligned_offsets_of_the_window_are_owned() {
+        type W = Mmio<0x320, 0x200>;
+        assert!(W::owns(0x200) && W::owns(0x31C));
+        assert!(!W::owns(0x1FC) && !W::owns(0x320) && !W::owns(0x202));
+    }
+
+    #[test]
+    fn a_window_reaches_only_its_own_memory() {
+        let mut block = [0u32; 8];
+        let base = block.as_mut_ptr() as usize;
+        // SAFETY: the window covers the 32 bytes of `block`, used by nothing else here.
+        let all: Mmio<32> = unsafe { Mmio::new(base) };
+        let (low, high) = all.split::<16>();
+        low.write32(4, 7);
+        high.write32(20, 9);
+        assert_eq!((low.read32(4), high.read32(20)), (7, 9));
+        assert_eq!(block[1], 7);
+        assert_eq!(block[5], 9);
     }
 }

@@ -191,7 +191,7 @@ impl<R: Registers> FlexCan<R> {
     /// is received with filter index 0).
     ///
     /// `sys` reaches the SIM and PORT registers by absolute address (firmware:
-    /// `Mmio` at base 0, as `Can0::begin` does; host: [`crate::HostSystem`]).
+    /// [`crate::regs::SystemRegs`], as `Can0::begin` uses; host: [`crate::HostSystem`]).
     /// `regs` may be `&mut M` to keep the registers (a model) after an error.
     pub fn begin<S: Registers>(
         mut regs: R,
@@ -220,19 +220,20 @@ impl<R: Registers> FlexCan<R> {
     any(feature = "teensy32", feature = "teensy35", feature = "teensy36")
 ))]
 mod firmware {
-    use twocan_core::{Filter, Mmio};
+    use twocan_core::Filter;
 
     use super::*;
     use crate::instance::Can0;
     #[cfg(feature = "teensy36")]
     use crate::instance::Can1;
+    use crate::regs::{FlexCanRegs, SystemRegs};
 
     /// The SIM and PORT registers, addressed absolutely.
-    fn system() -> Mmio {
-        // SAFETY: base 0 with absolute offsets: `begin` only touches SIM_SCGC3/5/6 and
-        // the PCRs of this instance's pins, read-modify-writes of SIM in a critical
-        // section; those registers exist on every Teensy 3.x chip.
-        unsafe { Mmio::new(0) }
+    fn system() -> SystemRegs {
+        // SAFETY: base 0 with absolute offsets, the window SIM..PORTE: `begin` only
+        // touches SIM_SCGC3/5/6 and the PCRs of this instance's pins, read-modify-writes
+        // of SIM in a critical section; those registers exist on every Teensy 3.x chip.
+        unsafe { SystemRegs::new(0) }
     }
 
     impl Can0 {
@@ -243,11 +244,11 @@ mod firmware {
             settings: &Settings,
             primary: &[Filter],
             secondary: &[Filter],
-        ) -> Result<FlexCan<Mmio>, (Self, BeginError)> {
+        ) -> Result<FlexCan<FlexCanRegs>, (Self, BeginError)> {
             let target = self.target();
             // SAFETY: the token is unique (taken once) and consumed here, so this is
             // the only access to FlexCAN0, at its reference-manual base address.
-            let regs = unsafe { Mmio::new(target.instance.base()) };
+            let regs = unsafe { FlexCanRegs::new(target.instance.base()) };
             FlexCan::begin(regs, &mut system(), target, settings, primary, secondary)
                 .map_err(|e| (self, e))
         }
@@ -261,10 +262,10 @@ mod firmware {
             settings: &Settings,
             primary: &[Filter],
             secondary: &[Filter],
-        ) -> Result<FlexCan<Mmio>, (Self, BeginError)> {
+        ) -> Result<FlexCan<FlexCanRegs>, (Self, BeginError)> {
             let target = self.target();
             // SAFETY: as for `Can0::begin`, for FlexCAN1.
-            let regs = unsafe { Mmio::new(target.instance.base()) };
+            let regs = unsafe { FlexCanRegs::new(target.instance.base()) };
             FlexCan::begin(regs, &mut system(), target, settings, primary, secondary)
                 .map_err(|e| (self, e))
         }

@@ -72,6 +72,16 @@ impl Field {
 
 /// FlexCAN0 base address (K20, K64, K66; memory map "CAN0").
 pub const CAN0_BASE: usize = 0x4002_4000;
+
+/// End of the module's registers (the last is `RXIMR15` at 0x8BC).
+pub const BLOCK_END: usize = 0x8C0;
+
+/// Volatile access to one FlexCAN module's registers (offsets `0..BLOCK_END`).
+pub type FlexCanRegs = twocan_core::Mmio<BLOCK_END>;
+
+/// Volatile access to the SIM and PORT registers `begin` writes, by absolute address
+/// (base 0; the window from the SIM to the end of PORTE).
+pub type SystemRegs = twocan_core::Mmio<0x4004_E000, 0x4004_7000>;
 /// FlexCAN1 base address (K66 only; memory map "CAN1").
 pub const CAN1_BASE: usize = 0x400A_4000;
 

@@ -3,7 +3,7 @@
 //! chapters "SIM" and "PORT"; ACAN §7, §16.7.5, §16.7.6).
 //!
 //! They are reached through a [`Registers`] whose offsets are absolute addresses. On
-//! the target that is [`twocan_core::Mmio`] at base 0 (see `Can0::begin`); on the host
+//! the target that is [`crate::regs::SystemRegs`] at base 0 (see `Can0::begin`); on the host
 //! [`HostSystem`] stands in and remembers what was written, so tests can check the
 //! pin set-up.
 

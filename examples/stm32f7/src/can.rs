@@ -3,10 +3,11 @@
 //! the example's four vectors run (TX, RX0, RX1, SCE: one handler per line, RM0410
 //! §40.8), and `start`, which puts the handles in place **before** it unmasks the lines.
 
+use twocan_bxcan::regs::CanRegs;
 use twocan_bxcan::BxCan;
 use twocan_core::irq_cell::IrqCell;
 use twocan_core::split::{Rx, RxIrq, State, StatusIrq, Tx, TxIrq};
-use twocan_core::{FifoQueue, Mmio};
+use twocan_core::{FifoQueue, Registers};
 
 /// Receive ring per FIFO, transmit queue and completion ring sizes of the examples.
 pub const RX: usize = 32;
@@ -17,28 +18,30 @@ pub const COMPLETIONS: usize = 8;
 
 /// A transmit queue in request order (`TXFP = 1`, the driver's default).
 pub type Queue = FifoQueue<TX>;
-/// The shared state of an instance with registers `R` and filter registers `F`.
-pub type CanState<F = Mmio> = State<BxCan<Mmio, F>, RX, Queue, RX, COMPLETIONS>;
+/// The shared state of an instance with registers `R` and filter registers `F` (a
+/// whole block by default; `ControlRegs` and `&'static FilterRegs` for CAN1 and CAN2
+/// sharing CAN1's filters).
+pub type CanState<R = CanRegs, F = CanRegs> = State<BxCan<R, F>, RX, Queue, RX, COMPLETIONS>;
 /// The transmit half.
-pub type CanTxHalf<F = Mmio> = Tx<'static, BxCan<Mmio, F>, RX, Queue, RX, COMPLETIONS>;
+pub type CanTxHalf<R = CanRegs, F = CanRegs> = Tx<'static, BxCan<R, F>, RX, Queue, RX, COMPLETIONS>;
 /// The receive half.
-pub type CanRxHalf<F = Mmio> = Rx<'static, BxCan<Mmio, F>, RX, Queue, RX, COMPLETIONS>;
+pub type CanRxHalf<R = CanRegs, F = CanRegs> = Rx<'static, BxCan<R, F>, RX, Queue, RX, COMPLETIONS>;
 
 /// The interrupt handles of one bxCAN instance.
-pub struct Vectors<F: twocan_core::Registers + 'static = Mmio> {
-    tx: IrqCell<TxIrq<'static, BxCan<Mmio, F>, RX, Queue, RX, COMPLETIONS>>,
-    rx0: IrqCell<RxIrq<'static, BxCan<Mmio, F>, RX, Queue, RX, COMPLETIONS>>,
-    rx1: IrqCell<RxIrq<'static, BxCan<Mmio, F>, RX, Queue, RX, COMPLETIONS>>,
-    sce: IrqCell<StatusIrq<'static, BxCan<Mmio, F>, RX, Queue, RX, COMPLETIONS>>,
+pub struct Vectors<R: Registers + 'static = CanRegs, F: Registers + 'static = CanRegs> {
+    tx: IrqCell<TxIrq<'static, BxCan<R, F>, RX, Queue, RX, COMPLETIONS>>,
+    rx0: IrqCell<RxIrq<'static, BxCan<R, F>, RX, Queue, RX, COMPLETIONS>>,
+    rx1: IrqCell<RxIrq<'static, BxCan<R, F>, RX, Queue, RX, COMPLETIONS>>,
+    sce: IrqCell<StatusIrq<'static, BxCan<R, F>, RX, Queue, RX, COMPLETIONS>>,
 }
 
-impl<F: twocan_core::Registers + 'static> Default for Vectors<F> {
+impl<R: Registers + 'static, F: Registers + 'static> Default for Vectors<R, F> {
     fn default() -> Self {
         Self::new()
     }
 }
 
-impl<F: twocan_core::Registers + 'static> Vectors<F> {
+impl<R: Registers + 'static, F: Registers + 'static> Vectors<R, F> {
     /// Empty: the vectors do nothing until `start` fills them.
     pub const fn new() -> Self {
         Vectors {
@@ -74,12 +77,12 @@ impl<F: twocan_core::Registers + 'static> Vectors<F> {
 /// `irqs` (TX, RX0, RX1, SCE). Returns the thread-side halves; `None` when `state` was
 /// split already.
 #[cfg(target_os = "none")]
-pub fn start<F: twocan_core::Registers + Sync + 'static>(
-    state: &'static CanState<F>,
-    vectors: &'static Vectors<F>,
-    hw: BxCan<Mmio, F>,
+pub fn start<R: Registers + Sync + 'static, F: Registers + Sync + 'static>(
+    state: &'static CanState<R, F>,
+    vectors: &'static Vectors<R, F>,
+    hw: BxCan<R, F>,
     irqs: [stm32f7xx_hal::pac::Interrupt; 4],
-) -> Option<(CanTxHalf<F>, CanRxHalf<F>)> {
+) -> Option<(CanTxHalf<R, F>, CanRxHalf<R, F>)> {
     let parts = state.split(hw).ok()?;
     let put = vectors.tx.put(parts.tx_irq).is_ok()
         && vectors.rx0.put(parts.rx0_irq).is_ok()

@@ -10,14 +10,15 @@
 
 use twocan_core::irq_cell::IrqCell;
 use twocan_core::split::{Rx, RxIrq, State, StatusIrq, Tx, TxIrq};
-use twocan_core::{FifoQueue, Mmio};
+use twocan_core::FifoQueue;
+use twocan_flexcan::regs::FlexCanRegs;
 use twocan_flexcan::{FlexCanHw, RECEIVE_BUFFER_SIZE, TRANSMIT_BUFFER_SIZE};
 
 /// Completions kept for the thread side.
 pub const COMPLETIONS: usize = 8;
 
 /// The controller on target registers.
-pub type Hw = FlexCanHw<Mmio>;
+pub type Hw = FlexCanHw<FlexCanRegs>;
 /// ACAN's buffer sizes: receive 32, transmit 16 (ACAN table 7).
 pub type Queue = FifoQueue<TRANSMIT_BUFFER_SIZE>;
 /// The shared state a `static` holds.

@@ -22,17 +22,25 @@ mod firmware {
     use critical_section::Mutex;
     use stm32f7xx_hal::pac::interrupt;
     use twocan_app::{App, AppStats};
+    use twocan_bxcan::regs::{ControlRegs, FilterRegs};
     use twocan_bxcan::{regs, Can, Config, FifoPolicy, Recovery};
-    use twocan_core::Mmio;
     use twocan_stm32f7::board::BIT_RATE;
     use twocan_stm32f7::can::{self, CanState, Vectors};
     use twocan_stm32f7::rt::{self, CAN_BLINKS};
     use twocan_stm32f7::time::{self, Every};
 
-    static CAN1: CanState = CanState::new();
-    static CAN1_VECTORS: Vectors = Vectors::new();
-    static CAN2: CanState = CanState::new();
-    static CAN2_VECTORS: Vectors = Vectors::new();
+    /// CAN1's filter block, shared by both controllers (RM0410 §40.9.4): one owner, lent
+    /// to CAN1 and CAN2; its writes are made under a critical section.
+    // SAFETY: CAN1's filter registers (RM0410 §2.2.2 CAN1 block + 0x200..0x320); no other
+    // handle of this firmware reaches them (CAN1's own handle stops at 0x200).
+    static FILTERS: FilterRegs = unsafe { FilterRegs::new(regs::CAN1_BASE) };
+
+    type Shared = CanState<ControlRegs, &'static FilterRegs>;
+    type SharedVectors = Vectors<ControlRegs, &'static FilterRegs>;
+    static CAN1: Shared = Shared::new();
+    static CAN1_VECTORS: SharedVectors = SharedVectors::new();
+    static CAN2: Shared = Shared::new();
+    static CAN2_VECTORS: SharedVectors = SharedVectors::new();
 
     /// The counters of node 1 (CAN1) and node 2 (CAN2), copied after each step
     /// (`None` before the first).
@@ -84,18 +92,17 @@ mod firmware {
         let mut node1 = App::new(1, 2);
         let mut node2 = App::new(2, 1);
 
-        // SAFETY: `boot` clocked CAN1 and CAN2 and dropped their PAC singletons. CAN1's
-        // block is reached twice: by CAN1's controller, and by CAN2's for the shared
-        // filter registers only; filters are written here, one controller after the
-        // other, before any interrupt is unmasked.
-        let (can1_regs, can2_regs, can2_filters) = unsafe {
+        // SAFETY: `boot` clocked CAN1 and CAN2 and dropped their PAC singletons; these
+        // are their control and mailbox registers (offsets below 0x200), one handle
+        // each. The filter block is the shared `FILTERS`.
+        let (can1_regs, can2_regs) = unsafe {
             (
-                Mmio::new(regs::CAN1_BASE),
-                Mmio::new(regs::CAN2_BASE),
-                Mmio::new(regs::CAN1_BASE),
+                ControlRegs::new(regs::CAN1_BASE),
+                ControlRegs::new(regs::CAN2_BASE),
             )
         };
-        let mut init1 = Can::can1(can1_regs, &config1).unwrap_or_else(|_| rt::halt(CAN_BLINKS));
+        let mut init1 =
+            Can::can1_dual(can1_regs, &FILTERS, &config1).unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         let plan1 = init1
             .can()
             .plan(&node1.filters(), FifoPolicy::Fifo0)
@@ -104,7 +111,7 @@ mod firmware {
             rt::halt(CAN_BLINKS);
         }
         let mut init2 =
-            Can::can2(can2_regs, can2_filters, &base).unwrap_or_else(|_| rt::halt(CAN_BLINKS));
+            Can::can2(can2_regs, &FILTERS, &base).unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         let plan2 = init2
             .can()
             .plan(&node2.filters(), FifoPolicy::Fifo1)

@@ -13,7 +13,7 @@ mod firmware {
 
     use stm32f7xx_hal::pac::interrupt;
     use twocan_bxcan::{regs, Can, Config, FifoPolicy};
-    use twocan_core::{Filter, Frame, Mmio};
+    use twocan_core::{Filter, Frame};
     use twocan_stm32f7::can::{self, CanState, Vectors};
     use twocan_stm32f7::rt::{self, CAN_BLINKS};
     use twocan_stm32f7::time::{self, Every};
@@ -52,7 +52,7 @@ mod firmware {
             .loopback(true);
         // SAFETY: `boot` clocked CAN1 and dropped its PAC singleton; this is the only
         // access to CAN1's registers.
-        let regs = unsafe { Mmio::new(regs::CAN1_BASE) };
+        let regs = unsafe { regs::CanRegs::new(regs::CAN1_BASE) };
         let mut init = Can::can1(regs, &config).unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         let plan = init
             .can()
