@@ -120,6 +120,14 @@ impl Image {
         })
     }
 
+    /// The function symbol containing `address` (Thumb bit ignored), for reports.
+    pub fn function_at(&self, address: u32) -> Option<&Symbol> {
+        self.symbols.iter().find(|s| {
+            let start = s.address & !1;
+            s.size > 0 && address >= start && u64::from(address - start) < s.size
+        })
+    }
+
     /// The symbol whose demangled name ends with `suffix` (`firmware::SENT`).
     pub fn symbol(&self, suffix: &str) -> Option<&Symbol> {
         self.symbols

@@ -187,6 +187,11 @@ pub struct Machine<'a> {
 }
 
 impl Board {
+    /// Address of the last instruction executed.
+    pub fn last_pc(&self) -> u32 {
+        self.pc
+    }
+
     /// Cycles since reset (executed plus slept).
     pub fn cycles(&self) -> u64 {
         self.instructions + self.idle_cycles

@@ -27,6 +27,8 @@ pub fn render(world: &World<'_>) -> String {
             b.profile.core_hz(),
             b.idle_cycles
         );
+        let at = m.image.function_at(b.last_pc()).map_or(String::new(), |s| format!(" in {}", s.name));
+        let _ = writeln!(out, "  last instruction: 0x{:08X}{at}", b.last_pc());
         let mut lines = Vec::new();
         for (e, n) in &b.taken {
             let mut name = exception_name(*e);
