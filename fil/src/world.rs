@@ -15,6 +15,7 @@ use std::cell::RefCell;
 use std::rc::Rc;
 
 use twocan_core::sim::{Bus, Fault, NodeId, Receivers, SimNode};
+use twocan_core::Frame;
 
 use crate::can::Model;
 use crate::elf::Image;
@@ -67,6 +68,29 @@ pub struct Attached {
     state: &'static str,
 }
 
+/// A plain simulated node: optional periodic traffic, its own bit rate.
+#[derive(Debug)]
+pub struct PlainNode {
+    /// Name on the bus.
+    pub name: String,
+    /// Bus node.
+    pub node: NodeId,
+    /// The node (for assertions on what it saw).
+    pub sim: Rc<RefCell<SimNode>>,
+    /// Its bit rate (the bus's unless it is meant to be wrong).
+    pub bit_rate: u32,
+    /// Frames it sends in turn, one per `period_ps`.
+    pub traffic: Vec<Frame>,
+    /// Period of the traffic.
+    pub period_ps: u128,
+    next_ps: u128,
+    sent: usize,
+    checked: bool,
+    /// Found out of tolerance.
+    pub misclocked: bool,
+    state: &'static str,
+}
+
 /// Boards and nodes on one bus.
 pub struct World<'a> {
     /// The boards.
@@ -76,7 +100,7 @@ pub struct World<'a> {
     /// Board controllers on the bus.
     pub attached: Vec<Attached>,
     /// Plain simulated nodes.
-    pub nodes: Vec<(String, NodeId, Rc<RefCell<SimNode>>)>,
+    pub nodes: Vec<PlainNode>,
     /// Error-state changes.
     pub changes: Vec<StateChange>,
     /// Simulated time reached (ps).
@@ -135,12 +159,73 @@ impl<'a> World<'a> {
         Ok(index)
     }
 
-    /// Adds a plain simulated node (traffic or faults).
-    pub fn add_node(&mut self, name: &str, node: SimNode) -> Rc<RefCell<SimNode>> {
+    /// Adds a plain simulated node sending `traffic` in turn every `period_ps` (none if
+    /// empty) at `bit_rate`.
+    pub fn add_node(
+        &mut self,
+        name: &str,
+        node: SimNode,
+        bit_rate: u32,
+        traffic: Vec<Frame>,
+        period_ps: u128,
+    ) -> Rc<RefCell<SimNode>> {
         let shared = node.shared();
         let id = self.bus.attach(name, shared.clone());
-        self.nodes.push((name.to_string(), id, shared.clone()));
+        self.nodes.push(PlainNode {
+            name: name.to_string(),
+            node: id,
+            sim: shared.clone(),
+            bit_rate,
+            traffic,
+            period_ps: period_ps.max(1),
+            next_ps: period_ps.max(1),
+            sent: 0,
+            checked: false,
+            misclocked: false,
+            state: "error-active",
+        });
         shared
+    }
+
+    fn queue_traffic(&mut self, t: u128) {
+        for n in &mut self.nodes {
+            while !n.traffic.is_empty() && n.next_ps <= t {
+                let f = n.traffic[n.sent % n.traffic.len()];
+                n.sim.borrow_mut().send(f);
+                n.sent += 1;
+                n.next_ps += n.period_ps;
+            }
+        }
+    }
+
+    /// Arms the faults of a node out of tolerance: every frame it receives gives it a
+    /// stuff error, every frame it sends gives the others one.
+    fn arm_mismatch(&mut self, me: NodeId) {
+        self.bus.inject_from(
+            me,
+            u32::MAX,
+            Fault::Stuff {
+                who: Receivers::All,
+                at: None,
+            },
+        );
+        let others: Vec<NodeId> = self
+            .attached
+            .iter()
+            .map(|o| o.node)
+            .chain(self.nodes.iter().map(|n| n.node))
+            .filter(|n| *n != me)
+            .collect();
+        for o in others {
+            self.bus.inject_from(
+                o,
+                u32::MAX,
+                Fault::Stuff {
+                    who: Receivers::Node(me),
+                    at: None,
+                },
+            );
+        }
     }
 
     /// Runs every board and the bus for `ps` picoseconds more.
@@ -152,6 +237,7 @@ impl<'a> World<'a> {
                 m.run_until(t);
             }
             self.check_bit_rates();
+            self.queue_traffic(t);
             let bits = (t * u128::from(self.bus.bit_rate()) / 1_000_000_000_000) as u64;
             while self.bus.step_until(bits).is_some() {}
             for m in &mut self.machines {
@@ -192,31 +278,19 @@ impl<'a> World<'a> {
             if (rate as f64 - nominal).abs() / nominal > TOLERANCE {
                 self.attached[i].misclocked = true;
                 let me = self.attached[i].node;
-                self.bus.inject_from(
-                    me,
-                    u32::MAX,
-                    Fault::Stuff {
-                        who: Receivers::All,
-                        at: None,
-                    },
-                );
-                let others: Vec<NodeId> = self
-                    .attached
-                    .iter()
-                    .map(|o| o.node)
-                    .chain(self.nodes.iter().map(|n| n.1))
-                    .filter(|n| *n != me)
-                    .collect();
-                for o in others {
-                    self.bus.inject_from(
-                        o,
-                        u32::MAX,
-                        Fault::Stuff {
-                            who: Receivers::Node(me),
-                            at: None,
-                        },
-                    );
-                }
+                self.arm_mismatch(me);
+            }
+        }
+        for i in 0..self.nodes.len() {
+            if self.nodes[i].checked {
+                continue;
+            }
+            self.nodes[i].checked = true;
+            let rate = f64::from(self.nodes[i].bit_rate);
+            if (rate - nominal).abs() / nominal > TOLERANCE {
+                self.nodes[i].misclocked = true;
+                let me = self.nodes[i].node;
+                self.arm_mismatch(me);
             }
         }
     }
@@ -236,6 +310,19 @@ impl<'a> World<'a> {
                 a.state = s;
             }
         }
+        for n in &mut self.nodes {
+            let c = n.sim.borrow().counters();
+            let s = error_state(c.tec, c.rec);
+            if s != n.state {
+                self.changes.push(StateChange {
+                    at_us,
+                    node: n.name.clone(),
+                    from: n.state,
+                    to: s,
+                });
+                n.state = s;
+            }
+        }
     }
 
     /// Whether every board ran without a fault, stuck interrupt or halt.
@@ -248,6 +335,8 @@ impl<'a> World<'a> {
 
     /// The bus in candump format.
     pub fn candump(&self) -> String {
-        self.bus.trace().candump_string("can0")
+        let mut out = Vec::new();
+        let _ = self.bus.trace().write_candump_with_errors(&mut out, "can0");
+        String::from_utf8_lossy(&out).into_owned()
     }
 }
