@@ -15,7 +15,7 @@ use twocan_fil::profile::{self, BOARDS};
 use twocan_fil::report;
 use twocan_fil::world::World;
 
-const USAGE: &str = "usage: can-fil --board BOARD ELF [--board BOARD ELF ...] --seconds S [--bitrate B] [--trace FILE] [--quantum-us Q]\nboards: teensy32 teensy35 teensy36 nucleo-f767zi disco-f746g";
+const USAGE: &str = "usage: can-fil --board BOARD ELF [--board BOARD ELF ...] --seconds S [--bitrate B] [--trace FILE] [--quantum-us Q] [--traffic ID,PERIOD_MS[,BITRATE] ...]\nboards: teensy32 teensy35 teensy36 nucleo-f767zi disco-f746g";
 
 struct Args {
     boards: Vec<(String, String)>,
@@ -23,6 +23,7 @@ struct Args {
     bitrate: u32,
     trace: Option<String>,
     quantum_us: u64,
+    traffic: Vec<(u32, u64, u32)>,
 }
 
 fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
@@ -32,6 +33,7 @@ fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
         bitrate: 500_000,
         trace: None,
         quantum_us: 20,
+        traffic: Vec::new(),
     };
     let mut seconds = false;
     while let Some(arg) = it.next() {
@@ -64,6 +66,28 @@ fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
                 if a.quantum_us == 0 {
                     return Err("--quantum-us must be at least 1".into());
                 }
+            }
+            "--traffic" => {
+                // ID,PERIOD_MS[,BITRATE]: a plain node sending a standard data frame.
+                let v = value("ID,PERIOD_MS[,BITRATE]")?;
+                let parts: Vec<&str> = v.split(',').collect();
+                let bad = || format!("--traffic {v:?}: expected ID,PERIOD_MS[,BITRATE]");
+                if !(2..=3).contains(&parts.len()) {
+                    return Err(bad());
+                }
+                let id = u32::from_str_radix(parts[0].trim_start_matches("0x"), 16).map_err(|_| bad())?;
+                if id > 0x7FF {
+                    return Err(format!("--traffic: 0x{id:X} is not a standard identifier"));
+                }
+                let period: u64 = parts[1].parse().map_err(|_| bad())?;
+                if period == 0 {
+                    return Err("--traffic: period must be at least 1 ms".into());
+                }
+                let rate = match parts.get(2) {
+                    Some(r) => r.parse().map_err(|_| bad())?,
+                    None => 0,
+                };
+                a.traffic.push((id, period, rate));
             }
             "-h" | "--help" => return Err(String::new()),
             other => return Err(format!("unexpected argument {other:?}")),
@@ -110,6 +134,23 @@ fn main() -> ExitCode {
             eprintln!("can-fil: {board}: {e}");
             return ExitCode::from(2);
         }
+    }
+    for (n, (id, period, rate)) in args.traffic.iter().enumerate() {
+        let frame = match twocan_core::Frame::standard(*id as u16, &[n as u8, 0x55]) {
+            Ok(f) => f,
+            Err(e) => {
+                eprintln!("can-fil: --traffic 0x{id:X}: {e:?}");
+                return ExitCode::from(2);
+            }
+        };
+        let rate = if *rate == 0 { args.bitrate } else { *rate };
+        world.add_node(
+            &format!("node{}", n + 1),
+            twocan_core::sim::SimNode::new(),
+            rate,
+            vec![frame],
+            u128::from(*period) * 1_000_000_000,
+        );
     }
     let start = std::time::Instant::now();
     world.run_for((args.seconds * 1e12) as u128);

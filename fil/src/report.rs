@@ -86,6 +86,16 @@ pub fn render(world: &World<'_>) -> String {
             }
         }
     }
+    for n in &world.nodes {
+        let s = world.bus.node_stats(n.node).unwrap_or_default();
+        let c = n.sim.borrow().counters();
+        let _ = writeln!(
+            out,
+            "\n[{}] plain node, {} bit/s{}: sent {}, received {}, tx errors {}, rx errors {}, TEC {} REC {}",
+            n.name, n.bit_rate, if n.misclocked { " (OUT OF TOLERANCE)" } else { "" },
+            s.sent, s.received, s.tx_errors, s.rx_errors, c.tec, c.rec
+        );
+    }
     for c in &world.changes {
         let _ = writeln!(out, "error state: {} {} -> {} at {} us", c.node, c.from, c.to, c.at_us);
     }
