@@ -41,7 +41,14 @@ impl Model {
         match self {
             Model::FlexCan(m) => {
                 let i = m.irq();
-                vec![i.message_buffer, i.bus_off, i.error, i.warning, false, false]
+                vec![
+                    i.message_buffer,
+                    i.bus_off,
+                    i.error,
+                    i.warning,
+                    false,
+                    false,
+                ]
             }
             Model::BxCan(m) => {
                 let l = m.irq_lines();
@@ -81,7 +88,11 @@ impl Model {
                 let pseg1 = u64::from((ctrl1 >> 19) & 7) + 1;
                 let pseg2 = u64::from((ctrl1 >> 16) & 7) + 1;
                 let propseg = u64::from(ctrl1 & 7) + 1;
-                let clk = if ctrl1 & (1 << 13) != 0 { bus_hz } else { can_hz };
+                let clk = if ctrl1 & (1 << 13) != 0 {
+                    bus_hz
+                } else {
+                    can_hz
+                };
                 let tq = 1 + propseg + pseg1 + pseg2;
                 (clk > 0).then(|| clk / (presdiv * tq))
             }

@@ -167,10 +167,22 @@ pub struct Board {
 }
 
 const S_REGS: [RegisterARM; 16] = [
-    RegisterARM::S0, RegisterARM::S1, RegisterARM::S2, RegisterARM::S3,
-    RegisterARM::S4, RegisterARM::S5, RegisterARM::S6, RegisterARM::S7,
-    RegisterARM::S8, RegisterARM::S9, RegisterARM::S10, RegisterARM::S11,
-    RegisterARM::S12, RegisterARM::S13, RegisterARM::S14, RegisterARM::S15,
+    RegisterARM::S0,
+    RegisterARM::S1,
+    RegisterARM::S2,
+    RegisterARM::S3,
+    RegisterARM::S4,
+    RegisterARM::S5,
+    RegisterARM::S6,
+    RegisterARM::S7,
+    RegisterARM::S8,
+    RegisterARM::S9,
+    RegisterARM::S10,
+    RegisterARM::S11,
+    RegisterARM::S12,
+    RegisterARM::S13,
+    RegisterARM::S14,
+    RegisterARM::S15,
 ];
 
 const PERIPH_BASE: u64 = 0x4000_0000;
@@ -313,7 +325,9 @@ fn execution_priority(uc: &Unicorn<'_, Board>) -> i32 {
     let primask = reg(uc, RegisterARM::PRIMASK) & 1 != 0;
     let faultmask = reg(uc, RegisterARM::FAULTMASK) & 1 != 0;
     let basepri = reg(uc, RegisterARM::BASEPRI) as u8;
-    uc.get_data().nvic.execution_priority(primask, faultmask, basepri)
+    uc.get_data()
+        .nvic
+        .execution_priority(primask, faultmask, basepri)
 }
 
 /// Exception entry (B1.5.6) with `ret` as the stacked return address.
@@ -383,7 +397,10 @@ fn enter(uc: &mut Unicorn<'_, Board>, e: u32, ret: u32) -> Result<(), String> {
         b.stuck_run.1 = count + 1;
         if count + 1 == STUCK_ENTRIES {
             let at_ns = b.time_ns();
-            b.stuck.push(StuckIrq { exception: e, at_ns });
+            b.stuck.push(StuckIrq {
+                exception: e,
+                at_ns,
+            });
         }
     } else {
         b.stuck_run = (e, 1, b.thread_instructions);
@@ -588,7 +605,11 @@ impl<'a> Machine<'a> {
         // Memory: flash and RAM from the profile; the load image into every region that
         // holds it (and into the aliases).
         for m in &memory {
-            let perms = if m.writable { Prot::ALL } else { Prot::READ | Prot::EXEC };
+            let perms = if m.writable {
+                Prot::ALL
+            } else {
+                Prot::READ | Prot::EXEC
+            };
             uc.mem_map(u64::from(m.base), u64::from(m.size), perms)
                 .map_err(|e| format!("map {}: {e:?}", m.name))?;
         }
@@ -699,22 +720,32 @@ impl<'a> Machine<'a> {
                     pc,
                     None,
                 ),
-                other => halt(uc, format!("unsupported CPU exception {other} at 0x{pc:08X}")),
+                other => halt(
+                    uc,
+                    format!("unsupported CPU exception {other} at 0x{pc:08X}"),
+                ),
             }
         })
         .map_err(|e| format!("intr hook: {e:?}"))?;
 
-        uc.add_mem_hook(HookType::MEM_INVALID, 1, 0, |uc, kind, addr, _size, _value| {
-            let b = uc.get_data_mut();
-            let what = match kind {
-                MemType::FETCH_UNMAPPED | MemType::FETCH_PROT => "instruction fetch from unmapped space",
-                MemType::WRITE_PROT => "write to read-only memory",
-                MemType::WRITE_UNMAPPED => "write to unmapped space",
-                _ => "read from unmapped space",
-            };
-            b.bus_error(format!("BusFault: {what}"), addr as u32);
-            false
-        })
+        uc.add_mem_hook(
+            HookType::MEM_INVALID,
+            1,
+            0,
+            |uc, kind, addr, _size, _value| {
+                let b = uc.get_data_mut();
+                let what = match kind {
+                    MemType::FETCH_UNMAPPED | MemType::FETCH_PROT => {
+                        "instruction fetch from unmapped space"
+                    }
+                    MemType::WRITE_PROT => "write to read-only memory",
+                    MemType::WRITE_UNMAPPED => "write to unmapped space",
+                    _ => "read from unmapped space",
+                };
+                b.bus_error(format!("BusFault: {what}"), addr as u32);
+                false
+            },
+        )
         .map_err(|e| format!("mem hook: {e:?}"))?;
 
         let mut machine = Machine { uc, image };
@@ -782,7 +813,13 @@ impl<'a> Machine<'a> {
             let pending = self.uc.get_data_mut().pending_fault.take();
             if let Some((kind, fpc, addr)) = pending {
                 let is_fetch = kind.contains("fetch");
-                take_fault(&mut self.uc, kind, exc::BUS_FAULT, fpc, (!is_fetch).then_some(addr));
+                take_fault(
+                    &mut self.uc,
+                    kind,
+                    exc::BUS_FAULT,
+                    fpc,
+                    (!is_fetch).then_some(addr),
+                );
                 continue;
             }
             if let Err(e) = result {
@@ -804,7 +841,10 @@ impl<'a> Machine<'a> {
             // WFI wakes on an exception that would preempt with PRIMASK = 0.
             let faultmask = reg(&self.uc, RegisterARM::FAULTMASK) & 1 != 0;
             let basepri = reg(&self.uc, RegisterARM::BASEPRI) as u8;
-            self.uc.get_data().nvic.execution_priority(false, faultmask, basepri)
+            self.uc
+                .get_data()
+                .nvic
+                .execution_priority(false, faultmask, basepri)
         };
         let b = self.uc.get_data_mut();
         if b.nvic.next_to_take(wake_prio).is_some() {
@@ -851,7 +891,13 @@ fn semihosting_or_fault(uc: &mut Unicorn<'_, Board>, pc: u32) {
         // A breakpoint with no debugger attached escalates to HardFault (C1.7).
         let prio = execution_priority(uc);
         let _ = prio;
-        take_fault(uc, "BKPT without debugger".into(), exc::USAGE_FAULT, pc, None);
+        take_fault(
+            uc,
+            "BKPT without debugger".into(),
+            exc::USAGE_FAULT,
+            pc,
+            None,
+        );
         return;
     }
     let op = reg(uc, RegisterARM::R0);
@@ -873,14 +919,18 @@ fn semihosting_or_fault(uc: &mut Unicorn<'_, Board>, pc: u32) {
                 s.push(b[0]);
                 a += 1;
             }
-            uc.get_data_mut().console.push_str(&String::from_utf8_lossy(&s));
+            uc.get_data_mut()
+                .console
+                .push_str(&String::from_utf8_lossy(&s));
         }
         0x05 => {
             // SYS_WRITE: [handle, buffer, length]; returns bytes not written.
             let words: Vec<u32> = (0..3).filter_map(|i| read_u32(uc, arg + 4 * i)).collect();
             if let [_, buf, len] = words[..] {
                 if let Ok(b) = uc.mem_read_as_vec(u64::from(buf), len as usize) {
-                    uc.get_data_mut().console.push_str(&String::from_utf8_lossy(&b));
+                    uc.get_data_mut()
+                        .console
+                        .push_str(&String::from_utf8_lossy(&b));
                 }
             }
         }
@@ -897,14 +947,19 @@ fn semihosting_or_fault(uc: &mut Unicorn<'_, Board>, pc: u32) {
 
 fn periph_read(uc: &mut Unicorn<'_, Board>, addr: u32, size: usize) -> u64 {
     let b = uc.get_data_mut();
-    if let Some(i) = b.cans.iter().position(|p| {
-        addr >= p.instance.base && addr < p.instance.base + p.instance.size
-    }) {
+    if let Some(i) = b
+        .cans
+        .iter()
+        .position(|p| addr >= p.instance.base && addr < p.instance.base + p.instance.size)
+    {
         let gate = b.cans[i].instance.gate;
         if !b.profile.gate_open(gate) {
             let g = b.profile.gate_name(gate);
             let n = b.cans[i].instance.name;
-            b.bus_error(format!("BusFault: {n} read with its clock gated ({g} = 0)"), addr);
+            b.bus_error(
+                format!("BusFault: {n} read with its clock gated ({g} = 0)"),
+                addr,
+            );
             b.stop_now();
             let _ = uc.emu_stop();
             return 0;
@@ -923,7 +978,10 @@ fn periph_read(uc: &mut Unicorn<'_, Board>, addr: u32, size: usize) -> u64 {
             0
         }
         Access::Gated { peripheral, gate } => {
-            b.bus_error(format!("BusFault: {peripheral} read with its clock gated ({gate} = 0)"), addr);
+            b.bus_error(
+                format!("BusFault: {peripheral} read with its clock gated ({gate} = 0)"),
+                addr,
+            );
             b.stop_now();
             let _ = uc.emu_stop();
             0
@@ -943,14 +1001,19 @@ fn periph_read(uc: &mut Unicorn<'_, Board>, addr: u32, size: usize) -> u64 {
 
 fn periph_write(uc: &mut Unicorn<'_, Board>, addr: u32, size: usize, value: u32) {
     let b = uc.get_data_mut();
-    if let Some(i) = b.cans.iter().position(|p| {
-        addr >= p.instance.base && addr < p.instance.base + p.instance.size
-    }) {
+    if let Some(i) = b
+        .cans
+        .iter()
+        .position(|p| addr >= p.instance.base && addr < p.instance.base + p.instance.size)
+    {
         let gate = b.cans[i].instance.gate;
         if !b.profile.gate_open(gate) {
             let g = b.profile.gate_name(gate);
             let n = b.cans[i].instance.name;
-            b.bus_error(format!("BusFault: {n} written with its clock gated ({g} = 0)"), addr);
+            b.bus_error(
+                format!("BusFault: {n} written with its clock gated ({g} = 0)"),
+                addr,
+            );
             b.stop_now();
             let _ = uc.emu_stop();
             return;
@@ -973,7 +1036,10 @@ fn periph_write(uc: &mut Unicorn<'_, Board>, addr: u32, size: usize, value: u32)
         }
         Access::Unknown { peripheral } => b.note_unknown(addr, peripheral, "write"),
         Access::Gated { peripheral, gate } => {
-            b.bus_error(format!("BusFault: {peripheral} written with its clock gated ({gate} = 0)"), addr);
+            b.bus_error(
+                format!("BusFault: {peripheral} written with its clock gated ({gate} = 0)"),
+                addr,
+            );
             b.stop_now();
             let _ = uc.emu_stop();
         }
@@ -1053,7 +1119,9 @@ fn ppb_read_word(uc: &mut Unicorn<'_, Board>, addr: u32) -> u32 {
         0xE000_ED14 => b.scb.ccr,
         0xE000_ED18..=0xE000_ED20 => {
             let first = 4 + (addr - 0xE000_ED18);
-            (0..4).fold(0, |v, i| v | u32::from(b.nvic.priority_byte(first + i)) << (8 * i))
+            (0..4).fold(0, |v, i| {
+                v | u32::from(b.nvic.priority_byte(first + i)) << (8 * i)
+            })
         }
         0xE000_ED24 => {
             let f = b.nvic.fault_enabled;
@@ -1085,15 +1153,15 @@ fn ppb_write(uc: &mut Unicorn<'_, Board>, addr: u32, size: usize, value: u32) {
     let b = uc.get_data_mut();
     let word_addr = addr & !3;
     // Byte writes are natural for IPR/SHPR; other registers are word registers.
-    if (0xE000_E400..=0xE000_E5EF).contains(&addr) || (0xE000_ED18..=0xE000_ED23).contains(&addr)
-    {
+    if (0xE000_E400..=0xE000_E5EF).contains(&addr) || (0xE000_ED18..=0xE000_ED23).contains(&addr) {
         let first = if addr >= 0xE000_ED18 {
             4 + (addr - 0xE000_ED18)
         } else {
             16 + (addr - 0xE000_E400)
         };
         for i in 0..size as u32 {
-            b.nvic.set_priority_byte(first + i, (value >> (8 * i)) as u8);
+            b.nvic
+                .set_priority_byte(first + i, (value >> (8 * i)) as u8);
         }
         b.check_irq = true;
         return;
@@ -1107,7 +1175,11 @@ fn ppb_write(uc: &mut Unicorn<'_, Board>, addr: u32, size: usize, value: u32) {
             if !was && value & 1 != 0 {
                 let d = b.systick_divider();
                 let cvr = u64::from(b.systick.cvr_stopped);
-                let first = if cvr == 0 { u64::from(b.systick.rvr) + 1 } else { cvr };
+                let first = if cvr == 0 {
+                    u64::from(b.systick.rvr) + 1
+                } else {
+                    cvr
+                };
                 b.systick.wrap_at = cycles + first * d;
             } else if was && value & 1 == 0 {
                 let d = b.systick_divider();
@@ -1176,8 +1248,9 @@ fn ppb_write(uc: &mut Unicorn<'_, Board>, addr: u32, size: usize, value: u32) {
                     halt(uc, "reset requested (AIRCR.SYSRESETREQ)".into());
                 }
             } else {
-                b.findings
-                    .push(format!("AIRCR written without VECTKEY (0x{value:08X}): ignored"));
+                b.findings.push(format!(
+                    "AIRCR written without VECTKEY (0x{value:08X}): ignored"
+                ));
             }
         }
         0xE000_ED10 => b.scb.scr = value & 0x16,
@@ -1236,6 +1309,8 @@ pub fn unknown_report(b: &Board) -> Vec<String> {
     b.unknown
         .iter()
         .filter(|(a, _)| seen.insert(**a))
-        .map(|(a, (pc, p, dir))| format!("{dir} of unknown {p} register 0x{a:08X} (first at PC 0x{pc:08X})"))
+        .map(|(a, (pc, p, dir))| {
+            format!("{dir} of unknown {p} register 0x{a:08X} (first at PC 0x{pc:08X})")
+        })
         .collect()
 }

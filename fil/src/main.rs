@@ -49,7 +49,9 @@ fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
             }
             "--seconds" => {
                 let v = value("a number")?;
-                a.seconds = v.parse().map_err(|_| format!("--seconds {v:?}: not a number"))?;
+                a.seconds = v
+                    .parse()
+                    .map_err(|_| format!("--seconds {v:?}: not a number"))?;
                 if !(a.seconds > 0.0 && a.seconds <= 3600.0) {
                     return Err("--seconds must be in (0, 3600]".into());
                 }
@@ -57,12 +59,16 @@ fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
             }
             "--bitrate" => {
                 let v = value("bits per second")?;
-                a.bitrate = v.parse().map_err(|_| format!("--bitrate {v:?}: not a number"))?;
+                a.bitrate = v
+                    .parse()
+                    .map_err(|_| format!("--bitrate {v:?}: not a number"))?;
             }
             "--trace" => a.trace = Some(value("a file")?),
             "--quantum-us" => {
                 let v = value("microseconds")?;
-                a.quantum_us = v.parse().map_err(|_| format!("--quantum-us {v:?}: not a number"))?;
+                a.quantum_us = v
+                    .parse()
+                    .map_err(|_| format!("--quantum-us {v:?}: not a number"))?;
                 if a.quantum_us == 0 {
                     return Err("--quantum-us must be at least 1".into());
                 }
@@ -75,7 +81,8 @@ fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
                 if !(2..=3).contains(&parts.len()) {
                     return Err(bad());
                 }
-                let id = u32::from_str_radix(parts[0].trim_start_matches("0x"), 16).map_err(|_| bad())?;
+                let id = u32::from_str_radix(parts[0].trim_start_matches("0x"), 16)
+                    .map_err(|_| bad())?;
                 if id > 0x7FF {
                     return Err(format!("--traffic: 0x{id:X} is not a standard identifier"));
                 }

@@ -75,7 +75,14 @@ impl Nvic {
             fault_enabled: [false; 3],
         };
         // System exceptions other than the configurable-enable faults are always enabled.
-        for e in [exc::NMI, exc::HARD_FAULT, exc::SVCALL, 12, exc::PENDSV, exc::SYSTICK] {
+        for e in [
+            exc::NMI,
+            exc::HARD_FAULT,
+            exc::SVCALL,
+            12,
+            exc::PENDSV,
+            exc::SYSTICK,
+        ] {
             n.enabled[e as usize] = true;
         }
         n
@@ -328,17 +335,27 @@ mod tests {
             n.set_irq_enabled(i, true);
             n.set_pending(16 + i, true);
         }
-        assert_eq!(n.next_to_take(THREAD_PRIORITY), Some(18), "0x20 before 0x40");
+        assert_eq!(
+            n.next_to_take(THREAD_PRIORITY),
+            Some(18),
+            "0x20 before 0x40"
+        );
         assert_eq!(n.execution_priority(true, false, 0), 0);
         assert_eq!(n.next_to_take(0), None, "PRIMASK masks all configurable");
-        assert_eq!(n.next_to_take(n.execution_priority(false, false, 0x30)), Some(18));
+        assert_eq!(
+            n.next_to_take(n.execution_priority(false, false, 0x30)),
+            Some(18)
+        );
         n.activate(18);
         assert_eq!(n.execution_priority(false, false, 0), 0x20);
         assert_eq!(n.next_to_take(0x20), None, "0x40 cannot preempt 0x20");
         // PRIGROUP 6: one group bit (bit 7): 0x20 and 0x40 are the same group.
         n.prigroup = 6;
         assert_eq!(n.group(0x40), 0);
-        assert_eq!(n.fault_target(exc::BUS_FAULT, THREAD_PRIORITY), exc::HARD_FAULT);
+        assert_eq!(
+            n.fault_target(exc::BUS_FAULT, THREAD_PRIORITY),
+            exc::HARD_FAULT
+        );
     }
 
     #[test]

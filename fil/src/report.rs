@@ -27,7 +27,10 @@ pub fn render(world: &World<'_>) -> String {
             b.profile.core_hz(),
             b.idle_cycles
         );
-        let at = m.image.function_at(b.last_pc()).map_or(String::new(), |s| format!(" in {}", s.name));
+        let at = m
+            .image
+            .function_at(b.last_pc())
+            .map_or(String::new(), |s| format!(" in {}", s.name));
         let _ = writeln!(out, "  last instruction: 0x{:08X}{at}", b.last_pc());
         let mut lines = Vec::new();
         for (e, n) in &b.taken {
@@ -43,11 +46,21 @@ pub fn render(world: &World<'_>) -> String {
             }
             lines.push(format!("{name}: {n}"));
         }
-        let _ = writeln!(out, "  interrupts taken: {}", if lines.is_empty() { "none".into() } else { lines.join(", ") });
+        let _ = writeln!(
+            out,
+            "  interrupts taken: {}",
+            if lines.is_empty() {
+                "none".into()
+            } else {
+                lines.join(", ")
+            }
+        );
         for a in world.attached.iter().filter(|a| a.board == i) {
             let s = world.bus.node_stats(a.node).unwrap_or_default();
             let (tec, rec) = b.cans[a.port].model.counters();
-            let rate = a.bit_rate.map_or("not on the bus".to_string(), |r| format!("{r} bit/s"));
+            let rate = a
+                .bit_rate
+                .map_or("not on the bus".to_string(), |r| format!("{r} bit/s"));
             let _ = writeln!(
                 out,
                 "  {}: sent {} (+{} internal), received {}, tx errors {}, rx errors {}, TEC {tec} REC {rec}, {rate}{}",
@@ -97,7 +110,11 @@ pub fn render(world: &World<'_>) -> String {
         );
     }
     for c in &world.changes {
-        let _ = writeln!(out, "error state: {} {} -> {} at {} us", c.node, c.from, c.to, c.at_us);
+        let _ = writeln!(
+            out,
+            "error state: {} {} -> {} at {} us",
+            c.node, c.from, c.to, c.at_us
+        );
     }
     out
 }

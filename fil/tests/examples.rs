@@ -29,10 +29,17 @@ fn loopback_frames_come_back_on_every_board() {
         let b = m.board();
         // The 1 ms SysTick ran (3,199 ticks less the start-up time).
         let ticks = b.taken.get(&exc::SYSTICK).copied().unwrap_or(0);
-        assert!((3_100..=3_200).contains(&ticks), "{board}: {ticks} SysTicks");
+        assert!(
+            (3_100..=3_200).contains(&ticks),
+            "{board}: {ticks} SysTicks"
+        );
         // The CAN receive interrupt was taken for each frame.
         let rx_line = b.cans[0].instance.irqs[if board.starts_with("teensy") { 0 } else { 1 }].1;
-        assert!(b.taken.get(&(16 + rx_line)).copied().unwrap_or(0) >= 3, "{board}: {:?}", b.taken);
+        assert!(
+            b.taken.get(&(16 + rx_line)).copied().unwrap_or(0) >= 3,
+            "{board}: {:?}",
+            b.taken
+        );
     }
 }
 
@@ -61,18 +68,27 @@ fn stm32_filters_deliver_exactly_the_expected_identifiers() {
             count(&|id, ext, r| ext && !r && id & 0x1FFF_00FF == 0x18FF_0000),
         ];
         let rejected = count(&|id, ext, _| !ext && id == 0x777);
-        assert!(rejected >= 2, "{board}: the frame no filter accepts was sent");
+        assert!(
+            rejected >= 2,
+            "{board}: the frame no filter accepts was sent"
+        );
         let m = &w.machines[0];
         let hits = m.read_static("firmware::HITS").expect("HITS");
         for (i, want) in expected.iter().enumerate() {
             let got = u32::from_le_bytes(hits[4 * i..4 * i + 4].try_into().unwrap());
             assert!(*want >= 2, "{board}: filter {i} frames sent: {want}");
             // The last frame may still wait in the driver's queue for the next loop.
-            assert!(got == *want || got + 1 == *want, "{board}: filter {i}: {got} of {want}");
+            assert!(
+                got == *want || got + 1 == *want,
+                "{board}: filter {i}: {got} of {want}"
+            );
         }
         assert_eq!(m.read_u32_static("firmware::ERRORS"), Some(0), "{board}");
         let banks = m.read_static("firmware::BANKS").expect("BANKS");
-        assert!(banks.iter().any(|b| *b != 0), "{board}: filter banks assigned");
+        assert!(
+            banks.iter().any(|b| *b != 0),
+            "{board}: filter banks assigned"
+        );
     }
 }
 
@@ -124,8 +140,7 @@ fn teensy_and_stm32_apps_talk_through_the_portable_application() {
         ("teensy32", "disco-f746g"),
         ("teensy35", "nucleo-f767zi"),
     ] {
-        let Some(mut w) = world(500_000, &[(teensy, "teensy-app"), (stm32, "stm32f7-app")])
-        else {
+        let Some(mut w) = world(500_000, &[(teensy, "teensy-app"), (stm32, "stm32f7-app")]) else {
             return;
         };
         w.run_for(secs(1.5));
@@ -138,7 +153,10 @@ fn teensy_and_stm32_apps_talk_through_the_portable_application() {
         assert_app_pair(n2, n1, hb(0x101), stm32);
         // Same application, same schedule: the two nodes count alike.
         assert!(n1.heartbeats.abs_diff(n2.heartbeats) <= 2, "{n1:?} {n2:?}");
-        assert!(n1.measurements.abs_diff(n2.measurements) <= 1, "{n1:?} {n2:?}");
+        assert!(
+            n1.measurements.abs_diff(n2.measurements) <= 1,
+            "{n1:?} {n2:?}"
+        );
         // Once both nodes are on the bus every frame is acknowledged: the only errors
         // are the acknowledge errors of the first node before its peer joined.
         let late_errors = w
@@ -156,7 +174,10 @@ fn teensy_and_stm32_apps_talk_through_the_portable_application() {
 /// chip exchange frames.
 #[test]
 fn two_controllers_of_one_chip_exchange_frames() {
-    for (board, bin) in [("teensy36", "teensy-can0-can1"), ("nucleo-f767zi", "stm32f7-can1-can2")] {
+    for (board, bin) in [
+        ("teensy36", "teensy-can0-can1"),
+        ("nucleo-f767zi", "stm32f7-can1-can2"),
+    ] {
         let Some(mut w) = world(500_000, &[(board, bin)]) else {
             return;
         };

@@ -35,14 +35,26 @@ fn touching_can_registers_with_the_clock_gated_faults_with_the_pc() {
         assert_eq!(b.faults.len(), 1, "{board}: {:?}", b.faults);
         let f = &b.faults[0];
         assert_eq!(f.address, Some(base), "{board}");
-        assert!(reset_range(&w).contains(&f.pc), "{board}: PC 0x{:08X}", f.pc);
+        assert!(
+            reset_range(&w).contains(&f.pc),
+            "{board}: PC 0x{:08X}",
+            f.pc
+        );
         // The instruction at the PC is the load (Thumb LDR immediate, 0x68xx).
         let insn = w.machines[0].read_memory(f.pc, 2).unwrap();
         assert_eq!(insn[1] & 0xF8, 0x68, "{board}: {insn:02X?}");
-        assert_eq!(f.taken_as, Some(exc::HARD_FAULT), "BusFault disabled: escalated");
+        assert_eq!(
+            f.taken_as,
+            Some(exc::HARD_FAULT),
+            "BusFault disabled: escalated"
+        );
         assert!(f.kind.contains("clock gated"), "{}", f.kind);
         assert_eq!(b.taken.get(&exc::HARD_FAULT), Some(&1));
-        assert!(b.console.contains("fault handler"), "{board}: {:?}", b.console);
+        assert!(
+            b.console.contains("fault handler"),
+            "{board}: {:?}",
+            b.console
+        );
         assert!(!b.console.contains("no fault"), "{board}");
     }
 }
@@ -62,7 +74,11 @@ fn an_interrupt_whose_cause_is_never_cleared_is_reported_stuck() {
         assert!(b.faults.is_empty(), "{board}: {:?}", b.faults);
         assert_eq!(b.stuck.len(), 1, "{board}");
         assert_eq!(b.stuck[0].exception, 16 + irq);
-        assert!(b.console.contains("enabling IRQ"), "{board}: {:?}", b.console);
+        assert!(
+            b.console.contains("enabling IRQ"),
+            "{board}: {:?}",
+            b.console
+        );
         assert!(!b.console.contains("back in thread mode"), "{board}");
     }
 }
@@ -104,7 +120,11 @@ fn a_node_at_the_wrong_bit_rate_gives_error_frames_and_error_state_changes() {
                 .count()
         };
         assert_eq!(late(&ok), 0, "{board}: no errors at the right rate");
-        assert!(ok.changes.iter().all(|c| c.at_us < 50_000), "{:?}", ok.changes);
+        assert!(
+            ok.changes.iter().all(|c| c.at_us < 50_000),
+            "{:?}",
+            ok.changes
+        );
 
         // The peer at 250 kbit/s on a 500 kbit/s bus.
         let bad = mismatch(board, bin, 250_000).unwrap();
@@ -127,7 +147,10 @@ fn a_node_at_the_wrong_bit_rate_gives_error_frames_and_error_state_changes() {
         assert_eq!(s.sent, 0, "{board}: {s:?}");
         assert!(s.tx_errors > 0 && s.rx_errors > 0, "{board}: {s:?}");
         // The candump trace shows the error frames.
-        assert!(bad.candump().contains("20000"), "SocketCAN error frames in the trace");
+        assert!(
+            bad.candump().contains("20000"),
+            "SocketCAN error frames in the trace"
+        );
         // No firmware fault: the firmware copes with a bad bus.
         assert!(bad.machines[0].board().faults.is_empty());
     }

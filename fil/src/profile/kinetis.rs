@@ -91,12 +91,12 @@ impl Kinetis {
         regs.write(WDOG + 0x04, 2, 0x004C); // TOVALH
         regs.write(WDOG + 0x06, 2, 0x4B4C); // TOVALL
         regs.write(WDOG + 0x16, 2, 0x0400); // PRESC
-        // MCG: C1 = 0x04 (IREFS, FEI), C2 = 0x80 (LOCRE0) on K20/K64; S computed.
+                                            // MCG: C1 = 0x04 (IREFS, FEI), C2 = 0x80 (LOCRE0) on K20/K64; S computed.
         regs.write(MCG_C1, 1, 0x04);
         regs.write(MCG_C2, 1, 0x80);
         regs.write(MCG + 3, 1, 0x00); // C4: DRST_DRS = 0, DMX32 = 0
-        // SIM gates (reset values per chapter "SIM"): SCGC4 0xF0100030, SCGC5 0x00040182,
-        // SCGC6 0x40000001, SCGC7 0x00000006; CLKDIV1 0x00010000 (flash ÷ 2).
+                                      // SIM gates (reset values per chapter "SIM"): SCGC4 0xF0100030, SCGC5 0x00040182,
+                                      // SCGC6 0x40000001, SCGC7 0x00000006; CLKDIV1 0x00010000 (flash ÷ 2).
         regs.set(SIM + 0x1034, 0xF010_0030);
         regs.set(SIM_SCGC5, 0x0004_0182);
         regs.set(SIM_SCGC6, 0x4000_0001);
@@ -296,9 +296,7 @@ impl Kinetis {
             self.regs.write(addr, size, value);
             return Access::Known(0);
         }
-        let open = self
-            .unlock_window_end
-            .is_some_and(|end| ctx.cycles <= end);
+        let open = self.unlock_window_end.is_some_and(|end| ctx.cycles <= end);
         let allow = self.regs.read(WDOG_STCTRLH, 2) & 0x10 != 0;
         if open && allow {
             self.regs.write(addr, size, value);
@@ -521,7 +519,10 @@ mod tests {
     use super::*;
 
     fn w8(k: &mut Kinetis, a: u32, v: u8) {
-        assert_eq!(k.write(a, 1, u32::from(v), Ctx::default()), Access::Known(0));
+        assert_eq!(
+            k.write(a, 1, u32::from(v), Ctx::default()),
+            Access::Known(0)
+        );
     }
     fn s(k: &mut Kinetis) -> u8 {
         match k.read(MCG_S, 1, Ctx::default()) {

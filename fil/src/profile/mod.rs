@@ -53,7 +53,7 @@ pub struct CanInstance {
     pub gate: (u32, u32),
     /// Controller family.
     pub kind: CanKind,
-    /// Interrupt numbers of the controller's lines, in the order of [`crate::can::Lines`].
+    /// Interrupt numbers of the controller's lines, in the order of [`crate::can::Model::lines`].
     pub irqs: Vec<(&'static str, u32)>,
 }
 

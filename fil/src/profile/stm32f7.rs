@@ -67,7 +67,7 @@ impl Stm32f7 {
         regs.set(RCC + 0x70, 0); // BDCR
         regs.set(RCC + 0x74, 0x0E00_0000); // CSR: reset flags
         regs.set(PWR, 0x0000_C000); // CR1: VOS = scale 1
-        // GPIO reset values (§6.4): MODER A/B have the debug pins in AF.
+                                    // GPIO reset values (§6.4): MODER A/B have the debug pins in AF.
         regs.set(GPIOA, 0xA800_0000);
         regs.set(GPIOA + 0x400, 0x0000_0280);
         regs.set(GPIOA + 0x0C, 0x6400_0000);
@@ -241,7 +241,13 @@ impl Stm32f7 {
     fn known(&self, name: &str, addr: u32) -> bool {
         let off = addr & 0x3FF & !3;
         match name {
-            "RCC" => off <= 0x90 && !matches!(off, 0x1C | 0x2C | 0x3C | 0x48 | 0x4C | 0x5C | 0x68 | 0x6C | 0x78 | 0x7C),
+            "RCC" => {
+                off <= 0x90
+                    && !matches!(
+                        off,
+                        0x1C | 0x2C | 0x3C | 0x48 | 0x4C | 0x5C | 0x68 | 0x6C | 0x78 | 0x7C
+                    )
+            }
             "FLASH" => off <= 0x1C,
             "PWR" => off <= 0x1C,
             "SYSCFG" => off <= 0x20,
@@ -473,7 +479,10 @@ mod tests {
     #[test]
     fn gates() {
         let mut s = Stm32f7::new(Chip::F746);
-        assert!(matches!(s.read(0x4002_0400, 4, Ctx::default()), Access::Gated { .. }));
+        assert!(matches!(
+            s.read(0x4002_0400, 4, Ctx::default()),
+            Access::Gated { .. }
+        ));
         w(&mut s, RCC_AHB1ENR, 1 << 1);
         assert_eq!(r(&mut s, 0x4002_0400), 0x0000_0280);
         assert!(!s.gate_open((RCC_APB1ENR, 1 << 25)));

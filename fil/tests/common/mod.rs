@@ -22,7 +22,10 @@ pub fn elf(board: &str, name: &str) -> Option<Image> {
         if std::env::var_os("FIL_REQUIRE_ELF").is_some() {
             panic!("{} missing: run fil/build-firmware.sh", path.display());
         }
-        eprintln!("skipped: {} missing (run fil/build-firmware.sh)", path.display());
+        eprintln!(
+            "skipped: {} missing (run fil/build-firmware.sh)",
+            path.display()
+        );
         return None;
     }
     Some(Image::load(path.to_str().expect("utf-8 path")).expect("ELF"))

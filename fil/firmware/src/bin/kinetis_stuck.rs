@@ -12,9 +12,7 @@
 
 #[cfg(target_os = "none")]
 mod image {
-    use twocan_fil_firmware::{
-        idle, kinetis_watchdog_off, print, read32, vector_table, write32,
-    };
+    use twocan_fil_firmware::{idle, kinetis_watchdog_off, print, read32, vector_table, write32};
 
     vector_table!(reset, fault, 75, can0_message);
 
@@ -22,8 +20,8 @@ mod image {
     #[no_mangle]
     #[used]
     static FLASH_CONFIG: [u8; 16] = [
-        0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFE, 0xFF,
-        0xFF, 0xFF,
+        0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFE, 0xFF, 0xFF,
+        0xFF,
     ];
 
     const SIM_SCGC6: u32 = 0x4004_803C;
@@ -56,8 +54,11 @@ mod image {
             // Leave Disable mode into Freeze (FRZ and HALT are set out of reset).
             write32(MCR, read32(MCR) & !(1 << 31));
             wait(MCR, 1 << 24, true); // FRZACK
-            // Loop-back, bus clock, 16 tq: PRESDIV 1, PROPSEG 7, PSEG1 3, PSEG2 3.
-            write32(CTRL1, (1 << 24) | (3 << 19) | (3 << 16) | (1 << 13) | (1 << 12) | 6);
+                                      // Loop-back, bus clock, 16 tq: PRESDIV 1, PROPSEG 7, PSEG1 3, PSEG2 3.
+            write32(
+                CTRL1,
+                (1 << 24) | (3 << 19) | (3 << 16) | (1 << 13) | (1 << 12) | 6,
+            );
             write32(MB0_CS, 0x8 << 24);
             write32(IMASK1, 1);
             // Leave Freeze.

@@ -45,7 +45,7 @@ mod image {
             write32(MCR, 1); // INRQ, SLEEP = 0
             wait(MSR, 1, true); // INAK
             wait(MSR, 2, false); // SLAK
-            // Silent loop-back; BRP 0, TS1 12, TS2 1 (the rate does not matter here).
+                                 // Silent loop-back; BRP 0, TS1 12, TS2 1 (the rate does not matter here).
             write32(BTR, (1 << 31) | (1 << 30) | (1 << 20) | (12 << 16));
             write32(IER, 1); // TMEIE
             write32(MCR, 0);
