@@ -49,8 +49,11 @@ pub struct Fault {
     /// The address accessed, if any.
     pub address: Option<u32>,
     /// The exception it was taken as (3 = HardFault, 5 = BusFault, ...), or `None` when
-    /// the board stopped (lockup, reset request).
+    /// the board stopped (lockup) or the chip raises no exception for it.
     pub taken_as: Option<u32>,
+    /// `true` when the chip raises no exception for it (an STM32 peripheral without
+    /// clock reads as 0 and ignores writes): reported all the same.
+    pub silent: bool,
     /// Core time of the fault (ns).
     pub at_ns: u64,
 }
@@ -64,6 +67,10 @@ impl std::fmt::Display for Fault {
         match self.taken_as {
             Some(exc::HARD_FAULT) => write!(f, " -> HardFault handler")?,
             Some(e) => write!(f, " -> exception {e} handler")?,
+            None if self.silent => write!(
+                f,
+                " -> no exception on this chip (read as 0, write ignored)"
+            )?,
             None => write!(f, " -> board stopped")?,
         }
         write!(f, " (t = {} us)", self.at_ns / 1000)
@@ -297,6 +304,31 @@ impl Board {
         }
     }
 
+    /// An access the chip answers without an exception but that firmware must not make
+    /// (a peripheral whose clock is off, on a chip where that reads as 0).
+    fn silent_fault(&mut self, kind: String, addr: u32) {
+        let at_ns = self.time_ns();
+        self.faults.push(Fault {
+            kind,
+            pc: self.pc,
+            address: Some(addr),
+            taken_as: None,
+            silent: true,
+            at_ns,
+        });
+    }
+
+    /// A gated access: a bus error where the chip gives one, else recorded only.
+    fn gated(&mut self, uc_stop: &mut bool, what: String, addr: u32) {
+        if self.profile.gated_access_is_bus_error() {
+            self.bus_error(format!("BusFault: {what}"), addr);
+            self.stop_now();
+            *uc_stop = true;
+        } else {
+            self.silent_fault(format!("clock-gated access: {what}"), addr);
+        }
+    }
+
     fn stop_now(&mut self) {
         self.stop_at = self.instructions;
     }
@@ -518,6 +550,7 @@ fn take_fault(uc: &mut Unicorn<'_, Board>, kind: String, fault: u32, pc: u32, ad
             pc,
             address: addr,
             taken_as: None,
+            silent: false,
             at_ns,
         });
         halt(uc, "lockup".into());
@@ -545,6 +578,7 @@ fn take_fault(uc: &mut Unicorn<'_, Board>, kind: String, fault: u32, pc: u32, ad
             pc,
             address: addr,
             taken_as: Some(target),
+            silent: false,
             at_ns,
         });
     }
@@ -956,12 +990,15 @@ fn periph_read(uc: &mut Unicorn<'_, Board>, addr: u32, size: usize) -> u64 {
         if !b.profile.gate_open(gate) {
             let g = b.profile.gate_name(gate);
             let n = b.cans[i].instance.name;
-            b.bus_error(
-                format!("BusFault: {n} read with its clock gated ({g} = 0)"),
+            let mut stop = false;
+            b.gated(
+                &mut stop,
+                format!("{n} read with its clock gated ({g} = 0)"),
                 addr,
             );
-            b.stop_now();
-            let _ = uc.emu_stop();
+            if stop {
+                let _ = uc.emu_stop();
+            }
             return 0;
         }
         let off = (addr - b.cans[i].instance.base) as usize;
@@ -978,12 +1015,15 @@ fn periph_read(uc: &mut Unicorn<'_, Board>, addr: u32, size: usize) -> u64 {
             0
         }
         Access::Gated { peripheral, gate } => {
-            b.bus_error(
-                format!("BusFault: {peripheral} read with its clock gated ({gate} = 0)"),
+            let mut stop = false;
+            b.gated(
+                &mut stop,
+                format!("{peripheral} read with its clock gated ({gate} = 0)"),
                 addr,
             );
-            b.stop_now();
-            let _ = uc.emu_stop();
+            if stop {
+                let _ = uc.emu_stop();
+            }
             0
         }
         Access::Unmapped => {
@@ -1010,12 +1050,15 @@ fn periph_write(uc: &mut Unicorn<'_, Board>, addr: u32, size: usize, value: u32)
         if !b.profile.gate_open(gate) {
             let g = b.profile.gate_name(gate);
             let n = b.cans[i].instance.name;
-            b.bus_error(
-                format!("BusFault: {n} written with its clock gated ({g} = 0)"),
+            let mut stop = false;
+            b.gated(
+                &mut stop,
+                format!("{n} written with its clock gated ({g} = 0)"),
                 addr,
             );
-            b.stop_now();
-            let _ = uc.emu_stop();
+            if stop {
+                let _ = uc.emu_stop();
+            }
             return;
         }
         let off = (addr - b.cans[i].instance.base) as usize;
@@ -1036,12 +1079,15 @@ fn periph_write(uc: &mut Unicorn<'_, Board>, addr: u32, size: usize, value: u32)
         }
         Access::Unknown { peripheral } => b.note_unknown(addr, peripheral, "write"),
         Access::Gated { peripheral, gate } => {
-            b.bus_error(
-                format!("BusFault: {peripheral} written with its clock gated ({gate} = 0)"),
+            let mut stop = false;
+            b.gated(
+                &mut stop,
+                format!("{peripheral} written with its clock gated ({gate} = 0)"),
                 addr,
             );
-            b.stop_now();
-            let _ = uc.emu_stop();
+            if stop {
+                let _ = uc.emu_stop();
+            }
         }
         Access::Unmapped => {
             b.bus_error("BusFault: write to unmapped peripheral space".into(), addr);

@@ -462,6 +462,10 @@ impl Profile for Kinetis {
         Access::Known(0)
     }
 
+    fn gated_access_is_bus_error(&self) -> bool {
+        true
+    }
+
     fn gate_open(&self, gate: (u32, u32)) -> bool {
         self.regs.get(gate.0) & gate.1 != 0
     }

@@ -109,6 +109,11 @@ pub trait Profile {
     fn read(&mut self, addr: u32, size: usize, ctx: Ctx) -> Access;
     /// A write of `size` bytes at `addr` in the peripheral space (not a CAN window).
     fn write(&mut self, addr: u32, size: usize, value: u32, ctx: Ctx) -> Access;
+    /// Whether an access to a peripheral whose clock is gated ends in a bus error (Kinetis:
+    /// "an attempt to access a gated module's registers generates an error termination",
+    /// SIM chapter) or is answered without one (STM32: reads as 0, writes ignored). The
+    /// harness reports both as faults of the firmware.
+    fn gated_access_is_bus_error(&self) -> bool;
     /// Whether the clock gate `(register, mask)` is open.
     fn gate_open(&self, gate: (u32, u32)) -> bool;
     /// Name of a gate for reports.

@@ -20,9 +20,9 @@
 //!   faster than `FLASH_ACR.LATENCY` allows (Table 7, 2.7–3.6 V: 30 MHz per wait state)
 //!   and an APB1 above 54 MHz / APB2 above 108 MHz are reported.
 //! - Enable registers gate the peripherals: GPIOx (`AHB1ENR`), PWR and CAN1/CAN2
-//!   (`APB1ENR`), SYSCFG (`APB2ENR`); an access while gated is a bus error. (On the
-//!   silicon a gated STM32 peripheral reads as zero and ignores writes; the harness
-//!   reports it as a fault all the same, since firmware that does it is broken.)
+//!   (`APB1ENR`), SYSCFG (`APB2ENR`). A gated STM32 peripheral raises no bus error: it
+//!   reads as zero and ignores writes, so the core goes on; the harness records the
+//!   access as a fault of the firmware all the same (it never works on the board).
 
 use super::{Access, CanInstance, CanKind, Ctx, Memory, Profile, RegStore};
 
@@ -402,6 +402,10 @@ impl Profile for Stm32f7 {
         } else {
             Access::Unknown { peripheral: name }
         }
+    }
+
+    fn gated_access_is_bus_error(&self) -> bool {
+        false
     }
 
     fn gate_open(&self, gate: (u32, u32)) -> bool {
