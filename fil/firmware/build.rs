@@ -14,6 +14,7 @@ fn main() {
     for (bin, script) in [
         ("kinetis-gate", "kinetis.ld"),
         ("kinetis-stuck", "kinetis.ld"),
+        ("kinetis-no-wdog", "kinetis.ld"),
         ("stm32-gate", "stm32f7.ld"),
         ("stm32-stuck", "stm32f7.ld"),
     ] {

@@ -814,6 +814,21 @@ impl<'a> Machine<'a> {
             {
                 let b = self.uc.get_data_mut();
                 b.systick_catch_up();
+                if let Some((at, why)) = b.profile.reset_deadline() {
+                    if b.cycles() >= at && b.halted.is_none() {
+                        let at_ns = b.time_ns();
+                        let pc = b.pc;
+                        b.faults.push(Fault {
+                            kind: why.clone(),
+                            pc,
+                            address: None,
+                            taken_as: None,
+                            silent: false,
+                            at_ns,
+                        });
+                        b.halted = Some(why);
+                    }
+                }
                 if b.halted.is_some() || b.time_ps() >= t_ps {
                     if b.halted.is_some() && b.time_ps() < t_ps {
                         let c = b.cycles_until(t_ps);
@@ -836,6 +851,9 @@ impl<'a> Machine<'a> {
                 let b = self.uc.get_data_mut();
                 let mut budget = b.cycles_until(t_ps).max(1);
                 if let Some(at) = b.systick_next() {
+                    budget = budget.min(at.saturating_sub(b.cycles()).max(1));
+                }
+                if let Some((at, _)) = b.profile.reset_deadline() {
                     budget = budget.min(at.saturating_sub(b.cycles()).max(1));
                 }
                 b.stop_at = b.instructions + budget;
@@ -887,6 +905,9 @@ impl<'a> Machine<'a> {
         }
         let mut until = b.cycles() + b.cycles_until(t_ps).max(1);
         if let Some(at) = b.systick_next() {
+            until = until.min(at.max(b.cycles() + 1));
+        }
+        if let Some((at, _)) = b.profile.reset_deadline() {
             until = until.min(at.max(b.cycles() + 1));
         }
         b.idle_cycles += until - b.cycles();

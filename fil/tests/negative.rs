@@ -165,3 +165,27 @@ fn a_node_at_the_wrong_bit_rate_gives_error_frames_and_error_state_changes() {
         assert!(bad.machines[0].board().faults.is_empty());
     }
 }
+
+#[test]
+fn a_kinetis_firmware_that_leaves_the_watchdog_alone_is_reset() {
+    for board in ["teensy32", "teensy36"] {
+        let Some(mut w) = world(500_000, &[(board, "../negative/kinetis-no-wdog")]) else {
+            return;
+        };
+        w.run_for(secs(0.001));
+        assert!(!w.clean());
+        let b = w.machines[0].board();
+        assert_eq!(b.faults.len(), 1, "{board}: {:?}", b.faults);
+        assert!(
+            b.faults[0]
+                .kind
+                .contains("WDOG not unlocked within the WCT"),
+            "{:?}",
+            b.faults
+        );
+        assert!(b.halted.is_some());
+        // Reset at 256 bus clocks (bus = core = 20.97 MHz out of reset): 12.2 µs.
+        let at = b.faults[0].at_ns;
+        assert!((12_000..=13_000).contains(&at), "{board}: {at} ns");
+    }
+}

@@ -7,17 +7,22 @@
 //! "General-Purpose Input/Output (GPIO)"; the Teensy 3.x schematics (16 MHz crystal).
 //!
 //! Rules modelled:
-//! - **WDOG** (16-bit registers): the unlock sequence is 0xC520 then 0xD928 written to
-//!   `WDOG_UNLOCK` within 20 bus clocks; the control registers may then be written within
-//!   the WCT window (256 bus clocks). A wrong unlock sequence resets the chip; a control
-//!   write outside the window is ignored (reported).
+//! - **WDOG** (16-bit registers, chapter "Watchdog Timer", "Unlocking and updating the
+//!   watchdog" and "The watchdog configuration time (WCT)"): the first unlock word must
+//!   come within the WCT (256 bus clocks) after reset; the unlock sequence is 0xC520 then
+//!   0xD928 written to `WDOG_UNLOCK` within 20 bus clocks; a control register must then
+//!   be updated within the WCT. Each of these missed, or a wrong unlock word, resets the
+//!   chip; a control write outside the window is ignored (reported). Left enabled, the
+//!   watchdog resets the chip after `TOVAL × (PRESCVAL + 1)` watchdog clocks unless
+//!   refreshed (0xA602, 0xB480 to `WDOG_REFRESH`).
 //! - **OSC/MCG**: the 16 MHz crystal starts (`MCG_S.OSCINIT0`) only when `MCG_C2.EREFS0`
 //!   requests the oscillator and `MCG_C2.RANGE0` selects the 8–32 MHz range; `IREFST`
 //!   follows `C1.IREFS` (the external reference only once it runs); `CLKST` follows
 //!   `C1.CLKS` when the selected clock runs; the PLL locks (`LOCK0`) only with its
 //!   reference (`OSCCLK / (PRDIV0+1)`) and VCO (`ref × multiplier`) inside the chip's
-//!   limits (K20/K64: reference 2–4 MHz, ×24…55, 48–100 MHz; K66: reference 8–16 MHz,
-//!   ×16…47, VCO 90–180 MHz, output VCO/2).
+//!   limits (K20/K64: reference 2–4 MHz, ×24…55, output 48–100 MHz on the K20 and
+//!   48–120 MHz on the K64; K66: reference 8–16 MHz, ×16…47, VCO 180–360 MHz, output
+//!   VCO/2).
 //! - **SIM**: clock gates `SCGC1..7` (an access to a gated peripheral is a bus error),
 //!   `CLKDIV1` output dividers (core = MCGOUTCLK / (OUTDIV1+1)), `SDID` read-only.
 //! - **PORT** (`PCRn`, gated by `SCGC5`) and **GPIO** (not gated) as storage, with the
@@ -79,6 +84,14 @@ pub struct Kinetis {
     unlock_first: Option<u64>,
     /// Cycle at which the WCT window after a complete unlock closes.
     unlock_window_end: Option<u64>,
+    /// The first unlock key was written (within the WCT after reset).
+    unlock_seen: bool,
+    /// A control register was updated in the current unlock window.
+    configured: bool,
+    /// Cycle at which the watchdog counter last restarted (reset, refresh, update).
+    wdog_epoch: u64,
+    /// Cycle of the first refresh word, if the sequence is under way.
+    refresh_first: Option<u64>,
     findings: Vec<String>,
 }
 
@@ -115,6 +128,10 @@ impl Kinetis {
             regs,
             unlock_first: None,
             unlock_window_end: None,
+            unlock_seen: false,
+            configured: false,
+            wdog_epoch: 0,
+            refresh_first: None,
             findings: Vec::new(),
         }
     }
@@ -140,18 +157,26 @@ impl Kinetis {
         let vdiv = u64::from(self.byte(MCG_C6) & 0x1F);
         match self.chip {
             Chip::K20 | Chip::K64 => {
+                // Reference 2–4 MHz, ×24…55; output 48–100 MHz (K20 data sheet) or
+                // 48–120 MHz (K64).
                 let reference = CRYSTAL_HZ / (prdiv + 1);
                 let out = reference * (vdiv + 24);
+                let max = if self.chip == Chip::K20 {
+                    100_000_000
+                } else {
+                    120_000_000
+                };
                 ((2_000_000..=4_000_000).contains(&reference)
-                    && (48_000_000..=100_000_000).contains(&out)
+                    && (48_000_000..=max).contains(&out)
                     && vdiv + 24 <= 55)
                     .then_some(out)
             }
             Chip::K66 => {
+                // Reference 8–16 MHz, ×16…47; VCO 180–360 MHz, MCGPLLCLK = VCO / 2.
                 let reference = CRYSTAL_HZ / (prdiv + 1);
                 let vco = reference * (vdiv + 16);
                 ((8_000_000..=16_000_000).contains(&reference)
-                    && (90_000_000..=180_000_000).contains(&vco)
+                    && (180_000_000..=360_000_000).contains(&vco)
                     && vdiv + 16 <= 47)
                     .then_some(vco / 2)
             }
@@ -272,11 +297,13 @@ impl Kinetis {
             match (value, self.unlock_first) {
                 (0xC520, _) => {
                     self.unlock_first = Some(ctx.cycles);
+                    self.unlock_seen = true;
                     return Access::Known(0);
                 }
-                (0xD928, Some(first)) if ctx.cycles - first <= 20 => {
+                (0xD928, Some(first)) if ctx.cycles - first <= self.core_cycles(20) => {
                     self.unlock_first = None;
-                    self.unlock_window_end = Some(ctx.cycles + 256);
+                    self.unlock_window_end = Some(ctx.cycles + self.core_cycles(256));
+                    self.configured = false;
                     return Access::Known(0);
                 }
                 (0xD928, Some(first)) => {
@@ -293,19 +320,49 @@ impl Kinetis {
             }
         }
         if addr == WDOG_REFRESH {
-            self.regs.write(addr, size, value);
+            // Refresh: 0xA602 then 0xB480 within 20 bus clocks restarts the counter.
+            match (value, self.refresh_first) {
+                (0xA602, _) => self.refresh_first = Some(ctx.cycles),
+                (0xB480, Some(first)) if ctx.cycles - first <= self.core_cycles(20) => {
+                    self.refresh_first = None;
+                    self.wdog_epoch = ctx.cycles;
+                }
+                _ => self.refresh_first = None,
+            }
             return Access::Known(0);
         }
         let open = self.unlock_window_end.is_some_and(|end| ctx.cycles <= end);
         let allow = self.regs.read(WDOG_STCTRLH, 2) & 0x10 != 0;
         if open && allow {
             self.regs.write(addr, size, value);
+            self.configured = true;
+            self.wdog_epoch = ctx.cycles;
         } else {
             self.findings.push(format!(
                 "WDOG register 0x{addr:08X} written outside the unlock window: ignored"
             ));
         }
         Access::Known(0)
+    }
+
+    /// Core cycles for `bus` bus clocks at the current dividers.
+    fn core_cycles(&self, bus: u64) -> u64 {
+        bus * (self.core_hz() / self.bus_hz().max(1)).max(1)
+    }
+
+    /// The watchdog's time-out in core cycles: `TOVAL × (PRESCVAL + 1)` watchdog clocks,
+    /// the watchdog clock being the bus clock (`STCTRLH.CLKSRC = 1`, the reset value) or
+    /// the 1 kHz LPO.
+    fn wdog_timeout(&self) -> u64 {
+        let toval = (u64::from(self.regs.read(WDOG + 0x04, 2)) << 16)
+            | u64::from(self.regs.read(WDOG + 0x06, 2));
+        let presc = u64::from((self.regs.read(WDOG + 0x16, 2) >> 8) & 7) + 1;
+        let ticks = toval.max(4) * presc;
+        if self.regs.read(WDOG_STCTRLH, 2) & 0x02 != 0 {
+            self.core_cycles(ticks)
+        } else {
+            ticks * (self.core_hz() / 1000)
+        }
     }
 
     fn gpio_write(&mut self, addr: u32, value: u32) {
@@ -508,6 +565,28 @@ impl Profile for Kinetis {
     fn take_findings(&mut self) -> Vec<String> {
         std::mem::take(&mut self.findings)
     }
+
+    fn reset_deadline(&self) -> Option<(u64, String)> {
+        if !self.unlock_seen {
+            return Some((
+                self.core_cycles(256),
+                "watchdog reset: WDOG not unlocked within the WCT (256 bus clocks) after reset"
+                    .into(),
+            ));
+        }
+        if let (Some(end), false) = (self.unlock_window_end, self.configured) {
+            return Some((
+                end,
+                "watchdog reset: WDOG unlocked but not updated within the WCT".into(),
+            ));
+        }
+        (self.regs.read(WDOG_STCTRLH, 2) & 1 != 0).then(|| {
+            (
+                self.wdog_epoch + self.wdog_timeout(),
+                "watchdog reset: time-out (WDOG left enabled and not refreshed)".into(),
+            )
+        })
+    }
 }
 
 impl Kinetis {
@@ -563,6 +642,16 @@ mod tests {
         // ref = 16 / 4 = 4 MHz, ×24 = 96 MHz: locks.
         w8(&mut k, MCG_C5, 0x03);
         assert_eq!(s(&mut k) & 0x40, 0x40);
+        // K66 at 180 MHz as Teensyduino sets it: 16 / 2 = 8 MHz × 45 = 360 MHz VCO.
+        let mut k = Kinetis::new(Chip::K66);
+        w8(&mut k, MCG_C2, 0x24);
+        w8(&mut k, MCG_C5, 0x01);
+        w8(&mut k, MCG_C6, 0x40 | 29);
+        assert_eq!(s(&mut k) & 0x40, 0x40);
+        assert_eq!(k.pll_output(), Some(180_000_000));
+        // 16 MHz × 45 = 720 MHz: out of range.
+        w8(&mut k, MCG_C5, 0x00);
+        assert_eq!(s(&mut k) & 0x40, 0);
     }
 
     #[test]
@@ -589,5 +678,32 @@ mod tests {
         ));
         assert!(!k.gate_open((SIM_SCGC6, 1 << 4)), "FlexCAN0 gated at reset");
         assert_eq!(k.read(0x4008_8000, 4, at(0)), Access::Unmapped);
+    }
+
+    #[test]
+    fn watchdog_deadlines() {
+        let at = |c| Ctx { cycles: c };
+        let k = Kinetis::new(Chip::K66);
+        let (when, why) = k.reset_deadline().unwrap();
+        assert_eq!(when, 256, "{why}");
+        let mut k = Kinetis::new(Chip::K66);
+        k.write(WDOG_UNLOCK, 2, 0xC520, at(10));
+        k.write(WDOG_UNLOCK, 2, 0xD928, at(12));
+        assert_eq!(
+            k.reset_deadline().unwrap().0,
+            12 + 256,
+            "update within the WCT"
+        );
+        k.write(WDOG_STCTRLH, 2, 0x01D3, at(20)); // still enabled
+                                                  // TOVAL 0x004C4B4C × (PRESCVAL 4 + 1) bus clocks from the update.
+        assert_eq!(k.reset_deadline().unwrap().0, 20 + 0x004C_4B4C * 5);
+        k.write(WDOG_REFRESH, 2, 0xA602, at(1000));
+        k.write(WDOG_REFRESH, 2, 0xB480, at(1005));
+        assert_eq!(k.reset_deadline().unwrap().0, 1005 + 0x004C_4B4C * 5);
+        let mut k = Kinetis::new(Chip::K66);
+        k.write(WDOG_UNLOCK, 2, 0xC520, at(10));
+        k.write(WDOG_UNLOCK, 2, 0xD928, at(12));
+        k.write(WDOG_STCTRLH, 2, 0x0010, at(16));
+        assert_eq!(k.reset_deadline(), None, "disabled");
     }
 }

@@ -127,6 +127,10 @@ pub trait Profile {
     fn systick_external_divider(&self) -> Option<u64>;
     /// Findings the register rules made (violations of the manual's sequences).
     fn take_findings(&mut self) -> Vec<String>;
+    /// The core cycle at which the chip resets by itself (a watchdog), and why.
+    fn reset_deadline(&self) -> Option<(u64, String)> {
+        None
+    }
 }
 
 /// Byte-addressed storage for registers a profile keeps as plain values, with sub-word
