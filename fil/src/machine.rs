@@ -727,6 +727,11 @@ impl<'a> Machine<'a> {
 
         for &site in &image.wfi_sites {
             uc.add_code_hook(u64::from(site), u64::from(site), |uc, addr, _| {
+                // The instruction hook may just have taken an exception here (PC moved to
+                // the handler): the WFI then runs after the handler returns.
+                if reg(uc, RegisterARM::PC) & !1 != addr as u32 {
+                    return;
+                }
                 let b = uc.get_data_mut();
                 b.wfi = true;
                 b.stop_now();
