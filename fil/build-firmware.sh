@@ -29,7 +29,7 @@ for board in nucleo-f767zi disco-f746g; do
 done
 cargo build --quiet --release --target "$target" --manifest-path fil/firmware/Cargo.toml
 mkdir -p "$out/negative"
-for bin in kinetis-gate kinetis-stuck kinetis-no-wdog stm32-gate stm32-stuck; do
+for bin in kinetis-gate kinetis-stuck kinetis-no-wdog core-check stm32-gate stm32-stuck; do
     cp "fil/firmware/target/$target/release/$bin" "$out/negative/"
 done
 echo "firmware for the harness in $out"
