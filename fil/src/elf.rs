@@ -21,6 +21,8 @@ pub struct Symbol {
     pub address: u32,
     /// Size in bytes.
     pub size: u64,
+    /// A data object (a static), not code.
+    pub is_data: bool,
 }
 
 /// A loaded ELF.
@@ -91,6 +93,7 @@ impl Image {
                     name,
                     address: s.address() as u32,
                     size: s.size(),
+                    is_data: s.kind() == object::SymbolKind::Data,
                 })
             })
             .collect();
@@ -128,10 +131,15 @@ impl Image {
         })
     }
 
-    /// The symbol whose demangled name ends with `suffix` (`firmware::SENT`).
+    /// The symbol named `suffix` or whose demangled path ends with `::suffix`
+    /// (`SENT` finds `teensy_loopback::firmware::SENT`), data objects first.
     pub fn symbol(&self, suffix: &str) -> Option<&Symbol> {
+        let tail = format!("::{suffix}");
+        let matches = |s: &&Symbol| s.name == suffix || s.name.ends_with(&tail);
         self.symbols
             .iter()
-            .find(|s| s.name == suffix || s.name.ends_with(&format!("::{suffix}")))
+            .filter(matches)
+            .find(|s| s.is_data)
+            .or_else(|| self.symbols.iter().find(matches))
     }
 }

@@ -929,7 +929,7 @@ impl<'a> Machine<'a> {
     }
 
     /// Reads a firmware static by the last components of its demangled symbol name
-    /// (e.g. `firmware::SENT`).
+    /// (e.g. `SENT`).
     pub fn read_static(&self, name: &str) -> Option<Vec<u8>> {
         let sym = self.image.symbol(name)?;
         self.read_memory(sym.address, sym.size as usize)

@@ -24,8 +24,8 @@ fn loopback_frames_come_back_on_every_board() {
         w.run_for(secs(3.2));
         assert_clean(&w);
         let m = &w.machines[0];
-        assert_eq!(m.read_u32_static("firmware::SENT"), Some(3), "{board}");
-        assert_eq!(m.read_u32_static("firmware::RECEIVED"), Some(3), "{board}");
+        assert_eq!(m.read_u32_static("SENT"), Some(3), "{board}");
+        assert_eq!(m.read_u32_static("RECEIVED"), Some(3), "{board}");
         let b = m.board();
         // The 1 ms SysTick ran (3,199 ticks less the start-up time).
         let ticks = b.taken.get(&exc::SYSTICK).copied().unwrap_or(0);
@@ -73,7 +73,7 @@ fn stm32_filters_deliver_exactly_the_expected_identifiers() {
             "{board}: the frame no filter accepts was sent"
         );
         let m = &w.machines[0];
-        let hits = m.read_static("firmware::HITS").expect("HITS");
+        let hits = m.read_static("HITS").expect("HITS");
         for (i, want) in expected.iter().enumerate() {
             let got = u32::from_le_bytes(hits[4 * i..4 * i + 4].try_into().unwrap());
             assert!(*want >= 2, "{board}: filter {i} frames sent: {want}");
@@ -83,8 +83,8 @@ fn stm32_filters_deliver_exactly_the_expected_identifiers() {
                 "{board}: filter {i}: {got} of {want}"
             );
         }
-        assert_eq!(m.read_u32_static("firmware::ERRORS"), Some(0), "{board}");
-        let banks = m.read_static("firmware::BANKS").expect("BANKS");
+        assert_eq!(m.read_u32_static("ERRORS"), Some(0), "{board}");
+        let banks = m.read_static("BANKS").expect("BANKS");
         assert!(
             banks.iter().any(|b| *b != 0),
             "{board}: filter banks assigned"
@@ -106,12 +106,12 @@ fn teensy_filters_deliver_exactly_the_expected_identifiers() {
         w.run_for(secs(1.25));
         assert_clean(&w);
         let m = &w.machines[0];
-        let hits = m.read_static("firmware::HITS").expect("HITS");
+        let hits = m.read_static("HITS").expect("HITS");
         for i in 0..5 {
             let got = u32::from_le_bytes(hits[4 * i..4 * i + 4].try_into().unwrap());
             assert!(got >= 1, "{board}: filter {i}: {got}");
         }
-        assert_eq!(m.read_u32_static("firmware::ERRORS"), Some(0), "{board}");
+        assert_eq!(m.read_u32_static("ERRORS"), Some(0), "{board}");
     }
 }
 

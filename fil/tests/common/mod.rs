@@ -85,7 +85,7 @@ pub struct Stats {
 
 pub fn app_stats(w: &World<'_>, board: usize, count: usize) -> Vec<Stats> {
     let bytes = w.machines[board]
-        .read_static("firmware::STATS")
+        .read_static("STATS")
         .expect("STATS symbol");
     assert_eq!(bytes.len(), 8 + 36 * count, "STATS layout changed");
     let word = |i: usize| u32::from_le_bytes(bytes[4 * i..4 * i + 4].try_into().unwrap());
