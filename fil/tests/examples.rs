@@ -196,3 +196,27 @@ fn two_controllers_of_one_chip_exchange_frames() {
         }
     }
 }
+
+/// The same ELF twice on one bus: two boards, each with its own CPU, memory and
+/// controllers.
+#[test]
+fn the_same_firmware_twice_on_one_bus() {
+    let Some(mut w) = world(
+        500_000,
+        &[
+            ("teensy36", "teensy-loopback"),
+            ("teensy36", "teensy-loopback"),
+        ],
+    ) else {
+        return;
+    };
+    w.run_for(secs(2.1));
+    assert_clean(&w);
+    assert_eq!(w.machines[1].board().name, "teensy36#2");
+    for m in &w.machines {
+        assert_eq!(m.read_u32_static("SENT"), Some(2));
+        assert_eq!(m.read_u32_static("RECEIVED"), Some(2));
+    }
+    // Loop-back frames stay inside each controller: nothing on the wire.
+    assert_eq!(w.bus.stats().frames_started, 0);
+}
