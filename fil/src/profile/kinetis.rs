@@ -46,8 +46,10 @@ pub enum Chip {
 pub const CRYSTAL_HZ: u64 = 16_000_000;
 /// FEI mode out of reset: FLL at 640 × the 32.768 kHz slow internal reference.
 pub const FEI_HZ: u64 = 32_768 * 640;
-/// The fast internal reference (MCG IRC, 4 MHz nominal, FCRDIV = 0 at reset... /2).
+/// The fast internal reference before its divider (MCG_SC.FCRDIV), 4 MHz nominal.
 pub const FAST_IRC_HZ: u64 = 4_000_000;
+/// The slow internal reference, 32.768 kHz nominal.
+pub const SLOW_IRC_HZ: u64 = 32_768;
 
 const WDOG: u32 = 0x4005_2000;
 const WDOG_STCTRLH: u32 = WDOG;
@@ -108,6 +110,7 @@ impl Kinetis {
         regs.write(MCG_C1, 1, 0x04);
         regs.write(MCG_C2, 1, 0x80);
         regs.write(MCG + 3, 1, 0x00); // C4: DRST_DRS = 0, DMX32 = 0
+        regs.write(MCG + 8, 1, 0x02); // SC: FCRDIV = 1 (fast IRC ÷ 2)
                                       // SIM gates (reset values per chapter "SIM"): SCGC4 0xF0100030, SCGC5 0x00040182,
                                       // SCGC6 0x40000001, SCGC7 0x00000006; CLKDIV1 0x00010000 (flash ÷ 2).
         regs.set(SIM + 0x1034, 0xF010_0030);
@@ -228,7 +231,10 @@ impl Kinetis {
     fn mcgout_hz(&self) -> u64 {
         match (self.regs.read(MCG_S, 1) >> 2) & 0b11 {
             0 => FEI_HZ,
-            1 => FAST_IRC_HZ,
+            // CLKS = 1: the internal reference C2.IRCS selects, the fast one divided by
+            // 2^FCRDIV (MCG_SC bits 3:1).
+            1 if self.byte(MCG_C2) & 1 != 0 => FAST_IRC_HZ >> ((self.byte(MCG + 8) >> 1) & 7),
+            1 => SLOW_IRC_HZ,
             2 => CRYSTAL_HZ,
             _ => self.pll_output().unwrap_or(FEI_HZ),
         }
