@@ -1,0 +1,35 @@
+#!/usr/bin/env bash
+# Builds what the firmware-in-the-loop tests run: every example firmware of every board
+# (copied to fil/target/elf/<board>/, since the three Teensy boards share ELF names) and
+# the negative-test firmwares of fil/firmware. Run from anywhere.
+set -euo pipefail
+root="$(cd "$(dirname "$0")/.." && pwd)"
+cd "$root"
+out="fil/target/elf"
+mkdir -p "$out"
+target=thumbv7em-none-eabihf
+rel="target/$target/release"
+for board in teensy32 teensy35 teensy36; do
+    cargo build --quiet --release --target "$target" -p twocan-teensy --features "$board" --bins
+    mkdir -p "$out/$board"
+    for bin in loopback filters app can0-can1; do
+        if [ -f "$rel/teensy-$bin" ] && { [ "$bin" != can0-can1 ] || [ "$board" = teensy36 ]; }; then
+            cp "$rel/teensy-$bin" "$out/$board/"
+        fi
+    done
+done
+for board in nucleo-f767zi disco-f746g; do
+    cargo build --quiet --release --target "$target" -p twocan-stm32f7 --features "$board" --bins
+    mkdir -p "$out/$board"
+    for bin in loopback filters app can1-can2; do
+        if [ -f "$rel/stm32f7-$bin" ] && { [ "$bin" != can1-can2 ] || [ "$board" = nucleo-f767zi ]; }; then
+            cp "$rel/stm32f7-$bin" "$out/$board/"
+        fi
+    done
+done
+cargo build --quiet --release --target "$target" --manifest-path fil/firmware/Cargo.toml
+mkdir -p "$out/negative"
+for bin in kinetis-gate kinetis-stuck kinetis-no-wdog core-check stm32-gate stm32-stuck; do
+    cp "fil/firmware/target/$target/release/$bin" "$out/negative/"
+done
+echo "firmware for the harness in $out"

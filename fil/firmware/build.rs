@@ -1,0 +1,27 @@
+//! Each bin gets the linker script of its chip family (flash at 0 for the Kinetis, at
+//! 0x0800_0000 for the STM32F7); nothing is linked for a host build.
+use std::env;
+use std::path::PathBuf;
+
+fn main() {
+    println!("cargo:rerun-if-changed=build.rs");
+    println!("cargo:rerun-if-changed=kinetis.ld");
+    println!("cargo:rerun-if-changed=stm32f7.ld");
+    if env::var("CARGO_CFG_TARGET_OS").as_deref() != Ok("none") {
+        return;
+    }
+    let dir = PathBuf::from(env::var_os("CARGO_MANIFEST_DIR").expect("manifest dir"));
+    for (bin, script) in [
+        ("kinetis-gate", "kinetis.ld"),
+        ("kinetis-stuck", "kinetis.ld"),
+        ("kinetis-no-wdog", "kinetis.ld"),
+        ("core-check", "kinetis.ld"),
+        ("stm32-gate", "stm32f7.ld"),
+        ("stm32-stuck", "stm32f7.ld"),
+    ] {
+        println!(
+            "cargo:rustc-link-arg-bin={bin}=-T{}",
+            dir.join(script).display()
+        );
+    }
+}

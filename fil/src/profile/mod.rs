@@ -1,0 +1,226 @@
+//! Board profiles: what a board's chip looks like to its firmware apart from the CPU core
+//! and the CAN controllers — memory map, system registers with their reset values and
+//! rules (clock generator, clock gates, watchdog), CAN instances and interrupt numbers.
+//!
+//! A profile answers every access in the peripheral space with [`Access`]: a register it
+//! knows (with the manual's behaviour), a register of a known peripheral it does not know
+//! (reported, behaves as plain storage so that the run goes on), an access to a gated
+//! peripheral or to unmapped space (a bus error, which the core turns into a fault).
+
+pub mod kinetis;
+pub mod stm32f7;
+
+use std::collections::HashMap;
+
+/// A memory region of the chip (flash or RAM).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Memory {
+    /// Name in reports.
+    pub name: &'static str,
+    /// First address.
+    pub base: u32,
+    /// Size in bytes (a multiple of 4 KiB).
+    pub size: u32,
+    /// Writable (RAM) or not (flash).
+    pub writable: bool,
+    /// Where the ELF's load image is copied, if this region aliases another (the
+    /// STM32F7's flash seen at 0x0020_0000 through the ITCM interface).
+    pub alias_of: Option<u32>,
+}
+
+/// The family of CAN controller of an instance.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CanKind {
+    /// NXP FlexCAN of a Kinetis chip.
+    FlexCan(twocan_flexcan::model::Chip),
+    /// ST bxCAN: CAN1 (master of the filter block) or CAN2.
+    BxCan {
+        /// 1 or 2.
+        instance: u8,
+    },
+}
+
+/// A CAN controller of the chip.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct CanInstance {
+    /// Name in reports (`CAN0`, `CAN1`, ...).
+    pub name: &'static str,
+    /// Register base address.
+    pub base: u32,
+    /// Size of the register window.
+    pub size: u32,
+    /// The clock gate: register address and bit mask.
+    pub gate: (u32, u32),
+    /// Controller family.
+    pub kind: CanKind,
+    /// Interrupt numbers of the controller's lines, in the order of [`crate::can::Model::lines`].
+    pub irqs: Vec<(&'static str, u32)>,
+}
+
+/// The outcome of an access to the peripheral space.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Access {
+    /// A register the profile models; the value read (0 for writes).
+    Known(u32),
+    /// A known peripheral, a register the profile does not model: reported.
+    Unknown {
+        /// The peripheral.
+        peripheral: &'static str,
+    },
+    /// A peripheral whose bus clock is gated: bus error.
+    Gated {
+        /// The peripheral.
+        peripheral: &'static str,
+        /// The gate register's name and bit.
+        gate: &'static str,
+    },
+    /// Nothing at this address: bus error.
+    Unmapped,
+    /// The access makes the chip reset (e.g. a watchdog unlock sequence violated).
+    Reset(String),
+}
+
+/// Context a profile's register rules may need.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Ctx {
+    /// Core clock cycles since reset.
+    pub cycles: u64,
+}
+
+/// A board as seen by the harness.
+pub trait Profile {
+    /// Board name (`teensy36`, `nucleo-f767zi`, ...).
+    fn name(&self) -> &'static str;
+    /// Unicorn CPU model (`UC_CPU_ARM_CORTEX_M4`/`M7`).
+    fn cpu_model(&self) -> i32;
+    /// Flash and RAM regions.
+    fn memory(&self) -> Vec<Memory>;
+    /// Where the vector table is at reset (VTOR's reset value, after the boot aliasing).
+    fn boot_address(&self) -> u32;
+    /// Number of external interrupts.
+    fn irq_count(&self) -> u32;
+    /// Implemented NVIC priority bits.
+    fn priority_bits(&self) -> u8 {
+        4
+    }
+    /// The CAN controllers.
+    fn can_instances(&self) -> Vec<CanInstance>;
+    /// A read of `size` bytes at `addr` in the peripheral space (not a CAN window).
+    fn read(&mut self, addr: u32, size: usize, ctx: Ctx) -> Access;
+    /// A write of `size` bytes at `addr` in the peripheral space (not a CAN window).
+    fn write(&mut self, addr: u32, size: usize, value: u32, ctx: Ctx) -> Access;
+    /// Whether an access to a peripheral whose clock is gated ends in a bus error (Kinetis:
+    /// "an attempt to access a gated module's registers generates an error termination",
+    /// SIM chapter) or is answered without one (STM32: reads as 0, writes ignored). The
+    /// harness reports both as faults of the firmware.
+    fn gated_access_is_bus_error(&self) -> bool;
+    /// Whether the clock gate `(register, mask)` is open.
+    fn gate_open(&self, gate: (u32, u32)) -> bool;
+    /// Name of a gate for reports.
+    fn gate_name(&self, gate: (u32, u32)) -> &'static str;
+    /// The core clock now (Hz).
+    fn core_hz(&self) -> u64;
+    /// The clock of a CAN instance's protocol engine now (Hz), for decoding its bit timing.
+    fn can_clock_hz(&self, can: &CanInstance) -> u64;
+    /// SysTick's external reference divider from the core clock (`CSR.CLKSOURCE = 0`),
+    /// `None` where the chip has none.
+    fn systick_external_divider(&self) -> Option<u64>;
+    /// Findings the register rules made (violations of the manual's sequences).
+    fn take_findings(&mut self) -> Vec<String>;
+    /// The core cycle at which the chip resets by itself (a watchdog), and why.
+    fn reset_deadline(&self) -> Option<(u64, String)> {
+        None
+    }
+}
+
+/// Byte-addressed storage for registers a profile keeps as plain values, with sub-word
+/// access (8/16/32 bits, little-endian).
+#[derive(Debug, Clone, Default)]
+pub struct RegStore {
+    words: HashMap<u32, u32>,
+}
+
+impl RegStore {
+    /// Sets a word (aligned address).
+    pub fn set(&mut self, addr: u32, value: u32) {
+        self.words.insert(addr & !3, value);
+    }
+
+    /// The word at an aligned address (0 if never written).
+    pub fn get(&self, addr: u32) -> u32 {
+        self.words.get(&(addr & !3)).copied().unwrap_or(0)
+    }
+
+    /// Reads `size` bytes at `addr`.
+    pub fn read(&self, addr: u32, size: usize) -> u32 {
+        extract(self.get(addr), addr, size)
+    }
+
+    /// Writes `size` bytes at `addr`.
+    pub fn write(&mut self, addr: u32, size: usize, value: u32) {
+        let w = insert(self.get(addr), addr, size, value);
+        self.set(addr, w);
+    }
+}
+
+/// The `size` bytes at `addr` of the aligned word `word`.
+pub fn extract(word: u32, addr: u32, size: usize) -> u32 {
+    let shift = (addr & 3) * 8;
+    let v = word >> shift;
+    match size {
+        1 => v & 0xFF,
+        2 => v & 0xFFFF,
+        _ => v,
+    }
+}
+
+/// `word` with the `size` bytes at `addr` replaced by `value`.
+pub fn insert(word: u32, addr: u32, size: usize, value: u32) -> u32 {
+    let shift = (addr & 3) * 8;
+    let mask: u32 = match size {
+        1 => 0xFF,
+        2 => 0xFFFF,
+        _ => return value,
+    };
+    (word & !(mask << shift)) | ((value & mask) << shift)
+}
+
+/// The profile of a board name, as the CLI spells it.
+pub fn by_name(name: &str) -> Option<Box<dyn Profile>> {
+    match name {
+        "teensy32" => Some(Box::new(kinetis::Kinetis::new(kinetis::Chip::K20))),
+        "teensy35" => Some(Box::new(kinetis::Kinetis::new(kinetis::Chip::K64))),
+        "teensy36" => Some(Box::new(kinetis::Kinetis::new(kinetis::Chip::K66))),
+        "nucleo-f767zi" => Some(Box::new(stm32f7::Stm32f7::new(stm32f7::Chip::F767))),
+        "disco-f746g" => Some(Box::new(stm32f7::Stm32f7::new(stm32f7::Chip::F746))),
+        _ => None,
+    }
+}
+
+/// Every board name [`by_name`] knows.
+pub const BOARDS: [&str; 5] = [
+    "teensy32",
+    "teensy35",
+    "teensy36",
+    "nucleo-f767zi",
+    "disco-f746g",
+];
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sub_word_access() {
+        let mut s = RegStore::default();
+        s.write(0x4006_4001, 1, 0xA5);
+        assert_eq!(s.get(0x4006_4000), 0x0000_A500);
+        s.write(0x4005_200E, 2, 0xC520);
+        assert_eq!(s.read(0x4005_200E, 2), 0xC520);
+        assert_eq!(s.read(0x4005_200C, 4), 0xC520_0000);
+        for b in BOARDS {
+            assert_eq!(by_name(b).map(|p| p.name()), Some(b));
+        }
+        assert!(by_name("teensy40").is_none());
+    }
+}

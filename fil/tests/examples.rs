@@ -1,0 +1,222 @@
+//! Every example firmware on every board it supports does what its documentation says,
+//! checked through what can be observed: bus frames, interrupts taken, the application
+//! counters the examples export (`SENT`, `RECEIVED`, `HITS`, `ERRORS`, `STATS`).
+
+mod common;
+
+use common::*;
+use twocan_fil::nvic::exc;
+
+const TEENSY: [&str; 3] = ["teensy32", "teensy35", "teensy36"];
+const STM32: [&str; 2] = ["nucleo-f767zi", "disco-f746g"];
+
+#[test]
+fn loopback_frames_come_back_on_every_board() {
+    let boards = TEENSY
+        .iter()
+        .map(|b| (*b, "teensy-loopback"))
+        .chain(STM32.iter().map(|b| (*b, "stm32f7-loopback")));
+    for (board, bin) in boards {
+        let Some(mut w) = world(500_000, &[(board, bin)]) else {
+            return;
+        };
+        // One frame per second: three by 3.2 s.
+        w.run_for(secs(3.2));
+        assert_clean(&w);
+        let m = &w.machines[0];
+        assert_eq!(m.read_u32_static("SENT"), Some(3), "{board}");
+        assert_eq!(m.read_u32_static("RECEIVED"), Some(3), "{board}");
+        let b = m.board();
+        // The 1 ms SysTick ran (3,199 ticks less the start-up time).
+        let ticks = b.taken.get(&exc::SYSTICK).copied().unwrap_or(0);
+        assert!(
+            (3_100..=3_200).contains(&ticks),
+            "{board}: {ticks} SysTicks"
+        );
+        // The CAN receive interrupt was taken for each frame.
+        let rx_line = b.cans[0].instance.irqs[if board.starts_with("teensy") { 0 } else { 1 }].1;
+        assert!(
+            b.taken.get(&(16 + rx_line)).copied().unwrap_or(0) >= 3,
+            "{board}: {:?}",
+            b.taken
+        );
+    }
+}
+
+/// STM32F7 `filters`: each frame reaches the call-back of its filter, 0x777 none.
+#[test]
+fn stm32_filters_deliver_exactly_the_expected_identifiers() {
+    for board in STM32 {
+        let Some(mut w) = world(500_000, &[(board, "stm32f7-filters")]) else {
+            return;
+        };
+        w.run_for(secs(2.05));
+        assert_clean(&w);
+        // bxCAN loop-back without silent mode: the frames are on the wire too.
+        let count = |p: &dyn Fn(u32, bool, bool) -> bool| {
+            wire_count(&w, |f| {
+                let (id, ext) = raw_id(f);
+                p(id, ext, is_remote(f))
+            })
+        };
+        let expected = [
+            count(&|id, ext, _| !ext && id == 0x100),
+            count(&|id, ext, _| !ext && id == 0x101),
+            count(&|id, ext, r| !ext && r && id == 0x542),
+            count(&|id, ext, r| !ext && !r && (0x300..=0x30F).contains(&id)),
+            count(&|id, ext, _| ext && id == 0x12_3456),
+            count(&|id, ext, r| ext && !r && id & 0x1FFF_00FF == 0x18FF_0000),
+        ];
+        let rejected = count(&|id, ext, _| !ext && id == 0x777);
+        assert!(
+            rejected >= 2,
+            "{board}: the frame no filter accepts was sent"
+        );
+        let m = &w.machines[0];
+        let hits = m.read_static("HITS").expect("HITS");
+        for (i, want) in expected.iter().enumerate() {
+            let got = u32::from_le_bytes(hits[4 * i..4 * i + 4].try_into().unwrap());
+            assert!(*want >= 2, "{board}: filter {i} frames sent: {want}");
+            // The last frame may still wait in the driver's queue for the next loop.
+            assert!(
+                got == *want || got + 1 == *want,
+                "{board}: filter {i}: {got} of {want}"
+            );
+        }
+        assert_eq!(m.read_u32_static("ERRORS"), Some(0), "{board}");
+        let banks = m.read_static("BANKS").expect("BANKS");
+        assert!(
+            banks.iter().any(|b| *b != 0),
+            "{board}: filter banks assigned"
+        );
+    }
+}
+
+/// Teensy `filters`: today every Teensy build halts in `begin` (blink code 5): the
+/// driver rejects the masked secondary filters #3 and #4 (`SECONDARY_FILTER_NOT_CONFORM`:
+/// `secondary_conforms` takes exact or pass-all filters only; reproduced on the host
+/// with the same settings and filters). Kept to document the expected behaviour; remove
+/// the `ignore` once the example starts.
+#[test]
+#[ignore = "teensy-filters halts in begin(): masked secondary filters, SECONDARY_FILTER_NOT_CONFORM"]
+fn teensy_filters_deliver_exactly_the_expected_identifiers() {
+    for board in TEENSY {
+        let Some(mut w) = world(500_000, &[(board, "teensy-filters")]) else {
+            return;
+        };
+        w.run_for(secs(1.25));
+        assert_clean(&w);
+        let m = &w.machines[0];
+        let hits = m.read_static("HITS").expect("HITS");
+        for i in 0..5 {
+            let got = u32::from_le_bytes(hits[4 * i..4 * i + 4].try_into().unwrap());
+            assert!(got >= 1, "{board}: filter {i}: {got}");
+        }
+        assert_eq!(m.read_u32_static("ERRORS"), Some(0), "{board}");
+    }
+}
+
+fn assert_app_pair(a: Stats, b: Stats, b_sent_heartbeats: u32, label: &str) {
+    assert_eq!(a.heartbeat_gaps, 0, "{label}: {a:?}");
+    assert_eq!(a.heartbeat_duplicates, 0, "{label}: {a:?}");
+    assert_eq!(a.unhandled, 0, "{label}: {a:?}");
+    assert_eq!(a.tx_full, 0, "{label}: {a:?}");
+    // Each peer heartbeat on the wire was counted (the last may await the next step).
+    assert!(
+        a.heartbeats + 1 >= b_sent_heartbeats && a.heartbeats <= b_sent_heartbeats,
+        "{label}: {} heartbeats counted, {b_sent_heartbeats} on the wire",
+        a.heartbeats
+    );
+    // A status request every 10 steps, answered by the peer.
+    assert!(a.requests >= 1 && a.answers >= 1, "{label}: {a:?}");
+    assert!(a.measurements >= 1, "{label}: {a:?}");
+    assert!(b.sent > 0);
+}
+
+/// The `app` of a Teensy (node 1) and of an STM32F7 board (node 2) on one bus.
+#[test]
+fn teensy_and_stm32_apps_talk_through_the_portable_application() {
+    for (teensy, stm32) in [
+        ("teensy36", "nucleo-f767zi"),
+        ("teensy32", "disco-f746g"),
+        ("teensy35", "nucleo-f767zi"),
+    ] {
+        let Some(mut w) = world(500_000, &[(teensy, "teensy-app"), (stm32, "stm32f7-app")]) else {
+            return;
+        };
+        w.run_for(secs(1.5));
+        assert_clean(&w);
+        let n1 = app_stats(&w, 0, 1)[0];
+        let n2 = app_stats(&w, 1, 1)[0];
+        let hb = |id: u32| wire_count(&w, |f| raw_id(f) == (id, false) && !is_remote(f));
+        assert!(hb(0x101) >= 140, "{teensy}: {} heartbeats", hb(0x101));
+        assert_app_pair(n1, n2, hb(0x102), teensy);
+        assert_app_pair(n2, n1, hb(0x101), stm32);
+        // Same application, same schedule: the two nodes count alike.
+        assert!(n1.heartbeats.abs_diff(n2.heartbeats) <= 2, "{n1:?} {n2:?}");
+        assert!(
+            n1.measurements.abs_diff(n2.measurements) <= 1,
+            "{n1:?} {n2:?}"
+        );
+        // Once both nodes are on the bus every frame is acknowledged: the only errors
+        // are the acknowledge errors of the first node before its peer joined.
+        let late_errors = w
+            .bus
+            .trace()
+            .records()
+            .iter()
+            .filter(|r| !r.is_error_free() && r.sof > 500_000 / 20)
+            .count();
+        assert_eq!(late_errors, 0, "{teensy} + {stm32}: errors after 50 ms");
+    }
+}
+
+/// Teensy 3.6 `can0-can1` and NUCLEO-F767ZI `can1-can2`: the two controllers of one
+/// chip exchange frames.
+#[test]
+fn two_controllers_of_one_chip_exchange_frames() {
+    for (board, bin) in [
+        ("teensy36", "teensy-can0-can1"),
+        ("nucleo-f767zi", "stm32f7-can1-can2"),
+    ] {
+        let Some(mut w) = world(500_000, &[(board, bin)]) else {
+            return;
+        };
+        w.run_for(secs(1.2));
+        assert_clean(&w);
+        let stats = app_stats(&w, 0, 2);
+        let hb = |id: u32| wire_count(&w, |f| raw_id(f) == (id, false) && !is_remote(f));
+        assert!(hb(0x101) >= 100 && hb(0x102) >= 100, "{board}");
+        assert_app_pair(stats[0], stats[1], hb(0x102), board);
+        assert_app_pair(stats[1], stats[0], hb(0x101), board);
+        // Both controllers sent and received on the wire.
+        for a in &w.attached {
+            let s = w.bus.node_stats(a.node).unwrap();
+            assert!(s.sent >= 100 && s.received >= 100, "{}: {s:?}", a.name);
+        }
+    }
+}
+
+/// The same ELF twice on one bus: two boards, each with its own CPU, memory and
+/// controllers.
+#[test]
+fn the_same_firmware_twice_on_one_bus() {
+    let Some(mut w) = world(
+        500_000,
+        &[
+            ("teensy36", "teensy-loopback"),
+            ("teensy36", "teensy-loopback"),
+        ],
+    ) else {
+        return;
+    };
+    w.run_for(secs(2.1));
+    assert_clean(&w);
+    assert_eq!(w.machines[1].board().name, "teensy36#2");
+    for m in &w.machines {
+        assert_eq!(m.read_u32_static("SENT"), Some(2));
+        assert_eq!(m.read_u32_static("RECEIVED"), Some(2));
+    }
+    // Loop-back frames stay inside each controller: nothing on the wire.
+    assert_eq!(w.bus.stats().frames_started, 0);
+}

@@ -1,0 +1,191 @@
+//! Tests that prove the harness can fail: a firmware that skips a clock gate faults
+//! with its PC reported; one that enables a CAN interrupt with its cause pending and a
+//! handler that does not clear it is caught as a stuck interrupt; a node at the wrong
+//! bit rate produces error frames and error-state changes.
+
+mod common;
+
+use common::*;
+use twocan_core::sim::SimNode;
+use twocan_core::Frame;
+use twocan_fil::nvic::exc;
+
+/// The address of the single `LDR` from `base` in function `reset`: found by running
+/// rather than by decoding, the test checks the reported PC lies inside `reset`.
+fn reset_range(w: &twocan_fil::world::World<'_>) -> std::ops::Range<u32> {
+    let s = w.machines[0].image.symbol("reset").expect("reset symbol");
+    let start = s.address & !1;
+    start..start + s.size as u32
+}
+
+#[test]
+fn touching_can_registers_with_the_clock_gated_faults_with_the_pc() {
+    for (board, bin, base) in [
+        ("teensy36", "kinetis-gate", 0x4002_4000),
+        ("teensy32", "kinetis-gate", 0x4002_4000),
+        ("nucleo-f767zi", "stm32-gate", 0x4000_6400),
+        ("disco-f746g", "stm32-gate", 0x4000_6400),
+    ] {
+        let Some(mut w) = world(500_000, &[(board, &format!("../negative/{bin}"))]) else {
+            return;
+        };
+        w.run_for(secs(0.005));
+        assert!(!w.clean(), "{board}");
+        let b = w.machines[0].board();
+        assert_eq!(b.faults.len(), 1, "{board}: {:?}", b.faults);
+        let f = &b.faults[0];
+        assert_eq!(f.address, Some(base), "{board}");
+        assert!(
+            reset_range(&w).contains(&f.pc),
+            "{board}: PC 0x{:08X}",
+            f.pc
+        );
+        // The instruction at the PC is the load (Thumb LDR immediate, 0x68xx).
+        let insn = w.machines[0].read_memory(f.pc, 2).unwrap();
+        assert_eq!(insn[1] & 0xF8, 0x68, "{board}: {insn:02X?}");
+        assert!(f.kind.contains("clock gated"), "{}", f.kind);
+        if board.starts_with("teensy") {
+            // Kinetis: a bus error; BusFault is disabled out of reset, so HardFault.
+            assert_eq!(f.taken_as, Some(exc::HARD_FAULT), "{board}");
+            assert!(!f.silent);
+            assert_eq!(b.taken.get(&exc::HARD_FAULT), Some(&1));
+            assert!(
+                b.console.contains("fault handler"),
+                "{board}: {:?}",
+                b.console
+            );
+            assert!(!b.console.contains("no fault"), "{board}");
+        } else {
+            // STM32: no bus error, the read gives 0 and the firmware goes on.
+            assert_eq!(f.taken_as, None, "{board}");
+            assert!(f.silent);
+            assert!(b.taken.is_empty(), "{board}: {:?}", b.taken);
+            assert!(
+                b.console.contains("the read returned"),
+                "{board}: {:?}",
+                b.console
+            );
+        }
+    }
+}
+
+#[test]
+fn an_interrupt_whose_cause_is_never_cleared_is_reported_stuck() {
+    for (board, bin, irq) in [
+        ("teensy36", "kinetis-stuck", 75),
+        ("nucleo-f767zi", "stm32-stuck", 19),
+    ] {
+        let Some(mut w) = world(500_000, &[(board, &format!("../negative/{bin}"))]) else {
+            return;
+        };
+        w.run_for(secs(0.01));
+        assert!(!w.clean(), "{board}");
+        let b = w.machines[0].board();
+        assert!(b.faults.is_empty(), "{board}: {:?}", b.faults);
+        assert_eq!(b.stuck.len(), 1, "{board}");
+        assert_eq!(b.stuck[0].exception, 16 + irq);
+        assert!(
+            b.console.contains("enabling IRQ"),
+            "{board}: {:?}",
+            b.console
+        );
+        assert!(!b.console.contains("back in thread mode"), "{board}");
+    }
+}
+
+#[test]
+fn the_example_apps_do_not_have_a_stuck_interrupt() {
+    // The same detector on the real firmware: an `app` alone on the bus (no peer: error
+    // interrupts and retransmissions) is not flagged.
+    for (board, bin) in [("teensy36", "teensy-app"), ("nucleo-f767zi", "stm32f7-app")] {
+        let Some(mut w) = world(500_000, &[(board, bin)]) else {
+            return;
+        };
+        w.run_for(secs(0.3));
+        assert!(w.machines[0].board().stuck.is_empty(), "{board}");
+    }
+}
+
+fn mismatch(board: &str, bin: &str, node_rate: u32) -> Option<twocan_fil::world::World<'static>> {
+    let mut w = world(500_000, &[(board, bin)])?;
+    let traffic = vec![Frame::standard(0x300, &[1, 2, 3, 4]).unwrap()];
+    w.add_node("peer", SimNode::new(), node_rate, traffic, 2_000_000_000);
+    w.run_for(secs(0.4));
+    Some(w)
+}
+
+#[test]
+fn a_node_at_the_wrong_bit_rate_gives_error_frames_and_error_state_changes() {
+    for (board, bin) in [("teensy36", "teensy-app"), ("nucleo-f767zi", "stm32f7-app")] {
+        // Control: the peer at the bus rate acknowledges everything.
+        let Some(ok) = mismatch(board, bin, 500_000) else {
+            return;
+        };
+        let late = |w: &twocan_fil::world::World<'_>| {
+            w.bus
+                .trace()
+                .records()
+                .iter()
+                .filter(|r| !r.is_error_free() && r.sof > 25_000)
+                .count()
+        };
+        assert_eq!(late(&ok), 0, "{board}: no errors at the right rate");
+        assert!(
+            ok.changes.iter().all(|c| c.at_us < 50_000),
+            "{:?}",
+            ok.changes
+        );
+
+        // The peer at 250 kbit/s on a 500 kbit/s bus.
+        let bad = mismatch(board, bin, 250_000).unwrap();
+        assert!(bad.nodes[0].misclocked);
+        assert!(late(&bad) > 100, "{board}: error frames");
+        let board_node = &bad.attached[0].name;
+        let change = bad
+            .changes
+            .iter()
+            .find(|c| &c.node == board_node && c.to != "error-active");
+        assert!(change.is_some(), "{board}: {:?}", bad.changes);
+        let (tec, rec) = bad.machines[0].board().cans[0].model.counters();
+        assert_ne!(
+            twocan_fil::world::error_state(tec, rec),
+            "error-active",
+            "{board}: TEC {tec} REC {rec}"
+        );
+        // Nothing the board sent got through.
+        let s = bad.bus.node_stats(bad.attached[0].node).unwrap();
+        assert_eq!(s.sent, 0, "{board}: {s:?}");
+        assert!(s.tx_errors > 0 && s.rx_errors > 0, "{board}: {s:?}");
+        // The candump trace shows the error frames.
+        assert!(
+            bad.candump().contains("20000"),
+            "SocketCAN error frames in the trace"
+        );
+        // No firmware fault: the firmware copes with a bad bus.
+        assert!(bad.machines[0].board().faults.is_empty());
+    }
+}
+
+#[test]
+fn a_kinetis_firmware_that_leaves_the_watchdog_alone_is_reset() {
+    for board in ["teensy32", "teensy36"] {
+        let Some(mut w) = world(500_000, &[(board, "../negative/kinetis-no-wdog")]) else {
+            return;
+        };
+        w.run_for(secs(0.001));
+        assert!(!w.clean());
+        let b = w.machines[0].board();
+        assert_eq!(b.faults.len(), 1, "{board}: {:?}", b.faults);
+        assert!(
+            b.faults[0]
+                .kind
+                .contains("WDOG not unlocked within the WCT"),
+            "{:?}",
+            b.faults
+        );
+        assert!(b.halted.is_some());
+        // Reset at 256 bus clocks (bus = core = 20.97 MHz out of reset): 12.2 µs.
+        let at = b.faults[0].at_ns;
+        assert!((12_000..=13_000).contains(&at), "{board}: {at} ns");
+    }
+}
