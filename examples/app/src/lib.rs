@@ -35,8 +35,10 @@ pub const F_STATUS_REQUEST: usize = 2;
 /// Filter index: the peer's status answers.
 pub const F_STATUS: usize = 3;
 
-/// Counters of what the application saw and did.
+/// Counters of what the application saw and did (`repr(C)`: the firmware-in-the-loop
+/// tests read them from the firmware's memory in this field order).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+#[repr(C)]
 pub struct AppStats {
     /// Frames accepted by the driver's transmit queue.
     pub sent: u32,
