@@ -14,3 +14,8 @@ pub mod backend;
 pub mod load;
 pub mod rng;
 pub mod support;
+
+/// The README's snippets, compiled and run as doctests.
+#[cfg(doctest)]
+#[doc = include_str!("../../README.md")]
+pub struct ReadmeDoctests;
