@@ -238,7 +238,10 @@ fn exchange(per_direction: u32) -> (u32, u32) {
         });
     });
 
-    for (name, state) in [("bxCAN", bx_state.traffic()), ("FlexCAN", flex_state.traffic())] {
+    for (name, state) in [
+        ("bxCAN", bx_state.traffic()),
+        ("FlexCAN", flex_state.traffic()),
+    ] {
         assert_eq!(state.queued, per_direction, "{name}");
         assert_eq!(state.sent, per_direction, "{name}");
         assert_eq!(state.received, per_direction, "{name}");
