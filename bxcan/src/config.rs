@@ -98,6 +98,8 @@ pub struct Config {
     interrupts: u32,
     can2_start_bank: Option<u8>,
     wait_iterations: u32,
+    /// The APB1 clock the timing was computed from (0: unknown, a raw `CAN_BTR`).
+    clock_hz: u32,
 }
 
 impl Config {
@@ -112,10 +114,13 @@ impl Config {
             rx_fifo_lock: false,
             timestamps: false,
             auto_wakeup: false,
-            debug_freeze: false,
+            // The reset value of `CAN_MCR.DBF` (RM0410 §40.9.2): CAN frozen while a
+            // debugger halts the core.
+            debug_freeze: true,
             interrupts: DEFAULT_INTERRUPTS,
             can2_start_bank: None,
             wait_iterations: DEFAULT_WAIT_ITERATIONS,
+            clock_hz: 0,
         }
     }
 
@@ -136,8 +141,12 @@ impl Config {
             Ok(t) => t,
             Err(e) => return Err(ConfigError::Timing(e)),
         };
+        let clock_hz = t.clock_hz;
         match t.bxcan_btr() {
-            Ok(b) => Ok(Self::with_btr(b)),
+            Ok(b) => Ok(Config {
+                clock_hz,
+                ..Self::with_btr(b)
+            }),
             Err(e) => Err(ConfigError::Timing(e)),
         }
     }
@@ -145,7 +154,13 @@ impl Config {
     /// Bit timing solved for `bitrate` from the APB1 clock `apb1_hz` (the bxCAN kernel
     /// clock, RM0410 §40.7.7 "Bit timing": tq = (BRP + 1) × tPCLK), CiA sample point,
     /// refused beyond [`DEFAULT_TOLERANCE_PPM`] (0.1 %) from the wished rate.
+    ///
+    /// A rate outside what the clock reaches is refused first, with the same typed error
+    /// on every backend ([`Limits::check_bitrate`]: `BitrateTooHigh`, `BitrateTooLow`).
     pub const fn from_bitrate(apb1_hz: u32, bitrate: u32) -> Result<Config, ConfigError> {
+        if let Err(e) = Limits::BXCAN.check_bitrate(apb1_hz, bitrate) {
+            return Err(ConfigError::Timing(e));
+        }
         match solve_cia(apb1_hz, bitrate, &Limits::BXCAN) {
             Ok(t) => Self::from_timing(t, DEFAULT_TOLERANCE_PPM),
             Err(e) => Err(ConfigError::Timing(e)),
@@ -159,6 +174,9 @@ impl Config {
         sample_point_permille: u16,
         tolerance_ppm: u32,
     ) -> Result<Config, ConfigError> {
+        if let Err(e) = Limits::BXCAN.check_bitrate(apb1_hz, bitrate) {
+            return Err(ConfigError::Timing(e));
+        }
         match solve(apb1_hz, bitrate, &Limits::BXCAN, sample_point_permille) {
             Ok(t) => Self::from_timing(t, tolerance_ppm),
             Err(e) => Err(ConfigError::Timing(e)),
@@ -234,7 +252,9 @@ impl Config {
         }
     }
 
-    /// Freeze the controller while the core is halted by a debugger (`CAN_MCR.DBF`).
+    /// Freeze the controller while the core is halted by a debugger (`CAN_MCR.DBF`, set
+    /// at reset and kept by default: RM0410 §40.9.2). Turn it off to keep the bus
+    /// traffic going while stepping through firmware.
     pub const fn debug_freeze(self, on: bool) -> Self {
         Config {
             debug_freeze: on,
@@ -337,7 +357,19 @@ impl Config {
         self.can2_start_bank
     }
 
-    /// The acknowledge wait bound.
+    /// The APB1 clock (Hz) the bit timing was computed from; 0 for a raw `CAN_BTR`
+    /// ([`Config::from_btr`]).
+    pub const fn get_clock_hz(&self) -> u32 {
+        self.clock_hz
+    }
+
+    /// Whether `CAN_MCR.DBF` is set: CAN frozen while a debugger halts the core (the
+    /// reset value, kept by default).
+    pub const fn get_debug_freeze(&self) -> bool {
+        self.debug_freeze
+    }
+
+    /// Register reads each acknowledge wait may take.
     pub const fn get_wait_iterations(&self) -> u32 {
         self.wait_iterations
     }
@@ -364,7 +396,9 @@ mod tests {
     #[test]
     fn options_map_to_mcr_bits() {
         let c = Config::from_btr(0).unwrap();
-        assert_eq!(c.mcr_options(), mcr::TXFP);
+        // Defaults: request order (TXFP = 1, the portable default), DBF kept as at reset.
+        assert_eq!(c.mcr_options(), mcr::TXFP | mcr::DBF);
+        assert_eq!(c.debug_freeze(false).mcr_options(), mcr::TXFP);
         let c = c
             .tx_policy(TxPolicy::Priority)
             .one_shot(true)
@@ -383,10 +417,23 @@ mod tests {
     fn timing_out_of_tolerance_is_refused() {
         // 54 MHz / 500 kbit/s = 108 clocks: exact.
         assert!(Config::from_bitrate(54_000_000, 500_000).is_ok());
-        // 1 bit/s cannot be reached (BRP ≤ 1024, ≤ 25 quanta).
+        // 1 bit/s cannot be reached (BRP ≤ 1024, ≤ 25 quanta): below the slowest rate,
+        // the same error as on every backend.
         assert_eq!(
             Config::from_bitrate(54_000_000, 1),
-            Err(ConfigError::Timing(TimingError::TooFarFromWishedBitrate))
+            Err(ConfigError::Timing(TimingError::BitrateTooLow))
+        );
+        let fastest = Limits::BXCAN.max_bitrate(54_000_000);
+        assert!(Config::from_bitrate(54_000_000, fastest).is_ok());
+        assert_eq!(
+            Config::from_bitrate(54_000_000, fastest + 1),
+            Err(ConfigError::Timing(TimingError::BitrateTooHigh))
+        );
+        assert_eq!(
+            Config::from_bitrate(54_000_000, 500_000)
+                .unwrap()
+                .get_clock_hz(),
+            54_000_000
         );
         assert_eq!(
             Config::from_bitrate(0, 500_000),

@@ -201,6 +201,9 @@ impl<R: Registers> FlexCan<R> {
         primary: &[Filter],
         secondary: &[Filter],
     ) -> Result<Self, BeginError> {
+        twocan_core::timing::Limits::FLEXCAN
+            .check_bitrate(crate::settings::CAN_CLOCK_HZ, settings.wished_bit_rate())
+            .map_err(BeginError::Timing)?;
         let plan = plan(target, settings, primary, secondary).map_err(BeginError::Config)?;
         plan.system.apply(sys);
         configure(&mut regs, &plan, settings.handshake_polls)?;

@@ -102,6 +102,11 @@ impl defmt::Format for ConfigErrors {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum BeginError {
+    /// The wished bit rate is outside what the 16 MHz CAN clock reaches (the rule every
+    /// backend applies first: [`twocan_core::timing::Limits::check_bitrate`]); no
+    /// register was written. ACAN's tolerance check ([`ConfigErrors::BIT_RATE_TOO_FAR`])
+    /// applies in addition.
+    Timing(twocan_core::timing::TimingError),
     /// The settings, filters or pins are invalid (ACAN table 5); no register was
     /// written.
     Config(ConfigErrors),
@@ -116,7 +121,7 @@ impl BeginError {
     pub const fn flags(&self) -> ConfigErrors {
         match self {
             BeginError::Config(f) => *f,
-            BeginError::Hardware(_) => ConfigErrors::NONE,
+            BeginError::Timing(_) | BeginError::Hardware(_) => ConfigErrors::NONE,
         }
     }
 }
@@ -130,13 +135,22 @@ impl From<twocan_core::Error> for BeginError {
 impl fmt::Display for BeginError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
+            BeginError::Timing(e) => write!(f, "bit rate out of range: {e}"),
             BeginError::Config(c) => write!(f, "invalid configuration: {c}"),
             BeginError::Hardware(e) => write!(f, "controller failure: {e}"),
         }
     }
 }
 
-impl core::error::Error for BeginError {}
+impl core::error::Error for BeginError {
+    fn source(&self) -> Option<&(dyn core::error::Error + 'static)> {
+        match self {
+            BeginError::Timing(e) => Some(e),
+            BeginError::Hardware(e) => Some(e),
+            BeginError::Config(_) => None,
+        }
+    }
+}
 
 #[cfg(test)]
 mod tests {

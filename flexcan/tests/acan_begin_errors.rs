@@ -38,6 +38,7 @@ fn begin_error(
     ) {
         Ok(_) => panic!("begin succeeded"),
         Err(BeginError::Hardware(e)) => panic!("hardware error {e:?}"),
+        Err(BeginError::Timing(e)) => panic!("bit rate out of range {e:?}"),
         Err(BeginError::Config(f)) => {
             assert_eq!(f, flags, "check() and begin() agree");
             assert!(
@@ -62,10 +63,53 @@ fn no_error() {
 
 #[test]
 fn bit_rate_too_far_15_2_1() {
-    // `ACANSettings settings (1)`: 1 bit/s; the error code is exactly bit 0.
-    let f = begin_error(T32_CAN0, &Settings::new(1), &[], &[]);
+    // `ACANSettings settings (1)`: 1 bit/s; ACAN's error code is exactly bit 0.
+    let f = twocan_flexcan::check(T32_CAN0, &Settings::new(1), &[], &[]);
     assert_eq!(f, ConfigErrors::BIT_RATE_TOO_FAR);
     assert_eq!(f.bits(), 1 << 0);
+}
+
+/// A wished rate outside what the 16 MHz clock reaches is refused by `begin` with the
+/// portable error every backend gives (before ACAN's tolerance check, which alone lets
+/// 3,200,001 bit/s through at 0.3 ppm), and nothing is written.
+#[test]
+fn bit_rates_out_of_range_are_refused_as_on_every_backend() {
+    use twocan_core::timing::TimingError;
+    for (rate, want) in [
+        (1, TimingError::BitrateTooLow),
+        (2_499, TimingError::BitrateTooLow),
+        (3_200_001, TimingError::BitrateTooHigh),
+        (0, TimingError::BitrateZero),
+    ] {
+        let model = model_for(T32_CAN0.board);
+        let mut sys = HostSystem::new();
+        let r = FlexCan::begin(
+            model.clone(),
+            &mut sys,
+            T32_CAN0,
+            &Settings::new(rate),
+            &[],
+            &[],
+        );
+        assert!(
+            matches!(r, Err(BeginError::Timing(e)) if e == want),
+            "{rate}"
+        );
+        assert!(sys.written().is_empty());
+        assert_eq!(model.mode(), ModelMode::Disabled);
+    }
+    for rate in [2_500, 3_200_000] {
+        let model = model_for(T32_CAN0.board);
+        let r = FlexCan::begin(
+            twocan_flexcan::IdleClocked::new(model),
+            &mut HostSystem::new(),
+            T32_CAN0,
+            &Settings::new(rate),
+            &[],
+            &[],
+        );
+        assert!(r.is_ok(), "{rate}: {:?}", r.err());
+    }
 }
 
 #[test]
@@ -194,7 +238,9 @@ fn can1_only_on_teensy_36() {
 
 #[test]
 fn every_flag_at_once() {
-    let mut s = Settings::new(1);
+    // In range, but the prescaler moved by hand puts the rate far from the wished one.
+    let mut s = Settings::new(125_000);
+    s.timing.prescaler += 3;
     s.timing.sjw = 0;
     s.configuration = Configuration::Filters8_0;
     s.use_alternate_tx_pin = true;
@@ -262,12 +308,13 @@ fn handshake_timeout_is_typed_and_retry_works() {
 fn begin_keeps_the_model_by_reference() {
     // `regs` may be `&mut M`: the caller keeps the registers after an error.
     let mut model = FlexCanModel::mk20dx256();
+    let too_many: Vec<Filter> = (0..20).map(|i| Filter::standard(i)).collect();
     let e = FlexCan::begin(
         &mut model,
         &mut HostSystem::new(),
         T32_CAN0,
-        &Settings::new(1),
-        &[],
+        &Settings::new(125_000),
+        &too_many,
         &[],
     );
     assert!(matches!(e, Err(BeginError::Config(_))));

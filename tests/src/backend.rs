@@ -99,6 +99,8 @@ pub enum TimingRefused {
     Zero,
     /// Faster than clock / fewest quanta per bit.
     TooHigh,
+    /// Slower than clock / (largest prescaler × most quanta per bit).
+    TooLow,
     /// No timing within the tolerance of the wished rate.
     TooFar,
     /// The sample point is not strictly between 50 % and 100 %.
@@ -190,6 +192,7 @@ fn timing_refused(e: TimingError) -> TimingRefused {
     match e {
         TimingError::BitrateZero => TimingRefused::Zero,
         TimingError::BitrateTooHigh => TimingRefused::TooHigh,
+        TimingError::BitrateTooLow => TimingRefused::TooLow,
         TimingError::TooFarFromWishedBitrate => TimingRefused::TooFar,
         TimingError::SamplePointOutOfRange => TimingRefused::SamplePoint,
         _ => TimingRefused::Other,
@@ -313,6 +316,10 @@ impl Backend for FlexCanBackend {
     }
 
     fn check_timing(bitrate: u32, sample_point_permille: u16) -> Result<u32, TimingRefused> {
+        // The rule `begin` applies first, as every backend does.
+        Limits::FLEXCAN
+            .check_bitrate(CAN_CLOCK_HZ, bitrate)
+            .map_err(timing_refused)?;
         let t = solve(
             CAN_CLOCK_HZ,
             bitrate,

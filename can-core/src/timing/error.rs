@@ -16,6 +16,9 @@ pub enum TimingError {
     /// shortest bit): no timing can be that fast (16 MHz FlexCAN: 3.2 Mbit/s,
     /// ACAN §16.1).
     BitrateTooHigh,
+    /// The wished bit rate is below the slowest the controller reaches (largest
+    /// prescaler, most quanta per bit: 16 MHz FlexCAN: 2.5 kbit/s, ACAN §16.1).
+    BitrateTooLow,
     /// The sample point target is not strictly between 50 % and 100 %
     /// (valid: 501..=999 per mille).
     SamplePointOutOfRange,
@@ -40,6 +43,9 @@ impl fmt::Display for TimingError {
             TimingError::BitrateZero => f.write_str("bit rate is 0 bit/s"),
             TimingError::BitrateTooHigh => {
                 f.write_str("bit rate above clock / minimum quanta per bit")
+            }
+            TimingError::BitrateTooLow => {
+                f.write_str("bit rate below clock / (largest prescaler × most quanta per bit)")
             }
             TimingError::SamplePointOutOfRange => {
                 f.write_str("sample point must be above 50 % and below 100 %")

@@ -30,6 +30,8 @@
 //!   `SJW = sjw − 1`. bxCAN has no separate propagation segment: its limits give
 //!   `prop_seg` the range 0..=0 and `phase_seg1` holds the whole TS1.
 
+use super::error::TimingError;
+
 /// An inclusive range of counts (quanta, or prescaler steps).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -165,6 +167,53 @@ impl Limits {
     /// Most quanta in a bit: 1 + max tseg1 + max tseg2 (25 for both).
     pub const fn max_quanta(&self) -> u32 {
         1 + self.tseg1().max as u32 + self.phase_seg2.max as u32
+    }
+
+    /// The fastest bit rate these limits reach from `clock_hz`: prescaler 1 (the
+    /// smallest), fewest quanta per bit.
+    pub const fn max_bitrate(&self, clock_hz: u32) -> u32 {
+        clock_hz / (self.prescaler.min as u32 * self.min_quanta())
+    }
+
+    /// The slowest bit rate these limits reach from `clock_hz` (largest prescaler, most
+    /// quanta per bit), rounded up: a wished rate below it cannot be met.
+    pub const fn min_bitrate(&self, clock_hz: u32) -> u32 {
+        let slowest = self.prescaler.max as u64 * self.max_quanta() as u64;
+        clock_hz.div_ceil(slowest as u32)
+    }
+
+    /// The one rule every backend applies to a wished bit rate before any tolerance
+    /// check: [`TimingError::ClockZero`], [`TimingError::BitrateZero`],
+    /// [`TimingError::BitrateTooHigh`] above [`Limits::max_bitrate`],
+    /// [`TimingError::BitrateTooLow`] below [`Limits::min_bitrate`].
+    ///
+    /// ```
+    /// use twocan_core::timing::{Limits, TimingError};
+    /// const OK: Result<(), TimingError> = Limits::FLEXCAN.check_bitrate(16_000_000, 500_000);
+    /// assert_eq!(OK, Ok(()));
+    /// assert_eq!(Limits::FLEXCAN.max_bitrate(16_000_000), 3_200_000); // ACAN §16.1
+    /// assert_eq!(Limits::FLEXCAN.min_bitrate(16_000_000), 2_500);
+    /// assert_eq!(
+    ///     Limits::FLEXCAN.check_bitrate(16_000_000, 3_200_001),
+    ///     Err(TimingError::BitrateTooHigh)
+    /// );
+    /// assert_eq!(
+    ///     Limits::BXCAN.check_bitrate(54_000_000, 1),
+    ///     Err(TimingError::BitrateTooLow)
+    /// );
+    /// ```
+    pub const fn check_bitrate(&self, clock_hz: u32, bitrate: u32) -> Result<(), TimingError> {
+        if clock_hz == 0 {
+            Err(TimingError::ClockZero)
+        } else if bitrate == 0 {
+            Err(TimingError::BitrateZero)
+        } else if bitrate > self.max_bitrate(clock_hz) {
+            Err(TimingError::BitrateTooHigh)
+        } else if bitrate < self.min_bitrate(clock_hz) {
+            Err(TimingError::BitrateTooLow)
+        } else {
+            Ok(())
+        }
     }
 
     /// Whether these limits can be used by the solver: every range non-empty,
