@@ -308,7 +308,7 @@ fn handshake_timeout_is_typed_and_retry_works() {
 fn begin_keeps_the_model_by_reference() {
     // `regs` may be `&mut M`: the caller keeps the registers after an error.
     let mut model = FlexCanModel::mk20dx256();
-    let too_many: Vec<Filter> = (0..20).map(|i| Filter::standard(i)).collect();
+    let too_many: Vec<Filter> = (0..20).map(Filter::standard).collect();
     let e = FlexCan::begin(
         &mut model,
         &mut HostSystem::new(),
