@@ -21,6 +21,9 @@
 //!   started: the bus polls only while idle).
 //! - [`BusNode::next_wakeup`]: the end of SYNC, and the end of each run of 11 recessive
 //!   bits of a bus-off recovery under way, so that the bus stops its idle stretches there.
+//! - Suspend transmission: error-passive after transmitting, the controller starts no frame
+//!   before 8 bits after the intermission (ISO 11898-1 §10.4.6.4), counted by the shared
+//!   `FaultConfinement` from the end of the frame or error frame.
 //! - Time stamps are the TTCM timer at the start of frame (`BusTime::sof`).
 
 use twocan_core::sim::{BusNode, BusTime, TxRequest, TxResult};
@@ -76,7 +79,11 @@ impl Controller {
             self.tx.bus_idle();
             self.settle();
         }
-        if self.mode() != Mode::Normal || self.modes.syncing() || self.errors.is_bus_off() {
+        if self.mode() != Mode::Normal
+            || self.modes.syncing()
+            || self.errors.is_bus_off()
+            || !self.errors.fault_confinement().may_start_transmission(now)
+        {
             return None;
         }
         let (lbkm, silm) = (self.lbkm(), self.silm());
@@ -199,7 +206,27 @@ impl Controller {
         }
         let recovering =
             self.mode() == Mode::Normal && self.errors.recovery_under_way(self.has(mcr::ABOM));
-        recovering.then(|| now.saturating_add(self.errors.recovery_bits_to_next_sequence()))
+        if recovering {
+            return Some(now.saturating_add(self.errors.recovery_bits_to_next_sequence()));
+        }
+        let waiting = self.tx.next(self.has(mcr::TXFP)).is_some();
+        if waiting {
+            self.errors.fault_confinement().suspend_end(now)
+        } else {
+            None
+        }
+    }
+
+    /// The end of an attempt the controller transmitted (see `BusNode::tx_attempt_end`).
+    fn tx_attempt_end(&mut self, dominant_in_passive_flag: bool, time: BusTime) {
+        self.observe(time.sof, time.now);
+        if self
+            .errors
+            .transmission_ended(time.now, dominant_in_passive_flag)
+        {
+            self.error_detected();
+        }
+        self.settle();
     }
 
     fn advance(&mut self, bits: u64, idle: bool, now: u64) {
@@ -260,5 +287,11 @@ impl BusNode for BxCanModel {
 
     fn next_wakeup(&self, now: u64) -> Option<u64> {
         self.inner.borrow().next_wakeup(now)
+    }
+
+    fn tx_attempt_end(&mut self, dominant_in_passive_flag: bool, time: BusTime) {
+        self.inner
+            .borrow_mut()
+            .tx_attempt_end(dominant_in_passive_flag, time);
     }
 }

@@ -177,6 +177,9 @@ enum Notice {
     Tx(crate::frame::Frame, TxResult),
     Rx,
     RxError(crate::error::LastErrorCode, bool),
+    /// The end of the attempt for a transmitter; whether it read a dominant bit during its
+    /// passive error flag.
+    TxEnd(bool),
 }
 
 struct Slot {
@@ -620,6 +623,14 @@ impl Bus {
                 PartOutcome::Error { code, at, .. } => (u64::from(at) + 1, TxResult::Error(code)),
             };
             schedule.push((at.min(end), 1, *k, Notice::Tx(r.frame, result)));
+            let flag = matches!(
+                *outcome,
+                PartOutcome::Error {
+                    dominant_in_passive_flag: true,
+                    ..
+                }
+            );
+            schedule.push((end, 3, *k, Notice::TxEnd(flag)));
         }
         for (&k, outcome) in receivers.iter().zip(&res.rx) {
             let (at, notice) = match *outcome {
@@ -628,6 +639,7 @@ impl Bus {
                     code,
                     at,
                     dominant_after_flag,
+                    ..
                 } => (
                     u64::from(at) + 8,
                     Notice::RxError(code, dominant_after_flag),
@@ -650,6 +662,10 @@ impl Bus {
             let slot = &mut self.slots[k];
             // A loser is told again as a receiver (unless it does not listen).
             in_frame[k] = matches!(notice, Notice::Lost(_)) && receivers.contains(&k);
+            if let Notice::TxEnd(flag) = notice {
+                slot.node.tx_attempt_end(flag, time);
+                continue;
+            }
             match notice {
                 Notice::Lost(f) => {
                     slot.node.tx_result(&f, TxResult::ArbitrationLost, time);
@@ -672,6 +688,7 @@ impl Bus {
                     slot.node.rx_error(code, dominant_after_flag, time);
                     slot.stats.rx_errors += 1;
                 }
+                Notice::TxEnd(_) => {}
             }
         }
         self.advance_span(&res.wire, sof, done, end, &in_frame);
@@ -709,6 +726,7 @@ impl Bus {
                     code,
                     at,
                     dominant_after_flag,
+                    ..
                 } => {
                     note_error(NodeId(k), false, code, at);
                     (

@@ -76,6 +76,9 @@ pub(crate) enum PartOutcome {
         at: u32,
         /// A receiver read a dominant bit right after its error flag (ISO rule 2).
         dominant_after_flag: bool,
+        /// It sent a passive error flag and read a dominant bit during it (rule 3,
+        /// exception 1 does not apply then).
+        dominant_in_passive_flag: bool,
     },
 }
 
@@ -116,6 +119,7 @@ struct Part {
     can_flag: bool,
     error: Option<(LastErrorCode, u32)>,
     dominant_after_flag: bool,
+    dominant_in_passive_flag: bool,
     ok: Option<u32>,
     // receiver bookkeeping
     run_last: bool,
@@ -131,6 +135,7 @@ impl Part {
             can_flag,
             error: None,
             dominant_after_flag: false,
+            dominant_in_passive_flag: false,
             ok: None,
             run_last: true,
             run: 0,
@@ -158,6 +163,9 @@ impl Part {
             Phase::ActiveFlag(n) if n + 1 >= 6 => Phase::AfterFlag { first: true },
             Phase::ActiveFlag(n) => Phase::ActiveFlag(n + 1),
             Phase::PassiveFlag { last, run } => {
+                if !wire {
+                    self.dominant_in_passive_flag = true;
+                }
                 let run = if run == 0 || wire == last { run + 1 } else { 1 };
                 if run >= 6 {
                     Phase::AfterFlag { first: true }
@@ -187,6 +195,7 @@ impl Part {
                 code,
                 at,
                 dominant_after_flag: self.dominant_after_flag,
+                dominant_in_passive_flag: self.dominant_in_passive_flag,
             },
             None => match self.ok {
                 Some(done) => PartOutcome::Ok { done },
@@ -195,6 +204,7 @@ impl Part {
                     code: LastErrorCode::Form,
                     at: end,
                     dominant_after_flag: false,
+                    dominant_in_passive_flag: false,
                 },
             },
         }
@@ -418,6 +428,7 @@ mod tests {
             code,
             at,
             dominant_after_flag: dom,
+            dominant_in_passive_flag: false,
         }
     }
 
@@ -449,7 +460,16 @@ mod tests {
         // A listen-only receiver sees the active error flag as a form error at the ACK delimiter.
         let r = resolve(&[tx(&w, true)], &[rx(false, false)]);
         assert_eq!(r.tx, vec![err(L::Acknowledge, ce + 1, false)]);
-        assert_eq!(r.rx, vec![err(L::Form, ce + 2, false)]);
+        // Its own passive flag overlaps the transmitter's active flag.
+        assert_eq!(
+            r.rx,
+            vec![PartOutcome::Error {
+                code: L::Form,
+                at: ce + 2,
+                dominant_after_flag: false,
+                dominant_in_passive_flag: true,
+            }]
+        );
         assert!(!r.observer_ok && !r.acked);
         // Flag ce+2..=ce+7, delimiter ce+8..=ce+15.
         assert_eq!(r.end, ce + 16);

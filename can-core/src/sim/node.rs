@@ -75,6 +75,17 @@ pub trait BusNode {
     /// `bits` bit times passed ending at `now`; `idle` says the bus was recessive all along.
     fn advance(&mut self, bits: u64, idle: bool, now: u64);
 
+    /// The frame attempt in which this node was a transmitter (it did not lose arbitration)
+    /// is over: `time.now` is the end of the last end of frame or error delimiter, where the
+    /// intermission starts; always after [`BusNode::tx_result`]. `dominant_in_passive_flag`:
+    /// the node sent a passive error flag and read a dominant bit during it (ISO 11898-1
+    /// §12.1.4.2 rule 3, exception 1 then does not apply). Nodes use it for
+    /// [`crate::fault::FaultConfinement::transmission_ended`] (that exception and suspend
+    /// transmission). The default does nothing.
+    fn tx_attempt_end(&mut self, dominant_in_passive_flag: bool, time: BusTime) {
+        let _ = (dominant_in_passive_flag, time);
+    }
+
     /// The earliest bus time after `now` at which this node may start a frame on its own,
     /// without software doing anything: the end of its suspend-transmission time, the moment
     /// its bus-off recovery completes, a timer. The bus ends idle stretches there, so that the
@@ -117,5 +128,9 @@ impl<T: BusNode + ?Sized> BusNode for std::rc::Rc<core::cell::RefCell<T>> {
     }
     fn next_wakeup(&self, now: u64) -> Option<u64> {
         self.borrow().next_wakeup(now)
+    }
+    fn tx_attempt_end(&mut self, dominant_in_passive_flag: bool, time: BusTime) {
+        self.borrow_mut()
+            .tx_attempt_end(dominant_in_passive_flag, time)
     }
 }

@@ -11,6 +11,9 @@
 //! - Self reception (MCR\[SRXDIS\] = 0): the module receives its own frames if they match a
 //!   filter. The simulated bus reports a node's own frame through `rx(.., own = true, ..)`
 //!   and the model drops it when SRXDIS = 1.
+//! - Suspend transmission: error-passive after transmitting, the module starts no frame
+//!   before 8 bits after the intermission (ISO 11898-1 §10.4.6.4; the Kinetis manuals:
+//!   "delay its transmission start time (error-passive)").
 //! - Time stamps are the TIMER value at the bit after SOF (the identifier's start).
 
 use twocan_core::error::LastErrorCode;
@@ -33,9 +36,9 @@ impl State {
         self.on_bus() && !self.bus_off() && !self.lom()
     }
 
-    /// What the controller would start now.
-    pub fn poll_tx(&self) -> Option<TxRequest> {
-        if !self.can_transmit() {
+    /// What the controller would start now (not before suspend transmission has ended).
+    pub fn poll_tx(&self, now: u64) -> Option<TxRequest> {
+        if !self.can_transmit() || !self.errors.fc.may_start_transmission(now) {
             return None;
         }
         let frame = self.mb_tx_frame(self.select_tx()?)?;
@@ -133,7 +136,13 @@ impl State {
         if !self.synched {
             return Some(now.saturating_add(11u64.saturating_sub(self.sync_run).max(1)));
         }
-        None
+        self.errors.fc.suspend_end(now)
+    }
+
+    /// The end of an attempt the module transmitted (see `BusNode::tx_attempt_end`).
+    pub fn tx_attempt_end(&mut self, dominant_in_passive_flag: bool, time: BusTime) {
+        self.time_to(time.now);
+        self.transmission_ended(time.now, dominant_in_passive_flag);
     }
 
     /// `bits` bit times passed, ending at `now`.

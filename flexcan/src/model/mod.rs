@@ -265,8 +265,8 @@ impl Registers for FlexCanModel {
 }
 
 impl BusNode for FlexCanModel {
-    fn poll_tx(&mut self, _now: u64) -> Option<TxRequest> {
-        self.inner.borrow().poll_tx()
+    fn poll_tx(&mut self, now: u64) -> Option<TxRequest> {
+        self.inner.borrow().poll_tx(now)
     }
 
     fn acknowledges(&self) -> bool {
@@ -301,5 +301,11 @@ impl BusNode for FlexCanModel {
 
     fn next_wakeup(&self, now: u64) -> Option<u64> {
         self.inner.borrow().next_wakeup(now)
+    }
+
+    fn tx_attempt_end(&mut self, dominant_in_passive_flag: bool, time: BusTime) {
+        self.inner
+            .borrow_mut()
+            .tx_attempt_end(dominant_in_passive_flag, time);
     }
 }
