@@ -49,6 +49,7 @@ use crate::regs::{Instance, FILTER_BANKS, RX_FIFOS, TX_MAILBOXES};
 use controller::Controller;
 use filters::{FilterBlock, Owner};
 
+pub use errors::REC_AFTER_PASSIVE_RECEPTION;
 pub use irq::IrqLines;
 pub use modes::Mode;
 

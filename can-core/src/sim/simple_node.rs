@@ -199,8 +199,7 @@ impl SimNode {
 
 impl BusNode for SimNode {
     fn poll_tx(&mut self, now: u64) -> Option<TxRequest> {
-        if self.fault.is_bus_off() || self.listen_only || !self.fault.may_start_transmission(now)
-        {
+        if self.fault.is_bus_off() || self.listen_only || !self.fault.may_start_transmission(now) {
             return None;
         }
         self.queue.front().map(|&frame| TxRequest {

@@ -127,7 +127,11 @@ impl State {
     /// The end of a frame attempt the module transmitted (`end`: end of its EOF or error
     /// delimiter): rule 3 exception 1 settled, suspend transmission armed.
     pub fn transmission_ended(&mut self, end: u64, dominant_in_passive_flag: bool) {
-        if self.errors.fc.transmission_ended(end, dominant_in_passive_flag) {
+        if self
+            .errors
+            .fc
+            .transmission_ended(end, dominant_in_passive_flag)
+        {
             let boffrec = self.ctrl1_bit(ctrl1::BOFFREC);
             self.errors.bus_off_entered(boffrec);
         }

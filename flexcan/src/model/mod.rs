@@ -31,6 +31,8 @@ mod rx_fifo;
 mod state;
 mod timer;
 
+pub use errors::REC_AFTER_PASSIVE_RECEPTION;
+
 use std::cell::RefCell;
 use std::rc::Rc;
 
