@@ -182,6 +182,23 @@ enum Notice {
     TxEnd(bool),
 }
 
+/// A wire frame attempt that has started and is not over yet (see [`Bus::run_bits`]).
+struct InFlight {
+    sof: u64,
+    /// Offset from SOF of the end of the last EOF or error delimiter.
+    end: u64,
+    schedule: Vec<(u64, u8, usize, Notice)>,
+    /// The next schedule entry to deliver.
+    next: usize,
+    /// Offset from SOF up to which every node has been advanced.
+    done: u64,
+    in_frame: Vec<bool>,
+    wire: Vec<bool>,
+    record: TraceRecord,
+    receivers: Vec<usize>,
+    frame: crate::frame::Frame,
+}
+
 struct Slot {
     name: String,
     node: Box<dyn BusNode>,
@@ -199,6 +216,7 @@ pub struct Bus {
     stats: BusStats,
     instant_streak: u32,
     idle_quantum: u64,
+    in_flight: Option<InFlight>,
 }
 
 impl core::fmt::Debug for Bus {
@@ -235,6 +253,7 @@ impl Bus {
             stats: BusStats::default(),
             instant_streak: 0,
             idle_quantum: u64::MAX,
+            in_flight: None,
         })
     }
 
@@ -362,20 +381,82 @@ impl Bus {
     }
 
     /// Runs one frame attempt or internal frame if some node wants to send now; `None` (and
-    /// no time passes) if none does.
+    /// no time passes) if none does. A frame attempt left in flight by [`Bus::run_bits`] is
+    /// finished first (that is the event returned).
     pub fn step(&mut self) -> Option<BusEvent> {
+        if self.in_flight.is_some() {
+            return self.continue_attempt(u64::MAX);
+        }
+        match self.begin()? {
+            Some(event) => Some(event),
+            None => self.continue_attempt(u64::MAX),
+        }
+    }
+
+    /// Starts the next event if some node wants to send: `Some(Some(event))` for an
+    /// internal frame (already over), `Some(None)` for a wire attempt now in flight.
+    fn begin(&mut self) -> Option<Option<BusEvent>> {
         let (internal, wire) = self.poll();
         if let Some((k, req)) = internal {
             if self.instant_streak < MAX_INSTANT_EVENTS {
                 self.instant_streak += 1;
-                return Some(self.internal_frame(k, req));
+                return Some(Some(self.internal_frame(k, req)));
             }
         }
         if wire.is_empty() {
             return None;
         }
         self.instant_streak = 0;
-        Some(self.frame_attempt(wire))
+        self.start_attempt(wire);
+        Some(None)
+    }
+
+    /// Whether a frame attempt is in flight: [`Bus::run_bits`] stopped inside it.
+    pub fn in_frame(&self) -> bool {
+        self.in_flight.is_some()
+    }
+
+    /// The bit offset from SOF of the attempt in flight (the number of its bits that have
+    /// passed), if one is.
+    pub fn frame_offset(&self) -> Option<u64> {
+        self.in_flight.as_ref().map(|f| self.now - f.sof)
+    }
+
+    /// Runs the bus for exactly `bits` bit times, stopping inside a frame attempt if the
+    /// time falls there (the other run methods never cut a frame). Software can then
+    /// access its controllers' registers while the frame is on the wire — between the
+    /// transmit request and the end of the frame, or between a read and a write-back — and
+    /// continue with another `run_bits` or any other run method. Every node has been
+    /// advanced to [`Bus::now`] and told [`BusNode::paused_in_frame`] the wire's level.
+    /// Returns the events that ended in the span (a frame cut by the end of the span is
+    /// returned by the call that finishes it).
+    pub fn run_bits(&mut self, bits: u64) -> Vec<BusEvent> {
+        let until = self.now.saturating_add(bits);
+        let mut events = Vec::new();
+        loop {
+            if self.in_flight.is_some() {
+                match self.continue_attempt(until) {
+                    Some(event) => events.push(event),
+                    None => break,
+                }
+                continue;
+            }
+            if self.now >= until {
+                break;
+            }
+            match self.begin() {
+                Some(Some(event)) => events.push(event),
+                Some(None) => {}
+                None => {
+                    let mut to = until.min(self.now.saturating_add(self.idle_quantum));
+                    if let Some(w) = self.next_wakeup() {
+                        to = to.min(w);
+                    }
+                    events.push(self.idle_to(to));
+                }
+            }
+        }
+        events
     }
 
     /// Runs one event if the bus time is before `until`: a frame if some node wants to send
@@ -547,7 +628,10 @@ impl Bus {
         BusEvent::Internal(self.record(record))
     }
 
-    fn frame_attempt(&mut self, requests: Vec<Request>) -> BusEvent {
+    /// Starts a wire frame attempt: arbitration, the attempt played bit by bit, and the
+    /// schedule of what each node is told when. Nothing is delivered yet: the attempt is
+    /// in flight until [`Bus::continue_attempt`] has reached its end.
+    fn start_attempt(&mut self, requests: Vec<Request>) {
         let sof = self.now;
         let seq = self.stats.frames_started;
         self.stats.frames_started += 1;
@@ -611,7 +695,7 @@ impl Bus {
         // a transmitter's error when it detects it (its counters change then, so a node that
         // goes bus-off counts the recessive bits of its error delimiter); a receiver's error
         // after the bit that follows its error flag (when rule 2 is known); successes at the
-        // end of the node's EOF.
+        // end of the node's EOF; the end of the attempt to each transmitter.
         let mut schedule: Vec<(u64, u8, usize, Notice)> = Vec::new();
         let arb = u64::from(bits.arbitration_end);
         for (k, r) in &losers {
@@ -654,44 +738,6 @@ impl Bus {
         for &k in contenders.iter().map(|(k, _)| k).chain(&receivers) {
             in_frame[k] = true;
         }
-        let mut done = 0;
-        for &(at, _, k, notice) in &schedule {
-            self.advance_span(&res.wire, sof, done, at, &in_frame);
-            done = at;
-            let time = BusTime { sof, now: self.now };
-            let slot = &mut self.slots[k];
-            // A loser is told again as a receiver (unless it does not listen).
-            in_frame[k] = matches!(notice, Notice::Lost(_)) && receivers.contains(&k);
-            if let Notice::TxEnd(flag) = notice {
-                slot.node.tx_attempt_end(flag, time);
-                continue;
-            }
-            match notice {
-                Notice::Lost(f) => {
-                    slot.node.tx_result(&f, TxResult::ArbitrationLost, time);
-                    slot.stats.arbitration_lost += 1;
-                }
-                Notice::Tx(f, result) => {
-                    slot.node.tx_result(&f, result, time);
-                    if result == TxResult::Acked {
-                        slot.node.rx(&f, true, time);
-                        slot.stats.sent += 1;
-                    } else {
-                        slot.stats.tx_errors += 1;
-                    }
-                }
-                Notice::Rx => {
-                    slot.node.rx(&frame, false, time);
-                    slot.stats.received += 1;
-                }
-                Notice::RxError(code, dominant_after_flag) => {
-                    slot.node.rx_error(code, dominant_after_flag, time);
-                    slot.stats.rx_errors += 1;
-                }
-                Notice::TxEnd(_) => {}
-            }
-        }
-        self.advance_span(&res.wire, sof, done, end, &in_frame);
 
         let mut reports = Vec::with_capacity(contenders.len() + receivers.len());
         let mut first_error: Option<ErrorInfo> = None;
@@ -744,19 +790,12 @@ impl Bus {
                 error_bit,
             });
         }
-        self.advance_all(u64::from(INTERMISSION_BITS), true);
-        self.stats.busy_bits += self.now - sof;
-        if first_error.is_some() {
-            self.stats.frames_with_errors += 1;
-        } else {
-            self.stats.frames_error_free += 1;
-        }
 
         let record = TraceRecord {
             seq,
             internal: false,
             sof,
-            end: self.now,
+            end: sof + end + u64::from(INTERMISSION_BITS),
             frame,
             bits,
             transmitters: tx_ids,
@@ -767,6 +806,114 @@ impl Bus {
             delivered: res.observer_ok,
             reports,
         };
-        BusEvent::Frame(self.record(record))
+
+        // Start of frame: every requester starts as a transmitter, every other listening
+        // node as a receiver.
+        let time = BusTime { sof, now: sof };
+        for (k, _) in contenders.iter().chain(&losers) {
+            self.slots[*k].node.attempt_started(true, time);
+        }
+        for &k in &receivers {
+            if !losers.iter().any(|(l, _)| *l == k) {
+                self.slots[k].node.attempt_started(false, time);
+            }
+        }
+
+        self.in_flight = Some(InFlight {
+            sof,
+            end,
+            schedule,
+            next: 0,
+            done: 0,
+            in_frame,
+            wire: res.wire,
+            record,
+            receivers,
+            frame,
+        });
+    }
+
+    /// Plays the attempt in flight up to bus time `until` (at most to the end of its
+    /// intermission), delivering what is due. Returns its event once it is over; `None`
+    /// while it is still in flight (or if there is none).
+    fn continue_attempt(&mut self, until: u64) -> Option<BusEvent> {
+        let mut f = self.in_flight.take()?;
+        let limit = until.saturating_sub(f.sof);
+        while let Some(&(at, _, k, notice)) = f.schedule.get(f.next) {
+            if at > limit {
+                break;
+            }
+            f.next += 1;
+            self.advance_span(&f.wire, f.sof, f.done, at, &f.in_frame);
+            f.done = f.done.max(at);
+            self.now = f.sof + f.done;
+            let time = BusTime {
+                sof: f.sof,
+                now: self.now,
+            };
+            let slot = &mut self.slots[k];
+            // A loser is told again as a receiver (unless it does not listen).
+            f.in_frame[k] = matches!(notice, Notice::Lost(_)) && f.receivers.contains(&k);
+            match notice {
+                Notice::Lost(fr) => {
+                    slot.node.tx_result(&fr, TxResult::ArbitrationLost, time);
+                    slot.stats.arbitration_lost += 1;
+                }
+                Notice::Tx(fr, result) => {
+                    slot.node.tx_result(&fr, result, time);
+                    if result == TxResult::Acked {
+                        slot.node.rx(&fr, true, time);
+                        slot.stats.sent += 1;
+                    } else {
+                        slot.stats.tx_errors += 1;
+                    }
+                }
+                Notice::Rx => {
+                    slot.node.rx(&f.frame, false, time);
+                    slot.stats.received += 1;
+                }
+                Notice::RxError(code, dominant_after_flag) => {
+                    slot.node.rx_error(code, dominant_after_flag, time);
+                    slot.stats.rx_errors += 1;
+                }
+                Notice::TxEnd(flag) => slot.node.tx_attempt_end(flag, time),
+            }
+        }
+        if limit < f.end {
+            self.advance_span(&f.wire, f.sof, f.done, limit, &f.in_frame);
+            f.done = f.done.max(limit);
+            self.now = f.sof + f.done;
+            let recessive = f
+                .done
+                .checked_sub(1)
+                .and_then(|i| f.wire.get(i as usize).copied())
+                .unwrap_or(true);
+            let now = self.now;
+            for slot in &mut self.slots {
+                slot.node.paused_in_frame(recessive, now);
+            }
+            self.in_flight = Some(f);
+            return None;
+        }
+        self.advance_span(&f.wire, f.sof, f.done, f.end, &f.in_frame);
+        f.done = f.done.max(f.end);
+        self.now = f.sof + f.done;
+        let total = f.end + u64::from(INTERMISSION_BITS);
+        let to = limit.min(total);
+        if to > f.done {
+            self.advance_all(to - f.done, true);
+            f.done = to;
+        }
+        if f.done < total {
+            self.in_flight = Some(f);
+            return None;
+        }
+        self.stats.busy_bits += self.now - f.sof;
+        if f.record.first_error.is_some() {
+            self.stats.frames_with_errors += 1;
+        } else {
+            self.stats.frames_error_free += 1;
+        }
+        Some(BusEvent::Frame(self.record(f.record)))
     }
 }

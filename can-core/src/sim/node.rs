@@ -86,6 +86,22 @@ pub trait BusNode {
         let _ = (dominant_in_passive_flag, time);
     }
 
+    /// A frame attempt starts (its SOF is at `time.sof`): `transmitter` for a node whose
+    /// [`BusNode::poll_tx`] request takes part in arbitration (it may lose it later), false
+    /// for a node that only listens. From here until its outcome is reported the node is
+    /// in the frame: a controller shows it as "transmitting" / "receiving", and a mailbox
+    /// whose frame is on the wire is in transmission. The default does nothing.
+    fn attempt_started(&mut self, transmitter: bool, time: BusTime) {
+        let _ = (transmitter, time);
+    }
+
+    /// The bus stopped inside a frame attempt at bus time `now` ([`crate::sim::Bus::run_bits`]);
+    /// `recessive` is the level of the last bit on the wire (what the controller's receive
+    /// pin shows and last sampled). The default does nothing.
+    fn paused_in_frame(&mut self, recessive: bool, now: u64) {
+        let _ = (recessive, now);
+    }
+
     /// The earliest bus time after `now` at which this node may start a frame on its own,
     /// without software doing anything: the end of its suspend-transmission time, the moment
     /// its bus-off recovery completes, a timer. The bus ends idle stretches there, so that the
@@ -132,5 +148,11 @@ impl<T: BusNode + ?Sized> BusNode for std::rc::Rc<core::cell::RefCell<T>> {
     fn tx_attempt_end(&mut self, dominant_in_passive_flag: bool, time: BusTime) {
         self.borrow_mut()
             .tx_attempt_end(dominant_in_passive_flag, time)
+    }
+    fn attempt_started(&mut self, transmitter: bool, time: BusTime) {
+        self.borrow_mut().attempt_started(transmitter, time)
+    }
+    fn paused_in_frame(&mut self, recessive: bool, now: u64) {
+        self.borrow_mut().paused_in_frame(recessive, now)
     }
 }
