@@ -232,7 +232,7 @@ impl BusNode for SimNode {
                 self.fault.transmit_succeeded();
                 self.queue.pop_front();
             }
-            TxResult::ArbitrationLost => return,
+            TxResult::ArbitrationLost => {}
             TxResult::Error(code) => {
                 self.last_error = code;
                 if self.fault.transmit_error(code) {

@@ -254,8 +254,16 @@ impl State {
             v |= esr1::TXWRN;
         }
         if self.on_bus() {
-            // Between the model's atomic frame events the bus is idle.
-            v |= esr1::SYNCH | esr1::IDLE;
+            v |= esr1::SYNCH;
+            if self.transmitting {
+                v |= esr1::TX;
+            }
+            if self.receiving {
+                v |= esr1::RX;
+            }
+            if !self.transmitting && !self.receiving {
+                v |= esr1::IDLE;
+            }
         }
         v
     }

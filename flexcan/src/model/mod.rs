@@ -310,4 +310,8 @@ impl BusNode for FlexCanModel {
             .borrow_mut()
             .tx_attempt_end(dominant_in_passive_flag, time);
     }
+
+    fn attempt_started(&mut self, transmitter: bool, time: BusTime) {
+        self.inner.borrow_mut().attempt_started(transmitter, time);
+    }
 }
