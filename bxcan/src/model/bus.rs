@@ -37,9 +37,10 @@ use super::BxCanModel;
 use crate::regs::{mcr, TX_MAILBOXES};
 
 impl Controller {
-    /// Whether the controller samples the bus (normal mode, not bus-off, not loop back).
+    /// Whether the controller samples the bus (normal mode, not bus-off, not loop back,
+    /// not frozen by a debug halt).
     pub(crate) fn listens(&self) -> bool {
-        self.mode() == Mode::Normal && !self.errors.is_bus_off() && !self.lbkm()
+        self.mode() == Mode::Normal && !self.errors.is_bus_off() && !self.lbkm() && !self.frozen()
     }
 
     /// Whether the controller would acknowledge a frame it received.
@@ -82,6 +83,7 @@ impl Controller {
         if self.mode() != Mode::Normal
             || self.modes.syncing()
             || self.errors.is_bus_off()
+            || self.frozen()
             || !self.errors.fault_confinement().may_start_transmission(now)
         {
             return None;
@@ -123,6 +125,10 @@ impl Controller {
 
     fn tx_result(&mut self, frame: &Frame, result: TxResult, time: BusTime) {
         self.observe(time.sof, time.now);
+        if result == TxResult::ArbitrationLost {
+            self.txm = false;
+            self.rxm = self.listens();
+        }
         self.modes.activity();
         self.errors.dominant();
         let mailbox = self.mailbox_of(frame, time.sof);
@@ -170,6 +176,9 @@ impl Controller {
 
     fn rx(&mut self, frame: &Frame, own: bool, time: BusTime) {
         self.observe(time.sof, time.now);
+        if !own {
+            self.rxm = false;
+        }
         if own {
             if self.lbkm() && self.mode() == Mode::Normal && !self.errors.is_bus_off() {
                 self.deliver(frame, time.sof);
@@ -186,6 +195,7 @@ impl Controller {
 
     fn rx_error(&mut self, code: LastErrorCode, dominant_after_flag: bool, time: BusTime) {
         self.observe(time.sof, time.now);
+        self.rxm = false;
         self.activity();
         if !self.listens() {
             return;
@@ -220,6 +230,7 @@ impl Controller {
     /// The end of an attempt the controller transmitted (see `BusNode::tx_attempt_end`).
     fn tx_attempt_end(&mut self, dominant_in_passive_flag: bool, time: BusTime) {
         self.observe(time.sof, time.now);
+        self.txm = false;
         if self
             .errors
             .transmission_ended(time.now, dominant_in_passive_flag)
@@ -229,7 +240,18 @@ impl Controller {
         self.settle();
     }
 
+    /// A frame attempt starts (see `BusNode::attempt_started`).
+    fn attempt_started(&mut self, transmitter: bool, time: BusTime) {
+        self.observe(time.sof, time.sof);
+        if transmitter {
+            self.txm = true;
+        } else {
+            self.rxm = true;
+        }
+    }
+
     fn advance(&mut self, bits: u64, idle: bool, now: u64) {
+        self.level = true;
         self.observe(now.saturating_sub(bits), now);
         if !idle {
             self.activity();
@@ -293,5 +315,13 @@ impl BusNode for BxCanModel {
         self.inner
             .borrow_mut()
             .tx_attempt_end(dominant_in_passive_flag, time);
+    }
+
+    fn attempt_started(&mut self, transmitter: bool, time: BusTime) {
+        self.inner.borrow_mut().attempt_started(transmitter, time);
+    }
+
+    fn paused_in_frame(&mut self, recessive: bool, _now: u64) {
+        self.inner.borrow_mut().level = recessive;
     }
 }
