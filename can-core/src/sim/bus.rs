@@ -93,6 +93,7 @@ use std::vec::Vec;
 
 use super::bits::{wire_bits, FrameBits, INTERMISSION_BITS};
 use super::engine::{self, PartOutcome, RxSpec, TxSpec};
+use super::fast;
 use super::inject::{Fault, Injector, RandomFaults};
 use super::node::{BusNode, BusTime, TxRequest, TxResult};
 use super::stats::{BusStats, NodeStats};
@@ -217,6 +218,8 @@ pub struct Bus {
     instant_streak: u32,
     idle_quantum: u64,
     in_flight: Option<InFlight>,
+    fast_path: bool,
+    stats_fast_attempts: u64,
 }
 
 impl core::fmt::Debug for Bus {
@@ -254,6 +257,8 @@ impl Bus {
             instant_streak: 0,
             idle_quantum: u64::MAX,
             in_flight: None,
+            fast_path: true,
+            stats_fast_attempts: 0,
         })
     }
 
@@ -371,6 +376,18 @@ impl Bus {
     /// Removes every scheduled and random fault.
     pub fn clear_faults(&mut self) {
         self.injector.clear();
+    }
+
+    /// Uses the fast path for attempts that cannot fail (one transmitter, no injected fault,
+    /// an acknowledgement: `sim/fast.rs`) instead of playing their bits (on by default).
+    /// The results are the same either way; turning it off measures the bit-level path.
+    pub fn set_fast_path(&mut self, on: bool) {
+        self.fast_path = on;
+    }
+
+    /// Frame attempts resolved by the fast path so far.
+    pub fn fast_path_attempts(&self) -> u64 {
+        self.stats_fast_attempts
     }
 
     /// The longest idle stretch one event may cover (default: unlimited). Setting 1 makes
@@ -684,7 +701,18 @@ impl Bus {
                 }
             })
             .collect();
-        let res = engine::resolve(&txs, &rxs);
+        let fast = if self.fast_path {
+            fast::resolve(&txs, &rxs)
+        } else {
+            None
+        };
+        let res = match fast {
+            Some(res) => {
+                self.stats_fast_attempts += 1;
+                res
+            }
+            None => engine::resolve(&txs, &rxs),
+        };
         drop(txs);
 
         let frame = contenders[res.reference].1.frame;

@@ -30,6 +30,7 @@
 pub mod bits;
 pub mod bus;
 mod engine;
+mod fast;
 pub mod inject;
 mod node;
 pub mod simple_node;
