@@ -31,9 +31,9 @@ fn run(seed: u64, fast: bool) -> (Bus, Nodes) {
     let nodes: Nodes = (0..count)
         .map(|k| {
             SimNode::new()
-                .with_listen_only(k > 0 && rng.next() % 3 == 0)
-                .with_one_shot(rng.next() % 4 == 0)
-                .with_self_ack(rng.next() % 5 == 0)
+                .with_listen_only(k > 0 && rng.next().is_multiple_of(3))
+                .with_one_shot(rng.next().is_multiple_of(4))
+                .with_self_ack(rng.next().is_multiple_of(5))
                 .shared()
         })
         .collect();
@@ -46,7 +46,7 @@ fn run(seed: u64, fast: bool) -> (Bus, Nodes) {
         let data: Vec<u8> = (0..len)
             .map(|j| (i as u8) ^ (j as u8).wrapping_mul(37))
             .collect();
-        let f = if rng.next() % 3 == 0 {
+        let f = if rng.next().is_multiple_of(3) {
             Frame::extended((rng.next() % 0x2000_0000) as u32, &data).unwrap()
         } else {
             Frame::standard((rng.next() % 0x800) as u16, &data).unwrap()
