@@ -241,9 +241,13 @@ impl State {
     /// ESR1 as read (without the read's side effect).
     pub fn esr1_value(&self) -> u32 {
         let fc = &self.errors.fc;
+        // Listen-only mode: "If the LOM bit in CTRL1 is asserted, after some delay that
+        // depends on the CAN bit timing the FLTCONF field will indicate 'Error Passive'"
+        // (ESR1[FLTCONF]); the model shows it at once.
         let fltconf = match fc.state() {
             ErrorState::BusOff => esr1::FLTCONF_BUS_OFF,
             ErrorState::Passive => esr1::FLTCONF_ERROR_PASSIVE,
+            _ if self.lom() => esr1::FLTCONF_ERROR_PASSIVE,
             _ => esr1::FLTCONF_ERROR_ACTIVE,
         };
         let mut v = self.errors.flags | esr1::FLTCONF.val(fltconf);
