@@ -26,6 +26,9 @@ pub struct FaultConfinement {
     /// Bus time before which an error-passive node that was transmitter may not start a
     /// transmission (suspend transmission); 0 when not suspended.
     suspend_until: u64,
+    /// The next transmit error is a stuff error in arbitration on a recessive stuff bit
+    /// (rule 3, exception 2).
+    arbitration_stuff_exception: bool,
 }
 
 /// The number of 11-recessive-bit sequences after which a bus-off node may recover.
@@ -76,6 +79,7 @@ impl FaultConfinement {
             rec_after_passive_reception: Self::DEFAULT_REC_AFTER_PASSIVE_RECEPTION,
             ack_exception_pending: false,
             suspend_until: 0,
+            arbitration_stuff_exception: false,
         }
     }
 
@@ -169,6 +173,10 @@ impl FaultConfinement {
         if self.bus_off {
             return false;
         }
+        let exempt = core::mem::replace(&mut self.arbitration_stuff_exception, false);
+        if exempt && code == LastErrorCode::Stuff {
+            return false;
+        }
         if code == LastErrorCode::Acknowledge && self.is_passive() {
             self.ack_exception_pending = true;
             return false;
@@ -225,6 +233,38 @@ impl FaultConfinement {
         } else {
             None
         }
+    }
+
+    /// Rule 3, exception 2: the next [`FaultConfinement::transmit_error`], a stuff error
+    /// on a recessive stuff bit of the arbitration field that was read dominant, leaves
+    /// TEC unchanged.
+    pub fn arbitration_stuff_exception(&mut self) {
+        self.arbitration_stuff_exception = true;
+    }
+
+    /// Rules 4 and 5 (a bit error while sending an active error or overload flag) and rule
+    /// 6 (the 14th / 8th consecutive dominant bit after a flag, and each 8 more): TEC + 8
+    /// for a transmitter, REC + 8 for a receiver. Returns whether bus-off was entered.
+    pub fn flag_penalty(&mut self, transmitter: bool) -> bool {
+        if self.bus_off {
+            return false;
+        }
+        if transmitter {
+            self.add_tec(8)
+        } else {
+            self.rec = (self.rec + 8).min(255);
+            false
+        }
+    }
+
+    /// `count` flag penalties at once ([`FaultConfinement::flag_penalty`]). Returns
+    /// whether bus-off was entered.
+    pub fn confinement_penalties(&mut self, transmitter: bool, count: u8) -> bool {
+        let mut off = false;
+        for _ in 0..count {
+            off |= self.flag_penalty(transmitter);
+        }
+        off
     }
 
     /// Rule 1: a receiver detects an error, REC += 1; rule 2, a dominant bit as the first

@@ -26,7 +26,7 @@
 //!   `FaultConfinement` from the end of the frame or error frame.
 //! - Time stamps are the TTCM timer at the start of frame (`BusTime::sof`).
 
-use twocan_core::sim::{BusNode, BusTime, TxRequest, TxResult};
+use twocan_core::sim::{BusNode, BusTime, ConfinementEvent, TxRequest, TxResult};
 use twocan_core::{Frame, LastErrorCode};
 
 use super::controller::Controller;
@@ -240,6 +240,21 @@ impl Controller {
         self.settle();
     }
 
+    /// A fault-confinement event (see `BusNode::confinement_event`).
+    fn confinement_event(&mut self, event: ConfinementEvent, time: BusTime) {
+        self.observe(time.sof, time.now);
+        match event {
+            ConfinementEvent::ArbitrationStuffException => {
+                self.errors.arbitration_stuff_exception()
+            }
+            ConfinementEvent::FlagPenalties { transmitter, count } => {
+                self.errors.flag_penalties(transmitter, count);
+                self.error_detected();
+            }
+        }
+        self.settle();
+    }
+
     /// A frame attempt starts (see `BusNode::attempt_started`).
     fn attempt_started(&mut self, transmitter: bool, time: BusTime) {
         self.observe(time.sof, time.sof);
@@ -323,5 +338,9 @@ impl BusNode for BxCanModel {
 
     fn paused_in_frame(&mut self, recessive: bool, _now: u64) {
         self.inner.borrow_mut().level = recessive;
+    }
+
+    fn confinement_event(&mut self, event: ConfinementEvent, time: BusTime) {
+        self.inner.borrow_mut().confinement_event(event, time);
     }
 }

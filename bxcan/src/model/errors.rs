@@ -158,6 +158,20 @@ impl ErrorUnit {
         off
     }
 
+    /// Rule 3 exception 2 for the transmit error that follows.
+    pub(crate) fn arbitration_stuff_exception(&mut self) {
+        self.fc.arbitration_stuff_exception();
+    }
+
+    /// `count` flag penalties (rules 4 to 6); returns whether bus-off was entered.
+    pub(crate) fn flag_penalties(&mut self, transmitter: bool, count: u8) -> bool {
+        let off = self.fc.confinement_penalties(transmitter, count);
+        if off {
+            self.entered_bus_off();
+        }
+        off
+    }
+
     /// A frame received without error.
     pub(crate) fn receive_ok(&mut self) {
         self.fc.receive_succeeded();

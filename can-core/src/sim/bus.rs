@@ -94,8 +94,8 @@ use std::vec::Vec;
 use super::bits::{wire_bits, FrameBits, INTERMISSION_BITS};
 use super::engine::{self, PartOutcome, RxSpec, TxSpec};
 use super::fast;
-use super::inject::{Fault, Injector, RandomFaults};
-use super::node::{BusNode, BusTime, TxRequest, TxResult};
+use super::inject::{Fault, FaultError, Injector, RandomFaults};
+use super::node::{BusNode, BusTime, ConfinementEvent, TxRequest, TxResult};
 use super::stats::{BusStats, NodeStats};
 use super::trace::{bits_to_micros, ErrorInfo, NodeOutcome, NodeReport, Trace, TraceRecord};
 
@@ -181,6 +181,8 @@ enum Notice {
     /// The end of the attempt for a transmitter; whether it read a dominant bit during its
     /// passive error flag.
     TxEnd(bool),
+    /// A fault-confinement event the outcome does not carry.
+    Confinement(ConfinementEvent),
 }
 
 /// A wire frame attempt that has started and is not over yet (see [`Bus::run_bits`]).
@@ -220,6 +222,7 @@ pub struct Bus {
     in_flight: Option<InFlight>,
     fast_path: bool,
     stats_fast_attempts: u64,
+    refused: Vec<(Fault, FaultError)>,
 }
 
 impl core::fmt::Debug for Bus {
@@ -259,6 +262,7 @@ impl Bus {
             in_flight: None,
             fast_path: true,
             stats_fast_attempts: 0,
+            refused: Vec::new(),
         })
     }
 
@@ -353,19 +357,56 @@ impl Bus {
     }
 
     /// Injects `fault` into wire frame attempt number `seq` (0 = the first SOF on the bus;
-    /// retransmissions count as new attempts).
+    /// retransmissions count as new attempts). A fault that cannot happen is refused:
+    /// [`Bus::try_inject`] says so at once; here it is recorded in
+    /// [`Bus::refused_faults`] (and, when the frame decides it, in the attempt's
+    /// [`TraceRecord::refused`]).
     pub fn inject(&mut self, seq: u64, fault: Fault) {
+        if let Err(e) = self.try_inject(seq, fault) {
+            self.refused.push((fault, e));
+        }
+    }
+
+    /// [`Bus::inject`], refusing at once a fault that cannot happen in any frame.
+    pub fn try_inject(&mut self, seq: u64, fault: Fault) -> Result<(), FaultError> {
+        fault.validate()?;
         self.injector.at_frame(seq, fault);
+        Ok(())
     }
 
-    /// Injects `fault` into the next frame attempt on the wire.
+    /// Injects `fault` into the next frame attempt on the wire (see [`Bus::inject`]).
     pub fn inject_next(&mut self, fault: Fault) {
-        self.injector.at_frame(self.stats.frames_started, fault);
+        self.inject(self.stats.frames_started, fault);
     }
 
-    /// Injects `fault` into the next `count` frame attempts that `node` transmits.
+    /// [`Bus::inject_next`], refusing at once a fault that cannot happen in any frame.
+    pub fn try_inject_next(&mut self, fault: Fault) -> Result<(), FaultError> {
+        self.try_inject(self.stats.frames_started, fault)
+    }
+
+    /// Injects `fault` into the next `count` frame attempts that `node` transmits (see
+    /// [`Bus::inject`]).
     pub fn inject_from(&mut self, node: NodeId, count: u32, fault: Fault) {
+        if let Err(e) = self.try_inject_from(node, count, fault) {
+            self.refused.push((fault, e));
+        }
+    }
+
+    /// [`Bus::inject_from`], refusing at once a fault that cannot happen in any frame.
+    pub fn try_inject_from(
+        &mut self,
+        node: NodeId,
+        count: u32,
+        fault: Fault,
+    ) -> Result<(), FaultError> {
+        fault.validate()?;
         self.injector.on_node(node, count, fault);
+        Ok(())
+    }
+
+    /// Every fault refused so far, at injection or when its frame showed it cannot happen.
+    pub fn refused_faults(&self) -> &[(Fault, FaultError)] {
+        &self.refused
     }
 
     /// Random injection (`None` turns it off). Same seed and same traffic give the same faults.
@@ -633,6 +674,7 @@ impl Bus {
             transmitters: vec![id],
             arbitration_losers: Vec::new(),
             faults: Vec::new(),
+            refused: Vec::new(),
             first_error: None,
             acked: true,
             delivered: false,
@@ -673,7 +715,17 @@ impl Bus {
 
         let tx_ids: Vec<NodeId> = contenders.iter().map(|(k, _)| NodeId(*k)).collect();
         let rx_ids: Vec<NodeId> = receivers.iter().map(|&k| NodeId(k)).collect();
-        let faults = self.injector.faults_for(seq, &tx_ids, &rx_ids, &ref_bits);
+        let mut faults = self.injector.faults_for(seq, &tx_ids, &rx_ids, &ref_bits);
+        let mut refused = Vec::new();
+        faults.retain(|f| match f.check_layout(&ref_bits, &streams[reference].0) {
+            Ok(()) => true,
+            Err(e) => {
+                refused.push((*f, e));
+                false
+            }
+        });
+        self.refused.extend_from_slice(&refused);
+        let stuck = faults.iter().find_map(Fault::stuck_range);
 
         let txs: Vec<TxSpec<'_>> = contenders
             .iter()
@@ -683,7 +735,10 @@ impl Bus {
                 bits: *bits,
                 self_ack: r.self_ack,
                 active: self.slots[*k].node.error_active(),
-                faults: faults.iter().filter_map(|f| f.tx_part(bits)).collect(),
+                faults: faults
+                    .iter()
+                    .filter_map(|f| f.tx_part(NodeId(*k), bits))
+                    .collect(),
             })
             .collect();
         let rxs: Vec<RxSpec> = receivers
@@ -701,7 +756,7 @@ impl Bus {
                 }
             })
             .collect();
-        let fast = if self.fast_path {
+        let fast = if self.fast_path && faults.is_empty() {
             fast::resolve(&txs, &rxs)
         } else {
             None
@@ -711,7 +766,7 @@ impl Bus {
                 self.stats_fast_attempts += 1;
                 res
             }
-            None => engine::resolve(&txs, &rxs),
+            None => engine::resolve_with(&txs, &rxs, stuck),
         };
         drop(txs);
 
@@ -735,13 +790,27 @@ impl Bus {
                 PartOutcome::Error { code, at, .. } => (u64::from(at) + 1, TxResult::Error(code)),
             };
             schedule.push((at.min(end), 1, *k, Notice::Tx(r.frame, result)));
-            let flag = matches!(
-                *outcome,
-                PartOutcome::Error {
-                    dominant_in_passive_flag: true,
-                    ..
+            let mut flag = false;
+            if let PartOutcome::Error {
+                dominant_in_passive_flag,
+                penalties,
+                arbitration_stuff_exception,
+                ..
+            } = *outcome
+            {
+                flag = dominant_in_passive_flag;
+                if arbitration_stuff_exception {
+                    let event = ConfinementEvent::ArbitrationStuffException;
+                    schedule.push((at.min(end), 0, *k, Notice::Confinement(event)));
                 }
-            );
+                if penalties > 0 {
+                    let event = ConfinementEvent::FlagPenalties {
+                        transmitter: true,
+                        count: penalties,
+                    };
+                    schedule.push((end, 3, *k, Notice::Confinement(event)));
+                }
+            }
             schedule.push((end, 3, *k, Notice::TxEnd(flag)));
         }
         for (&k, outcome) in receivers.iter().zip(&res.rx) {
@@ -758,6 +827,15 @@ impl Bus {
                 ),
             };
             schedule.push((at.min(end), 2, k, notice));
+            if let PartOutcome::Error { penalties, .. } = *outcome {
+                if penalties > 0 {
+                    let event = ConfinementEvent::FlagPenalties {
+                        transmitter: false,
+                        count: penalties,
+                    };
+                    schedule.push((end, 3, k, Notice::Confinement(event)));
+                }
+            }
         }
         schedule.sort_by_key(|&(at, order, k, _)| (at, order, k));
 
@@ -829,6 +907,7 @@ impl Bus {
             transmitters: tx_ids,
             arbitration_losers: losers.iter().map(|(k, _)| NodeId(*k)).collect(),
             faults,
+            refused,
             first_error,
             acked: res.acked,
             delivered: res.observer_ok,
@@ -905,6 +984,7 @@ impl Bus {
                     slot.stats.rx_errors += 1;
                 }
                 Notice::TxEnd(flag) => slot.node.tx_attempt_end(flag, time),
+                Notice::Confinement(event) => slot.node.confinement_event(event, time),
             }
         }
         if limit < f.end {

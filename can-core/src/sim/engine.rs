@@ -27,11 +27,24 @@
 //! others; here it is taken to be done with the others (it would resynchronise on the next
 //! idle bits anyway). Its detected error and rule-2 flag are still reported.
 //!
-//! Not modelled: overload frames, errors during error flags (rules 4 to 6), the "14/7
-//! dominant bits" tolerance, hard synchronisation effects.
+//! Fault-confinement details the engine records for each node that sends an error flag:
+//!
+//! - reading a dominant bit during its own passive error flag (rule 3, exception 1 does
+//!   not apply then);
+//! - a bit error during its own active error flag (rules 4 and 5: injected with
+//!   `Fault::FlagBit`): +8, and the node starts a new error flag at the next bit;
+//! - the dominant-bit tolerance after a flag (rule 6): counting consecutive dominant bits
+//!   from the start of an active error flag, or after the end of a passive one, the 14th
+//!   (active) or 8th (passive) and every 8th after it add 8 (a bus held dominant:
+//!   `Fault::StuckDominant`);
+//! - a transmitter's stuff error on a recessive stuff bit of the arbitration field read
+//!   dominant (rule 3, exception 2: TEC unchanged).
+//!
+//! Not modelled: overload frames, a dominant bit during an error delimiter (taken as a
+//! continuation of the flag period), hard synchronisation effects.
 
 use super::bits::FrameBits;
-use super::inject::{RxFault, TxFault};
+use super::inject::{is_stuff_bit, RxFault, TxFault};
 use crate::error::LastErrorCode;
 
 /// A transmitter of the frame attempt.
@@ -79,6 +92,12 @@ pub(crate) enum PartOutcome {
         /// It sent a passive error flag and read a dominant bit during it (rule 3,
         /// exception 1 does not apply then).
         dominant_in_passive_flag: bool,
+        /// Extra +8 penalties: bit errors during its own active error flag (rules 4, 5)
+        /// and dominant sequences after its flag (rule 6).
+        penalties: u8,
+        /// A transmitter's stuff error on a recessive stuff bit in arbitration (rule 3,
+        /// exception 2: TEC unchanged).
+        arbitration_stuff_exception: bool,
     },
 }
 
@@ -120,6 +139,14 @@ struct Part {
     error: Option<(LastErrorCode, u32)>,
     dominant_after_flag: bool,
     dominant_in_passive_flag: bool,
+    /// The flag it sent (or sends) is active.
+    active_flag: bool,
+    /// Injected: it misreads this bit of its active error flag (once).
+    flag_fault: Option<u8>,
+    /// Consecutive dominant bits counted for rule 6.
+    dominant_run: u32,
+    penalties: u8,
+    arbitration_stuff_exception: bool,
     ok: Option<u32>,
     // receiver bookkeeping
     run_last: bool,
@@ -136,6 +163,11 @@ impl Part {
             error: None,
             dominant_after_flag: false,
             dominant_in_passive_flag: false,
+            active_flag: false,
+            flag_fault: None,
+            dominant_run: 0,
+            penalties: 0,
+            arbitration_stuff_exception: false,
             ok: None,
             run_last: true,
             run: 0,
@@ -146,6 +178,8 @@ impl Part {
 
     fn detect(&mut self, code: LastErrorCode, at: u32) {
         self.error = Some((code, at));
+        self.active_flag = self.can_flag;
+        self.dominant_run = 0;
         self.phase = if self.can_flag {
             Phase::ActiveFlag(0)
         } else {
@@ -157,17 +191,47 @@ impl Part {
         matches!(self.phase, Phase::ActiveFlag(_))
     }
 
+    fn add_penalty(&mut self) {
+        self.penalties = self.penalties.saturating_add(1);
+    }
+
+    /// Rule 6: one more consecutive dominant bit after (or, active, including) the flag.
+    fn count_dominant(&mut self) {
+        self.dominant_run += 1;
+        let first = if self.active_flag { 14 } else { 8 };
+        if self.dominant_run >= first && (self.dominant_run - first).is_multiple_of(8) {
+            self.add_penalty();
+        }
+    }
+
     /// Reads one bit while in an error phase.
     fn error_phase(&mut self, wire: bool) {
         self.phase = match self.phase {
-            Phase::ActiveFlag(n) if n + 1 >= 6 => Phase::AfterFlag { first: true },
-            Phase::ActiveFlag(n) => Phase::ActiveFlag(n + 1),
+            Phase::ActiveFlag(n) if self.flag_fault == Some(n) => {
+                // Rules 4 / 5: a bit error during its own active error flag; a new flag
+                // starts at the next bit.
+                self.flag_fault = None;
+                self.add_penalty();
+                self.dominant_run = 0;
+                Phase::ActiveFlag(0)
+            }
+            Phase::ActiveFlag(n) => {
+                if !wire {
+                    self.count_dominant();
+                }
+                if n + 1 >= 6 {
+                    Phase::AfterFlag { first: true }
+                } else {
+                    Phase::ActiveFlag(n + 1)
+                }
+            }
             Phase::PassiveFlag { last, run } => {
                 if !wire {
                     self.dominant_in_passive_flag = true;
                 }
                 let run = if run == 0 || wire == last { run + 1 } else { 1 };
                 if run >= 6 {
+                    self.dominant_run = 0;
                     Phase::AfterFlag { first: true }
                 } else {
                     Phase::PassiveFlag { last: wire, run }
@@ -180,6 +244,7 @@ impl Part {
                     if first {
                         self.dominant_after_flag = true;
                     }
+                    self.count_dominant();
                     Phase::AfterFlag { first: false }
                 }
             }
@@ -196,6 +261,8 @@ impl Part {
                 at,
                 dominant_after_flag: self.dominant_after_flag,
                 dominant_in_passive_flag: self.dominant_in_passive_flag,
+                penalties: self.penalties,
+                arbitration_stuff_exception: self.arbitration_stuff_exception,
             },
             None => match self.ok {
                 Some(done) => PartOutcome::Ok { done },
@@ -205,6 +272,8 @@ impl Part {
                     at: end,
                     dominant_after_flag: false,
                     dominant_in_passive_flag: false,
+                    penalties: 0,
+                    arbitration_stuff_exception: false,
                 },
             },
         }
@@ -227,7 +296,14 @@ fn tx_read(tx: &TxSpec<'_>, p: &mut Part, wire: bool, i: u32) {
         LastErrorCode::BitDominant
     };
     let code = if tx.faults.contains(&TxFault::Bit(i)) {
-        Some(mismatch_code)
+        if i < tx.bits.arbitration_end && sent && is_stuff_bit(tx.stream, i) {
+            // A recessive stuff bit read dominant in arbitration: a stuff error, and rule 3
+            // exception 2 leaves TEC unchanged.
+            p.arbitration_stuff_exception = true;
+            Some(LastErrorCode::Stuff)
+        } else {
+            Some(mismatch_code)
+        }
     } else if i == tx.bits.crc_end + 1 {
         let read_recessive = wire || tx.faults.contains(&TxFault::Ack);
         (read_recessive && !tx.self_ack).then_some(LastErrorCode::Acknowledge)
@@ -291,7 +367,17 @@ fn rx_read(rx: &RxSpec, p: &mut Part, wire: bool, i: u32, reference: &[bool], ce
 }
 
 /// Plays one frame attempt. `txs` must not be empty (an empty slice gives an empty result).
+#[cfg(test)]
 pub(crate) fn resolve(txs: &[TxSpec<'_>], rxs: &[RxSpec]) -> Resolution {
+    resolve_with(txs, rxs, None)
+}
+
+/// [`resolve`] with the wire held dominant over bits `stuck.0..stuck.1`.
+pub(crate) fn resolve_with(
+    txs: &[TxSpec<'_>],
+    rxs: &[RxSpec],
+    stuck: Option<(u32, u32)>,
+) -> Resolution {
     let reference = (0..txs.len())
         .min_by(|&a, &b| txs[a].stream.cmp(txs[b].stream))
         .unwrap_or(0);
@@ -311,12 +397,39 @@ pub(crate) fn resolve(txs: &[TxSpec<'_>], rxs: &[RxSpec]) -> Resolution {
     let ref_stream = ref_tx.stream;
 
     let observer = RxSpec::default();
-    let mut tx_parts: Vec<Part> = txs.iter().map(|t| Part::new(t.active)).collect();
-    let mut rx_parts: Vec<Part> = rxs.iter().map(|r| Part::new(r.active)).collect();
+    let flag_fault = |tx: Option<&[TxFault]>, rx: Option<&[RxFault]>| {
+        tx.into_iter()
+            .flatten()
+            .find_map(|f| match f {
+                TxFault::FlagBit(b) => Some(*b),
+                _ => None,
+            })
+            .or_else(|| {
+                rx.into_iter().flatten().find_map(|f| match f {
+                    RxFault::FlagBit(b) => Some(*b),
+                    _ => None,
+                })
+            })
+    };
+    let mut tx_parts: Vec<Part> = txs
+        .iter()
+        .map(|t| Part {
+            flag_fault: flag_fault(Some(&t.faults), None),
+            ..Part::new(t.active)
+        })
+        .collect();
+    let mut rx_parts: Vec<Part> = rxs
+        .iter()
+        .map(|r| Part {
+            flag_fault: flag_fault(None, Some(&r.faults)),
+            ..Part::new(r.active)
+        })
+        .collect();
     let mut obs_part = Part::new(false);
 
     let longest = txs.iter().map(|t| t.bits.crc_end).max().unwrap_or(ce);
-    let limit = longest + 10 + 64;
+    let stuck_len = stuck.map_or(0, |(a, b)| b.saturating_sub(a));
+    let limit = longest + 10 + 64 + stuck_len.min(4096) + 32;
     let mut acked = false;
     let mut last_dominant_end = 0;
     let mut i = 0u32;
@@ -341,6 +454,9 @@ pub(crate) fn resolve(txs: &[TxSpec<'_>], rxs: &[RxSpec]) -> Resolution {
                 acked = true;
             }
             wire &= !drives_dominant;
+        }
+        if stuck.is_some_and(|(a, b)| (a..b).contains(&i)) {
+            wire = false;
         }
         if !wire {
             last_dominant_end = i + 1;
@@ -429,6 +545,8 @@ mod tests {
             at,
             dominant_after_flag: dom,
             dominant_in_passive_flag: false,
+            penalties: 0,
+            arbitration_stuff_exception: false,
         }
     }
 
@@ -468,6 +586,8 @@ mod tests {
                 at: ce + 2,
                 dominant_after_flag: false,
                 dominant_in_passive_flag: true,
+                penalties: 0,
+                arbitration_stuff_exception: false,
             }]
         );
         assert!(!r.observer_ok && !r.acked);

@@ -3,7 +3,7 @@
 //! frame). Then nothing can go wrong — no node can detect an error: the wire is the
 //! transmitter's stuffed bits, the ACK slot, the recessive delimiters and end of frame —
 //! and the outcome is known without playing the bits: every participant completes at the
-//! end of the end of frame, exactly as [`super::engine::resolve`] would find.
+//! end of the end of frame, exactly as the bit-level engine (`engine::resolve_with`) would find.
 //!
 //! Everything else (arbitration ties, faults, an attempt nobody acknowledges, which ends
 //! in an acknowledge error) goes through the bit-level engine. `sim_fast_path.rs` checks

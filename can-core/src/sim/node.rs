@@ -35,6 +35,25 @@ pub enum TxResult {
     Error(LastErrorCode),
 }
 
+/// A fault-confinement event that the outcome of an attempt does not carry (ISO 11898-1
+/// §12.1.4.2), for [`BusNode::confinement_event`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ConfinementEvent {
+    /// Rule 3, exception 2: the transmit error reported next — a stuff error on a
+    /// recessive stuff bit of the arbitration field read dominant — leaves TEC unchanged.
+    /// Told right before that [`BusNode::tx_result`].
+    ArbitrationStuffException,
+    /// Rules 4 and 5 (a bit error during the node's own active error flag) and rule 6
+    /// (dominant bits after its flag): `count` times +8 to TEC (`transmitter`) or REC.
+    /// Told at the end of the attempt.
+    FlagPenalties {
+        /// The node was a transmitter of the attempt.
+        transmitter: bool,
+        /// Number of +8 penalties.
+        count: u8,
+    },
+}
+
 /// Times of the bus event being reported, in bit times since the bus started.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct BusTime {
@@ -93,6 +112,13 @@ pub trait BusNode {
     /// whose frame is on the wire is in transmission. The default does nothing.
     fn attempt_started(&mut self, transmitter: bool, time: BusTime) {
         let _ = (transmitter, time);
+    }
+
+    /// A fault-confinement event the outcome does not carry (see [`ConfinementEvent`]).
+    /// Nodes apply it with [`crate::fault::FaultConfinement::confinement_event`]. The
+    /// default does nothing.
+    fn confinement_event(&mut self, event: ConfinementEvent, time: BusTime) {
+        let _ = (event, time);
     }
 
     /// The bus stopped inside a frame attempt at bus time `now` ([`crate::sim::Bus::run_bits`]);
@@ -154,5 +180,8 @@ impl<T: BusNode + ?Sized> BusNode for std::rc::Rc<core::cell::RefCell<T>> {
     }
     fn paused_in_frame(&mut self, recessive: bool, now: u64) {
         self.borrow_mut().paused_in_frame(recessive, now)
+    }
+    fn confinement_event(&mut self, event: ConfinementEvent, time: BusTime) {
+        self.borrow_mut().confinement_event(event, time)
     }
 }

@@ -12,7 +12,7 @@ use std::collections::VecDeque;
 use std::rc::Rc;
 use std::vec::Vec;
 
-use super::node::{BusNode, BusTime, TxRequest, TxResult};
+use super::node::{BusNode, BusTime, ConfinementEvent, TxRequest, TxResult};
 use crate::error::{ErrorCounters, ErrorState, LastErrorCode};
 use crate::fault::{FaultConfinement, BUS_OFF_RECOVERY_SEQUENCES};
 use crate::frame::Frame;
@@ -240,6 +240,19 @@ impl BusNode for SimNode {
                 }
                 if self.one_shot {
                     self.queue.pop_front();
+                }
+            }
+        }
+    }
+
+    fn confinement_event(&mut self, event: ConfinementEvent, _time: BusTime) {
+        match event {
+            ConfinementEvent::ArbitrationStuffException => {
+                self.fault.arbitration_stuff_exception();
+            }
+            ConfinementEvent::FlagPenalties { transmitter, count } => {
+                if self.fault.confinement_penalties(transmitter, count) {
+                    self.entered_bus_off();
                 }
             }
         }

@@ -19,7 +19,7 @@ use std::rc::Rc;
 
 use twocan_core::fault::BUS_OFF_RECOVERY_SEQUENCES;
 use twocan_core::sim::{frame_bits, Bus, BusEvent, Fault, NodeId, Receivers, SimNode, TraceRecord};
-use twocan_core::{ErrorCounters, ErrorState, Frame};
+use twocan_core::{ErrorCounters, ErrorState, Frame, LastErrorCode};
 
 /// A node kind under test, driven as its users drive it (registers for the models).
 pub trait Dut: Sized {
@@ -267,6 +267,121 @@ pub fn suspend_transmission_other_node_starts_first<D: Dut>() {
     assert_eq!(dut.counters(), ErrorCounters { tec: 127, rec: 0 });
 }
 
+/// Rule 3 exception 2: a transmitter that reads dominant on a recessive stuff bit of the
+/// arbitration field detects a stuff error and leaves TEC unchanged. Identifier 0x000:
+/// SOF and the first four identifier bits are dominant, so wire bit 5 is a recessive stuff
+/// bit inside the arbitration field. The retry succeeds; TEC stays 0 throughout.
+pub fn rule_3_exception_2_stuff_error_in_arbitration<D: Dut>() {
+    let mut bus = Bus::new(500_000).unwrap();
+    let (mut dut, id) = D::join(&mut bus);
+    let p = peer();
+    bus.attach("p", p.clone());
+    let f = Frame::standard(0x000, &[1]).unwrap();
+    assert!(frame_bits(&f).arbitration_end > 5);
+    bus.try_inject_from(id, 1, Fault::Bit { at: Some(5) })
+        .unwrap();
+    dut.send(&f);
+    let r = next_frame(&mut bus);
+    let e = r.first_error.unwrap();
+    assert_eq!((e.node, e.code, e.bit), (id, LastErrorCode::Stuff, 5));
+    assert!(r.refused.is_empty());
+    assert_eq!(dut.counters(), ErrorCounters { tec: 0, rec: 0 });
+    let retry = next_frame(&mut bus);
+    assert!(retry.is_error_free());
+    assert_eq!(dut.counters(), ErrorCounters { tec: 0, rec: 0 });
+}
+
+/// Rule 4: a transmitter that detects a bit error while sending its active error flag adds
+/// 8 (and starts a new flag). One bit error (rule 3: +8) whose error flag is hit at its
+/// third bit (rule 4: +8): TEC 16; the retry succeeds: 15.
+pub fn rule_4_bit_error_in_own_active_flag_transmitter<D: Dut>() {
+    let mut bus = Bus::new(500_000).unwrap();
+    let (mut dut, id) = D::join(&mut bus);
+    let p = peer();
+    bus.attach("p", p.clone());
+    let f = frame(0x0F5);
+    bus.inject_from(id, 1, Fault::Bit { at: None });
+    bus.try_inject_next(Fault::FlagBit { who: id, bit: 2 })
+        .unwrap();
+    dut.send(&f);
+    next_frame(&mut bus);
+    assert_eq!(dut.counters(), ErrorCounters { tec: 16, rec: 0 });
+    assert!(next_frame(&mut bus).is_error_free());
+    assert_eq!(dut.counters(), ErrorCounters { tec: 15, rec: 0 });
+}
+
+/// Rule 5: a receiver that detects a bit error while sending its active error flag adds 8.
+/// As in rule 2, the dut alone computes a wrong CRC and flags from ce+3, but it misreads
+/// the first bit of its flag: +8, and its new flag runs ce+4..=ce+9, together with the
+/// others' flags (their errors are at ce+3): its first bit after the flag (ce+10) is
+/// recessive, so rule 2 does not apply: REC = 1 + 8 = 9. Wire: last dominant ce+9, end
+/// ce+18, +3.
+pub fn rule_5_bit_error_in_own_active_flag_receiver<D: Dut>() {
+    let mut bus = Bus::new(500_000).unwrap();
+    let (dut, id) = D::join(&mut bus);
+    let t = SimNode::new().with_one_shot(true).shared();
+    let other = peer();
+    bus.attach("t", t.clone());
+    bus.attach("other", other.clone());
+    let f = frame(0x322);
+    t.borrow_mut().send(f);
+    bus.inject_next(Fault::Crc {
+        who: Receivers::Node(id),
+    });
+    bus.try_inject_next(Fault::FlagBit { who: id, bit: 0 })
+        .unwrap();
+    let r = next_frame(&mut bus);
+    assert_eq!(dut.counters(), ErrorCounters { tec: 0, rec: 9 });
+    assert_eq!(r.end - r.sof, ce_of(&f) + 21);
+}
+
+/// Rule 6, active flag: the 14th consecutive dominant bit counted from the start of the
+/// flag, and each 8 more, add 8. A lone error-active dut (a listen-only sniffer does not
+/// acknowledge): acknowledge error at ce+1 (+8), flag ce+2..=ce+7, then the bus is held
+/// dominant from ce+8 for 16 bits: dominant bits 14 (ce+15) and 22 (ce+23) add 8 each:
+/// TEC 24.
+pub fn rule_6_dominant_bits_after_active_flag<D: Dut>() {
+    let mut bus = Bus::new(500_000).unwrap();
+    let (mut dut, _) = D::join(&mut bus);
+    let sniffer = SimNode::new().with_listen_only(true).shared();
+    bus.attach("sniffer", sniffer);
+    let f = frame(0x0F6);
+    let ce = frame_bits(&f).crc_end;
+    bus.try_inject_next(Fault::StuckDominant {
+        at: ce + 8,
+        bits: 16,
+    })
+    .unwrap();
+    dut.send(&f);
+    let r = next_frame(&mut bus);
+    assert_eq!(r.first_error.unwrap().code, LastErrorCode::Acknowledge);
+    assert_eq!(dut.counters(), ErrorCounters { tec: 24, rec: 0 });
+    // Held dominant to ce+23, delimiter ce+24..=ce+31, end ce+32, +3.
+    assert_eq!(r.end - r.sof, u64::from(ce) + 35);
+}
+
+/// Rule 6, passive flag: the 8th consecutive dominant bit after a passive error flag adds
+/// 8. An error-passive dut reads a recessive ACK slot (acknowledge error, rule 3 exception
+/// 1 applies: its passive flag ce+2..=ce+7 is all recessive), then the bus is held dominant
+/// from ce+8 for 8 bits: TEC 128 + 8 = 136.
+pub fn rule_6_dominant_bits_after_passive_flag<D: Dut>() {
+    let mut bus = Bus::new(500_000).unwrap();
+    let (mut dut, id) = D::join(&mut bus);
+    let p = peer();
+    bus.attach("p", p.clone());
+    let f = frame(0x0F7);
+    let ce = frame_bits(&f).crc_end;
+    make_passive(&mut bus, &mut dut, id, &f);
+    bus.inject_next(Fault::Ack);
+    bus.try_inject_next(Fault::StuckDominant {
+        at: ce + 8,
+        bits: 8,
+    })
+    .unwrap();
+    next_frame(&mut bus);
+    assert_eq!(dut.counters(), ErrorCounters { tec: 136, rec: 0 });
+}
+
 /// Bus-off at TEC > 255 (32 bit errors) and recovery after 128 occurrences of 11
 /// consecutive recessive bits (§12.1.4.2, "bus-off"). The error delimiter and intermission
 /// of the last error frame (8 + 3 recessive bits) are the first sequence, so the retry
@@ -327,6 +442,26 @@ macro_rules! conformance_tests {
         #[test]
         fn suspend_transmission_other_node_starts_first() {
             conformance::suspend_transmission_other_node_starts_first::<$dut>();
+        }
+        #[test]
+        fn rule_3_exception_2_stuff_error_in_arbitration() {
+            conformance::rule_3_exception_2_stuff_error_in_arbitration::<$dut>();
+        }
+        #[test]
+        fn rule_4_bit_error_in_own_active_flag_transmitter() {
+            conformance::rule_4_bit_error_in_own_active_flag_transmitter::<$dut>();
+        }
+        #[test]
+        fn rule_5_bit_error_in_own_active_flag_receiver() {
+            conformance::rule_5_bit_error_in_own_active_flag_receiver::<$dut>();
+        }
+        #[test]
+        fn rule_6_dominant_bits_after_active_flag() {
+            conformance::rule_6_dominant_bits_after_active_flag::<$dut>();
+        }
+        #[test]
+        fn rule_6_dominant_bits_after_passive_flag() {
+            conformance::rule_6_dominant_bits_after_passive_flag::<$dut>();
         }
         #[test]
         fn bus_off_and_recovery() {

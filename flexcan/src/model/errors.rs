@@ -138,6 +138,20 @@ impl State {
         self.update_warnings();
     }
 
+    /// Rule 3 exception 2 for the transmit error that follows.
+    pub fn arbitration_stuff_exception(&mut self) {
+        self.errors.fc.arbitration_stuff_exception();
+    }
+
+    /// `count` flag penalties (rules 4 to 6).
+    pub fn flag_penalties(&mut self, transmitter: bool, count: u8) {
+        if self.errors.fc.confinement_penalties(transmitter, count) {
+            let boffrec = self.ctrl1_bit(ctrl1::BOFFREC);
+            self.errors.bus_off_entered(boffrec);
+        }
+        self.update_warnings();
+    }
+
     /// A transmission completed (rule 7).
     pub fn transmit_ok(&mut self) {
         self.errors.fc.transmit_succeeded();

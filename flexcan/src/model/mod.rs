@@ -40,7 +40,7 @@ use twocan_core::error::{ErrorCounters, LastErrorCode};
 use twocan_core::fault::FaultConfinement;
 use twocan_core::frame::Frame;
 use twocan_core::registers::Registers;
-use twocan_core::sim::{BusNode, BusTime, TxRequest, TxResult};
+use twocan_core::sim::{BusNode, BusTime, ConfinementEvent, TxRequest, TxResult};
 
 use crate::regs::{ctrl1, esr1, NUM_MB};
 
@@ -313,5 +313,16 @@ impl BusNode for FlexCanModel {
 
     fn attempt_started(&mut self, transmitter: bool, time: BusTime) {
         self.inner.borrow_mut().attempt_started(transmitter, time);
+    }
+
+    fn confinement_event(&mut self, event: ConfinementEvent, time: BusTime) {
+        let mut s = self.inner.borrow_mut();
+        s.time_to(time.now);
+        match event {
+            ConfinementEvent::ArbitrationStuffException => s.arbitration_stuff_exception(),
+            ConfinementEvent::FlagPenalties { transmitter, count } => {
+                s.flag_penalties(transmitter, count)
+            }
+        }
     }
 }
