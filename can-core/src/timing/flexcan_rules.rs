@@ -88,7 +88,13 @@ mod tests {
     use crate::timing::{cia_sample_point, solve, Limits};
 
     fn flexcan(bitrate: u32) -> Timing {
-        solve(16_000_000, bitrate, &Limits::FLEXCAN, cia_sample_point(bitrate)).unwrap()
+        solve(
+            16_000_000,
+            bitrate,
+            &Limits::FLEXCAN,
+            cia_sample_point(bitrate),
+        )
+        .unwrap()
     }
 
     #[test]
