@@ -115,7 +115,8 @@ pub trait BusNode {
     }
 
     /// A fault-confinement event the outcome does not carry (see [`ConfinementEvent`]).
-    /// Nodes apply it with [`crate::fault::FaultConfinement::confinement_event`]. The
+    /// Nodes apply it with [`crate::fault::FaultConfinement::arbitration_stuff_exception`]
+    /// and [`crate::fault::FaultConfinement::confinement_penalties`]. The
     /// default does nothing.
     fn confinement_event(&mut self, event: ConfinementEvent, time: BusTime) {
         let _ = (event, time);
