@@ -243,7 +243,9 @@ pub fn wire_bits(frame: &Frame) -> (Vec<bool>, FrameBits) {
     // Left-aligned: the next bit is always bit 127 (at most 118 bits).
     let mut all = ((header << 15) | u128::from(crc)) << (128 - count);
 
-    let mut out = Vec::with_capacity(count + count / 4 + 1);
+    // At most 118 bits and 29 stuff bits: a fixed buffer, copied out once.
+    let mut buf = [false; 160];
+    let mut n = 0usize;
     let mut last = true;
     let mut run = 0u32;
     // Each field boundary is right after the field's last bit, before a stuff bit that may
@@ -262,24 +264,27 @@ pub fn wire_bits(frame: &Frame) -> (Vec<bool>, FrameBits) {
         for _ in 0..len {
             let bit = all >> 127 == 1;
             all <<= 1;
-            out.push(bit);
+            buf[n] = bit;
+            n += 1;
             if bit == last {
                 run += 1;
             } else {
                 last = bit;
                 run = 1;
             }
-            *end = out.len() as u32;
+            *end = n as u32;
             if run == 5 {
-                out.push(!bit);
+                buf[n] = !bit;
+                n += 1;
                 last = !bit;
                 run = 1;
             }
         }
         previous = *end;
     }
+    let out = buf[..n].to_vec();
     let [arbitration_end, control_end, data_end, _] = ends;
-    let crc_end = out.len() as u32;
+    let crc_end = n as u32;
     let unstuffed = data_unstuffed as u32 + 15 + TAIL_BITS;
     let stuff_bits = crc_end - (data_unstuffed as u32 + 15);
     let total = unstuffed + stuff_bits;

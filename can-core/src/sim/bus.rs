@@ -704,7 +704,7 @@ impl Bus {
             .filter(|k| !contenders.iter().any(|(c, _)| c == k))
             .filter(|&k| self.slots[k].node.listens())
             .collect();
-        let streams: Vec<(Vec<bool>, FrameBits)> = contenders
+        let mut streams: Vec<(Vec<bool>, FrameBits)> = contenders
             .iter()
             .map(|(_, r)| wire_bits(&r.frame))
             .collect();
@@ -757,18 +757,23 @@ impl Bus {
             })
             .collect();
         let fast = if self.fast_path && faults.is_empty() {
-            fast::resolve(&txs, &rxs)
+            fast::applies(&txs, &rxs)
         } else {
             None
         };
         let res = match fast {
-            Some(res) => {
+            Some(acked) => {
+                drop(txs);
                 self.stats_fast_attempts += 1;
+                let stream = core::mem::take(&mut streams[0].0);
+                fast::resolve(streams[0].1, acked, rxs.len(), stream)
+            }
+            None => {
+                let res = engine::resolve_with(&txs, &rxs, stuck);
+                drop(txs);
                 res
             }
-            None => engine::resolve_with(&txs, &rxs, stuck),
         };
-        drop(txs);
 
         let frame = contenders[res.reference].1.frame;
         let bits = streams[res.reference].1;

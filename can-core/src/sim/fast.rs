@@ -9,11 +9,12 @@
 //! in an acknowledge error) goes through the bit-level engine. `sim_fast_path.rs` checks
 //! that both give the same traces and counters on random seeded traffic.
 
+use super::bits::FrameBits;
 use super::engine::{PartOutcome, Resolution, RxSpec, TxSpec};
 
-/// The resolution of a fault-free, acknowledged attempt, or `None` if the attempt needs
-/// the bit-level engine.
-pub(crate) fn resolve(txs: &[TxSpec<'_>], rxs: &[RxSpec]) -> Option<Resolution> {
+/// Whether the attempt can take the fast path: `Some(acked)` (some receiver drives the
+/// ACK slot) if it can, `None` if it needs the bit-level engine.
+pub(crate) fn applies(txs: &[TxSpec<'_>], rxs: &[RxSpec]) -> Option<bool> {
     let [tx] = txs else {
         return None;
     };
@@ -21,34 +22,41 @@ pub(crate) fn resolve(txs: &[TxSpec<'_>], rxs: &[RxSpec]) -> Option<Resolution> 
         return None;
     }
     let acked = rxs.iter().any(|r| r.acks);
-    if !acked && !tx.self_ack {
-        return None;
-    }
-    let ce = tx.bits.crc_end;
+    (acked || tx.self_ack).then_some(acked)
+}
+
+/// The resolution of a fault-free, acknowledged attempt of a frame laid out as `bits`
+/// whose stuffed bits are `stream` (taken as the start of the wire), with `receivers`
+/// receivers.
+pub(crate) fn resolve(
+    bits: FrameBits,
+    acked: bool,
+    receivers: usize,
+    mut stream: Vec<bool>,
+) -> Resolution {
+    let ce = bits.crc_end;
     let total = ce + 10;
-    let mut wire = Vec::with_capacity(total as usize);
-    wire.extend_from_slice(tx.stream);
-    wire.resize(ce as usize, true);
+    stream.resize(ce as usize, true);
     // CRC delimiter, ACK slot, ACK delimiter, 7 bits of end of frame.
-    wire.push(true);
-    wire.push(!acked);
-    wire.resize(total as usize, true);
+    stream.push(true);
+    stream.push(!acked);
+    stream.resize(total as usize, true);
     let last_dominant_end = if acked {
         ce + 2
     } else {
-        wire.iter().rposition(|&b| !b).map_or(0, |i| i as u32 + 1)
+        stream.iter().rposition(|&b| !b).map_or(0, |i| i as u32 + 1)
     };
     let done = PartOutcome::Ok { done: total };
-    Some(Resolution {
+    Resolution {
         tx: vec![done],
-        rx: vec![done; rxs.len()],
+        rx: vec![done; receivers],
         observer_ok: true,
         acked,
         end: total,
         last_dominant_end,
-        wire,
+        wire: stream,
         reference: 0,
-    })
+    }
 }
 
 #[cfg(test)]
@@ -95,9 +103,10 @@ mod tests {
                 })
                 .collect();
             let slow = engine::resolve(&txs, &rxs);
-            match resolve(&txs, &rxs) {
-                Some(fast) => {
+            match applies(&txs, &rxs) {
+                Some(acked) => {
                     fast_count += 1;
+                    let fast = resolve(w.1, acked, rxs.len(), w.0.clone());
                     assert_eq!(fast, slow, "{frame:?}");
                 }
                 None => assert!(!txs[0].self_ack && rxs.iter().all(|r| !r.acks)),
