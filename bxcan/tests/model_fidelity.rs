@@ -237,3 +237,44 @@ fn lec_set_to_seven_by_software_loses_a_code_latched_after_the_read() {
     assert_eq!(esr::LEC.get(a.read32(regs::ESR)), esr::LEC_SOFTWARE);
     assert_eq!(esr::TEC.get(a.read32(regs::ESR)), 16);
 }
+
+/// Bits until `done(m)` holds, running the bus one bit at a time (at most `max`).
+fn bits_until(bus: &mut Bus, max: u64, mut done: impl FnMut() -> bool) -> u64 {
+    for n in 0..max {
+        if done() {
+            return n;
+        }
+        bus.run_bits(1);
+    }
+    panic!("not within {max} bits");
+}
+
+#[test]
+fn initialization_request_waits_for_the_frame_in_flight_at_the_lowest_bit_rate() {
+    use twocan_core::sim::frame_bits;
+    use twocan_core::timing::frame_time::{bits_to_micros, MAX_FRAME_IN_FLIGHT_BITS};
+    // 2.5 kbit/s, the slowest exact ACAN rate; a long extended frame with heavy stuffing.
+    let mut bus = Bus::new(2_500).unwrap();
+    let mut a = accept_all(&mut bus, "a", 0);
+    let mut b = accept_all(&mut bus, "b", 0);
+    let f = Frame::extended(0, &[0; 8]).unwrap();
+    let total = u64::from(frame_bits(&f).total);
+    load(&mut a, 0, &f);
+    bus.run_bits(1);
+    // Both controllers are asked to enter initialization one bit into the frame.
+    a.modify32(regs::MCR, |v| v | mcr::INRQ);
+    b.modify32(regs::MCR, |v| v | mcr::INRQ);
+    let inak = |m: &BxCanModel| m.read32(regs::MSR) & msr::INAK != 0;
+    assert!(!inak(&a) && !inak(&b), "not while the frame is on the wire");
+    let waited = bits_until(&mut bus, 1_000, || inak(&a) && inak(&b));
+    // Transmitter and receiver acknowledge at the end of the end of frame.
+    assert_eq!(waited, total - 1);
+    assert!(waited <= u64::from(MAX_FRAME_IN_FLIGHT_BITS));
+    // At 2.5 kbit/s that is longer than a fixed 18 ms bound, and within the computed one.
+    let us = bus.bits_to_micros(waited);
+    assert!(us > 18_000, "{us} µs");
+    assert!(us <= bits_to_micros(MAX_FRAME_IN_FLIGHT_BITS, 2_500).unwrap());
+    // The frame was completed and stored before initialization mode.
+    assert_eq!(receive(&mut b, 0).map(|r| r.frame), Some(f));
+    assert_ne!(a.read32(regs::TSR) & tsr::TXOK0, 0);
+}

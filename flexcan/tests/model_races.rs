@@ -183,3 +183,31 @@ fn writing_back_every_esr1_flag_loses_one_raised_after_the_read() {
         assert_eq!(after & esr1::ERRINT, 0);
     }
 }
+
+#[test]
+fn freeze_request_waits_for_the_frame_in_flight_at_the_lowest_bit_rate() {
+    use twocan_core::sim::frame_bits;
+    use twocan_core::timing::frame_time::{bits_to_micros, MAX_FRAME_IN_FLIGHT_BITS};
+    let mut bus = Bus::new(2_500).unwrap();
+    let mut m = module(&mut bus, 0, None);
+    let peer = SimNode::new().shared();
+    bus.attach("peer", peer.clone());
+    let f = Frame::extended(0, &[0; 8]).unwrap();
+    let total = u64::from(frame_bits(&f).total);
+    load(&m, &f);
+    bus.run_bits(1);
+    m.modify32(regs::MCR, |v| v | mcr::FRZ | mcr::HALT);
+    let mut waited = 0;
+    while m.read32(regs::MCR) & mcr::FRZACK == 0 {
+        assert!(bus.in_frame(), "FRZACK only at the end of the frame");
+        bus.run_bits(1);
+        waited += 1;
+        assert!(waited < 1_000);
+    }
+    assert_eq!(waited, total - 1);
+    let us = bus.bits_to_micros(waited);
+    assert!(us > 18_000 && us <= bits_to_micros(MAX_FRAME_IN_FLIGHT_BITS, 2_500).unwrap());
+    // The frame was sent before freeze.
+    assert_eq!(peer.borrow().received_frames(), vec![f]);
+    assert_eq!(mb_code(&m), code::TX_INACTIVE);
+}

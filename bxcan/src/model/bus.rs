@@ -176,32 +176,32 @@ impl Controller {
 
     fn rx(&mut self, frame: &Frame, own: bool, time: BusTime) {
         self.observe(time.sof, time.now);
-        if !own {
-            self.rxm = false;
-        }
         if own {
             if self.lbkm() && self.mode() == Mode::Normal && !self.errors.is_bus_off() {
                 self.deliver(frame, time.sof);
             }
             return;
         }
+        // The reception completes (and is stored) before a mode request that waited for it
+        // takes effect.
         self.activity();
-        if !self.listens() {
-            return;
+        if self.listens() {
+            self.errors.receive_ok();
+            self.deliver(frame, time.sof);
         }
-        self.errors.receive_ok();
-        self.deliver(frame, time.sof);
+        self.rxm = false;
+        self.settle();
     }
 
     fn rx_error(&mut self, code: LastErrorCode, dominant_after_flag: bool, time: BusTime) {
         self.observe(time.sof, time.now);
-        self.rxm = false;
         self.activity();
-        if !self.listens() {
-            return;
+        if self.listens() {
+            self.errors.receive_error(code, dominant_after_flag);
+            self.error_detected();
         }
-        self.errors.receive_error(code, dominant_after_flag);
-        self.error_detected();
+        self.rxm = false;
+        self.settle();
     }
 
     /// The bus time at which the controller changes state on its own while the bus stays

@@ -287,7 +287,9 @@ impl Controller {
             let r = Requests {
                 inrq: self.has(mcr::INRQ),
                 sleep: self.has(mcr::SLEEP),
-                busy: self.tx.offered().is_some(),
+                // RM0410 40.4.1 / 40.4.3: initialization and sleep are entered once the
+                // current CAN activity (transmission or reception) has completed.
+                busy: self.tx.offered().is_some() || self.txm || self.rxm,
             };
             match self.modes.step(r, self.ack_stuck) {
                 Some((from, to)) => self.entered(from, to),

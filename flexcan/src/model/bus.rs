@@ -99,9 +99,15 @@ impl State {
     /// A frame received correctly (or the module's own frame).
     pub fn rx(&mut self, frame: &Frame, own: bool, time: BusTime) {
         self.time_to(time.now);
+        self.rx_inner(frame, own, time);
         if !own {
+            // A freeze or disable request that waited for this frame takes effect now.
             self.receiving = false;
+            self.settle_modes();
         }
+    }
+
+    fn rx_inner(&mut self, frame: &Frame, own: bool, time: BusTime) {
         if self.bus_off() {
             self.bus_off_dominant();
             return;
@@ -124,7 +130,12 @@ impl State {
     /// An error detected while receiving.
     pub fn rx_error(&mut self, code: LastErrorCode, dominant_after_flag: bool, time: BusTime) {
         self.time_to(time.now);
+        self.rx_error_inner(code, dominant_after_flag);
         self.receiving = false;
+        self.settle_modes();
+    }
+
+    fn rx_error_inner(&mut self, code: LastErrorCode, dominant_after_flag: bool) {
         if self.bus_off() {
             self.bus_off_dominant();
             return;
@@ -159,6 +170,7 @@ impl State {
         self.time_to(time.now);
         self.transmitting = false;
         self.transmission_ended(time.now, dominant_in_passive_flag);
+        self.settle_modes();
     }
 
     /// A frame attempt starts (see `BusNode::attempt_started`).
