@@ -789,7 +789,7 @@ impl Bus {
         for (k, r) in &losers {
             schedule.push((arb, 0, *k, Notice::Lost(r.frame)));
         }
-        for ((k, r), outcome) in contenders.iter().zip(&res.tx) {
+        for (n, ((k, r), outcome)) in contenders.iter().zip(&res.tx).enumerate() {
             let (at, result) = match *outcome {
                 PartOutcome::Ok { done } => (u64::from(done), TxResult::Acked),
                 PartOutcome::Error { code, at, .. } => (u64::from(at) + 1, TxResult::Error(code)),
@@ -798,7 +798,6 @@ impl Bus {
             let mut flag = false;
             if let PartOutcome::Error {
                 dominant_in_passive_flag,
-                penalties,
                 arbitration_stuff_exception,
                 ..
             } = *outcome
@@ -808,17 +807,18 @@ impl Bus {
                     let event = ConfinementEvent::ArbitrationStuffException;
                     schedule.push((at.min(end), 0, *k, Notice::Confinement(event)));
                 }
-                if penalties > 0 {
-                    let event = ConfinementEvent::FlagPenalties {
-                        transmitter: true,
-                        count: penalties,
-                    };
-                    schedule.push((end, 3, *k, Notice::Confinement(event)));
-                }
+            }
+            let penalties = res.tx_penalties.get(n).copied().unwrap_or(0);
+            if penalties > 0 {
+                let event = ConfinementEvent::FlagPenalties {
+                    transmitter: true,
+                    count: penalties,
+                };
+                schedule.push((end, 3, *k, Notice::Confinement(event)));
             }
             schedule.push((end, 3, *k, Notice::TxEnd(flag)));
         }
-        for (&k, outcome) in receivers.iter().zip(&res.rx) {
+        for (n, (&k, outcome)) in receivers.iter().zip(&res.rx).enumerate() {
             let (at, notice) = match *outcome {
                 PartOutcome::Ok { done } => (u64::from(done), Notice::Rx),
                 PartOutcome::Error {
@@ -832,14 +832,13 @@ impl Bus {
                 ),
             };
             schedule.push((at.min(end), 2, k, notice));
-            if let PartOutcome::Error { penalties, .. } = *outcome {
-                if penalties > 0 {
-                    let event = ConfinementEvent::FlagPenalties {
-                        transmitter: false,
-                        count: penalties,
-                    };
-                    schedule.push((end, 3, k, Notice::Confinement(event)));
-                }
+            let penalties = res.rx_penalties.get(n).copied().unwrap_or(0);
+            if penalties > 0 {
+                let event = ConfinementEvent::FlagPenalties {
+                    transmitter: false,
+                    count: penalties,
+                };
+                schedule.push((end, 3, k, Notice::Confinement(event)));
             }
         }
         schedule.sort_by_key(|&(at, order, k, _)| (at, order, k));

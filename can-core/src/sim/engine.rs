@@ -40,8 +40,16 @@
 //! - a transmitter's stuff error on a recessive stuff bit of the arbitration field read
 //!   dominant (rule 3, exception 2: TEC unchanged).
 //!
-//! Not modelled: overload frames, a dominant bit during an error delimiter (taken as a
-//! continuation of the flag period), hard synchronisation effects.
+//! Overload frames (§10.4.5): a receiver that reads a dominant last EOF bit (the frame is
+//! valid for it), and a node that reads a dominant bit in the first two bits of the
+//! intermission after its end of frame or delimiter, sends an overload flag (6 dominant
+//! bits, also when error-passive; not a silent node) and an overload delimiter; counters do
+//! not move, except by rule 6. The intermission is played only while something may drive it
+//! (an overload frame in progress, a stuck-dominant bus).
+//!
+//! Not modelled: a dominant bit during an error delimiter (taken as a continuation of the
+//! flag period) or at the last bit of a delimiter, the third intermission bit read dominant
+//! (a start of frame), hard synchronisation effects.
 
 use super::bits::FrameBits;
 use super::inject::{is_stuff_bit, RxFault, TxFault};
@@ -92,9 +100,6 @@ pub(crate) enum PartOutcome {
         /// It sent a passive error flag and read a dominant bit during it (rule 3,
         /// exception 1 does not apply then).
         dominant_in_passive_flag: bool,
-        /// Extra +8 penalties: bit errors during its own active error flag (rules 4, 5)
-        /// and dominant sequences after its flag (rule 6).
-        penalties: u8,
         /// A transmitter's stuff error on a recessive stuff bit in arbitration (rule 3,
         /// exception 2: TEC unchanged).
         arbitration_stuff_exception: bool,
@@ -120,22 +125,48 @@ pub(crate) struct Resolution {
     pub wire: Vec<bool>,
     /// Index into the transmitters of the frame the receivers followed.
     pub reference: usize,
+    /// Per transmitter, extra +8 penalties: bit errors during its own active error flag
+    /// (rules 4, 5) and dominant sequences after its error or overload flag (rule 6).
+    pub tx_penalties: Vec<u8>,
+    /// Per receiver, the same.
+    pub rx_penalties: Vec<u8>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Phase {
     Frame,
     ActiveFlag(u8),
-    PassiveFlag { last: bool, run: u8 },
-    AfterFlag { first: bool },
+    PassiveFlag {
+        last: bool,
+        run: u8,
+    },
+    /// Overload flag bit n (6 dominant bits).
+    Overload(u8),
+    AfterFlag {
+        first: bool,
+    },
     Delimiter(u8),
+    /// Intermission bit n after its end of frame or delimiter: a dominant bit at bit 0 or
+    /// 1 starts an overload frame.
+    Intermission(u8),
     Done,
+}
+
+impl Phase {
+    /// Finished with the attempt (the intermission counts as finished).
+    fn finished(self) -> bool {
+        matches!(self, Phase::Done | Phase::Intermission(_))
+    }
 }
 
 #[derive(Debug, Clone, Copy)]
 struct Part {
     phase: Phase,
     can_flag: bool,
+    /// It can drive the bus (a silent node cannot send overload flags).
+    can_drive: bool,
+    /// It is sending an overload frame (flag or delimiter).
+    overloading: bool,
     error: Option<(LastErrorCode, u32)>,
     dominant_after_flag: bool,
     dominant_in_passive_flag: bool,
@@ -160,6 +191,8 @@ impl Part {
         Part {
             phase: Phase::Frame,
             can_flag,
+            can_drive: true,
+            overloading: false,
             error: None,
             dominant_after_flag: false,
             dominant_in_passive_flag: false,
@@ -188,7 +221,35 @@ impl Part {
     }
 
     fn drives_flag(&self) -> bool {
-        matches!(self.phase, Phase::ActiveFlag(_))
+        matches!(self.phase, Phase::ActiveFlag(_) | Phase::Overload(_))
+    }
+
+    /// An overload condition (ISO 11898-1 §10.4.5): a dominant last EOF bit seen by a
+    /// receiver, or a dominant bit in the first two intermission bits. A node able to
+    /// drive the bus sends an overload flag from the next bit; counters do not move
+    /// (rule 6 still counts dominant bits from the start of the flag).
+    fn overload(&mut self) {
+        if self.can_drive {
+            self.overloading = true;
+            self.active_flag = true;
+            self.dominant_run = 0;
+            self.phase = Phase::Overload(0);
+        } else {
+            self.phase = Phase::Done;
+        }
+    }
+
+    /// Reads one intermission bit.
+    fn intermission(&mut self, wire: bool) {
+        if let Phase::Intermission(k) = self.phase {
+            if !wire && k < 2 {
+                self.overload();
+            } else if k + 1 >= 3 {
+                self.phase = Phase::Done;
+            } else {
+                self.phase = Phase::Intermission(k + 1);
+            }
+        }
     }
 
     fn add_penalty(&mut self) {
@@ -225,6 +286,16 @@ impl Part {
                     Phase::ActiveFlag(n + 1)
                 }
             }
+            Phase::Overload(n) => {
+                if !wire {
+                    self.count_dominant();
+                }
+                if n + 1 >= 6 {
+                    Phase::AfterFlag { first: true }
+                } else {
+                    Phase::Overload(n + 1)
+                }
+            }
             Phase::PassiveFlag { last, run } => {
                 if !wire {
                     self.dominant_in_passive_flag = true;
@@ -241,14 +312,18 @@ impl Part {
                 if wire {
                     Phase::Delimiter(1)
                 } else {
-                    if first {
+                    // Rule 2 is about error flags only.
+                    if first && !self.overloading {
                         self.dominant_after_flag = true;
                     }
                     self.count_dominant();
                     Phase::AfterFlag { first: false }
                 }
             }
-            Phase::Delimiter(n) if wire && n + 1 >= 8 => Phase::Done,
+            Phase::Delimiter(n) if wire && n + 1 >= 8 => {
+                self.overloading = false;
+                Phase::Intermission(0)
+            }
             Phase::Delimiter(n) if wire => Phase::Delimiter(n + 1),
             other => other,
         };
@@ -261,7 +336,6 @@ impl Part {
                 at,
                 dominant_after_flag: self.dominant_after_flag,
                 dominant_in_passive_flag: self.dominant_in_passive_flag,
-                penalties: self.penalties,
                 arbitration_stuff_exception: self.arbitration_stuff_exception,
             },
             None => match self.ok {
@@ -272,7 +346,6 @@ impl Part {
                     at: end,
                     dominant_after_flag: false,
                     dominant_in_passive_flag: false,
-                    penalties: 0,
                     arbitration_stuff_exception: false,
                 },
             },
@@ -316,7 +389,7 @@ fn tx_read(tx: &TxSpec<'_>, p: &mut Part, wire: bool, i: u32) {
         Some(c) => p.detect(c, i),
         None if i >= tx.bits.crc_end + 9 => {
             p.ok = Some(i + 1);
-            p.phase = Phase::Done;
+            p.phase = Phase::Intermission(0);
         }
         None => {}
     }
@@ -356,10 +429,14 @@ fn rx_read(rx: &RxSpec, p: &mut Part, wire: bool, i: u32, reference: &[bool], ce
             code = Some(LastErrorCode::Form);
         }
     } else {
-        // Last EOF bit: the frame is valid for a receiver; a dominant bit here would only
-        // start an overload frame (not modelled).
+        // Last EOF bit: the frame is valid for a receiver; a dominant bit here is an
+        // overload condition.
         p.ok = Some(i + 1);
-        p.phase = Phase::Done;
+        if wire {
+            p.phase = Phase::Intermission(0);
+        } else {
+            p.overload();
+        }
     }
     if let Some(c) = code {
         p.detect(c, i);
@@ -391,6 +468,8 @@ pub(crate) fn resolve_with(
             last_dominant_end: 0,
             wire: Vec::new(),
             reference: 0,
+            tx_penalties: Vec::new(),
+            rx_penalties: Vec::new(),
         };
     };
     let ce = ref_tx.bits.crc_end;
@@ -422,10 +501,14 @@ pub(crate) fn resolve_with(
         .iter()
         .map(|r| Part {
             flag_fault: flag_fault(None, Some(&r.faults)),
+            can_drive: r.acks,
             ..Part::new(r.active)
         })
         .collect();
-    let mut obs_part = Part::new(false);
+    let mut obs_part = Part {
+        can_drive: false,
+        ..Part::new(false)
+    };
 
     let longest = txs.iter().map(|t| t.bits.crc_end).max().unwrap_or(ce);
     let stuck_len = stuck.map_or(0, |(a, b)| b.saturating_sub(a));
@@ -468,6 +551,7 @@ pub(crate) fn resolve_with(
             match p.phase {
                 Phase::Frame => tx_read(t, p, wire, i),
                 Phase::Done => {}
+                Phase::Intermission(_) => p.intermission(wire),
                 _ => p.error_phase(wire),
             }
         }
@@ -479,24 +563,29 @@ pub(crate) fn resolve_with(
             match p.phase {
                 Phase::Frame => rx_read(r, p, wire, i, ref_stream, ce),
                 Phase::Done => {}
+                Phase::Intermission(_) => p.intermission(wire),
                 _ => p.error_phase(wire),
             }
         }
 
         i += 1;
-        let drivers_done = tx_parts.iter().all(|p| p.phase == Phase::Done)
+        let drivers_done = tx_parts.iter().all(|p| p.phase.finished())
             && rx_parts
                 .iter()
                 .zip(rxs)
-                .all(|(p, r)| !r.active || p.phase == Phase::Done);
-        if drivers_done && drivers_end.is_none() {
+                .all(|(p, r)| (!r.active && !p.overloading) || p.phase.finished());
+        if !drivers_done {
+            // An overload frame (or anything still driving) moves the end.
+            drivers_end = None;
+        } else if drivers_end.is_none() {
             drivers_end = Some(i);
         }
         let decided = rx_parts
             .iter()
             .chain(core::iter::once(&obs_part))
             .all(|p| p.phase != Phase::Frame);
-        if (drivers_done && decided) || i >= limit {
+        let stuck_over = stuck.is_none_or(|(_, b)| i >= b);
+        if (drivers_done && decided && stuck_over) || i >= limit {
             break drivers_end.unwrap_or(i);
         }
     };
@@ -513,6 +602,8 @@ pub(crate) fn resolve_with(
             bus
         },
         reference,
+        tx_penalties: tx_parts.iter().map(|p| p.penalties).collect(),
+        rx_penalties: rx_parts.iter().map(|p| p.penalties).collect(),
     }
 }
 
@@ -545,7 +636,6 @@ mod tests {
             at,
             dominant_after_flag: dom,
             dominant_in_passive_flag: false,
-            penalties: 0,
             arbitration_stuff_exception: false,
         }
     }
@@ -586,7 +676,6 @@ mod tests {
                 at: ce + 2,
                 dominant_after_flag: false,
                 dominant_in_passive_flag: true,
-                penalties: 0,
                 arbitration_stuff_exception: false,
             }]
         );

@@ -382,6 +382,33 @@ pub fn rule_6_dominant_bits_after_passive_flag<D: Dut>() {
     assert_eq!(dut.counters(), ErrorCounters { tec: 136, rec: 0 });
 }
 
+/// Overload frame (§10.4.5): a dominant first intermission bit makes every node send an
+/// overload flag (ce+11..=ce+16) and delimiter (ce+17..=ce+24); the frame stays valid and
+/// the counters move only by the success (rule 7): a TEC of 8 becomes 7. The attempt lasts
+/// ce + 25 bits and the intermission.
+pub fn overload_frame_leaves_the_counters<D: Dut>() {
+    let mut bus = Bus::new(500_000).unwrap();
+    let (mut dut, id) = D::join(&mut bus);
+    let p = peer();
+    bus.attach("p", p.clone());
+    let f = frame(0x0F8);
+    let ce = frame_bits(&f).crc_end;
+    bus.inject_from(id, 1, Fault::Bit { at: None });
+    dut.send(&f);
+    next_frame(&mut bus);
+    assert_eq!(dut.counters(), ErrorCounters { tec: 8, rec: 0 });
+    bus.try_inject_next(Fault::StuckDominant {
+        at: ce + 10,
+        bits: 1,
+    })
+    .unwrap();
+    let r = next_frame(&mut bus);
+    assert!(r.is_error_free());
+    assert_eq!(r.end - r.sof, u64::from(ce) + 28);
+    assert_eq!(dut.counters(), ErrorCounters { tec: 7, rec: 0 });
+    assert_eq!(p.borrow().received_frames(), vec![f]);
+}
+
 /// Bus-off at TEC > 255 (32 bit errors) and recovery after 128 occurrences of 11
 /// consecutive recessive bits (§12.1.4.2, "bus-off"). The error delimiter and intermission
 /// of the last error frame (8 + 3 recessive bits) are the first sequence, so the retry
@@ -462,6 +489,10 @@ macro_rules! conformance_tests {
         #[test]
         fn rule_6_dominant_bits_after_passive_flag() {
             conformance::rule_6_dominant_bits_after_passive_flag::<$dut>();
+        }
+        #[test]
+        fn overload_frame_leaves_the_counters() {
+            conformance::overload_frame_leaves_the_counters::<$dut>();
         }
         #[test]
         fn bus_off_and_recovery() {
