@@ -127,6 +127,7 @@ pub(crate) struct Resolution {
     pub reference: usize,
     /// Per transmitter, extra +8 penalties: bit errors during its own active error flag
     /// (rules 4, 5) and dominant sequences after its error or overload flag (rule 6).
+    /// Empty when there are none (the common case: no allocation).
     pub tx_penalties: Vec<u8>,
     /// Per receiver, the same.
     pub rx_penalties: Vec<u8>,
@@ -443,6 +444,15 @@ fn rx_read(rx: &RxSpec, p: &mut Part, wire: bool, i: u32, reference: &[bool], ce
     }
 }
 
+/// The parts' penalties, or an empty vector when all are 0.
+fn penalties(parts: &[Part]) -> Vec<u8> {
+    if parts.iter().all(|p| p.penalties == 0) {
+        Vec::new()
+    } else {
+        parts.iter().map(|p| p.penalties).collect()
+    }
+}
+
 /// Plays one frame attempt. `txs` must not be empty (an empty slice gives an empty result).
 #[cfg(test)]
 pub(crate) fn resolve(txs: &[TxSpec<'_>], rxs: &[RxSpec]) -> Resolution {
@@ -602,8 +612,8 @@ pub(crate) fn resolve_with(
             bus
         },
         reference,
-        tx_penalties: tx_parts.iter().map(|p| p.penalties).collect(),
-        rx_penalties: rx_parts.iter().map(|p| p.penalties).collect(),
+        tx_penalties: penalties(&tx_parts),
+        rx_penalties: penalties(&rx_parts),
     }
 }
 

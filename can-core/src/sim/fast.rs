@@ -56,8 +56,8 @@ pub(crate) fn resolve(
         last_dominant_end,
         wire: stream,
         reference: 0,
-        tx_penalties: vec![0],
-        rx_penalties: vec![0; receivers],
+        tx_penalties: Vec::new(),
+        rx_penalties: Vec::new(),
     }
 }
 
