@@ -85,3 +85,32 @@ fn dominant_last_eof_bit_is_an_overload_condition_for_the_other_receivers() {
         twocan_core::sim::TxResult::Error(LastErrorCode::BitRecessive)
     );
 }
+
+#[test]
+fn bit_error_in_an_overload_flag_counts_rule_4_and_5() {
+    let mut bus = Bus::new(500_000).unwrap();
+    let a = SimNode::new().shared();
+    let b = SimNode::new().shared();
+    let ia = bus.attach("a", a.clone());
+    let ib = bus.attach("b", b.clone());
+    let f = Frame::standard(0x2F3, &[5]).unwrap();
+    let ce = frame_bits(&f).crc_end;
+    a.borrow_mut().send(f);
+    bus.try_inject_next(Fault::StuckDominant {
+        at: ce + 10,
+        bits: 1,
+    })
+    .unwrap();
+    // Each node misreads bit 3 of its overload flag: +8 each (transmitter TEC, receiver
+    // REC), and a new overload flag: ce+11..=ce+14, then ce+15..=ce+20 (the flag
+    // restarts at the bit after the misread one), delimiter ce+21..=ce+28.
+    bus.try_inject_next(Fault::FlagBit { who: ia, bit: 3 })
+        .unwrap();
+    bus.try_inject_next(Fault::FlagBit { who: ib, bit: 3 })
+        .unwrap();
+    let r = bus.step().unwrap().record().unwrap().clone();
+    assert!(r.is_error_free());
+    assert_eq!(a.borrow().counters(), ErrorCounters { tec: 8, rec: 0 });
+    assert_eq!(b.borrow().counters(), ErrorCounters { tec: 0, rec: 8 });
+    assert_eq!(r.end - r.sof, u64::from(ce) + 29 + 3);
+}

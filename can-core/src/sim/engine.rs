@@ -31,8 +31,8 @@
 //!
 //! - reading a dominant bit during its own passive error flag (rule 3, exception 1 does
 //!   not apply then);
-//! - a bit error during its own active error flag (rules 4 and 5: injected with
-//!   `Fault::FlagBit`): +8, and the node starts a new error flag at the next bit;
+//! - a bit error during its own active error flag or overload flag (rules 4 and 5:
+//!   injected with `Fault::FlagBit`): +8, and the node starts a new flag at the next bit;
 //! - the dominant-bit tolerance after a flag (rule 6): counting consecutive dominant bits
 //!   from the start of an active error flag, or after the end of a passive one, the 14th
 //!   (active) or 8th (passive) and every 8th after it add 8 (a bus held dominant:
@@ -286,6 +286,13 @@ impl Part {
                 } else {
                     Phase::ActiveFlag(n + 1)
                 }
+            }
+            Phase::Overload(n) if self.flag_fault == Some(n) => {
+                // Rules 4 / 5 apply to overload flags too; a new overload flag starts.
+                self.flag_fault = None;
+                self.add_penalty();
+                self.dominant_run = 0;
+                Phase::Overload(0)
             }
             Phase::Overload(n) => {
                 if !wire {

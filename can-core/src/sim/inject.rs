@@ -104,9 +104,9 @@ pub enum Fault {
         field: FormField,
     },
     /// Rules 4 and 5: node `who` (transmitter or receiver) reads a recessive bit at bit
-    /// `bit` (0..=5) of its own active error flag: a bit error during its error flag. Its
-    /// counter rises by 8 and it starts a new error flag. No effect on a node that sends
-    /// no active error flag in that attempt.
+    /// `bit` (0..=5) of the first active error flag or overload flag it sends in the
+    /// attempt: a bit error during its flag. Its counter rises by 8 and it starts a new
+    /// flag. No effect on a node that sends no such flag in that attempt.
     FlagBit {
         /// The node.
         who: NodeId,
