@@ -714,8 +714,12 @@ impl Bus {
         let ref_bits = streams[reference].1;
 
         let tx_ids: Vec<NodeId> = contenders.iter().map(|(k, _)| NodeId(*k)).collect();
-        let rx_ids: Vec<NodeId> = receivers.iter().map(|&k| NodeId(k)).collect();
-        let mut faults = self.injector.faults_for(seq, &tx_ids, &rx_ids, &ref_bits);
+        let mut faults = if self.injector.is_idle() {
+            Vec::new()
+        } else {
+            let rx_ids: Vec<NodeId> = receivers.iter().map(|&k| NodeId(k)).collect();
+            self.injector.faults_for(seq, &tx_ids, &rx_ids, &ref_bits)
+        };
         let mut refused = Vec::new();
         faults.retain(|f| match f.check_layout(&ref_bits, &streams[reference].0) {
             Ok(()) => true,
@@ -727,51 +731,52 @@ impl Bus {
         self.refused.extend_from_slice(&refused);
         let stuck = faults.iter().find_map(Fault::stuck_range);
 
-        let txs: Vec<TxSpec<'_>> = contenders
-            .iter()
-            .zip(&streams)
-            .map(|((k, r), (stream, bits))| TxSpec {
-                stream,
-                bits: *bits,
-                self_ack: r.self_ack,
-                active: self.slots[*k].node.error_active(),
-                faults: faults
-                    .iter()
-                    .filter_map(|f| f.tx_part(NodeId(*k), bits))
-                    .collect(),
-            })
-            .collect();
-        let rxs: Vec<RxSpec> = receivers
-            .iter()
-            .map(|&k| {
-                let node = &self.slots[k].node;
-                let acks = node.acknowledges();
-                RxSpec {
-                    acks,
-                    active: acks && node.error_active(),
-                    faults: faults
-                        .iter()
-                        .filter_map(|f| f.rx_part(NodeId(k), &ref_bits))
-                        .collect(),
-                }
-            })
-            .collect();
-        let fast = if self.fast_path && faults.is_empty() {
-            fast::applies(&txs, &rxs)
+        // The fast path needs only whether someone acknowledges: no per-node specs.
+        let fast = if self.fast_path && faults.is_empty() && contenders.len() == 1 {
+            let any_ack = receivers
+                .iter()
+                .any(|&k| self.slots[k].node.acknowledges());
+            fast::decide(contenders[0].1.self_ack, any_ack)
         } else {
             None
         };
         let res = match fast {
             Some(acked) => {
-                drop(txs);
                 self.stats_fast_attempts += 1;
                 let stream = core::mem::take(&mut streams[0].0);
-                fast::resolve(streams[0].1, acked, rxs.len(), stream)
+                fast::resolve(streams[0].1, acked, receivers.len(), stream)
             }
             None => {
-                let res = engine::resolve_with(&txs, &rxs, stuck);
-                drop(txs);
-                res
+                let txs: Vec<TxSpec<'_>> = contenders
+                    .iter()
+                    .zip(&streams)
+                    .map(|((k, r), (stream, bits))| TxSpec {
+                        stream,
+                        bits: *bits,
+                        self_ack: r.self_ack,
+                        active: self.slots[*k].node.error_active(),
+                        faults: faults
+                            .iter()
+                            .filter_map(|f| f.tx_part(NodeId(*k), bits))
+                            .collect(),
+                    })
+                    .collect();
+                let rxs: Vec<RxSpec> = receivers
+                    .iter()
+                    .map(|&k| {
+                        let node = &self.slots[k].node;
+                        let acks = node.acknowledges();
+                        RxSpec {
+                            acks,
+                            active: acks && node.error_active(),
+                            faults: faults
+                                .iter()
+                                .filter_map(|f| f.rx_part(NodeId(k), &ref_bits))
+                                .collect(),
+                        }
+                    })
+                    .collect();
+                engine::resolve_with(&txs, &rxs, stuck)
             }
         };
 

@@ -10,19 +10,32 @@
 //! that both give the same traces and counters on random seeded traffic.
 
 use super::bits::FrameBits;
-use super::engine::{PartOutcome, Resolution, RxSpec, TxSpec};
+use super::engine::{PartOutcome, Resolution};
+#[cfg(test)]
+use super::engine::{RxSpec, TxSpec};
 
-/// Whether the attempt can take the fast path: `Some(acked)` (some receiver drives the
-/// ACK slot) if it can, `None` if it needs the bit-level engine.
-pub(crate) fn applies(txs: &[TxSpec<'_>], rxs: &[RxSpec]) -> Option<bool> {
+/// Whether an attempt with a single transmitter and no fault can take the fast path:
+/// `Some(acked)` if some receiver acknowledges (`any_ack`) or the transmitter acknowledges
+/// its own frame (`self_ack`), `None` otherwise (it ends in an acknowledge error: the
+/// bit-level engine plays it).
+pub(crate) const fn decide(self_ack: bool, any_ack: bool) -> Option<bool> {
+    if any_ack || self_ack {
+        Some(any_ack)
+    } else {
+        None
+    }
+}
+
+/// [`decide`] for attempts described as the engine's specs.
+#[cfg(test)]
+fn applies(txs: &[TxSpec<'_>], rxs: &[RxSpec]) -> Option<bool> {
     let [tx] = txs else {
         return None;
     };
     if !tx.faults.is_empty() || rxs.iter().any(|r| !r.faults.is_empty()) {
         return None;
     }
-    let acked = rxs.iter().any(|r| r.acks);
-    (acked || tx.self_ack).then_some(acked)
+    decide(tx.self_ack, rxs.iter().any(|r| r.acks))
 }
 
 /// The resolution of a fault-free, acknowledged attempt of a frame laid out as `bits`

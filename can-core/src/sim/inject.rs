@@ -475,6 +475,11 @@ impl Injector {
         *self = Injector::default();
     }
 
+    /// Nothing scheduled and no random injection: every attempt gets no fault.
+    pub(crate) fn is_idle(&self) -> bool {
+        self.at_frame.is_empty() && self.from_node.is_empty() && self.random.is_none()
+    }
+
     /// The faults for frame attempt `seq` sent by `transmitters`, received by `receivers`.
     pub(crate) fn faults_for(
         &mut self,
