@@ -733,9 +733,7 @@ impl Bus {
 
         // The fast path needs only whether someone acknowledges: no per-node specs.
         let fast = if self.fast_path && faults.is_empty() && contenders.len() == 1 {
-            let any_ack = receivers
-                .iter()
-                .any(|&k| self.slots[k].node.acknowledges());
+            let any_ack = receivers.iter().any(|&k| self.slots[k].node.acknowledges());
             fast::decide(contenders[0].1.self_ack, any_ack)
         } else {
             None
