@@ -8,7 +8,7 @@ mod tiny;
 use tiny::{accept_all, enter_init, load, receive, std_frame};
 use twocan_bxcan::model::{BxCanModel, Mode};
 use twocan_bxcan::regs::{self, btr, esr, mcr, msr, tsr};
-use twocan_core::sim::{Bus, Fault, SimNode};
+use twocan_core::sim::{Bus, BusEvent, Fault, SimNode};
 use twocan_core::Registers;
 
 /// Initialization, accept-all filter into FIFO 0, extra `MCR` bits, then INRQ cleared.
@@ -101,8 +101,14 @@ fn bus_off_and_automatic_recovery() {
     bus.inject_from(id_a, 32, Fault::Bit { at: None });
     let f = std_frame(0x42, &[4, 2]);
     load(&mut a, 0, &f);
+    // Error-passive from the 16th error on, it waits 8 bits of suspend transmission after
+    // each intermission (idle events of exactly 8 bits).
     while !a.state().bus_off {
-        assert!(bus.step().is_some(), "a retries until bus-off");
+        match bus.step_until(u64::MAX) {
+            Some(BusEvent::Frame(_)) => {}
+            Some(BusEvent::Idle { from, to }) => assert_eq!(to - from, 8),
+            other => panic!("a retries until bus-off: {other:?}"),
+        }
     }
     let off_at = bus.now();
     assert_ne!(a.read32(regs::ESR) & esr::BOFF, 0);

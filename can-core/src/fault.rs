@@ -7,7 +7,7 @@
 use crate::error::{ErrorCounters, ErrorState, LastErrorCode};
 
 /// Error counters of one node with the standard's update rules.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct FaultConfinement {
     tec: u16,
@@ -17,12 +17,57 @@ pub struct FaultConfinement {
     recovery_sequences: u16,
     /// Recessive bits in the current run while bus-off.
     recessive_run: u16,
+    /// The value REC takes after a successful reception while above 127 (rule 8 leaves
+    /// the choice in 119..=127 to the implementation).
+    rec_after_passive_reception: u8,
+    /// An error-passive transmitter detected an acknowledge error: whether TEC moves waits
+    /// for the end of its passive error flag (rule 3, exception 1).
+    ack_exception_pending: bool,
+    /// Bus time before which an error-passive node that was transmitter may not start a
+    /// transmission (suspend transmission); 0 when not suspended.
+    suspend_until: u64,
+    /// The next transmit error is a stuff error in arbitration on a recessive stuff bit
+    /// (rule 3, exception 2).
+    arbitration_stuff_exception: bool,
 }
 
 /// The number of 11-recessive-bit sequences after which a bus-off node may recover.
 pub const BUS_OFF_RECOVERY_SEQUENCES: u16 = 128;
 
+/// Bits of intermission after an end of frame or an error / overload delimiter
+/// (ISO 11898-1 §10.4.6.2 "Intermission").
+pub const INTERMISSION_BITS: u64 = 3;
+
+/// Bits an error-passive node that was transmitter waits after the intermission before it
+/// may start another transmission (ISO 11898-1 §10.4.6.4 "Suspend transmission").
+pub const SUSPEND_TRANSMISSION_BITS: u64 = 8;
+
+/// The implementation-defined REC value after a successful reception above 127 is outside
+/// the 119..=127 range that ISO 11898-1 §12.1.4.2 rule 8 allows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct RecResetOutOfRange(pub u8);
+
+impl core::fmt::Display for RecResetOutOfRange {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        write!(
+            f,
+            "REC after a successful reception above 127 must be in 119..=127, not {}",
+            self.0
+        )
+    }
+}
+
+impl Default for FaultConfinement {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
 impl FaultConfinement {
+    /// The REC value [`FaultConfinement::new`] uses after a successful reception above 127.
+    pub const DEFAULT_REC_AFTER_PASSIVE_RECEPTION: u8 = 127;
+
     /// A node fresh from reset: error-active, both counters zero.
     pub const fn new() -> Self {
         FaultConfinement {
@@ -31,7 +76,28 @@ impl FaultConfinement {
             bus_off: false,
             recovery_sequences: 0,
             recessive_run: 0,
+            rec_after_passive_reception: Self::DEFAULT_REC_AFTER_PASSIVE_RECEPTION,
+            ack_exception_pending: false,
+            suspend_until: 0,
+            arbitration_stuff_exception: false,
         }
+    }
+
+    /// A node fresh from reset whose REC is set to `value` by a successful reception while
+    /// above 127 (rule 8: "a value between 119 and 127"; each controller's reference manual
+    /// names its own). Refuses a value outside 119..=127.
+    pub const fn with_rec_after_passive_reception(value: u8) -> Result<Self, RecResetOutOfRange> {
+        if value < 119 || value > 127 {
+            return Err(RecResetOutOfRange(value));
+        }
+        let mut f = Self::new();
+        f.rec_after_passive_reception = value;
+        Ok(f)
+    }
+
+    /// The REC value after a successful reception above 127.
+    pub const fn rec_after_passive_reception(&self) -> u8 {
+        self.rec_after_passive_reception
     }
 
     /// The counters; TEC reads 256 while bus-off (ACAN §17 convention).
@@ -85,34 +151,120 @@ impl FaultConfinement {
         }
     }
 
-    /// Rule 8: a successful reception decrements REC (1..=127), or brings it back into
-    /// 119..=127 when above 127 (this implementation chooses 127).
+    /// Rule 8: a successful reception decrements REC (1..=127), or sets it to the
+    /// controller's value in 119..=127 when above 127
+    /// ([`FaultConfinement::with_rec_after_passive_reception`]).
     pub fn receive_succeeded(&mut self) {
         if self.rec > 127 {
-            self.rec = 127;
+            self.rec = u16::from(self.rec_after_passive_reception);
         } else if self.rec > 0 {
             self.rec -= 1;
         }
     }
 
-    /// Rule 3: the transmitter sends an error flag, TEC += 8 — except (exception 1) an
-    /// error-passive transmitter that detects an acknowledge error (and no dominant bit
-    /// during its passive error flag): no change. Returns whether bus-off was entered.
+    /// Rule 3: the transmitter sends an error flag, TEC += 8. Returns whether bus-off was
+    /// entered.
+    ///
+    /// Exception 1: an error-passive transmitter that detects an acknowledge error and
+    /// detects no dominant bit while sending its passive error flag leaves TEC unchanged.
+    /// The flag comes after the detection, so for an error-passive transmitter with
+    /// `Acknowledge` the decision waits for [`FaultConfinement::transmission_ended`].
     pub fn transmit_error(&mut self, code: LastErrorCode) -> bool {
         if self.bus_off {
             return false;
         }
-        if code == LastErrorCode::Acknowledge && self.is_passive() {
+        let exempt = core::mem::replace(&mut self.arbitration_stuff_exception, false);
+        if exempt && code == LastErrorCode::Stuff {
             return false;
         }
-        self.tec += 8;
+        if code == LastErrorCode::Acknowledge && self.is_passive() {
+            self.ack_exception_pending = true;
+            return false;
+        }
+        self.add_tec(8)
+    }
+
+    fn add_tec(&mut self, n: u16) -> bool {
+        self.tec += n;
         if self.tec > 255 {
             self.bus_off = true;
             self.recovery_sequences = 0;
             self.recessive_run = 0;
+            self.suspend_until = 0;
             return true;
         }
         false
+    }
+
+    /// The end of a frame attempt in which the node was a transmitter (to the end of its
+    /// end of frame or of its error delimiter, bus time `end`), after
+    /// [`FaultConfinement::transmit_error`] or [`FaultConfinement::transmit_succeeded`].
+    ///
+    /// - Rule 3 exception 1 settled: an acknowledge error of an error-passive transmitter
+    ///   that saw a dominant bit during its passive error flag
+    ///   (`dominant_in_passive_flag`) counts TEC += 8 after all.
+    /// - Suspend transmission (ISO 11898-1 §10.4.6.4): a node error-passive at this point
+    ///   may not start a transmission before `end` + intermission + 8 bits
+    ///   ([`FaultConfinement::may_start_transmission`]); it still receives a frame another
+    ///   node starts meanwhile.
+    ///
+    /// Returns whether bus-off was entered.
+    pub fn transmission_ended(&mut self, end: u64, dominant_in_passive_flag: bool) -> bool {
+        let pending = core::mem::replace(&mut self.ack_exception_pending, false);
+        if self.bus_off {
+            return false;
+        }
+        let off = pending && dominant_in_passive_flag && self.add_tec(8);
+        if !off && self.is_passive() {
+            self.suspend_until = end + INTERMISSION_BITS + SUSPEND_TRANSMISSION_BITS;
+        }
+        off
+    }
+
+    /// Whether suspend transmission lets the node start a frame at bus time `now`.
+    pub const fn may_start_transmission(&self, now: u64) -> bool {
+        now >= self.suspend_until
+    }
+
+    /// The bus time at which suspend transmission ends, if it has not ended by `now`.
+    pub const fn suspend_end(&self, now: u64) -> Option<u64> {
+        if now < self.suspend_until {
+            Some(self.suspend_until)
+        } else {
+            None
+        }
+    }
+
+    /// Rule 3, exception 2: the next [`FaultConfinement::transmit_error`], a stuff error
+    /// on a recessive stuff bit of the arbitration field that was read dominant, leaves
+    /// TEC unchanged.
+    pub fn arbitration_stuff_exception(&mut self) {
+        self.arbitration_stuff_exception = true;
+    }
+
+    /// Rules 4 and 5 (a bit error while sending an active error or overload flag) and rule
+    /// 6 (the 14th / 8th consecutive dominant bit after a flag, and each 8 more): TEC + 8
+    /// for a transmitter, REC + 8 for a receiver. Returns whether bus-off was entered.
+    pub fn flag_penalty(&mut self, transmitter: bool) -> bool {
+        if self.bus_off {
+            return false;
+        }
+        if transmitter {
+            self.add_tec(8)
+        } else {
+            self.rec = (self.rec + 8).min(255);
+            false
+        }
+    }
+
+    /// `count` flag penalties at once ([`FaultConfinement::flag_penalty`]). Returns
+    /// whether bus-off was entered.
+    pub fn confinement_penalties(&mut self, transmitter: bool, count: u8) -> bool {
+        let mut off = false;
+        for _ in 0..count {
+            off |= self.flag_penalty(transmitter);
+        }
+        off
     }
 
     /// Rule 1: a receiver detects an error, REC += 1; rule 2, a dominant bit as the first
@@ -172,7 +324,10 @@ impl FaultConfinement {
 
     /// Leaves bus-off: error-active with both counters zero (ISO 11898-1 §12.1.4.2).
     pub fn recover(&mut self) {
-        *self = Self::new();
+        *self = FaultConfinement {
+            rec_after_passive_reception: self.rec_after_passive_reception,
+            ..Self::new()
+        };
     }
 }
 

@@ -49,6 +49,13 @@ fn listen_only_receives_but_never_acknowledges_nor_transmits() {
     assert!(r.m.listens());
     assert!(!r.m.acknowledges());
     assert!(!r.m.error_active(), "listen-only behaves as error passive");
+    // ESR1[FLTCONF] reads error passive in listen-only mode, with both counters at 0.
+    let esr1 = r.m.peek32(regs::ESR1);
+    assert_eq!(
+        twocan_flexcan::regs::esr1::FLTCONF.get(esr1),
+        twocan_flexcan::regs::esr1::FLTCONF_ERROR_PASSIVE
+    );
+    assert_eq!(r.rd(regs::ECR), 0);
     r.load_mb(8, &std(0x1, &[]), code::TX_DATA);
     assert!(r.m.poll_tx(r.now).is_none());
     r.deliver(&ext(0x1_0000, &[9]));

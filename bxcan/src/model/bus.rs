@@ -21,9 +21,12 @@
 //!   started: the bus polls only while idle).
 //! - [`BusNode::next_wakeup`]: the end of SYNC, and the end of each run of 11 recessive
 //!   bits of a bus-off recovery under way, so that the bus stops its idle stretches there.
+//! - Suspend transmission: error-passive after transmitting, the controller starts no frame
+//!   before 8 bits after the intermission (ISO 11898-1 §10.4.6.4), counted by the shared
+//!   `FaultConfinement` from the end of the frame or error frame.
 //! - Time stamps are the TTCM timer at the start of frame (`BusTime::sof`).
 
-use twocan_core::sim::{BusNode, BusTime, TxRequest, TxResult};
+use twocan_core::sim::{BusNode, BusTime, ConfinementEvent, TxRequest, TxResult};
 use twocan_core::{Frame, LastErrorCode};
 
 use super::controller::Controller;
@@ -34,9 +37,10 @@ use super::BxCanModel;
 use crate::regs::{mcr, TX_MAILBOXES};
 
 impl Controller {
-    /// Whether the controller samples the bus (normal mode, not bus-off, not loop back).
+    /// Whether the controller samples the bus (normal mode, not bus-off, not loop back,
+    /// not frozen by a debug halt).
     pub(crate) fn listens(&self) -> bool {
-        self.mode() == Mode::Normal && !self.errors.is_bus_off() && !self.lbkm()
+        self.mode() == Mode::Normal && !self.errors.is_bus_off() && !self.lbkm() && !self.frozen()
     }
 
     /// Whether the controller would acknowledge a frame it received.
@@ -76,7 +80,12 @@ impl Controller {
             self.tx.bus_idle();
             self.settle();
         }
-        if self.mode() != Mode::Normal || self.modes.syncing() || self.errors.is_bus_off() {
+        if self.mode() != Mode::Normal
+            || self.modes.syncing()
+            || self.errors.is_bus_off()
+            || self.frozen()
+            || !self.errors.fault_confinement().may_start_transmission(now)
+        {
             return None;
         }
         let (lbkm, silm) = (self.lbkm(), self.silm());
@@ -116,6 +125,10 @@ impl Controller {
 
     fn tx_result(&mut self, frame: &Frame, result: TxResult, time: BusTime) {
         self.observe(time.sof, time.now);
+        if result == TxResult::ArbitrationLost {
+            self.txm = false;
+            self.rxm = self.listens();
+        }
         self.modes.activity();
         self.errors.dominant();
         let mailbox = self.mailbox_of(frame, time.sof);
@@ -169,22 +182,26 @@ impl Controller {
             }
             return;
         }
+        // The reception completes (and is stored) before a mode request that waited for it
+        // takes effect.
         self.activity();
-        if !self.listens() {
-            return;
+        if self.listens() {
+            self.errors.receive_ok();
+            self.deliver(frame, time.sof);
         }
-        self.errors.receive_ok();
-        self.deliver(frame, time.sof);
+        self.rxm = false;
+        self.settle();
     }
 
     fn rx_error(&mut self, code: LastErrorCode, dominant_after_flag: bool, time: BusTime) {
         self.observe(time.sof, time.now);
         self.activity();
-        if !self.listens() {
-            return;
+        if self.listens() {
+            self.errors.receive_error(code, dominant_after_flag);
+            self.error_detected();
         }
-        self.errors.receive_error(code, dominant_after_flag);
-        self.error_detected();
+        self.rxm = false;
+        self.settle();
     }
 
     /// The bus time at which the controller changes state on its own while the bus stays
@@ -199,10 +216,57 @@ impl Controller {
         }
         let recovering =
             self.mode() == Mode::Normal && self.errors.recovery_under_way(self.has(mcr::ABOM));
-        recovering.then(|| now.saturating_add(self.errors.recovery_bits_to_next_sequence()))
+        if recovering {
+            return Some(now.saturating_add(self.errors.recovery_bits_to_next_sequence()));
+        }
+        let waiting = self.tx.next(self.has(mcr::TXFP)).is_some();
+        if waiting {
+            self.errors.fault_confinement().suspend_end(now)
+        } else {
+            None
+        }
+    }
+
+    /// The end of an attempt the controller transmitted (see `BusNode::tx_attempt_end`).
+    fn tx_attempt_end(&mut self, dominant_in_passive_flag: bool, time: BusTime) {
+        self.observe(time.sof, time.now);
+        self.txm = false;
+        if self
+            .errors
+            .transmission_ended(time.now, dominant_in_passive_flag)
+        {
+            self.error_detected();
+        }
+        self.settle();
+    }
+
+    /// A fault-confinement event (see `BusNode::confinement_event`).
+    fn confinement_event(&mut self, event: ConfinementEvent, time: BusTime) {
+        self.observe(time.sof, time.now);
+        match event {
+            ConfinementEvent::ArbitrationStuffException => {
+                self.errors.arbitration_stuff_exception()
+            }
+            ConfinementEvent::FlagPenalties { transmitter, count } => {
+                self.errors.flag_penalties(transmitter, count);
+                self.error_detected();
+            }
+        }
+        self.settle();
+    }
+
+    /// A frame attempt starts (see `BusNode::attempt_started`).
+    fn attempt_started(&mut self, transmitter: bool, time: BusTime) {
+        self.observe(time.sof, time.sof);
+        if transmitter {
+            self.txm = true;
+        } else {
+            self.rxm = true;
+        }
     }
 
     fn advance(&mut self, bits: u64, idle: bool, now: u64) {
+        self.level = true;
         self.observe(now.saturating_sub(bits), now);
         if !idle {
             self.activity();
@@ -260,5 +324,23 @@ impl BusNode for BxCanModel {
 
     fn next_wakeup(&self, now: u64) -> Option<u64> {
         self.inner.borrow().next_wakeup(now)
+    }
+
+    fn tx_attempt_end(&mut self, dominant_in_passive_flag: bool, time: BusTime) {
+        self.inner
+            .borrow_mut()
+            .tx_attempt_end(dominant_in_passive_flag, time);
+    }
+
+    fn attempt_started(&mut self, transmitter: bool, time: BusTime) {
+        self.inner.borrow_mut().attempt_started(transmitter, time);
+    }
+
+    fn paused_in_frame(&mut self, recessive: bool, _now: u64) {
+        self.inner.borrow_mut().level = recessive;
+    }
+
+    fn confinement_event(&mut self, event: ConfinementEvent, time: BusTime) {
+        self.inner.borrow_mut().confinement_event(event, time);
     }
 }

@@ -5,11 +5,20 @@
 //! - `MCR`: bits `INRQ SLEEP TXFP RFLM NART AWUM ABOM TTCM DBF` read back as written;
 //!   `RESET` forces a master reset (every register of the controller to its reset
 //!   value, sleep mode, FIFOs emptied, counters cleared; the filter block is a separate
-//!   block and keeps its content) and reads 0. `DBF` has no effect (no debugger here).
+//!   block and keeps its content) and reads 0.
+//! - `MCR.DBF` (debug freeze): while the simulated debug halt is asserted
+//!   ([`super::BxCanModel::set_debug_halt`]) and `DBF = 1`, "CAN reception/transmission
+//!   [are] frozen": the controller starts no transmission and takes no part in the next
+//!   frames (no reception, no acknowledge, no error counting); its registers and FIFOs
+//!   stay accessible. A frame already on the wire when the halt comes is finished (an
+//!   assumption: RM0410 does not say when the freeze takes effect).
 //! - `MSR`: `INAK`/`SLAK` from the mode; `ERRI`, `WKUI`, `SLAKI` are `rc_w1`; `SLAKI`
 //!   is set on entering sleep mode only when `IER.SLKIE = 1`, and cleared by hardware
-//!   when `SLAK` clears. `TXM`, `RXM` read 0 and `SAMP`, `RX` read 1 (recessive): bus
-//!   events are instantaneous in this model.
+//!   when `SLAK` clears. `TXM` (transmitter) from the start of a frame it sends to the end
+//!   of that attempt (cleared when arbitration is lost), `RXM` (receiver) from the start
+//!   of a frame it receives (or loses arbitration to) to its outcome; `RX` (CANRX level)
+//!   and `SAMP` (last sampled bit) show the wire's level where the bus stopped inside a
+//!   frame, recessive otherwise (the model samples once per bit, so `SAMP` = `RX`).
 //! - `BTR`: written only in initialization mode (`INAK = 1`); reads are always allowed.
 //! - `ESR`: only `LEC` is writable. `IER`: the enable bits.
 //! - Reserved bits are ignored on write and read as 0 (those of `FMR` read as in its reset
@@ -83,6 +92,14 @@ pub(crate) struct Controller {
     pub(crate) ack_stuck: bool,
     /// Valid frames that no filter accepted (or arrived while `FINIT = 1`).
     pub(crate) dropped: u64,
+    /// `MSR.TXM`: the controller is transmitter of the frame on the wire.
+    pub(crate) txm: bool,
+    /// `MSR.RXM`: the controller is receiver of the frame on the wire.
+    pub(crate) rxm: bool,
+    /// The wire's level (true = recessive) where the bus stopped inside a frame.
+    pub(crate) level: bool,
+    /// The simulated debugger halts the core (the input `MCR.DBF` acts on).
+    pub(crate) debug_halt: bool,
 }
 
 impl Controller {
@@ -107,7 +124,16 @@ impl Controller {
             time_known: false,
             ack_stuck: false,
             dropped: 0,
+            txm: false,
+            rxm: false,
+            level: true,
+            debug_halt: false,
         }
+    }
+
+    /// Reception and transmission frozen by a debug halt (`MCR.DBF = 1`).
+    pub(crate) fn frozen(&self) -> bool {
+        self.debug_halt && self.has(mcr::DBF)
     }
 
     /// `MCR.RESET`: the controller returns to its reset state (the filter block, the bus
@@ -118,6 +144,7 @@ impl Controller {
             now: self.now,
             time_known: self.time_known,
             ack_stuck: self.ack_stuck,
+            debug_halt: self.debug_halt,
             ..fresh
         };
     }
@@ -140,7 +167,16 @@ impl Controller {
 
     /// `CAN_MSR` as read.
     pub(crate) fn msr(&self) -> u32 {
-        let mut v = msr::SAMP | msr::RX;
+        let mut v = 0;
+        if self.level {
+            v |= msr::SAMP | msr::RX;
+        }
+        if self.txm {
+            v |= msr::TXM;
+        }
+        if self.rxm {
+            v |= msr::RXM;
+        }
         match self.mode() {
             Mode::Initialization => v |= msr::INAK,
             Mode::Sleep => v |= msr::SLAK,
@@ -251,7 +287,9 @@ impl Controller {
             let r = Requests {
                 inrq: self.has(mcr::INRQ),
                 sleep: self.has(mcr::SLEEP),
-                busy: self.tx.offered().is_some(),
+                // RM0410 40.4.1 / 40.4.3: initialization and sleep are entered once the
+                // current CAN activity (transmission or reception) has completed.
+                busy: self.tx.offered().is_some() || self.txm || self.rxm,
             };
             match self.modes.step(r, self.ack_stuck) {
                 Some((from, to)) => self.entered(from, to),

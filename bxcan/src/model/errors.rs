@@ -34,8 +34,21 @@ pub(crate) fn lec_code(code: LastErrorCode) -> u32 {
     }
 }
 
+/// REC after a successful reception while above 127: RM0410 40.9.2 (`CAN_ESR.REC`):
+/// "After every successful reception, the counter is decremented by 1 or reset to 120 if
+/// its value was higher than 128". ISO 11898-1 rule 8 allows 119..=127. The model applies
+/// 120 to every REC above 127 (the standard's condition; RM0410's "higher than 128" would
+/// take REC = 128 to 127, docs/models.md says how silicon can tell).
+pub const REC_AFTER_PASSIVE_RECEPTION: u8 = 120;
+
+const FRESH_COUNTERS: FaultConfinement =
+    match FaultConfinement::with_rec_after_passive_reception(REC_AFTER_PASSIVE_RECEPTION) {
+        Ok(f) => f,
+        Err(_) => panic!("REC_AFTER_PASSIVE_RECEPTION outside 119..=127"),
+    };
+
 /// The error counters, last error code and bus-off recovery state of a controller.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone)]
 pub(crate) struct ErrorUnit {
     fc: FaultConfinement,
     lec: u32,
@@ -51,7 +64,18 @@ pub(crate) struct ErrorUnit {
 impl ErrorUnit {
     /// Error-active, counters zero, `LEC` = 0.
     pub(crate) fn new() -> Self {
-        Self::default()
+        ErrorUnit {
+            fc: FRESH_COUNTERS,
+            lec: 0,
+            init_entered: false,
+            manual_armed: false,
+            run: 0,
+        }
+    }
+
+    /// The shared fault-confinement state.
+    pub(crate) fn fault_confinement(&self) -> &FaultConfinement {
+        &self.fc
     }
 
     /// `CAN_ESR` as read.
@@ -113,10 +137,39 @@ impl ErrorUnit {
     pub(crate) fn transmit_error(&mut self, code: LastErrorCode) {
         self.lec = lec_code(code);
         if self.fc.transmit_error(code) {
-            self.init_entered = false;
-            self.manual_armed = false;
-            self.run = 0;
+            self.entered_bus_off();
         }
+    }
+
+    fn entered_bus_off(&mut self) {
+        self.init_entered = false;
+        self.manual_armed = false;
+        self.run = 0;
+    }
+
+    /// The end of an attempt the controller transmitted (`end`: end of its EOF or error
+    /// delimiter): rule 3 exception 1 settled, suspend transmission armed. Returns whether
+    /// bus-off was entered.
+    pub(crate) fn transmission_ended(&mut self, end: u64, dominant_in_passive_flag: bool) -> bool {
+        let off = self.fc.transmission_ended(end, dominant_in_passive_flag);
+        if off {
+            self.entered_bus_off();
+        }
+        off
+    }
+
+    /// Rule 3 exception 2 for the transmit error that follows.
+    pub(crate) fn arbitration_stuff_exception(&mut self) {
+        self.fc.arbitration_stuff_exception();
+    }
+
+    /// `count` flag penalties (rules 4 to 6); returns whether bus-off was entered.
+    pub(crate) fn flag_penalties(&mut self, transmitter: bool, count: u8) -> bool {
+        let off = self.fc.confinement_penalties(transmitter, count);
+        if off {
+            self.entered_bus_off();
+        }
+        off
     }
 
     /// A frame received without error.

@@ -19,8 +19,12 @@
 //!   list before identifier mask, then the lower filter number. Matches in different
 //!   FIFOs with equal scale and mode are ordered by bank number (RM0410 is silent).
 //! - A frame that matches no active filter is dropped.
-//! - Bit 0 of a 32-bit filter register is not part of the identifier mapping ("0" in the
-//!   figure) and is not compared.
+//! - 32-bit scale: the frame's side of the comparison is the identifier register layout
+//!   `STID[10:0] EXID[17:0] IDE RTR 0` (RM0410 Figure "Filter bank scale configuration -
+//!   register organization": bit 0 is shown as "0"), and all 32 bits are compared: a list
+//!   entry with bit 0 set never matches, a mask filter that sets bit 0 in its mask
+//!   matches only if its identifier has bit 0 clear (docs/models.md lists this as an
+//!   assumption to check on silicon).
 
 use core::ops::Range;
 
@@ -30,8 +34,6 @@ use crate::regs::{self, firx, fmr, FILTER_BANKS, FILTER_BANKS_SINGLE};
 
 /// The reserved bits of `FMR` read as in its reset value.
 const FMR_RESERVED: u32 = regs::fmr::RESET_VALUE & !(fmr::FINIT | fmr::CAN2SB.mask());
-/// The 32-bit filter bits compared with the identifier (bit 0 is not).
-const CMP32: u32 = !1;
 
 /// Which filter block a controller has, and which banks of it it uses.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -176,8 +178,8 @@ impl FilterBlock {
             }
             for k in 0..filters_in_bank(scale32, list) as usize {
                 let hit = match (scale32, list) {
-                    (true, false) => (w32 ^ r1) & r2 & CMP32 == 0,
-                    (true, true) => (w32 ^ [r1, r2][k]) & CMP32 == 0,
+                    (true, false) => (w32 ^ r1) & r2 == 0,
+                    (true, true) => w32 == [r1, r2][k],
                     (false, false) => {
                         let r = [r1, r2][k];
                         let id = firx::LOW_HALF.get(r);

@@ -17,11 +17,16 @@
 //! recovery), `timer.rs` (TTCM time stamps), `irq.rs` (interrupt lines), `bus.rs` (test
 //! modes, time, the bus contract) and `controller.rs` (register access rules).
 //!
-//! Not modelled: bit timing (`BTR` is stored, the bus runs in bit times), the `TXM`,
-//! `RXM`, `SAMP`, `RX` status bits (they read idle), debug freeze (`DBF` is a flag
-//! without effect), DLC codes 9..15 on the bus (sent as 8 bytes with DLC 8). The
-//! mailbox "transmit" state is the one `poll_tx` offered until the bus reports the
-//! attempt; a mode request is acknowledged at once (after a transmission in progress).
+//! Frames take bus time: with `Bus::run_bits` software can access the registers while a
+//! frame is on the wire (`MSR.TXM`/`RXM`/`RX`/`SAMP` show it; an `ABRQx` then waits for
+//! the outcome of the mailbox in transmit state). Debug freeze (`MCR.DBF`) acts on the
+//! simulated debug halt input [`BxCanModel::set_debug_halt`].
+//!
+//! Not modelled: bit timing (`BTR` is stored, the bus runs in bit times), DLC codes 9..15
+//! on the bus (sent as 8 bytes with DLC 8: the simulated bus carries `Frame`, whose DLC
+//! is the data length). The mailbox "transmit" state is the one `poll_tx` offered until
+//! the bus reports the attempt; a mode request is acknowledged at once (after a
+//! transmission in progress).
 //!
 //! Fault injection: [`BxCanModel::set_ack_stuck`]. Inspection without registers:
 //! [`BxCanModel::state`], [`BxCanModel::fifo_contents`], [`BxCanModel::irq_lines`].
@@ -49,6 +54,7 @@ use crate::regs::{Instance, FILTER_BANKS, RX_FIFOS, TX_MAILBOXES};
 use controller::Controller;
 use filters::{FilterBlock, Owner};
 
+pub use errors::REC_AFTER_PASSIVE_RECEPTION;
 pub use irq::IrqLines;
 pub use modes::Mode;
 
@@ -158,6 +164,14 @@ impl BxCanModel {
         let mut c = self.inner.borrow_mut();
         c.ack_stuck = stuck;
         c.settle();
+    }
+
+    /// The simulated debugger halts (`true`) or resumes (`false`) the core. With
+    /// `MCR.DBF = 1` reception and transmission are frozen while halted (RM0410 40.9.2
+    /// `CAN_MCR.DBF`: "CAN reception/transmission frozen during debug. Reception FIFOs can
+    /// still be accessed/controlled normally"); with `DBF = 0` the halt changes nothing.
+    pub fn set_debug_halt(&self, halted: bool) {
+        self.inner.borrow_mut().debug_halt = halted;
     }
 
     /// A snapshot of the internal state.

@@ -75,6 +75,75 @@ fn push_bits(out: &mut Vec<bool>, value: u32, count: u32) {
     }
 }
 
+/// CRC-15 steps for one byte, most significant bit first, from a zero register.
+const CRC15_TABLE: [u16; 256] = {
+    let mut table = [0u16; 256];
+    let mut i = 0;
+    while i < 256 {
+        let mut c = (i as u16) << 7;
+        let mut k = 0;
+        while k < 8 {
+            c = if c & 0x4000 != 0 {
+                ((c << 1) & 0x7FFF) ^ CRC15_POLYNOMIAL
+            } else {
+                (c << 1) & 0x7FFF
+            };
+            k += 1;
+        }
+        table[i] = c;
+        i += 1;
+    }
+    table
+};
+
+/// [`crc15`] of the `n` low bits of `word`, most significant first: the leading `n % 8`
+/// bits one at a time, then whole bytes through [`CRC15_TABLE`].
+fn crc15_word(word: u128, n: u32) -> u16 {
+    let mut crc: u16 = 0;
+    let lead = n % 8;
+    for i in (n - lead..n).rev() {
+        let feedback = ((word >> i) & 1 == 1) ^ (crc & 0x4000 != 0);
+        crc = (crc << 1) & 0x7FFF;
+        if feedback {
+            crc ^= CRC15_POLYNOMIAL;
+        }
+    }
+    let mut i = n - lead;
+    while i >= 8 {
+        i -= 8;
+        let byte = (word >> i) as u8;
+        crc = ((crc << 8) & 0x7FFF) ^ CRC15_TABLE[usize::from(((crc >> 7) as u8) ^ byte)];
+    }
+    crc
+}
+
+/// The unstuffed bits SOF..data as a word (last bit in bit 0) and their number.
+fn header_word(frame: &Frame) -> (u128, u32) {
+    let mut w: u128 = 0;
+    let mut n = 0u32;
+    let mut put = |value: u32, count: u32| {
+        w = (w << count) | u128::from(value & ((1u64 << count) - 1) as u32);
+        n += count;
+    };
+    let raw = frame.raw_id();
+    put(0, 1); // SOF
+    if frame.is_extended() {
+        put(raw >> 18, 11);
+        put(0b11, 2); // SRR, IDE
+        put(raw & 0x3_FFFF, 18);
+        put(u32::from(frame.is_remote()), 1); // RTR
+        put(0, 2); // r1, r0
+    } else {
+        put(raw, 11);
+        put(u32::from(frame.is_remote()) << 2, 3); // RTR, IDE, r0
+    }
+    put(u32::from(frame.dlc()), 4);
+    for byte in frame.data() {
+        put(u32::from(*byte), 8);
+    }
+    (w, n)
+}
+
 /// The unstuffed bits of a frame from SOF to the end of the data field (the CRC input).
 pub fn unstuffed_header_and_data(frame: &Frame) -> Vec<bool> {
     let mut out = Vec::with_capacity(39 + 64);
@@ -159,39 +228,63 @@ pub struct FrameBits {
 /// The wire bits of a frame from SOF through the CRC sequence (stuffed), plus its
 /// [`FrameBits`]. The tail (delimiters, ACK, EOF) is not stuffed and not included.
 pub fn wire_bits(frame: &Frame) -> (Vec<bool>, FrameBits) {
-    let header = unstuffed_header_and_data(frame);
-    let crc = crc15(header.iter().copied());
+    // The unstuffed bits SOF..data, most significant first, in one word (at most 103 bits),
+    // then the CRC over them: the same bits as `unstuffed_header_and_data`, without a
+    // vector of booleans (this runs once per simulated frame).
+    let (header, data_unstuffed) = header_word(frame);
+    let crc = crc15_word(header, data_unstuffed);
     let (arb_unstuffed, ctrl_unstuffed) = if frame.is_extended() {
         (33, 39)
     } else {
         (14, 19)
     };
-    let data_unstuffed = header.len();
+    let data_unstuffed = data_unstuffed as usize;
+    let count = data_unstuffed + 15;
+    // Left-aligned: the next bit is always bit 127 (at most 118 bits).
+    let mut all = ((header << 15) | u128::from(crc)) << (128 - count);
 
-    let mut out = Vec::with_capacity(header.len() + 15 + 30);
+    // At most 118 bits and 29 stuff bits: a fixed buffer, copied out once.
+    let mut buf = [false; 160];
+    let mut n = 0usize;
     let mut last = true;
     let mut run = 0u32;
-    let mut arbitration_end = 0;
-    let mut control_end = 0;
-    let mut data_end = 0;
-    let crc_bits = (0..15).rev().map(|i| (crc >> i) & 1 == 1);
-    for (index, bit) in header.iter().copied().chain(crc_bits).enumerate() {
-        let before = out.len();
-        push_stuffed(&mut out, bit, &mut last, &mut run);
-        // The boundary is right after this bit, before a stuff bit that may follow it.
-        let after_bit = (before + 1) as u32;
-        let consumed = index + 1;
-        if consumed == arb_unstuffed {
-            arbitration_end = after_bit;
+    // Each field boundary is right after the field's last bit, before a stuff bit that may
+    // follow it.
+    let mut ends = [0u32; 4];
+    let lengths = [
+        arb_unstuffed,
+        ctrl_unstuffed - arb_unstuffed,
+        data_unstuffed - ctrl_unstuffed,
+        15,
+    ];
+    let mut previous = 0;
+    for (end, len) in ends.iter_mut().zip(lengths) {
+        // An empty field (no data) ends where the one before it ends.
+        *end = previous;
+        for _ in 0..len {
+            let bit = all >> 127 == 1;
+            all <<= 1;
+            buf[n] = bit;
+            n += 1;
+            if bit == last {
+                run += 1;
+            } else {
+                last = bit;
+                run = 1;
+            }
+            *end = n as u32;
+            if run == 5 {
+                buf[n] = !bit;
+                n += 1;
+                last = !bit;
+                run = 1;
+            }
         }
-        if consumed == ctrl_unstuffed {
-            control_end = after_bit;
-        }
-        if consumed == data_unstuffed {
-            data_end = after_bit;
-        }
+        previous = *end;
     }
-    let crc_end = out.len() as u32;
+    let out = buf[..n].to_vec();
+    let [arbitration_end, control_end, data_end, _] = ends;
+    let crc_end = n as u32;
     let unstuffed = data_unstuffed as u32 + 15 + TAIL_BITS;
     let stuff_bits = crc_end - (data_unstuffed as u32 + 15);
     let total = unstuffed + stuff_bits;
@@ -228,6 +321,30 @@ pub const fn max_stuff_bits(extended: bool, data_len: u8) -> u32 {
 mod tests {
     use super::*;
     use crate::frame::Frame;
+
+    #[test]
+    fn wire_bits_equals_stuffing_the_boolean_header_and_crc() {
+        let mut x = 0x9E37_79B9_7F4A_7C15u64;
+        for _ in 0..3_000 {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            let len = (x % 9) as usize;
+            let data: Vec<u8> = (0..len).map(|i| (x >> (8 * i)) as u8).collect();
+            let f = match x % 4 {
+                0 => Frame::standard((x >> 20) as u16 & 0x7FF, &data).unwrap(),
+                1 => Frame::extended((x >> 20) as u32 & 0x1FFF_FFFF, &data).unwrap(),
+                2 => Frame::remote((x >> 20) as u32 & 0x7FF, false, len as u8).unwrap(),
+                _ => Frame::remote((x >> 20) as u32 & 0x1FFF_FFFF, true, len as u8).unwrap(),
+            };
+            let mut bits = unstuffed_header_and_data(&f);
+            let crc = crc15(bits.iter().copied());
+            bits.extend((0..15).rev().map(|i| (crc >> i) & 1 == 1));
+            let (wire, layout) = wire_bits(&f);
+            assert_eq!(wire, stuff(&bits), "{f:?}");
+            assert_eq!(layout.crc, crc);
+        }
+    }
 
     #[test]
     fn crc_catalogue_check_value() {

@@ -93,8 +93,9 @@ use std::vec::Vec;
 
 use super::bits::{wire_bits, FrameBits, INTERMISSION_BITS};
 use super::engine::{self, PartOutcome, RxSpec, TxSpec};
-use super::inject::{Fault, Injector, RandomFaults};
-use super::node::{BusNode, BusTime, TxRequest, TxResult};
+use super::fast;
+use super::inject::{Fault, FaultError, Injector, RandomFaults};
+use super::node::{BusNode, BusTime, ConfinementEvent, TxRequest, TxResult};
 use super::stats::{BusStats, NodeStats};
 use super::trace::{bits_to_micros, ErrorInfo, NodeOutcome, NodeReport, Trace, TraceRecord};
 
@@ -177,6 +178,28 @@ enum Notice {
     Tx(crate::frame::Frame, TxResult),
     Rx,
     RxError(crate::error::LastErrorCode, bool),
+    /// The end of the attempt for a transmitter; whether it read a dominant bit during its
+    /// passive error flag.
+    TxEnd(bool),
+    /// A fault-confinement event the outcome does not carry.
+    Confinement(ConfinementEvent),
+}
+
+/// A wire frame attempt that has started and is not over yet (see [`Bus::run_bits`]).
+struct InFlight {
+    sof: u64,
+    /// Offset from SOF of the end of the last EOF or error delimiter.
+    end: u64,
+    schedule: Vec<(u64, u8, usize, Notice)>,
+    /// The next schedule entry to deliver.
+    next: usize,
+    /// Offset from SOF up to which every node has been advanced.
+    done: u64,
+    in_frame: Vec<bool>,
+    wire: Vec<bool>,
+    record: TraceRecord,
+    receivers: Vec<usize>,
+    frame: crate::frame::Frame,
 }
 
 struct Slot {
@@ -196,6 +219,10 @@ pub struct Bus {
     stats: BusStats,
     instant_streak: u32,
     idle_quantum: u64,
+    in_flight: Option<InFlight>,
+    fast_path: bool,
+    stats_fast_attempts: u64,
+    refused: Vec<(Fault, FaultError)>,
 }
 
 impl core::fmt::Debug for Bus {
@@ -232,6 +259,10 @@ impl Bus {
             stats: BusStats::default(),
             instant_streak: 0,
             idle_quantum: u64::MAX,
+            in_flight: None,
+            fast_path: true,
+            stats_fast_attempts: 0,
+            refused: Vec::new(),
         })
     }
 
@@ -326,19 +357,56 @@ impl Bus {
     }
 
     /// Injects `fault` into wire frame attempt number `seq` (0 = the first SOF on the bus;
-    /// retransmissions count as new attempts).
+    /// retransmissions count as new attempts). A fault that cannot happen is refused:
+    /// [`Bus::try_inject`] says so at once; here it is recorded in
+    /// [`Bus::refused_faults`] (and, when the frame decides it, in the attempt's
+    /// [`TraceRecord::refused`]).
     pub fn inject(&mut self, seq: u64, fault: Fault) {
+        if let Err(e) = self.try_inject(seq, fault) {
+            self.refused.push((fault, e));
+        }
+    }
+
+    /// [`Bus::inject`], refusing at once a fault that cannot happen in any frame.
+    pub fn try_inject(&mut self, seq: u64, fault: Fault) -> Result<(), FaultError> {
+        fault.validate()?;
         self.injector.at_frame(seq, fault);
+        Ok(())
     }
 
-    /// Injects `fault` into the next frame attempt on the wire.
+    /// Injects `fault` into the next frame attempt on the wire (see [`Bus::inject`]).
     pub fn inject_next(&mut self, fault: Fault) {
-        self.injector.at_frame(self.stats.frames_started, fault);
+        self.inject(self.stats.frames_started, fault);
     }
 
-    /// Injects `fault` into the next `count` frame attempts that `node` transmits.
+    /// [`Bus::inject_next`], refusing at once a fault that cannot happen in any frame.
+    pub fn try_inject_next(&mut self, fault: Fault) -> Result<(), FaultError> {
+        self.try_inject(self.stats.frames_started, fault)
+    }
+
+    /// Injects `fault` into the next `count` frame attempts that `node` transmits (see
+    /// [`Bus::inject`]).
     pub fn inject_from(&mut self, node: NodeId, count: u32, fault: Fault) {
+        if let Err(e) = self.try_inject_from(node, count, fault) {
+            self.refused.push((fault, e));
+        }
+    }
+
+    /// [`Bus::inject_from`], refusing at once a fault that cannot happen in any frame.
+    pub fn try_inject_from(
+        &mut self,
+        node: NodeId,
+        count: u32,
+        fault: Fault,
+    ) -> Result<(), FaultError> {
+        fault.validate()?;
         self.injector.on_node(node, count, fault);
+        Ok(())
+    }
+
+    /// Every fault refused so far, at injection or when its frame showed it cannot happen.
+    pub fn refused_faults(&self) -> &[(Fault, FaultError)] {
+        &self.refused
     }
 
     /// Random injection (`None` turns it off). Same seed and same traffic give the same faults.
@@ -351,6 +419,18 @@ impl Bus {
         self.injector.clear();
     }
 
+    /// Uses the fast path for attempts that cannot fail (one transmitter, no injected fault,
+    /// an acknowledgement: `sim/fast.rs`) instead of playing their bits (on by default).
+    /// The results are the same either way; turning it off measures the bit-level path.
+    pub fn set_fast_path(&mut self, on: bool) {
+        self.fast_path = on;
+    }
+
+    /// Frame attempts resolved by the fast path so far.
+    pub fn fast_path_attempts(&self) -> u64 {
+        self.stats_fast_attempts
+    }
+
     /// The longest idle stretch one event may cover (default: unlimited). Setting 1 makes
     /// the bus poll every node after each idle bit, for models that cannot give a
     /// [`BusNode::next_wakeup`] hint.
@@ -359,20 +439,82 @@ impl Bus {
     }
 
     /// Runs one frame attempt or internal frame if some node wants to send now; `None` (and
-    /// no time passes) if none does.
+    /// no time passes) if none does. A frame attempt left in flight by [`Bus::run_bits`] is
+    /// finished first (that is the event returned).
     pub fn step(&mut self) -> Option<BusEvent> {
+        if self.in_flight.is_some() {
+            return self.continue_attempt(u64::MAX);
+        }
+        match self.begin()? {
+            Some(event) => Some(event),
+            None => self.continue_attempt(u64::MAX),
+        }
+    }
+
+    /// Starts the next event if some node wants to send: `Some(Some(event))` for an
+    /// internal frame (already over), `Some(None)` for a wire attempt now in flight.
+    fn begin(&mut self) -> Option<Option<BusEvent>> {
         let (internal, wire) = self.poll();
         if let Some((k, req)) = internal {
             if self.instant_streak < MAX_INSTANT_EVENTS {
                 self.instant_streak += 1;
-                return Some(self.internal_frame(k, req));
+                return Some(Some(self.internal_frame(k, req)));
             }
         }
         if wire.is_empty() {
             return None;
         }
         self.instant_streak = 0;
-        Some(self.frame_attempt(wire))
+        self.start_attempt(wire);
+        Some(None)
+    }
+
+    /// Whether a frame attempt is in flight: [`Bus::run_bits`] stopped inside it.
+    pub fn in_frame(&self) -> bool {
+        self.in_flight.is_some()
+    }
+
+    /// The bit offset from SOF of the attempt in flight (the number of its bits that have
+    /// passed), if one is.
+    pub fn frame_offset(&self) -> Option<u64> {
+        self.in_flight.as_ref().map(|f| self.now - f.sof)
+    }
+
+    /// Runs the bus for exactly `bits` bit times, stopping inside a frame attempt if the
+    /// time falls there (the other run methods never cut a frame). Software can then
+    /// access its controllers' registers while the frame is on the wire — between the
+    /// transmit request and the end of the frame, or between a read and a write-back — and
+    /// continue with another `run_bits` or any other run method. Every node has been
+    /// advanced to [`Bus::now`] and told [`BusNode::paused_in_frame`] the wire's level.
+    /// Returns the events that ended in the span (a frame cut by the end of the span is
+    /// returned by the call that finishes it).
+    pub fn run_bits(&mut self, bits: u64) -> Vec<BusEvent> {
+        let until = self.now.saturating_add(bits);
+        let mut events = Vec::new();
+        loop {
+            if self.in_flight.is_some() {
+                match self.continue_attempt(until) {
+                    Some(event) => events.push(event),
+                    None => break,
+                }
+                continue;
+            }
+            if self.now >= until {
+                break;
+            }
+            match self.begin() {
+                Some(Some(event)) => events.push(event),
+                Some(None) => {}
+                None => {
+                    let mut to = until.min(self.now.saturating_add(self.idle_quantum));
+                    if let Some(w) = self.next_wakeup() {
+                        to = to.min(w);
+                    }
+                    events.push(self.idle_to(to));
+                }
+            }
+        }
+        events
     }
 
     /// Runs one event if the bus time is before `until`: a frame if some node wants to send
@@ -532,6 +674,7 @@ impl Bus {
             transmitters: vec![id],
             arbitration_losers: Vec::new(),
             faults: Vec::new(),
+            refused: Vec::new(),
             first_error: None,
             acked: true,
             delivered: false,
@@ -544,7 +687,10 @@ impl Bus {
         BusEvent::Internal(self.record(record))
     }
 
-    fn frame_attempt(&mut self, requests: Vec<Request>) -> BusEvent {
+    /// Starts a wire frame attempt: arbitration, the attempt played bit by bit, and the
+    /// schedule of what each node is told when. Nothing is delivered yet: the attempt is
+    /// in flight until [`Bus::continue_attempt`] has reached its end.
+    fn start_attempt(&mut self, requests: Vec<Request>) {
         let sof = self.now;
         let seq = self.stats.frames_started;
         self.stats.frames_started += 1;
@@ -558,7 +704,7 @@ impl Bus {
             .filter(|k| !contenders.iter().any(|(c, _)| c == k))
             .filter(|&k| self.slots[k].node.listens())
             .collect();
-        let streams: Vec<(Vec<bool>, FrameBits)> = contenders
+        let mut streams: Vec<(Vec<bool>, FrameBits)> = contenders
             .iter()
             .map(|(_, r)| wire_bits(&r.frame))
             .collect();
@@ -568,37 +714,69 @@ impl Bus {
         let ref_bits = streams[reference].1;
 
         let tx_ids: Vec<NodeId> = contenders.iter().map(|(k, _)| NodeId(*k)).collect();
-        let rx_ids: Vec<NodeId> = receivers.iter().map(|&k| NodeId(k)).collect();
-        let faults = self.injector.faults_for(seq, &tx_ids, &rx_ids, &ref_bits);
+        let mut faults = if self.injector.is_idle() {
+            Vec::new()
+        } else {
+            let rx_ids: Vec<NodeId> = receivers.iter().map(|&k| NodeId(k)).collect();
+            self.injector.faults_for(seq, &tx_ids, &rx_ids, &ref_bits)
+        };
+        let mut refused = Vec::new();
+        faults.retain(|f| match f.check_layout(&ref_bits, &streams[reference].0) {
+            Ok(()) => true,
+            Err(e) => {
+                refused.push((*f, e));
+                false
+            }
+        });
+        self.refused.extend_from_slice(&refused);
+        let stuck = faults.iter().find_map(Fault::stuck_range);
 
-        let txs: Vec<TxSpec<'_>> = contenders
-            .iter()
-            .zip(&streams)
-            .map(|((k, r), (stream, bits))| TxSpec {
-                stream,
-                bits: *bits,
-                self_ack: r.self_ack,
-                active: self.slots[*k].node.error_active(),
-                faults: faults.iter().filter_map(|f| f.tx_part(bits)).collect(),
-            })
-            .collect();
-        let rxs: Vec<RxSpec> = receivers
-            .iter()
-            .map(|&k| {
-                let node = &self.slots[k].node;
-                let acks = node.acknowledges();
-                RxSpec {
-                    acks,
-                    active: acks && node.error_active(),
-                    faults: faults
-                        .iter()
-                        .filter_map(|f| f.rx_part(NodeId(k), &ref_bits))
-                        .collect(),
-                }
-            })
-            .collect();
-        let res = engine::resolve(&txs, &rxs);
-        drop(txs);
+        // The fast path needs only whether someone acknowledges: no per-node specs.
+        let fast = if self.fast_path && faults.is_empty() && contenders.len() == 1 {
+            let any_ack = receivers.iter().any(|&k| self.slots[k].node.acknowledges());
+            fast::decide(contenders[0].1.self_ack, any_ack)
+        } else {
+            None
+        };
+        let res = match fast {
+            Some(acked) => {
+                self.stats_fast_attempts += 1;
+                let stream = core::mem::take(&mut streams[0].0);
+                fast::resolve(streams[0].1, acked, receivers.len(), stream)
+            }
+            None => {
+                let txs: Vec<TxSpec<'_>> = contenders
+                    .iter()
+                    .zip(&streams)
+                    .map(|((k, r), (stream, bits))| TxSpec {
+                        stream,
+                        bits: *bits,
+                        self_ack: r.self_ack,
+                        active: self.slots[*k].node.error_active(),
+                        faults: faults
+                            .iter()
+                            .filter_map(|f| f.tx_part(NodeId(*k), bits))
+                            .collect(),
+                    })
+                    .collect();
+                let rxs: Vec<RxSpec> = receivers
+                    .iter()
+                    .map(|&k| {
+                        let node = &self.slots[k].node;
+                        let acks = node.acknowledges();
+                        RxSpec {
+                            acks,
+                            active: acks && node.error_active(),
+                            faults: faults
+                                .iter()
+                                .filter_map(|f| f.rx_part(NodeId(k), &ref_bits))
+                                .collect(),
+                        }
+                    })
+                    .collect();
+                engine::resolve_with(&txs, &rxs, stuck)
+            }
+        };
 
         let frame = contenders[res.reference].1.frame;
         let bits = streams[res.reference].1;
@@ -608,32 +786,63 @@ impl Bus {
         // a transmitter's error when it detects it (its counters change then, so a node that
         // goes bus-off counts the recessive bits of its error delimiter); a receiver's error
         // after the bit that follows its error flag (when rule 2 is known); successes at the
-        // end of the node's EOF.
+        // end of the node's EOF; the end of the attempt to each transmitter.
         let mut schedule: Vec<(u64, u8, usize, Notice)> = Vec::new();
         let arb = u64::from(bits.arbitration_end);
         for (k, r) in &losers {
             schedule.push((arb, 0, *k, Notice::Lost(r.frame)));
         }
-        for ((k, r), outcome) in contenders.iter().zip(&res.tx) {
+        for (n, ((k, r), outcome)) in contenders.iter().zip(&res.tx).enumerate() {
             let (at, result) = match *outcome {
                 PartOutcome::Ok { done } => (u64::from(done), TxResult::Acked),
                 PartOutcome::Error { code, at, .. } => (u64::from(at) + 1, TxResult::Error(code)),
             };
             schedule.push((at.min(end), 1, *k, Notice::Tx(r.frame, result)));
+            let mut flag = false;
+            if let PartOutcome::Error {
+                dominant_in_passive_flag,
+                arbitration_stuff_exception,
+                ..
+            } = *outcome
+            {
+                flag = dominant_in_passive_flag;
+                if arbitration_stuff_exception {
+                    let event = ConfinementEvent::ArbitrationStuffException;
+                    schedule.push((at.min(end), 0, *k, Notice::Confinement(event)));
+                }
+            }
+            let penalties = res.tx_penalties.get(n).copied().unwrap_or(0);
+            if penalties > 0 {
+                let event = ConfinementEvent::FlagPenalties {
+                    transmitter: true,
+                    count: penalties,
+                };
+                schedule.push((end, 3, *k, Notice::Confinement(event)));
+            }
+            schedule.push((end, 3, *k, Notice::TxEnd(flag)));
         }
-        for (&k, outcome) in receivers.iter().zip(&res.rx) {
+        for (n, (&k, outcome)) in receivers.iter().zip(&res.rx).enumerate() {
             let (at, notice) = match *outcome {
                 PartOutcome::Ok { done } => (u64::from(done), Notice::Rx),
                 PartOutcome::Error {
                     code,
                     at,
                     dominant_after_flag,
+                    ..
                 } => (
                     u64::from(at) + 8,
                     Notice::RxError(code, dominant_after_flag),
                 ),
             };
             schedule.push((at.min(end), 2, k, notice));
+            let penalties = res.rx_penalties.get(n).copied().unwrap_or(0);
+            if penalties > 0 {
+                let event = ConfinementEvent::FlagPenalties {
+                    transmitter: false,
+                    count: penalties,
+                };
+                schedule.push((end, 3, k, Notice::Confinement(event)));
+            }
         }
         schedule.sort_by_key(|&(at, order, k, _)| (at, order, k));
 
@@ -642,39 +851,6 @@ impl Bus {
         for &k in contenders.iter().map(|(k, _)| k).chain(&receivers) {
             in_frame[k] = true;
         }
-        let mut done = 0;
-        for &(at, _, k, notice) in &schedule {
-            self.advance_span(&res.wire, sof, done, at, &in_frame);
-            done = at;
-            let time = BusTime { sof, now: self.now };
-            let slot = &mut self.slots[k];
-            // A loser is told again as a receiver (unless it does not listen).
-            in_frame[k] = matches!(notice, Notice::Lost(_)) && receivers.contains(&k);
-            match notice {
-                Notice::Lost(f) => {
-                    slot.node.tx_result(&f, TxResult::ArbitrationLost, time);
-                    slot.stats.arbitration_lost += 1;
-                }
-                Notice::Tx(f, result) => {
-                    slot.node.tx_result(&f, result, time);
-                    if result == TxResult::Acked {
-                        slot.node.rx(&f, true, time);
-                        slot.stats.sent += 1;
-                    } else {
-                        slot.stats.tx_errors += 1;
-                    }
-                }
-                Notice::Rx => {
-                    slot.node.rx(&frame, false, time);
-                    slot.stats.received += 1;
-                }
-                Notice::RxError(code, dominant_after_flag) => {
-                    slot.node.rx_error(code, dominant_after_flag, time);
-                    slot.stats.rx_errors += 1;
-                }
-            }
-        }
-        self.advance_span(&res.wire, sof, done, end, &in_frame);
 
         let mut reports = Vec::with_capacity(contenders.len() + receivers.len());
         let mut first_error: Option<ErrorInfo> = None;
@@ -709,6 +885,7 @@ impl Bus {
                     code,
                     at,
                     dominant_after_flag,
+                    ..
                 } => {
                     note_error(NodeId(k), false, code, at);
                     (
@@ -726,29 +903,132 @@ impl Bus {
                 error_bit,
             });
         }
-        self.advance_all(u64::from(INTERMISSION_BITS), true);
-        self.stats.busy_bits += self.now - sof;
-        if first_error.is_some() {
-            self.stats.frames_with_errors += 1;
-        } else {
-            self.stats.frames_error_free += 1;
-        }
 
         let record = TraceRecord {
             seq,
             internal: false,
             sof,
-            end: self.now,
+            end: sof + end + u64::from(INTERMISSION_BITS),
             frame,
             bits,
             transmitters: tx_ids,
             arbitration_losers: losers.iter().map(|(k, _)| NodeId(*k)).collect(),
             faults,
+            refused,
             first_error,
             acked: res.acked,
             delivered: res.observer_ok,
             reports,
         };
-        BusEvent::Frame(self.record(record))
+
+        // Start of frame: every requester starts as a transmitter, every other listening
+        // node as a receiver.
+        let time = BusTime { sof, now: sof };
+        for (k, _) in contenders.iter().chain(&losers) {
+            self.slots[*k].node.attempt_started(true, time);
+        }
+        for &k in &receivers {
+            if !losers.iter().any(|(l, _)| *l == k) {
+                self.slots[k].node.attempt_started(false, time);
+            }
+        }
+
+        self.in_flight = Some(InFlight {
+            sof,
+            end,
+            schedule,
+            next: 0,
+            done: 0,
+            in_frame,
+            wire: res.wire,
+            record,
+            receivers,
+            frame,
+        });
+    }
+
+    /// Plays the attempt in flight up to bus time `until` (at most to the end of its
+    /// intermission), delivering what is due. Returns its event once it is over; `None`
+    /// while it is still in flight (or if there is none).
+    fn continue_attempt(&mut self, until: u64) -> Option<BusEvent> {
+        let mut f = self.in_flight.take()?;
+        let limit = until.saturating_sub(f.sof);
+        while let Some(&(at, _, k, notice)) = f.schedule.get(f.next) {
+            if at > limit {
+                break;
+            }
+            f.next += 1;
+            self.advance_span(&f.wire, f.sof, f.done, at, &f.in_frame);
+            f.done = f.done.max(at);
+            self.now = f.sof + f.done;
+            let time = BusTime {
+                sof: f.sof,
+                now: self.now,
+            };
+            let slot = &mut self.slots[k];
+            // A loser is told again as a receiver (unless it does not listen).
+            f.in_frame[k] = matches!(notice, Notice::Lost(_)) && f.receivers.contains(&k);
+            match notice {
+                Notice::Lost(fr) => {
+                    slot.node.tx_result(&fr, TxResult::ArbitrationLost, time);
+                    slot.stats.arbitration_lost += 1;
+                }
+                Notice::Tx(fr, result) => {
+                    slot.node.tx_result(&fr, result, time);
+                    if result == TxResult::Acked {
+                        slot.node.rx(&fr, true, time);
+                        slot.stats.sent += 1;
+                    } else {
+                        slot.stats.tx_errors += 1;
+                    }
+                }
+                Notice::Rx => {
+                    slot.node.rx(&f.frame, false, time);
+                    slot.stats.received += 1;
+                }
+                Notice::RxError(code, dominant_after_flag) => {
+                    slot.node.rx_error(code, dominant_after_flag, time);
+                    slot.stats.rx_errors += 1;
+                }
+                Notice::TxEnd(flag) => slot.node.tx_attempt_end(flag, time),
+                Notice::Confinement(event) => slot.node.confinement_event(event, time),
+            }
+        }
+        if limit < f.end {
+            self.advance_span(&f.wire, f.sof, f.done, limit, &f.in_frame);
+            f.done = f.done.max(limit);
+            self.now = f.sof + f.done;
+            let recessive = f
+                .done
+                .checked_sub(1)
+                .and_then(|i| f.wire.get(i as usize).copied())
+                .unwrap_or(true);
+            let now = self.now;
+            for slot in &mut self.slots {
+                slot.node.paused_in_frame(recessive, now);
+            }
+            self.in_flight = Some(f);
+            return None;
+        }
+        self.advance_span(&f.wire, f.sof, f.done, f.end, &f.in_frame);
+        f.done = f.done.max(f.end);
+        self.now = f.sof + f.done;
+        let total = f.end + u64::from(INTERMISSION_BITS);
+        let to = limit.min(total);
+        if to > f.done {
+            self.advance_all(to - f.done, true);
+            f.done = to;
+        }
+        if f.done < total {
+            self.in_flight = Some(f);
+            return None;
+        }
+        self.stats.busy_bits += self.now - f.sof;
+        if f.record.first_error.is_some() {
+            self.stats.frames_with_errors += 1;
+        } else {
+            self.stats.frames_error_free += 1;
+        }
+        Some(BusEvent::Frame(self.record(f.record)))
     }
 }

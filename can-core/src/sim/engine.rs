@@ -27,11 +27,32 @@
 //! others; here it is taken to be done with the others (it would resynchronise on the next
 //! idle bits anyway). Its detected error and rule-2 flag are still reported.
 //!
-//! Not modelled: overload frames, errors during error flags (rules 4 to 6), the "14/7
-//! dominant bits" tolerance, hard synchronisation effects.
+//! Fault-confinement details the engine records for each node that sends an error flag:
+//!
+//! - reading a dominant bit during its own passive error flag (rule 3, exception 1 does
+//!   not apply then);
+//! - a bit error during its own active error flag or overload flag (rules 4 and 5:
+//!   injected with `Fault::FlagBit`): +8, and the node starts a new flag at the next bit;
+//! - the dominant-bit tolerance after a flag (rule 6): counting consecutive dominant bits
+//!   from the start of an active error flag, or after the end of a passive one, the 14th
+//!   (active) or 8th (passive) and every 8th after it add 8 (a bus held dominant:
+//!   `Fault::StuckDominant`);
+//! - a transmitter's stuff error on a recessive stuff bit of the arbitration field read
+//!   dominant (rule 3, exception 2: TEC unchanged).
+//!
+//! Overload frames (§10.4.5): a receiver that reads a dominant last EOF bit (the frame is
+//! valid for it), and a node that reads a dominant bit in the first two bits of the
+//! intermission after its end of frame or delimiter, sends an overload flag (6 dominant
+//! bits, also when error-passive; not a silent node) and an overload delimiter; counters do
+//! not move, except by rule 6. The intermission is played only while something may drive it
+//! (an overload frame in progress, a stuck-dominant bus).
+//!
+//! Not modelled: a dominant bit during an error delimiter (taken as a continuation of the
+//! flag period) or at the last bit of a delimiter, the third intermission bit read dominant
+//! (a start of frame), hard synchronisation effects.
 
 use super::bits::FrameBits;
-use super::inject::{RxFault, TxFault};
+use super::inject::{is_stuff_bit, RxFault, TxFault};
 use crate::error::LastErrorCode;
 
 /// A transmitter of the frame attempt.
@@ -76,6 +97,12 @@ pub(crate) enum PartOutcome {
         at: u32,
         /// A receiver read a dominant bit right after its error flag (ISO rule 2).
         dominant_after_flag: bool,
+        /// It sent a passive error flag and read a dominant bit during it (rule 3,
+        /// exception 1 does not apply then).
+        dominant_in_passive_flag: bool,
+        /// A transmitter's stuff error on a recessive stuff bit in arbitration (rule 3,
+        /// exception 2: TEC unchanged).
+        arbitration_stuff_exception: bool,
     },
 }
 
@@ -98,24 +125,60 @@ pub(crate) struct Resolution {
     pub wire: Vec<bool>,
     /// Index into the transmitters of the frame the receivers followed.
     pub reference: usize,
+    /// Per transmitter, extra +8 penalties: bit errors during its own active error flag
+    /// (rules 4, 5) and dominant sequences after its error or overload flag (rule 6).
+    /// Empty when there are none (the common case: no allocation).
+    pub tx_penalties: Vec<u8>,
+    /// Per receiver, the same.
+    pub rx_penalties: Vec<u8>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Phase {
     Frame,
     ActiveFlag(u8),
-    PassiveFlag { last: bool, run: u8 },
-    AfterFlag { first: bool },
+    PassiveFlag {
+        last: bool,
+        run: u8,
+    },
+    /// Overload flag bit n (6 dominant bits).
+    Overload(u8),
+    AfterFlag {
+        first: bool,
+    },
     Delimiter(u8),
+    /// Intermission bit n after its end of frame or delimiter: a dominant bit at bit 0 or
+    /// 1 starts an overload frame.
+    Intermission(u8),
     Done,
+}
+
+impl Phase {
+    /// Finished with the attempt (the intermission counts as finished).
+    fn finished(self) -> bool {
+        matches!(self, Phase::Done | Phase::Intermission(_))
+    }
 }
 
 #[derive(Debug, Clone, Copy)]
 struct Part {
     phase: Phase,
     can_flag: bool,
+    /// It can drive the bus (a silent node cannot send overload flags).
+    can_drive: bool,
+    /// It is sending an overload frame (flag or delimiter).
+    overloading: bool,
     error: Option<(LastErrorCode, u32)>,
     dominant_after_flag: bool,
+    dominant_in_passive_flag: bool,
+    /// The flag it sent (or sends) is active.
+    active_flag: bool,
+    /// Injected: it misreads this bit of its active error flag (once).
+    flag_fault: Option<u8>,
+    /// Consecutive dominant bits counted for rule 6.
+    dominant_run: u32,
+    penalties: u8,
+    arbitration_stuff_exception: bool,
     ok: Option<u32>,
     // receiver bookkeeping
     run_last: bool,
@@ -129,8 +192,16 @@ impl Part {
         Part {
             phase: Phase::Frame,
             can_flag,
+            can_drive: true,
+            overloading: false,
             error: None,
             dominant_after_flag: false,
+            dominant_in_passive_flag: false,
+            active_flag: false,
+            flag_fault: None,
+            dominant_run: 0,
+            penalties: 0,
+            arbitration_stuff_exception: false,
             ok: None,
             run_last: true,
             run: 0,
@@ -141,6 +212,8 @@ impl Part {
 
     fn detect(&mut self, code: LastErrorCode, at: u32) {
         self.error = Some((code, at));
+        self.active_flag = self.can_flag;
+        self.dominant_run = 0;
         self.phase = if self.can_flag {
             Phase::ActiveFlag(0)
         } else {
@@ -149,17 +222,95 @@ impl Part {
     }
 
     fn drives_flag(&self) -> bool {
-        matches!(self.phase, Phase::ActiveFlag(_))
+        matches!(self.phase, Phase::ActiveFlag(_) | Phase::Overload(_))
+    }
+
+    /// An overload condition (ISO 11898-1 §10.4.5): a dominant last EOF bit seen by a
+    /// receiver, or a dominant bit in the first two intermission bits. A node able to
+    /// drive the bus sends an overload flag from the next bit; counters do not move
+    /// (rule 6 still counts dominant bits from the start of the flag).
+    fn overload(&mut self) {
+        if self.can_drive {
+            self.overloading = true;
+            self.active_flag = true;
+            self.dominant_run = 0;
+            self.phase = Phase::Overload(0);
+        } else {
+            self.phase = Phase::Done;
+        }
+    }
+
+    /// Reads one intermission bit.
+    fn intermission(&mut self, wire: bool) {
+        if let Phase::Intermission(k) = self.phase {
+            if !wire && k < 2 {
+                self.overload();
+            } else if k + 1 >= 3 {
+                self.phase = Phase::Done;
+            } else {
+                self.phase = Phase::Intermission(k + 1);
+            }
+        }
+    }
+
+    fn add_penalty(&mut self) {
+        self.penalties = self.penalties.saturating_add(1);
+    }
+
+    /// Rule 6: one more consecutive dominant bit after (or, active, including) the flag.
+    fn count_dominant(&mut self) {
+        self.dominant_run += 1;
+        let first = if self.active_flag { 14 } else { 8 };
+        if self.dominant_run >= first && (self.dominant_run - first).is_multiple_of(8) {
+            self.add_penalty();
+        }
     }
 
     /// Reads one bit while in an error phase.
     fn error_phase(&mut self, wire: bool) {
         self.phase = match self.phase {
-            Phase::ActiveFlag(n) if n + 1 >= 6 => Phase::AfterFlag { first: true },
-            Phase::ActiveFlag(n) => Phase::ActiveFlag(n + 1),
+            Phase::ActiveFlag(n) if self.flag_fault == Some(n) => {
+                // Rules 4 / 5: a bit error during its own active error flag; a new flag
+                // starts at the next bit.
+                self.flag_fault = None;
+                self.add_penalty();
+                self.dominant_run = 0;
+                Phase::ActiveFlag(0)
+            }
+            Phase::ActiveFlag(n) => {
+                if !wire {
+                    self.count_dominant();
+                }
+                if n + 1 >= 6 {
+                    Phase::AfterFlag { first: true }
+                } else {
+                    Phase::ActiveFlag(n + 1)
+                }
+            }
+            Phase::Overload(n) if self.flag_fault == Some(n) => {
+                // Rules 4 / 5 apply to overload flags too; a new overload flag starts.
+                self.flag_fault = None;
+                self.add_penalty();
+                self.dominant_run = 0;
+                Phase::Overload(0)
+            }
+            Phase::Overload(n) => {
+                if !wire {
+                    self.count_dominant();
+                }
+                if n + 1 >= 6 {
+                    Phase::AfterFlag { first: true }
+                } else {
+                    Phase::Overload(n + 1)
+                }
+            }
             Phase::PassiveFlag { last, run } => {
+                if !wire {
+                    self.dominant_in_passive_flag = true;
+                }
                 let run = if run == 0 || wire == last { run + 1 } else { 1 };
                 if run >= 6 {
+                    self.dominant_run = 0;
                     Phase::AfterFlag { first: true }
                 } else {
                     Phase::PassiveFlag { last: wire, run }
@@ -169,13 +320,18 @@ impl Part {
                 if wire {
                     Phase::Delimiter(1)
                 } else {
-                    if first {
+                    // Rule 2 is about error flags only.
+                    if first && !self.overloading {
                         self.dominant_after_flag = true;
                     }
+                    self.count_dominant();
                     Phase::AfterFlag { first: false }
                 }
             }
-            Phase::Delimiter(n) if wire && n + 1 >= 8 => Phase::Done,
+            Phase::Delimiter(n) if wire && n + 1 >= 8 => {
+                self.overloading = false;
+                Phase::Intermission(0)
+            }
             Phase::Delimiter(n) if wire => Phase::Delimiter(n + 1),
             other => other,
         };
@@ -187,6 +343,8 @@ impl Part {
                 code,
                 at,
                 dominant_after_flag: self.dominant_after_flag,
+                dominant_in_passive_flag: self.dominant_in_passive_flag,
+                arbitration_stuff_exception: self.arbitration_stuff_exception,
             },
             None => match self.ok {
                 Some(done) => PartOutcome::Ok { done },
@@ -195,6 +353,8 @@ impl Part {
                     code: LastErrorCode::Form,
                     at: end,
                     dominant_after_flag: false,
+                    dominant_in_passive_flag: false,
+                    arbitration_stuff_exception: false,
                 },
             },
         }
@@ -217,7 +377,14 @@ fn tx_read(tx: &TxSpec<'_>, p: &mut Part, wire: bool, i: u32) {
         LastErrorCode::BitDominant
     };
     let code = if tx.faults.contains(&TxFault::Bit(i)) {
-        Some(mismatch_code)
+        if i < tx.bits.arbitration_end && sent && is_stuff_bit(tx.stream, i) {
+            // A recessive stuff bit read dominant in arbitration: a stuff error, and rule 3
+            // exception 2 leaves TEC unchanged.
+            p.arbitration_stuff_exception = true;
+            Some(LastErrorCode::Stuff)
+        } else {
+            Some(mismatch_code)
+        }
     } else if i == tx.bits.crc_end + 1 {
         let read_recessive = wire || tx.faults.contains(&TxFault::Ack);
         (read_recessive && !tx.self_ack).then_some(LastErrorCode::Acknowledge)
@@ -230,7 +397,7 @@ fn tx_read(tx: &TxSpec<'_>, p: &mut Part, wire: bool, i: u32) {
         Some(c) => p.detect(c, i),
         None if i >= tx.bits.crc_end + 9 => {
             p.ok = Some(i + 1);
-            p.phase = Phase::Done;
+            p.phase = Phase::Intermission(0);
         }
         None => {}
     }
@@ -270,18 +437,41 @@ fn rx_read(rx: &RxSpec, p: &mut Part, wire: bool, i: u32, reference: &[bool], ce
             code = Some(LastErrorCode::Form);
         }
     } else {
-        // Last EOF bit: the frame is valid for a receiver; a dominant bit here would only
-        // start an overload frame (not modelled).
+        // Last EOF bit: the frame is valid for a receiver; a dominant bit here is an
+        // overload condition.
         p.ok = Some(i + 1);
-        p.phase = Phase::Done;
+        if wire {
+            p.phase = Phase::Intermission(0);
+        } else {
+            p.overload();
+        }
     }
     if let Some(c) = code {
         p.detect(c, i);
     }
 }
 
+/// The parts' penalties, or an empty vector when all are 0.
+fn penalties(parts: &[Part]) -> Vec<u8> {
+    if parts.iter().all(|p| p.penalties == 0) {
+        Vec::new()
+    } else {
+        parts.iter().map(|p| p.penalties).collect()
+    }
+}
+
 /// Plays one frame attempt. `txs` must not be empty (an empty slice gives an empty result).
+#[cfg(test)]
 pub(crate) fn resolve(txs: &[TxSpec<'_>], rxs: &[RxSpec]) -> Resolution {
+    resolve_with(txs, rxs, None)
+}
+
+/// [`resolve`] with the wire held dominant over bits `stuck.0..stuck.1`.
+pub(crate) fn resolve_with(
+    txs: &[TxSpec<'_>],
+    rxs: &[RxSpec],
+    stuck: Option<(u32, u32)>,
+) -> Resolution {
     let reference = (0..txs.len())
         .min_by(|&a, &b| txs[a].stream.cmp(txs[b].stream))
         .unwrap_or(0);
@@ -295,18 +485,51 @@ pub(crate) fn resolve(txs: &[TxSpec<'_>], rxs: &[RxSpec]) -> Resolution {
             last_dominant_end: 0,
             wire: Vec::new(),
             reference: 0,
+            tx_penalties: Vec::new(),
+            rx_penalties: Vec::new(),
         };
     };
     let ce = ref_tx.bits.crc_end;
     let ref_stream = ref_tx.stream;
 
     let observer = RxSpec::default();
-    let mut tx_parts: Vec<Part> = txs.iter().map(|t| Part::new(t.active)).collect();
-    let mut rx_parts: Vec<Part> = rxs.iter().map(|r| Part::new(r.active)).collect();
-    let mut obs_part = Part::new(false);
+    let flag_fault = |tx: Option<&[TxFault]>, rx: Option<&[RxFault]>| {
+        tx.into_iter()
+            .flatten()
+            .find_map(|f| match f {
+                TxFault::FlagBit(b) => Some(*b),
+                _ => None,
+            })
+            .or_else(|| {
+                rx.into_iter().flatten().find_map(|f| match f {
+                    RxFault::FlagBit(b) => Some(*b),
+                    _ => None,
+                })
+            })
+    };
+    let mut tx_parts: Vec<Part> = txs
+        .iter()
+        .map(|t| Part {
+            flag_fault: flag_fault(Some(&t.faults), None),
+            ..Part::new(t.active)
+        })
+        .collect();
+    let mut rx_parts: Vec<Part> = rxs
+        .iter()
+        .map(|r| Part {
+            flag_fault: flag_fault(None, Some(&r.faults)),
+            can_drive: r.acks,
+            ..Part::new(r.active)
+        })
+        .collect();
+    let mut obs_part = Part {
+        can_drive: false,
+        ..Part::new(false)
+    };
 
     let longest = txs.iter().map(|t| t.bits.crc_end).max().unwrap_or(ce);
-    let limit = longest + 10 + 64;
+    let stuck_len = stuck.map_or(0, |(a, b)| b.saturating_sub(a));
+    let limit = longest + 10 + 64 + stuck_len.min(4096) + 32;
     let mut acked = false;
     let mut last_dominant_end = 0;
     let mut i = 0u32;
@@ -332,6 +555,9 @@ pub(crate) fn resolve(txs: &[TxSpec<'_>], rxs: &[RxSpec]) -> Resolution {
             }
             wire &= !drives_dominant;
         }
+        if stuck.is_some_and(|(a, b)| (a..b).contains(&i)) {
+            wire = false;
+        }
         if !wire {
             last_dominant_end = i + 1;
         }
@@ -342,6 +568,7 @@ pub(crate) fn resolve(txs: &[TxSpec<'_>], rxs: &[RxSpec]) -> Resolution {
             match p.phase {
                 Phase::Frame => tx_read(t, p, wire, i),
                 Phase::Done => {}
+                Phase::Intermission(_) => p.intermission(wire),
                 _ => p.error_phase(wire),
             }
         }
@@ -353,24 +580,29 @@ pub(crate) fn resolve(txs: &[TxSpec<'_>], rxs: &[RxSpec]) -> Resolution {
             match p.phase {
                 Phase::Frame => rx_read(r, p, wire, i, ref_stream, ce),
                 Phase::Done => {}
+                Phase::Intermission(_) => p.intermission(wire),
                 _ => p.error_phase(wire),
             }
         }
 
         i += 1;
-        let drivers_done = tx_parts.iter().all(|p| p.phase == Phase::Done)
+        let drivers_done = tx_parts.iter().all(|p| p.phase.finished())
             && rx_parts
                 .iter()
                 .zip(rxs)
-                .all(|(p, r)| !r.active || p.phase == Phase::Done);
-        if drivers_done && drivers_end.is_none() {
+                .all(|(p, r)| (!r.active && !p.overloading) || p.phase.finished());
+        if !drivers_done {
+            // An overload frame (or anything still driving) moves the end.
+            drivers_end = None;
+        } else if drivers_end.is_none() {
             drivers_end = Some(i);
         }
         let decided = rx_parts
             .iter()
             .chain(core::iter::once(&obs_part))
             .all(|p| p.phase != Phase::Frame);
-        if (drivers_done && decided) || i >= limit {
+        let stuck_over = stuck.is_none_or(|(_, b)| i >= b);
+        if (drivers_done && decided && stuck_over) || i >= limit {
             break drivers_end.unwrap_or(i);
         }
     };
@@ -387,6 +619,8 @@ pub(crate) fn resolve(txs: &[TxSpec<'_>], rxs: &[RxSpec]) -> Resolution {
             bus
         },
         reference,
+        tx_penalties: penalties(&tx_parts),
+        rx_penalties: penalties(&rx_parts),
     }
 }
 
@@ -418,6 +652,8 @@ mod tests {
             code,
             at,
             dominant_after_flag: dom,
+            dominant_in_passive_flag: false,
+            arbitration_stuff_exception: false,
         }
     }
 
@@ -449,7 +685,17 @@ mod tests {
         // A listen-only receiver sees the active error flag as a form error at the ACK delimiter.
         let r = resolve(&[tx(&w, true)], &[rx(false, false)]);
         assert_eq!(r.tx, vec![err(L::Acknowledge, ce + 1, false)]);
-        assert_eq!(r.rx, vec![err(L::Form, ce + 2, false)]);
+        // Its own passive flag overlaps the transmitter's active flag.
+        assert_eq!(
+            r.rx,
+            vec![PartOutcome::Error {
+                code: L::Form,
+                at: ce + 2,
+                dominant_after_flag: false,
+                dominant_in_passive_flag: true,
+                arbitration_stuff_exception: false,
+            }]
+        );
         assert!(!r.observer_ok && !r.acked);
         // Flag ce+2..=ce+7, delimiter ce+8..=ce+15.
         assert_eq!(r.end, ce + 16);

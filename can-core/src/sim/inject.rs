@@ -36,7 +36,7 @@ pub enum FormField {
     /// The ACK delimiter.
     AckDelimiter,
     /// End-of-frame bit `0..=5` (a dominant last EOF bit is an overload condition for a
-    /// receiver, not an error; larger values are clamped to 5).
+    /// receiver, not an error: larger values are refused, [`FaultError::EofBitOutOfRange`]).
     Eof(u8),
 }
 
@@ -53,20 +53,28 @@ pub enum FaultKind {
     Form,
     /// [`Fault::Ack`].
     Ack,
+    /// [`Fault::FlagBit`] (not among the default random kinds).
+    FlagBit,
+    /// [`Fault::StuckDominant`] (not among the default random kinds).
+    StuckDominant,
 }
 
 /// An error injected into one frame attempt.
 ///
-/// Bit positions are wire-bit indices from SOF (0 = SOF), as in
-/// [`FrameBits`]. Positions inside the arbitration field are moved
-/// to the first bit after it: the simulation does not inject errors during arbitration.
+/// Bit positions are wire-bit indices from SOF (0 = SOF), as in [`FrameBits`]. A fault
+/// is placed at the exact bit it names, or refused with a [`FaultError`] if it cannot
+/// happen there ([`Fault::validate`] at injection, the frame's layout when the attempt
+/// starts: [`crate::sim::TraceRecord::refused`], [`crate::sim::Bus::refused_faults`]); it
+/// is never moved.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Fault {
     /// Every transmitter of the frame reads the opposite of the bit it sends at `at`
     /// (default: the first bit after the arbitration field) and detects a bit error
-    /// (`BitDominant` if it sent dominant, `BitRecessive` otherwise). Allowed up to the
-    /// last EOF bit; the ACK slot (where a dominant bit is normal) is moved to the ACK
-    /// delimiter.
+    /// (`BitDominant` if it sent dominant, `BitRecessive` otherwise), up to the last EOF
+    /// bit. Inside the arbitration field a recessive bit read dominant is lost arbitration,
+    /// not an error — refused — except on a stuff bit, where it is a stuff error that
+    /// leaves TEC unchanged (ISO 11898-1 §12.1.4.2 rule 3, exception 2). The ACK slot
+    /// (where reading dominant is normal) is refused.
     Bit {
         /// Wire-bit index, `None` for the first bit after arbitration.
         at: Option<u32>,
@@ -74,8 +82,8 @@ pub enum Fault {
     /// Every transmitter reads a recessive ACK slot (an acknowledge error unless it
     /// acknowledges its own frames).
     Ack,
-    /// The chosen receivers detect a stuff error at `at` (clamped to the stuffed region
-    /// after arbitration; default: the first bit after arbitration).
+    /// The chosen receivers detect a stuff error at `at` (default: the first bit after
+    /// arbitration); refused outside the stuffed region (SOF to the end of the CRC).
     Stuff {
         /// Who detects it.
         who: Receivers,
@@ -95,7 +103,76 @@ pub enum Fault {
         /// Where.
         field: FormField,
     },
+    /// Rules 4 and 5: node `who` (transmitter or receiver) reads a recessive bit at bit
+    /// `bit` (0..=5) of the first active error flag or overload flag it sends in the
+    /// attempt: a bit error during its flag. Its counter rises by 8 and it starts a new
+    /// flag. No effect on a node that sends no such flag in that attempt.
+    FlagBit {
+        /// The node.
+        who: NodeId,
+        /// The bit of its active error flag, 0..=5.
+        bit: u8,
+    },
+    /// The bus is held dominant (by a faulty node or transceiver) for `bits` bits from
+    /// wire bit `at`: after an error flag this is ISO 11898-1 rule 6 (every node adds 8
+    /// at its 14th consecutive dominant bit after an active flag, 8th after a passive one,
+    /// and at each 8 more). Refused inside the arbitration field (it would decide
+    /// arbitration, which the simulation resolves before the bits).
+    StuckDominant {
+        /// First wire bit held dominant.
+        at: u32,
+        /// How many bits.
+        bits: u32,
+    },
 }
+
+/// Why a fault was refused (see [`Fault`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum FaultError {
+    /// [`Fault::FlagBit`] names a bit beyond the 6-bit error flag.
+    FlagBitOutOfRange(u8),
+    /// [`FormField::Eof`] beyond bit 5: a dominant last EOF bit is an overload condition
+    /// for a receiver, not a form error.
+    EofBitOutOfRange(u8),
+    /// [`Fault::StuckDominant`] of 0 bits.
+    EmptyStuckDominant,
+    /// A bit fault in the ACK slot, where a transmitter reading dominant is normal.
+    AckSlot,
+    /// A bit fault on a recessive arbitration bit that is not a stuff bit: reading it
+    /// dominant is lost arbitration, not an error.
+    ArbitrationRecessiveBit(u32),
+    /// A bit fault after the last EOF bit of the frame.
+    AfterEndOfFrame(u32),
+    /// A stuff error outside the stuffed region.
+    OutsideStuffedRegion(u32),
+    /// A stuck-dominant bus inside the arbitration field.
+    StuckDuringArbitration(u32),
+}
+
+impl core::fmt::Display for FaultError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            FaultError::FlagBitOutOfRange(b) => write!(f, "error flag bit {b} (0..=5)"),
+            FaultError::EofBitOutOfRange(b) => {
+                write!(f, "EOF bit {b}: only bits 0..=5 give a form error")
+            }
+            FaultError::EmptyStuckDominant => f.write_str("stuck-dominant period of 0 bits"),
+            FaultError::AckSlot => f.write_str("bit fault in the ACK slot"),
+            FaultError::ArbitrationRecessiveBit(i) => {
+                write!(f, "bit {i}: recessive arbitration bit (lost arbitration)")
+            }
+            FaultError::AfterEndOfFrame(i) => write!(f, "bit {i} is after the end of frame"),
+            FaultError::OutsideStuffedRegion(i) => {
+                write!(f, "bit {i} is outside the stuffed region")
+            }
+            FaultError::StuckDuringArbitration(i) => {
+                write!(f, "stuck-dominant bus from bit {i}, inside arbitration")
+            }
+        }
+    }
+}
+
+impl std::error::Error for FaultError {}
 
 impl Fault {
     /// The kind of this fault.
@@ -106,8 +183,67 @@ impl Fault {
             Fault::Stuff { .. } => FaultKind::Stuff,
             Fault::Crc { .. } => FaultKind::Crc,
             Fault::Form { .. } => FaultKind::Form,
+            Fault::FlagBit { .. } => FaultKind::FlagBit,
+            Fault::StuckDominant { .. } => FaultKind::StuckDominant,
         }
     }
+
+    /// Refuses a fault that cannot happen whatever the frame.
+    pub const fn validate(&self) -> Result<(), FaultError> {
+        match *self {
+            Fault::FlagBit { bit, .. } if bit > 5 => Err(FaultError::FlagBitOutOfRange(bit)),
+            Fault::Form {
+                field: FormField::Eof(n),
+                ..
+            } if n > 5 => Err(FaultError::EofBitOutOfRange(n)),
+            Fault::StuckDominant { bits: 0, .. } => Err(FaultError::EmptyStuckDominant),
+            _ => Ok(()),
+        }
+    }
+
+    /// Refuses a fault that cannot happen in a frame laid out as `bits` with the stuffed
+    /// bits `stream` (SOF to the end of the CRC).
+    pub(crate) fn check_layout(&self, bits: &FrameBits, stream: &[bool]) -> Result<(), FaultError> {
+        self.validate()?;
+        match *self {
+            Fault::Bit { at } => {
+                let pos = at.unwrap_or(bits.arbitration_end);
+                if pos == bits.crc_end + 1 {
+                    return Err(FaultError::AckSlot);
+                }
+                if pos > bits.crc_end + 9 {
+                    return Err(FaultError::AfterEndOfFrame(pos));
+                }
+                let recessive = stream.get(pos as usize).copied().unwrap_or(true);
+                if pos < bits.arbitration_end && recessive && !is_stuff_bit(stream, pos) {
+                    return Err(FaultError::ArbitrationRecessiveBit(pos));
+                }
+                Ok(())
+            }
+            Fault::Stuff { at: Some(pos), .. } if pos >= bits.crc_end => {
+                Err(FaultError::OutsideStuffedRegion(pos))
+            }
+            Fault::StuckDominant { at, .. } if at < bits.arbitration_end => {
+                Err(FaultError::StuckDuringArbitration(at))
+            }
+            _ => Ok(()),
+        }
+    }
+
+    /// The wire bits `at..at + bits` a [`Fault::StuckDominant`] holds dominant.
+    pub(crate) fn stuck_range(&self) -> Option<(u32, u32)> {
+        match *self {
+            Fault::StuckDominant { at, bits } => Some((at, at.saturating_add(bits))),
+            _ => None,
+        }
+    }
+}
+
+/// Whether wire bit `pos` of a stuffed stream is a stuff bit: the five bits before it are
+/// equal (a stuff bit starts the next run, so this holds for stuff bits only).
+pub(crate) fn is_stuff_bit(stream: &[bool], pos: u32) -> bool {
+    let pos = pos as usize;
+    pos >= 5 && pos <= stream.len() && stream[pos - 5..pos].iter().all(|&b| b == stream[pos - 1])
 }
 
 /// A fault resolved against one frame's layout: absolute wire-bit positions.
@@ -117,6 +253,8 @@ pub(crate) enum TxFault {
     Bit(u32),
     /// The transmitter reads a recessive ACK slot.
     Ack,
+    /// It reads recessive at this bit of its own active error flag.
+    FlagBit(u8),
 }
 
 /// A receive-side fault at absolute wire-bit positions.
@@ -128,23 +266,18 @@ pub(crate) enum RxFault {
     Crc,
     /// Form error detected at this position (a fixed-form bit).
     Form(u32),
+    /// It reads recessive at this bit of its own active error flag.
+    FlagBit(u8),
 }
 
 impl Fault {
-    /// The transmitter-side part of this fault for a frame laid out as `bits`.
-    pub(crate) fn tx_part(&self, bits: &FrameBits) -> Option<TxFault> {
+    /// The transmitter-side part of this fault for transmitter `node` of a frame laid out
+    /// as `bits` (the fault has passed [`Fault::check_layout`]).
+    pub(crate) fn tx_part(&self, node: NodeId, bits: &FrameBits) -> Option<TxFault> {
         match *self {
-            Fault::Bit { at } => {
-                let last_eof = bits.crc_end + 9;
-                let mut pos = at
-                    .unwrap_or(bits.arbitration_end)
-                    .clamp(bits.arbitration_end, last_eof);
-                if pos == bits.crc_end + 1 {
-                    pos += 1;
-                }
-                Some(TxFault::Bit(pos))
-            }
+            Fault::Bit { at } => Some(TxFault::Bit(at.unwrap_or(bits.arbitration_end))),
             Fault::Ack => Some(TxFault::Ack),
+            Fault::FlagBit { who, bit } if who == node => Some(TxFault::FlagBit(bit)),
             _ => None,
         }
     }
@@ -153,18 +286,15 @@ impl Fault {
     pub(crate) fn rx_part(&self, node: NodeId, bits: &FrameBits) -> Option<RxFault> {
         match *self {
             Fault::Stuff { who, at } if who.includes(node) => {
-                let hi = bits.crc_end.saturating_sub(1).max(bits.arbitration_end);
-                Some(RxFault::Stuff(
-                    at.unwrap_or(bits.arbitration_end)
-                        .clamp(bits.arbitration_end, hi),
-                ))
+                Some(RxFault::Stuff(at.unwrap_or(bits.arbitration_end)))
             }
             Fault::Crc { who } if who.includes(node) => Some(RxFault::Crc),
             Fault::Form { who, field } if who.includes(node) => Some(RxFault::Form(match field {
                 FormField::CrcDelimiter => bits.crc_end,
                 FormField::AckDelimiter => bits.crc_end + 2,
-                FormField::Eof(n) => bits.crc_end + 3 + u32::from(n.min(5)),
+                FormField::Eof(n) => bits.crc_end + 3 + u32::from(n),
             })),
+            Fault::FlagBit { who, bit } if who == node => Some(RxFault::FlagBit(bit)),
             _ => None,
         }
     }
@@ -303,6 +433,14 @@ impl RandomState {
                 };
                 Fault::Form { who, field }
             }
+            FaultKind::FlagBit => Fault::FlagBit {
+                who: *receivers.get(self.rng.below(receivers.len().max(1) as u64) as usize)?,
+                bit: self.rng.below(6) as u8,
+            },
+            FaultKind::StuckDominant => Fault::StuckDominant {
+                at: bits.arbitration_end + self.rng.below(u64::from(bits.total)) as u32,
+                bits: 1 + self.rng.below(24) as u32,
+            },
         };
         Some(fault)
     }
@@ -335,6 +473,11 @@ impl Injector {
 
     pub(crate) fn clear(&mut self) {
         *self = Injector::default();
+    }
+
+    /// Nothing scheduled and no random injection: every attempt gets no fault.
+    pub(crate) fn is_idle(&self) -> bool {
+        self.at_frame.is_empty() && self.from_node.is_empty() && self.random.is_none()
     }
 
     /// The faults for frame attempt `seq` sent by `transmitters`, received by `receivers`.

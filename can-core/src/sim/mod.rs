@@ -30,6 +30,7 @@
 pub mod bits;
 pub mod bus;
 mod engine;
+mod fast;
 pub mod inject;
 mod node;
 pub mod poll_clock;
@@ -39,8 +40,8 @@ pub mod trace;
 
 pub use bits::{crc15, frame_bits, FrameBits};
 pub use bus::{Bus, BusEvent, NodeId, SimError, StillBusy};
-pub use inject::{Fault, FaultKind, FormField, RandomFaults, Receivers};
-pub use node::{BusNode, BusTime, TxRequest, TxResult};
+pub use inject::{Fault, FaultError, FaultKind, FormField, RandomFaults, Receivers};
+pub use node::{BusNode, BusTime, ConfinementEvent, TxRequest, TxResult};
 pub use poll_clock::{PollClock, SharedBus};
 pub use simple_node::SimNode;
 pub use stats::{BusStats, NodeStats};

@@ -35,6 +35,25 @@ pub enum TxResult {
     Error(LastErrorCode),
 }
 
+/// A fault-confinement event that the outcome of an attempt does not carry (ISO 11898-1
+/// §12.1.4.2), for [`BusNode::confinement_event`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ConfinementEvent {
+    /// Rule 3, exception 2: the transmit error reported next — a stuff error on a
+    /// recessive stuff bit of the arbitration field read dominant — leaves TEC unchanged.
+    /// Told right before that [`BusNode::tx_result`].
+    ArbitrationStuffException,
+    /// Rules 4 and 5 (a bit error during the node's own active error flag) and rule 6
+    /// (dominant bits after its flag): `count` times +8 to TEC (`transmitter`) or REC.
+    /// Told at the end of the attempt.
+    FlagPenalties {
+        /// The node was a transmitter of the attempt.
+        transmitter: bool,
+        /// Number of +8 penalties.
+        count: u8,
+    },
+}
+
 /// Times of the bus event being reported, in bit times since the bus started.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct BusTime {
@@ -74,6 +93,41 @@ pub trait BusNode {
 
     /// `bits` bit times passed ending at `now`; `idle` says the bus was recessive all along.
     fn advance(&mut self, bits: u64, idle: bool, now: u64);
+
+    /// The frame attempt in which this node was a transmitter (it did not lose arbitration)
+    /// is over: `time.now` is the end of the last end of frame or error delimiter, where the
+    /// intermission starts; always after [`BusNode::tx_result`]. `dominant_in_passive_flag`:
+    /// the node sent a passive error flag and read a dominant bit during it (ISO 11898-1
+    /// §12.1.4.2 rule 3, exception 1 then does not apply). Nodes use it for
+    /// [`crate::fault::FaultConfinement::transmission_ended`] (that exception and suspend
+    /// transmission). The default does nothing.
+    fn tx_attempt_end(&mut self, dominant_in_passive_flag: bool, time: BusTime) {
+        let _ = (dominant_in_passive_flag, time);
+    }
+
+    /// A frame attempt starts (its SOF is at `time.sof`): `transmitter` for a node whose
+    /// [`BusNode::poll_tx`] request takes part in arbitration (it may lose it later), false
+    /// for a node that only listens. From here until its outcome is reported the node is
+    /// in the frame: a controller shows it as "transmitting" / "receiving", and a mailbox
+    /// whose frame is on the wire is in transmission. The default does nothing.
+    fn attempt_started(&mut self, transmitter: bool, time: BusTime) {
+        let _ = (transmitter, time);
+    }
+
+    /// A fault-confinement event the outcome does not carry (see [`ConfinementEvent`]).
+    /// Nodes apply it with [`crate::fault::FaultConfinement::arbitration_stuff_exception`]
+    /// and [`crate::fault::FaultConfinement::confinement_penalties`]. The
+    /// default does nothing.
+    fn confinement_event(&mut self, event: ConfinementEvent, time: BusTime) {
+        let _ = (event, time);
+    }
+
+    /// The bus stopped inside a frame attempt at bus time `now` ([`crate::sim::Bus::run_bits`]);
+    /// `recessive` is the level of the last bit on the wire (what the controller's receive
+    /// pin shows and last sampled). The default does nothing.
+    fn paused_in_frame(&mut self, recessive: bool, now: u64) {
+        let _ = (recessive, now);
+    }
 
     /// The earliest bus time after `now` at which this node may start a frame on its own,
     /// without software doing anything: the end of its suspend-transmission time, the moment
@@ -117,5 +171,18 @@ impl<T: BusNode + ?Sized> BusNode for std::rc::Rc<core::cell::RefCell<T>> {
     }
     fn next_wakeup(&self, now: u64) -> Option<u64> {
         self.borrow().next_wakeup(now)
+    }
+    fn tx_attempt_end(&mut self, dominant_in_passive_flag: bool, time: BusTime) {
+        self.borrow_mut()
+            .tx_attempt_end(dominant_in_passive_flag, time)
+    }
+    fn attempt_started(&mut self, transmitter: bool, time: BusTime) {
+        self.borrow_mut().attempt_started(transmitter, time)
+    }
+    fn paused_in_frame(&mut self, recessive: bool, now: u64) {
+        self.borrow_mut().paused_in_frame(recessive, now)
+    }
+    fn confinement_event(&mut self, event: ConfinementEvent, time: BusTime) {
+        self.borrow_mut().confinement_event(event, time)
     }
 }

@@ -3,7 +3,8 @@
 //! It has a FIFO of frames to send (the head is retried until it is acknowledged, unless
 //! one-shot), keeps what it receives and what happened to its transmissions, and counts
 //! errors with the shared [`FaultConfinement`]. Error-passive, it waits the 8-bit suspend
-//! transmission after each of its transmissions; bus-off, it neither sends nor listens and
+//! transmission after the intermission that follows each of its transmissions (counted by
+//! [`FaultConfinement::transmission_ended`] from the end of the frame or error frame); bus-off, it neither sends nor listens and
 //! recovers by itself after 128 × 11 recessive bits (or waits for [`SimNode::recover`]).
 
 use std::cell::RefCell;
@@ -11,14 +12,10 @@ use std::collections::VecDeque;
 use std::rc::Rc;
 use std::vec::Vec;
 
-use super::node::{BusNode, BusTime, TxRequest, TxResult};
+use super::node::{BusNode, BusTime, ConfinementEvent, TxRequest, TxResult};
 use crate::error::{ErrorCounters, ErrorState, LastErrorCode};
 use crate::fault::{FaultConfinement, BUS_OFF_RECOVERY_SEQUENCES};
 use crate::frame::Frame;
-
-/// Bits an error-passive transmitter waits after the intermission (ISO 11898-1 suspend
-/// transmission), counted here from the end of its frame: intermission 3 + suspend 8.
-const SUSPEND_AFTER_FRAME: u64 = 3 + 8;
 
 /// A frame a [`SimNode`] received.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -67,7 +64,6 @@ pub struct SimNode {
     manual_recovery: bool,
     one_shot: bool,
     internal: bool,
-    suspend_until: u64,
     bus_off_count: u32,
     last_error: LastErrorCode,
     // Mirror of the recovery progress (FaultConfinement does not expose it) so that the
@@ -189,6 +185,12 @@ impl SimNode {
         }
     }
 
+    fn entered_bus_off(&mut self) {
+        self.bus_off_count += 1;
+        self.recovery_sequences = 0;
+        self.recessive_run = 0;
+    }
+
     fn bits_to_recovery(&self) -> u64 {
         let left = u64::from(BUS_OFF_RECOVERY_SEQUENCES).saturating_sub(self.recovery_sequences);
         (left * 11).saturating_sub(self.recessive_run)
@@ -197,7 +199,7 @@ impl SimNode {
 
 impl BusNode for SimNode {
     fn poll_tx(&mut self, now: u64) -> Option<TxRequest> {
-        if self.fault.is_bus_off() || self.listen_only || now < self.suspend_until {
+        if self.fault.is_bus_off() || self.listen_only || !self.fault.may_start_transmission(now) {
             return None;
         }
         self.queue.front().map(|&frame| TxRequest {
@@ -230,21 +232,38 @@ impl BusNode for SimNode {
                 self.fault.transmit_succeeded();
                 self.queue.pop_front();
             }
-            TxResult::ArbitrationLost => return,
+            TxResult::ArbitrationLost => {}
             TxResult::Error(code) => {
                 self.last_error = code;
                 if self.fault.transmit_error(code) {
-                    self.bus_off_count += 1;
-                    self.recovery_sequences = 0;
-                    self.recessive_run = 0;
+                    self.entered_bus_off();
                 }
                 if self.one_shot {
                     self.queue.pop_front();
                 }
             }
         }
-        if self.fault.is_passive() && time.now != time.sof {
-            self.suspend_until = time.now + SUSPEND_AFTER_FRAME;
+    }
+
+    fn confinement_event(&mut self, event: ConfinementEvent, _time: BusTime) {
+        match event {
+            ConfinementEvent::ArbitrationStuffException => {
+                self.fault.arbitration_stuff_exception();
+            }
+            ConfinementEvent::FlagPenalties { transmitter, count } => {
+                if self.fault.confinement_penalties(transmitter, count) {
+                    self.entered_bus_off();
+                }
+            }
+        }
+    }
+
+    fn tx_attempt_end(&mut self, dominant_in_passive_flag: bool, time: BusTime) {
+        if self
+            .fault
+            .transmission_ended(time.now, dominant_in_passive_flag)
+        {
+            self.entered_bus_off();
         }
     }
 
@@ -305,6 +324,6 @@ impl BusNode for SimNode {
             }
             return Some(now + self.bits_to_recovery().max(1));
         }
-        (self.suspend_until > now).then_some(self.suspend_until)
+        self.fault.suspend_end(now)
     }
 }

@@ -27,7 +27,7 @@ use std::io::{self, Write};
 
 use super::bits::FrameBits;
 use super::bus::NodeId;
-use super::inject::Fault;
+use super::inject::{Fault, FaultError};
 use super::node::TxResult;
 use crate::error::LastErrorCode;
 use crate::frame::Frame;
@@ -96,6 +96,9 @@ pub struct TraceRecord {
     pub arbitration_losers: Vec<NodeId>,
     /// Faults injected into this attempt.
     pub faults: Vec<Fault>,
+    /// Faults meant for this attempt and refused: they cannot happen in this frame (see
+    /// [`Fault`]); none of them was applied.
+    pub refused: Vec<(Fault, FaultError)>,
     /// The first error detected, if any.
     pub first_error: Option<ErrorInfo>,
     /// Some receiver drove the ACK slot dominant.

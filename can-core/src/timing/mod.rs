@@ -30,12 +30,16 @@
 //!   it) and [`Consistency`] (the rule flags).
 //! * [`encode`]: bxCAN `CAN_BTR` and FlexCAN `CTRL1` values.
 //! * [`iter`]: [`Solutions`], every timing within a tolerance.
+//! * [`frame_time`]: worst-case frame durations and wait bounds at a bit rate.
+//! * [`flexcan_rules`]: the FlexCAN manual's 8-quanta and clocks-per-bit rules.
 //!
 //! All arithmetic is integer (u64/u128 where products would overflow); see
 //! `docs/bit-timing.md` for worked examples.
 
 pub mod encode;
 pub mod error;
+pub mod flexcan_rules;
+pub mod frame_time;
 pub mod iter;
 pub mod limits;
 pub mod segments;

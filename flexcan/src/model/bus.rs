@@ -11,6 +11,13 @@
 //! - Self reception (MCR\[SRXDIS\] = 0): the module receives its own frames if they match a
 //!   filter. The simulated bus reports a node's own frame through `rx(.., own = true, ..)`
 //!   and the model drops it when SRXDIS = 1.
+//! - Suspend transmission: error-passive after transmitting, the module starts no frame
+//!   before 8 bits after the intermission (ISO 11898-1 §10.4.6.4; the Kinetis manuals:
+//!   "delay its transmission start time (error-passive)").
+//! - Frames take bus time: from the start of frame (`BusNode::attempt_started`) the
+//!   mailbox that won the internal arbitration is in transmission (an ABORT written then
+//!   waits for the outcome, see `mailboxes.rs`) and ESR1\[TX\] / ESR1\[RX\] show the
+//!   module transmitting / receiving (ESR1\[IDLE\] clear) until the outcome.
 //! - Time stamps are the TIMER value at the bit after SOF (the identifier's start).
 
 use twocan_core::error::LastErrorCode;
@@ -33,9 +40,9 @@ impl State {
         self.on_bus() && !self.bus_off() && !self.lom()
     }
 
-    /// What the controller would start now.
-    pub fn poll_tx(&self) -> Option<TxRequest> {
-        if !self.can_transmit() {
+    /// What the controller would start now (not before suspend transmission has ended).
+    pub fn poll_tx(&self, now: u64) -> Option<TxRequest> {
+        if !self.can_transmit() || !self.errors.fc.may_start_transmission(now) {
             return None;
         }
         let frame = self.mb_tx_frame(self.select_tx()?)?;
@@ -71,20 +78,36 @@ impl State {
         }
         match result {
             TxResult::Acked => {
-                if let Some(n) = self.tx_mb_of(frame) {
+                if let Some(n) = self.tx_succeeded_mb(frame) {
                     let stamp = self.timer.value_at(time.sof.saturating_add(1));
                     self.tx_done(n, stamp);
                 }
                 self.transmit_ok();
             }
-            TxResult::ArbitrationLost => {}
-            TxResult::Error(code) => self.transmit_error(code),
+            TxResult::ArbitrationLost => {
+                self.tx_failed();
+                self.transmitting = false;
+                self.receiving = self.listens();
+            }
+            TxResult::Error(code) => {
+                self.tx_failed();
+                self.transmit_error(code);
+            }
         }
     }
 
     /// A frame received correctly (or the module's own frame).
     pub fn rx(&mut self, frame: &Frame, own: bool, time: BusTime) {
         self.time_to(time.now);
+        self.rx_inner(frame, own, time);
+        if !own {
+            // A freeze or disable request that waited for this frame takes effect now.
+            self.receiving = false;
+            self.settle_modes();
+        }
+    }
+
+    fn rx_inner(&mut self, frame: &Frame, own: bool, time: BusTime) {
         if self.bus_off() {
             self.bus_off_dominant();
             return;
@@ -107,6 +130,12 @@ impl State {
     /// An error detected while receiving.
     pub fn rx_error(&mut self, code: LastErrorCode, dominant_after_flag: bool, time: BusTime) {
         self.time_to(time.now);
+        self.rx_error_inner(code, dominant_after_flag);
+        self.receiving = false;
+        self.settle_modes();
+    }
+
+    fn rx_error_inner(&mut self, code: LastErrorCode, dominant_after_flag: bool) {
         if self.bus_off() {
             self.bus_off_dominant();
             return;
@@ -133,7 +162,26 @@ impl State {
         if !self.synched {
             return Some(now.saturating_add(11u64.saturating_sub(self.sync_run).max(1)));
         }
-        None
+        self.errors.fc.suspend_end(now)
+    }
+
+    /// The end of an attempt the module transmitted (see `BusNode::tx_attempt_end`).
+    pub fn tx_attempt_end(&mut self, dominant_in_passive_flag: bool, time: BusTime) {
+        self.time_to(time.now);
+        self.transmitting = false;
+        self.transmission_ended(time.now, dominant_in_passive_flag);
+        self.settle_modes();
+    }
+
+    /// A frame attempt starts (see `BusNode::attempt_started`).
+    pub fn attempt_started(&mut self, transmitter: bool, time: BusTime) {
+        self.time_to(time.sof);
+        if transmitter {
+            self.transmitting = true;
+            self.tx_started();
+        } else {
+            self.receiving = true;
+        }
     }
 
     /// `bits` bit times passed, ending at `now`.

@@ -23,6 +23,19 @@ use crate::regs::{ctrl1, ecr, esr1, mcr};
 
 use super::state::State;
 
+/// RXERRCNT after a successful reception while above 127. The Kinetis reference manuals
+/// ("Error Counter (CANx_ECR)") say only "set to a value between 119 and 127", as ISO
+/// 11898-1 rule 8 does; the model takes 127 (docs/models.md says how silicon can tell:
+/// ECR is writable in Freeze mode).
+pub const REC_AFTER_PASSIVE_RECEPTION: u8 = 127;
+
+/// A fresh counter pair with FlexCAN's REC rule.
+pub(crate) const FRESH_COUNTERS: FaultConfinement =
+    match FaultConfinement::with_rec_after_passive_reception(REC_AFTER_PASSIVE_RECEPTION) {
+        Ok(f) => f,
+        Err(_) => panic!("REC_AFTER_PASSIVE_RECEPTION outside 119..=127"),
+    };
+
 /// FlexCAN's view of fault confinement.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Errors {
@@ -54,7 +67,7 @@ impl Errors {
     /// Reset state: error active, counters zero, no flags.
     pub const fn new() -> Self {
         Errors {
-            fc: FaultConfinement::new(),
+            fc: FRESH_COUNTERS,
             flags: 0,
             boffrec_latched: false,
             rxwrn: false,
@@ -105,6 +118,34 @@ impl State {
     pub fn transmit_error(&mut self, code: LastErrorCode) {
         self.note_error(code);
         if self.errors.fc.transmit_error(code) {
+            let boffrec = self.ctrl1_bit(ctrl1::BOFFREC);
+            self.errors.bus_off_entered(boffrec);
+        }
+        self.update_warnings();
+    }
+
+    /// The end of a frame attempt the module transmitted (`end`: end of its EOF or error
+    /// delimiter): rule 3 exception 1 settled, suspend transmission armed.
+    pub fn transmission_ended(&mut self, end: u64, dominant_in_passive_flag: bool) {
+        if self
+            .errors
+            .fc
+            .transmission_ended(end, dominant_in_passive_flag)
+        {
+            let boffrec = self.ctrl1_bit(ctrl1::BOFFREC);
+            self.errors.bus_off_entered(boffrec);
+        }
+        self.update_warnings();
+    }
+
+    /// Rule 3 exception 2 for the transmit error that follows.
+    pub fn arbitration_stuff_exception(&mut self) {
+        self.errors.fc.arbitration_stuff_exception();
+    }
+
+    /// `count` flag penalties (rules 4 to 6).
+    pub fn flag_penalties(&mut self, transmitter: bool, count: u8) {
+        if self.errors.fc.confinement_penalties(transmitter, count) {
             let boffrec = self.ctrl1_bit(ctrl1::BOFFREC);
             self.errors.bus_off_entered(boffrec);
         }
@@ -196,7 +237,7 @@ impl State {
     pub fn ecr_write(&mut self, value: u32) {
         let tec = ecr::TXERRCNT.get(value).min(248);
         let rec = ecr::RXERRCNT.get(value);
-        let mut fc = FaultConfinement::new();
+        let mut fc = FRESH_COUNTERS;
         for _ in 0..rec {
             fc.receive_error(false);
         }
@@ -214,9 +255,13 @@ impl State {
     /// ESR1 as read (without the read's side effect).
     pub fn esr1_value(&self) -> u32 {
         let fc = &self.errors.fc;
+        // Listen-only mode: "If the LOM bit in CTRL1 is asserted, after some delay that
+        // depends on the CAN bit timing the FLTCONF field will indicate 'Error Passive'"
+        // (ESR1[FLTCONF]); the model shows it at once.
         let fltconf = match fc.state() {
             ErrorState::BusOff => esr1::FLTCONF_BUS_OFF,
             ErrorState::Passive => esr1::FLTCONF_ERROR_PASSIVE,
+            _ if self.lom() => esr1::FLTCONF_ERROR_PASSIVE,
             _ => esr1::FLTCONF_ERROR_ACTIVE,
         };
         let mut v = self.errors.flags | esr1::FLTCONF.val(fltconf);
@@ -227,8 +272,16 @@ impl State {
             v |= esr1::TXWRN;
         }
         if self.on_bus() {
-            // Between the model's atomic frame events the bus is idle.
-            v |= esr1::SYNCH | esr1::IDLE;
+            v |= esr1::SYNCH;
+            if self.transmitting {
+                v |= esr1::TX;
+            }
+            if self.receiving {
+                v |= esr1::RX;
+            }
+            if !self.transmitting && !self.receiving {
+                v |= esr1::IDLE;
+            }
         }
         v
     }

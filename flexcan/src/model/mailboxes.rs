@@ -32,6 +32,11 @@ pub(crate) struct Mailboxes {
     smb: Option<Pending>,
     /// Frames written over an unread frame (OVERRUN) or dropped from the SMB.
     pub overruns: u64,
+    /// The mailbox whose frame is on the wire (from its start of frame to the outcome).
+    pub in_tx: Option<usize>,
+    /// ABORT was written to `in_tx` while it was being transmitted (with MCR\[AEN\]): the
+    /// abort waits for the end of the transmission.
+    pub abort_pending: bool,
 }
 
 /// Which mailboxes a received frame matched.
@@ -54,6 +59,8 @@ impl Mailboxes {
     pub fn reset_locks(&mut self) {
         self.locked = None;
         self.smb = None;
+        self.in_tx = None;
+        self.abort_pending = false;
     }
 }
 
@@ -139,18 +146,57 @@ impl State {
     }
 
     /// Software wrote the C/S word of mailbox `n`. With MCR\[AEN\] = 1, writing ABORT over a
-    /// pending transmission aborts it ("Transmission abort mechanism"): the model's frames
-    /// are atomic, so the mailbox is never caught mid-transmission and the abort always
-    /// succeeds: the code stays ABORT and IFLAG is set. Without AEN the write simply
-    /// replaces the code (mailbox inactivation).
+    /// pending transmission aborts it ("Transmission abort mechanism"):
+    /// - a mailbox not being transmitted is aborted at once: the code becomes ABORT and
+    ///   IFLAG is set;
+    /// - a mailbox whose frame is on the wire keeps transmitting; the abort request is
+    ///   captured and waits: if the transmission succeeds the mailbox completes as usual
+    ///   (code INACTIVE, IFLAG set: the abort was not done), if it fails or loses
+    ///   arbitration the abort is done (code ABORT, IFLAG set). Until then the C/S word
+    ///   keeps its transmit code (the manual only lets software read CODE after IFLAG).
+    ///
+    /// Without AEN the write simply replaces the code (mailbox inactivation).
     pub fn cs_write(&mut self, n: usize, value: u32) {
         let old = self.mb_code(n);
-        self.ram[4 * n] = value;
         let new = cs::CODE.get(value);
-        if self.mcr_bit(mcr::AEN) && new == code::TX_ABORT && is_tx_pending(old) {
+        let aen_abort = self.mcr_bit(mcr::AEN) && new == code::TX_ABORT && is_tx_pending(old);
+        if aen_abort && self.mbx.in_tx == Some(n) {
+            self.mbx.abort_pending = true;
+            return;
+        }
+        self.ram[4 * n] = value;
+        if aen_abort {
             self.iflag1 |= 1 << n;
         }
         self.mbx.serviced[n] = false;
+    }
+
+    /// A frame attempt starts with this module as a transmitter: the mailbox that wins the
+    /// internal arbitration is in transmission.
+    pub fn tx_started(&mut self) {
+        self.mbx.in_tx = self.select_tx();
+        self.mbx.abort_pending = false;
+    }
+
+    /// The transmission in progress ended without success (error or lost arbitration): a
+    /// captured abort is done now (code ABORT, IFLAG set).
+    pub fn tx_failed(&mut self) {
+        if let Some(n) = self.mbx.in_tx.take() {
+            if core::mem::replace(&mut self.mbx.abort_pending, false) {
+                self.set_mb_code(n, code::TX_ABORT);
+                self.mbx.serviced[n] = false;
+                self.iflag1 |= 1 << n;
+            }
+        }
+    }
+
+    /// The mailbox that sent `frame` now: the one in transmission, else as
+    /// [`State::tx_mb_of`] finds it. A captured abort is dropped (the frame was sent).
+    pub fn tx_succeeded_mb(&mut self, frame: &Frame) -> Option<usize> {
+        self.mbx.abort_pending = false;
+        let n = self.mbx.in_tx.take();
+        n.filter(|&n| is_tx_pending(self.mb_code(n)))
+            .or_else(|| self.tx_mb_of(frame))
     }
 
     // --- remote request answering --------------------------------------------------------

@@ -31,6 +31,8 @@ mod rx_fifo;
 mod state;
 mod timer;
 
+pub use errors::REC_AFTER_PASSIVE_RECEPTION;
+
 use std::cell::RefCell;
 use std::rc::Rc;
 
@@ -38,7 +40,7 @@ use twocan_core::error::{ErrorCounters, LastErrorCode};
 use twocan_core::fault::FaultConfinement;
 use twocan_core::frame::Frame;
 use twocan_core::registers::Registers;
-use twocan_core::sim::{BusNode, BusTime, TxRequest, TxResult};
+use twocan_core::sim::{BusNode, BusTime, ConfinementEvent, TxRequest, TxResult};
 
 use crate::regs::{ctrl1, esr1, NUM_MB};
 
@@ -265,8 +267,8 @@ impl Registers for FlexCanModel {
 }
 
 impl BusNode for FlexCanModel {
-    fn poll_tx(&mut self, _now: u64) -> Option<TxRequest> {
-        self.inner.borrow().poll_tx()
+    fn poll_tx(&mut self, now: u64) -> Option<TxRequest> {
+        self.inner.borrow().poll_tx(now)
     }
 
     fn acknowledges(&self) -> bool {
@@ -301,5 +303,26 @@ impl BusNode for FlexCanModel {
 
     fn next_wakeup(&self, now: u64) -> Option<u64> {
         self.inner.borrow().next_wakeup(now)
+    }
+
+    fn tx_attempt_end(&mut self, dominant_in_passive_flag: bool, time: BusTime) {
+        self.inner
+            .borrow_mut()
+            .tx_attempt_end(dominant_in_passive_flag, time);
+    }
+
+    fn attempt_started(&mut self, transmitter: bool, time: BusTime) {
+        self.inner.borrow_mut().attempt_started(transmitter, time);
+    }
+
+    fn confinement_event(&mut self, event: ConfinementEvent, time: BusTime) {
+        let mut s = self.inner.borrow_mut();
+        s.time_to(time.now);
+        match event {
+            ConfinementEvent::ArbitrationStuffException => s.arbitration_stuff_exception(),
+            ConfinementEvent::FlagPenalties { transmitter, count } => {
+                s.flag_penalties(transmitter, count)
+            }
+        }
     }
 }

@@ -14,6 +14,9 @@
 //!   internal state machines; CTRL1, CTRL2, the masks, RXFIR and the message buffers are
 //!   not affected. It reads 1 until the reset is done, which needs the module clocked:
 //!   requested in Disable mode, it completes when the module is enabled.
+//! - Entering Freeze or Disable mode while a frame is on the wire (ESR1\[TX\] or \[RX\])
+//!   waits for the end of that frame ("Freeze mode": FlexCAN "waits to be in either
+//!   Intermission, Passive Error, Bus Off or Idle state").
 //! - Fault injection: with no module clock no handshake completes (FRZACK, LPMACK and
 //!   SOFTRST keep their values).
 
@@ -45,8 +48,12 @@ impl State {
         if self.clock_stuck {
             return;
         }
+        // "When Freeze mode is requested during transmission or reception, FlexCAN ...
+        // waits to be in either Intermission, Passive Error, Bus Off or Idle state"; the
+        // same holds for Disable mode: the frame on the wire is finished first.
+        let busy = self.transmitting || self.receiving;
         if self.mcr_bit(mcr::MDIS) {
-            if !self.lpmack {
+            if !self.lpmack && !busy {
                 self.lpmack = true;
                 self.frzack = false;
                 self.lose_sync();
@@ -61,6 +68,9 @@ impl State {
             self.soft_reset();
         }
         let freeze_requested = self.mcr_bit(mcr::FRZ) && self.mcr_bit(mcr::HALT);
+        if freeze_requested && !self.frzack && busy {
+            return;
+        }
         if freeze_requested != self.frzack {
             self.frzack = freeze_requested;
             self.lose_sync();

@@ -49,6 +49,10 @@ pub(crate) struct State {
     pub mbx: Mailboxes,
     /// Frames that matched no filter and no mailbox.
     pub discarded: u64,
+    /// Transmitting a frame (ESR1\[TX\]): from its start of frame to the end of the attempt.
+    pub transmitting: bool,
+    /// Receiving a frame (ESR1\[RX\]): from its start of frame to its outcome.
+    pub receiving: bool,
 }
 
 impl State {
@@ -78,6 +82,8 @@ impl State {
             fifo: RxFifo::new(),
             mbx: Mailboxes::new(),
             discarded: 0,
+            transmitting: false,
+            receiving: false,
         }
     }
 

@@ -1,0 +1,136 @@
+//! The Kinetis FlexCAN rules on bit timing that the CTRL1 field ranges do not express
+//! (K20/K64/K66 reference manuals, FlexCAN chapter, "Arbitration and matching timing"):
+//!
+//! - "A valid CAN bit timing must be programmed" and, as its "direct consequence", "the
+//!   minimum number of time quanta per CAN bit must be 8" — the CTRL1 fields alone allow
+//!   1 + 1 + 1 + 2 = 5;
+//! - "There must be a minimum ratio between the peripheral clock frequency and the CAN bit
+//!   rate" (table "Minimum Ratio Between Peripheral Clock Frequency and CAN Bit Rate"): the
+//!   module scans every message buffer during arbitration and matching and needs that many
+//!   peripheral clocks per CAN bit: 16 for 16 message buffers, with or without the Rx FIFO
+//!   (17 for 32 MBs with the FIFO, 25 / 30 for 64 MBs).
+//!
+//! ACAN (§16.1) checks only the field ranges, so it accepts 5 quanta per bit (its "fastest
+//! exact bit rate" of 3.2 Mbit/s from the 16 MHz clock is 5 quanta, which it reports
+//! working in loop-back and self-reception mode only). [`Limits::FLEXCAN`](super::Limits::FLEXCAN)
+//! keeps ACAN's ranges so that the solver reproduces ACAN's figures; [`check`] is the
+//! reference manual's stricter rule, for a backend that refuses what the manual forbids.
+
+use super::Timing;
+
+/// The least number of time quanta per bit the manual allows.
+pub const MIN_QUANTA_PER_BIT: u32 = 8;
+
+/// The least number of peripheral clocks per CAN bit for `mailboxes` message buffers
+/// (16, 32 or 64; other counts are rounded up to the next of these) with the Rx FIFO on
+/// or off.
+pub const fn min_peripheral_clocks_per_bit(mailboxes: u8, rx_fifo: bool) -> u32 {
+    match (mailboxes, rx_fifo) {
+        (0..=16, _) => 16,
+        (17..=32, false) => 16,
+        (17..=32, true) => 17,
+        (_, false) => 25,
+        (_, true) => 30,
+    }
+}
+
+/// A timing the FlexCAN reference manual forbids.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum FlexcanTimingViolation {
+    /// Fewer than [`MIN_QUANTA_PER_BIT`] time quanta per bit.
+    TooFewQuanta {
+        /// The timing's quanta per bit.
+        quanta: u32,
+    },
+    /// Fewer peripheral clocks per CAN bit than the table requires.
+    TooFewPeripheralClocks {
+        /// Peripheral clocks per bit (rounded down).
+        clocks_per_bit: u64,
+        /// The table's minimum.
+        min: u32,
+    },
+    /// A peripheral clock of 0 Hz, or a timing with a bit rate of 0.
+    Zero,
+}
+
+/// Checks `timing` against the FlexCAN manual's rules, for a module with `mailboxes`
+/// message buffers, the Rx FIFO on or off, and a peripheral (bus) clock of
+/// `peripheral_hz`.
+pub const fn check(
+    timing: &Timing,
+    peripheral_hz: u32,
+    mailboxes: u8,
+    rx_fifo: bool,
+) -> Result<(), FlexcanTimingViolation> {
+    let quanta = timing.quanta();
+    if quanta < MIN_QUANTA_PER_BIT {
+        return Err(FlexcanTimingViolation::TooFewQuanta { quanta });
+    }
+    let bitrate = timing.actual_bitrate();
+    if peripheral_hz == 0 || bitrate == 0 {
+        return Err(FlexcanTimingViolation::Zero);
+    }
+    let clocks_per_bit = peripheral_hz as u64 / bitrate as u64;
+    let min = min_peripheral_clocks_per_bit(mailboxes, rx_fifo);
+    if clocks_per_bit < min as u64 {
+        return Err(FlexcanTimingViolation::TooFewPeripheralClocks {
+            clocks_per_bit,
+            min,
+        });
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::timing::{cia_sample_point, solve, Limits};
+
+    fn flexcan(bitrate: u32) -> Timing {
+        solve(
+            16_000_000,
+            bitrate,
+            &Limits::FLEXCAN,
+            cia_sample_point(bitrate),
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn acan_fastest_exact_rate_breaks_the_manual_rules() {
+        let t = flexcan(3_200_000);
+        assert_eq!(t.quanta(), 5);
+        assert_eq!(
+            check(&t, 60_000_000, 16, true),
+            Err(FlexcanTimingViolation::TooFewQuanta { quanta: 5 })
+        );
+    }
+
+    #[test]
+    fn one_megabit_needs_a_fast_enough_bus_clock() {
+        let t = flexcan(1_000_000);
+        assert!(t.quanta() >= 8);
+        // Teensy 3.2 bus clock 48 MHz, 3.6 60 MHz: 48 and 60 clocks per bit.
+        assert_eq!(check(&t, 48_000_000, 16, true), Ok(()));
+        // A 15 MHz peripheral clock gives 15 clocks per bit, below 16.
+        assert_eq!(
+            check(&t, 15_000_000, 16, true),
+            Err(FlexcanTimingViolation::TooFewPeripheralClocks {
+                clocks_per_bit: 15,
+                min: 16
+            })
+        );
+        assert_eq!(check(&t, 0, 16, true), Err(FlexcanTimingViolation::Zero));
+    }
+
+    #[test]
+    fn table_of_minimum_clocks() {
+        assert_eq!(min_peripheral_clocks_per_bit(16, false), 16);
+        assert_eq!(min_peripheral_clocks_per_bit(16, true), 16);
+        assert_eq!(min_peripheral_clocks_per_bit(32, false), 16);
+        assert_eq!(min_peripheral_clocks_per_bit(32, true), 17);
+        assert_eq!(min_peripheral_clocks_per_bit(64, false), 25);
+        assert_eq!(min_peripheral_clocks_per_bit(64, true), 30);
+    }
+}

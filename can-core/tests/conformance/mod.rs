@@ -1,0 +1,502 @@
+//! The fault-confinement conformance table, shared by the three node kinds: the simulated
+//! node (`can-core/tests/sim_conformance.rs`), the bxCAN model
+//! (`bxcan/tests/model_conformance.rs`) and the FlexCAN model
+//! (`flexcan/tests/model_conformance.rs`).
+//!
+//! Each case is one rule or exception of ISO 11898-1 §12.1.4.2 (Bosch CAN 2.0 part B §8)
+//! or §10.4.6.4 (suspend transmission), played on the simulated bus with the node under
+//! test ("dut") and plain [`SimNode`] peers. The expected counters, states and bit times
+//! are worked out by hand in each case's comment from the frame layout
+//! (`ce` = end of the CRC sequence = index of the CRC delimiter, from
+//! [`twocan_core::sim::frame_bits`]) and the rules, not read back from a run.
+//!
+//! A node kind plugs in through [`Dut`]; [`conformance_tests!`] makes one `#[test]` per case.
+
+#![allow(dead_code)]
+
+use std::cell::RefCell;
+use std::rc::Rc;
+
+use twocan_core::fault::BUS_OFF_RECOVERY_SEQUENCES;
+use twocan_core::sim::{frame_bits, Bus, BusEvent, Fault, NodeId, Receivers, SimNode, TraceRecord};
+use twocan_core::{ErrorCounters, ErrorState, Frame, LastErrorCode};
+
+/// A node kind under test, driven as its users drive it (registers for the models).
+pub trait Dut: Sized {
+    /// Builds the node with automatic retransmission and automatic bus-off recovery,
+    /// attaches it to `bus` and lets it join the bus (synchronisation).
+    fn join(bus: &mut Bus) -> (Self, NodeId);
+    /// Queues one frame for transmission (at most one pending at a time in this table).
+    fn send(&mut self, frame: &Frame);
+    /// TEC and REC (TEC reads 256 while bus-off).
+    fn counters(&self) -> ErrorCounters;
+    /// The fault-confinement state as the controller reports it.
+    fn state(&self) -> ErrorState;
+    /// REC after a successful reception above 127, from the controller's manual.
+    const REC_AFTER_PASSIVE_RECEPTION: u16;
+}
+
+fn peer() -> Rc<RefCell<SimNode>> {
+    SimNode::new().shared()
+}
+
+fn frame(id: u16) -> Frame {
+    Frame::standard(id, &[0x5A, id as u8]).unwrap()
+}
+
+/// Runs until the next frame attempt on the wire and returns it.
+fn next_frame(bus: &mut Bus) -> Box<TraceRecord> {
+    for _ in 0..10_000 {
+        match bus.step_until(u64::MAX) {
+            Some(BusEvent::Frame(r)) => return r,
+            Some(_) => continue,
+            None => break,
+        }
+    }
+    panic!("no frame attempt");
+}
+
+fn ce_of(f: &Frame) -> u64 {
+    u64::from(frame_bits(f).crc_end)
+}
+
+/// Rule 1: a receiver that detects an error adds 1 to REC.
+///
+/// The dut is the only receiver and computes a wrong CRC: it does not acknowledge, so the
+/// transmitter detects an acknowledge error at the ACK slot (ce+1) and flags ce+2..=ce+7.
+/// The dut reads that dominant ACK delimiter (ce+2): form error, flag ce+3..=ce+8. Its first
+/// bit after the flag (ce+9) is recessive (the transmitter's delimiter): rule 2 does not
+/// apply. REC = 1. Wire: error delimiter ce+9..=ce+16, end ce+17, intermission: the record
+/// lasts ce+20 bits.
+pub fn rule_1_receiver_error<D: Dut>() {
+    let mut bus = Bus::new(500_000).unwrap();
+    let (dut, id) = D::join(&mut bus);
+    let t = SimNode::new().with_one_shot(true).shared();
+    bus.attach("t", t.clone());
+    let f = frame(0x123);
+    t.borrow_mut().send(f);
+    bus.inject_next(Fault::Crc {
+        who: Receivers::Node(id),
+    });
+    let r = next_frame(&mut bus);
+    assert_eq!(dut.counters(), ErrorCounters { tec: 0, rec: 1 });
+    assert_eq!(dut.state(), ErrorState::Active);
+    assert_eq!(
+        t.borrow().counters().tec,
+        8,
+        "transmitter: acknowledge error"
+    );
+    assert_eq!(r.end - r.sof, ce_of(&f) + 20);
+}
+
+/// Rule 2: a receiver that reads a dominant bit as the first bit after its own error flag
+/// adds 8 more (REC = 9).
+///
+/// Another receiver acknowledges, so only the dut's CRC is wrong: it flags from ce+3 (after
+/// the ACK delimiter) to ce+8; the other receiver (form error at EOF bit 1, ce+3) and the
+/// transmitter (bit error at ce+3) flag ce+4..=ce+9, so the dut's first bit after its flag,
+/// ce+9, is dominant. Wire: last dominant ce+9, delimiter ce+10..=ce+17, end ce+18, +3.
+pub fn rule_2_dominant_after_own_flag<D: Dut>() {
+    let mut bus = Bus::new(500_000).unwrap();
+    let (dut, id) = D::join(&mut bus);
+    let t = SimNode::new().with_one_shot(true).shared();
+    let other = peer();
+    bus.attach("t", t.clone());
+    bus.attach("other", other.clone());
+    let f = frame(0x321);
+    t.borrow_mut().send(f);
+    bus.inject_next(Fault::Crc {
+        who: Receivers::Node(id),
+    });
+    let r = next_frame(&mut bus);
+    assert_eq!(dut.counters(), ErrorCounters { tec: 0, rec: 9 });
+    assert_eq!(other.borrow().counters().rec, 1);
+    assert_eq!(r.end - r.sof, ce_of(&f) + 21);
+}
+
+/// Rule 3 then rule 7: a transmitter that sends an error flag adds 8 to TEC; a successful
+/// transmission subtracts 1. One injected bit error then a clean retransmission: TEC 8
+/// then 7. An error-active transmitter is not suspended: the retransmission starts right
+/// after the intermission of the error frame.
+pub fn rule_3_and_7_transmitter<D: Dut>() {
+    let mut bus = Bus::new(500_000).unwrap();
+    let (mut dut, id) = D::join(&mut bus);
+    let p = peer();
+    bus.attach("p", p.clone());
+    let f = frame(0x0F0);
+    bus.inject_from(id, 1, Fault::Bit { at: None });
+    dut.send(&f);
+    let first = next_frame(&mut bus);
+    assert_eq!(dut.counters(), ErrorCounters { tec: 8, rec: 0 });
+    let second = next_frame(&mut bus);
+    assert_eq!(
+        second.sof, first.end,
+        "no suspend transmission while active"
+    );
+    assert!(second.is_error_free());
+    assert_eq!(dut.counters(), ErrorCounters { tec: 7, rec: 0 });
+    assert_eq!(p.borrow().received_frames(), vec![f]);
+}
+
+/// Drives the dut to TEC = 128 (error-passive) with 16 injected bit errors on its frame,
+/// the peer acknowledging; returns the last error record. Attempt k (0-based) starts at
+/// the end of attempt k-1 while active; the 16th error makes it passive.
+fn make_passive<D: Dut>(bus: &mut Bus, dut: &mut D, id: NodeId, f: &Frame) -> Box<TraceRecord> {
+    bus.inject_from(id, 16, Fault::Bit { at: None });
+    dut.send(f);
+    let mut last = next_frame(bus);
+    for _ in 1..16 {
+        let r = next_frame(bus);
+        assert_eq!(r.sof, last.end);
+        last = r;
+    }
+    assert_eq!(dut.counters(), ErrorCounters { tec: 128, rec: 0 });
+    assert_eq!(dut.state(), ErrorState::Passive);
+    last
+}
+
+/// Rule 3 exception 1, condition met: an error-passive transmitter that detects an
+/// acknowledge error and no dominant bit during its passive error flag keeps its TEC.
+/// The dut reads a recessive ACK slot (the peer did acknowledge): its passive flag
+/// ce+2..=ce+7 is recessive and so is everything else: TEC stays 128.
+///
+/// Suspend transmission (§10.4.6.4): after the 16th error (passive), the next attempt
+/// starts 8 bits after the intermission. After the ACK-error attempt (delimiter
+/// ce+8..=ce+15, end ce+16, intermission to ce+19), the retry starts at ce+19+8.
+pub fn rule_3_exception_1_ack_error_when_passive<D: Dut>() {
+    let mut bus = Bus::new(500_000).unwrap();
+    let (mut dut, id) = D::join(&mut bus);
+    let p = peer();
+    bus.attach("p", p.clone());
+    let f = frame(0x0F1);
+    let last = make_passive(&mut bus, &mut dut, id, &f);
+    bus.inject_next(Fault::Ack);
+    let ack = next_frame(&mut bus);
+    assert_eq!(
+        ack.sof,
+        last.end + 8,
+        "suspend transmission after the error frame"
+    );
+    assert_eq!(ack.end - ack.sof, ce_of(&f) + 19);
+    assert_eq!(dut.counters(), ErrorCounters { tec: 128, rec: 0 });
+    let retry = next_frame(&mut bus);
+    assert_eq!(retry.sof, ack.end + 8);
+    assert!(retry.is_error_free());
+    assert_eq!(dut.counters(), ErrorCounters { tec: 127, rec: 0 });
+    // The peer accepted the frame of the ACK-error attempt (its last EOF bit passed) and
+    // the retry: the known double reception.
+    assert_eq!(p.borrow().received_frames(), vec![f, f]);
+}
+
+/// Rule 3 exception 1, condition not met: the only receiver computes a wrong CRC, so it
+/// does not acknowledge (acknowledge error for the passive dut at ce+1, passive flag from
+/// ce+2) and flags ce+3..=ce+8 after its ACK delimiter (CRC error at ce+2): the dut reads
+/// dominant bits during its passive flag, so TEC += 8 after all: 136.
+pub fn rule_3_exception_1_not_met_dominant_during_passive_flag<D: Dut>() {
+    let mut bus = Bus::new(500_000).unwrap();
+    let (mut dut, id) = D::join(&mut bus);
+    let p = peer();
+    let pid = bus.attach("p", p.clone());
+    let f = frame(0x0F2);
+    make_passive(&mut bus, &mut dut, id, &f);
+    let rec_before = p.borrow().counters().rec;
+    bus.inject_next(Fault::Crc {
+        who: Receivers::Node(pid),
+    });
+    let r = next_frame(&mut bus);
+    assert_eq!(dut.counters(), ErrorCounters { tec: 136, rec: 0 });
+    assert_eq!(p.borrow().counters().rec, rec_before + 1);
+    // Wire: the receiver's flag ce+3..=ce+8 is the last dominant stretch; the dut's passive
+    // flag needs six equal bits: ce+3..=ce+8, then delimiters ce+9..=ce+16, end ce+17.
+    assert_eq!(r.end - r.sof, ce_of(&f) + 20);
+}
+
+/// Rule 8: a successful reception with REC above 127 sets REC to the controller's value in
+/// 119..=127. 15 rule-2 errors (9 each, the dut still error-active at the start of each:
+/// 14 × 9 = 126 < 128) bring REC to 135; one good frame then sets it to the value its
+/// manual names (the node is then error-warning: REC ≥ 96).
+pub fn rule_8_reception_above_127<D: Dut>() {
+    let mut bus = Bus::new(500_000).unwrap();
+    let (dut, id) = D::join(&mut bus);
+    let t = SimNode::new().with_one_shot(true).shared();
+    let other = peer();
+    bus.attach("t", t.clone());
+    bus.attach("other", other.clone());
+    for k in 0..15u64 {
+        t.borrow_mut().send(frame(0x200 + k as u16));
+        bus.inject_next(Fault::Crc {
+            who: Receivers::Node(id),
+        });
+        next_frame(&mut bus);
+    }
+    assert_eq!(dut.counters(), ErrorCounters { tec: 0, rec: 135 });
+    assert_eq!(dut.state(), ErrorState::Passive);
+    t.borrow_mut().send(frame(0x300));
+    let r = next_frame(&mut bus);
+    assert!(r.is_error_free());
+    assert_eq!(
+        dut.counters(),
+        ErrorCounters {
+            tec: 0,
+            rec: D::REC_AFTER_PASSIVE_RECEPTION
+        }
+    );
+    assert_eq!(dut.state(), ErrorState::Warning);
+}
+
+/// Suspend transmission, other node first: an error-passive dut that was transmitter must
+/// wait 8 bits after the intermission, but a node that starts in that window wins the bus
+/// and the dut receives its frame; the dut's frame follows right after (no new suspension:
+/// it was a receiver).
+pub fn suspend_transmission_other_node_starts_first<D: Dut>() {
+    let mut bus = Bus::new(500_000).unwrap();
+    let (mut dut, id) = D::join(&mut bus);
+    let p = peer();
+    bus.attach("p", p.clone());
+    let f = frame(0x0F3);
+    let last = make_passive(&mut bus, &mut dut, id, &f);
+    let g = frame(0x7FF);
+    p.borrow_mut().send(g);
+    let other = next_frame(&mut bus);
+    assert_eq!(other.sof, last.end, "the peer starts at once");
+    assert_eq!(other.frame, g);
+    let mine = next_frame(&mut bus);
+    assert_eq!(mine.sof, other.end, "the dut was a receiver: no suspension");
+    assert_eq!(mine.frame, f);
+    assert!(mine.is_error_free());
+    assert_eq!(dut.counters(), ErrorCounters { tec: 127, rec: 0 });
+}
+
+/// Rule 3 exception 2: a transmitter that reads dominant on a recessive stuff bit of the
+/// arbitration field detects a stuff error and leaves TEC unchanged. Identifier 0x000:
+/// SOF and the first four identifier bits are dominant, so wire bit 5 is a recessive stuff
+/// bit inside the arbitration field. The retry succeeds; TEC stays 0 throughout.
+pub fn rule_3_exception_2_stuff_error_in_arbitration<D: Dut>() {
+    let mut bus = Bus::new(500_000).unwrap();
+    let (mut dut, id) = D::join(&mut bus);
+    let p = peer();
+    bus.attach("p", p.clone());
+    let f = Frame::standard(0x000, &[1]).unwrap();
+    assert!(frame_bits(&f).arbitration_end > 5);
+    bus.try_inject_from(id, 1, Fault::Bit { at: Some(5) })
+        .unwrap();
+    dut.send(&f);
+    let r = next_frame(&mut bus);
+    let e = r.first_error.unwrap();
+    assert_eq!((e.node, e.code, e.bit), (id, LastErrorCode::Stuff, 5));
+    assert!(r.refused.is_empty());
+    assert_eq!(dut.counters(), ErrorCounters { tec: 0, rec: 0 });
+    let retry = next_frame(&mut bus);
+    assert!(retry.is_error_free());
+    assert_eq!(dut.counters(), ErrorCounters { tec: 0, rec: 0 });
+}
+
+/// Rule 4: a transmitter that detects a bit error while sending its active error flag adds
+/// 8 (and starts a new flag). One bit error (rule 3: +8) whose error flag is hit at its
+/// third bit (rule 4: +8): TEC 16; the retry succeeds: 15.
+pub fn rule_4_bit_error_in_own_active_flag_transmitter<D: Dut>() {
+    let mut bus = Bus::new(500_000).unwrap();
+    let (mut dut, id) = D::join(&mut bus);
+    let p = peer();
+    bus.attach("p", p.clone());
+    let f = frame(0x0F5);
+    bus.inject_from(id, 1, Fault::Bit { at: None });
+    bus.try_inject_next(Fault::FlagBit { who: id, bit: 2 })
+        .unwrap();
+    dut.send(&f);
+    next_frame(&mut bus);
+    assert_eq!(dut.counters(), ErrorCounters { tec: 16, rec: 0 });
+    assert!(next_frame(&mut bus).is_error_free());
+    assert_eq!(dut.counters(), ErrorCounters { tec: 15, rec: 0 });
+}
+
+/// Rule 5: a receiver that detects a bit error while sending its active error flag adds 8.
+/// As in rule 2, the dut alone computes a wrong CRC and flags from ce+3, but it misreads
+/// the first bit of its flag: +8, and its new flag runs ce+4..=ce+9, together with the
+/// others' flags (their errors are at ce+3): its first bit after the flag (ce+10) is
+/// recessive, so rule 2 does not apply: REC = 1 + 8 = 9. Wire: last dominant ce+9, end
+/// ce+18, +3.
+pub fn rule_5_bit_error_in_own_active_flag_receiver<D: Dut>() {
+    let mut bus = Bus::new(500_000).unwrap();
+    let (dut, id) = D::join(&mut bus);
+    let t = SimNode::new().with_one_shot(true).shared();
+    let other = peer();
+    bus.attach("t", t.clone());
+    bus.attach("other", other.clone());
+    let f = frame(0x322);
+    t.borrow_mut().send(f);
+    bus.inject_next(Fault::Crc {
+        who: Receivers::Node(id),
+    });
+    bus.try_inject_next(Fault::FlagBit { who: id, bit: 0 })
+        .unwrap();
+    let r = next_frame(&mut bus);
+    assert_eq!(dut.counters(), ErrorCounters { tec: 0, rec: 9 });
+    assert_eq!(r.end - r.sof, ce_of(&f) + 21);
+}
+
+/// Rule 6, active flag: the 14th consecutive dominant bit counted from the start of the
+/// flag, and each 8 more, add 8. A lone error-active dut (a listen-only sniffer does not
+/// acknowledge): acknowledge error at ce+1 (+8), flag ce+2..=ce+7, then the bus is held
+/// dominant from ce+8 for 16 bits: dominant bits 14 (ce+15) and 22 (ce+23) add 8 each:
+/// TEC 24.
+pub fn rule_6_dominant_bits_after_active_flag<D: Dut>() {
+    let mut bus = Bus::new(500_000).unwrap();
+    let (mut dut, _) = D::join(&mut bus);
+    let sniffer = SimNode::new().with_listen_only(true).shared();
+    bus.attach("sniffer", sniffer);
+    let f = frame(0x0F6);
+    let ce = frame_bits(&f).crc_end;
+    bus.try_inject_next(Fault::StuckDominant {
+        at: ce + 8,
+        bits: 16,
+    })
+    .unwrap();
+    dut.send(&f);
+    let r = next_frame(&mut bus);
+    assert_eq!(r.first_error.unwrap().code, LastErrorCode::Acknowledge);
+    assert_eq!(dut.counters(), ErrorCounters { tec: 24, rec: 0 });
+    // Held dominant to ce+23, delimiter ce+24..=ce+31, end ce+32, +3.
+    assert_eq!(r.end - r.sof, u64::from(ce) + 35);
+}
+
+/// Rule 6, passive flag: the 8th consecutive dominant bit after a passive error flag adds
+/// 8. An error-passive dut reads a recessive ACK slot (acknowledge error, rule 3 exception
+/// 1 applies: its passive flag ce+2..=ce+7 is all recessive), then the bus is held dominant
+/// from ce+8 for 8 bits: TEC 128 + 8 = 136.
+pub fn rule_6_dominant_bits_after_passive_flag<D: Dut>() {
+    let mut bus = Bus::new(500_000).unwrap();
+    let (mut dut, id) = D::join(&mut bus);
+    let p = peer();
+    bus.attach("p", p.clone());
+    let f = frame(0x0F7);
+    let ce = frame_bits(&f).crc_end;
+    make_passive(&mut bus, &mut dut, id, &f);
+    bus.inject_next(Fault::Ack);
+    bus.try_inject_next(Fault::StuckDominant {
+        at: ce + 8,
+        bits: 8,
+    })
+    .unwrap();
+    next_frame(&mut bus);
+    assert_eq!(dut.counters(), ErrorCounters { tec: 136, rec: 0 });
+}
+
+/// Overload frame (§10.4.5): a dominant first intermission bit makes every node send an
+/// overload flag (ce+11..=ce+16) and delimiter (ce+17..=ce+24); the frame stays valid and
+/// the counters move only by the success (rule 7): a TEC of 8 becomes 7. The attempt lasts
+/// ce + 25 bits and the intermission.
+pub fn overload_frame_leaves_the_counters<D: Dut>() {
+    let mut bus = Bus::new(500_000).unwrap();
+    let (mut dut, id) = D::join(&mut bus);
+    let p = peer();
+    bus.attach("p", p.clone());
+    let f = frame(0x0F8);
+    let ce = frame_bits(&f).crc_end;
+    bus.inject_from(id, 1, Fault::Bit { at: None });
+    dut.send(&f);
+    next_frame(&mut bus);
+    assert_eq!(dut.counters(), ErrorCounters { tec: 8, rec: 0 });
+    bus.try_inject_next(Fault::StuckDominant {
+        at: ce + 10,
+        bits: 1,
+    })
+    .unwrap();
+    let r = next_frame(&mut bus);
+    assert!(r.is_error_free());
+    assert_eq!(r.end - r.sof, u64::from(ce) + 28);
+    assert_eq!(dut.counters(), ErrorCounters { tec: 7, rec: 0 });
+    assert_eq!(p.borrow().received_frames(), vec![f]);
+}
+
+/// Bus-off at TEC > 255 (32 bit errors) and recovery after 128 occurrences of 11
+/// consecutive recessive bits (§12.1.4.2, "bus-off"). The error delimiter and intermission
+/// of the last error frame (8 + 3 recessive bits) are the first sequence, so the retry
+/// starts 127 × 11 bits after that error frame ends.
+pub fn bus_off_and_recovery<D: Dut>() {
+    let mut bus = Bus::new(500_000).unwrap();
+    let (mut dut, id) = D::join(&mut bus);
+    let p = peer();
+    bus.attach("p", p.clone());
+    let f = frame(0x0F4);
+    bus.inject_from(id, 32, Fault::Bit { at: None });
+    dut.send(&f);
+    let mut last = next_frame(&mut bus);
+    for _ in 1..32 {
+        last = next_frame(&mut bus);
+    }
+    assert_eq!(dut.state(), ErrorState::BusOff);
+    assert_eq!(dut.counters().tec, 256);
+    let retry = next_frame(&mut bus);
+    assert_eq!(
+        retry.sof,
+        last.end + 11 * u64::from(BUS_OFF_RECOVERY_SEQUENCES - 1)
+    );
+    assert!(retry.is_error_free());
+    assert_eq!(dut.state(), ErrorState::Active);
+    assert_eq!(dut.counters(), ErrorCounters { tec: 0, rec: 0 });
+    assert_eq!(p.borrow().received_frames(), vec![f]);
+}
+
+/// One `#[test]` per case of the table for the node kind `$dut`.
+#[macro_export]
+macro_rules! conformance_tests {
+    ($dut:ty) => {
+        #[test]
+        fn rule_1_receiver_error() {
+            conformance::rule_1_receiver_error::<$dut>();
+        }
+        #[test]
+        fn rule_2_dominant_after_own_flag() {
+            conformance::rule_2_dominant_after_own_flag::<$dut>();
+        }
+        #[test]
+        fn rule_3_and_7_transmitter() {
+            conformance::rule_3_and_7_transmitter::<$dut>();
+        }
+        #[test]
+        fn rule_3_exception_1_ack_error_when_passive() {
+            conformance::rule_3_exception_1_ack_error_when_passive::<$dut>();
+        }
+        #[test]
+        fn rule_3_exception_1_not_met_dominant_during_passive_flag() {
+            conformance::rule_3_exception_1_not_met_dominant_during_passive_flag::<$dut>();
+        }
+        #[test]
+        fn rule_8_reception_above_127() {
+            conformance::rule_8_reception_above_127::<$dut>();
+        }
+        #[test]
+        fn suspend_transmission_other_node_starts_first() {
+            conformance::suspend_transmission_other_node_starts_first::<$dut>();
+        }
+        #[test]
+        fn rule_3_exception_2_stuff_error_in_arbitration() {
+            conformance::rule_3_exception_2_stuff_error_in_arbitration::<$dut>();
+        }
+        #[test]
+        fn rule_4_bit_error_in_own_active_flag_transmitter() {
+            conformance::rule_4_bit_error_in_own_active_flag_transmitter::<$dut>();
+        }
+        #[test]
+        fn rule_5_bit_error_in_own_active_flag_receiver() {
+            conformance::rule_5_bit_error_in_own_active_flag_receiver::<$dut>();
+        }
+        #[test]
+        fn rule_6_dominant_bits_after_active_flag() {
+            conformance::rule_6_dominant_bits_after_active_flag::<$dut>();
+        }
+        #[test]
+        fn rule_6_dominant_bits_after_passive_flag() {
+            conformance::rule_6_dominant_bits_after_passive_flag::<$dut>();
+        }
+        #[test]
+        fn overload_frame_leaves_the_counters() {
+            conformance::overload_frame_leaves_the_counters::<$dut>();
+        }
+        #[test]
+        fn bus_off_and_recovery() {
+            conformance::bus_off_and_recovery::<$dut>();
+        }
+    };
+}

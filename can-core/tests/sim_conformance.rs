@@ -1,0 +1,37 @@
+//! The fault-confinement conformance table (`conformance/mod.rs`) on the simulated node.
+#![cfg(feature = "sim")]
+
+#[path = "conformance/mod.rs"]
+mod conformance;
+
+use std::cell::RefCell;
+use std::rc::Rc;
+
+use conformance::Dut;
+use twocan_core::fault::FaultConfinement;
+use twocan_core::sim::{Bus, NodeId, SimNode};
+use twocan_core::{ErrorCounters, ErrorState, Frame};
+
+/// A [`SimNode`] kept by the test while the bus drives a clone.
+struct Sim(Rc<RefCell<SimNode>>);
+
+impl Dut for Sim {
+    fn join(bus: &mut Bus) -> (Self, NodeId) {
+        let n = SimNode::new().shared();
+        let id = bus.attach("dut", n.clone());
+        (Sim(n), id)
+    }
+    fn send(&mut self, frame: &Frame) {
+        self.0.borrow_mut().send(*frame);
+    }
+    fn counters(&self) -> ErrorCounters {
+        self.0.borrow().counters()
+    }
+    fn state(&self) -> ErrorState {
+        self.0.borrow().state()
+    }
+    const REC_AFTER_PASSIVE_RECEPTION: u16 =
+        FaultConfinement::DEFAULT_REC_AFTER_PASSIVE_RECEPTION as u16;
+}
+
+conformance_tests!(Sim);

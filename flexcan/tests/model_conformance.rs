@@ -1,0 +1,82 @@
+//! The fault-confinement conformance table (`can-core/tests/conformance/mod.rs`) on the
+//! FlexCAN model, driven through its registers (automatic bus-off recovery:
+//! CTRL1\[BOFFREC\] = 0).
+
+#[path = "../../can-core/tests/conformance/mod.rs"]
+mod conformance;
+#[path = "model_support.rs"]
+mod support;
+
+use conformance::Dut;
+use support::Rig;
+use twocan_core::registers::Registers;
+use twocan_core::sim::{Bus, NodeId};
+use twocan_core::{ErrorCounters, ErrorState, Frame};
+use twocan_flexcan::model::FlexCanModel;
+use twocan_flexcan::model::REC_AFTER_PASSIVE_RECEPTION;
+use twocan_flexcan::regs::{self, code, cs, ecr, esr1, mcr};
+
+struct FlexCan(FlexCanModel);
+
+impl Dut for FlexCan {
+    fn join(bus: &mut Bus) -> (Self, NodeId) {
+        let mut m = FlexCanModel::mk20dx256();
+        m.modify32(regs::MCR, |v| v & !mcr::MDIS);
+        m.modify32(regs::MCR, |v| v | mcr::RFEN | mcr::IRMQ | mcr::SRXDIS);
+        for n in 0..8 {
+            m.write32(regs::rx_fifo_filter(n), 0);
+            m.write32(regs::rximr(n), 0);
+        }
+        for n in 8..16 {
+            m.write32(regs::mb_cs(n), 0);
+            m.write32(regs::rximr(n), u32::MAX);
+        }
+        let id = bus.attach("dut", m.clone());
+        m.modify32(regs::MCR, |v| v & !mcr::HALT);
+        // Synchronisation: 11 recessive bits ("FlexCAN ... waits for 11 consecutive
+        // recessive bits to synchronize to the CAN bus").
+        bus.run_for(11);
+        assert!(m.is_synchronised());
+        (FlexCan(m), id)
+    }
+    fn send(&mut self, frame: &Frame) {
+        let n = (8..16)
+            .find(|&n| {
+                let c = cs::CODE.get(self.0.read32(regs::mb_cs(n)));
+                c == code::TX_INACTIVE || c == 0
+            })
+            .unwrap();
+        let mut rig = Rig {
+            m: self.0.clone(),
+            now: 0,
+        };
+        rig.load_mb(n, frame, code::TX_DATA);
+    }
+    fn counters(&self) -> ErrorCounters {
+        let e = self.0.read32(regs::ECR);
+        let tec = if self.state() == ErrorState::BusOff {
+            256
+        } else {
+            ecr::TXERRCNT.get(e) as u16
+        };
+        ErrorCounters {
+            tec,
+            rec: ecr::RXERRCNT.get(e) as u16,
+        }
+    }
+    fn state(&self) -> ErrorState {
+        // Reading ESR1 clears its error bits; the table does not use them.
+        let e = self.0.read32(regs::ESR1);
+        match esr1::FLTCONF.get(e) {
+            esr1::FLTCONF_ERROR_ACTIVE if e & (esr1::RXWRN | esr1::TXWRN) != 0 => {
+                ErrorState::Warning
+            }
+            esr1::FLTCONF_ERROR_ACTIVE => ErrorState::Active,
+            esr1::FLTCONF_ERROR_PASSIVE => ErrorState::Passive,
+            _ => ErrorState::BusOff,
+        }
+    }
+    const REC_AFTER_PASSIVE_RECEPTION: u16 = REC_AFTER_PASSIVE_RECEPTION as u16;
+}
+
+conformance_tests!(FlexCan);
