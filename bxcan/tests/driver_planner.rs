@@ -81,11 +81,26 @@ fn check_exact(filters: &[Filter], p: &FilterPlan) {
 
 #[test]
 fn nine_standard_ids_take_three_banks() {
-    let f: Vec<Filter> = (0..9).map(|i| Filter::standard(0x100 + i)).collect();
+    // Identifiers of even parity: no two differ in one bit only, nothing to merge.
+    let f: Vec<Filter> = (0u16..32)
+        .filter(|i| i.count_ones() % 2 == 0)
+        .take(9)
+        .map(|i| Filter::standard(0x100 + i))
+        .collect();
     let p = plan(&f, ALL).unwrap();
     assert_eq!(p.bank_count(), 3);
     assert_eq!(kinds(&p), [BankKind::List16; 3]);
     assert!(p.is_proven_optimal());
+    check_exact(&f, &p);
+    // Without merging, consecutive identifiers take the same three banks.
+    let f: Vec<Filter> = (0..9).map(|i| Filter::standard(0x100 + i)).collect();
+    let p = plan(&f, ALL.merge(false)).unwrap();
+    assert_eq!(kinds(&p), [BankKind::List16; 3]);
+    check_exact(&f, &p);
+    // Merged: 0x100..=0x107 is one 16-bit mask entry, 0x108 the bank's second entry.
+    let p = plan(&f, ALL).unwrap();
+    assert_eq!(kinds(&p), [BankKind::Mask16]);
+    assert_eq!(p.list_only_banks(), 3);
     check_exact(&f, &p);
 }
 
@@ -110,8 +125,13 @@ fn mixes() {
     let mut f: Vec<Filter> = (0..9).map(|i| Filter::standard(0x200 + i)).collect();
     f.push(Filter::extended(0x10));
     f.push(Filter::extended(0x11));
-    let p = plan(&f, ALL).unwrap();
+    let p = plan(&f, ALL.merge(false)).unwrap();
     assert_eq!(p.bank_count(), 4);
+    check_exact(&f, &p);
+    // Merged: 0x200..=0x207 and 0x208 in one 16-bit mask bank, the two extended ids in
+    // a 32-bit list bank.
+    let p = plan(&f, ALL).unwrap();
+    assert_eq!(p.bank_count(), 2);
     check_exact(&f, &p);
 
     // 5 standard + 1 extended: 4 std in a 16-bit list, 1 std + 1 ext in a 32-bit list.
@@ -287,7 +307,13 @@ fn typed_errors() {
         })
     );
     let many = vec![Filter::standard(1); MAX_FILTERS + 1];
-    assert_eq!(plan(&many, ALL), Err(PlanError::TooManyFilters));
+    assert_eq!(
+        plan(&many, ALL),
+        Err(PlanError::TooManyFilters {
+            given: MAX_FILTERS as u16 + 1,
+            max: MAX_FILTERS as u16
+        })
+    );
     // Duplicates are shadowed: 128 copies of one id need one bank.
     let dup = vec![Filter::standard(1); MAX_FILTERS];
     assert_eq!(plan(&dup, ALL).unwrap().bank_count(), 1);
