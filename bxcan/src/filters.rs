@@ -639,11 +639,10 @@ impl FilterPlan {
         &self,
         traffic: impl IntoIterator<Item = (&'a Frame, u64)>,
     ) -> (u64, u64) {
-        let map = self.fmi_map();
         let mut accepted = 0u64;
         let mut dropped = 0u64;
         for (frame, w) in traffic {
-            if let Some(a) = self.evaluate_with(&map, frame) {
+            if let Some(a) = self.evaluate(frame) {
                 accepted += w;
                 if a.filter == NO_FILTER {
                     dropped += w;
@@ -729,10 +728,6 @@ impl FilterPlan {
     /// [`Acceptance::filter`] is the resolved user index ([`FmiMap::resolve`]):
     /// [`NO_FILTER`] for a frame a superset plan accepts that no user filter does.
     pub fn evaluate(&self, frame: &Frame) -> Option<Acceptance> {
-        self.evaluate_with(&self.fmi_map(), frame)
-    }
-
-    fn evaluate_with(&self, map: &FmiMap, frame: &Frame) -> Option<Acceptance> {
         let (id, ext, rtr) = (frame.raw_id(), frame.is_extended(), frame.is_remote());
         // (class, bank, slot, FIFO, FMI, user index)
         let mut best: Option<(u8, usize, usize, Fifo, u8, u16)> = None;
@@ -764,10 +759,13 @@ impl FilterPlan {
                 }
             }
         }
-        best.map(|(_, _, _, fifo, fmi, _)| Acceptance {
+        best.map(|(_, _, _, fifo, fmi, user)| Acceptance {
             fifo,
             fmi,
-            filter: map.resolve(fifo, fmi, id, ext, rtr).unwrap_or(NO_FILTER),
+            filter: match user {
+                LOOKUP => self.keys.lookup(key(id, ext, rtr)).unwrap_or(NO_FILTER),
+                user => user,
+            },
         })
     }
 

@@ -651,7 +651,9 @@ impl Problem {
                 if cost[n] < best_cost {
                     best_cost = cost[n];
                     best_classes = classes;
-                    if best_cost == bound {
+                    // Fewest banks reached: stop (the tie-break is best effort, the
+                    // depth-first order tries the cheapest classes first).
+                    if banks(best_cost) == banks(bound) {
                         break;
                     }
                 }
@@ -800,7 +802,9 @@ pub fn plan(filters: &[Filter], options: PlanOptions) -> Result<FilterPlan, Plan
     };
     loop {
         let q: u32 = general_quarters + grown.as_slice().iter().map(quarters).sum::<u32>();
-        if q <= 4 * available as u32 {
+        if q <= 4 * available as u32
+            && relaxed_banks(prep.items(grown.as_slice())) <= available as u16
+        {
             if let Ok(a) = attempt(&prep, grown.as_slice()) {
                 if a.banks <= available as u16 {
                     let extra = grown.extra(&prep.keys);

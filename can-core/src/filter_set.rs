@@ -209,25 +209,15 @@ impl KeyTable {
         self.keys[..self.len()].binary_search(&k).is_ok()
     }
 
-    /// How many keys of the table `c` holds.
+    /// How many keys of the table `c` holds (a scan of the keys between the cube's
+    /// lowest and highest key: at most the table's length, whatever the cube's size).
     pub fn count_in(&self, c: &Cube) -> u64 {
-        // Keys of one cube lie between its lowest and highest key.
         let lo = c.base;
         let hi = c.base | c.dc;
         let keys = self.keys();
         let start = keys.partition_point(|&k| k < lo);
         let end = keys.partition_point(|&k| k <= hi);
-        if c.size() <= (end - start) as u64 * 2 {
-            keys[start..end].iter().filter(|&&k| c.contains(k)).count() as u64
-        } else {
-            let mut n = 0;
-            c.for_each(|k| {
-                if self.contains(k) {
-                    n += 1;
-                }
-            });
-            n
-        }
+        keys[start..end].iter().filter(|&&k| c.contains(k)).count() as u64
     }
 
     /// Whether every key of `c` is in the table.
@@ -319,15 +309,46 @@ impl CubeList {
         self.len -= 1;
     }
 
-    /// Identifiers the cubes accept beyond `keys`, counted cube by cube (an identifier
-    /// outside the set in two overlapping cubes counts twice: an upper bound, exact
-    /// when the cubes are disjoint outside the set).
+    /// Identifiers the cubes accept beyond `keys`: the size of the cubes' union minus
+    /// the keys it holds (exact, overlaps counted once).
     pub fn extra(&self, keys: &KeyTable) -> u64 {
-        self.as_slice()
+        let cubes = self.as_slice();
+        let union: u64 = (0..cubes.len())
+            .map(|i| count_outside(cubes[i], &cubes[..i]))
+            .sum();
+        let inside = keys
+            .keys()
             .iter()
-            .map(|c| c.size() - keys.count_in(c))
-            .sum()
+            .filter(|&&k| cubes.iter().any(|c| c.contains(k)))
+            .count() as u64;
+        union - inside
     }
+}
+
+/// Keys of `c` in none of `others`: `c` is split on a bit one of them fixes until each
+/// piece is inside or outside it.
+fn count_outside(c: Cube, others: &[Cube]) -> u64 {
+    let Some((d, rest)) = others.split_first() else {
+        return c.size();
+    };
+    if !c.meets(d) {
+        return count_outside(c, rest);
+    }
+    if d.covers(&c) {
+        return 0;
+    }
+    // `c` meets `d` without being inside it: some bit is free in `c` and fixed in `d`.
+    let free = c.dc & !d.dc;
+    let bit = free & free.wrapping_neg();
+    let toward = Cube {
+        base: c.base | (d.base & bit),
+        dc: c.dc & !bit,
+    };
+    let away = Cube {
+        base: c.base | (!d.base & bit),
+        dc: c.dc & !bit,
+    };
+    count_outside(away, rest) + count_outside(toward, others)
 }
 
 /// Grows the cube of `seed` one ignored bit at a time while it stays inside `keys`,
@@ -624,6 +645,19 @@ mod tests {
         assert!(cubes.as_slice().contains(&Cube { base: 0x100, dc: 3 }));
         let t = table(&[0x100, 0x101, 0x103, 0x400]);
         assert_eq!(cubes.extra(&t), 1);
+        // Overlapping cubes: counted once.
+        let mut o = CubeList::new();
+        o.push(Cube {
+            base: 0x100,
+            dc: 0xF,
+        })
+        .unwrap();
+        o.push(Cube {
+            base: 0x100,
+            dc: 0x33,
+        })
+        .unwrap();
+        assert_eq!(o.extra(&table(&[0x100])), 16 + 16 - 4 - 1);
         // A remote and a data key never merge.
         let mut two = CubeList::new();
         two.push(Cube::single(key(5, false, false))).unwrap();
