@@ -117,6 +117,7 @@ pub mod filters;
 mod handshake;
 pub mod instance;
 mod message_buffer;
+pub mod planner;
 pub mod settings;
 mod status;
 pub mod system;
