@@ -265,7 +265,7 @@ pub fn bxcan_rows(sets: &[IdSet]) -> Vec<BxRow> {
     sets.iter()
         .map(|set| {
             let f = set.filters();
-            let all = PlanOptions::new(28);
+            let all = PlanOptions::new(28).merge(true);
             let merged = banks(plan(&f, all));
             let superset_extra = (merged > 28).then(|| {
                 plan(&f, all.superset(true))

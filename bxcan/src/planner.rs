@@ -118,7 +118,9 @@ pub struct PlanOptions {
     pub banks: u8,
     /// FIFO assignment.
     pub fifo: FifoPolicy,
-    /// Merge identifiers into exact mask entries (default `true`).
+    /// Merge identifiers into exact mask entries (default `false` until the driver
+    /// resolves merged entries with [`crate::filters::FmiMap::resolve`]: a merged slot's
+    /// [`crate::filters::FmiMap::get`] is [`LOOKUP`], not a user index).
     pub merge: bool,
     /// When the exact plan does not fit, accept a superset in hardware and let the
     /// driver drop the extra frames (default `false`: refuse with the bank counts).
@@ -126,19 +128,20 @@ pub struct PlanOptions {
 }
 
 impl Default for PlanOptions {
-    /// All 28 banks, FIFO 0, merging, no superset.
+    /// All 28 banks, FIFO 0, no merging, no superset.
     fn default() -> Self {
         Self::new(FILTER_BANKS as u8)
     }
 }
 
 impl PlanOptions {
-    /// `banks` banks available, every bank to FIFO 0, merging on, superset off.
+    /// `banks` banks available, every bank to FIFO 0, merging off, superset off (the
+    /// v1 plans, whose every slot names its user filter for `FmiMap::get`).
     pub const fn new(banks: u8) -> Self {
         PlanOptions {
             banks,
             fifo: FifoPolicy::Fifo0,
-            merge: true,
+            merge: false,
             superset: false,
         }
     }
@@ -1207,7 +1210,7 @@ mod tests {
                 };
                 list.push(f);
             }
-            let got = plan(&list, PlanOptions::new(28)).unwrap();
+            let got = plan(&list, PlanOptions::new(28).merge(true)).unwrap();
             let want = exhaustive_banks(&list);
             assert_eq!(got.bank_count() as u16, want, "{list:?}");
             merged_somewhere |= (got.bank_count() as u16) < got.list_only_banks();

@@ -126,13 +126,8 @@ fn each_bank_mode_end_to_end() {
 
 /// A plan from the planner, installed, and every frame of a sweep sent in loop-back:
 /// the model's accept/reject and reported index must equal the first match in list order.
-///
-/// Merging is off: the controller reports `FmiMap::get`, which cannot name the user
-/// filter of a merged entry (`LOOKUP`) until it resolves frames with
-/// `FmiMap::resolve` (merged and superset plans are tested through the model at
-/// register level in `model_planner.rs`).
 fn end_to_end(filters: &[Filter], fifo: FifoPolicy, frames: &[Frame]) {
-    let p = plan(filters, PlanOptions::new(14).fifo(fifo).merge(false)).unwrap();
+    let p = plan(filters, PlanOptions::new(14).fifo(fifo)).unwrap();
     let cfg = loopback_config(TxPolicy::Fifo);
     let (mut can, _regs, bus) = can1_with(&cfg, &p);
     for f in frames {
@@ -215,7 +210,7 @@ fn planner_plans_are_exact_end_to_end() {
 #[test]
 fn nine_ids_in_three_banks_end_to_end() {
     let filters: Vec<Filter> = (0..9).map(|i| Filter::standard(0x700 + i)).collect();
-    let p = plan(&filters, PlanOptions::new(14).merge(false)).unwrap();
+    let p = plan(&filters, PlanOptions::new(14)).unwrap();
     assert_eq!(p.bank_count(), 3);
     let frames: Vec<Frame> = (0x6F0..0x720)
         .map(|i| Frame::standard(i, &[]).unwrap())

@@ -98,7 +98,7 @@ fn nine_standard_ids_take_three_banks() {
     assert_eq!(kinds(&p), [BankKind::List16; 3]);
     check_exact(&f, &p);
     // Merged: 0x100..=0x107 is one 16-bit mask entry, 0x108 the bank's second entry.
-    let p = plan(&f, ALL).unwrap();
+    let p = plan(&f, ALL.merge(true)).unwrap();
     assert_eq!(kinds(&p), [BankKind::Mask16]);
     assert_eq!(p.list_only_banks(), 3);
     check_exact(&f, &p);
@@ -130,7 +130,7 @@ fn mixes() {
     check_exact(&f, &p);
     // Merged: 0x200..=0x207 and 0x208 in one 16-bit mask bank, the two extended ids in
     // a 32-bit list bank.
-    let p = plan(&f, ALL).unwrap();
+    let p = plan(&f, ALL.merge(true)).unwrap();
     assert_eq!(p.bank_count(), 2);
     check_exact(&f, &p);
 

@@ -142,7 +142,7 @@ fn merged_plan_delivers_exactly_through_the_model() {
     f.push(Filter::exact(FrameKind::Any, Format::Standard, 0x123));
     // Shadowed by the mask filter above: index of the mask.
     f.push(Filter::standard(0x605));
-    let p = check(&f, PlanOptions::new(28), &mut r);
+    let p = check(&f, PlanOptions::new(28).merge(true), &mut r);
     assert!(p.bank_count() < p.list_only_banks() as usize, "{p:?}");
 }
 
@@ -153,7 +153,7 @@ fn superset_plan_delivers_exactly_and_drops_the_rest() {
     let ids: Vec<u32> = (0..120).map(|i| (i * 17 + 3) % 0x800).collect();
     let f = std_ids(ids);
     assert!(plan(&f, PlanOptions::new(14)).is_err());
-    let p = check(&f, PlanOptions::new(14).superset(true), &mut r);
+    let p = check(&f, PlanOptions::new(14).merge(true).superset(true), &mut r);
     assert!(p.is_superset());
     assert!(p.bank_count() <= 14);
     // The drops the model saw are the plan's superset identifiers (data frames only:

@@ -113,7 +113,7 @@ proptest! {
 
     #[test]
     fn plans_are_exact_and_never_worse_than_list_only(filters in list(), seed in any::<u32>()) {
-        let merged = plan(&filters, PlanOptions::new(28));
+        let merged = plan(&filters, PlanOptions::new(28).merge(true));
         let list_only = plan(&filters, PlanOptions::new(28).merge(false));
         prop_assert!(banks(&merged) <= banks(&list_only));
         let frames = probes(&filters, seed);
@@ -124,7 +124,7 @@ proptest! {
         // Superset mode: always a plan (the lists have few general filters), within the
         // banks, exact on the requested frames.
         for banks in [28u8, 14, 4] {
-            match plan(&filters, PlanOptions::new(banks).superset(true)) {
+            match plan(&filters, PlanOptions::new(banks).merge(true).superset(true)) {
                 Ok(p) => {
                     prop_assert!(p.bank_count() <= banks as usize);
                     check(&filters, &p, &frames)?;
