@@ -17,7 +17,7 @@
 
 use crate::filter::{Filter, Format, FrameKind};
 
-/// The most frame keys a [`KeySet`] / [`KeyTable`] holds.
+/// The most frame keys a [`KeyTable`] holds.
 pub const MAX_KEYS: usize = 1024;
 
 /// The most cubes a [`CubeList`] holds.
