@@ -5,7 +5,8 @@
 use twocan_bxcan::filters::{Acceptance, NO_FILTER};
 use twocan_bxcan::planner::MAX_FILTERS;
 use twocan_bxcan::{
-    plan, Bank, BankError, BankKind, Fifo, FifoPolicy, FilterPlan, PlanError, PlanOptions,
+    plan, plan_dual, Bank, BankError, BankKind, Fifo, FifoPolicy, FilterPlan, PlanError,
+    PlanOptions,
 };
 use twocan_core::{Filter, FilterError, Format, Frame, FrameKind};
 
@@ -528,4 +529,39 @@ fn evaluate_breaks_cross_fifo_ties_by_bank_number() {
         assert_eq!((a.fifo, a.fmi), (low, 0));
         assert_eq!(a.filter, p.user_index(low, 0));
     }
+}
+
+#[test]
+fn dual_plans_choose_can2sb() {
+    // CAN1: 20 scattered standard ids (5 banks); CAN2: 6 extended ids (3 banks).
+    let can1: Vec<Filter> = (0..20u16).map(|i| Filter::standard(i * 0x51)).collect();
+    let can2: Vec<Filter> = (0..6u32).map(|i| Filter::extended(i * 0x1001)).collect();
+    let d = plan_dual(&can1, &can2, ALL).unwrap();
+    assert_eq!(d.can2sb as usize, d.can1.bank_count());
+    assert_eq!(d.can1.bank_count(), 5);
+    assert!(d.can2.bank_count() <= 28 - d.can2sb as usize);
+    check_exact(&can1, &d.can1);
+    check_exact(&can2, &d.can2);
+    // 29 single-bank masks on CAN1 and one on CAN2: says who needs what.
+    let big: Vec<Filter> = (0..29)
+        .map(|i| Filter::masked(FrameKind::Data, Format::Extended, 0x1FFF_FFF0, i << 8))
+        .collect();
+    assert_eq!(
+        plan_dual(&big, &big[..1], ALL),
+        Err(PlanError::DualTooManyBanks {
+            can1_needed: 29,
+            can2_needed: 1,
+            available: 28
+        })
+    );
+    assert_eq!(
+        twocan_core::Error::from(PlanError::TooManyBanks {
+            needed: 40,
+            available: 14
+        }),
+        twocan_core::Error::FilterSpace {
+            needed: 40,
+            available: 14
+        }
+    );
 }

@@ -366,6 +366,26 @@ impl FilterTable {
         self.extra
     }
 
+    /// Of `traffic` (frames with a weight each, e.g. their rate on the bus), the weight
+    /// the hardware accepts and the weight the driver then drops (accepted by a superset
+    /// element only): `(accepted, dropped)`; the expected software drop rate is their
+    /// ratio.
+    pub fn drop_weight<'a>(
+        &self,
+        traffic: impl IntoIterator<Item = (&'a Frame, u64)>,
+    ) -> (u64, u64) {
+        let (mut accepted, mut dropped) = (0, 0);
+        for (frame, w) in traffic {
+            if let Some((_, index)) = self.evaluate(frame) {
+                accepted += w;
+                if index.is_none() {
+                    dropped += w;
+                }
+            }
+        }
+        (accepted, dropped)
+    }
+
     /// The hardware's decision for a frame (format A, first element whose masked bits
     /// agree; Kinetis RM "Rx FIFO structure") and the resolved user index:
     /// `Some((IDHIT, index))`, index `None` for a frame a superset table accepts that no

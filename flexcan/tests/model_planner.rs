@@ -121,4 +121,7 @@ fn superset_tables_deliver_exactly_and_drop_the_rest() {
     let (delivered, dropped) = run(&t, &data);
     assert_eq!(delivered.len(), 60);
     assert_eq!(dropped, t.superset_extra());
+    // With every identifier equally likely, the drop weight is the extra identifiers.
+    let (accepted, weight) = t.drop_weight(data.iter().map(|f| (f, 1)));
+    assert_eq!((accepted, weight), (60 + dropped, dropped));
 }
