@@ -12,7 +12,7 @@ mod bus;
 use bus::*;
 use twocan_bxcan::model::BxCanModel;
 use twocan_bxcan::regs::{self, fa1r, ffa1r, fm1r, fmr, fs1r};
-use twocan_bxcan::{plan, Fifo, FilterPlan, PlanOptions};
+use twocan_bxcan::{plan, Fifo, FifoPolicy, FilterPlan, PlanOptions};
 use twocan_core::{Filter, Format, Frame, FrameKind, Registers};
 
 /// Programs the plan's banks (FINIT, deactivate, configure, activate).
@@ -144,6 +144,10 @@ fn merged_plan_delivers_exactly_through_the_model() {
     f.push(Filter::standard(0x605));
     let p = check(&f, PlanOptions::new(28).merge(true), &mut r);
     assert!(p.bank_count() < p.list_only_banks() as usize, "{p:?}");
+    // Both FIFOs: the resolver works per FIFO.
+    let both = PlanOptions::new(28).merge(true).fifo(FifoPolicy::Balanced);
+    let p = check(&f, both, &mut r);
+    assert!(p.uses_fifo(Fifo::Fifo0) && p.uses_fifo(Fifo::Fifo1));
 }
 
 #[test]

@@ -665,6 +665,53 @@ mod tests {
         assert!(!merge_step(&mut two, |_| true));
     }
 
+    proptest::proptest! {
+        /// Covers are exact (every cube inside the set) and complete; merging keeps
+        /// every key and `extra` counts the union exactly (checked by enumeration of
+        /// the 2048 standard identifiers).
+        #[test]
+        fn covers_and_merges(ids in proptest::collection::btree_set(0u32..0x800, 1..120),
+                             remote in proptest::collection::btree_set(0u32..0x800, 0..20),
+                             steps in 0usize..40) {
+            let mut t = KeyTable::new();
+            for (i, &id) in ids.iter().enumerate() {
+                t.insert(key(id, false, false), i as u16).unwrap();
+            }
+            for (i, &id) in remote.iter().enumerate() {
+                t.insert(key(id, false, true), (1000 + i) as u16).unwrap();
+            }
+            for min_gain in [2, 3] {
+                let mut out = CubeList::new();
+                exact_cover(&t, min_gain, &mut out).unwrap();
+                for c in out.as_slice() {
+                    proptest::prop_assert!(t.holds(c));
+                }
+                for &k in t.keys() {
+                    proptest::prop_assert!(out.as_slice().iter().any(|c| c.contains(k)));
+                }
+                proptest::prop_assert_eq!(out.extra(&t), 0);
+                let mut merged = out.clone();
+                for _ in 0..steps {
+                    if !merge_step(&mut merged, |_| true) {
+                        break;
+                    }
+                }
+                let mut union = 0u64;
+                for id in 0..0x800 {
+                    for rtr in [false, true] {
+                        let k = key(id, false, rtr);
+                        if merged.as_slice().iter().any(|c| c.contains(k)) {
+                            union += 1;
+                            continue;
+                        }
+                        proptest::prop_assert!(!t.contains(k), "key {:#x} lost", k);
+                    }
+                }
+                proptest::prop_assert_eq!(merged.extra(&t), union - t.len() as u64);
+            }
+        }
+    }
+
     #[test]
     fn cube_filter_accepts_the_cube() {
         let c = Cube {
