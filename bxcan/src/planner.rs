@@ -27,7 +27,10 @@
 //!    identifier and some ignored bits, every identifier of the cube a key of the same
 //!    format and kind: what one mask entry accepts exactly), greedily, taking a block
 //!    while it replaces at least three single entries
-//!    ([`twocan_core::filter_set::exact_cover`]). A cube whose keys belong to several
+//!    ([`twocan_core::filter_set::exact_cover`]); a greedy cover taking blocks of two,
+//!    and the lightest cover found by branch and bound over the maximal exact cubes
+//!    ([`twocan_core::filter_set::min_cover`], up to [`COVER_SEARCH_KEYS`] keys and
+//!    [`COVER_BUDGET`] nodes) are tried too. A cube whose keys belong to several
 //!    user filters is resolved on the thread side ([`crate::filters::FmiMap::resolve`]:
 //!    one binary search in the plan's key table); listed in a list bank, its
 //!    identifiers report their own user indices directly.
@@ -72,7 +75,7 @@
 //! distance to the exact lower bound).
 
 use twocan_core::filter_set::{
-    exact_cover, key, keys_of, merge_step, narrow, Cube, CubeList, KeyTable,
+    exact_cover, key, keys_of, merge_step, min_cover, narrow, Cube, CubeList, KeyTable,
 };
 use twocan_core::{Filter, FilterError, Format, FrameKind};
 
@@ -90,6 +93,13 @@ pub const MAX_FILTERS: usize = 512;
 /// Items (general filters and cubes) the bank search holds: every item takes at least a
 /// quarter bank, so more than `4 × 28 = 112` never fit.
 const ITEMS: usize = 128;
+
+/// Nodes of the minimum-weight cover search ([`min_cover`]).
+pub const COVER_BUDGET: u32 = 20_000;
+
+/// Keys up to which the minimum-weight cover search runs (its recursion is as deep as
+/// the keys it covers one by one).
+pub const COVER_SEARCH_KEYS: usize = 256;
 
 /// Branch-and-bound nodes explored before the planner settles for the best plan found.
 pub const SEARCH_BUDGET: u32 = 200_000;
@@ -765,13 +775,22 @@ pub fn plan(filters: &[Filter], options: PlanOptions) -> Result<FilterPlan, Plan
     }
     let list_only = attempt(&prep, singles.as_slice());
     let list_only_banks = banks_of(&list_only);
-    let mut covers = [CubeList::new(), CubeList::new()];
+    let mut covers = [CubeList::new(), CubeList::new(), CubeList::new()];
     let (mut best, mut cubes) = (list_only, &singles);
     if options.merge {
         // Blocks of three or more keys save entries; blocks of two save none but can
         // fill a half-used 16-bit mask bank: both covers are tried.
         for (cover, min_gain) in covers.iter_mut().zip([3, 2]) {
             exact_cover(&prep.keys, min_gain, cover).map_err(|_| PlanError::BankOutOfRange)?;
+        }
+        // The lightest cover (a block weighs two single entries), by branch and bound.
+        if prep.keys.len() <= COVER_SEARCH_KEYS {
+            let (head, tail) = covers.split_at_mut(2);
+            min_cover(&prep.keys, 2, 1, &head[0], COVER_BUDGET, &mut tail[0]);
+        }
+        if covers[2].is_empty() {
+            // Not lighter than the greedy cover (or not searched): no new candidate.
+            covers[2] = covers[0].clone();
         }
         for cover in covers.iter() {
             let merged = attempt(&prep, cover.as_slice());

@@ -437,6 +437,189 @@ pub fn exact_cover(keys: &KeyTable, min_gain: u64, out: &mut CubeList) -> Result
     Ok(())
 }
 
+/// Every maximal exact cube holding `seed` (no exact cube of `keys` contains it and is
+/// larger), pushed to `out` if not there yet; sub-cubes are explored bit by bit in
+/// ascending order, at most `limit` of them.
+fn maximal_cubes_of(keys: &KeyTable, seed: Key, out: &mut CubeList, limit: &mut u32) {
+    let bits = id_bits(seed);
+    // Depth-first over the exact cubes holding `seed`, adding bits in ascending order.
+    fn walk(keys: &KeyTable, c: Cube, from: u32, bits: u32, out: &mut CubeList, limit: &mut u32) {
+        if *limit == 0 {
+            return;
+        }
+        *limit -= 1;
+        let mut maximal = true;
+        for b in 0..29 {
+            let bit = 1u32 << b;
+            if bits & bit == 0 || c.dc & bit != 0 {
+                continue;
+            }
+            let wider = Cube {
+                base: c.base & !bit,
+                dc: c.dc | bit,
+            };
+            if keys.holds(&wider) {
+                maximal = false;
+                if b >= from {
+                    walk(keys, wider, b + 1, bits, out, limit);
+                }
+            }
+        }
+        if maximal && c.is_block() && !out.as_slice().contains(&c) {
+            // A full list keeps the cubes found so far.
+            let _ = out.push(c);
+        }
+    }
+    walk(keys, Cube::single(seed), 0, bits, out, limit);
+}
+
+/// A minimum-weight cover of `keys` by exact cubes — a block costs `block`, a single
+/// key `single` — by branch and bound over the maximal exact cubes, started from the
+/// weight of `seed` (a cover already known, e.g. [`exact_cover`]'s). Writes the cover to
+/// `out` only if it is lighter than `seed`. Returns whether the search finished within
+/// `budget` nodes (then the result, or `seed`, is a minimum over covers by maximal
+/// cubes and singles, which is the minimum over all exact covers: a block can always
+/// be enlarged to a maximal one at the same weight).
+pub fn min_cover(
+    keys: &KeyTable,
+    block: u32,
+    single: u32,
+    seed: &CubeList,
+    budget: u32,
+    out: &mut CubeList,
+) -> bool {
+    let n = keys.len();
+    let mut cands = CubeList::new();
+    let mut limit = 64 * n as u32 + 1024;
+    for &k in keys.keys() {
+        maximal_cubes_of(keys, k, &mut cands, &mut limit);
+    }
+    let complete = limit > 0 && cands.len() < MAX_CUBES;
+    let weight = |c: &Cube| if c.is_block() { block } else { single };
+    let seed_weight: u32 = seed.as_slice().iter().map(weight).sum();
+    // Each key's least possible share of the weight, scaled by 1024.
+    let mut share = [0u32; MAX_KEYS];
+    for (i, &k) in keys.keys().iter().enumerate() {
+        let mut s = single * 1024;
+        for c in cands.as_slice() {
+            if c.contains(k) {
+                let per = (block * 1024) / keys.count_in(c).max(1) as u32;
+                s = s.min(per);
+            }
+        }
+        share[i] = s;
+    }
+    struct Search<'a> {
+        keys: &'a KeyTable,
+        cands: &'a [Cube],
+        share: &'a [u32; MAX_KEYS],
+        count: [u16; MAX_KEYS],
+        chosen: [u16; MAX_KEYS],
+        depth: usize,
+        best: u32,
+        best_set: [u16; MAX_KEYS],
+        best_len: usize,
+        nodes: u32,
+        budget: u32,
+        block: u32,
+        single: u32,
+    }
+    /// Marker in `chosen` for "this key alone" (a single), as `SINGLE_BASE + key index`.
+    const SINGLE_BASE: u16 = 0x8000;
+    impl Search<'_> {
+        fn mark(&mut self, c: &Cube, add: bool) {
+            let keys = self.keys.keys();
+            let start = keys.partition_point(|&k| k < c.base);
+            let end = keys.partition_point(|&k| k <= c.base | c.dc);
+            for i in start..end {
+                if c.contains(keys[i]) {
+                    if add {
+                        self.count[i] += 1;
+                    } else {
+                        self.count[i] -= 1;
+                    }
+                }
+            }
+        }
+        fn go(&mut self, cost: u32) {
+            self.nodes += 1;
+            if self.nodes > self.budget {
+                return;
+            }
+            let n = self.keys.len();
+            let mut bound = 0u32;
+            let mut pick: Option<(usize, usize)> = None;
+            for i in 0..n {
+                if self.count[i] == 0 {
+                    bound += self.share[i];
+                    let k = self.keys.keys()[i];
+                    let options = self.cands.iter().filter(|c| c.contains(k)).count();
+                    if pick.is_none_or(|(_, o)| options < o) {
+                        pick = Some((i, options));
+                    }
+                }
+            }
+            if cost * 1024 + bound >= self.best * 1024 {
+                return;
+            }
+            let Some((i, _)) = pick else {
+                self.best = cost;
+                self.best_set[..self.depth].copy_from_slice(&self.chosen[..self.depth]);
+                self.best_len = self.depth;
+                return;
+            };
+            let k = self.keys.keys()[i];
+            for ci in 0..self.cands.len() {
+                let c = self.cands[ci];
+                if !c.contains(k) {
+                    continue;
+                }
+                self.mark(&c, true);
+                self.chosen[self.depth] = ci as u16;
+                self.depth += 1;
+                self.go(cost + self.block);
+                self.depth -= 1;
+                self.mark(&c, false);
+            }
+            self.count[i] += 1;
+            self.chosen[self.depth] = SINGLE_BASE + i as u16;
+            self.depth += 1;
+            self.go(cost + self.single);
+            self.depth -= 1;
+            self.count[i] -= 1;
+        }
+    }
+    let mut s = Search {
+        keys,
+        cands: cands.as_slice(),
+        share: &share,
+        count: [0; MAX_KEYS],
+        chosen: [0; MAX_KEYS],
+        depth: 0,
+        best: seed_weight,
+        best_set: [0; MAX_KEYS],
+        best_len: 0,
+        nodes: 0,
+        budget,
+        block,
+        single,
+    };
+    s.go(0);
+    let finished = s.nodes <= budget && complete;
+    if s.best < seed_weight {
+        for &c in &s.best_set[..s.best_len] {
+            let cube = if c >= SINGLE_BASE {
+                Cube::single(keys.keys()[(c - SINGLE_BASE) as usize])
+            } else {
+                cands.as_slice()[c as usize]
+            };
+            // No more cubes than keys: room in the list.
+            let _ = out.push(cube);
+        }
+    }
+    finished
+}
+
 /// One superset merge: replaces the pair of cubes (of one format and kind, the join
 /// allowed by `allowed`) whose join adds the fewest identifiers beyond what the two
 /// held, by their join, and drops every other cube the join covers. Ties go to the

@@ -14,8 +14,11 @@
 //!    ([`twocan_core::filter_set::narrow`]); split it into *keys* (filters of whole
 //!    identifiers: one format, one or both kinds) and *general* filters.
 //! 2. Cover the keys by exact cubes ([`twocan_core::filter_set::exact_cover`]; a block
-//!    of two identifiers already saves an element) — three covers are tried: no
-//!    merging, blocks of two or more, blocks of three or more.
+//!    of two identifiers already saves an element) — covers tried: no merging, greedy
+//!    with blocks of two or more, greedy with blocks of three or more, and the fewest
+//!    cubes by branch and bound ([`twocan_core::filter_set::min_cover`], up to
+//!    [`COVER_SEARCH_KEYS`] keys and [`COVER_BUDGET`] nodes); each also with blocks
+//!    split back into single keys while secondary elements are free.
 //! 3. Place: general filters and blocks take primary elements (a mask each); single
 //!    keys take the secondary elements (global mask comparing everything, or only the
 //!    standard identifier bits when every secondary key is standard), except keys that
@@ -36,7 +39,7 @@
 //! table lookup, or a binary search for a merged or superset element).
 
 use twocan_core::filter_set::{
-    exact_cover, keys_of, merge_step, narrow, overlaps, Cube, CubeList, KeyTable,
+    exact_cover, keys_of, merge_step, min_cover, narrow, overlaps, Cube, CubeList, KeyTable,
 };
 use twocan_core::{Filter, FilterError, Format};
 
@@ -209,6 +212,13 @@ impl Prepared {
     }
 }
 
+/// Nodes of the minimum-cover search ([`min_cover`]).
+pub const COVER_BUDGET: u32 = 20_000;
+
+/// Keys up to which the minimum-cover search runs (its recursion is as deep as the
+/// keys it covers one by one).
+pub const COVER_SEARCH_KEYS: usize = 256;
+
 /// Primary elements a cover needs once the secondary elements are full.
 #[derive(Debug, Clone, Copy)]
 struct Need {
@@ -281,18 +291,86 @@ fn place(prep: &Prepared, cubes: &[Cube], configuration: Configuration, extra: u
     )
 }
 
-/// The best exact cover for `configuration` (fewest primary elements needed), its need.
+/// Whether a single key may take a secondary element.
+fn secondary_eligible(prep: &Prepared, c: &Cube) -> bool {
+    !c.is_block() && prep.keys.count_in(c) == 1 && !prep.must_be_primary(c)
+}
+
+/// `cover` with blocks split back into single keys while the secondary elements have
+/// room for them, smallest blocks first: a block of `k` keys costs one primary element,
+/// its keys cost none while `k` secondary elements are free.
+fn tuned(prep: &Prepared, cover: &CubeList, capacity_s: usize) -> CubeList {
+    let mut out = cover.clone();
+    let singles = out
+        .as_slice()
+        .iter()
+        .filter(|c| secondary_eligible(prep, c))
+        .count();
+    let mut free = capacity_s.saturating_sub(singles);
+    loop {
+        // The block whose keys covered by no other cube are fewest (and fit).
+        let cubes = out.as_slice();
+        let mut pick: Option<(usize, usize)> = None;
+        for (i, c) in cubes.iter().enumerate() {
+            if !c.is_block() || prep.keys.count_in(c) != c.size() {
+                continue;
+            }
+            let mut own = 0;
+            let mut ok = true;
+            for &k in prep.keys.keys() {
+                if c.contains(k)
+                    && !cubes
+                        .iter()
+                        .enumerate()
+                        .any(|(j, o)| j != i && o.contains(k))
+                {
+                    own += 1;
+                    ok &= secondary_eligible(prep, &Cube::single(k));
+                }
+            }
+            if ok && own <= free && pick.is_none_or(|(_, n)| own < n) {
+                pick = Some((i, own));
+            }
+        }
+        let Some((i, own)) = pick else {
+            return out;
+        };
+        let c = out.as_slice()[i];
+        let mut next = CubeList::new();
+        for (j, o) in out.as_slice().iter().enumerate() {
+            if j != i {
+                // Room: the list only shrinks or trades a block for its own keys.
+                let _ = next.push(*o);
+            }
+        }
+        for &k in prep.keys.keys() {
+            if c.contains(k) && !next.as_slice().iter().any(|o| o.contains(k)) {
+                let _ = next.push(Cube::single(k));
+            }
+        }
+        out = next;
+        free -= own;
+    }
+}
+
+/// The best exact cover for `configuration` (fewest primary elements needed) and its
+/// need: each cover as found and with blocks split back into secondary singles.
 fn best_cover(
     prep: &Prepared,
-    covers: &[CubeList; 3],
+    covers: &[CubeList; 4],
     configuration: Configuration,
-) -> (usize, Need) {
+) -> (CubeList, Need) {
     let capacity_s = configuration.secondary_filter_capacity();
-    let mut best = (0, need(prep, covers[0].as_slice(), capacity_s));
-    for (i, c) in covers.iter().enumerate().skip(1) {
-        let n = need(prep, c.as_slice(), capacity_s);
-        if n.primary < best.1.primary {
-            best = (i, n);
+    let mut best = (
+        covers[0].clone(),
+        need(prep, covers[0].as_slice(), capacity_s),
+    );
+    for c in covers.iter() {
+        for candidate in [c.clone(), tuned(prep, c, capacity_s)] {
+            let n = need(prep, candidate.as_slice(), capacity_s);
+            if n.primary < best.1.primary {
+                best = (candidate, n);
+            }
         }
     }
     best
@@ -301,15 +379,15 @@ fn best_cover(
 /// Plans one configuration: the table, or the primary elements needed.
 fn plan_for(
     prep: &Prepared,
-    covers: &[CubeList; 3],
+    covers: &[CubeList; 4],
     configuration: Configuration,
     superset: bool,
 ) -> Result<FilterTable, PlanError> {
     let capacity_p = configuration.primary_filter_capacity();
     let capacity_s = configuration.secondary_filter_capacity();
-    let (i, n) = best_cover(prep, covers, configuration);
+    let (cover, n) = best_cover(prep, covers, configuration);
     if n.primary <= capacity_p {
-        return Ok(place(prep, covers[i].as_slice(), configuration, 0));
+        return Ok(place(prep, cover.as_slice(), configuration, 0));
     }
     let refused = PlanError::TooManyPrimary {
         needed: n.primary.min(u16::MAX as usize) as u16,
@@ -319,7 +397,7 @@ fn plan_for(
     if !superset || prep.n_general > capacity_p {
         return Err(refused);
     }
-    let mut grown = covers[i].clone();
+    let mut grown = cover;
     let allowed = |c: &Cube| !prep.must_be_primary(c);
     while need(prep, grown.as_slice(), capacity_s).primary > capacity_p {
         if !merge_step(&mut grown, allowed) {
@@ -338,7 +416,12 @@ fn plan_for(
 /// off (or general filters alone are too many).
 pub fn plan(filters: &[Filter], options: PlanOptions) -> Result<FilterTable, PlanError> {
     let prep = Prepared::new(filters)?;
-    let mut covers = [CubeList::new(), CubeList::new(), CubeList::new()];
+    let mut covers = [
+        CubeList::new(),
+        CubeList::new(),
+        CubeList::new(),
+        CubeList::new(),
+    ];
     for &k in prep.keys.keys() {
         // MAX_KEYS = MAX_CUBES: room for every key.
         let _ = covers[0].push(Cube::single(k));
@@ -346,9 +429,19 @@ pub fn plan(filters: &[Filter], options: PlanOptions) -> Result<FilterTable, Pla
     if options.merge {
         let _ = exact_cover(&prep.keys, 2, &mut covers[1]);
         let _ = exact_cover(&prep.keys, 3, &mut covers[2]);
+        // The fewest cubes (every element costs one): exact search when small.
+        if prep.keys.len() <= COVER_SEARCH_KEYS {
+            let (head, tail) = covers.split_at_mut(3);
+            min_cover(&prep.keys, 1, 1, &head[1], COVER_BUDGET, &mut tail[0]);
+        }
+        if covers[3].is_empty() {
+            covers[3] = covers[1].clone();
+        }
     } else {
-        covers[1] = covers[0].clone();
-        covers[2] = covers[0].clone();
+        let singles = covers[0].clone();
+        for c in covers.iter_mut().skip(1) {
+            *c = singles.clone();
+        }
     }
     if let Some(c) = options.configuration {
         return plan_for(&prep, &covers, c, options.superset);
@@ -436,6 +529,86 @@ mod tests {
         for c in Configuration::ALL {
             let t = plan(&f, PlanOptions::new(c)).unwrap();
             exact(&f, &t);
+        }
+    }
+
+    /// Every exact cube of two or more keys (identifier bits 0–3, the test range).
+    fn all_blocks(keys: &KeyTable) -> Vec<Cube> {
+        let mut out: Vec<Cube> = Vec::new();
+        for &k in keys.keys() {
+            let span = 0xF;
+            let mut dc: u32 = 0;
+            loop {
+                dc = dc.wrapping_sub(span) & span;
+                if dc == 0 {
+                    break;
+                }
+                let c = Cube { base: k & !dc, dc };
+                if keys.holds(&c) && !out.contains(&c) {
+                    out.push(c);
+                }
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn primary_need_matches_exhaustive_search_on_small_sets() {
+        let mut s = 0x2545_F491_u64;
+        let mut next = move || {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            s
+        };
+        for _ in 0..200 {
+            let n = 3 + next() % 9;
+            let f: Vec<Filter> = (0..n)
+                .map(|_| {
+                    let id = 0x100 | (next() % 16) as u32;
+                    match next() % 3 {
+                        0 => Filter::exact(FrameKind::Remote, Format::Standard, id),
+                        _ => Filter::standard(id as u16),
+                    }
+                })
+                .collect();
+            let prep = Prepared::new(&f).unwrap();
+            let blocks = all_blocks(&prep.keys);
+            assert!(blocks.len() <= 16);
+            let mut covers = [
+                CubeList::new(),
+                CubeList::new(),
+                CubeList::new(),
+                CubeList::new(),
+            ];
+            for &k in prep.keys.keys() {
+                covers[0].push(Cube::single(k)).unwrap();
+            }
+            exact_cover(&prep.keys, 2, &mut covers[1]).unwrap();
+            exact_cover(&prep.keys, 3, &mut covers[2]).unwrap();
+            let (head, tail) = covers.split_at_mut(3);
+            min_cover(&prep.keys, 1, 1, &head[1], COVER_BUDGET, &mut tail[0]);
+            if covers[3].is_empty() {
+                covers[3] = covers[1].clone();
+            }
+            for c in [Configuration::Filters8_0, Configuration::Filters10_6] {
+                let cap = c.secondary_filter_capacity();
+                let mut best = usize::MAX;
+                for set in 0u32..(1 << blocks.len()) {
+                    let mut cubes: Vec<Cube> = (0..blocks.len())
+                        .filter(|b| set & (1 << b) != 0)
+                        .map(|b| blocks[b])
+                        .collect();
+                    for &k in prep.keys.keys() {
+                        if !cubes.iter().any(|x| x.contains(k)) {
+                            cubes.push(Cube::single(k));
+                        }
+                    }
+                    best = best.min(need(&prep, &cubes, cap).primary);
+                }
+                let (_, got) = best_cover(&prep, &covers, c);
+                assert_eq!(got.primary, best, "{c:?} {f:?}");
+            }
         }
     }
 
