@@ -1027,6 +1027,16 @@ fn balance(p: &Problem, bank_of: &[[u8; 4]; ITEMS], counts: &[u8; ITEMS], out: &
             g.union(i, j);
             bits &= bits - 1;
         }
+        // Overlapping cubes do not constrain each other's class, but share a FIFO too:
+        // a frame they both accept must have one FIFO whichever entry wins.
+        for i in 0..j {
+            if p.items[i].cube
+                && p.items[j].cube
+                && overlaps(&p.items[i].filter, &p.items[j].filter)
+            {
+                g.union(i, j);
+            }
+        }
     }
     // Weight of each group root: number of user filters.
     let mut weight = [0u16; ITEMS + FILTER_BANKS];

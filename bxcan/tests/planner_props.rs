@@ -7,7 +7,7 @@
 
 use proptest::prelude::*;
 use twocan_bxcan::filters::NO_FILTER;
-use twocan_bxcan::{plan, FilterPlan, PlanError, PlanOptions};
+use twocan_bxcan::{plan, FifoPolicy, FilterPlan, PlanError, PlanOptions};
 use twocan_core::{Filter, Format, Frame, FrameKind};
 
 /// A filter list: blocks (dense runs), scattered identifiers, some masks and kind-any.
@@ -109,7 +109,7 @@ fn banks(r: &Result<FilterPlan, PlanError>) -> u16 {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 128, ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: 64, ..ProptestConfig::default() })]
 
     #[test]
     fn plans_are_exact_and_never_worse_than_list_only(filters in list(), seed in any::<u32>()) {
@@ -120,6 +120,22 @@ proptest! {
         if let Ok(p) = &merged {
             prop_assert!(!p.is_superset());
             check(&filters, p, &frames)?;
+        }
+        // Both FIFOs: exact, and a frame's matching entries all in one FIFO (RM0410 does
+        // not say how filters of different FIFOs compare).
+        if let Ok(p) = plan(&filters, PlanOptions::new(28).merge(true).fifo(FifoPolicy::Balanced)) {
+            check(&filters, &p, &frames)?;
+            for f in &frames {
+                let (id, ext, rtr) = (f.raw_id(), f.is_extended(), f.is_remote());
+                let mut fifos = p
+                    .banks()
+                    .iter()
+                    .filter(|b| (0..b.kind.slots()).any(|s| b.slot_matches(s, id, ext, rtr)))
+                    .map(|b| b.fifo);
+                if let Some(first) = fifos.next() {
+                    prop_assert!(fifos.all(|x| x == first), "{:?}", f);
+                }
+            }
         }
         // Superset mode: always a plan (the lists have few general filters), within the
         // banks, exact on the requested frames.
