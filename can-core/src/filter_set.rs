@@ -531,12 +531,12 @@ pub fn min_cover(
             let keys = self.keys.keys();
             let start = keys.partition_point(|&k| k < c.base);
             let end = keys.partition_point(|&k| k <= c.base | c.dc);
-            for i in start..end {
-                if c.contains(keys[i]) {
+            for (k, count) in keys[start..end].iter().zip(&mut self.count[start..end]) {
+                if c.contains(*k) {
                     if add {
-                        self.count[i] += 1;
+                        *count += 1;
                     } else {
-                        self.count[i] -= 1;
+                        *count -= 1;
                     }
                 }
             }
