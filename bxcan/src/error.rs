@@ -52,9 +52,17 @@ impl fmt::Display for PlanError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             PlanError::Filter { index, .. } => write!(f, "filter {index} does not conform"),
-            PlanError::TooManyFilters => {
-                write!(f, "more than {} filters", crate::planner::MAX_FILTERS)
+            PlanError::TooManyFilters { given, max } => {
+                write!(f, "{given} filters given, the planner takes at most {max}")
             }
+            PlanError::DualTooManyBanks {
+                can1_needed,
+                can2_needed,
+                available,
+            } => write!(
+                f,
+                "CAN1 needs {can1_needed} and CAN2 {can2_needed} filter banks, {available} are shared"
+            ),
             PlanError::TooManyBanks { needed, available } => write!(
                 f,
                 "the filters need {needed} filter banks, {available} are available"

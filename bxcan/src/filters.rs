@@ -23,6 +23,7 @@
 //! [`Filter`]s; [`FilterPlan::manual`] and [`FilterPlan::set_bank`] configure banks
 //! directly.
 
+use twocan_core::filter_set::{key, KeyTable};
 use twocan_core::{Filter, FilterError, Format, Frame, FrameKind};
 
 use crate::regs::{firx, FILTER_BANKS};
@@ -421,13 +422,28 @@ pub enum PlanError {
         /// Why.
         error: FilterError,
     },
-    /// More filters than the planner takes ([`crate::planner::MAX_FILTERS`]).
-    TooManyFilters,
+    /// More filters than the planner takes.
+    TooManyFilters {
+        /// Filters given.
+        given: u16,
+        /// The most the planner takes ([`crate::planner::MAX_FILTERS`]).
+        max: u16,
+    },
     /// The filters need more banks than the instance has.
     TooManyBanks {
-        /// Banks the smallest exact plan needs.
-        needed: u8,
+        /// Banks the smallest exact plan needs (after merging).
+        needed: u16,
         /// Banks available to the instance.
+        available: u8,
+    },
+    /// CAN1's and CAN2's lists together need more than the 28 banks of the shared block
+    /// ([`crate::planner::plan_dual`]).
+    DualTooManyBanks {
+        /// Banks CAN1's list needs.
+        can1_needed: u16,
+        /// Banks CAN2's list needs.
+        can2_needed: u16,
+        /// Banks of the block.
         available: u8,
     },
     /// A bank index beyond the filter block (0..28).
@@ -435,16 +451,40 @@ pub enum PlanError {
 }
 
 impl From<PlanError> for twocan_core::Error {
+    /// Keeps the counts: [`twocan_core::Error::FilterSpace`] with banks needed and
+    /// available (both instances' needs added for a dual plan), or filters given and the
+    /// most the planner takes.
     fn from(e: PlanError) -> Self {
         match e {
             PlanError::Filter { error, .. } => twocan_core::Error::Filter(error),
-            _ => twocan_core::Error::InvalidArgument,
+            PlanError::TooManyFilters { given, max } => twocan_core::Error::FilterSpace {
+                needed: given,
+                available: max,
+            },
+            PlanError::TooManyBanks { needed, available } => twocan_core::Error::FilterSpace {
+                needed,
+                available: available as u16,
+            },
+            PlanError::DualTooManyBanks {
+                can1_needed,
+                can2_needed,
+                available,
+            } => twocan_core::Error::FilterSpace {
+                needed: can1_needed.saturating_add(can2_needed),
+                available: available as u16,
+            },
+            PlanError::BankOutOfRange => twocan_core::Error::InvalidArgument,
         }
     }
 }
 
 /// Value of [`FilterPlan::user_index`] slots that map to no user filter.
 pub const NO_FILTER: u16 = u16::MAX;
+
+/// Value of [`FilterPlan::user_index`] / [`FmiMap::get`] for a slot whose user index
+/// depends on the frame (a mask entry standing for several user filters, or a superset
+/// entry): use [`FmiMap::resolve`].
+pub const LOOKUP: u16 = u16::MAX - 1;
 
 /// The largest number of filter numbers one FIFO can have (28 banks × 4).
 pub const MAX_FMI: usize = FILTER_BANKS * 4;
@@ -457,7 +497,8 @@ pub struct Acceptance {
     pub fifo: Fifo,
     /// The filter match index stored with it (`CAN_RDTxR.FMI`).
     pub fmi: u8,
-    /// The user's filter index it maps to ([`NO_FILTER`] if none).
+    /// The user's filter index it maps to ([`FmiMap::resolve`]; [`NO_FILTER`] if none:
+    /// a frame accepted by a superset plan only, which the driver drops).
     pub filter: u16,
 }
 
@@ -474,6 +515,9 @@ pub struct FilterPlan {
     users: [[u16; 4]; FILTER_BANKS],
     len: u8,
     optimal: bool,
+    keys: KeyTable,
+    extra: u64,
+    list_only_banks: u16,
 }
 
 impl Default for FilterPlan {
@@ -491,6 +535,9 @@ impl FilterPlan {
             users: [[NO_FILTER; 4]; FILTER_BANKS],
             len: 0,
             optimal: true,
+            keys: KeyTable::new(),
+            extra: 0,
+            list_only_banks: 0,
         }
     }
 
@@ -541,6 +588,70 @@ impl FilterPlan {
         self.optimal = optimal;
     }
 
+    pub(crate) fn set_resolution(&mut self, keys: &KeyTable, extra: u64, list_only_banks: u16) {
+        self.keys = keys.clone();
+        self.extra = extra;
+        self.list_only_banks = list_only_banks;
+    }
+
+    /// Identifiers the hardware accepts beyond the user's filters (0 for an exact plan;
+    /// counted entry by entry, so an upper bound if superset entries overlap). The
+    /// driver drops frames with these identifiers ([`FmiMap::resolve`] gives `None`).
+    pub const fn superset_extra(&self) -> u64 {
+        self.extra
+    }
+
+    /// Whether the hardware accepts more than the user's filters (superset mode).
+    pub const fn is_superset(&self) -> bool {
+        self.extra != 0
+    }
+
+    /// Banks the same list takes without merging (one list or mask entry per user
+    /// filter), as the planner computed it; 0 for manual plans.
+    pub const fn list_only_banks(&self) -> u16 {
+        self.list_only_banks
+    }
+
+    /// The keys (identifier, format, kind) of the user's whole-identifier filters with
+    /// their user indices: the table [`FmiMap::resolve`] searches.
+    pub fn key_table(&self) -> &KeyTable {
+        &self.keys
+    }
+
+    /// The user index of a frame the hardware stored in `fifo` with match index `fmi`
+    /// (see [`FmiMap::resolve`]).
+    pub fn resolve(
+        &self,
+        fifo: Fifo,
+        fmi: u8,
+        raw_id: u32,
+        extended: bool,
+        remote: bool,
+    ) -> Option<u16> {
+        self.fmi_map().resolve(fifo, fmi, raw_id, extended, remote)
+    }
+
+    /// Of `traffic` (frames with a weight each, e.g. their rate on the bus), the weight
+    /// the hardware accepts and the weight the driver then drops (accepted by a superset
+    /// entry only): `(accepted, dropped)`. The expected software drop rate is
+    /// `dropped / accepted` of received frames, `dropped / total` of bus traffic.
+    pub fn drop_weight<'a>(
+        &self,
+        traffic: impl IntoIterator<Item = (&'a Frame, u64)>,
+    ) -> (u64, u64) {
+        let mut accepted = 0u64;
+        let mut dropped = 0u64;
+        for (frame, w) in traffic {
+            if let Some(a) = self.evaluate(frame) {
+                accepted += w;
+                if a.filter == NO_FILTER {
+                    dropped += w;
+                }
+            }
+        }
+        (accepted, dropped)
+    }
+
     /// The banks in use (relative to the instance's first bank).
     pub fn banks(&self) -> &[Bank] {
         &self.banks[..self.len as usize]
@@ -584,6 +695,7 @@ impl FilterPlan {
     /// The map from each FIFO's match index to the user's filter index.
     pub fn fmi_map(&self) -> FmiMap {
         let mut map = FmiMap::empty();
+        map.keys = self.keys.clone();
         let mut next = [0usize; 2];
         for (b, users) in self.banks().iter().zip(self.users.iter()) {
             let f = b.fifo.index();
@@ -612,6 +724,9 @@ impl FilterPlan {
     /// is the lower filter number). Plans made by the planner never let one frame match
     /// filters of both FIFOs (overlapping filters share a FIFO), so the question only
     /// arises for manual plans; check it on silicon before relying on it.
+    ///
+    /// [`Acceptance::filter`] is the resolved user index ([`FmiMap::resolve`]):
+    /// [`NO_FILTER`] for a frame a superset plan accepts that no user filter does.
     pub fn evaluate(&self, frame: &Frame) -> Option<Acceptance> {
         let (id, ext, rtr) = (frame.raw_id(), frame.is_extended(), frame.is_remote());
         // (class, bank, slot, FIFO, FMI, user index)
@@ -644,7 +759,14 @@ impl FilterPlan {
                 }
             }
         }
-        best.map(|(_, _, _, fifo, fmi, filter)| Acceptance { fifo, fmi, filter })
+        best.map(|(_, _, _, fifo, fmi, user)| Acceptance {
+            fifo,
+            fmi,
+            filter: match user {
+                LOOKUP => self.keys.lookup(key(id, ext, rtr)).unwrap_or(NO_FILTER),
+                user => user,
+            },
+        })
     }
 
     /// Whether any bank of the plan sends frames to `fifo`.
@@ -658,6 +780,7 @@ impl FilterPlan {
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct FmiMap {
     map: [[u16; MAX_FMI]; 2],
+    keys: KeyTable,
 }
 
 impl FmiMap {
@@ -665,10 +788,38 @@ impl FmiMap {
     pub const fn empty() -> Self {
         FmiMap {
             map: [[NO_FILTER; MAX_FMI]; 2],
+            keys: KeyTable::new(),
         }
     }
 
-    /// The user index for `fmi` in `fifo`, [`NO_FILTER`] if none.
+    /// The thread-side resolver: the user's filter index of a frame the hardware stored
+    /// in `fifo` with match index `fmi` (`CAN_RDTxR.FMI`), given the frame's raw
+    /// identifier, format and kind (`CAN_RIxR`).
+    ///
+    /// - a slot of one user filter: that index (a table lookup);
+    /// - a mask slot standing for several user filters (merged identifiers) or for a
+    ///   superset: the user filter of the frame's identifier, by binary search in the
+    ///   plan's key table (at most ⌈log₂ 1024⌉ = 10 steps); `None` for an identifier no
+    ///   user filter accepts — a frame the hardware took only because of a superset
+    ///   plan, which the driver drops and counts;
+    /// - an FMI no slot has (not produced by the hardware for this plan): `None`.
+    pub fn resolve(
+        &self,
+        fifo: Fifo,
+        fmi: u8,
+        raw_id: u32,
+        extended: bool,
+        remote: bool,
+    ) -> Option<u16> {
+        match self.get(fifo, fmi) {
+            NO_FILTER => None,
+            LOOKUP => self.keys.lookup(key(raw_id, extended, remote)),
+            user => Some(user),
+        }
+    }
+
+    /// The user index for `fmi` in `fifo`, [`NO_FILTER`] if none, [`LOOKUP`] if it
+    /// depends on the frame ([`FmiMap::resolve`]).
     pub fn get(&self, fifo: Fifo, fmi: u8) -> u16 {
         self.map[fifo.index()]
             .get(fmi as usize)

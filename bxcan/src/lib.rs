@@ -122,5 +122,5 @@ pub use config::{Config, ConfigError, Recovery};
 pub use controller::{Can, Failed, Init};
 pub use filters::{Bank, BankError, BankKind, Fifo, FilterPlan, PlanError};
 pub use instance::Instance;
-pub use planner::{plan, FifoPolicy, PlanOptions};
+pub use planner::{plan, plan_dual, DualPlan, FifoPolicy, PlanOptions};
 pub use split::{BxCan, RawFrame};

@@ -50,7 +50,9 @@ pub struct BxCan<R: Registers, F: Registers = R> {
     filter_regs: Option<F>,
     instance: Instance,
     config: Config,
-    fmi: FmiMap,
+    /// The installed filters' map from (FIFO, FMI) to the user's index: touched only
+    /// from the receive half's context (`decode`, `install_filters`), so one copy.
+    fmi: UnsafeCell<FmiMap>,
     /// Token of the frame in each mailbox (written before `TXRQ`).
     tokens: [AtomicU32; TX_MAILBOXES],
     /// Mailboxes whose abort was requested to make room (displacement).
@@ -79,7 +81,7 @@ impl<R: Registers, F: Registers> Can<R, F> {
             filter_regs: self.filter_regs,
             instance: self.instance,
             config: self.config,
-            fmi: self.fmi,
+            fmi: UnsafeCell::new(self.fmi),
             tokens: [const { AtomicU32::new(0) }; TX_MAILBOXES],
             displacing: AtomicU8::new(0),
             aborting: AtomicU8::new(0),
@@ -113,7 +115,7 @@ impl<R: Registers, F: Registers> BxCan<R, F> {
             filter_regs: self.filter_regs,
             instance: self.instance,
             config: self.config,
-            fmi: self.fmi,
+            fmi: self.fmi.into_inner(),
         }
     }
 
@@ -210,7 +212,7 @@ impl<R: Registers, F: Registers> BxCan<R, F> {
 // only from `displace`/`settle` (transmit interrupt context).
 unsafe impl<R: Registers, F: Registers> Hardware for BxCan<R, F> {
     type Raw = RawFrame;
-    type FilterMap = FmiMap;
+    type FilterMap = ();
     type Filters = FilterPlan;
     const RX_QUEUES: usize = 2;
 
@@ -452,8 +454,11 @@ unsafe impl<R: Registers, F: Registers> Hardware for BxCan<R, F> {
         Some(raw)
     }
 
+    /// The user's filter through the map of the installed plan
+    /// ([`FmiMap::resolve`]: a table entry, or a search for a merged or superset
+    /// entry); `None` (dropped and counted) for a frame no user filter accepts.
     #[inline]
-    fn decode(&self, raw: &RawFrame, map: &FmiMap) -> Option<RxFrame> {
+    unsafe fn decode(&self, raw: &RawFrame, _map: &()) -> Option<RxFrame> {
         let [ir, dt, lo, hi] = *raw;
         let frame = mailbox::frame_of(ir, rdtxr::DLC.get(dt), lo, hi);
         let fifo = if (dt >> 4) & 1 == 0 {
@@ -461,9 +466,18 @@ unsafe impl<R: Registers, F: Registers> Hardware for BxCan<R, F> {
         } else {
             Fifo::Fifo1
         };
+        // SAFETY: the receive half's context, the only one touching the map.
+        let map = unsafe { &*self.fmi.get() };
+        let filter = map.resolve(
+            fifo,
+            rdtxr::FMI.get(dt) as u8,
+            frame.raw_id(),
+            frame.is_extended(),
+            frame.is_remote(),
+        )?;
         Some(RxFrame {
             frame,
-            filter: map.get(fifo, rdtxr::FMI.get(dt) as u8),
+            filter,
             timestamp: self
                 .config
                 .get_timestamps()
@@ -477,18 +491,18 @@ unsafe impl<R: Registers, F: Registers> Hardware for BxCan<R, F> {
             .then_some(rdtxr::TIME.get(raw[1]) as u16)
     }
 
-    unsafe fn install_filters(&self, filters: &FilterPlan) -> Result<FmiMap, Error> {
+    unsafe fn install_filters(&self, filters: &FilterPlan) -> Result<(), Error> {
         let r = match &self.filter_regs {
             Some(f) => filter_block::program(f, self.instance, filters),
             None => filter_block::program(&self.regs, self.instance, filters),
         };
         r.map_err(|_| Error::InvalidArgument)?;
-        Ok(filters.fmi_map())
+        // SAFETY: the receive half's context, the only one touching the map.
+        unsafe { *self.fmi.get() = filters.fmi_map() };
+        Ok(())
     }
 
-    fn filter_map(&self) -> FmiMap {
-        self.fmi.clone()
-    }
+    fn filter_map(&self) {}
 
     /// `CAN_MSR`: `ERRI`, `WKUI`, `SLAKI` acknowledged; `CAN_ESR.LEC` reported and set
     /// to 0b111 so the next error is seen as new (notes "Error management").

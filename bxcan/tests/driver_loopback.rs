@@ -209,10 +209,14 @@ fn planner_plans_are_exact_end_to_end() {
 }
 
 #[test]
-fn nine_ids_in_three_banks_end_to_end() {
+fn nine_ids_merged_into_one_bank_end_to_end() {
     let filters: Vec<Filter> = (0..9).map(|i| Filter::standard(0x700 + i)).collect();
+    // One entry per identifier: three 16-bit list banks.
+    let list_only = plan(&filters, PlanOptions::new(14).merge(false)).unwrap();
+    assert_eq!(list_only.bank_count(), 3);
+    // Merged (the default): 0x700..=0x707 is one exact mask, 0x708 a list entry.
     let p = plan(&filters, PlanOptions::new(14)).unwrap();
-    assert_eq!(p.bank_count(), 3);
+    assert_eq!(p.bank_count(), 1);
     let frames: Vec<Frame> = (0x6F0..0x720)
         .map(|i| Frame::standard(i, &[]).unwrap())
         .collect();

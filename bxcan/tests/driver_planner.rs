@@ -5,7 +5,8 @@
 use twocan_bxcan::filters::{Acceptance, NO_FILTER};
 use twocan_bxcan::planner::MAX_FILTERS;
 use twocan_bxcan::{
-    plan, Bank, BankError, BankKind, Fifo, FifoPolicy, FilterPlan, PlanError, PlanOptions,
+    plan, plan_dual, Bank, BankError, BankKind, Fifo, FifoPolicy, FilterPlan, PlanError,
+    PlanOptions,
 };
 use twocan_core::{Filter, FilterError, Format, Frame, FrameKind};
 
@@ -81,11 +82,26 @@ fn check_exact(filters: &[Filter], p: &FilterPlan) {
 
 #[test]
 fn nine_standard_ids_take_three_banks() {
-    let f: Vec<Filter> = (0..9).map(|i| Filter::standard(0x100 + i)).collect();
+    // Identifiers of even parity: no two differ in one bit only, nothing to merge.
+    let f: Vec<Filter> = (0u16..32)
+        .filter(|i| i.count_ones() % 2 == 0)
+        .take(9)
+        .map(|i| Filter::standard(0x100 + i))
+        .collect();
     let p = plan(&f, ALL).unwrap();
     assert_eq!(p.bank_count(), 3);
     assert_eq!(kinds(&p), [BankKind::List16; 3]);
     assert!(p.is_proven_optimal());
+    check_exact(&f, &p);
+    // Without merging, consecutive identifiers take the same three banks.
+    let f: Vec<Filter> = (0..9).map(|i| Filter::standard(0x100 + i)).collect();
+    let p = plan(&f, ALL.merge(false)).unwrap();
+    assert_eq!(kinds(&p), [BankKind::List16; 3]);
+    check_exact(&f, &p);
+    // Merged: 0x100..=0x107 is one 16-bit mask entry, 0x108 the bank's second entry.
+    let p = plan(&f, ALL.merge(true)).unwrap();
+    assert_eq!(kinds(&p), [BankKind::Mask16]);
+    assert_eq!(p.list_only_banks(), 3);
     check_exact(&f, &p);
 }
 
@@ -110,8 +126,13 @@ fn mixes() {
     let mut f: Vec<Filter> = (0..9).map(|i| Filter::standard(0x200 + i)).collect();
     f.push(Filter::extended(0x10));
     f.push(Filter::extended(0x11));
-    let p = plan(&f, ALL).unwrap();
+    let p = plan(&f, ALL.merge(false)).unwrap();
     assert_eq!(p.bank_count(), 4);
+    check_exact(&f, &p);
+    // Merged: 0x200..=0x207 and 0x208 in one 16-bit mask bank, the two extended ids in
+    // a 32-bit list bank.
+    let p = plan(&f, ALL.merge(true)).unwrap();
+    assert_eq!(p.bank_count(), 2);
     check_exact(&f, &p);
 
     // 5 standard + 1 extended: 4 std in a 16-bit list, 1 std + 1 ext in a 32-bit list.
@@ -287,7 +308,13 @@ fn typed_errors() {
         })
     );
     let many = vec![Filter::standard(1); MAX_FILTERS + 1];
-    assert_eq!(plan(&many, ALL), Err(PlanError::TooManyFilters));
+    assert_eq!(
+        plan(&many, ALL),
+        Err(PlanError::TooManyFilters {
+            given: MAX_FILTERS as u16 + 1,
+            max: MAX_FILTERS as u16
+        })
+    );
     // Duplicates are shadowed: 128 copies of one id need one bank.
     let dup = vec![Filter::standard(1); MAX_FILTERS];
     assert_eq!(plan(&dup, ALL).unwrap().bank_count(), 1);
@@ -502,4 +529,39 @@ fn evaluate_breaks_cross_fifo_ties_by_bank_number() {
         assert_eq!((a.fifo, a.fmi), (low, 0));
         assert_eq!(a.filter, p.user_index(low, 0));
     }
+}
+
+#[test]
+fn dual_plans_choose_can2sb() {
+    // CAN1: 20 scattered standard ids (5 banks); CAN2: 6 extended ids (3 banks).
+    let can1: Vec<Filter> = (0..20u16).map(|i| Filter::standard(i * 0x51)).collect();
+    let can2: Vec<Filter> = (0..6u32).map(|i| Filter::extended(i * 0x1001)).collect();
+    let d = plan_dual(&can1, &can2, ALL).unwrap();
+    assert_eq!(d.can2sb as usize, d.can1.bank_count());
+    assert_eq!(d.can1.bank_count(), 5);
+    assert!(d.can2.bank_count() <= 28 - d.can2sb as usize);
+    check_exact(&can1, &d.can1);
+    check_exact(&can2, &d.can2);
+    // 29 single-bank masks on CAN1 and one on CAN2: says who needs what.
+    let big: Vec<Filter> = (0..29)
+        .map(|i| Filter::masked(FrameKind::Data, Format::Extended, 0x1FFF_FFF0, i << 8))
+        .collect();
+    assert_eq!(
+        plan_dual(&big, &big[..1], ALL),
+        Err(PlanError::DualTooManyBanks {
+            can1_needed: 29,
+            can2_needed: 1,
+            available: 28
+        })
+    );
+    assert_eq!(
+        twocan_core::Error::from(PlanError::TooManyBanks {
+            needed: 40,
+            available: 14
+        }),
+        twocan_core::Error::FilterSpace {
+            needed: 40,
+            available: 14
+        }
+    );
 }

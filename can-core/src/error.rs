@@ -127,6 +127,15 @@ pub enum Error {
     Filter(crate::filter::FilterError),
     /// An argument is out of range (mailbox index, filter index, ...).
     InvalidArgument,
+    /// A filter list does not fit the hardware: it `needs` more filter space than is
+    /// `available` (bxCAN: filter banks after merging; FlexCAN: ID table elements; a list
+    /// longer than a planner takes: filters given against the most it takes).
+    FilterSpace {
+        /// What the list needs.
+        needed: u16,
+        /// What the hardware (or planner) has.
+        available: u16,
+    },
 }
 
 impl embedded_can::Error for Error {
@@ -167,6 +176,10 @@ impl core::fmt::Display for Error {
             Error::Frame(_) => f.write_str("invalid frame"),
             Error::Filter(_) => f.write_str("invalid filter"),
             Error::InvalidArgument => f.write_str("argument out of range"),
+            Error::FilterSpace { needed, available } => write!(
+                f,
+                "the filter list needs {needed} units of filter space, {available} available"
+            ),
         }
     }
 }

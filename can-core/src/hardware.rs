@@ -88,7 +88,9 @@ pub unsafe trait Hardware {
     /// One received frame as the receive interrupt copies it out of the hardware (raw
     /// register words and the hardware match index); decoded on the thread side.
     type Raw: Copy + Send;
-    /// The thread side's map from hardware match index to the user's filter index.
+    /// The thread side's map from hardware match index to the user's filter index, kept
+    /// by the receive half (`()` for a backend that keeps its map in the controller,
+    /// read only from the receive half's context).
     type FilterMap: Send;
     /// A compiled filter list for [`Hardware::install_filters`].
     type Filters;
@@ -159,8 +161,13 @@ pub unsafe trait Hardware {
     unsafe fn read_rx(&self, queue: usize, overrun: &mut bool) -> Option<Self::Raw>;
 
     /// Receive half: the frame, its user filter index and time stamp. `None` when the
-    /// frame must be dropped (the filter map has no user filter for it).
-    fn decode(&self, raw: &Self::Raw, map: &Self::FilterMap) -> Option<RxFrame>;
+    /// frame must be dropped (the filter map has no user filter for it: e.g. the extra
+    /// identifiers of a superset filter plan).
+    ///
+    /// # Safety
+    /// Called from the receive half's context only (a backend may keep its filter map
+    /// in the controller, written by [`Hardware::install_filters`] in that context).
+    unsafe fn decode(&self, raw: &Self::Raw, map: &Self::FilterMap) -> Option<RxFrame>;
 
     /// The 16-bit receive time stamp of a raw frame, if the hardware records one (to
     /// keep arrival order across several receive queues).

@@ -61,6 +61,7 @@ pub mod driver;
 pub mod error;
 pub mod fault;
 pub mod filter;
+pub mod filter_set;
 pub mod frame;
 pub mod hardware;
 pub mod io;

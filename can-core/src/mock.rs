@@ -356,7 +356,7 @@ unsafe impl Hardware for MockHardware {
         })
     }
 
-    fn decode(&self, raw: &Frame, map: &MockFilterList) -> Option<RxFrame> {
+    unsafe fn decode(&self, raw: &Frame, map: &MockFilterList) -> Option<RxFrame> {
         let index = map.iter().position(|f| f.matches(raw))?;
         Some(RxFrame {
             frame: *raw,

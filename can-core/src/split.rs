@@ -492,7 +492,8 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
         loop {
             // SAFETY: the caller is the rings' only consumer.
             let raw = unsafe { self.pop_raw() }.ok_or(nb::Error::WouldBlock)?;
-            match self.hw().decode(&raw, map) {
+            // SAFETY: the caller is the receive half's context.
+            match unsafe { self.hw().decode(&raw, map) } {
                 Some(frame) => return Ok(frame),
                 None => self.dropped.inc(),
             }

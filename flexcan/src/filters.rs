@@ -44,6 +44,7 @@
 //! matches first in software ([`Filter::matches`], the reference semantics), so the
 //! reported index is still the one §13.3 describes.
 
+use twocan_core::filter_set::{key, KeyTable};
 use twocan_core::{Filter, Format, Frame, FrameKind};
 
 use crate::begin_error::ConfigErrors;
@@ -71,6 +72,11 @@ pub enum Hit {
     /// Accepted under a zero global mask: the first matching secondary filter (found
     /// in software) gives the index.
     ScanSecondary,
+    /// A planned element standing for several user filters (merged identifiers) or for
+    /// a superset ([`crate::planner`]): the frame's identifier gives the index, by
+    /// binary search in the table's key table; an identifier no user filter accepts
+    /// gives none (the driver drops the frame and counts it).
+    Lookup,
 }
 
 /// A filter list compiled for one [`Configuration`]: the ID filter table, the masks
@@ -87,6 +93,8 @@ pub struct FilterTable {
     secondary: [Filter; MAX_SECONDARY_FILTERS],
     primary_count: u8,
     secondary_count: u8,
+    keys: KeyTable,
+    extra: u64,
 }
 
 /// Whether `f` conforms as a secondary filter (ACAN §13.4).
@@ -193,6 +201,8 @@ impl FilterTable {
             secondary: [Filter::pass_all(); MAX_SECONDARY_FILTERS],
             primary_count: p as u8,
             secondary_count: s as u8,
+            keys: KeyTable::new(),
+            extra: 0,
         };
         t.secondary[..s].copy_from_slice(secondary);
 
@@ -270,14 +280,132 @@ impl FilterTable {
     /// secondary filter matches: neither is produced by the hardware for this table
     /// (a frame read with a stale or corrupted `IDHIT`), and no filter index can be
     /// told — the controller reports such a frame with [`UNKNOWN_FILTER`].
+    ///
+    /// For a planned table ([`crate::planner::plan`]) this is the thread-side resolver:
+    /// a table lookup for an element of one user filter; for a merged or superset
+    /// element ([`Hit::Lookup`]) a binary search of the frame's identifier, `None` for
+    /// an identifier no user filter accepts (a superset frame: drop and count it).
     pub fn filter_index(&self, element: usize, frame: &Frame) -> Option<u16> {
         match self.hit(element)? {
             Hit::Filter(i) => Some(i),
+            Hit::Lookup => {
+                self.keys
+                    .lookup(key(frame.raw_id(), frame.is_extended(), frame.is_remote()))
+            }
             Hit::ScanSecondary => self.secondary[..self.secondary_count()]
                 .iter()
                 .position(|f| f.matches(frame))
                 .map(|j| self.secondary_index(j) as u16),
         }
+    }
+}
+
+impl FilterTable {
+    /// A table from planned elements (crate-internal: [`crate::planner`]).
+    ///
+    /// `primary`: (element, individual mask, hit) for the first `primary.len()` primary
+    /// elements; `secondary`: (element, hit) under `global_mask`. Unused elements repeat
+    /// the last used one of their part (after it, so never hit first); with no primary
+    /// element the primaries repeat the first secondary element under the global mask,
+    /// with no secondary element the secondaries repeat the last primary element under
+    /// the global mask (which then compares everything: a subset of that element).
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn planned(
+        configuration: Configuration,
+        primary: &[(u32, u32, Hit)],
+        secondary: &[(u32, Hit)],
+        global_mask: u32,
+        keys: &KeyTable,
+        extra: u64,
+    ) -> Self {
+        let capacity_p = configuration.primary_filter_capacity();
+        let capacity_s = configuration.secondary_filter_capacity();
+        let global_mask = if secondary.is_empty() {
+            FULL_MASK
+        } else {
+            global_mask
+        };
+        let mut t = FilterTable {
+            configuration,
+            elements: [0; MAX_TABLE_ELEMENTS],
+            individual_masks: [FULL_MASK; MAX_PRIMARY_FILTERS],
+            global_mask,
+            hits: [Hit::Filter(0); MAX_TABLE_ELEMENTS],
+            secondary: [Filter::pass_all(); MAX_SECONDARY_FILTERS],
+            primary_count: primary.len() as u8,
+            secondary_count: 0,
+            keys: keys.clone(),
+            extra,
+        };
+        for i in 0..capacity_p {
+            let (e, m, h) = match (primary.get(i), primary.last(), secondary.first()) {
+                (Some(x), _, _) | (None, Some(x), _) => *x,
+                (None, None, Some(&(e, h))) => (e, global_mask, h),
+                (None, None, None) => (0, FULL_MASK, Hit::Filter(0)),
+            };
+            t.elements[i] = e;
+            t.individual_masks[i] = m;
+            t.hits[i] = h;
+        }
+        for j in 0..capacity_s {
+            let (e, h) = match (secondary.get(j), secondary.last(), primary.last()) {
+                (Some(x), _, _) | (None, Some(x), _) => *x,
+                (None, None, Some(&(e, _, h))) => (e, h),
+                (None, None, None) => (0, Hit::Filter(0)),
+            };
+            t.elements[capacity_p + j] = e;
+            t.hits[capacity_p + j] = h;
+        }
+        t
+    }
+
+    /// Identifiers the hardware accepts beyond the user's filters (0 unless the table
+    /// was planned in superset mode); the driver drops those frames
+    /// ([`FilterTable::filter_index`] gives `None`).
+    pub const fn superset_extra(&self) -> u64 {
+        self.extra
+    }
+
+    /// Of `traffic` (frames with a weight each, e.g. their rate on the bus), the weight
+    /// the hardware accepts and the weight the driver then drops (accepted by a superset
+    /// element only): `(accepted, dropped)`; the expected software drop rate is their
+    /// ratio.
+    pub fn drop_weight<'a>(
+        &self,
+        traffic: impl IntoIterator<Item = (&'a Frame, u64)>,
+    ) -> (u64, u64) {
+        let (mut accepted, mut dropped) = (0, 0);
+        for (frame, w) in traffic {
+            if let Some((_, index)) = self.evaluate(frame) {
+                accepted += w;
+                if index.is_none() {
+                    dropped += w;
+                }
+            }
+        }
+        (accepted, dropped)
+    }
+
+    /// The hardware's decision for a frame (format A, first element whose masked bits
+    /// agree; Kinetis RM "Rx FIFO structure") and the resolved user index:
+    /// `Some((IDHIT, index))`, index `None` for a frame a superset table accepts that no
+    /// user filter does. `None`: the frame is rejected.
+    pub fn evaluate(&self, frame: &Frame) -> Option<(usize, Option<u16>)> {
+        let word = if frame.is_extended() {
+            ELEMENT_IDE | frame.raw_id() << ELEMENT_EXT_SHIFT
+        } else {
+            frame.raw_id() << ELEMENT_STD_SHIFT
+        } | if frame.is_remote() { ELEMENT_RTR } else { 0 };
+        let p = self.configuration.primary_filter_capacity();
+        let hit = self.elements().iter().enumerate().position(|(i, e)| {
+            let m = if i < p {
+                self.individual_masks[i]
+            } else {
+                self.global_mask
+            };
+            (word ^ e) & m == 0
+        })?;
+        Some((hit, self.filter_index(hit, frame)))
     }
 }
 

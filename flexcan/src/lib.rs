@@ -132,6 +132,7 @@ pub mod filters;
 mod handshake;
 pub mod instance;
 mod message_buffer;
+pub mod planner;
 pub mod settings;
 pub mod split;
 mod status;

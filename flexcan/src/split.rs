@@ -74,7 +74,12 @@ fn code_index(c: LastErrorCode) -> u8 {
 pub struct FlexCanHw<R: Registers> {
     regs: R,
     target: Target,
-    table: FilterTable,
+    /// The installed filter table (ID table, masks, map from `IDHIT` to the user's
+    /// index): touched only from the receive half's context (`decode`,
+    /// `install_filters`), so one copy.
+    table: core::cell::UnsafeCell<FilterTable>,
+    /// The table's message-buffer configuration (read from every context).
+    configuration: Configuration,
     listen_only: bool,
     polls: u32,
     irq_priority: u8,
@@ -97,7 +102,8 @@ impl<R: Registers> FlexCan<R> {
         FlexCanHw {
             regs: self.regs,
             target: self.target,
-            table: self.table,
+            configuration: self.table.configuration(),
+            table: core::cell::UnsafeCell::new(self.table),
             listen_only: self.listen_only,
             polls: self.polls,
             irq_priority: self.irq_priority,
@@ -118,7 +124,7 @@ impl<R: Registers> FlexCanHw<R> {
 
     /// The message-buffer configuration.
     pub const fn configuration(&self) -> Configuration {
-        self.table.configuration()
+        self.configuration
     }
 
     /// `mMessageIRQPriority` of the settings `begin` took.
@@ -136,10 +142,12 @@ impl<R: Registers> FlexCanHw<R> {
         regs::timer::TIMER.get(self.regs.read32(regs::TIMER)) as u16
     }
 
-    /// The filter table installed at split time (the receive half keeps the one in
-    /// force).
-    pub fn filters(&self) -> &FilterTable {
-        &self.table
+    /// A copy of the filter table in force (read it from the receive half's context,
+    /// or while no other context runs).
+    pub fn filters(&self) -> FilterTable {
+        // SAFETY: a read; the table is written only by `install_filters`, from the
+        // receive half's context, which this caller is or does not overlap with.
+        unsafe { (*self.table.get()).clone() }
     }
 
     /// Frames whose `RXFIR.IDHIT` mapped to no filter (reported with
@@ -222,14 +230,16 @@ impl<R: Registers> FlexCanHw<R> {
     }
 }
 
-// SAFETY: the shared fields are atomics; the register accesses of each context are
-// those listed in the module docs (disjoint registers, write-1-to-clear bits).
+// SAFETY: the shared fields are atomics; the filter table is touched only from the
+// receive half's context (the `Hardware` contract of `decode` and `install_filters`);
+// the register accesses of each context are those listed in the module docs (disjoint
+// registers, write-1-to-clear bits).
 unsafe impl<R: Registers + Sync> Sync for FlexCanHw<R> {}
 
 // SAFETY: as for `Sync`: each method stays within its context's registers.
 unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
     type Raw = RawFrame;
-    type FilterMap = FilterTable;
+    type FilterMap = ();
     type Filters = FilterTable;
 
     /// MB15 is the one data mailbox: request order (ACAN §3 "sequentiality").
@@ -439,7 +449,9 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
     /// The frame, the user's filter for `IDHIT` ([`FilterTable::filter_index`];
     /// [`UNKNOWN_FILTER`] when it maps to none) and the TIME STAMP.
     #[inline]
-    fn decode(&self, raw: &RawFrame, map: &FilterTable) -> Option<RxFrame> {
+    unsafe fn decode(&self, raw: &RawFrame, _map: &()) -> Option<RxFrame> {
+        // SAFETY: the receive half's context, the only one touching the table.
+        let map = unsafe { &*self.table.get() };
         let [control, id, word0, word1, hit] = *raw;
         let frame = MbWords {
             cs: control,
@@ -448,14 +460,21 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
             word1,
         }
         .frame();
-        Some(RxFrame {
-            frame,
-            filter: map.filter_index(hit as usize, &frame).unwrap_or_else(|| {
+        let filter = match map.filter_index(hit as usize, &frame) {
+            Some(i) => i,
+            // A superset element's extra identifier: dropped and counted by the driver.
+            None if map.hit(hit as usize) == Some(crate::filters::Hit::Lookup) => return None,
+            // An IDHIT the table does not produce (stale, corrupted): kept, flagged.
+            None => {
                 let n = self.unresolved.load(Ordering::Relaxed);
                 self.unresolved
                     .store(n.saturating_add(1), Ordering::Relaxed);
                 UNKNOWN_FILTER
-            }),
+            }
+        };
+        Some(RxFrame {
+            frame,
+            filter,
             timestamp: Some(MbWords::timestamp_of(control)),
         })
     }
@@ -466,7 +485,7 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
 
     /// Freeze, write the table, come back to the mode it was in (the table must be
     /// compiled for the configuration `begin` chose).
-    unsafe fn install_filters(&self, filters: &FilterTable) -> Result<FilterTable, Error> {
+    unsafe fn install_filters(&self, filters: &FilterTable) -> Result<(), Error> {
         if filters.configuration() != self.configuration() {
             return Err(Error::InvalidArgument);
         }
@@ -477,13 +496,12 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
         };
         self.mode_change(Mode::Stopped)?;
         FlexCan::write_filters(&self.regs, filters);
-        self.mode_change(previous)?;
-        Ok(filters.clone())
+        // SAFETY: the receive half's context, the only one touching the table.
+        unsafe { *self.table.get() = filters.clone() };
+        self.mode_change(previous)
     }
 
-    fn filter_map(&self) -> FilterTable {
-        self.table.clone()
-    }
+    fn filter_map(&self) {}
 
     /// `ESR1`: the error code latched, the write-1-to-clear interrupt bits read
     /// acknowledged (exactly those), wake-up; the state from `FLTCONF` and `ECR`.

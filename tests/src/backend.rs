@@ -399,9 +399,9 @@ fn bxcan_refused(e: SetupError) -> Refused {
         SetupError::BxCanPlan(PlanError::Filter { index, .. }) => Refused::FilterNotConform {
             index: Some(index as usize),
         },
-        SetupError::BxCanPlan(PlanError::TooManyBanks { .. } | PlanError::TooManyFilters) => {
-            Refused::TooManyFilters
-        }
+        SetupError::BxCanPlan(
+            PlanError::TooManyBanks { .. } | PlanError::TooManyFilters { .. },
+        ) => Refused::TooManyFilters,
         other => Refused::Other(format!("{other:?}")),
     }
 }

@@ -238,14 +238,17 @@ fn invalid_filters_are_refused<B: Backend>() {
 
 fn filter_capacity<B: Backend>() {
     let n = B::MAX_EXACT_STD_FILTERS;
-    let filters: Vec<Filter> = (0..n).map(|i| Filter::standard(0x100 + i as u16)).collect();
+    // Identifiers 3 apart: no two differ in one bit only, so no planner can merge them
+    // into masks, and each takes its own hardware entry.
+    let id = |i: usize| 0x100 + 3 * i as u16;
+    let filters: Vec<Filter> = (0..n).map(|i| Filter::standard(id(i))).collect();
     let (mut h, mut dut, peer) = setup::<B>(&NodeOptions::filters(&filters));
     // Every one of them is live and reports its own index; others are refused.
     let mut cases: Vec<(Frame, Option<u16>)> = (0..n)
         .rev()
-        .map(|i| (std_frame(0x100 + i as u16, &[i as u8]), Some(i as u16)))
+        .map(|i| (std_frame(id(i), &[i as u8]), Some(i as u16)))
         .collect();
-    cases.push((std_frame(0x100 + n as u16, &[]), None));
+    cases.push((std_frame(id(n), &[]), None));
     cases.push((std_frame(0x0FF, &[]), None));
     cases.push((remote_frame(0x100, false, 0), None));
     let (got, refused) = run_cases(&mut h, &mut dut, &peer, &cases);
@@ -260,9 +263,7 @@ fn filter_capacity<B: Backend>() {
         B::NAME
     );
     // One more does not fit: a typed error, not a silently dropped filter.
-    let more: Vec<Filter> = (0..=n)
-        .map(|i| Filter::standard(0x100 + i as u16))
-        .collect();
+    let more: Vec<Filter> = (0..=n).map(|i| Filter::standard(id(i))).collect();
     let mut h = Harness::new(RATE).unwrap();
     assert_eq!(
         B::attach(&mut h, &NodeOptions::filters(&more)).err(),
