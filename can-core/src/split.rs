@@ -89,16 +89,17 @@ pub struct TrafficStats {
     pub state_changes: u32,
 }
 
-const STATE_UNKNOWN: u8 = 0xFF;
+/// No state recorded yet (0, so that a `static State` is all zeros and lives in `.bss`).
+const STATE_UNKNOWN: u8 = 0;
 
 fn state_code(s: ErrorState) -> u8 {
     match s {
-        ErrorState::Active => 0,
-        ErrorState::Warning => 1,
-        ErrorState::Passive => 2,
-        ErrorState::BusOff => 3,
-        ErrorState::Stopped => 4,
-        ErrorState::Sleeping => 5,
+        ErrorState::Active => 1,
+        ErrorState::Warning => 2,
+        ErrorState::Passive => 3,
+        ErrorState::BusOff => 4,
+        ErrorState::Stopped => 5,
+        ErrorState::Sleeping => 6,
     }
 }
 
