@@ -230,7 +230,6 @@ pub fn check(ok: bool, what: &str) {
     }
 }
 
-
 /// Whether transmit mailbox `x` holds the frame [`ID`]/[`DATA`] with its request set.
 pub fn loaded(x: usize) -> bool {
     reg_read(regs::tixr(x)) == tixr::STID.val(ID as u32) | tixr::TXRQ

@@ -30,17 +30,20 @@ use core::hint::black_box;
 use bxcan::filter::Mask32;
 use cortex_m_rt::entry;
 use heapless::spsc::{Consumer, Producer, Queue};
+use twocan_bxcan::RawFrame;
 use twocan_bxcan::{Bank, BxCan, Can, Config, Fifo, FilterPlan};
-use twocan_core::split::{Rx, RxIrq, State, Tx, TxIrq};
+use twocan_core::split::{Rx, RxIrq, State, StateChange, Tx, TxIrq, STATE_CHANGES};
 use twocan_core::timing::{solve_cia, Limits};
+use twocan_core::txqueue::Queued;
+use twocan_core::Completion;
 use twocan_core::{FifoQueue, Filter, Frame, Mmio, RxFrame, TxOutcome, TxPolicy};
 
 #[path = "../../shared/ram_can.rs"]
 mod ram_can;
 
 use ram_can::{
-    check, fail, loaded, measure, reg_read, released, reset_block, responder_off,
-    responder_on, restore, save, snapshots, Snapshots, DATA, ID, REGS, REPEAT,
+    check, fail, loaded, measure, reg_read, released, reset_block, responder_off, responder_on,
+    restore, save, snapshots, Snapshots, DATA, ID, REGS, REPEAT,
 };
 
 const APB1_HZ: u32 = 54_000_000;
@@ -50,6 +53,8 @@ const BITRATE: u32 = 500_000;
 const RX: usize = 8;
 /// See [`RX`].
 const TXQ: usize = 8;
+/// Completion ring capacity (the `State` default).
+const DONE: usize = 8;
 
 /// Loop-back, request-order transmit (TXFP = 1, the FIFO policy of `FifoQueue`).
 const CONFIG: Config = match Config::from_bitrate(APB1_HZ, BITRATE) {
@@ -105,13 +110,28 @@ const THEIRS_RX0_RECEIVE: usize = 15;
 
 type Hw = BxCan<Mmio>;
 type Q = FifoQueue<TXQ>;
-type OurTx = Tx<'static, Hw, RX, Q, 0, 8>;
-type OurRx = Rx<'static, Hw, RX, Q, 0, 8>;
-type OurTxIrq = TxIrq<'static, Hw, RX, Q, 0, 8>;
-type OurRxIrq = RxIrq<'static, Hw, RX, Q, 0, 8>;
+type OurState = State<Hw, RX, Q, 0, DONE>;
+type OurTx = Tx<'static, Hw, RX, Q, 0, DONE>;
+type OurRx = Rx<'static, Hw, RX, Q, 0, DONE>;
+type OurTxIrq = TxIrq<'static, Hw, RX, Q, 0, DONE>;
+type OurRxIrq = RxIrq<'static, Hw, RX, Q, 0, DONE>;
 
-/// The driver's shared state: all zeros, in `.bss`.
-static CAN: State<Hw, RX, Q> = State::new();
+/// The driver's shared state: all zeros, in `.bss`. The same type as `loopback-twocan`'s.
+static CAN: OurState = State::new();
+
+/// Size of [`OurState`], read by can-bench (checked against `loopback-twocan`'s static).
+#[no_mangle]
+#[used]
+static BENCH_STATE_BYTES: u32 = size_of::<OurState>() as u32;
+
+/// Bytes of [`OurState`] that are ring and queue slots (receive ring, transmit queue,
+/// completion ring, state-change ring), read by can-bench: the rest is driver state.
+#[no_mangle]
+#[used]
+static BENCH_RING_BYTES: u32 = (RX * size_of::<RawFrame>()
+    + TXQ * size_of::<Queued>()
+    + DONE * size_of::<Completion>()
+    + STATE_CHANGES * size_of::<StateChange>()) as u32;
 
 #[inline(never)]
 fn ours_try_send(tx: &mut OurTx, f: &Frame) -> bool {
@@ -182,8 +202,7 @@ fn run_ours(snap: &Snapshots, hw: Hw) {
             "twocan tx irq acknowledged RQCP0",
         );
         check(
-            p.tx
-                .take_completion()
+            p.tx.take_completion()
                 .is_some_and(|c| c.token == token && c.outcome == TxOutcome::Sent),
             "twocan tx irq completion",
         );
@@ -198,7 +217,8 @@ fn run_ours(snap: &Snapshots, hw: Hw) {
         let r = black_box(&mut p.rx);
         let rx = measure::<OURS_RECEIVE, _>(|| ours_receive(r));
         check(
-            rx.is_some_and(|r| r.frame == frame && r.filter == FilterPlan::slot_index(0, 0)) && CAN.rx_stats().count == 0,
+            rx.is_some_and(|r| r.frame == frame && r.filter == FilterPlan::slot_index(0, 0))
+                && CAN.rx_stats().count == 0,
             "twocan receive",
         );
 
@@ -224,7 +244,10 @@ fn run_ours(snap: &Snapshots, hw: Hw) {
         );
         // The one-busy and queued frames never complete on this block: their
         // completions are not expected, and none arrived.
-        check(p.tx.take_completion().is_none(), "twocan no stray completion");
+        check(
+            p.tx.take_completion().is_none(),
+            "twocan no stray completion",
+        );
     }
 }
 
@@ -367,7 +390,10 @@ fn run_theirs(snap: &Snapshots, can: &mut Theirs) {
         restore(&snap.rx_one);
         let cc = black_box(can.rx0());
         let rx = measure::<THEIRS_RX0_RECEIVE, _>(|| theirs_rx0_receive(cc));
-        check(rx.as_ref() == Some(&frame) && released(), "bxcan rx0 receive");
+        check(
+            rx.as_ref() == Some(&frame) && released(),
+            "bxcan rx0 receive",
+        );
 
         // The feature-equivalent service. TX interrupt: one completion cleared, then
         // the call that finds none (on RAM the flag does not clear, so the two calls of
