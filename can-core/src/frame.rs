@@ -79,8 +79,9 @@ const REMOTE_BIT: u32 = 1 << 30;
 const ID_BITS: u32 = 0x1FFF_FFFF;
 
 /// A classical CAN frame (data or remote), 16 bytes: one identifier word (29-bit
-/// identifier, format and kind flags), the DLC and eight data bytes, so copies stay a
-/// few word loads and stores.
+/// identifier, format and kind flags), eight data bytes and the DLC, so copies stay a
+/// few word loads and stores (the data bytes are word-aligned: a mailbox register pair
+/// is two aligned loads or stores).
 ///
 /// Invariants kept by every constructor and setter: the identifier is in range for its
 /// format, the DLC is `0..=8`, data bytes beyond the DLC (and all bytes of a remote
@@ -91,8 +92,8 @@ const ID_BITS: u32 = 0x1FFF_FFFF;
 #[repr(C)]
 pub struct Frame {
     word: u32,
-    dlc: u8,
     data: [u8; 8],
+    dlc: u8,
 }
 
 #[cfg(feature = "defmt")]
@@ -240,17 +241,15 @@ impl Frame {
         let id_mask = if extended { ID_BITS } else { 0x7FF };
         let word = word & (EXTENDED_BIT | REMOTE_BIT | id_mask);
         let dlc = if dlc > MAX_DLC { MAX_DLC } else { dlc };
-        let mut bytes = data;
-        let keep = if word & REMOTE_BIT != 0 {
-            0
+        let keep = if word & REMOTE_BIT != 0 { 0 } else { dlc };
+        // Bytes beyond `keep` cleared with one mask over the little-endian 64-bit value
+        // (a few shifts instead of a byte loop or a `memset` call).
+        let mask = if keep >= 8 {
+            u64::MAX
         } else {
-            dlc as usize
+            (1u64 << (8 * keep as u32)) - 1
         };
-        let mut i = keep;
-        while i < 8 {
-            bytes[i] = 0;
-            i += 1;
-        }
+        let bytes = (u64::from_le_bytes(data) & mask).to_le_bytes();
         Frame {
             word,
             dlc,

@@ -107,10 +107,16 @@ impl<T: Copy, const N: usize> SpscRing<T, N> {
         }
     }
 
+    /// Whether `N` is a power of two: the index arithmetic is then masks (the compiler
+    /// folds the test away).
+    const POW2: bool = N.is_power_of_two();
+
     #[inline(always)]
     fn slot(index: u32) -> usize {
         let i = index as usize;
-        if i >= N {
+        if Self::POW2 {
+            i & (N - 1)
+        } else if i >= N {
             i - N
         } else {
             i
@@ -119,6 +125,9 @@ impl<T: Copy, const N: usize> SpscRing<T, N> {
 
     #[inline(always)]
     fn advance(index: u32) -> u32 {
+        if Self::POW2 {
+            return index.wrapping_add(1) & (Self::WRAP - 1);
+        }
         let next = index + 1;
         if next == Self::WRAP {
             0
@@ -129,11 +138,24 @@ impl<T: Copy, const N: usize> SpscRing<T, N> {
 
     #[inline(always)]
     fn distance(head: u32, tail: u32) -> u32 {
+        if Self::POW2 {
+            return tail.wrapping_sub(head) & (Self::WRAP - 1);
+        }
         if tail >= head {
             tail - head
         } else {
             tail + Self::WRAP - head
         }
+    }
+
+    /// The slot of `index` (an index modulo `2 × N`, as `head` and `tail` always are:
+    /// only [`Self::advance`] moves them).
+    #[inline(always)]
+    fn cell(&self, index: u32) -> &UnsafeCell<MaybeUninit<T>> {
+        let i = Self::slot(index);
+        debug_assert!(i < N);
+        // SAFETY: `index < 2 × N`, so `slot` maps it below `N`.
+        unsafe { self.slots.get_unchecked(i) }
     }
 
     /// Appends `item`; gives it back, counted as an overflow (and the peak set to
@@ -155,7 +177,7 @@ impl<T: Copy, const N: usize> SpscRing<T, N> {
         }
         // SAFETY: the slot at `tail` is outside `head..tail`, so the consumer does not
         // read it; the caller guarantees no other producer writes it.
-        unsafe { (*self.slots[Self::slot(tail)].get()).write(item) };
+        unsafe { (*self.cell(tail).get()).write(item) };
         self.tail.store(Self::advance(tail), Ordering::Release);
         let count = count + 1;
         if count > self.peak.load(Ordering::Relaxed) {
@@ -177,7 +199,7 @@ impl<T: Copy, const N: usize> SpscRing<T, N> {
         }
         // SAFETY: the slot at `head` was written before `tail` was published past it
         // (acquire above); the producer does not rewrite it until `head` moves on.
-        let item = unsafe { (*self.slots[Self::slot(head)].get()).assume_init() };
+        let item = unsafe { (*self.cell(head).get()).assume_init() };
         self.head.store(Self::advance(head), Ordering::Release);
         Some(item)
     }
@@ -194,7 +216,7 @@ impl<T: Copy, const N: usize> SpscRing<T, N> {
             return None;
         }
         // SAFETY: as in `pop`, without freeing the slot.
-        Some(unsafe { (*self.slots[Self::slot(head)].get()).assume_init() })
+        Some(unsafe { (*self.cell(head).get()).assume_init() })
     }
 
     /// Entries held now (exact from either end; a snapshot from anywhere else).
