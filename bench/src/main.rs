@@ -185,6 +185,7 @@ fn run() -> Result<()> {
                 ours: sizes::measure(&dir.join("loopback-twocan"))?,
                 theirs: sizes::measure(&dir.join("loopback-bxcan"))?,
                 equiv: sizes::measure(&dir.join("loopback-bxcan-equiv"))?,
+                async_fw: sizes::measure(&dir.join("loopback-async"))?,
             });
         }
         let dir = &firmware_dirs[0].1;
@@ -217,6 +218,14 @@ fn run() -> Result<()> {
                 .context(format!("instruction counts ({profile} profile)"))?;
             runs.push((opt.to_string(), counts));
         }
+        let mut async_runs = Vec::new();
+        for ((profile, opt), (_, dir)) in COUNT_PROFILES.iter().zip(&firmware_dirs) {
+            let elf = dir.join("insn-count-async");
+            let tag = format!("{profile}-async");
+            let counts = qemu::run(&paths, &tools, &plugin, &elf, &tag)
+                .context(format!("async instruction counts ({profile} profile)"))?;
+            async_runs.push((opt.to_string(), counts));
+        }
         let window = sizes::read_u32_symbol(
             &firmware_dirs[0].1.join("insn-count"),
             "BENCH_MARKER_WINDOW",
@@ -224,6 +233,7 @@ fn run() -> Result<()> {
         report.insn = Some(InsnSection {
             tools,
             runs,
+            async_runs,
             window,
         });
     }

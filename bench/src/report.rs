@@ -22,6 +22,8 @@ pub struct SizeBuild {
     pub theirs: Size,
     /// `loopback-bxcan-equiv` (the `bxcan` crate and the service work of our features).
     pub equiv: Size,
+    /// `loopback-async` (our driver through its async API).
+    pub async_fw: Size,
 }
 
 /// The loop-back comparison.
@@ -58,6 +60,8 @@ pub struct InsnSection {
     pub tools: Tools,
     /// (opt-level, counts) per firmware build.
     pub runs: Vec<(String, Counts)>,
+    /// (opt-level, counts) of `insn-count-async` per build.
+    pub async_runs: Vec<(String, Counts)>,
     /// The marker window address.
     pub window: u32,
 }
@@ -168,6 +172,125 @@ impl Report {
         }
     }
 
+    fn render_async(&self, s: &mut String, insn: &InsnSection) -> Result<()> {
+        let _ = writeln!(s, "### Async receive path (issue 11)\n");
+        let _ = writeln!(
+            s,
+            "`bench/firmware/insn-count-async`: the same driver and register stand-in, built \
+             with twocan-core's `async` feature (a cargo invocation of its own, so the \
+             feature does not reach the other firmwares). One frame through the async API \
+             as an executor drives it: the task polls its `Rx::recv` future on an empty ring \
+             (it registers its waker: `Pending`), the RX0 handler moves one frame into the \
+             ring and wakes the waker, the task polls again and gets the frame with its \
+             filter index (`Ready`). The waker is a flag and the executor a hand-rolled \
+             poll, so what an executor adds around a wake (queueing the task) is not \
+             counted. `Rx::receive` in the same build shows the non-async take.\n"
+        );
+        let mut header = String::from("| step | what is measured |");
+        let mut rule = String::from("|---|---|");
+        for (opt, _) in &insn.async_runs {
+            let _ = write!(header, " opt {opt} |");
+            rule.push_str("---:|");
+        }
+        let _ = writeln!(s, "{header}\n{rule}");
+        let rows: [(&str, &str, &[&str]); 5] = [
+            (
+                "1",
+                "`Rx::recv` polled, ring empty → `Pending` (waker registered)",
+                &["async.recv.pending"],
+            ),
+            (
+                "2",
+                "RX0 handler: one frame into the ring, waker woken",
+                &["async.rx_irq"],
+            ),
+            (
+                "3",
+                "`Rx::recv` polled again → `Ready(frame)`",
+                &["async.recv.ready"],
+            ),
+            (
+                "**1 + 2 + 3**",
+                "**the async receive path per frame**",
+                &["async.recv.pending", "async.rx_irq", "async.recv.ready"],
+            ),
+            (
+                "–",
+                "`Rx::receive` (same build, no future)",
+                &["async.receive"],
+            ),
+        ];
+        for (step, what, keys) in rows {
+            let mut line = format!("| {step} | {what} |");
+            for (_, counts) in &insn.async_runs {
+                let _ = write!(line, " {} |", thousands(sum(counts, keys)?));
+            }
+            let _ = writeln!(s, "{line}");
+        }
+        let _ = writeln!(s);
+        let sync: Vec<String> = insn
+            .runs
+            .iter()
+            .map(|(opt, c)| {
+                Ok(format!(
+                    "{} at opt {opt}",
+                    thousands(sum(c, &["twocan.rx_irq", "twocan.rx.receive"])?)
+                ))
+            })
+            .collect::<Result<_>>()?;
+        let _ = writeln!(
+            s,
+            "For comparison, the same frame without the async feature (RX0 handler + \
+             `Rx::receive`, `insn-count`): {}.\n",
+            sync.join(", ")
+        );
+        if let Some(sz) = &self.sizes {
+            let _ = writeln!(
+                s,
+                "Flash of an async firmware: `bench/firmware/loopback-async` (the loop-back \
+                 firmware of section 1 with `Tx::send`, `Rx::recv` and `Tx::completed` \
+                 polled by a hand-rolled loop with the flag waker; no executor crate):"
+            );
+            for b in &sz.builds {
+                let _ = writeln!(
+                    s,
+                    "- opt {}: flash **{}** B (RAM {} B), against {} B for the non-async \
+                     `loopback-twocan`;",
+                    b.opt,
+                    thousands(b.async_fw.flash()),
+                    thousands(b.async_fw.ram()),
+                    thousands(b.ours.flash())
+                );
+            }
+            let echo: Vec<String> = self
+                .examples
+                .iter()
+                .flat_map(|e| e.builds.iter())
+                .filter(|b| b.bin == "async_echo")
+                .map(|b| {
+                    format!(
+                        "`{}` ({}): flash **{}** B, RAM {} B",
+                        b.package,
+                        b.board.as_deref().unwrap_or("no feature"),
+                        thousands(b.size.flash()),
+                        thousands(b.size.ram())
+                    )
+                })
+                .collect();
+            if echo.is_empty() {
+                let _ = writeln!(
+                    s,
+                    "- the `async_echo` firmware examples were not among the examples built \
+                     in this run (section 1, \"Firmware examples\"), so their flash is not \
+                     given here.\n"
+                );
+            } else {
+                let _ = writeln!(s, "- the `async_echo` examples: {}.\n", echo.join("; "));
+            }
+        }
+        Ok(())
+    }
+
     /// `target/bench/summary.json` (issue 10): the ratios ours / theirs as floats and the
     /// driver state's RAM; `None` unless both the sizes and the instruction counts (opt s
     /// and opt 3) were measured.
@@ -216,6 +339,20 @@ impl Report {
                 "bxcan_equiv": size_s.equiv.flash(),
             },
             "instructions": counts,
+            "async_rx_path": insn
+                .async_runs
+                .iter()
+                .map(|(opt, c)| {
+                    Ok((
+                        format!("opt_{opt}"),
+                        serde_json::Value::from(sum(
+                            c,
+                            &["async.recv.pending", "async.rx_irq", "async.recv.ready"],
+                        )?),
+                    ))
+                })
+                .collect::<Result<serde_json::Map<_, _>>>()?,
+            "flash_bytes_async_s": size_s.async_fw.flash(),
         })))
     }
 
@@ -586,6 +723,7 @@ impl Report {
             },
             overheads.join("; ")
         );
+        self.render_async(s, insn)?;
         let _ = writeln!(s, "QEMU command line (per build):\n");
         let example = qemu::command(
             &insn.tools,
@@ -869,8 +1007,11 @@ fn render_sources(s: &mut String) {
          | the command, the report, section sizes, bit-timing grid and exhaustive search, \
          simulator scenarios | `bench/src/` (package `twocan-bench`, binary `can-bench`) |\n\
          | loop-back firmwares (STM32F7) | `bench/firmware/loopback-twocan`, \
-         `bench/firmware/loopback-bxcan`, `bench/firmware/shared/stm32f7.rs` |\n\
-         | instruction-count firmware (QEMU mps2-an386) | `bench/firmware/insn-count` |\n\
+         `bench/firmware/loopback-bxcan`, `bench/firmware/loopback-bxcan-equiv`, \
+         `bench/firmware/loopback-async`, `bench/firmware/shared/stm32f7.rs` |\n\
+         | instruction-count firmwares (QEMU mps2-an386) | `bench/firmware/insn-count`, \
+         `bench/firmware/insn-count-async`, `bench/firmware/shared/ram_can.rs`, \
+         `bench/firmware/shared/flag_waker.rs` |\n\
          | QEMU plugin | `bench/plugin/insn_count.c` |\n\
          | firmware examples | `examples/*` (see `docs/firmware.md`) |\n\n\
          The bench firmware is its own cargo workspace (`bench/firmware/Cargo.toml`, \

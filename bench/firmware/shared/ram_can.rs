@@ -34,6 +34,9 @@
 //! release store (`RFOM0` alone) leaves `FMP0` = 0, as the hardware would after the last
 //! frame.
 
+// Each firmware that includes this module uses a part of it.
+#![allow(dead_code)]
+
 use core::ptr::{read_volatile, write_volatile};
 use core::sync::atomic::{compiler_fence, Ordering};
 
