@@ -388,7 +388,15 @@ unsafe impl<R: Registers, F: Registers> Hardware for BxCan<R, F> {
                 a
             }
         });
-        ended.sort_unstable_by_key(|e| e.0.wrapping_sub(base));
+        // At most three entries: an insertion sort by distance from the oldest token
+        // (no generic sort linked).
+        for i in 1..ended.len() {
+            let mut j = i;
+            while j > 0 && ended[j].0.wrapping_sub(base) < ended[j - 1].0.wrapping_sub(base) {
+                ended.swap(j, j - 1);
+                j -= 1;
+            }
+        }
         for (_, s) in ended.iter() {
             f(*s);
         }
