@@ -181,6 +181,10 @@ pub struct StateFigures {
     /// Of which ring and queue slots (`BENCH_RING_BYTES` of `insn-count`, which holds a
     /// `State` of the same type and checks its size in `BENCH_STATE_BYTES`).
     pub ring_bytes: u64,
+    /// Of which the controller value `BxCan<Mmio>` (`BENCH_HW_BYTES`).
+    pub hw_bytes: u64,
+    /// Of which, inside the controller value, the filter map (`BENCH_FMI_BYTES`).
+    pub fmi_bytes: u64,
 }
 
 /// Reads [`StateFigures`] from the two firmwares; refuses figures of two different types.
@@ -200,5 +204,7 @@ pub fn state_figures(loopback: &Path, insn_count: &Path) -> Result<StateFigures>
     Ok(StateFigures {
         static_bytes,
         ring_bytes,
+        hw_bytes: u64::from(read_u32_symbol(insn_count, "BENCH_HW_BYTES")?),
+        fmi_bytes: u64::from(read_u32_symbol(insn_count, "BENCH_FMI_BYTES")?),
     })
 }

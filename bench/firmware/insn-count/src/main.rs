@@ -124,6 +124,16 @@ static CAN: OurState = State::new();
 #[used]
 static BENCH_STATE_BYTES: u32 = size_of::<OurState>() as u32;
 
+/// Size of the controller value the state holds (`BxCan<Mmio>`), read by can-bench.
+#[no_mangle]
+#[used]
+static BENCH_HW_BYTES: u32 = size_of::<Hw>() as u32;
+
+/// Size of the filter map inside it (`FmiMap`), read by can-bench.
+#[no_mangle]
+#[used]
+static BENCH_FMI_BYTES: u32 = size_of::<twocan_bxcan::filters::FmiMap>() as u32;
+
 /// Bytes of [`OurState`] that are ring and queue slots (receive ring, transmit queue,
 /// completion ring, state-change ring), read by can-bench: the rest is driver state.
 #[no_mangle]
