@@ -262,6 +262,56 @@ impl<R: Registers, F: Registers> BxCan<R, F> {
         }
     }
 
+    /// `settle` when several mailboxes ended between two interrupts: reports them in
+    /// token (acceptance) order, which is the transmit order under TXFP = 1. Out of line
+    /// and not generic (`dyn`), so that the usual single completion needs no sort buffer
+    /// in its frame and the caller's `f` has one static call site, inlined there.
+    ///
+    /// # Safety
+    /// As for `settle`.
+    #[cold]
+    #[inline(never)]
+    unsafe fn settle_many(&self, t: u32, f: &mut dyn FnMut(Settled)) {
+        let mut ended = [(
+            0u32,
+            Settled::Done(Completion {
+                token: Token(0),
+                outcome: TxOutcome::Sent,
+                cause: None,
+                timestamp: None,
+            }),
+        ); TX_MAILBOXES];
+        let mut n = 0;
+        for x in 0..TX_MAILBOXES {
+            if t & tsr::rqcp(x) == 0 {
+                continue;
+            }
+            // SAFETY: the caller's contract (transmit interrupt context).
+            unsafe { self.settle_one(t, x, |token, settled| ended[n] = (token, settled)) };
+            n += 1;
+        }
+        let ended = &mut ended[..n];
+        let base = ended.iter().map(|e| e.0).fold(ended[0].0, |a, b| {
+            if (b.wrapping_sub(a) as i32) < 0 {
+                b
+            } else {
+                a
+            }
+        });
+        // At most three entries: an insertion sort by distance from the oldest token
+        // (no generic sort linked).
+        for i in 1..ended.len() {
+            let mut j = i;
+            while j > 0 && ended[j].0.wrapping_sub(base) < ended[j - 1].0.wrapping_sub(base) {
+                ended.swap(j, j - 1);
+                j -= 1;
+            }
+        }
+        for (_, s) in ended.iter() {
+            f(*s);
+        }
+    }
+
     fn status_now(&self) -> ErrorStatus {
         let m = self.regs.read32(MSR);
         let e = self.regs.read32(ESR);
@@ -360,46 +410,8 @@ unsafe impl<R: Registers, F: Registers> Hardware for BxCan<R, F> {
             unsafe { self.settle_one(t, x, |_, settled| f(settled)) };
             return;
         }
-        // Several mailboxes can end between two interrupts: report them in token
-        // (acceptance) order, which is the transmit order under TXFP = 1.
-        let mut ended = [(
-            0u32,
-            Settled::Done(Completion {
-                token: Token(0),
-                outcome: TxOutcome::Sent,
-                cause: None,
-                timestamp: None,
-            }),
-        ); TX_MAILBOXES];
-        let mut n = 0;
-        for x in 0..TX_MAILBOXES {
-            if t & tsr::rqcp(x) == 0 {
-                continue;
-            }
-            // SAFETY: the caller's contract (transmit interrupt context).
-            unsafe { self.settle_one(t, x, |token, settled| ended[n] = (token, settled)) };
-            n += 1;
-        }
-        let ended = &mut ended[..n];
-        let base = ended.iter().map(|e| e.0).fold(ended[0].0, |a, b| {
-            if (b.wrapping_sub(a) as i32) < 0 {
-                b
-            } else {
-                a
-            }
-        });
-        // At most three entries: an insertion sort by distance from the oldest token
-        // (no generic sort linked).
-        for i in 1..ended.len() {
-            let mut j = i;
-            while j > 0 && ended[j].0.wrapping_sub(base) < ended[j - 1].0.wrapping_sub(base) {
-                ended.swap(j, j - 1);
-                j -= 1;
-            }
-        }
-        for (_, s) in ended.iter() {
-            f(*s);
-        }
+        // SAFETY: the caller's contract (transmit interrupt context).
+        unsafe { self.settle_many(t, &mut f) }
     }
 
     /// With all three mailboxes pending, the one lowest in the hardware's order

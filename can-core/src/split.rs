@@ -469,19 +469,24 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
     /// Called inside the critical section (the transmit interrupt's context).
     unsafe fn settle_into(&self, q: &mut Q) {
         // SAFETY: the caller's contract.
-        unsafe {
-            self.hw().settle(|s| match s {
-                Settled::Done(c) => self.record(c),
-                Settled::Displaced(token, frame) => {
-                    // Room was reserved when the displacement was requested (and stays
-                    // counted in `queue_len`, now by the frame itself).
-                    let _ = q.push(Queued { token, frame });
-                }
-                Settled::DoneDisplacing(c) => {
-                    self.queue_len.fetch_sub(1, Ordering::Relaxed);
-                    self.record(c);
-                }
-            })
+        unsafe { self.hw().settle(|s| self.on_settled(q, s)) }
+    }
+
+    /// One settled mailbox (inlined into each of the backend's call sites, so that each
+    /// handles the one variant it builds).
+    #[inline(always)]
+    fn on_settled(&self, q: &mut Q, s: Settled) {
+        match s {
+            Settled::Done(c) => self.record(c),
+            Settled::Displaced(token, frame) => {
+                // Room was reserved when the displacement was requested (and stays
+                // counted in `queue_len`, now by the frame itself).
+                let _ = q.push(Queued { token, frame });
+            }
+            Settled::DoneDisplacing(c) => {
+                self.queue_len.fetch_sub(1, Ordering::Relaxed);
+                self.record(c);
+            }
         }
     }
 
