@@ -361,7 +361,7 @@ unsafe impl<R: Registers, F: Registers> Hardware for BxCan<R, F> {
 
     /// Reads `CAN_TSR` once: `CODE` names an empty mailbox when any `TMEx` is set (RM0410
     /// §40.9.2); it is taken when its last completion was settled (`RQCPx` = 0). With
-    /// no `RQCPx` pending (the usual case) that is `CODE` itself.
+    /// no `RQCPx` pending (the usual case) that is `CODE` itself, its `TMEx` checked.
     #[inline(always)]
     fn free_mailbox(&self, _frame: &Frame) -> Result<Option<u8>, Error> {
         let t = self.regs.read32(TSR);
@@ -369,7 +369,9 @@ unsafe impl<R: Registers, F: Registers> Hardware for BxCan<R, F> {
             return Ok(None);
         }
         let code = tsr::CODE.get(t) as usize;
-        if t & RQCP_ALL == 0 && code < TX_MAILBOXES {
+        // `TMEx` of `CODE` is checked too: a wrong `CODE` must not make a pending
+        // mailbox look free (its frame would be overwritten).
+        if t & RQCP_ALL == 0 && code < TX_MAILBOXES && t & tsr::tme(code) != 0 {
             return Ok(Some(code as u8));
         }
         Ok(free_of(t, code))
