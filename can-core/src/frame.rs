@@ -525,6 +525,30 @@ mod tests {
     }
 
     #[test]
+    fn from_words_clears_beyond_the_dlc_clamps_and_masks() {
+        let all = [0xA1, 0xA2, 0xA3, 0xA4, 0xA5, 0xA6, 0xA7, 0xA8];
+        for dlc in 0..=15u8 {
+            let f = Frame::from_words(Frame::id_word(0x123, false, false), dlc, all);
+            let keep = dlc.min(8) as usize;
+            assert_eq!(f.dlc() as usize, keep, "DLC {dlc} clamps to 8");
+            assert_eq!(f.data(), &all[..keep]);
+            let padded = f.data_padded();
+            assert!(
+                padded[keep..].iter().all(|&b| b == 0),
+                "DLC {dlc}: {padded:?}"
+            );
+            assert_eq!(f, Frame::standard(0x123, &all[..keep]).unwrap());
+        }
+        // A remote frame keeps its DLC and no data.
+        let r = Frame::from_words(Frame::id_word(0x1ABC_DEF1, true, true), 3, all);
+        assert_eq!((r.dlc(), r.data_padded()), (3, [0; 8]));
+        assert_eq!(r, Frame::remote(0x1ABC_DEF1, true, 3).unwrap());
+        // Identifier bits beyond the format are dropped.
+        let m = Frame::from_words(0x0000_FFFF, 0, all);
+        assert_eq!(m.raw_id(), 0x7FF);
+    }
+
+    #[test]
     fn equality_ignores_bytes_beyond_dlc() {
         let a = Frame::from_raw_parts(standard_id(5).unwrap(), false, 2, [1, 2, 3, 0, 0, 0, 0, 0]);
         let b = Frame::standard(5, &[1, 2]);
