@@ -114,18 +114,31 @@ pub fn ensure_target(install: bool) -> Result<()> {
 pub fn bench_firmware(paths: &Paths, profile: &str) -> Result<PathBuf> {
     let target_dir = paths.scratch("bench-firmware");
     let manifest = paths.firmware().join("Cargo.toml");
-    let mut c = cargo();
-    c.current_dir(paths.firmware())
-        .arg("build")
-        .args(["--profile", profile, "--target", TARGET])
-        .arg("--manifest-path")
-        .arg(&manifest)
-        .arg("--target-dir")
-        .arg(&target_dir);
-    eprintln!("can-bench: {}", cmd::display(&c));
-    cmd::run_ok(&mut c, BUILD_LIMIT).context("building the bench firmware")?;
+    // Two invocations: the `async` feature of the async firmwares must not reach the
+    // others (cargo unifies features over the packages of one build).
+    let mut selections: Vec<Vec<&str>> = vec![vec!["--workspace"], Vec::new()];
+    for p in ASYNC_PACKAGES {
+        selections[0].extend(["--exclude", p]);
+        selections[1].extend(["-p", p]);
+    }
+    for selection in selections {
+        let mut c = cargo();
+        c.current_dir(paths.firmware())
+            .arg("build")
+            .args(["--profile", profile, "--target", TARGET])
+            .arg("--manifest-path")
+            .arg(&manifest)
+            .arg("--target-dir")
+            .arg(&target_dir)
+            .args(selection);
+        eprintln!("can-bench: {}", cmd::display(&c));
+        cmd::run_ok(&mut c, BUILD_LIMIT).context("building the bench firmware")?;
+    }
     Ok(target_dir.join(TARGET).join(profile))
 }
+
+/// The bench firmware packages built with twocan-core's `async` feature.
+pub const ASYNC_PACKAGES: [&str; 2] = ["bench-insn-count-async", "bench-loopback-async"];
 
 /// A firmware example package of the workspace, as `cargo metadata` describes it.
 #[derive(Debug, Clone)]

@@ -7,11 +7,16 @@
 //! It measures, in one run, and writes `docs/benchmarks.md` (also printed):
 //!
 //! 1. flash and RAM of the firmware examples and of a minimal loop-back firmware built
-//!    with our bxCAN backend and with the `bxcan` crate 0.8 ([`sizes`], [`firmware`]);
+//!    with our bxCAN backend, with the bare `bxcan` crate 0.8 and with the `bxcan` crate
+//!    plus the service work that makes it feature-equivalent ([`sizes`], [`firmware`]);
 //! 2. instructions per frame on a Cortex-M4 under QEMU, counted by the TCG plugin
 //!    `bench/plugin/insn_count.c` ([`qemu`]);
 //! 3. the bit-timing solver against an exhaustive search ([`timing`]);
 //! 4. the simulator's speed ([`simspeed`], [`models`]).
+//!
+//! With the sizes and the instruction counts measured it also writes
+//! `target/bench/summary.json`: the ratios ours / theirs of issue 10 as numbers, for
+//! scripts (see [`report::Report::summary`]).
 //!
 //! Any step that cannot run ends the command with an error and a non-zero exit code,
 //! without touching `docs/benchmarks.md`. `--skip STEP` (sizes, examples, qemu, timing,
@@ -179,9 +184,19 @@ fn run() -> Result<()> {
                 opt: opt.to_string(),
                 ours: sizes::measure(&dir.join("loopback-twocan"))?,
                 theirs: sizes::measure(&dir.join("loopback-bxcan"))?,
+                equiv: sizes::measure(&dir.join("loopback-bxcan-equiv"))?,
+                async_fw: sizes::measure(&dir.join("loopback-async"))?,
             });
         }
-        report.sizes = Some(SizeSection { builds });
+        let dir = &firmware_dirs[0].1;
+        let state = sizes::state_figures(&dir.join("loopback-twocan"), &dir.join("insn-count"))?;
+        eprintln!(
+            "can-bench: State static {} B = rings {} B + state {} B",
+            state.static_bytes,
+            state.ring_bytes,
+            state.static_bytes - state.ring_bytes
+        );
+        report.sizes = Some(SizeSection { builds, state });
     }
 
     if !skipped("examples") {
@@ -203,6 +218,14 @@ fn run() -> Result<()> {
                 .context(format!("instruction counts ({profile} profile)"))?;
             runs.push((opt.to_string(), counts));
         }
+        let mut async_runs = Vec::new();
+        for ((profile, opt), (_, dir)) in COUNT_PROFILES.iter().zip(&firmware_dirs) {
+            let elf = dir.join("insn-count-async");
+            let tag = format!("{profile}-async");
+            let counts = qemu::run(&paths, &tools, &plugin, &elf, &tag)
+                .context(format!("async instruction counts ({profile} profile)"))?;
+            async_runs.push((opt.to_string(), counts));
+        }
         let window = sizes::read_u32_symbol(
             &firmware_dirs[0].1.join("insn-count"),
             "BENCH_MARKER_WINDOW",
@@ -210,12 +233,21 @@ fn run() -> Result<()> {
         report.insn = Some(InsnSection {
             tools,
             runs,
+            async_runs,
             window,
         });
     }
 
     lap(started);
     report.elapsed_secs = started.elapsed().as_secs_f64();
+    if let Some(summary) = report.summary()? {
+        let dir = paths.scratch("bench");
+        std::fs::create_dir_all(&dir).context(format!("creating {}", dir.display()))?;
+        let path = dir.join("summary.json");
+        let json = serde_json::to_string_pretty(&summary).context("summary.json")?;
+        std::fs::write(&path, json + "\n").context(format!("writing {}", path.display()))?;
+        eprintln!("can-bench: wrote {}", path.display());
+    }
     let text = report.render()?;
     println!("{text}");
     if skip.is_empty() {

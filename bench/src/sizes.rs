@@ -162,3 +162,49 @@ pub fn read_u32_symbol(path: &Path, symbol: &str) -> Result<u32> {
         path.display()
     )))
 }
+
+/// The size of the symbol `symbol` in the ELF at `path` (its `st_size`).
+pub fn symbol_size(path: &Path, symbol: &str) -> Result<u64> {
+    let data = std::fs::read(path).context(format!("reading {}", path.display()))?;
+    let elf = parse(&data).context(path.display())?;
+    elf.symbols()
+        .find(|s| s.name() == Ok(symbol))
+        .map(|s| s.size())
+        .ok_or_else(|| Error::new(format!("{}: no symbol `{symbol}`", path.display())))
+}
+
+/// What the driver's shared `State` static of the loop-back firmware holds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct StateFigures {
+    /// Size of the `State` static (`BENCH_CAN_STATE` of `loopback-twocan`).
+    pub static_bytes: u64,
+    /// Of which ring and queue slots (`BENCH_RING_BYTES` of `insn-count`, which holds a
+    /// `State` of the same type and checks its size in `BENCH_STATE_BYTES`).
+    pub ring_bytes: u64,
+    /// Of which the controller value `BxCan<Mmio>` (`BENCH_HW_BYTES`).
+    pub hw_bytes: u64,
+    /// Of which, inside the controller value, the filter map (`BENCH_FMI_BYTES`).
+    pub fmi_bytes: u64,
+}
+
+/// Reads [`StateFigures`] from the two firmwares; refuses figures of two different types.
+pub fn state_figures(loopback: &Path, insn_count: &Path) -> Result<StateFigures> {
+    let static_bytes = symbol_size(loopback, "BENCH_CAN_STATE")?;
+    let same_type = u64::from(read_u32_symbol(insn_count, "BENCH_STATE_BYTES")?);
+    if same_type != static_bytes {
+        return Err(Error::new(format!(
+            "the State of insn-count is {same_type} B, that of loopback-twocan {static_bytes} B: \
+             they must be the same type"
+        )));
+    }
+    let ring_bytes = u64::from(read_u32_symbol(insn_count, "BENCH_RING_BYTES")?);
+    if ring_bytes > static_bytes {
+        return Err(Error::new("ring bytes exceed the State's size"));
+    }
+    Ok(StateFigures {
+        static_bytes,
+        ring_bytes,
+        hw_bytes: u64::from(read_u32_symbol(insn_count, "BENCH_HW_BYTES")?),
+        fmi_bytes: u64::from(read_u32_symbol(insn_count, "BENCH_FMI_BYTES")?),
+    })
+}

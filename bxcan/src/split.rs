@@ -39,6 +39,19 @@ use crate::regs::{
 
 /// `CAN_TSR.TMEx` of the three mailboxes.
 const TME_ALL: u32 = tsr::TME0 | tsr::TME1 | tsr::TME2;
+/// `CAN_TSR.RQCPx` of the three mailboxes.
+const RQCP_ALL: u32 = tsr::RQCP0 | tsr::RQCP1 | tsr::RQCP2;
+
+/// A mailbox empty (`TMEx`) and settled (`RQCPx` = 0) in `CAN_TSR` value `t`, `CODE`'s
+/// first: the slow path of `free_mailbox`, when a completion is still pending.
+#[cold]
+fn free_of(t: u32, code: usize) -> Option<u8> {
+    let ok = |x: usize| t & tsr::tme(x) != 0 && t & tsr::rqcp(x) == 0;
+    if code < TX_MAILBOXES && ok(code) {
+        return Some(code as u8);
+    }
+    (0..TX_MAILBOXES).find(|&x| ok(x)).map(|x| x as u8)
+}
 
 /// One received frame as the receive interrupt copies it: `CAN_RIxR`, `CAN_RDTxR` (FIFO
 /// number in bits 7:4), `CAN_RDLxR`, `CAN_RDHxR`.
@@ -173,6 +186,134 @@ impl<R: Registers, F: Registers> BxCan<R, F> {
         mailbox::read_tx(&self.regs, x)
     }
 
+    /// Settles mailbox `x`, whose `RQCPx` is set in `t` (`CAN_TSR` as read): what ended
+    /// (RM0410 §40.9.2: `TXOKx` → sent, with `CAN_TDTxR.TIME` when TTCM is on; an abort
+    /// the application requested → aborted; a displacement abort → the frame goes back
+    /// to the queue; otherwise a one-shot failure, `ALSTx` or `TERRx` saying why), then
+    /// acknowledges it (writing `RQCPx` clears `TXOKx`, `ALSTx` and `TERRx`: the flags
+    /// were read in `t` before), and reports it to `f` with the mailbox's token.
+    ///
+    /// # Safety
+    /// Transmit interrupt context (the one context of `settle`, which alone touches
+    /// `displaced` and clears `aborting`/`displacing` bits, inside the driver's critical
+    /// section, as `request_abort` sets them).
+    #[inline(always)]
+    unsafe fn settle_one(&self, t: u32, x: usize, mut f: impl FnMut(u32, Settled)) {
+        let bit = 1u8 << x;
+        // Relaxed: see `load`.
+        let token = Token(self.tokens[x].load(Ordering::Relaxed));
+        // Plain load, then clear only when set: both flags change only inside the
+        // driver's critical section (this method's context and `request_abort`).
+        let user_abort = self.aborting.load(Ordering::Relaxed) & bit != 0;
+        if user_abort {
+            self.aborting.fetch_and(!bit, Ordering::Relaxed);
+        }
+        let displacing = self.displacing.load(Ordering::Relaxed) & bit != 0;
+        if displacing {
+            self.displacing.fetch_and(!bit, Ordering::Relaxed);
+        }
+        self.regs.write32(TSR, tsr::rqcp(x));
+        // Each outcome calls `f` with its own variant, so that an inlined `f` matches
+        // on a known variant instead of copying a generic `Settled` around.
+        let mut done = |c: Completion| {
+            if displacing {
+                f(token.0, Settled::DoneDisplacing(c))
+            } else {
+                f(token.0, Settled::Done(c))
+            }
+        };
+        if t & tsr::txok(x) != 0 {
+            let timestamp = self
+                .config
+                .get_timestamps()
+                .then(|| rdtxr::TIME.get(self.regs.read32(tdtxr(x))) as u16);
+            done(Completion {
+                token,
+                outcome: TxOutcome::Sent,
+                cause: None,
+                timestamp,
+            })
+        } else if user_abort {
+            done(Completion {
+                token,
+                outcome: TxOutcome::Aborted,
+                cause: None,
+                timestamp: None,
+            })
+        } else if displacing {
+            // SAFETY: transmit interrupt context, the only one touching `displaced`.
+            let frame = unsafe { (*self.displaced.get())[x] };
+            f(token.0, Settled::Displaced(token, frame))
+        } else {
+            let cause = if t & tsr::alst(x) != 0 {
+                Some(TxFailure::ArbitrationLost)
+            } else if t & tsr::terr(x) != 0 {
+                Some(TxFailure::Error)
+            } else {
+                None
+            };
+            f(
+                token.0,
+                Settled::Done(Completion {
+                    token,
+                    outcome: TxOutcome::Failed,
+                    cause,
+                    timestamp: None,
+                }),
+            )
+        }
+    }
+
+    /// `settle` when several mailboxes ended between two interrupts: reports them in
+    /// token (acceptance) order, which is the transmit order under TXFP = 1. Out of line
+    /// and not generic (`dyn`), so that the usual single completion needs no sort buffer
+    /// in its frame and the caller's `f` has one static call site, inlined there.
+    ///
+    /// # Safety
+    /// As for `settle`.
+    #[cold]
+    #[inline(never)]
+    unsafe fn settle_many(&self, t: u32, f: &mut dyn FnMut(Settled)) {
+        let mut ended = [(
+            0u32,
+            Settled::Done(Completion {
+                token: Token(0),
+                outcome: TxOutcome::Sent,
+                cause: None,
+                timestamp: None,
+            }),
+        ); TX_MAILBOXES];
+        let mut n = 0;
+        for x in 0..TX_MAILBOXES {
+            if t & tsr::rqcp(x) == 0 {
+                continue;
+            }
+            // SAFETY: the caller's contract (transmit interrupt context).
+            unsafe { self.settle_one(t, x, |token, settled| ended[n] = (token, settled)) };
+            n += 1;
+        }
+        let ended = &mut ended[..n];
+        let base = ended.iter().map(|e| e.0).fold(ended[0].0, |a, b| {
+            if (b.wrapping_sub(a) as i32) < 0 {
+                b
+            } else {
+                a
+            }
+        });
+        // At most three entries: an insertion sort by distance from the oldest token
+        // (no generic sort linked).
+        for i in 1..ended.len() {
+            let mut j = i;
+            while j > 0 && ended[j].0.wrapping_sub(base) < ended[j - 1].0.wrapping_sub(base) {
+                ended.swap(j, j - 1);
+                j -= 1;
+            }
+        }
+        for (_, s) in ended.iter() {
+            f(*s);
+        }
+    }
+
     fn status_now(&self) -> ErrorStatus {
         let m = self.regs.read32(MSR);
         let e = self.regs.read32(ESR);
@@ -220,8 +361,9 @@ unsafe impl<R: Registers, F: Registers> Hardware for BxCan<R, F> {
         self.config.get_tx_policy()
     }
 
-    /// Reads `CAN_TSR` once: `CODE` names an empty mailbox when `TMEx` is set (RM0410
-    /// §40.9.2); it is taken when its last completion was settled (`RQCPx` = 0).
+    /// Reads `CAN_TSR` once: `CODE` names an empty mailbox when any `TMEx` is set (RM0410
+    /// §40.9.2); it is taken when its last completion was settled (`RQCPx` = 0). With
+    /// no `RQCPx` pending (the usual case) that is `CODE` itself, its `TMEx` checked.
     #[inline(always)]
     fn free_mailbox(&self, _frame: &Frame) -> Result<Option<u8>, Error> {
         let t = self.regs.read32(TSR);
@@ -229,19 +371,23 @@ unsafe impl<R: Registers, F: Registers> Hardware for BxCan<R, F> {
             return Ok(None);
         }
         let code = tsr::CODE.get(t) as usize;
-        if t & tsr::tme(code) != 0 && t & tsr::rqcp(code) == 0 {
+        // `TMEx` of `CODE` is checked too: a wrong `CODE` must not make a pending
+        // mailbox look free (its frame would be overwritten).
+        if t & RQCP_ALL == 0 && code < TX_MAILBOXES && t & tsr::tme(code) != 0 {
             return Ok(Some(code as u8));
         }
-        Ok((0..TX_MAILBOXES)
-            .find(|&x| t & tsr::tme(x) != 0 && t & tsr::rqcp(x) == 0)
-            .map(|x| x as u8))
+        Ok(free_of(t, code))
     }
 
     /// Notes "Transmission handling": DLC, data, then identifier with `TXRQ`.
     #[inline(always)]
     unsafe fn load(&self, mailbox: u8, frame: &Frame, token: Token) {
         let x = mailbox as usize;
-        self.tokens[x].store(token.0, Ordering::Release);
+        // Relaxed: the token is stored before the `TXRQ` store in program order, and the
+        // transmit interrupt reads it only after seeing this mailbox's `RQCPx`, which the
+        // hardware sets after acting on `TXRQ` (on the host, the model's lock around each
+        // register access orders the two).
+        self.tokens[x].store(token.0, Ordering::Relaxed);
         mailbox::load(&self.regs, x, frame);
     }
 
@@ -251,91 +397,25 @@ unsafe impl<R: Registers, F: Registers> Hardware for BxCan<R, F> {
     /// `TERRx` saying why. Writing `RQCPx` clears `TXOKx`, `ALSTx` and `TERRx`.
     unsafe fn settle<G: FnMut(Settled)>(&self, mut f: G) {
         let t = self.regs.read32(TSR);
-        if t & (tsr::RQCP0 | tsr::RQCP1 | tsr::RQCP2) == 0 {
+        let rq = t & RQCP_ALL;
+        if rq == 0 {
             return;
         }
-        // Several mailboxes can end between two interrupts: report them in token
-        // (acceptance) order, which is the transmit order under TXFP = 1.
-        let mut ended = [(
-            0u32,
-            Settled::Done(Completion {
-                token: Token(0),
-                outcome: TxOutcome::Sent,
-                cause: None,
-                timestamp: None,
-            }),
-        ); TX_MAILBOXES];
-        let mut n = 0;
-        for x in 0..TX_MAILBOXES {
-            if t & tsr::rqcp(x) == 0 {
-                continue;
-            }
-            let bit = 1u8 << x;
-            let token = Token(self.tokens[x].load(Ordering::Acquire));
-            let user_abort = self.aborting.fetch_and(!bit, Ordering::Relaxed) & bit != 0;
-            let displacing = self.displacing.fetch_and(!bit, Ordering::Relaxed) & bit != 0;
-            let done = |c: Completion| {
-                if displacing {
-                    Settled::DoneDisplacing(c)
-                } else {
-                    Settled::Done(c)
-                }
-            };
-            let settled = if t & tsr::txok(x) != 0 {
-                let timestamp = self
-                    .config
-                    .get_timestamps()
-                    .then(|| rdtxr::TIME.get(self.regs.read32(tdtxr(x))) as u16);
-                done(Completion {
-                    token,
-                    outcome: TxOutcome::Sent,
-                    cause: None,
-                    timestamp,
-                })
-            } else if user_abort {
-                done(Completion {
-                    token,
-                    outcome: TxOutcome::Aborted,
-                    cause: None,
-                    timestamp: None,
-                })
-            } else if displacing {
-                // SAFETY: transmit interrupt context, the only one touching `displaced`.
-                let frame = unsafe { (*self.displaced.get())[x] };
-                Settled::Displaced(token, frame)
+        if rq & (rq - 1) == 0 {
+            // One mailbox ended (the usual case): no ordering needed.
+            let x = if rq == tsr::RQCP0 {
+                0
+            } else if rq == tsr::RQCP1 {
+                1
             } else {
-                let cause = if t & tsr::alst(x) != 0 {
-                    Some(TxFailure::ArbitrationLost)
-                } else if t & tsr::terr(x) != 0 {
-                    Some(TxFailure::Error)
-                } else {
-                    None
-                };
-                Settled::Done(Completion {
-                    token,
-                    outcome: TxOutcome::Failed,
-                    cause,
-                    timestamp: None,
-                })
+                2
             };
-            self.regs.write32(TSR, tsr::rqcp(x));
-            ended[n] = (token.0, settled);
-            n += 1;
+            // SAFETY: the caller's contract (transmit interrupt context).
+            unsafe { self.settle_one(t, x, |_, settled| f(settled)) };
+            return;
         }
-        let ended = &mut ended[..n];
-        if n > 1 {
-            let base = ended.iter().map(|e| e.0).fold(ended[0].0, |a, b| {
-                if (b.wrapping_sub(a) as i32) < 0 {
-                    b
-                } else {
-                    a
-                }
-            });
-            ended.sort_unstable_by_key(|e| e.0.wrapping_sub(base));
-        }
-        for (_, s) in ended.iter() {
-            f(*s);
-        }
+        // SAFETY: the caller's contract (transmit interrupt context).
+        unsafe { self.settle_many(t, &mut f) }
     }
 
     /// With all three mailboxes pending, the one lowest in the hardware's order

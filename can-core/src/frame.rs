@@ -79,8 +79,9 @@ const REMOTE_BIT: u32 = 1 << 30;
 const ID_BITS: u32 = 0x1FFF_FFFF;
 
 /// A classical CAN frame (data or remote), 16 bytes: one identifier word (29-bit
-/// identifier, format and kind flags), the DLC and eight data bytes, so copies stay a
-/// few word loads and stores.
+/// identifier, format and kind flags), eight data bytes and the DLC, so copies stay a
+/// few word loads and stores (the data bytes are word-aligned: a mailbox register pair
+/// is two aligned loads or stores).
 ///
 /// Invariants kept by every constructor and setter: the identifier is in range for its
 /// format, the DLC is `0..=8`, data bytes beyond the DLC (and all bytes of a remote
@@ -91,8 +92,8 @@ const ID_BITS: u32 = 0x1FFF_FFFF;
 #[repr(C)]
 pub struct Frame {
     word: u32,
-    dlc: u8,
     data: [u8; 8],
+    dlc: u8,
 }
 
 #[cfg(feature = "defmt")]
@@ -240,17 +241,15 @@ impl Frame {
         let id_mask = if extended { ID_BITS } else { 0x7FF };
         let word = word & (EXTENDED_BIT | REMOTE_BIT | id_mask);
         let dlc = if dlc > MAX_DLC { MAX_DLC } else { dlc };
-        let mut bytes = data;
-        let keep = if word & REMOTE_BIT != 0 {
-            0
+        let keep = if word & REMOTE_BIT != 0 { 0 } else { dlc };
+        // Bytes beyond `keep` cleared with one mask over the little-endian 64-bit value
+        // (a few shifts instead of a byte loop or a `memset` call).
+        let mask = if keep >= 8 {
+            u64::MAX
         } else {
-            dlc as usize
+            (1u64 << (8 * keep as u32)) - 1
         };
-        let mut i = keep;
-        while i < 8 {
-            bytes[i] = 0;
-            i += 1;
-        }
+        let bytes = (u64::from_le_bytes(data) & mask).to_le_bytes();
         Frame {
             word,
             dlc,
@@ -523,6 +522,30 @@ mod tests {
         assert!(!f.is_remote_frame());
         assert!(f.is_data_frame());
         assert!(!embedded_can::Frame::is_extended(&f));
+    }
+
+    #[test]
+    fn from_words_clears_beyond_the_dlc_clamps_and_masks() {
+        let all = [0xA1, 0xA2, 0xA3, 0xA4, 0xA5, 0xA6, 0xA7, 0xA8];
+        for dlc in 0..=15u8 {
+            let f = Frame::from_words(Frame::id_word(0x123, false, false), dlc, all);
+            let keep = dlc.min(8) as usize;
+            assert_eq!(f.dlc() as usize, keep, "DLC {dlc} clamps to 8");
+            assert_eq!(f.data(), &all[..keep]);
+            let padded = f.data_padded();
+            assert!(
+                padded[keep..].iter().all(|&b| b == 0),
+                "DLC {dlc}: {padded:?}"
+            );
+            assert_eq!(f, Frame::standard(0x123, &all[..keep]).unwrap());
+        }
+        // A remote frame keeps its DLC and no data.
+        let r = Frame::from_words(Frame::id_word(0x1ABC_DEF1, true, true), 3, all);
+        assert_eq!((r.dlc(), r.data_padded()), (3, [0; 8]));
+        assert_eq!(r, Frame::remote(0x1ABC_DEF1, true, 3).unwrap());
+        // Identifier bits beyond the format are dropped.
+        let m = Frame::from_words(0x0000_FFFF, 0, all);
+        assert_eq!(m.raw_id(), 0x7FF);
     }
 
     #[test]

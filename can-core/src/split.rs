@@ -89,16 +89,17 @@ pub struct TrafficStats {
     pub state_changes: u32,
 }
 
-const STATE_UNKNOWN: u8 = 0xFF;
+/// No state recorded yet (0, so that a `static State` is all zeros and lives in `.bss`).
+const STATE_UNKNOWN: u8 = 0;
 
 fn state_code(s: ErrorState) -> u8 {
     match s {
-        ErrorState::Active => 0,
-        ErrorState::Warning => 1,
-        ErrorState::Passive => 2,
-        ErrorState::BusOff => 3,
-        ErrorState::Stopped => 4,
-        ErrorState::Sleeping => 5,
+        ErrorState::Active => 1,
+        ErrorState::Warning => 2,
+        ErrorState::Passive => 3,
+        ErrorState::BusOff => 4,
+        ErrorState::Stopped => 5,
+        ErrorState::Sleeping => 6,
     }
 }
 
@@ -414,6 +415,7 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
             .store(self.queue_len.load(Ordering::Relaxed), Ordering::Relaxed);
     }
 
+    #[inline]
     fn record(&self, done: Completion) {
         match done.outcome {
             TxOutcome::Sent => self.sent.inc(),
@@ -467,19 +469,24 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
     /// Called inside the critical section (the transmit interrupt's context).
     unsafe fn settle_into(&self, q: &mut Q) {
         // SAFETY: the caller's contract.
-        unsafe {
-            self.hw().settle(|s| match s {
-                Settled::Done(c) => self.record(c),
-                Settled::Displaced(token, frame) => {
-                    // Room was reserved when the displacement was requested (and stays
-                    // counted in `queue_len`, now by the frame itself).
-                    let _ = q.push(Queued { token, frame });
-                }
-                Settled::DoneDisplacing(c) => {
-                    self.queue_len.fetch_sub(1, Ordering::Relaxed);
-                    self.record(c);
-                }
-            })
+        unsafe { self.hw().settle(|s| self.on_settled(q, s)) }
+    }
+
+    /// One settled mailbox (inlined into each of the backend's call sites, so that each
+    /// handles the one variant it builds).
+    #[inline(always)]
+    fn on_settled(&self, q: &mut Q, s: Settled) {
+        match s {
+            Settled::Done(c) => self.record(c),
+            Settled::Displaced(token, frame) => {
+                // Room was reserved when the displacement was requested (and stays
+                // counted in `queue_len`, now by the frame itself).
+                let _ = q.push(Queued { token, frame });
+            }
+            Settled::DoneDisplacing(c) => {
+                self.queue_len.fetch_sub(1, Ordering::Relaxed);
+                self.record(c);
+            }
         }
     }
 
@@ -535,6 +542,14 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
         unsafe { self.changes.pop() }
     }
 
+    /// Whether the controller is bus-off now (read when the status handler last saw
+    /// bus-off: it may have recovered since). Out of line: the transmit path's rare case.
+    #[cold]
+    #[inline(never)]
+    fn bus_off_now(&self) -> bool {
+        self.hw().error_status().state == ErrorState::BusOff
+    }
+
     fn note_queue_peak(&self, len: u32) {
         if len > self.queue_peak.load(Ordering::Relaxed) {
             self.queue_peak.store(len, Ordering::Relaxed);
@@ -578,13 +593,13 @@ impl<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE:
     pub fn try_send(&mut self, frame: &Frame) -> nb::Result<Token, Error> {
         let s = self.s;
         let hw = s.hw();
-        if s.state.load(Ordering::Relaxed) == state_code(ErrorState::BusOff)
-            && hw.error_status().state == ErrorState::BusOff
-        {
+        if s.state.load(Ordering::Relaxed) == state_code(ErrorState::BusOff) && s.bus_off_now() {
             return Err(nb::Error::Other(Error::BusOff));
         }
         let token = Token(self.next);
-        if s.queue_len.load(Ordering::Acquire) == 0 {
+        // Relaxed: on the direct path this half reads no memory that the transmit
+        // interrupt writes, only the hardware's mailbox status (`free_mailbox`).
+        if s.queue_len.load(Ordering::Relaxed) == 0 {
             match hw.free_mailbox(frame) {
                 Ok(Some(m)) => {
                     // SAFETY: the transmit half's direct path: the queue is empty and only
@@ -597,6 +612,17 @@ impl<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE:
                 Err(e) => return Err(nb::Error::Other(e)),
             }
         }
+        self.send_queued(frame, token)
+    }
+
+    /// The slow path of [`Tx::try_send`]: the frame joins the queue (in the critical
+    /// section shared with the transmit interrupt). Out of line so that the direct path
+    /// stays a short leaf.
+    #[cold]
+    #[inline(never)]
+    fn send_queued(&mut self, frame: &Frame, token: Token) -> nb::Result<Token, Error> {
+        let s = self.s;
+        let hw = s.hw();
         critical_section::with(|cs| {
             // SAFETY: the queue is only touched inside a critical section.
             let q = unsafe { &mut *s.queue.borrow(cs).get() };
@@ -639,9 +665,7 @@ impl<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE:
     pub fn try_send_now(&mut self, frame: &Frame) -> nb::Result<Token, Error> {
         let s = self.s;
         let hw = s.hw();
-        if s.state.load(Ordering::Relaxed) == state_code(ErrorState::BusOff)
-            && hw.error_status().state == ErrorState::BusOff
-        {
+        if s.state.load(Ordering::Relaxed) == state_code(ErrorState::BusOff) && s.bus_off_now() {
             return Err(nb::Error::Other(Error::BusOff));
         }
         let token = Token(self.next);
@@ -892,33 +916,14 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
     #[inline]
     pub fn on_interrupt(&mut self) {
         let s = self.s;
-        let hw = s.hw();
-        let mut overrun = false;
-        let q = self.queue as usize;
-        #[cfg(feature = "async")]
-        let mut any = false;
-        // SAFETY: this handle is the only caller of `read_rx` for its queue and the only
-        // producer of its ring.
-        unsafe {
-            while let Some(raw) = hw.read_rx(q, &mut overrun) {
-                s.received.inc();
-                let _ = if q == 0 {
-                    s.rx0.push(raw)
-                } else {
-                    s.rx1.push(raw)
-                };
-                #[cfg(feature = "async")]
-                {
-                    any = true;
-                }
-            }
-        }
-        if overrun {
-            overrun_counter(s).inc();
-        }
-        #[cfg(feature = "async")]
-        if any {
-            s.wakers.rx.wake();
+        // The queue number as a constant in each branch, so that the backend's register
+        // offsets fold into the loop.
+        // SAFETY (both): this handle is the only caller of `read_rx` for its queue and
+        // the only producer of its ring.
+        if self.queue == 0 {
+            unsafe { drain(s, 0, &s.rx0) }
+        } else {
+            unsafe { drain(s, 1, &s.rx1) }
         }
     }
 
@@ -926,6 +931,45 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
     pub fn queue(&self) -> usize {
         self.queue as usize
     }
+}
+
+/// The receive handler's loop for hardware queue `q` into `ring`.
+///
+/// # Safety
+/// Called from queue `q`'s receive interrupt handle only (the one caller of `read_rx`
+/// for `q` and the one producer of `ring`).
+#[inline(always)]
+unsafe fn drain<
+    H: Hardware,
+    const RX: usize,
+    Q: TxQueue,
+    const RX1: usize,
+    const DONE: usize,
+    const N: usize,
+>(
+    s: &State<H, RX, Q, RX1, DONE>,
+    q: usize,
+    ring: &SpscRing<H::Raw, N>,
+) {
+    let hw = s.hw();
+    let mut overrun = false;
+    let mut any = false;
+    // SAFETY: the caller's contract.
+    unsafe {
+        while let Some(raw) = hw.read_rx(q, &mut overrun) {
+            any = true;
+            s.received.inc();
+            let _ = ring.push(raw);
+        }
+    }
+    if overrun {
+        overrun_counter(s).inc();
+    }
+    #[cfg(feature = "async")]
+    if any {
+        s.wakers.rx.wake();
+    }
+    let _ = any;
 }
 
 fn overrun_counter<
