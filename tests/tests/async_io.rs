@@ -51,7 +51,7 @@ fn seq_frame(node: u8, k: u32) -> Frame {
     data[..4].copy_from_slice(&k.to_le_bytes());
     data[4] = node;
     data[5] = (k >> 3) as u8;
-    if k % 3 == 0 {
+    if k.is_multiple_of(3) {
         Frame::extended(
             0x0100_0000 | (node as u32) << 16 | (k & 0xFFFF),
             &data[..len],
@@ -413,6 +413,9 @@ impl<'a> Chaos<'a> {
     /// transmit queue fills and sends pend), the receiver polls until it pends; before
     /// each attempt, a pending future is dropped with probability 1/3; a new future is
     /// made for the same frame (send) or the next one (receive).
+    // The futures hold the half's `RefCell` borrow while they wait: one future per half
+    // at a time, as `&mut` would enforce; a drop releases it.
+    #[allow(clippy::await_holding_refcell_ref)]
     fn round<T: AsyncCanTx, R: AsyncCanRx>(
         &mut self,
         tx: &'a RefCell<T>,
