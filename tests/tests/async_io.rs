@@ -618,7 +618,7 @@ fn pin_box<'a, F: Future + 'a>(f: F) -> Pin<Box<dyn Future<Output = F::Output> +
 #[allow(clippy::too_many_arguments)]
 fn run_once_each(
     sim: &mut Sim<'_>,
-    done: &mut Pin<Box<dyn Future<Output = twocan_core::Completion> + '_>>,
+    done: &mut Pin<Box<dyn Future<Output = Result<twocan_core::Completion, Error>> + '_>>,
     tw: &Waker,
     tc: &Counted,
     got: &mut Pin<Box<dyn Future<Output = Result<RxFrame, Error>> + '_>>,
@@ -634,7 +634,9 @@ fn run_once_each(
     sim.idle(2_000);
     assert_eq!(tc.wakes() - wakes_before, 1, "completion waker woken once");
     assert_eq!(rc.wakes(), 1, "receiver woken once");
-    let c = poll_once(done.as_mut(), tw).expect("completion after the wake");
+    let c = poll_once(done.as_mut(), tw)
+        .expect("completion after the wake")
+        .expect("not lost");
     assert_eq!((c.token, c.outcome), (token, TxOutcome::Sent));
     let f = poll_once(got.as_mut(), rw)
         .expect("frame after the wake")
