@@ -643,3 +643,38 @@ fn run_once_each(
         .expect("no receive error");
     assert_eq!(&f.frame, frame);
 }
+
+/// `Rx::event` on a bxCAN node alone on the bus: its frame is never acknowledged, so
+/// each attempt adds 8 to TEC (ISO 11898-1 §12.1.4.2, acknowledge error) until the node
+/// is error passive (128), where an acknowledge error no longer raises it. The task
+/// waiting in `event` sees the two changes in order, warning then passive.
+#[test]
+fn async_event_follows_the_error_state_of_an_unacknowledged_sender() {
+    use std::pin::pin;
+    use twocan_core::{ErrorState, RxEvent};
+    use twocan_host::asynch::{drive, split_bx, BxState};
+
+    let mut h = Harness::new(500_000).expect("bit rate");
+    let node = BxNode::stm32f767_can1(&mut h, &[Filter::pass_all()]).expect("bxCAN node");
+    let bs = BxState::new();
+    let (mut irqs, mut tx, mut rx) = split_bx(&bs, node).expect("split");
+    tx.try_send(&seq_frame(2, 0)).expect("accepted");
+    let seen = RefCell::new(Vec::new());
+    let mut watch = pin!(async {
+        for _ in 0..2 {
+            match rx.event().await? {
+                RxEvent::StateChange(c) => seen.borrow_mut().push((c.state, c.counters.tec)),
+                RxEvent::Frame(f) => panic!("no frame expected: {f:?}"),
+            }
+        }
+        Ok(())
+    });
+    let until = h.now() + 20_000;
+    let done = drive(&mut h, &mut [&mut irqs], &mut [watch.as_mut()], until);
+    assert!(matches!(done[0], Some(Ok(()))), "{done:?}");
+    let seen = seen.borrow().clone();
+    assert_eq!(seen.len(), 2, "{seen:?}");
+    assert_eq!(seen[0].0, ErrorState::Warning, "{seen:?}");
+    assert!((96..128).contains(&seen[0].1), "{seen:?}");
+    assert_eq!(seen[1], (ErrorState::Passive, 128), "{seen:?}");
+}
