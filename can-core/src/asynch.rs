@@ -36,13 +36,13 @@
 //! let hw = state.hardware().unwrap();
 //! let frame = Frame::standard(0x42, &[1])?;
 //! // A tiny executor: poll once, play the bus and the interrupts, poll again.
-//! let token = futures_lite_block_on(p.tx.send(&frame))?;
+//! let token = block_on(p.tx.send(&frame))?;
 //! hw.complete_all();
 //! p.tx_irq.on_interrupt();
 //! p.rx0_irq.on_interrupt();
-//! assert_eq!(futures_lite_block_on(p.rx.recv())?.frame, frame);
-//! assert_eq!(futures_lite_block_on(p.tx.completion()).token, token);
-//! # fn futures_lite_block_on<F: core::future::Future>(f: F) -> F::Output {
+//! assert_eq!(block_on(p.rx.recv())?.frame, frame);
+//! assert_eq!(block_on(p.tx.completion()).token, token);
+//! # fn block_on<F: core::future::Future>(f: F) -> F::Output {
 //! #     let mut f = core::pin::pin!(f);
 //! #     let w = std::task::Waker::noop();
 //! #     let mut cx = core::task::Context::from_waker(w);
