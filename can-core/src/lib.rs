@@ -78,6 +78,8 @@ pub mod spsc;
 pub mod timing;
 pub mod txqueue;
 
+#[cfg(feature = "async")]
+pub use asynch::RxEvent;
 pub use controller::{ErrorStatus, Mode};
 pub use dispatch::Dispatcher;
 pub use driver::{Driver, TrafficStats};

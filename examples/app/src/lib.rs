@@ -21,6 +21,9 @@
 #![no_std]
 #![deny(missing_docs)]
 
+#[cfg(feature = "async")]
+pub mod asynch;
+
 use twocan_core::{CanRx, CanTx, Dispatcher, Filter, Format, Frame, FrameKind, RxFrame};
 
 /// Number of filters of the application's list.
@@ -149,37 +152,56 @@ impl App {
             }
         }
         while self.state.pending_answers > 0 {
-            let answer = Frame::standard(0x200 + self.node as u16, &self.counter.to_le_bytes());
             self.state.pending_answers -= 1;
-            if let Ok(f) = answer {
+            if let Some(f) = self.answer() {
                 if !self.send(driver, f) {
                     return;
                 }
             }
         }
-        let heartbeat = Frame::standard(0x100 + self.node as u16, &self.counter.to_le_bytes());
-        if let Ok(f) = heartbeat {
-            // The counter moves on even if the frame waits in `pending`: it goes first next time.
-            self.counter = self.counter.wrapping_add(1);
+        if let Some(f) = self.heartbeat() {
             if !self.send(driver, f) {
                 return;
             }
         }
         if self.tick.is_multiple_of(4) {
-            let mut m = [0u8; 8];
-            m[..4].copy_from_slice(&self.tick.to_le_bytes());
-            m[4..].copy_from_slice(&(self.counter ^ 0xA5A5_A5A5).to_le_bytes());
-            if let Ok(f) = Frame::extended(0x18FF_0000 | (self.node as u32) << 8, &m) {
+            if let Some(f) = self.measurement() {
                 if !self.send(driver, f) {
                     return;
                 }
             }
         }
         if self.tick.is_multiple_of(10) {
-            if let Ok(f) = Frame::remote(0x200 + self.peer as u32, false, 4) {
+            if let Some(f) = self.status_request() {
                 self.send(driver, f);
             }
         }
+    }
+
+    /// The answer to a status request: our counter.
+    fn answer(&self) -> Option<Frame> {
+        Frame::standard(0x200 + self.node as u16, &self.counter.to_le_bytes()).ok()
+    }
+
+    /// This period's heartbeat. The counter moves on even if the frame waits in
+    /// `pending`: it goes first next time.
+    fn heartbeat(&mut self) -> Option<Frame> {
+        let f = Frame::standard(0x100 + self.node as u16, &self.counter.to_le_bytes()).ok()?;
+        self.counter = self.counter.wrapping_add(1);
+        Some(f)
+    }
+
+    /// The measurement (every 4th period).
+    fn measurement(&self) -> Option<Frame> {
+        let mut m = [0u8; 8];
+        m[..4].copy_from_slice(&self.tick.to_le_bytes());
+        m[4..].copy_from_slice(&(self.counter ^ 0xA5A5_A5A5).to_le_bytes());
+        Frame::extended(0x18FF_0000 | (self.node as u32) << 8, &m).ok()
+    }
+
+    /// The remote status request to the peer (every 10th period).
+    fn status_request(&self) -> Option<Frame> {
+        Frame::remote(0x200 + self.peer as u32, false, 4).ok()
     }
 
     /// Queues `frame`; if the queue is full keeps it for the next step and returns false.

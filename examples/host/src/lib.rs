@@ -18,6 +18,8 @@
 //! ```
 #![deny(missing_docs)]
 
+pub mod asynch;
+
 use std::cell::RefCell;
 use std::rc::Rc;
 

@@ -89,3 +89,20 @@ fn trace_is_streamed_in_candump_form() {
         "{stdout}"
     );
 }
+
+#[test]
+fn async_demo_runs_the_async_app_on_both_boards() {
+    let out = can_demo(&["--async", "--seconds", "0.2"]);
+    assert_eq!(out.status.code(), Some(0));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("async API"), "{stdout}");
+    // 200 periods: both applications heard every heartbeat of the other, in order.
+    let apps: Vec<&str> = stdout.lines().filter(|l| l.contains(" app: ")).collect();
+    assert_eq!(apps.len(), 2, "{stdout}");
+    for line in apps {
+        assert!(
+            line.contains("heartbeats 200 (gaps 0, duplicates 0)") && line.contains("queue full 0"),
+            "{line}"
+        );
+    }
+}

@@ -228,47 +228,67 @@ pub fn enable_can_irqs(
     }
 }
 
+// The vector name, kept as the symbol (the ELF check and debuggers find it).
+#[export_name = "CAN0_ORED_MESSAGE_BUFFER"]
 extern "C" fn can0_message() {
     crate::can::CAN0_VECTORS.on_message();
 }
 
+// The vector name, kept as the symbol (the ELF check and debuggers find it).
+#[export_name = "CAN0_BUS_OFF"]
 extern "C" fn can0_bus_off() {
     crate::can::CAN0_VECTORS.on_status();
 }
 
+// The vector name, kept as the symbol (the ELF check and debuggers find it).
+#[export_name = "CAN0_ERROR"]
 extern "C" fn can0_error() {
     crate::can::CAN0_VECTORS.on_status();
 }
 
+// The vector name, kept as the symbol (the ELF check and debuggers find it).
+#[export_name = "CAN0_TX_WARNING"]
 extern "C" fn can0_tx_warning() {
     crate::can::CAN0_VECTORS.on_status();
 }
 
+// The vector name, kept as the symbol (the ELF check and debuggers find it).
+#[export_name = "CAN0_RX_WARNING"]
 extern "C" fn can0_rx_warning() {
     crate::can::CAN0_VECTORS.on_status();
 }
 
 #[cfg(feature = "teensy36")]
+// The vector name, kept as the symbol (the ELF check and debuggers find it).
+#[export_name = "CAN1_ORED_MESSAGE_BUFFER"]
 extern "C" fn can1_message() {
     crate::can::CAN1_VECTORS.on_message();
 }
 
 #[cfg(feature = "teensy36")]
+// The vector name, kept as the symbol (the ELF check and debuggers find it).
+#[export_name = "CAN1_BUS_OFF"]
 extern "C" fn can1_bus_off() {
     crate::can::CAN1_VECTORS.on_status();
 }
 
 #[cfg(feature = "teensy36")]
+// The vector name, kept as the symbol (the ELF check and debuggers find it).
+#[export_name = "CAN1_ERROR"]
 extern "C" fn can1_error() {
     crate::can::CAN1_VECTORS.on_status();
 }
 
 #[cfg(feature = "teensy36")]
+// The vector name, kept as the symbol (the ELF check and debuggers find it).
+#[export_name = "CAN1_TX_WARNING"]
 extern "C" fn can1_tx_warning() {
     crate::can::CAN1_VECTORS.on_status();
 }
 
 #[cfg(feature = "teensy36")]
+// The vector name, kept as the symbol (the ELF check and debuggers find it).
+#[export_name = "CAN1_RX_WARNING"]
 extern "C" fn can1_rx_warning() {
     crate::can::CAN1_VECTORS.on_status();
 }

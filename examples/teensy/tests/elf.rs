@@ -47,7 +47,12 @@ fn firmware_dir() -> PathBuf {
 }
 
 fn bins(board: &twocan_teensy::Board) -> Vec<&'static str> {
-    let mut v = vec!["teensy-loopback", "teensy-filters", "teensy-app"];
+    let mut v = vec![
+        "teensy-loopback",
+        "teensy-filters",
+        "teensy-app",
+        "teensy-async-echo",
+    ];
     if board.can_instances().len() > 1 {
         v.push("teensy-can0-can1");
     }
