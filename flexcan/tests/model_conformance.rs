@@ -20,7 +20,7 @@ struct FlexCan(FlexCanModel);
 
 impl Dut for FlexCan {
     fn join(bus: &mut Bus) -> (Self, NodeId) {
-        let mut m = FlexCanModel::mk20dx256();
+        let m = FlexCanModel::mk20dx256();
         m.modify32(regs::MCR, |v| v & !mcr::MDIS);
         m.modify32(regs::MCR, |v| v | mcr::RFEN | mcr::IRMQ | mcr::SRXDIS);
         for n in 0..8 {

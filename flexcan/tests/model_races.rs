@@ -26,7 +26,7 @@ const MB: usize = 8;
 /// A module with the Rx FIFO accepting everything, `extra` MCR bits, optionally a TEC
 /// written in freeze, on `bus`, synchronised.
 fn module(bus: &mut Bus, extra: u32, tec: Option<u32>) -> FlexCanModel {
-    let mut m = FlexCanModel::mk20dx256();
+    let m = FlexCanModel::mk20dx256();
     m.modify32(regs::MCR, |v| v & !mcr::MDIS);
     m.modify32(regs::MCR, |v| {
         v | mcr::RFEN | mcr::IRMQ | mcr::SRXDIS | extra
@@ -139,7 +139,7 @@ fn writing_back_every_esr1_flag_loses_one_raised_after_the_read() {
     for exact in [false, true] {
         let mut bus = Bus::new(500_000).unwrap();
         // TEC 240 (ECR written in Freeze mode): one error → 248, the next → bus-off.
-        let mut m = module(&mut bus, 0, Some(240));
+        let m = module(&mut bus, 0, Some(240));
         let peer = SimNode::new().shared();
         bus.attach("peer", peer.clone());
         let f = Frame::standard(0x126, &[6]).unwrap();
@@ -189,7 +189,7 @@ fn freeze_request_waits_for_the_frame_in_flight_at_the_lowest_bit_rate() {
     use twocan_core::sim::frame_bits;
     use twocan_core::timing::frame_time::{bits_to_micros, MAX_FRAME_IN_FLIGHT_BITS};
     let mut bus = Bus::new(2_500).unwrap();
-    let mut m = module(&mut bus, 0, None);
+    let m = module(&mut bus, 0, None);
     let peer = SimNode::new().shared();
     bus.attach("peer", peer.clone());
     let f = Frame::extended(0, &[0; 8]).unwrap();
