@@ -35,6 +35,7 @@ compile_error!("choose one board feature only");
 pub mod board;
 pub mod can;
 pub mod clock;
+pub mod configs;
 pub mod filters_example;
 pub mod flash_config;
 pub mod io;

@@ -34,7 +34,7 @@ mod firmware {
     /// Echoes sent so far (for a debugger).
     pub static ECHOED: AtomicU32 = AtomicU32::new(0);
 
-    const SETTINGS: Settings = Settings::new(500_000);
+    const SETTINGS: Settings = twocan_teensy::configs::BUS;
 
     /// Receives and echoes, forever; drains the completions it does not wait for.
     #[embassy_executor::task]

@@ -30,7 +30,7 @@ mod firmware {
     pub static STATS: Mutex<RefCell<Option<[AppStats; 2]>>> = Mutex::new(RefCell::new(None));
 
     /// 500 kbit/s, computed at compile time (the bit-timing solver is `const`).
-    const SETTINGS: Settings = Settings::new(500_000);
+    const SETTINGS: Settings = twocan_teensy::configs::BUS;
 
     #[cortex_m_rt::entry]
     fn main() -> ! {

@@ -25,12 +25,7 @@ mod firmware {
 
     /// ACAN §4: 125 kbit/s, loop-back and self reception. Computed at compile time
     /// (the bit-timing solver is `const`), so the solver is not in the image.
-    const SETTINGS: Settings = {
-        let mut s = Settings::new(125_000);
-        s.loop_back = true;
-        s.self_reception = true;
-        s
-    };
+    const SETTINGS: Settings = twocan_teensy::configs::LOOPBACK;
 
     #[cortex_m_rt::entry]
     fn main() -> ! {
