@@ -4,6 +4,7 @@
 //! §40.4.1 "Initialization mode": `CAN_BTR` can only be written there; the notes'
 //! `CAN_MCR` bit list for TTCM, ABOM, AWUM, NART, RFLM, TXFP, DBF).
 
+use twocan_core::timing::frame_time::frame_in_flight_wait;
 use twocan_core::timing::{solve, solve_cia, Limits, Timing, TimingError, DEFAULT_TOLERANCE_PPM};
 use twocan_core::TxPolicy;
 
@@ -142,9 +143,23 @@ impl Config {
             Err(e) => return Err(ConfigError::Timing(e)),
         };
         let clock_hz = t.clock_hz;
+        // Each poll reads an APB1 register, at least one APB1 cycle: twice the longest
+        // frame in flight at this rate, in APB1 cycles, bounds the waits that a frame on
+        // the bus delays (at 10 kbit/s and below, more than the default).
+        let wait_iterations = match frame_in_flight_wait(t.bitrate, clock_hz, 2) {
+            Ok(polls) if polls > DEFAULT_WAIT_ITERATIONS as u64 => {
+                if polls > u32::MAX as u64 {
+                    u32::MAX
+                } else {
+                    polls as u32
+                }
+            }
+            _ => DEFAULT_WAIT_ITERATIONS,
+        };
         match t.bxcan_btr() {
             Ok(b) => Ok(Config {
                 clock_hz,
+                wait_iterations,
                 ..Self::with_btr(b)
             }),
             Err(e) => Err(ConfigError::Timing(e)),
@@ -391,6 +406,26 @@ mod tests {
             .loopback(true)
             .silent(true);
         assert_eq!(c.btr_value(), 0x001C_0005 | btr::LBKM | btr::SILM);
+    }
+
+    #[test]
+    fn acknowledge_waits_cover_a_frame_in_flight_at_slow_rates() {
+        // 2.5 kbit/s: the longest frame in flight lasts ~76 ms; the polls (one APB1
+        // cycle at least each) must last longer than that, twice over.
+        let slow = Config::from_bitrate(54_000_000, 2_500).unwrap();
+        let frame_ms =
+            twocan_core::timing::frame_time::MAX_FRAME_IN_FLIGHT_BITS as u64 * 1000 / 2_500;
+        let polls_ms = slow.get_wait_iterations() as u64 * 1000 / 54_000_000;
+        assert!(
+            polls_ms >= 2 * frame_ms - 1,
+            "{polls_ms} ms for {frame_ms} ms"
+        );
+        assert_eq!(
+            Config::from_bitrate(54_000_000, 500_000)
+                .unwrap()
+                .get_wait_iterations(),
+            DEFAULT_WAIT_ITERATIONS
+        );
     }
 
     #[test]

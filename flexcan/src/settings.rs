@@ -46,6 +46,27 @@ pub const DEFAULT_IRQ_PRIORITY: u8 = 64;
 /// covered with margin.
 pub const DEFAULT_HANDSHAKE_POLLS: u32 = 2_000_000;
 
+/// The fastest peripheral bus clock of the Teensy 3.x chips (K64/K66: 60 MHz): one
+/// register poll lasts at least one of its cycles, so a poll count scaled by it lasts at
+/// least the time it stands for.
+const MAX_BUS_CLOCK_HZ: u32 = 60_000_000;
+
+/// The acknowledge wait bound for `bit_rate`: [`DEFAULT_HANDSHAKE_POLLS`], or more when
+/// a frame in flight at that rate (which a freeze request waits for) lasts longer than
+/// that many polls: twice the longest frame in flight, counted in bus-clock polls.
+pub const fn handshake_polls_for(bit_rate: u32) -> u32 {
+    match twocan_core::timing::frame_time::frame_in_flight_wait(bit_rate, MAX_BUS_CLOCK_HZ, 2) {
+        Ok(polls) if polls > DEFAULT_HANDSHAKE_POLLS as u64 => {
+            if polls > u32::MAX as u64 {
+                u32::MAX
+            } else {
+                polls as u32
+            }
+        }
+        _ => DEFAULT_HANDSHAKE_POLLS,
+    }
+}
+
 /// The driver settings (ACAN `ACANSettings`, §16; table 7 gives the defaults).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -129,7 +150,7 @@ impl Settings {
             message_irq_priority: DEFAULT_IRQ_PRIORITY,
             tx_pin_open_collector: false,
             rx_pin_pull_up: false,
-            handshake_polls: DEFAULT_HANDSHAKE_POLLS,
+            handshake_polls: handshake_polls_for(bit_rate),
             error_interrupts: true,
         }
     }
@@ -214,6 +235,22 @@ const fn timing_for(bit_rate: u32) -> Timing {
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn handshake_polls_cover_a_frame_in_flight_at_slow_rates() {
+        use twocan_core::timing::frame_time::MAX_FRAME_IN_FLIGHT_BITS;
+        let s = Settings::new(2_500);
+        let frame_ms = MAX_FRAME_IN_FLIGHT_BITS as u64 * 1000 / 2_500;
+        let polls_ms = s.handshake_polls as u64 * 1000 / MAX_BUS_CLOCK_HZ as u64;
+        assert!(
+            polls_ms >= 2 * frame_ms - 1,
+            "{polls_ms} ms for {frame_ms} ms"
+        );
+        assert_eq!(
+            Settings::new(500_000).handshake_polls,
+            DEFAULT_HANDSHAKE_POLLS
+        );
+    }
+
     use super::*;
 
     #[test]
