@@ -135,6 +135,26 @@ impl<R: Registers, F: Registers> Can<R, F> {
         self.configure(config)
     }
 
+    /// Software master reset (`CAN_MCR.RESET`, RM0410 §40.9.2): every register of the
+    /// controller back to its reset value (the controller asleep), the filter block left
+    /// alone; waits (bounded) for the sleep acknowledge `CAN_MSR.SLAK`. Gives the
+    /// register handles back, to configure the instance again from scratch.
+    ///
+    /// Errors: [`Error::Timeout`] when `SLAK` does not come, with this value handed back.
+    pub fn master_reset(self) -> Result<(R, Option<F>), Failed<Can<R, F>>> {
+        self.regs.write32(MCR, mcr::RESET);
+        let bound = self.bound();
+        match mode::wait_msr(
+            &self.regs,
+            crate::regs::msr::SLAK,
+            crate::regs::msr::SLAK,
+            bound,
+        ) {
+            Ok(()) => Ok(self.release()),
+            Err(error) => Err(Failed { error, value: self }),
+        }
+    }
+
     /// Gives the register handles back (CAN1's for CAN2's filters as the second value).
     pub fn release(self) -> (R, Option<F>) {
         (self.regs, self.filter_regs)

@@ -132,6 +132,12 @@ impl<R: Registers, F: Registers> BxCan<R, F> {
         }
     }
 
+    /// Software master reset of a controller taken back from the driver
+    /// ([`Can::master_reset`]: every controller register to its reset value).
+    pub fn master_reset(self) -> Result<(R, Option<F>), crate::controller::Failed<Can<R, F>>> {
+        self.into_can().master_reset()
+    }
+
     /// Clears the last error code by software (`CAN_ESR.LEC = 0b111`, "set by
     /// software": the hardware overwrites it with the next bus event); the sticky copy
     /// the error status reports reads [`LastErrorCode::None`] too.
@@ -562,6 +568,7 @@ unsafe impl<R: Registers, F: Registers> Hardware for BxCan<R, F> {
                 .config
                 .get_timestamps()
                 .then_some(rdtxr::TIME.get(dt) as u16),
+            hw_match: (rdtxr::FMI.get(dt) as u16) | ((dt >> 4) & 1) as u16 * 0x100,
         })
     }
 

@@ -228,3 +228,25 @@ fn blocking_transmit_fails_off_the_bus_instead_of_spinning() {
     assert_eq!(d.traffic().sent, 5);
     let _ = TxOutcome::Sent;
 }
+
+#[test]
+fn master_reset_puts_every_register_back_and_the_instance_can_start_again() {
+    use twocan_bxcan::regs::{BTR, MCR, MSR};
+    let (can, regs, bus, _peer) = can1_and_peer(&config().loopback(true), &pass_all());
+    let d = driver(can);
+    assert_ne!(regs.model.read32(BTR), 0x0123_0000, "configured");
+    let (r, _) = d.release().master_reset().map_err(|f| f.error).unwrap();
+    // Reset values (RM0410 §40.9.2): MCR 0x0001_0002, MSR 0x0000_0C02 (asleep), BTR
+    // 0x0123_0000.
+    assert_eq!(regs.model.read32(MCR), 0x0001_0002);
+    assert_eq!(regs.model.read32(MSR) & 0x3, 0x2, "SLAK, not INAK");
+    assert_eq!(regs.model.read32(BTR), 0x0123_0000);
+    // And it configures again from scratch.
+    let mut init = Can::can1(r, &config()).map_err(|f| f.error).unwrap();
+    init.set_filters(&pass_all()).unwrap();
+    let mut d = driver(init.enable().map_err(|f| f.error).unwrap());
+    d.try_send(&std(0x42)).unwrap();
+    settle(&bus);
+    d.on_interrupt();
+    assert_eq!(d.traffic().sent, 1);
+}

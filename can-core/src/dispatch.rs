@@ -127,6 +127,7 @@ mod tests {
             frame: Frame::standard(1, &[1, 2]).unwrap(),
             filter,
             timestamp: None,
+            hw_match: 0,
         };
         assert!(d.dispatch(&mut ctx, &rx(0)));
         assert!(d.dispatch(&mut ctx, &rx(2)));

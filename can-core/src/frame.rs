@@ -451,6 +451,10 @@ pub struct RxFrame {
     pub filter: u16,
     /// The controller's time stamp (free-running bit-time counter) when it has one.
     pub timestamp: Option<u16>,
+    /// The hardware's own match index, for users who want it next to the portable
+    /// [`RxFrame::filter`]: bxCAN `CAN_RDTxR.FMI` with the FIFO number in bit 8,
+    /// FlexCAN `RXFIR.IDHIT`.
+    pub hw_match: u16,
 }
 
 #[cfg(test)]

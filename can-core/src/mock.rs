@@ -362,6 +362,7 @@ unsafe impl Hardware for MockHardware {
             frame: *raw,
             filter: index as u16,
             timestamp: None,
+            hw_match: 0,
         })
     }
 

@@ -476,6 +476,7 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
             frame,
             filter,
             timestamp: Some(MbWords::timestamp_of(control)),
+            hw_match: hit as u16,
         })
     }
 

@@ -88,7 +88,7 @@ proptest! {
     fn dispatcher_indices(index in any::<usize>(), filter in any::<u16>()) {
         let mut d: Dispatcher<u32, 8> = Dispatcher::new();
         prop_assert_eq!(d.set(index, |c, _| *c += 1).is_ok(), index < 8);
-        let rx = RxFrame { frame: Frame::standard(1, &[]).unwrap(), filter, timestamp: None };
+        let rx = RxFrame { frame: Frame::standard(1, &[]).unwrap(), filter, timestamp: None, hw_match: 0 };
         let mut ctx = 0;
         let taken = d.dispatch(&mut ctx, &rx);
         prop_assert_eq!(taken, index < 8 && filter as usize == index);

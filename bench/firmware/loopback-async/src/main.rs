@@ -76,7 +76,7 @@ fn loop_back(hw: BxCan<Mmio>) -> Result<bool, Error> {
     };
     let token = run(p.tx.send(&frame), &mut lines).ok_or(Error::WrongMode)??;
     let rx = run(p.rx.recv(), &mut lines).ok_or(Error::WrongMode)??;
-    let done = run(p.tx.completed(token), &mut lines).ok_or(Error::WrongMode)?;
+    let done = run(p.tx.completed(token), &mut lines).ok_or(Error::WrongMode)??;
     Ok(rx.frame == frame && done.token == token)
 }
 
