@@ -440,8 +440,12 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
                 Ok(Some(m)) => {
                     let e = *next;
                     q.pop();
-                    self.queue_len.fetch_sub(1, Ordering::Relaxed);
                     unsafe { hw.load(m, &e.frame, e.token) };
+                    // Only now may the transmit half see an empty queue and take its
+                    // direct path: a core running it beside this one (host threads)
+                    // must not pick the mailbox being loaded here (release: the load's
+                    // register writes come first).
+                    self.queue_len.fetch_sub(1, Ordering::Release);
                 }
                 Ok(None) => {
                     if displaced

@@ -255,10 +255,13 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
         if self.listen_only || self.mode() == MODE_SLEEP {
             return Err(Error::WrongMode);
         }
-        let flags = self.regs.read32(IFLAG1);
+        // The control word first, then the flag: a mailbox reading INACTIVE stays so
+        // until someone loads it, so a clear flag read after it means "settled". (Read
+        // the other way round, a frame ending between the two reads would look free
+        // with its completion unsettled, and the load would overwrite its token.)
         let free = |mb: usize| {
-            flags & iflag1::buf(mb) == 0
-                && cs::CODE.get(self.regs.read32(regs::mb_cs(mb))) == code::TX_INACTIVE
+            cs::CODE.get(self.regs.read32(regs::mb_cs(mb))) == code::TX_INACTIVE
+                && self.regs.read32(IFLAG1) & iflag1::buf(mb) == 0
         };
         if !frame.is_remote() {
             let mb = DATA_MAILBOX as usize;

@@ -85,16 +85,28 @@ fn frame(id: u16, seq: u32) -> Frame {
     Frame::standard(id, &seq.to_le_bytes()).unwrap()
 }
 
+/// Sets the stop flag when its thread unwinds (a failed assertion).
+struct StopOnPanic<'a>(&'a AtomicBool);
+
+impl Drop for StopOnPanic<'_> {
+    fn drop(&mut self) {
+        if std::thread::panicking() {
+            self.0.store(true, Ordering::Release);
+        }
+    }
+}
+
 /// Sends `count` sequenced frames with identifier `id`, then accounts every completion:
 /// one per token, in order, all sent.
 fn sender<H: twocan_core::Hardware>(
     tx: &mut twocan_core::split::Tx<'_, H, 256, FifoQueue<32>, 0, 64>,
     id: u16,
     count: u32,
+    stop: &AtomicBool,
 ) {
     let mut next = 0u32;
     let mut expected_token = 0u32;
-    while expected_token < count {
+    while expected_token < count && !stop.load(Ordering::Acquire) {
         if next < count {
             match tx.try_send(&frame(id, next)) {
                 Ok(t) => {
@@ -107,7 +119,10 @@ fn sender<H: twocan_core::Hardware>(
         }
         while let Some(c) = tx.take_completion() {
             assert_eq!(c.outcome, TxOutcome::Sent);
-            assert_eq!(c.token.0, expected_token, "completions in order");
+            assert_eq!(
+                c.token.0, expected_token,
+                "completions in order (sender {id:#x}): {c:?}"
+            );
             expected_token += 1;
         }
     }
@@ -164,6 +179,8 @@ fn exchange(per_direction: u32) -> (u32, u32) {
     let flex_parts = flex_state.split(flex_can.into_split()).ok().unwrap();
     let received = [AtomicU32::new(0), AtomicU32::new(0)];
     let done = AtomicBool::new(false);
+    // Set by a thread that panics, so that the others stop instead of spinning on.
+    let stop = AtomicBool::new(false);
 
     std::thread::scope(|s| {
         let (mut bx_tx, mut bx_rx) = (bx_parts.tx, bx_parts.rx);
@@ -175,10 +192,12 @@ fn exchange(per_direction: u32) -> (u32, u32) {
         let world = &world;
         let done = &done;
         let received = &received;
+        let stop = &stop;
 
         // The interrupt context: the bus runs, the raised lines are serviced.
         s.spawn(move || {
-            while !done.load(Ordering::Acquire) {
+            let _stop = StopOnPanic(stop);
+            while !done.load(Ordering::Acquire) && !stop.load(Ordering::Acquire) {
                 let (bx_lines, flex_pending) = {
                     let mut w = world.lock().unwrap();
                     w.bus.run_for(40);
@@ -202,13 +221,20 @@ fn exchange(per_direction: u32) -> (u32, u32) {
         });
 
         // A sender per node: sequenced frames, then every completion accounted.
-        s.spawn(move || sender(&mut bx_tx, 0x200, per_direction));
-        s.spawn(move || sender(&mut fx_tx, 0x100, per_direction));
+        s.spawn(move || {
+            let _stop = StopOnPanic(stop);
+            sender(&mut bx_tx, 0x200, per_direction, stop)
+        });
+        s.spawn(move || {
+            let _stop = StopOnPanic(stop);
+            sender(&mut fx_tx, 0x100, per_direction, stop)
+        });
 
         // A receiver per node: every frame of the peer, once, in order.
         s.spawn(move || {
+            let _stop = StopOnPanic(stop);
             let mut expect = 0u32;
-            while expect < per_direction {
+            while expect < per_direction && !stop.load(Ordering::Acquire) {
                 match bx_rx.receive() {
                     Ok(rx) => {
                         assert_eq!(rx.frame, frame(0x100, expect), "bxCAN node");
@@ -220,8 +246,9 @@ fn exchange(per_direction: u32) -> (u32, u32) {
             }
         });
         s.spawn(move || {
+            let _stop = StopOnPanic(stop);
             let mut expect = 0u32;
-            while expect < per_direction {
+            while expect < per_direction && !stop.load(Ordering::Acquire) {
                 match fx_rx.receive() {
                     Ok(rx) => {
                         assert_eq!(rx.frame, frame(0x200, expect), "FlexCAN node");
@@ -231,7 +258,9 @@ fn exchange(per_direction: u32) -> (u32, u32) {
                     Err(_) => std::thread::yield_now(),
                 }
             }
-            while received[0].load(Ordering::Acquire) < per_direction {
+            while received[0].load(Ordering::Acquire) < per_direction
+                && !stop.load(Ordering::Acquire)
+            {
                 std::thread::yield_now();
             }
             done.store(true, Ordering::Release);
