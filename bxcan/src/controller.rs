@@ -141,6 +141,7 @@ impl<R: Registers, F: Registers> Can<R, F> {
     /// register handles back, to configure the instance again from scratch.
     ///
     /// Errors: [`Error::Timeout`] when `SLAK` does not come, with this value handed back.
+    #[allow(clippy::result_large_err, clippy::type_complexity)]
     pub fn master_reset(self) -> Result<(R, Option<F>), Failed<Can<R, F>>> {
         self.regs.write32(MCR, mcr::RESET);
         let bound = self.bound();

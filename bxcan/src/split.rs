@@ -134,6 +134,7 @@ impl<R: Registers, F: Registers> BxCan<R, F> {
 
     /// Software master reset of a controller taken back from the driver
     /// ([`Can::master_reset`]: every controller register to its reset value).
+    #[allow(clippy::result_large_err, clippy::type_complexity)]
     pub fn master_reset(self) -> Result<(R, Option<F>), crate::controller::Failed<Can<R, F>>> {
         self.into_can().master_reset()
     }
@@ -568,7 +569,7 @@ unsafe impl<R: Registers, F: Registers> Hardware for BxCan<R, F> {
                 .config
                 .get_timestamps()
                 .then_some(rdtxr::TIME.get(dt) as u16),
-            hw_match: (rdtxr::FMI.get(dt) as u16) | ((dt >> 4) & 1) as u16 * 0x100,
+            hw_match: (rdtxr::FMI.get(dt) as u16) | ((((dt >> 4) & 1) as u16) << 8),
         })
     }
 

@@ -12,8 +12,10 @@ use twocan_flexcan::{
 };
 use twocan_teensy::{configs, filters_example};
 
-/// (example, instance, settings, primary, secondary).
-fn examples() -> Vec<(&'static str, Instance, Settings, Vec<Filter>, Vec<Filter>)> {
+/// One example's configuration: (example, instance, settings, primary, secondary).
+type Example = (&'static str, Instance, Settings, Vec<Filter>, Vec<Filter>);
+
+fn examples() -> Vec<Example> {
     let node1 = App::new(1, 2);
     let node2 = App::new(2, 1);
     vec![
