@@ -31,6 +31,7 @@
 mod cmd;
 mod firmware;
 mod models;
+mod planner;
 mod qemu;
 mod report;
 mod simspeed;
@@ -248,7 +249,8 @@ fn run() -> Result<()> {
         std::fs::write(&path, json + "\n").context(format!("writing {}", path.display()))?;
         eprintln!("can-bench: wrote {}", path.display());
     }
-    let text = report.render()?;
+    eprintln!("can-bench: ==> filter planner quality on the identifier corpus");
+    let text = report.render()? + "\n" + &planner::report();
     println!("{text}");
     if skip.is_empty() {
         let path = paths.root.join("docs").join("benchmarks.md");
