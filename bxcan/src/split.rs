@@ -19,10 +19,10 @@
 use core::cell::UnsafeCell;
 use core::sync::atomic::{AtomicU32, AtomicU8, Ordering};
 
-use twocan_core::hardware::{Completion, Settled, StatusEvents, Token, TxFailure};
+use twocan_core::hardware::{sort_by_token, Completion, Settled, StatusEvents, Token, TxFailure};
 use twocan_core::{
-    Error, ErrorCounters, ErrorState, ErrorStatus, Frame, Hardware, LastErrorCode, Mode, Priority,
-    Registers, RxFrame, TxOutcome, TxPolicy,
+    AtomicLastError, Error, ErrorCounters, ErrorState, ErrorStatus, Frame, Hardware, LastErrorCode,
+    Mode, Priority, Registers, RxFrame, TxOutcome, TxPolicy,
 };
 use twocan_core::{MailboxId, MailboxState};
 
@@ -77,7 +77,7 @@ pub struct BxCan<R: Registers, F: Registers = R> {
     displaced: UnsafeCell<[Frame; TX_MAILBOXES]>,
     /// The last error code latched (`LastErrorCode` as its index), kept after LEC is
     /// set to 0b111.
-    last_error: AtomicU8,
+    last_error: AtomicLastError,
 }
 
 // SAFETY: the atomics are shared; `displaced` is touched by the transmit interrupt's
@@ -99,23 +99,9 @@ impl<R: Registers, F: Registers> Can<R, F> {
             displacing: AtomicU8::new(0),
             aborting: AtomicU8::new(0),
             displaced: UnsafeCell::new([Frame::default(); TX_MAILBOXES]),
-            last_error: AtomicU8::new(0),
+            last_error: AtomicLastError::new(LastErrorCode::None),
         }
     }
-}
-
-const CODES: [LastErrorCode; 7] = [
-    LastErrorCode::None,
-    LastErrorCode::Stuff,
-    LastErrorCode::Form,
-    LastErrorCode::Acknowledge,
-    LastErrorCode::BitRecessive,
-    LastErrorCode::BitDominant,
-    LastErrorCode::Crc,
-];
-
-fn code_index(c: LastErrorCode) -> u8 {
-    CODES.iter().position(|&x| x == c).unwrap_or(0) as u8
 }
 
 impl<R: Registers, F: Registers> BxCan<R, F> {
@@ -144,7 +130,7 @@ impl<R: Registers, F: Registers> BxCan<R, F> {
     /// the error status reports reads [`LastErrorCode::None`] too.
     pub fn clear_last_error(&self) {
         self.regs.write32(ESR, esr::LEC.val(esr::LEC_SOFTWARE));
-        self.last_error.store(0, Ordering::Relaxed);
+        self.last_error.store(LastErrorCode::None);
     }
 
     /// The operating mode the acknowledge bits (`CAN_MSR.INAK`, `SLAK`) show now.
@@ -300,22 +286,7 @@ impl<R: Registers, F: Registers> BxCan<R, F> {
             n += 1;
         }
         let ended = &mut ended[..n];
-        let base = ended.iter().map(|e| e.0).fold(ended[0].0, |a, b| {
-            if (b.wrapping_sub(a) as i32) < 0 {
-                b
-            } else {
-                a
-            }
-        });
-        // At most three entries: an insertion sort by distance from the oldest token
-        // (no generic sort linked).
-        for i in 1..ended.len() {
-            let mut j = i;
-            while j > 0 && ended[j].0.wrapping_sub(base) < ended[j - 1].0.wrapping_sub(base) {
-                ended.swap(j, j - 1);
-                j -= 1;
-            }
-        }
+        sort_by_token(ended);
         for (_, s) in ended.iter() {
             f(*s);
         }
@@ -346,12 +317,12 @@ impl<R: Registers, F: Registers> BxCan<R, F> {
         // (the handler reports and clears it; reading it here changes nothing).
         let code = lec(esr::LEC.get(e));
         if code != LastErrorCode::None {
-            self.last_error.store(code_index(code), Ordering::Relaxed);
+            self.last_error.store(code);
         }
         ErrorStatus {
             state,
             counters,
-            last_error: CODES[self.last_error.load(Ordering::Relaxed) as usize % CODES.len()],
+            last_error: self.last_error.load(),
         }
     }
 }
@@ -605,7 +576,7 @@ unsafe impl<R: Registers, F: Registers> Hardware for BxCan<R, F> {
         let e = self.regs.read32(ESR);
         let code = lec(esr::LEC.get(e));
         let bus_error = if code != LastErrorCode::None {
-            self.last_error.store(code_index(code), Ordering::Relaxed);
+            self.last_error.store(code);
             self.regs.write32(ESR, esr::LEC.val(esr::LEC_SOFTWARE));
             Some(code)
         } else {

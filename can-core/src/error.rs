@@ -69,6 +69,41 @@ pub enum LastErrorCode {
     Crc,
 }
 
+/// A [`LastErrorCode`] shared between contexts (the status interrupt writes it, any
+/// context reads it): one relaxed atomic byte, zero-initialised as
+/// [`LastErrorCode::None`].
+#[derive(Debug, Default)]
+pub struct AtomicLastError(core::sync::atomic::AtomicU8);
+
+impl AtomicLastError {
+    const CODES: [LastErrorCode; 7] = [
+        LastErrorCode::None,
+        LastErrorCode::Stuff,
+        LastErrorCode::Form,
+        LastErrorCode::Acknowledge,
+        LastErrorCode::BitRecessive,
+        LastErrorCode::BitDominant,
+        LastErrorCode::Crc,
+    ];
+
+    /// Holding `code`.
+    pub const fn new(code: LastErrorCode) -> Self {
+        AtomicLastError(core::sync::atomic::AtomicU8::new(code as u8))
+    }
+
+    /// The code held.
+    pub fn load(&self) -> LastErrorCode {
+        let i = self.0.load(core::sync::atomic::Ordering::Relaxed) as usize;
+        Self::CODES[i % Self::CODES.len()]
+    }
+
+    /// Replaces the code held.
+    pub fn store(&self, code: LastErrorCode) {
+        self.0
+            .store(code as u8, core::sync::atomic::Ordering::Relaxed);
+    }
+}
+
 /// Error statistics counters the driver keeps (saturating).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -256,6 +291,26 @@ impl core::error::Error for crate::sim::bus::StillBusy {}
 
 #[cfg(test)]
 mod tests {
+
+    #[test]
+    fn atomic_last_error_keeps_every_code() {
+        use super::{AtomicLastError, LastErrorCode as L};
+        let cell = AtomicLastError::default();
+        assert_eq!(cell.load(), L::None);
+        for c in [
+            L::Stuff,
+            L::Form,
+            L::Acknowledge,
+            L::BitRecessive,
+            L::BitDominant,
+            L::Crc,
+            L::None,
+        ] {
+            cell.store(c);
+            assert_eq!(cell.load(), c);
+        }
+    }
+
     use super::*;
     use embedded_can::{Error as _, ErrorKind};
 

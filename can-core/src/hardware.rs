@@ -65,6 +65,31 @@ pub enum Settled {
     DoneDisplacing(Completion),
 }
 
+/// Puts `ended` — mailboxes that ended between two transmit interrupts, each with its
+/// token — in token (acceptance) order, across the tokens' wrap: the order in which
+/// [`Hardware::settle`] reports them. An insertion sort: at most a handful of entries,
+/// and no generic sort linked into firmware.
+pub fn sort_by_token<T>(ended: &mut [(u32, T)]) {
+    let Some(first) = ended.first() else {
+        return;
+    };
+    // The oldest token: the one no other is before (wrapping comparison).
+    let base = ended.iter().fold(first.0, |oldest, e| {
+        if (e.0.wrapping_sub(oldest) as i32) < 0 {
+            e.0
+        } else {
+            oldest
+        }
+    });
+    for i in 1..ended.len() {
+        let mut j = i;
+        while j > 0 && ended[j].0.wrapping_sub(base) < ended[j - 1].0.wrapping_sub(base) {
+            ended.swap(j, j - 1);
+            j -= 1;
+        }
+    }
+}
+
 /// What the status interrupt found.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct StatusEvents {
@@ -202,4 +227,17 @@ pub unsafe trait Hardware {
 
     /// Starts bus-off recovery by software.
     fn recover(&self) -> Result<(), Error>;
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn tokens_sort_in_acceptance_order_across_the_wrap() {
+        let mut e = [(1u32, 'c'), (u32::MAX, 'a'), (0, 'b')];
+        super::sort_by_token(&mut e);
+        assert_eq!(e.map(|x| x.1), ['a', 'b', 'c']);
+        let mut one = [(7u32, ())];
+        super::sort_by_token(&mut one);
+        super::sort_by_token::<()>(&mut []);
+    }
 }

@@ -84,7 +84,9 @@ pub use controller::{ErrorStatus, Mode};
 pub use dispatch::Dispatcher;
 pub use driver::{Driver, TrafficStats};
 pub use embedded_can::{ExtendedId, Id, StandardId};
-pub use error::{Error, ErrorCounters, ErrorState, ErrorStatistics, LastErrorCode};
+pub use error::{
+    AtomicLastError, Error, ErrorCounters, ErrorState, ErrorStatistics, LastErrorCode,
+};
 pub use filter::{Filter, FilterError, Format, FrameKind};
 pub use frame::{Frame, FrameError, RxFrame};
 pub use hardware::{Completion, Hardware, Settled, StatusEvents, Token, TxFailure};

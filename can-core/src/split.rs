@@ -1053,67 +1053,8 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
     }
 }
 
-// SAFETY (all handles): a handle is a shared reference to a `Sync` state plus data
-// owned by its context; moving it to another context is what it is for.
-unsafe impl<
-        H: Hardware + Sync,
-        const RX: usize,
-        Q: TxQueue + Send,
-        const RX1: usize,
-        const DONE: usize,
-    > Send for Tx<'_, H, RX, Q, RX1, DONE>
-where
-    H::Raw: Send,
-{
-}
-// SAFETY: as for `Tx`; the filter map is `Send`.
-unsafe impl<
-        H: Hardware + Sync,
-        const RX: usize,
-        Q: TxQueue + Send,
-        const RX1: usize,
-        const DONE: usize,
-    > Send for Rx<'_, H, RX, Q, RX1, DONE>
-where
-    H::Raw: Send,
-{
-}
-// SAFETY: as for `Tx`.
-unsafe impl<
-        H: Hardware + Sync,
-        const RX: usize,
-        Q: TxQueue + Send,
-        const RX1: usize,
-        const DONE: usize,
-    > Send for TxIrq<'_, H, RX, Q, RX1, DONE>
-where
-    H::Raw: Send,
-{
-}
-// SAFETY: as for `Tx`.
-unsafe impl<
-        H: Hardware + Sync,
-        const RX: usize,
-        Q: TxQueue + Send,
-        const RX1: usize,
-        const DONE: usize,
-    > Send for RxIrq<'_, H, RX, Q, RX1, DONE>
-where
-    H::Raw: Send,
-{
-}
-// SAFETY: as for `Tx`.
-unsafe impl<
-        H: Hardware + Sync,
-        const RX: usize,
-        Q: TxQueue + Send,
-        const RX1: usize,
-        const DONE: usize,
-    > Send for StatusIrq<'_, H, RX, Q, RX1, DONE>
-where
-    H::Raw: Send,
-{
-}
+// The handles need no `unsafe impl Send`: each is a shared reference to the state
+// (`Send` exactly when the state is `Sync`, see above) plus data owned by its context.
 
 /// Errors of the control operations shared by both halves.
 impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize>

@@ -21,10 +21,10 @@
 
 use core::sync::atomic::{AtomicU32, AtomicU8, Ordering};
 
-use twocan_core::hardware::{Completion, Settled, StatusEvents, Token};
+use twocan_core::hardware::{sort_by_token, Completion, Settled, StatusEvents, Token};
 use twocan_core::{
-    Error, ErrorCounters, ErrorState, ErrorStatus, Frame, Hardware, LastErrorCode, Mode, Registers,
-    RxFrame, TxOutcome, TxPolicy,
+    AtomicLastError, Error, ErrorCounters, ErrorState, ErrorStatus, Frame, Hardware, LastErrorCode,
+    Mode, Registers, RxFrame, TxOutcome, TxPolicy,
 };
 use twocan_core::{MailboxId, MailboxState};
 
@@ -56,20 +56,6 @@ fn mode_code(m: Mode) -> u8 {
     }
 }
 
-const CODES: [LastErrorCode; 7] = [
-    LastErrorCode::None,
-    LastErrorCode::Stuff,
-    LastErrorCode::Form,
-    LastErrorCode::Acknowledge,
-    LastErrorCode::BitRecessive,
-    LastErrorCode::BitDominant,
-    LastErrorCode::Crc,
-];
-
-fn code_index(c: LastErrorCode) -> u8 {
-    CODES.iter().position(|&x| x == c).unwrap_or(0) as u8
-}
-
 /// A FlexCAN instance shared by the halves and handlers of the split driver.
 pub struct FlexCanHw<R: Registers> {
     regs: R,
@@ -86,7 +72,7 @@ pub struct FlexCanHw<R: Registers> {
     mode: AtomicU8,
     /// Token of the frame in each transmit mailbox, indexed by `15 - MB`.
     tokens: [AtomicU32; MAX_TX],
-    last_error: AtomicU8,
+    last_error: AtomicLastError,
     /// Written by the receive half's `decode` only.
     unresolved: AtomicU32,
     /// Transmit mailboxes loaded and not settled yet (bit per MB): a flag raised by a
@@ -109,7 +95,7 @@ impl<R: Registers> FlexCan<R> {
             irq_priority: self.irq_priority,
             mode: AtomicU8::new(mode_code(mode)),
             tokens: [const { AtomicU32::new(0) }; MAX_TX],
-            last_error: AtomicU8::new(code_index(self.last_error.get())),
+            last_error: AtomicLastError::new(self.last_error.get()),
             unresolved: AtomicU32::new(0),
             loaded: AtomicU32::new(0),
         }
@@ -174,13 +160,13 @@ impl<R: Registers> FlexCanHw<R> {
     fn latch(&self, esr: u32) -> Option<LastErrorCode> {
         let code = status::last_error(esr);
         if let Some(c) = code {
-            self.last_error.store(code_index(c), Ordering::Relaxed);
+            self.last_error.store(c);
         }
         code
     }
 
     fn last_error(&self) -> LastErrorCode {
-        CODES[self.last_error.load(Ordering::Relaxed) as usize % CODES.len()]
+        self.last_error.load()
     }
 
     fn status_now(&self) -> ErrorStatus {
@@ -342,16 +328,7 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
             n += 1;
         }
         let out = &mut out[..n];
-        if n > 1 {
-            let base = out.iter().map(|e| e.0).fold(out[0].0, |a, b| {
-                if (b.wrapping_sub(a) as i32) < 0 {
-                    b
-                } else {
-                    a
-                }
-            });
-            out.sort_unstable_by_key(|e| e.0.wrapping_sub(base));
-        }
+        sort_by_token(out);
         for (_, c) in out.iter() {
             f(Settled::Done(*c));
         }
