@@ -6,7 +6,7 @@ use twocan_core::{Error, LastErrorCode, Mode, Registers};
 
 use crate::config::Config;
 use crate::filter_block;
-use crate::filters::{Fifo, FilterPlan, FmiMap};
+use crate::filters::{Fifo, FilterPlan, FmiMap, LOOKUP_KEYS};
 use crate::instance::Instance;
 use crate::mode;
 use crate::planner::{self, FifoPolicy, PlanOptions};
@@ -37,20 +37,24 @@ impl<T> From<Failed<T>> for Error {
 /// behavioural model on the host). `F` reaches the filter registers of CAN1 for CAN2
 /// (see [`Can::can2`]); CAN1 and CAN3 use their own registers and `F` is unused.
 #[derive(Debug)]
-pub struct Can<R: Registers, F: Registers = R> {
+///
+/// `K` is how many identifiers of merged filters the driver can map back to the user's
+/// filter index ([`FmiMap`], 6 bytes each, [`LOOKUP_KEYS`] by default); change it with
+/// [`Init::with_lookup_capacity`].
+pub struct Can<R: Registers, F: Registers = R, const K: usize = LOOKUP_KEYS> {
     pub(crate) regs: R,
     pub(crate) filter_regs: Option<F>,
     pub(crate) instance: Instance,
     pub(crate) config: Config,
-    pub(crate) fmi: FmiMap,
+    pub(crate) fmi: FmiMap<K>,
 }
 
 /// A controller in initialization mode (RM0410 §40.4.1), configured but off the bus.
 /// Install filters with [`Init::set_filters`], then go on the bus with [`Init::enable`].
 #[must_use = "the controller stays in initialization mode, off the bus, until `enable` is called"]
 #[derive(Debug)]
-pub struct Init<R: Registers, F: Registers = R> {
-    can: Can<R, F>,
+pub struct Init<R: Registers, F: Registers = R, const K: usize = LOOKUP_KEYS> {
+    can: Can<R, F, K>,
 }
 
 // The error values hand the whole controller back (nothing is lost on a timeout); its
@@ -100,7 +104,10 @@ impl<R: Registers, F: Registers> Can<R, F> {
     ) -> Result<Init<R, F>, Failed<Can<R, F>>> {
         Can::new(regs, Some(can1_filters), Instance::Can2, config).configure(config)
     }
+}
 
+#[allow(clippy::result_large_err)]
+impl<R: Registers, F: Registers, const K: usize> Can<R, F, K> {
     fn new(regs: R, filter_regs: Option<F>, instance: Instance, config: &Config) -> Self {
         Can {
             regs,
@@ -111,7 +118,7 @@ impl<R: Registers, F: Registers> Can<R, F> {
         }
     }
 
-    fn configure(mut self, config: &Config) -> Result<Init<R, F>, Failed<Can<R, F>>> {
+    fn configure(mut self, config: &Config) -> Result<Init<R, F, K>, Failed<Can<R, F, K>>> {
         self.config = *config;
         let bound = config.get_wait_iterations();
         if let Err(error) = mode::request(&self.regs, Mode::Stopped, bound) {
@@ -131,7 +138,7 @@ impl<R: Registers, F: Registers> Can<R, F> {
     }
 
     /// Re-enters initialization mode with a new configuration (the filters stay).
-    pub fn reconfigure(self, config: &Config) -> Result<Init<R, F>, Failed<Can<R, F>>> {
+    pub fn reconfigure(self, config: &Config) -> Result<Init<R, F, K>, Failed<Can<R, F, K>>> {
         self.configure(config)
     }
 
@@ -142,7 +149,7 @@ impl<R: Registers, F: Registers> Can<R, F> {
     ///
     /// Errors: [`Error::Timeout`] when `SLAK` does not come, with this value handed back.
     #[allow(clippy::result_large_err, clippy::type_complexity)]
-    pub fn master_reset(self) -> Result<(R, Option<F>), Failed<Can<R, F>>> {
+    pub fn master_reset(self) -> Result<(R, Option<F>), Failed<Can<R, F, K>>> {
         self.regs.write32(MCR, mcr::RESET);
         let bound = self.bound();
         match mode::wait_msr(
@@ -215,13 +222,15 @@ impl<R: Registers, F: Registers> Can<R, F> {
     }
 
     fn write_filters(&mut self, plan: &FilterPlan) -> Result<(), Error> {
+        // The map first: a plan the map cannot hold is refused before any bank changes.
+        let fmi = plan.fmi_map::<K>()?;
         let instance = self.instance;
         let r = match &mut self.filter_regs {
             Some(f) => filter_block::program(f, instance, plan),
             None => filter_block::program(&self.regs, instance, plan),
         };
         r.map_err(|_| Error::InvalidArgument)?;
-        self.fmi = plan.fmi_map();
+        self.fmi = fmi;
         Ok(())
     }
 }
@@ -241,19 +250,36 @@ pub fn lec(code: u32) -> LastErrorCode {
 }
 
 #[allow(clippy::result_large_err)]
-impl<R: Registers, F: Registers> Init<R, F> {
+impl<R: Registers, F: Registers, const K: usize> Init<R, F, K> {
+    /// The same controller with room for `K2` identifiers in its merged-filter lookup
+    /// ([`FmiMap`]; `K` = [`LOOKUP_KEYS`] unless chosen): call before
+    /// [`Init::set_filters`] (the map starts empty again). Plans whose merged or
+    /// superset slots need more are refused with [`Error::FilterSpace`].
+    pub fn with_lookup_capacity<const K2: usize>(self) -> Init<R, F, K2> {
+        let c = self.can;
+        Init {
+            can: Can {
+                regs: c.regs,
+                filter_regs: c.filter_regs,
+                instance: c.instance,
+                config: c.config,
+                fmi: FmiMap::empty(),
+            },
+        }
+    }
+
     /// Installs filters before going on the bus (the receive half's `set_filters` installs later lists).
     pub fn set_filters(&mut self, plan: &FilterPlan) -> Result<(), Error> {
         self.can.write_filters(plan)
     }
 
     /// The controller, still in initialization mode (to plan filters for its banks).
-    pub fn can(&self) -> &Can<R, F> {
+    pub fn can(&self) -> &Can<R, F, K> {
         &self.can
     }
 
     /// The controller, still in initialization mode, mutably.
-    pub fn can_mut(&mut self) -> &mut Can<R, F> {
+    pub fn can_mut(&mut self) -> &mut Can<R, F, K> {
         &mut self.can
     }
 
@@ -261,7 +287,7 @@ impl<R: Registers, F: Registers> Init<R, F> {
     /// hardware gives after 11 recessive bits on CANRX (RM0410 §40.4.2).
     ///
     /// Errors: [`Error::Timeout`], with this value handed back in [`Failed::value`].
-    pub fn enable(self) -> Result<Can<R, F>, Failed<Init<R, F>>> {
+    pub fn enable(self) -> Result<Can<R, F, K>, Failed<Init<R, F, K>>> {
         let bound = self.can.bound();
         match mode::request(&self.can.regs, Mode::Normal, bound) {
             Ok(()) => Ok(self.can),

@@ -67,6 +67,10 @@ impl fmt::Display for PlanError {
                 f,
                 "the filters need {needed} filter banks, {available} are available"
             ),
+            PlanError::TooManyLookupKeys { needed, max } => write!(
+                f,
+                "the merged filters leave {needed} identifiers to the driver's lookup, which holds {max}"
+            ),
             PlanError::BankOutOfRange => f.write_str("filter bank index above 27"),
         }
     }

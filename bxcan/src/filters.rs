@@ -23,7 +23,7 @@
 //! [`Filter`]s; [`FilterPlan::manual`] and [`FilterPlan::set_bank`] configure banks
 //! directly.
 
-use twocan_core::filter_set::{key, KeyTable};
+use twocan_core::filter_set::{key, key_parts, KeyTable, MAX_KEYS};
 use twocan_core::{Filter, FilterError, Format, Frame, FrameKind};
 
 use crate::regs::{firx, FILTER_BANKS};
@@ -446,6 +446,14 @@ pub enum PlanError {
         /// Banks of the block.
         available: u8,
     },
+    /// The plan's merged or superset slots leave more identifiers to the thread-side
+    /// lookup than the driver keeps ([`LOOKUP_KEYS`]).
+    TooManyLookupKeys {
+        /// Identifiers that would need the lookup.
+        needed: u16,
+        /// [`LOOKUP_KEYS`].
+        max: u16,
+    },
     /// A bank index beyond the filter block (0..28).
     BankOutOfRange,
 }
@@ -473,6 +481,10 @@ impl From<PlanError> for twocan_core::Error {
                 needed: can1_needed.saturating_add(can2_needed),
                 available: available as u16,
             },
+            PlanError::TooManyLookupKeys { needed, max } => twocan_core::Error::FilterSpace {
+                needed,
+                available: max,
+            },
             PlanError::BankOutOfRange => twocan_core::Error::InvalidArgument,
         }
     }
@@ -488,6 +500,21 @@ pub const LOOKUP: u16 = u16::MAX - 1;
 
 /// The largest number of filter numbers one FIFO can have (28 banks × 4).
 pub const MAX_FMI: usize = FILTER_BANKS * 4;
+
+/// How many identifiers a driver's [`FmiMap`] holds by default for the thread-side
+/// lookup ([`FmiMap::resolve`]): the keys (identifier, format, kind) that reach a mask
+/// slot standing for several user filters, or a superset slot. Slots of one user filter
+/// (list entries, masks of one filter) need no key.
+///
+/// The map lives in the driver's state (6 bytes a key), so the default is sized for
+/// firmware with a modest filter list, not for the planner's
+/// [`crate::planner::MAX_FILTERS`]. Of the project's DBC corpus (`bench/data/`), the
+/// largest exact plan needs 122 keys and the superset plans of the largest sets up to 365:
+/// give such a controller room with [`crate::Init::with_lookup_capacity`] (e.g. 512).
+/// A plan that needs more than the map holds is refused when installed
+/// ([`PlanError::TooManyLookupKeys`], [`twocan_core::Error::FilterSpace`] with both
+/// counts); [`FilterPlan::key_table`] tells how many it needs.
+pub const LOOKUP_KEYS: usize = 64;
 
 /// What the hardware does with a frame under a plan (see [`FilterPlan::evaluate`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -588,10 +615,32 @@ impl FilterPlan {
         self.optimal = optimal;
     }
 
-    pub(crate) fn set_resolution(&mut self, keys: &KeyTable, extra: u64, list_only_banks: u16) {
-        self.keys = keys.clone();
+    /// Keeps, of the user's keys, those the hardware routes to a slot that stands for
+    /// several user filters ([`LOOKUP`]): the only ones [`FmiMap::resolve`] searches.
+    /// Call after every bank and its users are in place.
+    pub(crate) fn set_resolution(
+        &mut self,
+        keys: &KeyTable,
+        extra: u64,
+        list_only_banks: u16,
+    ) -> Result<(), PlanError> {
+        let mut lookup = KeyTable::new();
+        for (&k, &user) in keys.keys().iter().zip(keys.users()) {
+            let (id, ext, rtr) = key_parts(k);
+            if let Some((_, _, LOOKUP)) = self.decide(id, ext, rtr) {
+                // A subset of `keys`, which has the same capacity: it fits.
+                lookup
+                    .insert(k, user)
+                    .map_err(|_| PlanError::TooManyLookupKeys {
+                        needed: keys.len() as u16,
+                        max: MAX_KEYS as u16,
+                    })?;
+            }
+        }
+        self.keys = lookup;
         self.extra = extra;
         self.list_only_banks = list_only_banks;
+        Ok(())
     }
 
     /// Identifiers the hardware accepts beyond the user's filters (0 for an exact plan;
@@ -612,8 +661,9 @@ impl FilterPlan {
         self.list_only_banks
     }
 
-    /// The keys (identifier, format, kind) of the user's whole-identifier filters with
-    /// their user indices: the table [`FmiMap::resolve`] searches.
+    /// The keys (identifier, format, kind) that reach a slot standing for several user
+    /// filters, with their user indices: the table [`FmiMap::resolve`] searches (empty
+    /// for a plan without merged or superset slots).
     pub fn key_table(&self) -> &KeyTable {
         &self.keys
     }
@@ -628,7 +678,11 @@ impl FilterPlan {
         extended: bool,
         remote: bool,
     ) -> Option<u16> {
-        self.fmi_map().resolve(fifo, fmi, raw_id, extended, remote)
+        match self.user_index(fifo, fmi) {
+            NO_FILTER => None,
+            LOOKUP => self.keys.lookup(key(raw_id, extended, remote)),
+            user => Some(user),
+        }
     }
 
     /// Of `traffic` (frames with a weight each, e.g. their rate on the bus), the weight
@@ -692,10 +746,22 @@ impl FilterPlan {
         Some((b.fifo, (before + slot) as u8))
     }
 
-    /// The map from each FIFO's match index to the user's filter index.
-    pub fn fmi_map(&self) -> FmiMap {
-        let mut map = FmiMap::empty();
-        map.keys = self.keys.clone();
+    /// The map from each FIFO's match index to the user's filter index, with room for
+    /// `K` lookup keys (the driver's map: [`LOOKUP_KEYS`] unless the controller was
+    /// given another capacity).
+    ///
+    /// Errors: [`PlanError::TooManyLookupKeys`] when the plan's merged or superset slots
+    /// leave more identifiers to the lookup than `K` ([`FilterPlan::key_table`]).
+    pub fn fmi_map<const K: usize>(&self) -> Result<FmiMap<K>, PlanError> {
+        let mut map = FmiMap::<K>::empty();
+        for (&k, &user) in self.keys.keys().iter().zip(self.keys.users()) {
+            map.keys
+                .insert(k, user)
+                .map_err(|_| PlanError::TooManyLookupKeys {
+                    needed: self.keys.len() as u16,
+                    max: K as u16,
+                })?;
+        }
         let mut next = [0usize; 2];
         for (b, users) in self.banks().iter().zip(self.users.iter()) {
             let f = b.fifo.index();
@@ -706,12 +772,25 @@ impl FilterPlan {
                 next[f] += 1;
             }
         }
-        map
+        Ok(map)
     }
 
-    /// The user index reported for a frame stored in `fifo` with match index `fmi`.
+    /// The user index reported for a frame stored in `fifo` with match index `fmi`
+    /// ([`NO_FILTER`] if no slot has it, [`LOOKUP`] if it depends on the identifier).
     pub fn user_index(&self, fifo: Fifo, fmi: u8) -> u16 {
-        self.fmi_map().get(fifo, fmi)
+        let mut next = 0usize;
+        for (b, users) in self.banks().iter().zip(self.users.iter()) {
+            if b.fifo != fifo {
+                continue;
+            }
+            for &u in users.iter().take(b.kind.slots()) {
+                if next == fmi as usize {
+                    return u;
+                }
+                next += 1;
+            }
+        }
+        NO_FILTER
     }
 
     /// The hardware's decision for a frame, by the notes' rules: among the active banks'
@@ -729,6 +808,20 @@ impl FilterPlan {
     /// [`NO_FILTER`] for a frame a superset plan accepts that no user filter does.
     pub fn evaluate(&self, frame: &Frame) -> Option<Acceptance> {
         let (id, ext, rtr) = (frame.raw_id(), frame.is_extended(), frame.is_remote());
+        self.decide(id, ext, rtr)
+            .map(|(fifo, fmi, user)| Acceptance {
+                fifo,
+                fmi,
+                filter: match user {
+                    LOOKUP => self.keys.lookup(key(id, ext, rtr)).unwrap_or(NO_FILTER),
+                    user => user,
+                },
+            })
+    }
+
+    /// [`FilterPlan::evaluate`] before the key lookup: FIFO, match index and the slot's
+    /// user entry (a user index, [`LOOKUP`] or [`NO_FILTER`]).
+    fn decide(&self, id: u32, ext: bool, rtr: bool) -> Option<(Fifo, u8, u16)> {
         // (class, bank, slot, FIFO, FMI, user index)
         let mut best: Option<(u8, usize, usize, Fifo, u8, u16)> = None;
         for (i, b) in self.banks().iter().enumerate() {
@@ -759,14 +852,7 @@ impl FilterPlan {
                 }
             }
         }
-        best.map(|(_, _, _, fifo, fmi, user)| Acceptance {
-            fifo,
-            fmi,
-            filter: match user {
-                LOOKUP => self.keys.lookup(key(id, ext, rtr)).unwrap_or(NO_FILTER),
-                user => user,
-            },
-        })
+        best.map(|(_, _, _, fifo, fmi, user)| (fifo, fmi, user))
     }
 
     /// Whether any bank of the plan sends frames to `fifo`.
@@ -778,12 +864,12 @@ impl FilterPlan {
 /// Map from (FIFO, filter match index) to the user's filter index, kept by the
 /// controller for [`twocan_core::RxFrame::filter`].
 #[derive(Debug, Clone, PartialEq, Eq)]
-pub struct FmiMap {
+pub struct FmiMap<const K: usize = LOOKUP_KEYS> {
     map: [[u16; MAX_FMI]; 2],
-    keys: KeyTable,
+    keys: KeyTable<K>,
 }
 
-impl FmiMap {
+impl<const K: usize> FmiMap<K> {
     /// A map where nothing maps ([`NO_FILTER`] everywhere).
     pub const fn empty() -> Self {
         FmiMap {
@@ -799,7 +885,7 @@ impl FmiMap {
     /// - a slot of one user filter: that index (a table lookup);
     /// - a mask slot standing for several user filters (merged identifiers) or for a
     ///   superset: the user filter of the frame's identifier, by binary search in the
-    ///   plan's key table (at most ⌈log₂ 1024⌉ = 10 steps); `None` for an identifier no
+    ///   plan's key table (at most ⌈log₂ 256⌉ = 8 steps); `None` for an identifier no
     ///   user filter accepts — a frame the hardware took only because of a superset
     ///   plan, which the driver drops and counts;
     /// - an FMI no slot has (not produced by the hardware for this plan): `None`.

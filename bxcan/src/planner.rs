@@ -929,7 +929,7 @@ fn layout(
     }
     debug_assert_eq!(out.bank_count(), a.banks as usize);
     out.set_optimal(a.proven);
-    out.set_resolution(&prep.keys, extra, list_only_banks);
+    out.set_resolution(&prep.keys, extra, list_only_banks)?;
 
     match options.fifo {
         FifoPolicy::Fifo0 => {}

@@ -29,7 +29,7 @@ use twocan_core::{MailboxId, MailboxState};
 use crate::config::{Config, Recovery};
 use crate::controller::{lec, Can};
 use crate::filter_block;
-use crate::filters::{Fifo, FilterPlan, FmiMap};
+use crate::filters::{Fifo, FilterPlan, FmiMap, LOOKUP_KEYS};
 use crate::instance::Instance;
 use crate::mailbox;
 use crate::mode;
@@ -58,14 +58,16 @@ fn free_of(t: u32, code: usize) -> Option<u8> {
 pub type RawFrame = [u32; 4];
 
 /// A bxCAN instance shared by the halves and handlers of the split driver.
-pub struct BxCan<R: Registers, F: Registers = R> {
+///
+/// `K`: the capacity of the merged-filter lookup ([`FmiMap`]), as the [`Can`] it came from.
+pub struct BxCan<R: Registers, F: Registers = R, const K: usize = LOOKUP_KEYS> {
     regs: R,
     filter_regs: Option<F>,
     instance: Instance,
     config: Config,
     /// The installed filters' map from (FIFO, FMI) to the user's index: touched only
     /// from the receive half's context (`decode`, `install_filters`), so one copy.
-    fmi: UnsafeCell<FmiMap>,
+    fmi: UnsafeCell<FmiMap<K>>,
     /// Token of the frame in each mailbox (written before `TXRQ`).
     tokens: [AtomicU32; TX_MAILBOXES],
     /// Mailboxes whose abort was requested to make room (displacement).
@@ -83,12 +85,12 @@ pub struct BxCan<R: Registers, F: Registers = R> {
 // SAFETY: the atomics are shared; `displaced` is touched by the transmit interrupt's
 // methods only (one context at a time, the `Hardware` contract); the register handles
 // are shared as `Hardware` documents (disjoint registers or write-1-to-clear bits).
-unsafe impl<R: Registers + Sync, F: Registers + Sync> Sync for BxCan<R, F> {}
+unsafe impl<R: Registers + Sync, F: Registers + Sync, const K: usize> Sync for BxCan<R, F, K> {}
 
-impl<R: Registers, F: Registers> Can<R, F> {
+impl<R: Registers, F: Registers, const K: usize> Can<R, F, K> {
     /// The controller for the split driver (`twocan_core::split::State::split`); the
     /// installed filters come along.
-    pub fn into_split(self) -> BxCan<R, F> {
+    pub fn into_split(self) -> BxCan<R, F, K> {
         BxCan {
             regs: self.regs,
             filter_regs: self.filter_regs,
@@ -104,11 +106,11 @@ impl<R: Registers, F: Registers> Can<R, F> {
     }
 }
 
-impl<R: Registers, F: Registers> BxCan<R, F> {
+impl<R: Registers, F: Registers, const K: usize> BxCan<R, F, K> {
     /// Back to the configuration-level controller (for [`Can::reconfigure`]); the
     /// filters installed (and their map) come along. Transmit bookkeeping is dropped:
     /// take it back only when no frame is in flight.
-    pub fn into_can(self) -> Can<R, F> {
+    pub fn into_can(self) -> Can<R, F, K> {
         Can {
             regs: self.regs,
             filter_regs: self.filter_regs,
@@ -121,7 +123,7 @@ impl<R: Registers, F: Registers> BxCan<R, F> {
     /// Software master reset of a controller taken back from the driver
     /// ([`Can::master_reset`]: every controller register to its reset value).
     #[allow(clippy::result_large_err, clippy::type_complexity)]
-    pub fn master_reset(self) -> Result<(R, Option<F>), crate::controller::Failed<Can<R, F>>> {
+    pub fn master_reset(self) -> Result<(R, Option<F>), crate::controller::Failed<Can<R, F, K>>> {
         self.into_can().master_reset()
     }
 
@@ -329,7 +331,7 @@ impl<R: Registers, F: Registers> BxCan<R, F> {
 
 // SAFETY: each method touches the registers its context owns (module docs); `displaced`
 // only from `displace`/`settle` (transmit interrupt context).
-unsafe impl<R: Registers, F: Registers> Hardware for BxCan<R, F> {
+unsafe impl<R: Registers, F: Registers, const K: usize> Hardware for BxCan<R, F, K> {
     type Raw = RawFrame;
     type FilterMap = ();
     type Filters = FilterPlan;
@@ -551,13 +553,15 @@ unsafe impl<R: Registers, F: Registers> Hardware for BxCan<R, F> {
     }
 
     unsafe fn install_filters(&self, filters: &FilterPlan) -> Result<(), Error> {
+        // The map first: a plan it cannot hold is refused before any bank changes.
+        let fmi = filters.fmi_map::<K>()?;
         let r = match &self.filter_regs {
             Some(f) => filter_block::program(f, self.instance, filters),
             None => filter_block::program(&self.regs, self.instance, filters),
         };
         r.map_err(|_| Error::InvalidArgument)?;
         // SAFETY: the receive half's context, the only one touching the map.
-        unsafe { *self.fmi.get() = filters.fmi_map() };
+        unsafe { *self.fmi.get() = fmi };
         Ok(())
     }
 

@@ -76,7 +76,9 @@ fn run(p: &FilterPlan, frames: &[Frame]) -> (Vec<(Frame, u16)>, usize) {
     enter_init(&mut m);
     install(&mut m, p);
     leave_init(&mut m, &mut bus);
-    let map = p.fmi_map();
+    let map = p
+        .fmi_map::<{ twocan_core::filter_set::MAX_KEYS }>()
+        .unwrap();
     let mut delivered = Vec::new();
     let mut dropped = 0;
     for f in frames {

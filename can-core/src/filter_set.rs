@@ -138,28 +138,40 @@ impl Cube {
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Full;
 
-/// A sorted set of keys, each with the user filter index it belongs to.
+/// A sorted set of at most `N` keys, each with the user filter index it belongs to.
+///
+/// The planners work on the full-size table ([`MAX_KEYS`], 6 KiB: a transient on the
+/// planning call's stack); a driver keeps only the keys its merged filters need to
+/// resolve, in a table sized for that (e.g. `twocan_bxcan::filters::LOOKUP_KEYS`).
 #[derive(Debug, Clone, PartialEq, Eq)]
-pub struct KeyTable {
-    keys: [Key; MAX_KEYS],
-    users: [u16; MAX_KEYS],
+pub struct KeyTable<const N: usize = MAX_KEYS> {
+    keys: [Key; N],
+    users: [u16; N],
     len: u16,
 }
 
-impl Default for KeyTable {
+impl<const N: usize> Default for KeyTable<N> {
     fn default() -> Self {
         Self::new()
     }
 }
 
-impl KeyTable {
+impl<const N: usize> KeyTable<N> {
+    /// The capacity.
+    pub const CAPACITY: usize = N;
+
     /// An empty table.
     pub const fn new() -> Self {
         KeyTable {
-            keys: [0; MAX_KEYS],
-            users: [0; MAX_KEYS],
+            keys: [0; N],
+            users: [0; N],
             len: 0,
         }
+    }
+
+    /// The user index of each key, in key order.
+    pub fn users(&self) -> &[u16] {
+        &self.users[..self.len()]
     }
 
     /// Number of keys.
@@ -183,7 +195,7 @@ impl KeyTable {
         match self.keys[..n].binary_search(&k) {
             Ok(_) => Ok(()),
             Err(at) => {
-                if n == MAX_KEYS {
+                if n == N {
                     return Err(Full);
                 }
                 self.keys.copy_within(at..n, at + 1);
