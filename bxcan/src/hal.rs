@@ -55,6 +55,96 @@
 //!
 //! A pin a package lacks (PH13, PI9 on the 100- and 144-pin packages) cannot be split
 //! from the HAL's GPIO port there, so it cannot be passed either.
+//!
+//! The pins are checked by the compiler. CAN1 on PB8 (RX) and PB9 (TX), in AF9:
+//!
+//! ```no_run
+//! # use stm32f7xx_hal::{pac, prelude::*};
+//! # use twocan_bxcan::hal;
+//! # let dp = pac::Peripherals::take().unwrap();
+//! # let rcc = dp.RCC.constrain();
+//! # let clocks = rcc.cfgr.freeze();
+//! # let mut apb1 = rcc.apb1;
+//! let gpiob = dp.GPIOB.split();
+//! let (rx, tx) = (gpiob.pb8.into_alternate::<9>(), gpiob.pb9.into_alternate::<9>());
+//! let can1 = hal::can1(dp.CAN1, tx, rx, &mut apb1, &clocks);
+//! ```
+//!
+//! CAN2's pins (PB5, PB6) given to CAN1 do not compile:
+//!
+//! ```compile_fail
+//! # use stm32f7xx_hal::{pac, prelude::*};
+//! # use twocan_bxcan::hal;
+//! # let dp = pac::Peripherals::take().unwrap();
+//! # let rcc = dp.RCC.constrain();
+//! # let clocks = rcc.cfgr.freeze();
+//! # let mut apb1 = rcc.apb1;
+//! let gpiob = dp.GPIOB.split();
+//! let (rx, tx) = (gpiob.pb5.into_alternate::<9>(), gpiob.pb6.into_alternate::<9>());
+//! let can1 = hal::can1(dp.CAN1, tx, rx, &mut apb1, &clocks);
+//! ```
+//!
+//! Nor does the right pin in another alternate function (PB9 in AF8):
+//!
+//! ```compile_fail
+//! # use stm32f7xx_hal::{pac, prelude::*};
+//! # use twocan_bxcan::hal;
+//! # let dp = pac::Peripherals::take().unwrap();
+//! # let rcc = dp.RCC.constrain();
+//! # let clocks = rcc.cfgr.freeze();
+//! # let mut apb1 = rcc.apb1;
+//! let gpiob = dp.GPIOB.split();
+//! let (rx, tx) = (gpiob.pb8.into_alternate::<9>(), gpiob.pb9.into_alternate::<8>());
+//! let can1 = hal::can1(dp.CAN1, tx, rx, &mut apb1, &clocks);
+//! ```
+//!
+//! Nor TX and RX swapped:
+//!
+//! ```compile_fail
+//! # use stm32f7xx_hal::{pac, prelude::*};
+//! # use twocan_bxcan::hal;
+//! # let dp = pac::Peripherals::take().unwrap();
+//! # let rcc = dp.RCC.constrain();
+//! # let clocks = rcc.cfgr.freeze();
+//! # let mut apb1 = rcc.apb1;
+//! let gpiob = dp.GPIOB.split();
+//! let (rx, tx) = (gpiob.pb8.into_alternate::<9>(), gpiob.pb9.into_alternate::<9>());
+//! let can1 = hal::can1(dp.CAN1, rx, tx, &mut apb1, &clocks);
+//! ```
+//!
+//! And CAN2 takes a [`Can1Filters`], which only [`can1_dual`] makes; CAN1 handed over
+//! alone ([`can1`]) leaves no way to build one:
+//!
+//! ```compile_fail
+//! # use stm32f7xx_hal::{pac, prelude::*};
+//! # use twocan_bxcan::hal;
+//! # let dp = pac::Peripherals::take().unwrap();
+//! # let rcc = dp.RCC.constrain();
+//! # let clocks = rcc.cfgr.freeze();
+//! # let mut apb1 = rcc.apb1;
+//! let gpiob = dp.GPIOB.split();
+//! let (rx, tx) = (gpiob.pb8.into_alternate::<9>(), gpiob.pb9.into_alternate::<9>());
+//! let can1 = hal::can1(dp.CAN1, tx, rx, &mut apb1, &clocks);
+//! let (rx2, tx2) = (gpiob.pb5.into_alternate::<9>(), gpiob.pb6.into_alternate::<9>());
+//! let filters = hal::Can1Filters::default();
+//! let can2 = hal::can2(dp.CAN2, tx2, rx2, &mut apb1, &clocks, filters);
+//! ```
+//!
+//! The same with [`can1_dual`], which gives the handle:
+//!
+//! ```no_run
+//! # use stm32f7xx_hal::{pac, prelude::*};
+//! # use twocan_bxcan::hal;
+//! # let dp = pac::Peripherals::take().unwrap();
+//! # let rcc = dp.RCC.constrain();
+//! # let clocks = rcc.cfgr.freeze();
+//! # let mut apb1 = rcc.apb1;
+//! let gpiob = dp.GPIOB.split();
+//! let (rx, tx) = (gpiob.pb8.into_alternate::<9>(), gpiob.pb9.into_alternate::<9>());
+//! let (can1, filters) = hal::can1_dual(dp.CAN1, tx, rx, &mut apb1, &clocks);
+//! let (rx2, tx2) = (gpiob.pb5.into_alternate::<9>(), gpiob.pb6.into_alternate::<9>());
+//! let can2 = hal::can2(dp.CAN2, tx2, rx2, &mut apb1, &clocks, filters);
+//! ```
 
 use stm32f7xx_hal::gpio::{Alternate, Pin};
 use stm32f7xx_hal::pac;
