@@ -414,6 +414,28 @@ impl HandedOver<CanRegs> {
     /// when `config` was computed for another clock ([`HandedOver::accepts`]);
     /// [`Error::Timeout`] when the controller does not acknowledge initialization mode.
     pub fn configure(self, config: &Config) -> Result<Init<CanRegs>, Failed<Self>> {
+        self.configure_single(config)
+    }
+}
+
+#[allow(clippy::result_large_err)]
+impl HandedOver<ControlRegs, Can1Filters> {
+    /// Configures CAN1 ([`Can::can1_dual`]: `CAN2SB` is written when `config` sets
+    /// [`Config::can2_start_bank`]) or CAN2 ([`Can::can2`]); errors as for a whole
+    /// block's `configure`.
+    pub fn configure(
+        self,
+        config: &Config,
+    ) -> Result<Init<ControlRegs, Can1Filters>, Failed<Self>> {
+        self.configure_dual(config)
+    }
+}
+
+// The register types stay generic below, so that the host tests run the same code over
+// the behavioural model.
+#[allow(clippy::result_large_err)]
+impl<R: Registers> HandedOver<R, R> {
+    fn configure_single(self, config: &Config) -> Result<Init<R, R>, Failed<Self>> {
         if !self.accepts(config) {
             return Err(self.refuse(Error::InvalidArgument));
         }
@@ -430,25 +452,34 @@ impl HandedOver<CanRegs> {
 }
 
 #[allow(clippy::result_large_err)]
-impl HandedOver<ControlRegs, Can1Filters> {
-    /// Configures CAN1 ([`Can::can1_dual`]: `CAN2SB` is written when `config` sets
-    /// [`Config::can2_start_bank`]) or CAN2 ([`Can::can2`]); as
-    /// [`HandedOver::<CanRegs>::configure`](HandedOver::configure).
-    pub fn configure(
-        self,
-        config: &Config,
-    ) -> Result<Init<ControlRegs, Can1Filters>, Failed<Self>> {
-        if !self.accepts(config) {
-            return Err(self.refuse(Error::InvalidArgument));
-        }
-        let apb1_hz = self.apb1_hz;
-        let Some(filters) = self.filters else {
-            // Not built by this module: `can1_dual` and `can2` always set the filters.
-            return Err(self.refuse(Error::InvalidArgument));
+impl<R: Registers, F: Registers> HandedOver<R, F> {
+    fn configure_dual(self, config: &Config) -> Result<Init<R, F>, Failed<Self>> {
+        let accepted = self.accepts(config);
+        let HandedOver {
+            regs,
+            filters,
+            instance,
+            apb1_hz,
+        } = self;
+        let filters = match filters {
+            Some(f) if accepted => f,
+            // Another clock, or no filter handle (not built by this module, whose dual
+            // handles always have one).
+            filters => {
+                return Err(Failed {
+                    error: Error::InvalidArgument,
+                    value: HandedOver {
+                        regs,
+                        filters,
+                        instance,
+                        apb1_hz,
+                    },
+                })
+            }
         };
-        let made = match self.instance {
-            Instance::Can2 => Can::can2(self.regs, filters, config),
-            _ => Can::can1_dual(self.regs, filters, config),
+        let made = match instance {
+            Instance::Can2 => Can::can2(regs, filters, config),
+            _ => Can::can1_dual(regs, filters, config),
         };
         made.map_err(|f| Failed {
             error: f.error,
@@ -469,6 +500,126 @@ mod tests {
         #[cfg(feature = "hal-stm32f7-can3")]
         assert_eq!(pac::CAN3::ptr() as usize, CAN3_BASE);
         let _ = CAN3_BASE;
+    }
+
+    // `configure` over the behavioural model (the same generic code as on target).
+    use crate::model::BxCanModel;
+    use crate::regs::{BTR, FMR, MCR, MSR};
+    use std::{cell::RefCell, rc::Rc};
+    use twocan_core::sim::{Bus, PollClock};
+    use twocan_core::Mode;
+
+    type Regs = PollClock<BxCanModel>;
+
+    fn bus() -> Rc<RefCell<Bus>> {
+        Rc::new(RefCell::new(Bus::new(500_000).unwrap()))
+    }
+
+    fn handed<F: Registers>(
+        regs: Regs,
+        filters: Option<F>,
+        instance: Instance,
+    ) -> HandedOver<Regs, F> {
+        HandedOver {
+            regs,
+            filters,
+            instance,
+            apb1_hz: 54_000_000,
+        }
+    }
+
+    #[test]
+    fn a_config_for_another_clock_is_refused_before_any_register_is_written() {
+        let bus = bus();
+        let model = BxCanModel::can1();
+        let regs = PollClock::new(model.clone(), &bus, MSR);
+        let mcr_at_reset = model.read32(MCR);
+        let h = handed::<Regs>(regs, None, Instance::Can1);
+        assert_eq!(h.config(500_000).unwrap().get_clock_hz(), 54_000_000);
+        let other = Config::from_bitrate(48_000_000, 500_000).unwrap();
+        assert!(!h.accepts(&other));
+        let back = h.configure_single(&other).unwrap_err();
+        assert_eq!(back.error, Error::InvalidArgument);
+        assert_eq!(
+            (back.value.instance(), back.value.apb1_hz()),
+            (Instance::Can1, 54_000_000)
+        );
+        assert_eq!(model.read32(MCR), mcr_at_reset);
+        // The handle handed back configures with a config for its clock.
+        let config = back.value.config(500_000).unwrap();
+        let init = back
+            .value
+            .configure_single(&config)
+            .map_err(|f| f.error)
+            .unwrap();
+        assert_eq!(init.can().mode(), Mode::Stopped);
+        assert_eq!(
+            model.read32(BTR) & 0x03FF_03FF,
+            config.btr_value() & 0x03FF_03FF
+        );
+    }
+
+    #[test]
+    fn a_raw_btr_config_is_the_caller_s_word() {
+        let bus = bus();
+        let model = BxCanModel::can3();
+        let h = handed::<Regs>(
+            PollClock::new(model.clone(), &bus, MSR),
+            None,
+            Instance::Can3,
+        );
+        let raw = Config::from_btr(0x001C_0005).unwrap();
+        assert!(h.accepts(&raw));
+        let init = h.configure_single(&raw).map_err(|f| f.error).unwrap();
+        assert_eq!(init.can().instance(), Instance::Can3);
+        assert_eq!(init.can().bank_range(), (0, 14));
+    }
+
+    #[test]
+    fn dual_handles_share_can1_s_filter_block() {
+        let bus = bus();
+        let (m1, m2) = BxCanModel::can1_can2();
+        let can1 = handed(
+            PollClock::new(m1.clone(), &bus, MSR),
+            Some(m1.clone()),
+            Instance::Can1,
+        );
+        let can2 = handed(
+            PollClock::new(m2.clone(), &bus, MSR),
+            Some(m1.clone()),
+            Instance::Can2,
+        );
+        let config1 = can1.config(500_000).unwrap().can2_start_bank(10).unwrap();
+        let init1 = can1.configure_dual(&config1).map_err(|f| f.error).unwrap();
+        let init2 = can2
+            .configure_dual(&Config::from_bitrate(54_000_000, 500_000).unwrap())
+            .map_err(|f| f.error)
+            .unwrap();
+        assert_eq!(crate::regs::fmr::CAN2SB.get(m1.read32(FMR)), 10);
+        assert_eq!(init1.can().bank_range(), (0, 10));
+        assert_eq!(init2.can().bank_range(), (10, 28));
+        assert_eq!(init2.can().instance(), Instance::Can2);
+    }
+
+    #[test]
+    fn a_dual_handle_without_filters_or_for_another_clock_is_handed_back() {
+        let bus = bus();
+        let (_m1, m2) = BxCanModel::can1_can2();
+        let no_filters =
+            handed::<BxCanModel>(PollClock::new(m2.clone(), &bus, MSR), None, Instance::Can2);
+        let config = Config::from_bitrate(54_000_000, 500_000).unwrap();
+        let back = no_filters.configure_dual(&config).unwrap_err();
+        assert_eq!(back.error, Error::InvalidArgument);
+        assert_eq!(back.value.instance(), Instance::Can2);
+        let (m1, m2) = BxCanModel::can1_can2();
+        let other_clock = handed(PollClock::new(m2, &bus, MSR), Some(m1), Instance::Can2);
+        let config = Config::from_bitrate(27_000_000, 500_000).unwrap();
+        let back = other_clock.configure_dual(&config).unwrap_err();
+        assert_eq!(back.error, Error::InvalidArgument);
+        assert!(
+            back.value.filters.is_some(),
+            "the filter handle comes back too"
+        );
     }
 
     fn tx<CAN, P: TxPin<CAN>>() {}
