@@ -1,4 +1,5 @@
-//! Target-only start-up: clocks, CAN clocks and pins, LED, SysTick, panic handler.
+//! Target-only start-up: clocks, the CAN singletons and pins for the hand-over, LED,
+//! SysTick, panic handler.
 //!
 //! Clocks are set by `stm32f7xx-hal` (RM0410 §5 "Reset and clock control"): SYSCLK
 //! 108 MHz from the PLL, AHB 108 MHz, APB1 54 MHz (its maximum, and bxCAN's clock: the
