@@ -19,12 +19,15 @@
 //!   PA11/PA12, PB8/PB9, PD0/PD1, PI9/PH13) and CAN2 (PB12/PB13, PB5/PB6); CAN3 (PA8/PA15,
 //!   PB3/PB4) uses **AF11** on F76x/F77x — check the data sheet's alternate-function
 //!   table for the pin chosen;
-//! - build the register access: `regs::CanRegs::new(regs::CAN1_BASE)` (an `unsafe`
-//!   promise that nothing else touches the peripheral; the handle reaches the block's
-//!   registers and nothing else). With CAN2, no register has two owners: CAN1 and CAN2
-//!   each get their control registers (`regs::ControlRegs`, `0x000..0x200`) and both
-//!   borrow one `static` `regs::FilterRegs` (CAN1's `0x200..0x320`): `Can::can1_dual`
-//!   and `Can::can2`.
+//! - build the register access. With `stm32f7xx-hal`, the `hal` module (feature
+//!   `hal-stm32f7`) does the three steps above with no `unsafe` in the program: it takes
+//!   the PAC singleton, the pins (typed: only the table's pins in their alternate
+//!   function) and RCC's `APB1` and `Clocks`. Without it: `regs::CanRegs::new(regs::CAN1_BASE)`
+//!   (an `unsafe` promise that nothing else touches the peripheral; the handle reaches the
+//!   block's registers and nothing else). With CAN2, no register has two owners: CAN1 and
+//!   CAN2 each get their control registers (`regs::ControlRegs`, `0x000..0x200`) and both
+//!   borrow CAN1's filter registers (`0x200..0x320`: `hal::Can1Filters`, or a `static`
+//!   `regs::FilterRegs`): `Can::can1_dual` and `Can::can2`.
 //! - CAN2 alone: CAN1 must be clocked, but need not be enabled on the bus, for its filter
 //!   block to take the configuration.
 

@@ -3,79 +3,34 @@
 //! implementation ([`BxCan`]) behind the portable split driver of
 //! [`twocan_core::split`] and the one-struct [`twocan_core::Driver`].
 //!
-//! Quick start on the host, over the behavioural model of CAN1 (feature `model`) in
-//! loop-back mode; firmware runs the same code over [`regs::CanRegs`]:
+//! # Quick start
 //!
-//! ```
-//! # #[cfg(feature = "model")] {
-//! use twocan_bxcan::model::BxCanModel;
-//! use twocan_bxcan::{BxCan, Can, Config, FifoPolicy};
-//! use twocan_core::split::State;
-//! use twocan_core::{FifoQueue, Filter, Frame, TxOutcome};
+//! On the host, over the behavioural model of CAN1 (feature `model`) in loop-back mode;
+//! firmware runs the same code over the registers the HAL hand-over gives. The same
+//! text is compiled and run by the workspace test `tests/tests/first_program.rs`:
 //!
-//! // The state the halves share: a `static` in firmware (zero-initialised, `.bss`);
-//! // here a local, as the model's handle is not `Sync`.
-//! let state: State<BxCan<PollClock<BxCanModel>>, 16, FifoQueue<8>, 16> = State::new();
+#![doc = concat!("```\n", include_str!("../doc/quick_start.rs"), "```")]
 //!
-//! use std::{cell::RefCell, rc::Rc};
-//! use twocan_core::sim::{Bus, PollClock};
+//! In firmware, the `hal` module (feature `hal-stm32f7`) takes `stm32f7xx-hal`'s PAC singleton,
+//! its `Clocks` and the pins in their CAN alternate function, and builds the register
+//! handle ([`regs::CanRegs`], a [`twocan_core::Mmio`] window over the instance's block:
+//! safe code reaches no other address) with no `unsafe` in the program; the state is a
+//! `static`, and the handlers go to the TX, RX0, RX1 and SCE vectors before those are
+//! unmasked (see `examples/stm32f7/src/can.rs`). Compiled by the same test:
 //!
-//! let model = BxCanModel::can1();
-//! let bus = Rc::new(RefCell::new(Bus::new(500_000).unwrap()));
-//! bus.borrow_mut().attach("can1", model.clone());
-//! // Bus time passes while the driver polls CAN_MSR for an acknowledge.
-//! let regs = PollClock::new(model.clone(), &bus, twocan_bxcan::regs::MSR);
-//! let config = Config::from_bitrate(54_000_000, 500_000).unwrap().loopback(true);
-//! let mut init = Can::can1(regs, &config).map_err(|f| f.error).unwrap();
-//! let plan = init.can().plan(&[Filter::standard(0x123)], FifoPolicy::Fifo0).unwrap();
-//! init.set_filters(&plan).unwrap();
-//! let can = init.enable().map_err(|f| f.error).unwrap(); // on the bus
+#![cfg_attr(
+    feature = "hal-stm32f7",
+    doc = concat!("```no_run\n", include_str!("../doc/firmware_quick_start.rs"), "```")
+)]
+#![cfg_attr(
+    not(feature = "hal-stm32f7"),
+    doc = concat!("```ignore\n", include_str!("../doc/firmware_quick_start.rs"), "```")
+)]
 //!
-//! let mut parts = state.split(can.into_split()).ok().unwrap();
-//! let token = parts.tx.try_send(&Frame::standard(0x123, &[1, 2, 3]).unwrap()).unwrap();
-//! bus.borrow_mut().run_for(200); // the frame goes round the loop-back
-//! // The interrupt lines' handlers (TX, RX0) — in firmware, the vectors run them.
-//! parts.tx_irq.on_interrupt();
-//! parts.rx0_irq.on_interrupt();
-//! let rx = parts.rx.receive().unwrap();
-//! assert_eq!((rx.frame.raw_id(), rx.filter), (0x123, 0)); // the user's filter index
-//! let done = parts.tx.take_completion().unwrap();
-//! assert_eq!((done.token, done.outcome), (token, TxOutcome::Sent));
-//! # }
-//! ```
-//!
-//! In firmware the register handle is [`regs::CanRegs`] (a [`twocan_core::Mmio`] window
-//! over the instance's block: safe code reaches no other address) at its base, the
-//! state a `static`, and the handlers go to the TX, RX0, RX1 and SCE vectors before those
-//! are unmasked (see `examples/stm32f7/src/can.rs`):
-//!
-//! ```no_run
-//! use twocan_bxcan::regs::{self, CanRegs};
-//! use twocan_bxcan::{BxCan, Can, Config, FifoPolicy, Recovery};
-//! use twocan_core::split::State;
-//! use twocan_core::{FifoQueue, Filter};
-//!
-//! static CAN1: State<BxCan<CanRegs>, 32, FifoQueue<16>, 32> = State::new();
-//!
-//! fn start() -> Result<(), twocan_core::Error> {
-//!     // Firmware first: RCC_APB1ENR.CAN1EN = 1, PD0/PD1 in AF9 (see `instance`).
-//!     // SAFETY: CAN1's registers, clocked, used by nothing else.
-//!     let regs = unsafe { CanRegs::new(regs::CAN1_BASE) };
-//!     let config = Config::from_bitrate(54_000_000, 500_000)
-//!         .map_err(|_| twocan_core::Error::InvalidArgument)?
-//!         .recovery(Recovery::Automatic);
-//!     let mut init = Can::can1(regs, &config)?; // initialization mode, #[must_use]
-//!     let filters = [Filter::standard(0x100), Filter::extended(0x1234_5678)];
-//!     let plan = init.can().plan(&filters, FifoPolicy::Fifo0)?;
-//!     init.set_filters(&plan)?;
-//!     let can = init.enable()?; // on the bus (bounded wait on INAK)
-//!     let parts = CAN1.split(can.into_split()).map_err(|(e, _)| e)?;
-//!     // Move parts.tx_irq / rx0_irq / rx1_irq / status_irq to the four vectors, then
-//!     // unmask them; parts.tx and parts.rx belong to thread code or tasks.
-//!     # let _ = parts;
-//!     Ok(())
-//! }
-//! ```
+//! Without the HAL, a register handle is built from the instance's base address with an
+//! `unsafe` promise that nothing else reaches it: `unsafe { CanRegs::new(regs::CAN1_BASE) }`
+//! (CAN1 and CAN2 sharing the filter block: [`regs::ControlRegs`] each, and one
+//! [`regs::FilterRegs`] lent to both, see [`Can::can1_dual`]).
 //!
 //! Modules:
 //! - [`config`]: the builder ([`Config`]): bit timing (solver or raw `CAN_BTR`), loop-back
@@ -86,6 +41,8 @@
 //! - [`filters`]: banks ([`Bank`]), direct configuration, match-index numbering, the
 //!   compiled [`FilterPlan`]; [`planner`]: portable filters → fewest banks, exactly;
 //! - [`instance`]: CAN1/CAN2/CAN3 and what the firmware must do (RCC, AF9);
+//! - `hal` (feature `hal-stm32f7`): the hand-over from `stm32f7xx-hal` (singletons,
+//!   clocks, typed pins; CAN2 only with CAN1's filter-block handle);
 //! - [`regs`]: the register map.
 //!
 //! # Critical sections
@@ -110,6 +67,11 @@ pub mod controller;
 mod error;
 pub mod filter_block;
 pub mod filters;
+// The hand-over from `stm32f7xx-hal`: the one `unsafe` turning a consumed PAC singleton
+// into a register window.
+#[cfg(feature = "hal-stm32f7")]
+#[allow(unsafe_code)]
+pub mod hal;
 pub mod instance;
 mod mailbox;
 mod mode;

@@ -19,8 +19,8 @@ pub const COMPLETIONS: usize = 8;
 /// A transmit queue in request order (`TXFP = 1`, the driver's default).
 pub type Queue = FifoQueue<TX>;
 /// The shared state of an instance with registers `R` and filter registers `F` (a
-/// whole block by default; `ControlRegs` and `&'static FilterRegs` for CAN1 and CAN2
-/// sharing CAN1's filters).
+/// whole block by default; `ControlRegs` and `twocan_bxcan::hal::Can1Filters` for CAN1
+/// and CAN2 sharing CAN1's filters).
 pub type CanState<R = CanRegs, F = CanRegs> = State<BxCan<R, F>, RX, Queue, RX, COMPLETIONS>;
 /// The transmit half.
 pub type CanTxHalf<R = CanRegs, F = CanRegs> = Tx<'static, BxCan<R, F>, RX, Queue, RX, COMPLETIONS>;

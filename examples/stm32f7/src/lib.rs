@@ -4,7 +4,8 @@
 //!
 //! - [`board`]: the board facts (oscillator, CAN pins, LED), plain data;
 //! - `rt` (target only): clocks with `stm32f7xx-hal` after a bounded probe of the
-//!   external oscillator, CAN peripheral clocks and pins, SysTick, the panic handler;
+//!   external oscillator, the CAN singletons and pins (AF9) for the hand-over of
+//!   `twocan_bxcan::hal`, SysTick, the panic handler;
 //! - [`can`]: the split driver's state and its interrupt vectors' handles;
 //! - [`time`]: the SysTick time base — the very file of `twocan-teensy` (nothing in it
 //!   is chip-specific).

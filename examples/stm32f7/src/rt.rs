@@ -1,4 +1,5 @@
-//! Target-only start-up: clocks, CAN clocks and pins, LED, SysTick, panic handler.
+//! Target-only start-up: clocks, the CAN singletons and pins for the hand-over, LED,
+//! SysTick, panic handler.
 //!
 //! Clocks are set by `stm32f7xx-hal` (RM0410 §5 "Reset and clock control"): SYSCLK
 //! 108 MHz from the PLL, AHB 108 MHz, APB1 54 MHz (its maximum, and bxCAN's clock: the
@@ -13,10 +14,10 @@
 //! target (solder bridges). The HAL's remaining waits (`HSIRDY`, `PLLRDY`, `SWS`) are on
 //! on-chip clocks that always start.
 
-use stm32f7xx_hal::gpio::{Output, Pin, PushPull};
+use stm32f7xx_hal::gpio::{Alternate, Output, Pin, PushPull};
 use stm32f7xx_hal::pac;
 use stm32f7xx_hal::prelude::*;
-use stm32f7xx_hal::rcc::{Enable, HSEClock, HSEClockMode, Reset};
+use stm32f7xx_hal::rcc::{HSEClock, HSEClockMode, APB1};
 
 use crate::board::BOARD;
 
@@ -36,6 +37,25 @@ pub type Led = Pin<'B', 0, Output<PushPull>>;
 /// The LED pin of the board.
 #[cfg(feature = "disco-f746g")]
 pub type Led = Pin<'I', 1, Output<PushPull>>;
+
+/// CAN1_RX of the board, in AF9 (see [`crate::board`]).
+#[cfg(feature = "nucleo-f767zi")]
+pub type Can1Rx = Pin<'D', 0, Alternate<9>>;
+/// CAN1_TX of the board, in AF9.
+#[cfg(feature = "nucleo-f767zi")]
+pub type Can1Tx = Pin<'D', 1, Alternate<9>>;
+/// CAN1_RX of the board, in AF9 (see [`crate::board`]).
+#[cfg(feature = "disco-f746g")]
+pub type Can1Rx = Pin<'B', 8, Alternate<9>>;
+/// CAN1_TX of the board, in AF9.
+#[cfg(feature = "disco-f746g")]
+pub type Can1Tx = Pin<'B', 9, Alternate<9>>;
+/// CAN2_RX of the board, in AF9 (NUCLEO-F767ZI only).
+#[cfg(feature = "nucleo-f767zi")]
+pub type Can2Rx = Pin<'B', 5, Alternate<9>>;
+/// CAN2_TX of the board, in AF9.
+#[cfg(feature = "nucleo-f767zi")]
+pub type Can2Tx = Pin<'B', 6, Alternate<9>>;
 
 /// Starts the HSE (bypass or crystal as the board needs) and waits at most `polls` reads
 /// for `HSERDY`. Leaves it off and returns `false` when it does not come.
@@ -59,11 +79,24 @@ pub struct Boot {
     pub hse: bool,
     /// The user LED, off.
     pub led: Led,
+    /// The APB1 bus of RCC: the bxCAN hand-over (`twocan_bxcan::hal`) enables and
+    /// resets the CAN clocks through it.
+    pub apb1: APB1,
+    /// CAN1's PAC singleton, for `twocan_bxcan::hal::can1` or `can1_dual`.
+    pub can1: pac::CAN1,
+    /// CAN1's pins, in AF9.
+    pub can1_pins: (Can1Tx, Can1Rx),
+    /// CAN2's PAC singleton, for `twocan_bxcan::hal::can2`.
+    #[cfg(feature = "nucleo-f767zi")]
+    pub can2: pac::CAN2,
+    /// CAN2's pins, in AF9.
+    #[cfg(feature = "nucleo-f767zi")]
+    pub can2_pins: (Can2Tx, Can2Rx),
 }
 
-/// The common start of every example: clocks, SysTick, LED; CAN1 (and CAN2 where the
-/// board has pins for it) clocked, reset and routed to its AF9 pins. Call once, first
-/// thing in `main`.
+/// The common start of every example: clocks, SysTick, LED; CAN1's (and CAN2's, where
+/// the board has pins for it) PAC singleton and pins in AF9, for the hand-over
+/// (`twocan_bxcan::hal`). Call once, first thing in `main`.
 pub fn boot() -> Boot {
     let core = cortex_m::Peripherals::take();
     let dp = pac::Peripherals::take();
@@ -72,7 +105,7 @@ pub fn boot() -> Boot {
     };
 
     let hse = hse_starts(&dp.RCC, HSE_POLLS);
-    let mut rcc = dp.RCC.constrain();
+    let rcc = dp.RCC.constrain();
     let mut cfgr = rcc.cfgr;
     if hse {
         let mode = if BOARD.hse_bypass {
@@ -87,46 +120,27 @@ pub fn boot() -> Boot {
         .pclk1(BOARD.apb1_hz.Hz())
         .freeze();
 
-    // bxCAN clocks (RM0410 §5.3.13 RCC_APB1ENR.CAN1EN / CAN2EN); CAN2's filters live in
-    // CAN1, so CAN1 is clocked whenever CAN2 is used.
-    pac::CAN1::enable(&mut rcc.apb1);
-    pac::CAN1::reset(&mut rcc.apb1);
-    // The PAC singleton is consumed: CAN1's registers belong to the bxCAN driver now.
-    let _can1: pac::CAN1 = dp.CAN1;
-
-    // Pins in AF9 (the pin objects are not needed afterwards: the mode stays).
+    // The CAN pins in AF9; the CAN clocks are enabled by the hand-over
+    // (`twocan_bxcan::hal`), which takes the singletons, the pins and `rcc.apb1`.
     #[cfg(feature = "nucleo-f767zi")]
-    {
+    let (can1_pins, can2_pins, led) = {
         let gpiod = dp.GPIOD.split();
-        let _ = (
-            gpiod.pd0.into_alternate::<9>(),
-            gpiod.pd1.into_alternate::<9>(),
-        );
-        pac::CAN2::enable(&mut rcc.apb1);
-        pac::CAN2::reset(&mut rcc.apb1);
-        let _can2: pac::CAN2 = dp.CAN2;
-    }
-    #[cfg(feature = "disco-f746g")]
-    {
-        let gpiob = dp.GPIOB.split();
-        let _ = (
-            gpiob.pb8.into_alternate::<9>(),
-            gpiob.pb9.into_alternate::<9>(),
-        );
-    }
-
-    #[cfg(feature = "nucleo-f767zi")]
-    let led = {
         // PB5/PB6 are CAN2's pins on this board (see `board`).
         let gpiob = dp.GPIOB.split();
-        let _ = (
-            gpiob.pb5.into_alternate::<9>(),
-            gpiob.pb6.into_alternate::<9>(),
-        );
-        gpiob.pb0.into_push_pull_output()
+        (
+            (gpiod.pd1.into_alternate(), gpiod.pd0.into_alternate()),
+            (gpiob.pb6.into_alternate(), gpiob.pb5.into_alternate()),
+            gpiob.pb0.into_push_pull_output(),
+        )
     };
     #[cfg(feature = "disco-f746g")]
-    let led = dp.GPIOI.split().pi1.into_push_pull_output();
+    let (can1_pins, led) = {
+        let gpiob = dp.GPIOB.split();
+        (
+            (gpiob.pb9.into_alternate(), gpiob.pb8.into_alternate()),
+            dp.GPIOI.split().pi1.into_push_pull_output(),
+        )
+    };
 
     crate::time::start(&mut core.SYST, clocks.hclk().raw());
     Boot {
@@ -134,6 +148,13 @@ pub fn boot() -> Boot {
         clocks,
         hse,
         led,
+        apb1: rcc.apb1,
+        can1: dp.CAN1,
+        can1_pins,
+        #[cfg(feature = "nucleo-f767zi")]
+        can2: dp.CAN2,
+        #[cfg(feature = "nucleo-f767zi")]
+        can2_pins,
     }
 }
 

@@ -18,7 +18,7 @@ mod firmware {
     use critical_section::Mutex;
     use stm32f7xx_hal::pac::interrupt;
     use twocan_app::{App, AppStats};
-    use twocan_bxcan::{regs, Can, Config, FifoPolicy, Recovery};
+    use twocan_bxcan::{hal, FifoPolicy, Recovery};
     use twocan_stm32f7::board::BIT_RATE;
     use twocan_stm32f7::can::{self, CanState, Vectors};
     use twocan_stm32f7::rt::{self, CAN_BLINKS};
@@ -55,15 +55,17 @@ mod firmware {
     fn main() -> ! {
         let mut boot = rt::boot();
         let mut app = App::new(NODE, PEER);
-        // The bit timing is solved for the APB1 frequency the HAL reports.
-        let apb1 = boot.clocks.pclk1().raw();
-        let config = Config::from_bitrate(apb1, BIT_RATE)
+        // The hand-over: CAN1's singleton and pins (AF9), CAN1 clocked through APB1; the
+        // bit timing is solved for the APB1 frequency of the HAL's clocks.
+        let (tx_pin, rx_pin) = boot.can1_pins;
+        let can1 = hal::can1(boot.can1, tx_pin, rx_pin, &mut boot.apb1, &boot.clocks);
+        let config = can1
+            .config(BIT_RATE)
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS))
             .recovery(Recovery::Automatic);
-        // SAFETY: `boot` clocked CAN1 and dropped its PAC singleton; this is the only
-        // access to CAN1's registers.
-        let regs = unsafe { regs::CanRegs::new(regs::CAN1_BASE) };
-        let mut init = Can::can1(regs, &config).unwrap_or_else(|_| rt::halt(CAN_BLINKS));
+        let mut init = can1
+            .configure(&config)
+            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         let plan = init
             .can()
             .plan(&app.filters(), FifoPolicy::Fifo0)

@@ -24,8 +24,8 @@ mod firmware {
     use static_cell::StaticCell;
     use stm32f7xx_hal::pac::interrupt;
     use twocan_app::asynch::{echo, EchoStats};
-    use twocan_bxcan::{regs, Can, Config, FifoPolicy, Recovery};
-    use twocan_core::{Filter, Mmio};
+    use twocan_bxcan::{hal, FifoPolicy, Recovery};
+    use twocan_core::Filter;
     use twocan_stm32f7::board::BIT_RATE;
     use twocan_stm32f7::can::{self, CanRxHalf, CanState, CanTxHalf, Vectors};
     use twocan_stm32f7::rt::{self, Led, CAN_BLINKS};
@@ -71,15 +71,18 @@ mod firmware {
 
     #[cortex_m_rt::entry]
     fn main() -> ! {
-        let boot = rt::boot();
-        let apb1 = boot.clocks.pclk1().raw();
-        let config = Config::from_bitrate(apb1, BIT_RATE)
+        let mut boot = rt::boot();
+        // The hand-over: CAN1's singleton and pins (AF9), CAN1 clocked through APB1; the
+        // bit timing is solved for the APB1 frequency of the HAL's clocks.
+        let (tx_pin, rx_pin) = boot.can1_pins;
+        let can1 = hal::can1(boot.can1, tx_pin, rx_pin, &mut boot.apb1, &boot.clocks);
+        let config = can1
+            .config(BIT_RATE)
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS))
             .recovery(Recovery::Automatic);
-        // SAFETY: `boot` clocked CAN1 and dropped its PAC singleton; this is the only
-        // access to CAN1's registers.
-        let regs = unsafe { Mmio::new(regs::CAN1_BASE) };
-        let mut init = Can::can1(regs, &config).unwrap_or_else(|_| rt::halt(CAN_BLINKS));
+        let mut init = can1
+            .configure(&config)
+            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         // One FIFO keeps the frames in arrival order.
         let plan = init
             .can()

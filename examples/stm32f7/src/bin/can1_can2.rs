@@ -22,21 +22,18 @@ mod firmware {
     use critical_section::Mutex;
     use stm32f7xx_hal::pac::interrupt;
     use twocan_app::{App, AppStats};
-    use twocan_bxcan::regs::{ControlRegs, FilterRegs};
-    use twocan_bxcan::{regs, Can, Config, FifoPolicy, Recovery};
+    use twocan_bxcan::hal::{self, Can1Filters};
+    use twocan_bxcan::regs::ControlRegs;
+    use twocan_bxcan::{FifoPolicy, Recovery};
     use twocan_stm32f7::board::BIT_RATE;
     use twocan_stm32f7::can::{self, CanState, Vectors};
     use twocan_stm32f7::rt::{self, CAN_BLINKS};
     use twocan_stm32f7::time::{self, Every};
 
-    /// CAN1's filter block, shared by both controllers (RM0410 §40.9.4): one owner, lent
-    /// to CAN1 and CAN2; its writes are made under a critical section.
-    // SAFETY: CAN1's filter registers (RM0410 §2.2.2 CAN1 block + 0x200..0x320); no other
-    // handle of this firmware reaches them (CAN1's own handle stops at 0x200).
-    static FILTERS: FilterRegs = unsafe { FilterRegs::new(regs::CAN1_BASE) };
-
-    type Shared = CanState<ControlRegs, &'static FilterRegs>;
-    type SharedVectors = Vectors<ControlRegs, &'static FilterRegs>;
+    // Each controller owns its control registers and shares CAN1's filter block (RM0410
+    // §40.9.4) through the `Can1Filters` handle of the hand-over.
+    type Shared = CanState<ControlRegs, Can1Filters>;
+    type SharedVectors = Vectors<ControlRegs, Can1Filters>;
     static CAN1: Shared = Shared::new();
     static CAN1_VECTORS: SharedVectors = SharedVectors::new();
     static CAN2: Shared = Shared::new();
@@ -82,8 +79,13 @@ mod firmware {
     #[cortex_m_rt::entry]
     fn main() -> ! {
         let mut boot = rt::boot();
-        let apb1 = boot.clocks.pclk1().raw();
-        let base = Config::from_bitrate(apb1, BIT_RATE)
+        // The hand-over: CAN1 in dual mode gives the filter-block handle that CAN2 needs.
+        let (tx1, rx1) = boot.can1_pins;
+        let (can1, filters) = hal::can1_dual(boot.can1, tx1, rx1, &mut boot.apb1, &boot.clocks);
+        let (tx2, rx2) = boot.can2_pins;
+        let can2 = hal::can2(boot.can2, tx2, rx2, &mut boot.apb1, &boot.clocks, filters);
+        let base = can1
+            .config(BIT_RATE)
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS))
             .recovery(Recovery::Automatic);
         let config1 = base
@@ -92,17 +94,9 @@ mod firmware {
         let mut node1 = App::new(1, 2);
         let mut node2 = App::new(2, 1);
 
-        // SAFETY: `boot` clocked CAN1 and CAN2 and dropped their PAC singletons; these
-        // are their control and mailbox registers (offsets below 0x200), one handle
-        // each. The filter block is the shared `FILTERS`.
-        let (can1_regs, can2_regs) = unsafe {
-            (
-                ControlRegs::new(regs::CAN1_BASE),
-                ControlRegs::new(regs::CAN2_BASE),
-            )
-        };
-        let mut init1 =
-            Can::can1_dual(can1_regs, &FILTERS, &config1).unwrap_or_else(|_| rt::halt(CAN_BLINKS));
+        let mut init1 = can1
+            .configure(&config1)
+            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         let plan1 = init1
             .can()
             .plan(&node1.filters(), FifoPolicy::Fifo0)
@@ -110,8 +104,9 @@ mod firmware {
         if init1.set_filters(&plan1).is_err() {
             rt::halt(CAN_BLINKS);
         }
-        let mut init2 =
-            Can::can2(can2_regs, &FILTERS, &base).unwrap_or_else(|_| rt::halt(CAN_BLINKS));
+        let mut init2 = can2
+            .configure(&base)
+            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         let plan2 = init2
             .can()
             .plan(&node2.filters(), FifoPolicy::Fifo1)
