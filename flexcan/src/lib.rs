@@ -128,6 +128,7 @@ pub mod begin_error;
 pub mod board;
 pub mod configuration;
 pub mod controller;
+pub mod end;
 pub mod filters;
 mod handshake;
 pub mod instance;
