@@ -133,6 +133,8 @@ pub mod filters;
 mod handshake;
 pub mod instance;
 mod message_buffer;
+#[cfg(any(feature = "teensy32", feature = "teensy35", feature = "teensy36"))]
+pub mod pin;
 pub mod planner;
 pub mod settings;
 pub mod split;
