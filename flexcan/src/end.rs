@@ -45,6 +45,8 @@ impl<R: Registers> FlexCan<R> {
     /// `handshake_polls`) is [`Error::Timeout`], with the controller given back: nothing
     /// of the chip level was released then, and the module may be left frozen. Firmware
     /// uses `Can0::end` / `Can1::end`, which also give the instance token back.
+    // The controller comes back by value on error (no allocator to box it in).
+    #[allow(clippy::result_large_err)]
     pub fn end<S: Registers>(self, sys: &mut S) -> Result<R, (Self, Error)> {
         if let Err(e) = self.stop() {
             return Err((self, e));
@@ -76,6 +78,7 @@ mod firmware {
     use crate::instance::{Can0, Instance};
     use crate::regs::{FlexCanRegs, SystemRegs};
 
+    #[allow(clippy::result_large_err)]
     fn end(
         controller: FlexCan<FlexCanRegs>,
         instance: Instance,
@@ -95,6 +98,7 @@ mod firmware {
         /// ([`FlexCan::end`]) and gives the token back, so that [`Can0::begin`] can run
         /// again. A controller of another instance is [`Error::InvalidArgument`];
         /// either error gives the controller back.
+        #[allow(clippy::result_large_err)]
         pub fn end(
             controller: FlexCan<FlexCanRegs>,
         ) -> Result<Can0, (FlexCan<FlexCanRegs>, Error)> {
@@ -105,6 +109,7 @@ mod firmware {
     #[cfg(feature = "teensy36")]
     impl Can1 {
         /// ACAN `ACAN::can1.end ()`: as [`Can0::end`], for FlexCAN1 (Teensy 3.6).
+        #[allow(clippy::result_large_err)]
         pub fn end(
             controller: FlexCan<FlexCanRegs>,
         ) -> Result<Can1, (FlexCan<FlexCanRegs>, Error)> {

@@ -142,6 +142,9 @@ mod status;
 pub mod system;
 
 pub mod regs;
+#[cfg(feature = "rt")]
+#[cfg_attr(docsrs, doc(cfg(feature = "rt")))]
+pub mod rt;
 
 #[cfg(feature = "model")]
 pub mod model;
