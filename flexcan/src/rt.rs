@@ -60,39 +60,52 @@ use crate::regs::FlexCanRegs;
 use crate::settings::{RECEIVE_BUFFER_SIZE, TRANSMIT_BUFFER_SIZE};
 use crate::split::FlexCanHw;
 
+/// A FlexCAN device interrupt number. Only [`IrqState::start`] makes them, from
+/// [`Instance::irqs`] of the controller's chip (the reference manuals' "Interrupt
+/// channel assignments"), so an [`Nvic`] is never handed a line that does not exist.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct IrqNumber(u16);
+
+impl IrqNumber {
+    /// The NVIC interrupt number (vector number − 16).
+    pub const fn number(self) -> u16 {
+        self.0
+    }
+}
+
 /// The NVIC operations `start` needs (a seam for host tests).
 pub trait Nvic {
     /// Sets the priority byte of device interrupt `irq` (0 highest).
-    fn set_priority(&mut self, irq: u16, priority: u8);
+    fn set_priority(&mut self, irq: IrqNumber, priority: u8);
     /// Unmasks (enables) device interrupt `irq`.
-    fn unmask(&mut self, irq: u16);
+    fn unmask(&mut self, irq: IrqNumber);
 }
 
-/// A device interrupt number for `cortex-m`.
-#[derive(Clone, Copy)]
-struct Irq(u16);
-
-// SAFETY: the numbers come from `Instance::irqs` of the controller's chip (the
-// reference manuals' interrupt channel assignments): existing device interrupts.
-unsafe impl cortex_m::interrupt::InterruptNumber for Irq {
+// SAFETY: an `IrqNumber` is made only from `Instance::irqs` (see its documentation):
+// an existing device interrupt of the chip.
+unsafe impl cortex_m::interrupt::InterruptNumber for IrqNumber {
     fn number(self) -> u16 {
         self.0
     }
 }
 
+/// Firmware's NVIC. `start` is meant for applications whose critical sections mask all
+/// interrupts (`cortex-m`'s `critical-section-single-core`, PRIMASK); a framework that
+/// builds critical sections from NVIC masks or priorities (RTIC) owns the NVIC and runs
+/// the handlers of [`twocan_core::split::State::split`] itself, without `rt`.
 impl Nvic for cortex_m::peripheral::NVIC {
-    fn set_priority(&mut self, irq: u16, priority: u8) {
-        // SAFETY: changing a priority can break priority-based critical sections only;
-        // `critical-section` on these single-core parts masks all interrupts, and
-        // `start` sets the priority before it unmasks the line.
-        unsafe { cortex_m::peripheral::NVIC::set_priority(self, Irq(irq), priority) };
+    fn set_priority(&mut self, irq: IrqNumber, priority: u8) {
+        // SAFETY: changing a priority can only break priority-based critical sections,
+        // which the applications this is for do not use (see the impl's documentation);
+        // `start` sets the priority while the line is still masked.
+        unsafe { cortex_m::peripheral::NVIC::set_priority(self, irq, priority) };
     }
 
-    fn unmask(&mut self, irq: u16) {
-        // SAFETY: `start` calls this after the handlers the entry points run are in
-        // place, so no mask-based critical section of this crate is broken and the
-        // line has a handler.
-        unsafe { cortex_m::peripheral::NVIC::unmask(Irq(irq)) };
+    fn unmask(&mut self, irq: IrqNumber) {
+        // SAFETY: unmasking can only break mask-based critical sections, which the
+        // applications this is for do not use; `start` calls it after the handler the
+        // entry point runs is in place.
+        unsafe { cortex_m::peripheral::NVIC::unmask(irq) };
     }
 }
 
@@ -356,8 +369,8 @@ fn enable(nvic: &mut impl Nvic, irqs: Irqs, priority: u8) {
         irqs.tx_warning,
         irqs.rx_warning,
     ] {
-        nvic.set_priority(irq, priority);
-        nvic.unmask(irq);
+        nvic.set_priority(IrqNumber(irq), priority);
+        nvic.unmask(IrqNumber(irq));
     }
 }
 

@@ -15,7 +15,7 @@ use std::sync::atomic::{AtomicU32, Ordering};
 
 use twocan_core::{Frame, Registers};
 use twocan_flexcan::regs::{self, cs, esr1, iflag1, mcr, ESR1, IFLAG1, MCR};
-use twocan_flexcan::rt::{self, IrqState, Line, Nvic, StartError};
+use twocan_flexcan::rt::{self, IrqNumber, IrqState, Line, Nvic, StartError};
 use twocan_flexcan::{Board, FlexCan, HostSystem, Instance, Settings, Target};
 
 /// FlexCAN registers as plain memory, with the handshakes acknowledged at once.
@@ -88,12 +88,14 @@ impl Recorder {
 }
 
 impl Nvic for Recorder {
-    fn set_priority(&mut self, irq: u16, priority: u8) {
+    fn set_priority(&mut self, irq: IrqNumber, priority: u8) {
+        let irq = irq.number();
         self.priorities.insert(irq, priority);
         self.calls.push(("priority", irq, priority));
     }
 
-    fn unmask(&mut self, irq: u16) {
+    fn unmask(&mut self, irq: IrqNumber) {
+        let irq = irq.number();
         let message = Target::new(Board::Teensy36, self.instance)
             .irqs()
             .unwrap()
