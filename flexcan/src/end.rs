@@ -5,7 +5,8 @@
 //! "Freeze mode", "Module disable mode"; SIM "Clock gating"; PORT "Pin Control
 //! Register n"):
 //!
-//! 1. freeze (`MCR.FRZ` = `HALT` = 1, wait `FRZACK`): a frame on the wire is finished
+//! 1. (a module put to sleep, `MCR.MDIS` = 1, is enabled first: clear `MDIS`, wait for
+//!    `LPMACK` to clear), freeze (`MCR.FRZ` = `HALT` = 1, wait `FRZACK`): a frame on the wire is finished
 //!    first, so the wait is bounded by one frame time ([`crate::Settings::handshake_polls`]
 //!    covers a frame in flight at the slowest rates);
 //! 2. in freeze: `IMASK1` = 0, the error and warning interrupt masks of `CTRL1`
@@ -27,7 +28,7 @@ use twocan_core::{Error, Registers};
 
 use crate::controller::FlexCan;
 use crate::handshake;
-use crate::regs::{ctrl1, esr1, CTRL1, ESR1, IFLAG1, IMASK1};
+use crate::regs::{ctrl1, esr1, mcr, CTRL1, ESR1, IFLAG1, IMASK1, MCR};
 
 /// `CTRL1`'s interrupt masks `begin` may set.
 const CTRL1_IRQ_MASKS: u32 = ctrl1::ERRMSK | ctrl1::BOFFMSK | ctrl1::TWRNMSK | ctrl1::RWRNMSK;
@@ -58,6 +59,12 @@ impl<R: Registers> FlexCan<R> {
     /// Steps 1–3 of the module documentation ([`crate::system::SystemPlan::release`] is step 4).
     fn stop(&self) -> Result<(), Error> {
         let regs = &self.regs;
+        // A module put to sleep (disabled) is enabled first: freeze is requested and
+        // acknowledged only while the module is enabled ("Freeze mode"), and the
+        // interrupt registers are written in freeze.
+        if regs.read32(MCR) & (mcr::MDIS | mcr::LPMACK) != 0 {
+            handshake::enable(regs, self.polls)?;
+        }
         handshake::freeze(regs, self.polls)?;
         regs.write32(IMASK1, 0);
         regs.modify32(CTRL1, |v| v & !CTRL1_IRQ_MASKS);

@@ -146,3 +146,27 @@ fn end_that_cannot_freeze_gives_the_controller_back_and_releases_nothing() {
         .expect("end after the fault cleared");
     assert_eq!(model.mode(), ModelMode::Disabled);
 }
+
+#[test]
+fn end_of_a_sleeping_controller() {
+    let target = Target::new(Board::Teensy36, Instance::Can0);
+    let model = FlexCanModel::mk66fx1m0();
+    let mut sys = HostSystem::new();
+    let mut can = start(
+        Ticking::new(model.clone()),
+        &mut sys,
+        target,
+        &loop_back(125_000),
+    );
+    can.set_mode(twocan_core::Mode::Sleep).unwrap();
+    assert_eq!(model.mode(), ModelMode::Disabled);
+    let controller = can.release().into_controller();
+    assert_eq!(controller.mode(), twocan_core::Mode::Sleep);
+    let regs = controller.end(&mut sys).expect("end from sleep");
+    assert_eq!(model.mode(), ModelMode::Disabled);
+    assert_eq!(model.peek32(twocan_flexcan::regs::IMASK1), 0);
+    assert_eq!(sys.read32(sim::SIM_SCGC6) & sim::SCGC6_FLEXCAN0, 0);
+    let mut can = start(regs, &mut sys, target, &loop_back(125_000));
+    let mut bus = bus_with(125_000, &[&model]);
+    round_trip(&mut bus, &mut can, 0x55);
+}
