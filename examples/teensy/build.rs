@@ -16,7 +16,10 @@ use std::path::PathBuf;
 const BOARDS: [&str; 3] = ["teensy32", "teensy35", "teensy36"];
 
 /// Interrupt handler names of the FlexCAN vectors (one set per instance), as the vendor
-/// SVD names them (`CAN0_ORed_Message_buffer` ...). Keep in step with `src/rt.rs`.
+/// SVD names them (`CAN0_ORed_Message_buffer` ...). Keep in step with `src/rt.rs`. The
+/// message, bus-off, error and warning entries are defined by `twocan_flexcan::rt` (a
+/// `PROVIDE` only applies to a symbol nothing defines), the wake-up ones fall back to
+/// `DefaultHandler`.
 const CAN_VECTORS: [&str; 12] = [
     "CAN0_ORED_MESSAGE_BUFFER",
     "CAN0_BUS_OFF",

@@ -214,6 +214,7 @@ impl<R: Registers> FlexCan<R> {
             settings.listen_only,
             settings.handshake_polls,
             settings.message_irq_priority,
+            plan.system,
         ))
     }
 }

@@ -9,7 +9,9 @@
 //! documentation, "Board features"). This is deliberately not a compile error, so that
 //! `--all-features` builds keep working.
 //!
-//! Pin numbers and port pins come from [`crate::regs::pins`].
+//! Pin numbers and port pins come from [`crate::regs::pins`]. With a board feature,
+//! `crate::pin` gives each pin of the selected board's row a type (ACAN's alternate-pin
+//! choice checked at compile time), derived from [`Board::pins`].
 
 use crate::instance::Instance;
 use crate::regs::pins::{self, CanPin};

@@ -34,6 +34,7 @@ use crate::configuration::Configuration;
 use crate::filters::FilterTable;
 use crate::instance::Target;
 use crate::regs::{self, TIMER};
+use crate::system::SystemPlan;
 
 /// A FlexCAN instance configured by `begin` (see [`crate::instance`]), over its
 /// registers `R`. Give it to the portable driver with [`FlexCan::into_split`].
@@ -48,6 +49,8 @@ pub struct FlexCan<R: Registers> {
     pub(crate) mode: Mode,
     /// The newest error `ESR1` reported.
     pub(crate) last_error: Cell<LastErrorCode>,
+    /// The clock gate and pins `begin` set up, which [`FlexCan::end`] releases.
+    pub(crate) system: SystemPlan,
 }
 
 impl<R: Registers> FlexCan<R> {
@@ -58,8 +61,10 @@ impl<R: Registers> FlexCan<R> {
         listen_only: bool,
         polls: u32,
         irq_priority: u8,
+        system: SystemPlan,
     ) -> Self {
         FlexCan {
+            system,
             regs,
             target,
             table,
@@ -89,6 +94,11 @@ impl<R: Registers> FlexCan<R> {
     /// The message interrupt priority of the settings (ACAN §16.7.4), for the NVIC.
     pub const fn message_irq_priority(&self) -> u8 {
         self.irq_priority
+    }
+
+    /// The clock gate and the Tx and Rx pins `begin` set up (ACAN §7).
+    pub const fn system(&self) -> SystemPlan {
+        self.system
     }
 
     /// The mode the controller was last put in.

@@ -148,6 +148,13 @@ mod tokens {
         pub const fn target(&self) -> Target {
             Target::new(Board::DEFAULT, Instance::Can0)
         }
+
+        /// The token again, for `end`: the controller it comes from was made from the
+        /// one taken token (the flag stays set, so `take` still gives `None`).
+        #[allow(dead_code)] // used by `Can0::end` on the target only
+        pub(crate) const fn returned() -> Self {
+            Can0 { _private: () }
+        }
     }
 
     /// Ownership of FlexCAN1 on the Teensy 3.6 (ACAN `ACAN::can1`, §6).
@@ -167,6 +174,12 @@ mod tokens {
         /// The module this token owns.
         pub const fn target(&self) -> Target {
             Target::new(Board::DEFAULT, Instance::Can1)
+        }
+
+        /// The token again, for `end` (see `Can0::returned`).
+        #[allow(dead_code)] // used by `Can1::end` on the target only
+        pub(crate) const fn returned() -> Self {
+            Can1 { _private: () }
         }
     }
 

@@ -11,20 +11,28 @@
 #![doc = concat!("```\n", include_str!("../doc/quick_start.rs"), "```")]
 //!
 //! On a Teensy (feature `teensy32`, `teensy35` or `teensy36`, target
-//! `thumbv7em-none-eabihf`), the singleton token gives the controller:
+//! `thumbv7em-none-eabihf`), the singleton token gives the controller, typed pins
+//! choose its pins (module `pin`), and with feature `rt` the library wires the interrupts
+//! as ACAN's `begin` does (`rt::IrqState::start`: handlers installed behind the
+//! exported `CAN0_*` entry points, then the lines unmasked at `mMessageIRQPriority`):
 //!
 //! ```ignore
-//! use twocan_core::{irq_cell::IrqCell, split::State, FifoQueue, Mmio};
-//! use twocan_flexcan::{Can0, FlexCanHw, Settings};
-//! static CAN0: State<FlexCanHw<Mmio>, 32, FifoQueue<16>> = State::new();
+//! use twocan_flexcan::pin::{Pin3, Pin4};
+//! use twocan_flexcan::rt::AcanState;
+//! use twocan_flexcan::{Can0, Settings};
+//! static CAN0: AcanState = AcanState::new();
 //! let settings = Settings::new(500_000);
-//! let controller = Can0::take().unwrap().begin(&settings, &[], &[]).map_err(|(_, e)| e)?;
-//! let irqs = controller.target().irqs().unwrap();
-//! let parts = CAN0.split(controller.into_split()).ok().unwrap();
-//! // Put parts.tx_irq and parts.rx0_irq in an IrqCell run by the irqs.message vector,
-//! // parts.status_irq in one run by the bus-off/error/warning vectors, *then* unmask
-//! // those vectors; use parts.tx / parts.rx from thread code or tasks.
+//! let controller = Can0::take().unwrap().begin_on(Pin3, Pin4, &settings, &[], &[])
+//!     .map_err(|(_, e)| e)?;
+//! let (mut tx, mut rx) = CAN0.start(controller.into_split(), &mut core.NVIC)
+//!     .map_err(|(e, _)| e)?;
+//! // The application's vector table names `CAN0_ORED_MESSAGE_BUFFER` ... (see `rt`).
 //! ```
+//!
+//! Without `rt`, [`twocan_core::split::State::split`] gives the interrupt handlers to
+//! run from the application's own vectors (RTIC tasks, for instance). An un-split
+//! controller is stopped with [`FlexCan::end`] (`Can0::end` on the target gives the
+//! token back).
 //!
 //! # Board features
 //!
@@ -53,7 +61,9 @@
 //! |---|---|
 //! | §4 `ACANSettings`, §16, table 7 | [`Settings`] (bit timing from [`twocan_core::timing`]) |
 //! | §6 `ACAN::can0`, `ACAN::can1` | `Can0::take()`, `Can1::take()` ([`instance`]); [`Target`] on the host |
-//! | §7 alternate pins, §16.7.5–6 | [`Settings`] fields, [`Board::pins`], [`system`] |
+//! | §7 alternate pins, §16.7.5–6 | [`Settings`] fields, [`Board::pins`], [`system`]; typed: `pin` (board features) |
+//! | §15 `begin` wiring the interrupt, §16.7.4 `mMessageIRQPriority` | `rt::IrqState::start` (feature `rt`) |
+//! | `end` | [`FlexCan::end`], `Can0::end` / `Can1::end` ([`end`]) |
 //! | §8, §9 `tryToSend`, transmit buffer | [`twocan_core::Driver::try_send`], `tx_stats` ([`controller`] explains the mailboxes) |
 //! | §10 `receive`, receive buffer | [`twocan_core::Driver::receive`], `rx_stats` |
 //! | §11 `mConfiguration` | [`Configuration`] |
@@ -78,10 +88,13 @@ pub mod begin_error;
 pub mod board;
 pub mod configuration;
 pub mod controller;
+pub mod end;
 pub mod filters;
 mod handshake;
 pub mod instance;
 mod message_buffer;
+#[cfg(any(feature = "teensy32", feature = "teensy35", feature = "teensy36"))]
+pub mod pin;
 pub mod planner;
 pub mod settings;
 pub mod split;
@@ -89,6 +102,9 @@ mod status;
 pub mod system;
 
 pub mod regs;
+#[cfg(feature = "rt")]
+#[cfg_attr(docsrs, doc(cfg(feature = "rt")))]
+pub mod rt;
 
 #[cfg(feature = "model")]
 pub mod model;

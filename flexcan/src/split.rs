@@ -36,6 +36,7 @@ use crate::instance::Target;
 use crate::message_buffer::MbWords;
 use crate::regs::{self, code, cs, esr1, iflag1, rxfir, ECR, ESR1, IFLAG1, RXFIR};
 use crate::status;
+use crate::system::SystemPlan;
 
 /// One received frame: the Rx FIFO output's control/status, identifier and two data
 /// words, and `RXFIR.IDHIT`.
@@ -78,6 +79,8 @@ pub struct FlexCanHw<R: Registers> {
     /// Transmit mailboxes loaded and not settled yet (bit per MB): a flag raised by a
     /// remote-frame mailbox that became a receive mailbox is not a completion.
     loaded: AtomicU32,
+    /// The clock gate and pins `begin` set up (for [`FlexCanHw::into_controller`]).
+    system: SystemPlan,
 }
 
 impl<R: Registers> FlexCan<R> {
@@ -98,6 +101,7 @@ impl<R: Registers> FlexCan<R> {
             last_error: AtomicLastError::new(self.last_error.get()),
             unresolved: AtomicU32::new(0),
             loaded: AtomicU32::new(0),
+            system: self.system,
         }
     }
 }
@@ -145,6 +149,30 @@ impl<R: Registers> FlexCanHw<R> {
     /// The register handle back (to run `begin` again).
     pub fn into_registers(self) -> R {
         self.regs
+    }
+
+    /// The controller back, as `begin` gave it (the reverse of
+    /// [`FlexCan::into_split`]): for [`FlexCan::end`] after
+    /// [`twocan_core::Driver::release`].
+    pub fn into_controller(self) -> FlexCan<R> {
+        let mode = match self.mode() {
+            MODE_STOPPED => Mode::Stopped,
+            MODE_SLEEP => Mode::Sleep,
+            _ => Mode::Normal,
+        };
+        let last_error = self.last_error();
+        let mut controller = FlexCan::configured(
+            self.regs,
+            self.target,
+            self.table.into_inner(),
+            self.listen_only,
+            self.polls,
+            self.irq_priority,
+            self.system,
+        );
+        controller.mode = mode;
+        controller.last_error.set(last_error);
+        controller
     }
 
     fn mode(&self) -> u8 {

@@ -111,6 +111,23 @@ impl SystemPlan {
     }
 }
 
+impl SystemPlan {
+    /// Undoes [`SystemPlan::apply`] for the module (`end`): the Tx and Rx pins back to
+    /// their reset function — `PORTx_PCRn` written 0, `MUX` = 000 "pin disabled
+    /// (analog)" with no pull or open drain ("PORT", "Pin Control Register n") — then
+    /// the module's clock gate cleared (`SIM_SCGC6.FLEXCAN0` or `SIM_SCGC3.FLEXCAN1`,
+    /// "SIM": the module must not be accessed afterwards; call it once the module is
+    /// disabled, `MCR.LPMACK` = 1). The port clock gates stay as they are: other pins of
+    /// the same ports may be in use. The read-modify-write of SIM runs in a critical
+    /// section.
+    pub fn release<S: Registers>(&self, sys: &mut S) {
+        sys.write32(self.tx.0.pcr(), 0);
+        sys.write32(self.rx.0.pcr(), 0);
+        let (gate, bit) = self.clock_gate;
+        critical_section::with(|_| sys.modify32(gate, |v| v & !bit));
+    }
+}
+
 /// Picks the pins (ACAN §7). `Err((no_tx, no_rx))` says which alternate was asked
 /// for but does not exist.
 pub const fn choose_pins(
@@ -170,5 +187,16 @@ mod tests {
         );
         assert_eq!(sys.read32(Port::B.pcr(18)), 0x200 | PCR_ODE);
         assert_eq!(sys.read32(Port::A.pcr(13)), 0x200 | PCR_PE | PCR_PS);
+
+        // `end`: pins back to MUX 0, the module's gate cleared, the port gates kept.
+        sys.write32(sim::SIM_SCGC6, sim::SCGC6_FLEXCAN0 | 1 << 9);
+        plan.release(&mut sys);
+        assert_eq!(sys.read32(sim::SIM_SCGC6), 1 << 9);
+        assert_eq!(sys.read32(Port::B.pcr(18)), 0);
+        assert_eq!(sys.read32(Port::A.pcr(13)), 0);
+        assert_eq!(
+            sys.read32(sim::SIM_SCGC5),
+            sim::SCGC5_PORTA | sim::SCGC5_PORTB
+        );
     }
 }

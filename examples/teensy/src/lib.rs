@@ -12,7 +12,8 @@
 //! - [`clock`]: the 16 MHz crystal started and the MCG switched to FBE with bounded
 //!   waits; OSCERCLK, FlexCAN's clock, enabled;
 //! - [`led`]: pin 13; [`time`]: a SysTick millisecond time base; [`can`]: the split
-//!   driver's state, its interrupt vectors' handles and their start-up order.
+//!   driver's `static` state type (`twocan_flexcan::rt::IrqState`: the library installs
+//!   its interrupt handlers behind its `CAN0_*` entry points, then unmasks the lines).
 //!
 //! Everything except `rt` is plain code over the [`io::Io`] trait, built and tested on
 //! the host as well.

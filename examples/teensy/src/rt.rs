@@ -1,6 +1,10 @@
 //! What a Kinetis needs beyond cortex-m-rt: the watchdog disabled at the first
 //! instruction, the device interrupt vectors, the flash configuration field at 0x400, a
 //! SysTick handler and the panic handler. Built only for the target (`target_os = "none"`).
+//!
+//! The FlexCAN entries of the vector table name the entry points `twocan-flexcan`
+//! exports with its `rt` feature (`CAN0_ORED_MESSAGE_BUFFER` ...): the library installs
+//! the driver's handlers behind them and enables the lines (`IrqState::start`).
 
 use crate::board::{BOARD, CAN_VECTORS_PER_INSTANCE};
 use crate::regs::{
@@ -57,29 +61,45 @@ extern "C" {
     // cortex-m-rt's default handler (an infinite loop unless the application defines
     // `DefaultHandler`).
     fn DefaultHandler();
+    // The FlexCAN entry points of `twocan_flexcan::rt` (feature `rt`).
+    fn CAN0_ORED_MESSAGE_BUFFER();
+    fn CAN0_BUS_OFF();
+    fn CAN0_ERROR();
+    fn CAN0_TX_WARNING();
+    fn CAN0_RX_WARNING();
+    #[cfg(feature = "teensy36")]
+    fn CAN1_ORED_MESSAGE_BUFFER();
+    #[cfg(feature = "teensy36")]
+    fn CAN1_BUS_OFF();
+    #[cfg(feature = "teensy36")]
+    fn CAN1_ERROR();
+    #[cfg(feature = "teensy36")]
+    fn CAN1_TX_WARNING();
+    #[cfg(feature = "teensy36")]
+    fn CAN1_RX_WARNING();
     // The FlexCAN wake-up vectors, weakly aliased to `DefaultHandler` by the `device.x`
-    // build.rs writes (the examples never enable them).
+    // build.rs writes (the library never enables them).
     fn CAN0_WAKE_UP();
     #[cfg(feature = "teensy36")]
     fn CAN1_WAKE_UP();
 }
 
 const CAN0: [Vector; CAN_VECTORS_PER_INSTANCE] = [
-    can0_message,
-    can0_bus_off,
-    can0_error,
-    can0_tx_warning,
-    can0_rx_warning,
+    CAN0_ORED_MESSAGE_BUFFER,
+    CAN0_BUS_OFF,
+    CAN0_ERROR,
+    CAN0_TX_WARNING,
+    CAN0_RX_WARNING,
     CAN0_WAKE_UP,
 ];
 
 #[cfg(feature = "teensy36")]
 const CAN1: [Vector; CAN_VECTORS_PER_INSTANCE] = [
-    can1_message,
-    can1_bus_off,
-    can1_error,
-    can1_tx_warning,
-    can1_rx_warning,
+    CAN1_ORED_MESSAGE_BUFFER,
+    CAN1_BUS_OFF,
+    CAN1_ERROR,
+    CAN1_TX_WARNING,
+    CAN1_RX_WARNING,
     CAN1_WAKE_UP,
 ];
 
@@ -188,107 +208,4 @@ pub fn boot() -> Boot {
     // ports or pins and `begin` only read-modify-writes SIM_SCGC5 in a critical section.
     let led = crate::led::Led::new(unsafe { crate::io::Mmio::new() });
     Boot { core, clocks, led }
-}
-
-/// An NVIC interrupt number.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Irq(pub u16);
-
-// SAFETY: `Irq` values come from the board's interrupt table (`twocan_flexcan::Irqs`),
-// all below `BOARD.irq_count`, so they name existing device interrupts.
-unsafe impl cortex_m::interrupt::InterruptNumber for Irq {
-    fn number(self) -> u16 {
-        self.0
-    }
-}
-
-/// Sets the priority of a FlexCAN controller's interrupts from its settings
-/// (`mMessageIRQPriority`, ACAN §16.7.4; the Kinetis NVIC keeps the 4 upper bits) and
-/// unmasks the message, bus-off, error and warning lines. Call it after the handles the
-/// vectors run are in place ([`crate::can::start`] does).
-pub fn enable_can_irqs(
-    nvic: &mut cortex_m::peripheral::NVIC,
-    irqs: twocan_flexcan::Irqs,
-    priority: u8,
-) {
-    for n in [
-        irqs.message,
-        irqs.bus_off,
-        irqs.error,
-        irqs.tx_warning,
-        irqs.rx_warning,
-    ] {
-        let irq = Irq(n);
-        // SAFETY: changing a priority is only unsound under priority-based critical
-        // sections; this crate's critical sections mask all interrupts
-        // (`critical-section-single-core`).
-        unsafe { nvic.set_priority(irq, priority) };
-        // SAFETY: as above; the vectors run handles that were put in place before.
-        unsafe { cortex_m::peripheral::NVIC::unmask(irq) };
-    }
-}
-
-// The vector name, kept as the symbol (the ELF check and debuggers find it).
-#[export_name = "CAN0_ORED_MESSAGE_BUFFER"]
-extern "C" fn can0_message() {
-    crate::can::CAN0_VECTORS.on_message();
-}
-
-// The vector name, kept as the symbol (the ELF check and debuggers find it).
-#[export_name = "CAN0_BUS_OFF"]
-extern "C" fn can0_bus_off() {
-    crate::can::CAN0_VECTORS.on_status();
-}
-
-// The vector name, kept as the symbol (the ELF check and debuggers find it).
-#[export_name = "CAN0_ERROR"]
-extern "C" fn can0_error() {
-    crate::can::CAN0_VECTORS.on_status();
-}
-
-// The vector name, kept as the symbol (the ELF check and debuggers find it).
-#[export_name = "CAN0_TX_WARNING"]
-extern "C" fn can0_tx_warning() {
-    crate::can::CAN0_VECTORS.on_status();
-}
-
-// The vector name, kept as the symbol (the ELF check and debuggers find it).
-#[export_name = "CAN0_RX_WARNING"]
-extern "C" fn can0_rx_warning() {
-    crate::can::CAN0_VECTORS.on_status();
-}
-
-#[cfg(feature = "teensy36")]
-// The vector name, kept as the symbol (the ELF check and debuggers find it).
-#[export_name = "CAN1_ORED_MESSAGE_BUFFER"]
-extern "C" fn can1_message() {
-    crate::can::CAN1_VECTORS.on_message();
-}
-
-#[cfg(feature = "teensy36")]
-// The vector name, kept as the symbol (the ELF check and debuggers find it).
-#[export_name = "CAN1_BUS_OFF"]
-extern "C" fn can1_bus_off() {
-    crate::can::CAN1_VECTORS.on_status();
-}
-
-#[cfg(feature = "teensy36")]
-// The vector name, kept as the symbol (the ELF check and debuggers find it).
-#[export_name = "CAN1_ERROR"]
-extern "C" fn can1_error() {
-    crate::can::CAN1_VECTORS.on_status();
-}
-
-#[cfg(feature = "teensy36")]
-// The vector name, kept as the symbol (the ELF check and debuggers find it).
-#[export_name = "CAN1_TX_WARNING"]
-extern "C" fn can1_tx_warning() {
-    crate::can::CAN1_VECTORS.on_status();
-}
-
-#[cfg(feature = "teensy36")]
-// The vector name, kept as the symbol (the ELF check and debuggers find it).
-#[export_name = "CAN1_RX_WARNING"]
-extern "C" fn can1_rx_warning() {
-    crate::can::CAN1_VECTORS.on_status();
 }

@@ -18,8 +18,9 @@ mod firmware {
 
     use critical_section::Mutex;
     use twocan_app::{App, AppStats};
+    use twocan_flexcan::pin::{Pin3, Pin4};
     use twocan_flexcan::{Can0, Settings};
-    use twocan_teensy::can::{self, CanState, CAN0_VECTORS};
+    use twocan_teensy::can::CanState;
     use twocan_teensy::rt::{self, CAN_BLINKS};
     use twocan_teensy::time::{self, Every};
 
@@ -42,11 +43,11 @@ mod firmware {
         let token = Can0::take().unwrap_or_else(|| rt::halt(CAN_BLINKS));
         // The application's portable filter list, as primary filters.
         let can = token
-            .begin(&SETTINGS, &app.filters(), &[])
+            .begin_on(Pin3, Pin4, &SETTINGS, &app.filters(), &[])
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        let (mut tx, mut rx) =
-            can::start(&CAN0, &CAN0_VECTORS, can.into_split(), &mut boot.core.NVIC)
-                .unwrap_or_else(|| rt::halt(CAN_BLINKS));
+        let (mut tx, mut rx) = CAN0
+            .start(can.into_split(), &mut boot.core.NVIC)
+            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
 
         let mut period = Every::new(time::millis(), 10);
         let mut shown = 0;

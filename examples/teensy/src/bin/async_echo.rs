@@ -4,7 +4,7 @@
 //! `tx.send().await` of the split driver's halves.
 //!
 //! The FlexCAN vectors run the driver's interrupt handlers as in the other examples
-//! (`can::start` puts them in place, then unmasks the lines); the handlers wake the
+//! (`CAN0.start`, `twocan_flexcan::rt`, puts them in place, then unmasks the lines); the handlers wake the
 //! waiting task through its waker, and the executor sleeps in `WFE` between wakes.
 //! Try it with a USB-CAN adapter on the bus (Teensy pins 3 = CAN0 TX, 4 = CAN0 RX,
 //! through a transceiver, 120 Ω at each end): `cansend can0 123#01` answers `124#01`.
@@ -22,8 +22,9 @@ mod firmware {
     use static_cell::StaticCell;
     use twocan_app::asynch::{echo, EchoStats};
     use twocan_core::Filter;
+    use twocan_flexcan::pin::{Pin3, Pin4};
     use twocan_flexcan::{Can0, Settings};
-    use twocan_teensy::can::{self, CanRxHalf, CanState, CanTxHalf, CAN0_VECTORS};
+    use twocan_teensy::can::{CanRxHalf, CanState, CanTxHalf};
     use twocan_teensy::io::Mmio;
     use twocan_teensy::led::Led;
     use twocan_teensy::rt::{self, CAN_BLINKS};
@@ -56,10 +57,11 @@ mod firmware {
         let mut boot = rt::boot();
         let token = Can0::take().unwrap_or_else(|| rt::halt(CAN_BLINKS));
         let can = token
-            .begin(&SETTINGS, &[Filter::pass_all()], &[])
+            .begin_on(Pin3, Pin4, &SETTINGS, &[Filter::pass_all()], &[])
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        let (tx, rx) = can::start(&CAN0, &CAN0_VECTORS, can.into_split(), &mut boot.core.NVIC)
-            .unwrap_or_else(|| rt::halt(CAN_BLINKS));
+        let (tx, rx) = CAN0
+            .start(can.into_split(), &mut boot.core.NVIC)
+            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         let led = boot.led;
         EXECUTOR.init(Executor::new()).run(|spawner| {
             spawner.spawn(echo_task(tx, rx, led).unwrap_or_else(|_| rt::halt(CAN_BLINKS)));

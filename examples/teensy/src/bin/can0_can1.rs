@@ -17,8 +17,9 @@ mod firmware {
 
     use critical_section::Mutex;
     use twocan_app::{App, AppStats};
+    use twocan_flexcan::pin::{Pin3, Pin33, Pin34, Pin4};
     use twocan_flexcan::{Can0, Can1, Settings};
-    use twocan_teensy::can::{self, CanState, CAN0_VECTORS, CAN1_VECTORS};
+    use twocan_teensy::can::CanState;
     use twocan_teensy::rt::{self, CAN_BLINKS};
     use twocan_teensy::time::{self, Every};
 
@@ -40,17 +41,19 @@ mod firmware {
 
         let can0 = Can0::take()
             .unwrap_or_else(|| rt::halt(CAN_BLINKS))
-            .begin(&SETTINGS, &node1.filters(), &[])
+            .begin_on(Pin3, Pin4, &SETTINGS, &node1.filters(), &[])
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         let can1 = Can1::take()
             .unwrap_or_else(|| rt::halt(CAN_BLINKS))
-            .begin(&SETTINGS, &node2.filters(), &[])
+            .begin_on(Pin33, Pin34, &SETTINGS, &node2.filters(), &[])
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         let nvic = &mut boot.core.NVIC;
-        let (mut tx0, mut rx0) = can::start(&CAN0, &CAN0_VECTORS, can0.into_split(), nvic)
-            .unwrap_or_else(|| rt::halt(CAN_BLINKS));
-        let (mut tx1, mut rx1) = can::start(&CAN1, &CAN1_VECTORS, can1.into_split(), nvic)
-            .unwrap_or_else(|| rt::halt(CAN_BLINKS));
+        let (mut tx0, mut rx0) = CAN0
+            .start(can0.into_split(), nvic)
+            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
+        let (mut tx1, mut rx1) = CAN1
+            .start(can1.into_split(), nvic)
+            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
 
         let mut period = Every::new(time::millis(), 10);
         let mut shown = 0;

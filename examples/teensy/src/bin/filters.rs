@@ -24,8 +24,9 @@ mod firmware {
     use core::sync::atomic::{AtomicU32, Ordering};
 
     use twocan_core::{Dispatcher, Frame, RxFrame};
+    use twocan_flexcan::pin::{Pin3, Pin4};
     use twocan_flexcan::{Can0, Settings};
-    use twocan_teensy::can::{self, CanState, CAN0_VECTORS};
+    use twocan_teensy::can::CanState;
     use twocan_teensy::filters_example::{self, FILTERS};
     use twocan_teensy::rt::{self, CAN_BLINKS};
     use twocan_teensy::time::{self, Every};
@@ -80,11 +81,11 @@ mod firmware {
         let secondary = filters_example::secondary();
         let token = Can0::take().unwrap_or_else(|| rt::halt(CAN_BLINKS));
         let can = token
-            .begin(&SETTINGS, &primary, &secondary)
+            .begin_on(Pin3, Pin4, &SETTINGS, &primary, &secondary)
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        let (mut tx, mut rx) =
-            can::start(&CAN0, &CAN0_VECTORS, can.into_split(), &mut boot.core.NVIC)
-                .unwrap_or_else(|| rt::halt(CAN_BLINKS));
+        let (mut tx, mut rx) = CAN0
+            .start(can.into_split(), &mut boot.core.NVIC)
+            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
 
         let mut dispatcher: Dispatcher<(), FILTERS> = Dispatcher::new();
         let callbacks: [fn(&mut (), &RxFrame); FILTERS] = [on_0, on_1, on_2, on_3, on_4];

@@ -11,8 +11,9 @@ mod firmware {
     use core::sync::atomic::{AtomicU32, Ordering};
 
     use twocan_core::Frame;
+    use twocan_flexcan::pin::{Pin3, Pin4};
     use twocan_flexcan::{Can0, Settings};
-    use twocan_teensy::can::{self, CanState, CAN0_VECTORS};
+    use twocan_teensy::can::CanState;
     use twocan_teensy::rt::{self, CAN_BLINKS};
     use twocan_teensy::time::{self, Every};
 
@@ -32,11 +33,11 @@ mod firmware {
         let mut boot = rt::boot();
         let token = Can0::take().unwrap_or_else(|| rt::halt(CAN_BLINKS));
         let can = token
-            .begin(&SETTINGS, &[], &[])
+            .begin_on(Pin3, Pin4, &SETTINGS, &[], &[])
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        let (mut tx, mut rx) =
-            can::start(&CAN0, &CAN0_VECTORS, can.into_split(), &mut boot.core.NVIC)
-                .unwrap_or_else(|| rt::halt(CAN_BLINKS));
+        let (mut tx, mut rx) = CAN0
+            .start(can.into_split(), &mut boot.core.NVIC)
+            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
 
         let message = Frame::standard(0x542, &[]).unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         let mut send = Every::new(time::millis(), 1000);

@@ -1,0 +1,126 @@
+//! `end`: stop the module and give back what `begin` took (ACAN's `end`, which frees
+//! the driver so that `begin` can run again).
+//!
+//! The sequence, from the Kinetis reference manuals (FlexCAN "Modes of operation",
+//! "Freeze mode", "Module disable mode"; SIM "Clock gating"; PORT "Pin Control
+//! Register n"):
+//!
+//! 1. (a module put to sleep, `MCR.MDIS` = 1, is enabled first: clear `MDIS`, wait for
+//!    `LPMACK` to clear), freeze (`MCR.FRZ` = `HALT` = 1, wait `FRZACK`): a frame on the wire is finished
+//!    first, so the wait is bounded by one frame time ([`crate::Settings::handshake_polls`]
+//!    covers a frame in flight at the slowest rates);
+//! 2. in freeze: `IMASK1` = 0, the error and warning interrupt masks of `CTRL1`
+//!    cleared, `IFLAG1` and the interrupt flags of `ESR1` cleared (write 1), so no
+//!    FlexCAN interrupt line stays asserted;
+//! 3. module disabled (`MCR.MDIS` = 1, wait `LPMACK`);
+//! 4. the Tx and Rx pins back to `MUX` = 0 and the module's SIM clock gate cleared
+//!    ([`crate::system::SystemPlan::release`]).
+//!
+//! `end` takes the un-split [`FlexCan`]: no interrupt handler can reach a controller
+//! the caller holds by value. A controller given to the one-struct
+//! [`twocan_core::Driver`] comes back with [`twocan_core::Driver::release`] and
+//! [`crate::FlexCanHw::into_controller`]. One given to a `static`
+//! [`twocan_core::split::State`] (the split halves and interrupt handlers, or
+//! `rt::IrqState` with feature `rt`) stays there for the life of the program: that
+//! state has no way back, so such a controller cannot be ended.
+
+use twocan_core::{Error, Registers};
+
+use crate::controller::FlexCan;
+use crate::handshake;
+use crate::regs::{ctrl1, esr1, mcr, CTRL1, ESR1, IFLAG1, IMASK1, MCR};
+
+/// `CTRL1`'s interrupt masks `begin` may set.
+const CTRL1_IRQ_MASKS: u32 = ctrl1::ERRMSK | ctrl1::BOFFMSK | ctrl1::TWRNMSK | ctrl1::RWRNMSK;
+/// `ESR1`'s write-1-to-clear interrupt flags.
+const ESR1_IRQ_FLAGS: u32 =
+    esr1::WAKINT | esr1::ERRINT | esr1::BOFFINT | esr1::RWRNINT | esr1::TWRNINT;
+
+impl<R: Registers> FlexCan<R> {
+    /// Stops the module and releases its pins and clock gate (see the [module
+    /// documentation](crate::end)); gives the registers back, so that
+    /// [`FlexCan::begin`] can run again. `sys` reaches the SIM and PORT registers as
+    /// for `begin`.
+    ///
+    /// A missing acknowledge (freeze or disable, each bounded by the settings'
+    /// `handshake_polls`) is [`Error::Timeout`], with the controller given back: nothing
+    /// of the chip level was released then, and the module may be left frozen. Firmware
+    /// uses `Can0::end` / `Can1::end`, which also give the instance token back.
+    // The controller comes back by value on error (no allocator to box it in).
+    #[allow(clippy::result_large_err)]
+    pub fn end<S: Registers>(self, sys: &mut S) -> Result<R, (Self, Error)> {
+        if let Err(e) = self.stop() {
+            return Err((self, e));
+        }
+        self.system.release(sys);
+        Ok(self.regs)
+    }
+
+    /// Steps 1–3 of the module documentation ([`crate::system::SystemPlan::release`] is step 4).
+    fn stop(&self) -> Result<(), Error> {
+        let regs = &self.regs;
+        // A module put to sleep (disabled) is enabled first: freeze is requested and
+        // acknowledged only while the module is enabled ("Freeze mode"), and the
+        // interrupt registers are written in freeze.
+        if regs.read32(MCR) & (mcr::MDIS | mcr::LPMACK) != 0 {
+            handshake::enable(regs, self.polls)?;
+        }
+        handshake::freeze(regs, self.polls)?;
+        regs.write32(IMASK1, 0);
+        regs.modify32(CTRL1, |v| v & !CTRL1_IRQ_MASKS);
+        regs.write32(IFLAG1, u32::MAX);
+        regs.write32(ESR1, ESR1_IRQ_FLAGS);
+        handshake::disable(regs, self.polls)
+    }
+}
+
+#[cfg(all(
+    target_os = "none",
+    any(feature = "teensy32", feature = "teensy35", feature = "teensy36")
+))]
+mod firmware {
+    use super::*;
+    #[cfg(feature = "teensy36")]
+    use crate::instance::Can1;
+    use crate::instance::{Can0, Instance};
+    use crate::regs::{FlexCanRegs, SystemRegs};
+
+    #[allow(clippy::result_large_err)]
+    fn end(
+        controller: FlexCan<FlexCanRegs>,
+        instance: Instance,
+    ) -> Result<(), (FlexCan<FlexCanRegs>, Error)> {
+        if controller.target().instance != instance {
+            return Err((controller, Error::InvalidArgument));
+        }
+        // SAFETY: as in `begin`: base 0 with absolute offsets, the window SIM..PORTE;
+        // `end` touches SIM_SCGC3/6 (read-modify-write in a critical section) and the
+        // PCRs of this instance's pins, which the controller (from `begin`) owns.
+        let mut sys = unsafe { SystemRegs::new(0) };
+        controller.end(&mut sys).map(drop)
+    }
+
+    impl Can0 {
+        /// ACAN `ACAN::can0.end ()`: stops FlexCAN0, releases its pins and clock gate
+        /// ([`FlexCan::end`]) and gives the token back, so that [`Can0::begin`] can run
+        /// again. A controller of another instance is [`Error::InvalidArgument`];
+        /// either error gives the controller back.
+        #[allow(clippy::result_large_err)]
+        pub fn end(
+            controller: FlexCan<FlexCanRegs>,
+        ) -> Result<Can0, (FlexCan<FlexCanRegs>, Error)> {
+            end(controller, Instance::Can0).map(|()| Can0::returned())
+        }
+    }
+
+    #[cfg(feature = "teensy36")]
+    impl Can1 {
+        /// ACAN `ACAN::can1.end ()`: as [`Can0::end`], for FlexCAN1 (Teensy 3.6).
+        #[allow(clippy::result_large_err)]
+        pub fn end(
+            controller: FlexCan<FlexCanRegs>,
+        ) -> Result<Can1, (FlexCan<FlexCanRegs>, Error)> {
+            end(controller, Instance::Can1).map(|()| Can1::returned())
+        }
+    }
+}

@@ -1,0 +1,431 @@
+//! Interrupts wired by the library, as ACAN's `begin` does (feature `rt`): the FlexCAN
+//! interrupt entry points of each instance, the place their handlers live, and
+//! [`IrqState::start`], which installs the split driver's interrupt handlers and then
+//! unmasks the lines in the NVIC at `mMessageIRQPriority` (ACAN §16.7.4).
+//!
+//! # Entry points and the vector table
+//!
+//! This module exports one `extern "C"` function per interrupt line, under the vector
+//! names of the Kinetis reference manuals' "Interrupt channel assignments" (as the
+//! vendor SVD files spell them, upper case): `CAN0_ORED_MESSAGE_BUFFER`, `CAN0_BUS_OFF`,
+//! `CAN0_ERROR`, `CAN0_TX_WARNING`, `CAN0_RX_WARNING`, and with `teensy36` the same for
+//! `CAN1_`. It does not build a vector table and needs no runtime crate: the
+//! application's table (with `cortex-m-rt`'s `device` feature, its `__INTERRUPTS`)
+//! names these symbols, and the linker takes them from this crate. The wake-up vectors
+//! are not among them (`start` never enables wake-up).
+//!
+//! Which handler each line runs (Kinetis RM, FlexCAN "Interrupts"): the ORed
+//! message-buffer line the transmit handler then the Rx FIFO handler
+//! ([`twocan_core::split::TxIrq`], [`twocan_core::split::RxIrq`]); the bus-off, error
+//! and warning lines the status handler ([`twocan_core::split::StatusIrq`]).
+//!
+//! # Order
+//!
+//! [`IrqState::start`] splits the controller, puts the handlers where the entry points
+//! find them, and only then sets the priorities and unmasks the lines: an interrupt
+//! that fires at once (a frame already in the FIFO) finds its handler, whereas a line
+//! unmasked first would run an empty entry point and, its cause never cleared, stay
+//! asserted for ever (the firmware-in-the-loop harness's negative test shows that
+//! failure). The NVIC is reached through the [`Nvic`] trait, implemented for
+//! `cortex_m::peripheral::NVIC`, so host tests check the order with a recording one.
+//!
+//! # Priority
+//!
+//! Every line of the instance gets `Settings::message_irq_priority` (ACAN's
+//! `mMessageIRQPriority`, default 64; 0 is the highest). The Kinetis NVIC implements the
+//! upper 4 bits of each priority byte (ARMv7-M "NVIC_IPRn"; K20/K66 RM "Nested Vectored
+//! Interrupt Controller": 16 levels), so 64 is level 4. One priority for all lines
+//! means no FlexCAN handler preempts another of the same instance.
+//!
+//! ```ignore
+//! use twocan_flexcan::rt::AcanState;
+//! use twocan_flexcan::{Can0, Settings};
+//! static CAN0: AcanState = AcanState::new();
+//! let can = Can0::take().unwrap().begin(&Settings::new(500_000), &[], &[]).map_err(|(_, e)| e)?;
+//! let (tx, rx) = CAN0.start(can.into_split(), &mut core.NVIC).map_err(|(e, _)| e)?;
+//! ```
+
+use core::cell::UnsafeCell;
+use core::fmt;
+use core::mem::MaybeUninit;
+use core::sync::atomic::{AtomicU8, Ordering};
+
+use twocan_core::irq_cell::IrqCell;
+use twocan_core::split::{Rx, RxIrq, State, StatusIrq, Tx, TxIrq};
+use twocan_core::txqueue::TxQueue;
+use twocan_core::{Error, FifoQueue, Registers};
+
+use crate::instance::{Instance, Irqs};
+use crate::regs::FlexCanRegs;
+use crate::settings::{RECEIVE_BUFFER_SIZE, TRANSMIT_BUFFER_SIZE};
+use crate::split::FlexCanHw;
+
+/// A FlexCAN device interrupt number. Only [`IrqState::start`] makes them, from
+/// [`Instance::irqs`] of the controller's chip (the reference manuals' "Interrupt
+/// channel assignments"), so an [`Nvic`] is never handed a line that does not exist.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct IrqNumber(u16);
+
+impl IrqNumber {
+    /// The NVIC interrupt number (vector number − 16).
+    pub const fn number(self) -> u16 {
+        self.0
+    }
+}
+
+/// The NVIC operations `start` needs (a seam for host tests).
+pub trait Nvic {
+    /// Sets the priority byte of device interrupt `irq` (0 highest).
+    fn set_priority(&mut self, irq: IrqNumber, priority: u8);
+    /// Unmasks (enables) device interrupt `irq`.
+    fn unmask(&mut self, irq: IrqNumber);
+}
+
+// SAFETY: an `IrqNumber` is made only from `Instance::irqs` (see its documentation):
+// an existing device interrupt of the chip.
+unsafe impl cortex_m::interrupt::InterruptNumber for IrqNumber {
+    fn number(self) -> u16 {
+        self.0
+    }
+}
+
+/// Firmware's NVIC. `start` is meant for applications whose critical sections mask all
+/// interrupts (`cortex-m`'s `critical-section-single-core`, PRIMASK); a framework that
+/// builds critical sections from NVIC masks or priorities (RTIC) owns the NVIC and runs
+/// the handlers of [`twocan_core::split::State::split`] itself, without `rt`.
+impl Nvic for cortex_m::peripheral::NVIC {
+    fn set_priority(&mut self, irq: IrqNumber, priority: u8) {
+        // SAFETY: changing a priority can only break priority-based critical sections,
+        // which the applications this is for do not use (see the impl's documentation);
+        // `start` sets the priority while the line is still masked.
+        unsafe { cortex_m::peripheral::NVIC::set_priority(self, irq, priority) };
+    }
+
+    fn unmask(&mut self, irq: IrqNumber) {
+        // SAFETY: unmasking can only break mask-based critical sections, which the
+        // applications this is for do not use; `start` calls it after the handler the
+        // entry point runs is in place.
+        unsafe { cortex_m::peripheral::NVIC::unmask(irq) };
+    }
+}
+
+/// The interrupt lines of one instance.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Line {
+    /// ORed message buffer (transmit mailboxes, Rx FIFO).
+    Message,
+    /// Bus off, error, Tx warning, Rx warning.
+    Status,
+}
+
+/// What an instance's entry points run (implemented by [`IrqState`]).
+pub trait Handlers: Sync {
+    /// The message-buffer line's work; `false` when no handler is in place.
+    fn on_message(&self) -> bool;
+    /// The status lines' work; `false` when no handler is in place.
+    fn on_status(&self) -> bool;
+}
+
+const EMPTY: u8 = 0;
+const CLAIMED: u8 = 1;
+const READY: u8 = 2;
+
+/// Where an instance's entry points find its handlers: set once, read from then on.
+struct Slot {
+    state: AtomicU8,
+    handlers: UnsafeCell<MaybeUninit<&'static dyn Handlers>>,
+}
+
+// SAFETY: `handlers` is written only by the one context that moved `state` from
+// CLAIMED (its `claim` succeeded) and read only after `state` is READY (release/
+// acquire); a `&'static dyn Handlers` is `Send + Sync` (`Handlers: Sync`).
+unsafe impl Sync for Slot {}
+
+impl Slot {
+    const fn new() -> Self {
+        Slot {
+            state: AtomicU8::new(EMPTY),
+            handlers: UnsafeCell::new(MaybeUninit::uninit()),
+        }
+    }
+
+    fn claim(&self) -> bool {
+        self.state
+            .compare_exchange(EMPTY, CLAIMED, Ordering::Acquire, Ordering::Relaxed)
+            .is_ok()
+    }
+
+    fn unclaim(&self) {
+        self.state.store(EMPTY, Ordering::Release);
+    }
+
+    /// After a successful `claim`.
+    fn publish(&self, handlers: &'static dyn Handlers) {
+        // SAFETY: CLAIMED by this caller: no other writer, and no reader before READY.
+        unsafe { (*self.handlers.get()).write(handlers) };
+        self.state.store(READY, Ordering::Release);
+    }
+
+    fn get(&self) -> Option<&'static dyn Handlers> {
+        if self.state.load(Ordering::Acquire) == READY {
+            // SAFETY: READY is stored after the write and never left.
+            Some(unsafe { (*self.handlers.get()).assume_init() })
+        } else {
+            None
+        }
+    }
+}
+
+static SLOTS: [Slot; 2] = [Slot::new(), Slot::new()];
+
+const fn slot(instance: Instance) -> &'static Slot {
+    match instance {
+        Instance::Can0 => &SLOTS[0],
+        Instance::Can1 => &SLOTS[1],
+    }
+}
+
+/// Runs `line` of `instance`: what the exported entry points do. `false` when no
+/// handler was installed for it (the line should not be unmasked then).
+#[inline]
+pub fn dispatch(instance: Instance, line: Line) -> bool {
+    match slot(instance).get() {
+        Some(h) => match line {
+            Line::Message => h.on_message(),
+            Line::Status => h.on_status(),
+        },
+        None => false,
+    }
+}
+
+/// Whether [`IrqState::start`] wired `instance`.
+pub fn is_wired(instance: Instance) -> bool {
+    slot(instance).get().is_some()
+}
+
+type Message<R, const RX: usize, Q, const DONE: usize> = (
+    TxIrq<'static, FlexCanHw<R>, RX, Q, 0, DONE>,
+    RxIrq<'static, FlexCanHw<R>, RX, Q, 0, DONE>,
+);
+type Status<R, const RX: usize, Q, const DONE: usize> =
+    StatusIrq<'static, FlexCanHw<R>, RX, Q, 0, DONE>;
+
+/// The split driver's state of one FlexCAN instance together with its interrupt
+/// handlers, for a `static`. `RX`: receive ring (frames); `Q`: transmit queue
+/// ([`FifoQueue`] keeps ACAN's send order); `DONE`: completion ring.
+pub struct IrqState<
+    R: Registers + 'static,
+    const RX: usize,
+    Q: TxQueue + 'static,
+    const DONE: usize,
+> {
+    state: State<FlexCanHw<R>, RX, Q, 0, DONE>,
+    message: IrqCell<Message<R, RX, Q, DONE>>,
+    status: IrqCell<Status<R, RX, Q, DONE>>,
+}
+
+/// ACAN's buffer sizes (receive 32, transmit 16, table 7) on the target registers, with
+/// 8 completions.
+pub type AcanState = IrqState<FlexCanRegs, RECEIVE_BUFFER_SIZE, FifoQueue<TRANSMIT_BUFFER_SIZE>, 8>;
+
+/// Why [`IrqState::start`] did not start; the controller comes back with it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum StartError {
+    /// The controller's board has no interrupt numbers for its instance.
+    NoInterrupts,
+    /// The instance's entry points already run another state's handlers.
+    AlreadyWired,
+    /// This state was split before (it holds a controller already).
+    AlreadySplit,
+    /// The controller's transmit order is not the queue's (`twocan_core` split:
+    /// [`Error::InvalidArgument`]).
+    Split(Error),
+}
+
+impl fmt::Display for StartError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            StartError::NoInterrupts => f.write_str("the instance has no interrupt numbers"),
+            StartError::AlreadyWired => {
+                f.write_str("the instance's interrupt entry points are wired already")
+            }
+            StartError::AlreadySplit => f.write_str("the state holds a controller already"),
+            StartError::Split(e) => write!(f, "split refused the controller: {e}"),
+        }
+    }
+}
+
+impl core::error::Error for StartError {}
+
+impl<R: Registers + 'static, const RX: usize, Q: TxQueue + 'static, const DONE: usize> Default
+    for IrqState<R, RX, Q, DONE>
+{
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<R: Registers + 'static, const RX: usize, Q: TxQueue + 'static, const DONE: usize>
+    IrqState<R, RX, Q, DONE>
+{
+    /// Empty (all zeros: `.bss`).
+    pub const fn new() -> Self {
+        IrqState {
+            state: State::new(),
+            message: IrqCell::new(),
+            status: IrqCell::new(),
+        }
+    }
+
+    /// The split driver's shared state (statistics, error state).
+    pub fn state(&self) -> &State<FlexCanHw<R>, RX, Q, 0, DONE> {
+        &self.state
+    }
+}
+
+impl<R, const RX: usize, Q, const DONE: usize> Handlers for IrqState<R, RX, Q, DONE>
+where
+    R: Registers + 'static,
+    Q: TxQueue + 'static,
+    Self: Sync,
+{
+    #[inline]
+    fn on_message(&self) -> bool {
+        self.message.run(|(tx, rx)| {
+            tx.on_interrupt();
+            rx.on_interrupt();
+        })
+    }
+
+    #[inline]
+    fn on_status(&self) -> bool {
+        self.status.run(|s| s.on_interrupt())
+    }
+}
+
+/// The transmit and receive halves [`IrqState::start`] gives the thread side.
+pub type Halves<R, const RX: usize, Q, const DONE: usize> = (
+    Tx<'static, FlexCanHw<R>, RX, Q, 0, DONE>,
+    Rx<'static, FlexCanHw<R>, RX, Q, 0, DONE>,
+);
+
+impl<R, const RX: usize, Q, const DONE: usize> IrqState<R, RX, Q, DONE>
+where
+    R: Registers + 'static,
+    Q: TxQueue + 'static,
+    Self: Sync,
+{
+    /// ACAN's `begin` interrupt set-up, after [`crate::FlexCan::begin`]: splits `hw`
+    /// into this state, installs the interrupt handlers for the instance's entry
+    /// points, **then** gives the message, bus-off, error and warning lines the
+    /// settings' `message_irq_priority` and unmasks them (module docs, "Order").
+    /// Returns the thread-side halves. On error nothing was unmasked and the controller
+    /// comes back.
+    // The controller comes back by value on error (no allocator to box it in).
+    #[allow(clippy::type_complexity, clippy::result_large_err)]
+    pub fn start(
+        &'static self,
+        hw: FlexCanHw<R>,
+        nvic: &mut impl Nvic,
+    ) -> Result<Halves<R, RX, Q, DONE>, (StartError, FlexCanHw<R>)> {
+        let target = hw.target();
+        let Some(irqs) = target.irqs() else {
+            return Err((StartError::NoInterrupts, hw));
+        };
+        let priority = hw.message_irq_priority();
+        let slot = slot(target.instance);
+        if !slot.claim() {
+            return Err((StartError::AlreadyWired, hw));
+        }
+        let parts = match self.state.split(hw) {
+            Ok(parts) => parts,
+            Err((e, hw)) => {
+                slot.unclaim();
+                let e = match e {
+                    Error::WrongMode => StartError::AlreadySplit,
+                    e => StartError::Split(e),
+                };
+                return Err((e, hw));
+            }
+        };
+        // The cells are empty: only a successful split (once per state) fills them.
+        let filled = self.message.put((parts.tx_irq, parts.rx0_irq)).is_ok()
+            && self.status.put(parts.status_irq).is_ok();
+        debug_assert!(filled, "split succeeds once per state");
+        slot.publish(self);
+        enable(nvic, irqs, priority);
+        Ok((parts.tx, parts.rx))
+    }
+}
+
+/// Priority, then unmask, for each line `start` uses.
+fn enable(nvic: &mut impl Nvic, irqs: Irqs, priority: u8) {
+    for irq in [
+        irqs.message,
+        irqs.bus_off,
+        irqs.error,
+        irqs.tx_warning,
+        irqs.rx_warning,
+    ] {
+        nvic.set_priority(IrqNumber(irq), priority);
+        nvic.unmask(IrqNumber(irq));
+    }
+}
+
+macro_rules! entry {
+    ($(#[$m:meta])* $name:ident = $symbol:literal, $instance:ident, $line:ident) => {
+        $(#[$m])*
+        #[export_name = $symbol]
+        pub extern "C" fn $name() {
+            dispatch(Instance::$instance, Line::$line);
+        }
+    };
+}
+
+entry!(
+    /// Entry point `CAN0_ORED_MESSAGE_BUFFER` (FlexCAN0 message buffers, Rx FIFO).
+    can0_ored_message_buffer = "CAN0_ORED_MESSAGE_BUFFER", Can0, Message
+);
+entry!(
+    /// Entry point `CAN0_BUS_OFF`.
+    can0_bus_off = "CAN0_BUS_OFF", Can0, Status
+);
+entry!(
+    /// Entry point `CAN0_ERROR`.
+    can0_error = "CAN0_ERROR", Can0, Status
+);
+entry!(
+    /// Entry point `CAN0_TX_WARNING`.
+    can0_tx_warning = "CAN0_TX_WARNING", Can0, Status
+);
+entry!(
+    /// Entry point `CAN0_RX_WARNING`.
+    can0_rx_warning = "CAN0_RX_WARNING", Can0, Status
+);
+entry!(
+    /// Entry point `CAN1_ORED_MESSAGE_BUFFER` (Teensy 3.6).
+    #[cfg(feature = "teensy36")]
+    can1_ored_message_buffer = "CAN1_ORED_MESSAGE_BUFFER", Can1, Message
+);
+entry!(
+    /// Entry point `CAN1_BUS_OFF` (Teensy 3.6).
+    #[cfg(feature = "teensy36")]
+    can1_bus_off = "CAN1_BUS_OFF", Can1, Status
+);
+entry!(
+    /// Entry point `CAN1_ERROR` (Teensy 3.6).
+    #[cfg(feature = "teensy36")]
+    can1_error = "CAN1_ERROR", Can1, Status
+);
+entry!(
+    /// Entry point `CAN1_TX_WARNING` (Teensy 3.6).
+    #[cfg(feature = "teensy36")]
+    can1_tx_warning = "CAN1_TX_WARNING", Can1, Status
+);
+entry!(
+    /// Entry point `CAN1_RX_WARNING` (Teensy 3.6).
+    #[cfg(feature = "teensy36")]
+    can1_rx_warning = "CAN1_RX_WARNING", Can1, Status
+);

@@ -1,0 +1,264 @@
+//! The library's interrupt wiring (feature `rt`, issue 17): `IrqState::start` installs
+//! the handlers before it unmasks each line, gives every line the settings'
+//! `message_irq_priority`, refuses a second wiring with a typed error, and the exported
+//! entry points (`CAN0_ORED_MESSAGE_BUFFER` ...) run the split driver's handlers.
+//!
+//! The NVIC is the `Nvic` seam: a recorder that, at each `unmask`, calls the entry
+//! point of that line and notes whether a handler ran. The registers are a small
+//! `Sync` register file (the split state lives in a `static`-like leaked box and is
+//! shared with interrupt context, which the behavioural model, single-threaded, is not):
+//! it acknowledges the mode handshakes at once (Kinetis RM, FlexCAN "Modes of
+//! operation") and clears `IFLAG1`/`ESR1` bits written 1.
+#![cfg(feature = "rt")]
+
+use std::sync::atomic::{AtomicU32, Ordering};
+
+use twocan_core::{Frame, Registers};
+use twocan_flexcan::regs::{self, cs, esr1, iflag1, mcr, ESR1, IFLAG1, MCR};
+use twocan_flexcan::rt::{self, IrqNumber, IrqState, Line, Nvic, StartError};
+use twocan_flexcan::{Board, FlexCan, HostSystem, Instance, Settings, Target};
+
+/// FlexCAN registers as plain memory, with the handshakes acknowledged at once.
+struct SyncRegs {
+    words: Vec<AtomicU32>,
+}
+
+impl SyncRegs {
+    fn new() -> Self {
+        SyncRegs {
+            words: (0..regs::BLOCK_END / 4)
+                .map(|_| AtomicU32::new(0))
+                .collect(),
+        }
+    }
+
+    /// Sets bits as the hardware would (an interrupt cause).
+    fn raise(&self, offset: usize, bits: u32) {
+        self.words[offset / 4].fetch_or(bits, Ordering::SeqCst);
+    }
+}
+
+impl Registers for SyncRegs {
+    fn read32(&self, offset: usize) -> u32 {
+        let v = self.words[offset / 4].load(Ordering::SeqCst);
+        match offset {
+            MCR if v & mcr::MDIS != 0 => v | mcr::LPMACK | mcr::NOTRDY,
+            MCR if v & mcr::FRZ != 0 && v & mcr::HALT != 0 => v | mcr::FRZACK | mcr::NOTRDY,
+            ESR1 => v | esr1::SYNCH,
+            _ => v,
+        }
+    }
+
+    fn write32(&self, offset: usize, value: u32) {
+        let w = &self.words[offset / 4];
+        match offset {
+            MCR => w.store(
+                value & !(mcr::FRZACK | mcr::LPMACK | mcr::NOTRDY | mcr::SOFTRST),
+                Ordering::SeqCst,
+            ),
+            IFLAG1 | ESR1 => {
+                w.fetch_and(!value, Ordering::SeqCst);
+            }
+            _ => w.store(value, Ordering::SeqCst),
+        }
+    }
+}
+
+type Regs = &'static SyncRegs;
+type Wired = IrqState<Regs, 32, twocan_core::FifoQueue<16>, 8>;
+
+/// Records the NVIC calls; at each unmask, runs that line's entry point as the
+/// hardware would if the cause were pending, and notes whether a handler ran.
+struct Recorder {
+    instance: Instance,
+    calls: Vec<(&'static str, u16, u8)>,
+    handled_at_unmask: Vec<bool>,
+    priorities: std::collections::HashMap<u16, u8>,
+}
+
+impl Recorder {
+    fn new(instance: Instance) -> Self {
+        Recorder {
+            instance,
+            calls: Vec::new(),
+            handled_at_unmask: Vec::new(),
+            priorities: Default::default(),
+        }
+    }
+}
+
+impl Nvic for Recorder {
+    fn set_priority(&mut self, irq: IrqNumber, priority: u8) {
+        let irq = irq.number();
+        self.priorities.insert(irq, priority);
+        self.calls.push(("priority", irq, priority));
+    }
+
+    fn unmask(&mut self, irq: IrqNumber) {
+        let irq = irq.number();
+        let message = Target::new(Board::Teensy36, self.instance)
+            .irqs()
+            .unwrap()
+            .message;
+        let line = if irq == message {
+            Line::Message
+        } else {
+            Line::Status
+        };
+        self.handled_at_unmask
+            .push(rt::dispatch(self.instance, line));
+        let p = self.priorities.get(&irq).copied();
+        self.calls.push(("unmask", irq, p.unwrap_or(0xFF)));
+    }
+}
+
+fn begin(regs: Regs, instance: Instance, priority: u8) -> FlexCan<Regs> {
+    let mut settings = Settings::new(500_000);
+    settings.message_irq_priority = priority;
+    FlexCan::begin(
+        regs,
+        &mut HostSystem::new(),
+        Target::new(Board::Teensy36, instance),
+        &settings,
+        &[],
+        &[],
+    )
+    .expect("begin")
+}
+
+fn leak<T>(t: T) -> &'static T {
+    Box::leak(Box::new(t))
+}
+
+/// Puts one standard frame in the Rx FIFO output (MB0) and raises `BUF5I`.
+fn frame_arrives(regs: &SyncRegs, id: u16, data: &[u8]) {
+    let mut bytes = [0u8; 8];
+    bytes[..data.len()].copy_from_slice(data);
+    regs.write32(regs::mb_cs(0), cs::DLC.val(data.len() as u32));
+    regs.write32(regs::mb_id(0), regs::id::STD.val(id as u32));
+    regs.write32(
+        regs::mb_word0(0),
+        u32::from_be_bytes(bytes[..4].try_into().unwrap()),
+    );
+    regs.write32(
+        regs::mb_word1(0),
+        u32::from_be_bytes(bytes[4..].try_into().unwrap()),
+    );
+    regs.write32(regs::RXFIR, 0);
+    regs.raise(IFLAG1, iflag1::BUF5I);
+}
+
+#[test]
+fn can0_handlers_installed_before_each_line_is_unmasked_at_the_settings_priority() {
+    // Nothing wired yet: the entry points do nothing.
+    assert!(!rt::dispatch(Instance::Can0, Line::Message));
+    assert!(!rt::is_wired(Instance::Can0));
+
+    let regs: Regs = leak(SyncRegs::new());
+    let state: &'static Wired = leak(Wired::new());
+    let mut nvic = Recorder::new(Instance::Can0);
+    let hw = begin(regs, Instance::Can0, 0x30).into_split();
+    let (mut tx, mut rx) = state.start(hw, &mut nvic).map_err(|(e, _)| e).unwrap();
+
+    // Teensy 3.6 FlexCAN0: message 75, bus off 76, error 77, Tx/Rx warning 78/79.
+    let unmasked: Vec<_> = nvic
+        .calls
+        .iter()
+        .filter(|c| c.0 == "unmask")
+        .map(|c| (c.1, c.2))
+        .collect();
+    assert_eq!(
+        unmasked,
+        [(75, 0x30), (76, 0x30), (77, 0x30), (78, 0x30), (79, 0x30)],
+        "each line gets its priority before it is unmasked: {:?}",
+        nvic.calls
+    );
+    assert_eq!(
+        nvic.handled_at_unmask, [true; 5],
+        "a handler at every unmask"
+    );
+    assert!(rt::is_wired(Instance::Can0));
+
+    // The exported entry point runs the receive handler: the frame reaches `rx`.
+    frame_arrives(regs, 0x123, &[1, 2, 3]);
+    rt::can0_ored_message_buffer();
+    assert_eq!(regs.read32(IFLAG1) & iflag1::BUF5I, 0, "FIFO popped");
+    let got = rx.receive().expect("a frame");
+    assert_eq!(got.frame, Frame::standard(0x123, &[1, 2, 3]).unwrap());
+
+    // ... and the transmit handler: a frame queued behind a busy MB15 goes out once
+    // the entry point settles MB15.
+    tx.try_send(&Frame::standard(0x10, &[1]).unwrap()).unwrap();
+    tx.try_send(&Frame::standard(0x11, &[2]).unwrap()).unwrap();
+    let mb15_id = || regs::id::STD.get(regs.read32(regs::mb_id(15)));
+    assert_eq!(mb15_id(), 0x10);
+    // MB15 sent: the hardware writes code INACTIVE and raises its flag.
+    regs.write32(regs::mb_cs(15), cs::CODE.val(regs::code::TX_INACTIVE));
+    regs.raise(IFLAG1, iflag1::buf(15));
+    rt::can0_ored_message_buffer();
+    assert_eq!(mb15_id(), 0x11, "the transmit handler refilled MB15");
+    for entry in [
+        rt::can0_bus_off,
+        rt::can0_error,
+        rt::can0_tx_warning,
+        rt::can0_rx_warning,
+    ] {
+        entry();
+    }
+    assert!(rt::dispatch(Instance::Can0, Line::Status));
+
+    // A second wiring of FlexCAN0 is refused, with the controller back and nothing
+    // unmasked.
+    let other: &'static Wired = leak(Wired::new());
+    let mut nvic2 = Recorder::new(Instance::Can0);
+    let hw = begin(leak(SyncRegs::new()), Instance::Can0, 0x30).into_split();
+    let (e, hw) = other.start(hw, &mut nvic2).map(|_| ()).unwrap_err();
+    assert_eq!(e, StartError::AlreadyWired);
+    assert!(nvic2.calls.is_empty());
+    assert_eq!(hw.target().instance, Instance::Can0);
+}
+
+#[test]
+fn can1_errors_leave_the_slot_free() {
+    let state: &'static Wired = leak(Wired::new());
+    let regs: Regs = leak(SyncRegs::new());
+    let mut nvic = Recorder::new(Instance::Can1);
+    let controller = FlexCan::begin(
+        regs,
+        &mut HostSystem::new(),
+        Target::new(Board::Teensy36, Instance::Can1),
+        &Settings::new(500_000),
+        &[],
+        &[],
+    )
+    .unwrap();
+    let hw = controller.into_split();
+    // A state split already (here: by another controller) refuses, and the slot
+    // stays free for the next try.
+    let used: &'static Wired = leak(Wired::new());
+    let parts = used
+        .state()
+        .split(begin(leak(SyncRegs::new()), Instance::Can1, 0).into_split());
+    assert!(parts.is_ok());
+    let (e, hw) = used.start(hw, &mut nvic).map(|_| ()).unwrap_err();
+    assert_eq!(e, StartError::AlreadySplit);
+    let _: &dyn core::error::Error = &e;
+    assert_eq!(e.to_string(), "the state holds a controller already");
+    assert!(nvic.calls.is_empty());
+    assert!(!rt::is_wired(Instance::Can1));
+
+    let _halves = state.start(hw, &mut nvic).map_err(|(e, _)| e).unwrap();
+    assert!(rt::is_wired(Instance::Can1));
+    assert_eq!(nvic.handled_at_unmask, [true; 5]);
+    let unmasked: Vec<_> = nvic
+        .calls
+        .iter()
+        .filter(|c| c.0 == "unmask")
+        .map(|c| c.1)
+        .collect();
+    assert_eq!(unmasked, [94, 95, 96, 97, 98]);
+    assert!(nvic
+        .calls
+        .iter()
+        .all(|c| c.2 == twocan_flexcan::settings::DEFAULT_IRQ_PRIORITY));
+}
