@@ -47,7 +47,7 @@ use clap::{Parser, ValueEnum};
 use cmd::{Context, Result};
 use firmware::Paths;
 use report::{ExampleBuild, ExampleSection, InsnSection, Report, SizeBuild, SizeSection};
-use simspeed::Trials;
+use simspeed::SimRow;
 
 /// A step of the command, for `--skip`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -144,16 +144,21 @@ fn run() -> Result<()> {
         step("simulator speed");
         let mut speeds = Vec::new();
         for (senders, tracing) in [(1, false), (1, true), (4, false)] {
-            speeds.push(Trials::run(|| simspeed::bare_bus(senders, tracing))?);
+            speeds.push(SimRow::run(|fast| {
+                simspeed::bare_bus(senders, tracing, fast)
+            })?);
         }
-        speeds.push(Trials::run(models::two_drivers)?);
-        speeds.push(Trials::run(models::harness)?);
-        for t in &speeds {
+        speeds.push(SimRow::run(models::two_drivers)?);
+        speeds.push(SimRow::run(models::harness)?);
+        for r in &speeds {
             eprintln!(
-                "can-bench: {}: {:.0} frames/s (median of {})",
-                t.scenario(),
-                t.median().frames_per_sec(),
-                t.runs.len()
+                "can-bench: {}: {:.0} frames/s, bit-level path {:.0} frames/s, ratio {:.2} \
+                 (medians of {})",
+                r.fast.scenario(),
+                r.fast.median().frames_per_sec(),
+                r.bit_level.median().frames_per_sec(),
+                r.ratio(),
+                r.fast.runs.len()
             );
         }
         report.sim = Some(speeds);

@@ -80,12 +80,14 @@ fn flexcan_driver(model: &FlexCanModel) -> Result<AcanDriver<IdleClocked>> {
     Ok(AcanDriver::new(controller.into_split()))
 }
 
-/// Runs the two drivers against each other; frames delivered per host second.
-pub fn two_drivers() -> Result<Speed> {
+/// Runs the two drivers against each other; frames delivered per host second. With
+/// `fast_path` false the bus plays every attempt bit by bit.
+pub fn two_drivers(fast_path: bool) -> Result<Speed> {
     let bx_model = BxCanModel::can1();
     let fx_model = FlexCanModel::mk20dx256();
     let mut bus = Bus::new(BITRATE).context("Bus::new")?;
     bus.set_tracing(false);
+    bus.set_fast_path(fast_path);
     bus.attach("bxcan", bx_model.clone());
     bus.attach("flexcan", fx_model.clone());
     let mut fx = flexcan_driver(&fx_model)?;
@@ -144,11 +146,12 @@ pub fn two_drivers() -> Result<Speed> {
             "{lost} frames lost to full receive rings"
         )));
     }
+    let scenario = "twocan bxCAN driver over the bxCAN model ⇄ twocan FlexCAN driver over the \
+                    FlexCAN model, both sending 8-byte frames, interrupt handler run on each \
+                    interrupt line, trace off";
+    crate::simspeed::check_path(fast_path, bus.fast_path_attempts(), scenario)?;
     Ok(Speed {
-        scenario: "twocan bxCAN driver over the bxCAN model ⇄ twocan FlexCAN driver over the \
-                   FlexCAN model, both sending 8-byte frames, interrupt handler run on each \
-                   interrupt line, trace off"
-            .into(),
+        scenario: scenario.into(),
         frames: delivered[0] + delivered[1],
         secs,
         bus_secs: bus.now() as f64 / BITRATE as f64,
@@ -159,9 +162,10 @@ pub fn two_drivers() -> Result<Speed> {
 const HARNESS_STEP_BITS: u64 = 150;
 
 /// The same traffic as [`two_drivers`] through the `twocan-host` harness.
-pub fn harness() -> Result<Speed> {
+pub fn harness(fast_path: bool) -> Result<Speed> {
     let mut h = Harness::new(BITRATE).map_err(|e| Error::new(format!("harness: {e:?}")))?;
     h.bus().borrow_mut().set_tracing(false);
+    h.bus().borrow_mut().set_fast_path(fast_path);
     let mut teensy = FlexNode::teensy36_can0(&mut h, &[Filter::pass_all()])
         .map_err(|e| Error::new(format!("harness FlexCAN node: {e:?}")))?;
     let mut stm32 = BxNode::stm32f767_can1(&mut h, &[Filter::pass_all()])
@@ -209,11 +213,13 @@ pub fn harness() -> Result<Speed> {
     if teensy.lost() + stm32.lost() != 0 {
         return Err(Error::new("the harness nodes lost frames"));
     }
+    let scenario = "the same through `twocan_host::Harness` (can-demo's harness: Teensy 3.6 \
+                    FlexCAN0 ⇄ STM32F767 CAN1, clocked register access, every node serviced \
+                    after each bus event), trace off";
+    let fast_attempts = h.bus().borrow().fast_path_attempts();
+    crate::simspeed::check_path(fast_path, fast_attempts, scenario)?;
     Ok(Speed {
-        scenario: "the same through `twocan_host::Harness` (can-demo's harness: Teensy 3.6 \
-                   FlexCAN0 ⇄ STM32F767 CAN1, clocked register access, every node serviced \
-                   after each bus event), trace off"
-            .into(),
+        scenario: scenario.into(),
         frames: delivered[0] + delivered[1],
         secs,
         bus_secs: (h.now() - start_bits) as f64 / BITRATE as f64,

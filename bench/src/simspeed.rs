@@ -3,6 +3,12 @@
 //! Each scenario runs batches of frames until at least [`MIN_SECS`] of host time have
 //! passed, counting only frames delivered to a receiver, and the time of the bus run
 //! (frame construction and queueing included).
+//!
+//! Every scenario runs twice in the same command, trial by trial: with the bus's fast
+//! path (the default: an attempt that cannot fail is resolved without playing its bits,
+//! `twocan_core::sim` `fast.rs`) and forced onto the bit-level path
+//! (`Bus::set_fast_path(false)`), so the report gives the fast path's speed as a ratio
+//! to the bit-level path measured in the same run ([`SimRow`]).
 
 use std::time::{Duration, Instant};
 
@@ -50,11 +56,26 @@ fn frame(id: u16, n: u64) -> Result<Frame> {
         .map_err(|e| Error::new(format!("building a frame: {e:?}")))
 }
 
+/// Checks that the run took the path it was asked for: with the fast path on, some
+/// attempts were resolved by it; off, none.
+pub fn check_path(fast_path: bool, fast_attempts: u64, scenario: &str) -> Result<()> {
+    if fast_path == (fast_attempts > 0) {
+        Ok(())
+    } else {
+        Err(Error::new(format!(
+            "`{scenario}`: fast path {}, but {fast_attempts} attempts took it",
+            if fast_path { "on" } else { "off" }
+        )))
+    }
+}
+
 /// `senders` SimNodes (identifiers 0x100 + node) each sending 8-byte frames, one more
-/// listening node; with or without the trace.
-pub fn bare_bus(senders: usize, tracing: bool) -> Result<Speed> {
+/// listening node; with or without the trace; on the fast path or forced onto the
+/// bit-level path.
+pub fn bare_bus(senders: usize, tracing: bool, fast_path: bool) -> Result<Speed> {
     let mut bus = Bus::new(BITRATE).context("Bus::new")?;
     bus.set_tracing(tracing);
+    bus.set_fast_path(fast_path);
     let nodes: Vec<_> = (0..senders).map(|_| SimNode::new().shared()).collect();
     for (k, n) in nodes.iter().enumerate() {
         bus.attach(&format!("tx{k}"), n.clone());
@@ -91,12 +112,14 @@ pub fn bare_bus(senders: usize, tracing: bool) -> Result<Speed> {
             "the listener received {delivered} of {n} frames"
         )));
     }
+    let scenario = format!(
+        "bare bus: {senders} SimNode sender{} + 1 listener, 8-byte frames, trace {}",
+        if senders == 1 { "" } else { "s (arbitration)" },
+        if tracing { "on" } else { "off" }
+    );
+    check_path(fast_path, bus.fast_path_attempts(), &scenario)?;
     Ok(Speed {
-        scenario: format!(
-            "bare bus: {senders} SimNode sender{} + 1 listener, 8-byte frames, trace {}",
-            if senders == 1 { "" } else { "s (arbitration)" },
-            if tracing { "on" } else { "off" }
-        ),
+        scenario,
         frames: delivered,
         secs,
         bus_secs: bus.now() as f64 / BITRATE as f64,
@@ -111,17 +134,12 @@ pub struct Trials {
 }
 
 impl Trials {
-    /// Runs `trial` [`TRIALS`] times.
-    pub fn run(mut trial: impl FnMut() -> Result<Speed>) -> Result<Trials> {
-        let mut runs = Vec::new();
-        for _ in 0..TRIALS {
-            let s = trial()?;
-            if s.frames == 0 || s.secs < Duration::from_millis(100).as_secs_f64() {
-                return Err(Error::new(format!("scenario `{}` did not run", s.scenario)));
-            }
-            runs.push(s);
+    /// Checks that one trial ran (frames delivered, enough host time).
+    fn run_once(s: Speed) -> Result<Speed> {
+        if s.frames == 0 || s.secs < Duration::from_millis(100).as_secs_f64() {
+            return Err(Error::new(format!("scenario `{}` did not run", s.scenario)));
         }
-        Ok(Trials { runs })
+        Ok(s)
     }
 
     /// The scenario's description.
@@ -145,5 +163,37 @@ impl Trials {
     pub fn range(&self) -> (f64, f64) {
         let v = self.sorted();
         (v[0].frames_per_sec(), v[v.len() - 1].frames_per_sec())
+    }
+}
+
+/// One scenario on the fast path and forced onto the bit-level path, measured in the
+/// same run with the trials interleaved (fast, bit-level, fast, ...), so that both see
+/// the same load on the shared host.
+#[derive(Debug, Clone)]
+pub struct SimRow {
+    /// With the fast path (the bus's default).
+    pub fast: Trials,
+    /// With `Bus::set_fast_path(false)`.
+    pub bit_level: Trials,
+}
+
+impl SimRow {
+    /// Runs `trial(fast_path)` [`TRIALS`] times each way, interleaved.
+    pub fn run(mut trial: impl FnMut(bool) -> Result<Speed>) -> Result<SimRow> {
+        let mut fast = Vec::new();
+        let mut bit_level = Vec::new();
+        for _ in 0..TRIALS {
+            fast.push(Trials::run_once(trial(true)?)?);
+            bit_level.push(Trials::run_once(trial(false)?)?);
+        }
+        Ok(SimRow {
+            fast: Trials { runs: fast },
+            bit_level: Trials { runs: bit_level },
+        })
+    }
+
+    /// Median frames per second on the fast path over the median on the bit-level path.
+    pub fn ratio(&self) -> f64 {
+        self.fast.median().frames_per_sec() / self.bit_level.median().frames_per_sec()
     }
 }

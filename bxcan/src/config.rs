@@ -285,10 +285,16 @@ impl Config {
         }
     }
 
-    /// CAN1 only: the first filter bank of CAN2 (`CAN_FMR.CAN2SB`): CAN1 gets banks
-    /// `0..bank`, CAN2 `bank..28`; 28 gives every bank to CAN1 (the notes' "sets to zero
-    /// for one CAN" would give them all to CAN2: see `docs/filters.md`). Unset: the value
-    /// in the register is kept (14 after reset). Ignored by CAN2 and CAN3.
+    /// The first filter bank of CAN2 (`CAN_FMR.CAN2SB`): CAN1 gets banks `0..bank`,
+    /// CAN2 `bank..28`; 28 gives every bank to CAN1 (the notes' "sets to zero for one
+    /// CAN" would give them all to CAN2: see `docs/filters.md`). Unset: the value in the
+    /// register is kept (14 after reset).
+    ///
+    /// CAN1 writes it ([`crate::Can::can1`], [`crate::Can::reconfigure`]); a change is
+    /// refused with [`twocan_core::Error::WrongMode`] while a filter bank it would move
+    /// or renumber is active (CAN2's filters, or CAN1's above the new split): install
+    /// an empty plan on the instance first. CAN2 checks it against the shared block
+    /// ([`twocan_core::Error::InvalidArgument`] if it disagrees). Ignored by CAN3.
     pub const fn can2_start_bank(self, bank: u8) -> Result<Self, ConfigError> {
         if bank as usize > FILTER_BANKS {
             return Err(ConfigError::StartBankOutOfRange);

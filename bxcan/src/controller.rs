@@ -97,6 +97,12 @@ impl<R: Registers, F: Registers> Can<R, F> {
     /// CAN1's register block, used for the filter registers only (`CAN_FMR` ..
     /// `CAN_F27R2`, RM0410 §40.9.4: CAN2 has none of its own). CAN1 must be clocked;
     /// CAN2 owns banks `CAN2SB..28`.
+    ///
+    /// `CAN2SB` belongs to CAN1's configuration (the register is CAN1's); a start bank
+    /// in CAN2's own `config` ([`Config::can2_start_bank`]) is a check: it must agree
+    /// with the value in the shared block, or this returns [`Error::InvalidArgument`]
+    /// before touching a register (so CAN2 never runs on banks its planner did not
+    /// expect).
     pub fn can2(
         regs: R,
         can1_filters: F,
@@ -118,7 +124,41 @@ impl<R: Registers, F: Registers, const K: usize> Can<R, F, K> {
         }
     }
 
+    /// The start bank rules before any register is written: CAN2's configured start
+    /// bank must agree with the block's `CAN2SB`; CAN1 may move `CAN2SB` only when no
+    /// bank it would affect is active ([`filter_block::check_can2sb`]).
+    fn check_start_bank(&self, config: &Config) -> Result<(), Error> {
+        let Some(start) = config.get_can2_start_bank() else {
+            return Ok(());
+        };
+        match self.instance {
+            Instance::Can2 => {
+                let current = match &self.filter_regs {
+                    Some(r) => filter_block::can2sb(r),
+                    None => filter_block::can2sb(&self.regs),
+                };
+                let first = |sb| crate::instance::bank_range(Instance::Can2, sb).0;
+                if first(current) == first(start as u32) {
+                    Ok(())
+                } else {
+                    Err(Error::InvalidArgument)
+                }
+            }
+            Instance::Can1 => {
+                let r = match &self.filter_regs {
+                    Some(f) => filter_block::check_can2sb(f, start),
+                    None => filter_block::check_can2sb(&self.regs, start),
+                };
+                r.map_err(|_| Error::WrongMode)
+            }
+            Instance::Can3 => Ok(()),
+        }
+    }
+
     fn configure(mut self, config: &Config) -> Result<Init<R, F, K>, Failed<Can<R, F, K>>> {
+        if let Err(error) = self.check_start_bank(config) {
+            return Err(Failed { error, value: self });
+        }
         self.config = *config;
         let bound = config.get_wait_iterations();
         if let Err(error) = mode::request(&self.regs, Mode::Stopped, bound) {
@@ -129,9 +169,17 @@ impl<R: Registers, F: Registers, const K: usize> Can<R, F, K> {
         self.regs.write32(BTR, config.btr_value());
         self.regs.write32(IER, config.get_interrupts());
         if let (Instance::Can1, Some(start)) = (self.instance, config.get_can2_start_bank()) {
-            match &self.filter_regs {
+            // Checked again inside the critical section: CAN2's driver may have
+            // activated a bank since `check_start_bank`.
+            let r = match &self.filter_regs {
                 Some(f) => filter_block::set_can2sb(f, start),
                 None => filter_block::set_can2sb(&self.regs, start),
+            };
+            if r.is_err() {
+                return Err(Failed {
+                    error: Error::WrongMode,
+                    value: self,
+                });
             }
         }
         Ok(Init { can: self })

@@ -34,15 +34,57 @@ pub(crate) fn banks_of<F: Registers>(regs: &F, instance: Instance) -> (usize, us
     bank_range(instance, can2sb(regs))
 }
 
+/// A `CAN2SB` change refused: bank `bank` is active and the change would give it to
+/// the other instance, or renumber it (a CAN2 bank's filter match index counts from
+/// `CAN2SB`, see `docs/models.md`), behind the back of the driver that installed it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct StartBankInUse {
+    /// The lowest active bank the change would affect.
+    pub bank: usize,
+}
+
+/// Whether moving the split of the block behind `regs` to `start` leaves every
+/// installed filter where its driver put it: the banks from `min(old, new)` up change
+/// owner (between the two values) or, above both, stay CAN2's but are numbered from the
+/// new `CAN2SB`; none of them may be active (`CAN_FA1R.FACTx`, RM0410 §40.9.4).
+/// Banks below both values stay CAN1's with their numbers. An unchanged split (values
+/// above 28 read as 28, [`bank_range`]) is always allowed.
+pub(crate) fn check_can2sb<F: Registers>(regs: &F, start: u8) -> Result<(), StartBankInUse> {
+    let old = bank_range(Instance::Can2, can2sb(regs)).0;
+    let new = bank_range(Instance::Can2, start as u32).0;
+    if old == new {
+        return Ok(());
+    }
+    let lowest = old.min(new);
+    let affected = regs.read32(FA1R) >> lowest;
+    if affected == 0 {
+        Ok(())
+    } else {
+        Err(StartBankInUse {
+            bank: lowest + affected.trailing_zeros() as usize,
+        })
+    }
+}
+
 /// Sets `CAN2SB` (in filter initialization mode, as RM0410 requires), in a critical
-/// section (`CAN_FMR` is shared with CAN2's driver, see the module notes).
-pub(crate) fn set_can2sb<F: Registers>(regs: &F, start: u8) {
+/// section (`CAN_FMR` is shared with CAN2's driver, see the module notes), if
+/// [`check_can2sb`] allows it (checked inside the same section, so CAN2's driver cannot
+/// activate a bank between the check and the write). An unchanged value is not
+/// written (no `FINIT` section: reception through the block goes on).
+pub(crate) fn set_can2sb<F: Registers>(regs: &F, start: u8) -> Result<(), StartBankInUse> {
     critical_section::with(|_| {
+        check_can2sb(regs, start)?;
         let fmr_value = regs.read32(FMR);
+        if bank_range(Instance::Can2, fmr::CAN2SB.get(fmr_value)).0
+            == bank_range(Instance::Can2, start as u32).0
+        {
+            return Ok(());
+        }
         regs.write32(FMR, fmr_value | fmr::FINIT);
         let with = fmr::CAN2SB.set(fmr_value | fmr::FINIT, start as u32);
         regs.write32(FMR, with);
         regs.write32(FMR, with & !fmr::FINIT);
+        Ok(())
     })
 }
 

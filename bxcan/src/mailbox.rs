@@ -37,8 +37,8 @@ pub(crate) fn data_words(frame: &Frame) -> (u32, u32) {
     )
 }
 
-/// The frame of mailbox words: identifier register, DLC (9..=15 counts as 8, ISO
-/// 11898-1), data registers.
+/// The frame of mailbox words: identifier register, DLC (a code 9..=15 is kept as
+/// written and means 8 bytes, ISO 11898-1), data registers.
 #[inline(always)]
 pub(crate) fn frame_of(ir: u32, dlc: u32, lo: u32, hi: u32) -> Frame {
     let mut data = [0u8; 8];
@@ -85,7 +85,9 @@ mod tests {
         let r = Frame::remote(0x7FF, false, 3).unwrap();
         assert_eq!(id_register(&r), (0x7FF << 21) | 0b10);
         assert_eq!(frame_of(id_register(&r), 3, 0xFFFF_FFFF, 0), r);
-        // DLC 15 reads as 8 bytes.
-        assert_eq!(frame_of(0, 15, 0, 0).dlc(), 8);
+        // DLC 15 is kept as written and reads as 8 bytes.
+        let f = frame_of(0, 15, 0x0403_0201, 0x0807_0605);
+        assert_eq!((f.dlc(), f.data()), (15, &[1, 2, 3, 4, 5, 6, 7, 8][..]));
+        assert_eq!(data_words(&f), (0x0403_0201, 0x0807_0605));
     }
 }

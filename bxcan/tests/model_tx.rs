@@ -382,12 +382,16 @@ fn remote_and_extended_frames_and_dlc_above_8() {
     load(&mut a, 0, &r);
     bus.run(1);
     assert_eq!(receive(&mut b, 0).unwrap().frame, r);
-    // A DLC code of 9..15 goes on the (classical) simulated bus as 8 bytes.
     load(&mut a, 1, &std_frame(0x5, &[1, 2, 3, 4, 5, 6, 7, 8]));
     bus.run(1);
     assert_eq!(receive(&mut b, 0).unwrap().frame.dlc(), 8);
+    // A DLC code of 9..15 goes on the simulated bus as written, with 8 bytes, and the
+    // receiver's RDTxR.DLC holds it unchanged.
     a.write32(regs::tdtxr(1), tdtxr::DLC.val(15));
+    a.write32(regs::tdlxr(1), 0x0403_0201);
+    a.write32(regs::tdhxr(1), 0x0807_0605);
     a.write32(regs::tixr(1), tixr::STID.val(0x6) | tixr::TXRQ);
     bus.run(1);
-    assert_eq!(receive(&mut b, 0).unwrap().frame.dlc(), 8);
+    let got = receive(&mut b, 0).unwrap().frame;
+    assert_eq!((got.dlc(), got.data()), (15, &[1, 2, 3, 4, 5, 6, 7, 8][..]));
 }

@@ -239,7 +239,10 @@ impl core::fmt::Display for crate::frame::FrameError {
             E::ExtendedIdOutOfRange(id) => {
                 write!(f, "extended identifier {id:#X} above 0x1FFFFFFF")
             }
-            E::DlcTooLarge(dlc) => write!(f, "data length code {dlc} above 8"),
+            E::DlcTooLarge(dlc) => write!(f, "data length code {dlc} out of range"),
+            E::DlcMismatch { dlc, len } => {
+                write!(f, "data length code {dlc} does not fit {len} data bytes")
+            }
             E::TooMuchData(n) => write!(f, "{n} data bytes, more than 8"),
             E::DataOnRemoteFrame => f.write_str("a remote frame carries no data"),
             E::OutOfBounds => f.write_str("word view outside the frame's data length"),

@@ -2,16 +2,28 @@
 //!
 //! [`Frame`] implements [`embedded_can::Frame`] and uses its [`Id`]. Its constructors check
 //! every rule of the frame format and return a [`FrameError`] instead of panicking:
-//! identifiers in range (11 or 29 bits), DLC `0..=8`, no data on a remote frame.
+//! identifiers in range (11 or 29 bits), at most 8 data bytes, a DLC code `0..=15`
+//! that agrees with the data, no data on a remote frame.
 //!
 //! A remote frame carries a DLC (the length of the answer it asks for) but no data bytes.
+//!
+//! The DLC is kept as written: ISO 11898-1 (classical CAN) gives the DLC field four
+//! bits and says codes 9..=15 mean eight data bytes. A frame built with
+//! [`Frame::with_dlc`] (or read from a mailbox holding such a code) keeps the code,
+//! so it goes back onto the wire unchanged: [`Frame::dlc`] is the code, [`Frame::data`]
+//! holds `min(code, 8)` bytes, and `embedded_can::Frame::dlc` — documented as
+//! `0..=8` and equal to the data length of a data frame — returns that length.
 //! The payload can be read as bytes or, as ACAN's data union offers, as little-endian
 //! `u16`/`u32`/`u64` words (ACAN §8.1), without `unsafe`.
 
 use embedded_can::{ExtendedId, Id, StandardId};
 
-/// The largest data length code of classical CAN.
+/// The largest data length of classical CAN, in bytes (and the largest DLC code that
+/// is also a length).
 pub const MAX_DLC: u8 = 8;
+
+/// The largest DLC code the four-bit field holds (ISO 11898-1: 9..=15 mean 8 bytes).
+pub const MAX_DLC_CODE: u8 = 15;
 
 /// Why a frame could not be built.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -21,8 +33,17 @@ pub enum FrameError {
     StandardIdOutOfRange(u32),
     /// An extended identifier above `0x1FFF_FFFF`.
     ExtendedIdOutOfRange(u32),
-    /// A data length code above 8 (classical CAN).
+    /// A data length code out of range: above 15 (the field has four bits), or above 8
+    /// where only a length is accepted ([`Frame::new_remote`], [`Frame::remote`]).
     DlcTooLarge(u8),
+    /// A DLC code that does not agree with the data: a code `0..=8` other than the
+    /// number of data bytes, or a code `9..=15` with fewer than 8 data bytes.
+    DlcMismatch {
+        /// The DLC code asked for.
+        dlc: u8,
+        /// The number of data bytes.
+        len: usize,
+    },
     /// More than 8 data bytes.
     TooMuchData(usize),
     /// A data-bearing operation was asked of a remote frame.
@@ -84,8 +105,9 @@ const ID_BITS: u32 = 0x1FFF_FFFF;
 /// is two aligned loads or stores).
 ///
 /// Invariants kept by every constructor and setter: the identifier is in range for its
-/// format, the DLC is `0..=8`, data bytes beyond the DLC (and all bytes of a remote
-/// frame) are zero — so the derived equality compares identifier, kind, DLC and data.
+/// format, the DLC code is `0..=15` (the field as written; the data length is
+/// `min(code, 8)`), data bytes beyond the data length (and all bytes of a remote frame)
+/// are zero — so the derived equality compares identifier, kind, DLC code and data.
 ///
 /// `Frame::default()` is a standard data frame with identifier 0 and no data.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
@@ -187,10 +209,10 @@ impl Frame {
 
     /// Builds a frame from the raw fields a controller register holds.
     ///
-    /// `data` is always 8 bytes as read from a mailbox; bytes beyond `dlc` are ignored
-    /// for a data frame and dropped for a remote frame. A DLC above 8 is an error here:
-    /// a backend that reads a hardware DLC of 9..=15 clamps it first (ISO 11898-1 treats
-    /// such codes as 8 bytes).
+    /// `data` is always 8 bytes as read from a mailbox; bytes beyond the data length are
+    /// ignored for a data frame and dropped for a remote frame. A DLC code of 9..=15 is
+    /// kept as written (eight data bytes, ISO 11898-1); above 15 is an error (the field
+    /// has four bits).
     pub fn from_raw_parts(
         id: Id,
         remote: bool,
@@ -211,13 +233,14 @@ impl Frame {
         if let Err(e) = raw_to_id(raw_id, extended) {
             return Err(e);
         }
-        if dlc > MAX_DLC {
+        if dlc > MAX_DLC_CODE {
             return Err(FrameError::DlcTooLarge(dlc));
         }
         let mut bytes = [0u8; 8];
         if !remote {
+            let len = if dlc > MAX_DLC { MAX_DLC } else { dlc };
             let mut i = 0;
-            while i < dlc as usize {
+            while i < len as usize {
                 bytes[i] = data[i];
                 i += 1;
             }
@@ -232,16 +255,22 @@ impl Frame {
     /// Builds a frame from an identifier word as [`Frame::id_word`] packs it, a DLC and
     /// the eight data bytes, without re-checking the identifier: the fast path of a
     /// backend decoding its registers. The identifier bits are masked to 29 bits (11
-    /// for a standard identifier), the DLC is clamped to 8 (ISO 11898-1: DLC codes
-    /// 9..=15 mean 8 bytes), bytes beyond the DLC (all of them for a remote frame)
-    /// are cleared, so every invariant holds whatever the inputs.
+    /// for a standard identifier), the DLC to its four bits and kept as written (ISO
+    /// 11898-1: codes 9..=15 mean 8 bytes), bytes beyond the data length (all of them
+    /// for a remote frame) are cleared, so every invariant holds whatever the inputs.
     #[inline]
     pub const fn from_words(word: u32, dlc: u8, data: [u8; 8]) -> Self {
         let extended = word & EXTENDED_BIT != 0;
         let id_mask = if extended { ID_BITS } else { 0x7FF };
         let word = word & (EXTENDED_BIT | REMOTE_BIT | id_mask);
-        let dlc = if dlc > MAX_DLC { MAX_DLC } else { dlc };
-        let keep = if word & REMOTE_BIT != 0 { 0 } else { dlc };
+        let dlc = dlc & MAX_DLC_CODE;
+        let keep = if word & REMOTE_BIT != 0 {
+            0
+        } else if dlc > MAX_DLC {
+            MAX_DLC
+        } else {
+            dlc
+        };
         // Bytes beyond `keep` cleared with one mask over the little-endian 64-bit value
         // (a few shifts instead of a byte loop or a `memset` call).
         let mask = if keep >= 8 {
@@ -304,18 +333,71 @@ impl Frame {
         self.word & REMOTE_BIT != 0
     }
 
-    /// The data length code, `0..=8`.
+    /// The data length code as written, `0..=15` (9..=15 only when built with
+    /// [`Frame::with_dlc`]/[`Frame::set_dlc`] or read from a mailbox holding such a
+    /// code). `embedded_can::Frame::dlc` returns [`Frame::len_from_dlc`] instead.
+    #[inline]
     pub const fn dlc(&self) -> u8 {
         self.dlc
     }
 
-    /// The data bytes (empty for a remote frame).
-    pub fn data(&self) -> &[u8] {
-        if self.is_remote() {
-            &[]
+    /// The length the DLC stands for: `min(dlc, 8)` (ISO 11898-1). For a data frame
+    /// this is the number of data bytes; for a remote frame, the length asked for.
+    #[inline]
+    pub const fn len_from_dlc(&self) -> u8 {
+        if self.dlc > MAX_DLC {
+            MAX_DLC
         } else {
-            &self.data[..self.dlc as usize]
+            self.dlc
         }
+    }
+
+    /// The number of data bytes (`min(dlc, 8)`, 0 for a remote frame).
+    #[inline]
+    pub const fn data_len(&self) -> usize {
+        if self.is_remote() {
+            0
+        } else {
+            self.len_from_dlc() as usize
+        }
+    }
+
+    /// A data frame with an explicit DLC code: `dlc` `0..=8` must equal `data.len()`,
+    /// `9..=15` needs exactly 8 data bytes (ISO 11898-1: such codes mean 8 bytes and
+    /// are sent as written). Anything else is a [`FrameError`].
+    pub fn with_dlc(id: Id, data: &[u8], dlc: u8) -> Result<Self, FrameError> {
+        let mut f = Self::new_data(id, data)?;
+        f.set_dlc(dlc)?;
+        Ok(f)
+    }
+
+    /// Sets the DLC code, keeping the data. A data frame accepts its own data length
+    /// (`0..=8`) or, with 8 data bytes, any code `9..=15`; a remote frame accepts any
+    /// code `0..=15` (the length asked for is `min(code, 8)`). Above 15 is
+    /// [`FrameError::DlcTooLarge`]; a code that disagrees with the data is
+    /// [`FrameError::DlcMismatch`]. The frame is unchanged on error.
+    pub fn set_dlc(&mut self, dlc: u8) -> Result<(), FrameError> {
+        if dlc > MAX_DLC_CODE {
+            return Err(FrameError::DlcTooLarge(dlc));
+        }
+        if !self.is_remote() {
+            let len = self.data_len();
+            let fits = if dlc > MAX_DLC {
+                len == MAX_DLC as usize
+            } else {
+                dlc as usize == len
+            };
+            if !fits {
+                return Err(FrameError::DlcMismatch { dlc, len });
+            }
+        }
+        self.dlc = dlc;
+        Ok(())
+    }
+
+    /// The data bytes (empty for a remote frame; `min(dlc, 8)` bytes otherwise).
+    pub fn data(&self) -> &[u8] {
+        &self.data[..self.data_len()]
     }
 
     /// All eight data bytes, zero beyond the DLC (what a mailbox register pair holds).
@@ -333,14 +415,14 @@ impl Frame {
         if self.is_remote() {
             return Err(FrameError::DataOnRemoteFrame);
         }
-        if index >= self.dlc as usize {
+        if index >= self.data_len() {
             return Err(FrameError::OutOfBounds);
         }
         self.data[index] = value;
         Ok(())
     }
 
-    /// Replaces the payload (and DLC) of a data frame.
+    /// Replaces the payload (and DLC: the new data length) of a data frame.
     pub fn set_data(&mut self, data: &[u8]) -> Result<(), FrameError> {
         if self.is_remote() {
             return Err(FrameError::DataOnRemoteFrame);
@@ -364,7 +446,7 @@ impl Frame {
         }
         let start = index.checked_mul(W).ok_or(FrameError::OutOfBounds)?;
         let end = start.checked_add(W).ok_or(FrameError::OutOfBounds)?;
-        if end > self.dlc as usize {
+        if end > self.data_len() {
             return Err(FrameError::OutOfBounds);
         }
         self.data[start..end].copy_from_slice(&bytes);
@@ -431,8 +513,11 @@ impl embedded_can::Frame for Frame {
         Frame::id(self)
     }
 
+    /// The length the DLC stands for, `0..=8` as this trait documents (for a data
+    /// frame, the data length): a DLC code of 9..=15 reads as 8 here; the code as
+    /// written is [`Frame::dlc`].
     fn dlc(&self) -> usize {
-        self.dlc as usize
+        self.len_from_dlc() as usize
     }
 
     fn data(&self) -> &[u8] {
@@ -529,20 +614,28 @@ mod tests {
     }
 
     #[test]
-    fn from_words_clears_beyond_the_dlc_clamps_and_masks() {
+    fn from_words_clears_beyond_the_data_keeps_the_code_and_masks() {
         let all = [0xA1, 0xA2, 0xA3, 0xA4, 0xA5, 0xA6, 0xA7, 0xA8];
         for dlc in 0..=15u8 {
             let f = Frame::from_words(Frame::id_word(0x123, false, false), dlc, all);
             let keep = dlc.min(8) as usize;
-            assert_eq!(f.dlc() as usize, keep, "DLC {dlc} clamps to 8");
+            assert_eq!(f.dlc(), dlc, "DLC {dlc} kept as written");
             assert_eq!(f.data(), &all[..keep]);
             let padded = f.data_padded();
             assert!(
                 padded[keep..].iter().all(|&b| b == 0),
                 "DLC {dlc}: {padded:?}"
             );
-            assert_eq!(f, Frame::standard(0x123, &all[..keep]).unwrap());
+            let id = standard_id(0x123).unwrap();
+            assert_eq!(f, Frame::with_dlc(id, &all[..keep], dlc).unwrap());
+            assert_eq!(
+                embedded_can::Frame::dlc(&f),
+                keep,
+                "the trait's DLC is the length"
+            );
         }
+        // Only the four bits of the field count.
+        assert_eq!(Frame::from_words(0x123, 0x1C, all).dlc(), 0xC);
         // A remote frame keeps its DLC and no data.
         let r = Frame::from_words(Frame::id_word(0x1ABC_DEF1, true, true), 3, all);
         assert_eq!((r.dlc(), r.data_padded()), (3, [0; 8]));
@@ -550,6 +643,65 @@ mod tests {
         // Identifier bits beyond the format are dropped.
         let m = Frame::from_words(0x0000_FFFF, 0, all);
         assert_eq!(m.raw_id(), 0x7FF);
+    }
+
+    #[test]
+    fn dlc_codes_above_eight_are_kept_as_written() {
+        let id = standard_id(0x321).unwrap();
+        let eight = [1, 2, 3, 4, 5, 6, 7, 8];
+        for code in 9..=15u8 {
+            let f = Frame::with_dlc(id, &eight, code).unwrap();
+            assert_eq!((f.dlc(), f.len_from_dlc(), f.data_len()), (code, 8, 8));
+            assert_eq!(f.data(), &eight);
+            assert_eq!(f.data_u64(), Some(0x0807_0605_0403_0201));
+            assert_ne!(
+                f,
+                Frame::new_data(id, &eight).unwrap(),
+                "the code is part of the frame"
+            );
+            let raw = Frame::from_registers(0x321, false, false, code, eight).unwrap();
+            assert_eq!(raw, f);
+        }
+        assert_eq!(
+            Frame::with_dlc(id, &eight[..7], 9),
+            Err(FrameError::DlcMismatch { dlc: 9, len: 7 })
+        );
+        assert_eq!(
+            Frame::with_dlc(id, &eight[..3], 4),
+            Err(FrameError::DlcMismatch { dlc: 4, len: 3 })
+        );
+        assert_eq!(
+            Frame::with_dlc(id, &eight, 16),
+            Err(FrameError::DlcTooLarge(16))
+        );
+        assert_eq!(
+            Frame::from_registers(0x321, false, false, 16, eight),
+            Err(FrameError::DlcTooLarge(16))
+        );
+        assert_eq!(Frame::with_dlc(id, &eight[..3], 3).unwrap().dlc(), 3);
+        // set_dlc moves between 8 and 9..=15 and leaves the frame alone on error.
+        let mut f = Frame::new_data(id, &eight).unwrap();
+        f.set_dlc(15).unwrap();
+        assert_eq!(f.dlc(), 15);
+        assert_eq!(
+            f.set_dlc(7),
+            Err(FrameError::DlcMismatch { dlc: 7, len: 8 })
+        );
+        assert_eq!(f.dlc(), 15);
+        f.set_dlc(8).unwrap();
+        assert_eq!(f, Frame::new_data(id, &eight).unwrap());
+        // set_data gives the frame the new length as its DLC.
+        f.set_dlc(12).unwrap();
+        f.set_data(&[9]).unwrap();
+        assert_eq!((f.dlc(), f.data()), (1, &[9u8][..]));
+        // A remote frame takes any code; the length asked for is min(code, 8).
+        let mut r = Frame::new_remote(id, 2).unwrap();
+        r.set_dlc(13).unwrap();
+        assert_eq!((r.dlc(), r.len_from_dlc(), r.data_len()), (13, 8, 0));
+        assert_eq!(embedded_can::Frame::dlc(&r), 8);
+        assert!(r.data().is_empty());
+        assert_eq!(r.set_dlc(16), Err(FrameError::DlcTooLarge(16)));
+        assert_eq!(core::mem::size_of::<Frame>(), 16);
     }
 
     #[test]

@@ -66,6 +66,20 @@ fn plan(
         errors |= ConfigErrors::BIT_TIMING_INCONSISTENT;
     }
 
+    // The Kinetis manual's rules beyond the field ranges ("Arbitration and matching
+    // timing"): 8 quanta per bit, 16 bus clocks per CAN bit (16 MBs, Rx FIFO on), a
+    // bus clock not below the oscillator (CAN) clock.
+    let bus = settings.bus_clock_hz.unwrap_or(CAN_CLOCK_HZ);
+    let rules = twocan_core::timing::flexcan_rules::check(
+        &settings.timing,
+        bus,
+        crate::configuration::MESSAGE_BUFFERS,
+        true,
+    );
+    if rules.is_err() {
+        errors |= ConfigErrors::BIT_TIMING_FORBIDDEN;
+    }
+
     let table = FilterTable::compile(settings.configuration, primary, secondary);
     if let Err(e) = &table {
         errors |= *e;

@@ -47,6 +47,13 @@ bitflags::bitflags! {
         /// Bit 8 (not in ACAN): the board has no such FlexCAN instance (`can1` exists on
         /// the Teensy 3.6 only, ACAN §6 table 2).
         const NO_SUCH_INSTANCE = 1 << 8;
+        /// Bit 9 (not in ACAN): a bit timing the Kinetis reference manual forbids
+        /// (FlexCAN chapter, "Arbitration and matching timing"): fewer than 8 time
+        /// quanta per bit, fewer than 16 peripheral (bus) clocks per CAN bit with the
+        /// 16 message buffers and the Rx FIFO, or a bus clock below the 16 MHz
+        /// oscillator clock ([`twocan_core::timing::flexcan_rules`],
+        /// [`crate::Settings::bus_clock_hz`]). ACAN checks only the field ranges.
+        const BIT_TIMING_FORBIDDEN = 1 << 9;
     }
 }
 
@@ -176,7 +183,8 @@ mod tests {
             ConfigErrors::from_bits_truncate(u32::MAX),
             ConfigErrors::ALL
         );
-        assert_eq!(ConfigErrors::ALL.count(), 9);
+        assert_eq!(ConfigErrors::BIT_TIMING_FORBIDDEN.bits(), 0x200);
+        assert_eq!(ConfigErrors::ALL.count(), 10);
         assert_eq!(BeginError::Config(e).flags(), e);
         assert_eq!(
             BeginError::from(twocan_core::Error::Timeout).flags(),

@@ -66,7 +66,8 @@ impl MbWords {
         regs.write32(regs::mb_cs(n), self.cs);
     }
 
-    /// The frame these words hold. A DLC of 9–15 counts as 8 (ISO 11898-1).
+    /// The frame these words hold. A DLC code of 9–15 is kept as written and means
+    /// 8 bytes (ISO 11898-1).
     #[inline(always)]
     pub fn frame(&self) -> Frame {
         let extended = self.cs & cs::IDE != 0;
@@ -115,8 +116,13 @@ mod tests {
         assert_eq!(MbWords::transmit(&frames[0]).id, 0x542 << 18);
         let long = MbWords {
             cs: cs::DLC.val(15),
+            word0: 0x0102_0304,
+            word1: 0x0506_0708,
             ..Default::default()
         };
-        assert_eq!(long.frame().dlc(), 8);
+        let f = long.frame();
+        assert_eq!((f.dlc(), f.data()), (15, &[1, 2, 3, 4, 5, 6, 7, 8][..]));
+        let back = MbWords::transmit(&f);
+        assert_eq!(cs::DLC.get(back.cs), 15, "the code goes back as written");
     }
 }

@@ -114,6 +114,15 @@ pub struct Settings {
     /// message interrupt only; default `true`. The firmware routes the error, bus-off
     /// and warning vectors of [`crate::Irqs`] to the same handler.
     pub error_interrupts: bool,
+    /// The peripheral (bus) clock the module runs on, for the Kinetis manual's
+    /// clocks-per-bit rule ([`twocan_core::timing::flexcan_rules`]; not in ACAN).
+    /// `None` (the default) assumes the least the manual allows, the 16 MHz
+    /// oscillator clock ("the peripheral clock frequency can not be smaller than the
+    /// oscillator clock frequency"), which admits up to 1 Mbit/s; give the real bus
+    /// clock (e.g. 48 or 60 MHz under the usual Teensy start-up code) for up to
+    /// 2 Mbit/s. `begin` refuses a timing below the rule with
+    /// [`crate::ConfigErrors::BIT_TIMING_FORBIDDEN`].
+    pub bus_clock_hz: Option<u32>,
 }
 
 impl Default for Settings {
@@ -152,6 +161,7 @@ impl Settings {
             rx_pin_pull_up: false,
             handshake_polls: handshake_polls_for(bit_rate),
             error_interrupts: true,
+            bus_clock_hz: None,
         }
     }
 

@@ -81,6 +81,9 @@ pub struct FlexCanHw<R: Registers> {
     loaded: AtomicU32,
     /// The clock gate and pins `begin` set up (for [`FlexCanHw::into_controller`]).
     system: SystemPlan,
+    /// Frames caught by remote-frame mailboxes turned receive mailboxes (written by the
+    /// transmit interrupt's `settle` only).
+    caught: AtomicU32,
 }
 
 impl<R: Registers> FlexCan<R> {
@@ -102,6 +105,7 @@ impl<R: Registers> FlexCan<R> {
             unresolved: AtomicU32::new(0),
             loaded: AtomicU32::new(0),
             system: self.system,
+            caught: AtomicU32::new(0),
         }
     }
 }
@@ -144,6 +148,18 @@ impl<R: Registers> FlexCanHw<R> {
     /// [`UNKNOWN_FILTER`]); the hardware never produces one for the installed table.
     pub fn unresolved_filter_hits(&self) -> u32 {
         self.unresolved.load(Ordering::Relaxed)
+    }
+
+    /// Frames a remote-frame mailbox caught after sending its remote frame (Kinetis RM
+    /// "Transmit process": a remote frame's mailbox becomes a receive mailbox with the
+    /// same identifier, its mask the exact one `begin` writes, so it takes a frame of
+    /// that identifier and kind that the Rx FIFO — matched first, `CTRL2[MRP] = 0` —
+    /// did not accept). Such a frame passed none of the user's filters: like ACAN, the
+    /// driver does not deliver it and makes the mailbox inactive again; unlike ACAN,
+    /// which overwrites it silently on the next remote frame, it is counted here (a
+    /// mailbox found `OVERRUN` counts 2, the least it held).
+    pub fn remote_mailbox_catches(&self) -> u32 {
+        self.caught.load(Ordering::Relaxed)
     }
 
     /// The register handle back (to run `begin` again).
@@ -323,6 +339,16 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
             let control = self.regs.read32(regs::mb_cs(mb));
             let c = cs::CODE.get(control);
             let was_loaded = self.loaded.fetch_and(!(1 << mb), Ordering::Relaxed) & (1 << mb) != 0;
+            let caught = match c {
+                code::RX_FULL => 1,
+                code::RX_OVERRUN => 2,
+                _ => 0,
+            };
+            if caught != 0 {
+                // Counted before the mailbox is made inactive (`remote_mailbox_catches`).
+                let n = self.caught.load(Ordering::Relaxed);
+                self.caught.store(n.wrapping_add(caught), Ordering::Relaxed);
+            }
             if !was_loaded {
                 // A flag without a frame of ours (an answer caught by a remote-frame
                 // mailbox turned receive mailbox): acknowledge, deactivate, no completion.

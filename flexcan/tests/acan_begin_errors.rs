@@ -61,6 +61,76 @@ fn no_error() {
     assert_eq!(flags.bits(), 0);
 }
 
+/// Issue 14: the Kinetis reference manual ("Arbitration and matching timing") asks for
+/// at least 8 time quanta per bit and, with 16 message buffers and the Rx FIFO, at
+/// least 16 peripheral (bus) clocks per CAN bit, with a bus clock not below the 16 MHz
+/// oscillator clock. `begin` refuses what it forbids, writing nothing; the edges of
+/// each rule are accepted.
+#[test]
+fn bit_timing_the_manual_forbids_is_refused() {
+    let accepted = |s: &Settings| {
+        assert_eq!(
+            twocan_flexcan::check(T32_CAN0, s, &[], &[]),
+            ConfigErrors::NONE
+        );
+        let model = model_for(T32_CAN0.board);
+        let regs = twocan_flexcan::IdleClocked::new(model);
+        let r = FlexCan::begin(regs, &mut HostSystem::new(), T32_CAN0, s, &[], &[]);
+        assert!(r.is_ok(), "{:?}: {:?}", s.timing, r.err());
+    };
+    let with_bus = |rate: u32, bus: Option<u32>| {
+        let mut s = Settings::new(rate);
+        s.bus_clock_hz = bus;
+        s
+    };
+    // 1 Mbit/s from the least bus clock the manual allows (16 MHz, the default
+    // assumption): 16 clocks and 16 quanta per bit, the edge of the clock rule.
+    let one = with_bus(1_000_000, None);
+    assert_eq!(one.timing.quanta(), 16);
+    accepted(&one);
+    // 2 Mbit/s: 8 quanta (the edge of the quanta rule), 8 clocks per bit from a
+    // 16 MHz bus: refused; from a 32 MHz bus, 16 clocks: accepted; 31 MHz: refused.
+    let two = with_bus(2_000_000, None);
+    assert_eq!(two.timing.quanta(), 8);
+    assert_eq!(
+        begin_error(T32_CAN0, &two, &[], &[]),
+        ConfigErrors::BIT_TIMING_FORBIDDEN
+    );
+    accepted(&with_bus(2_000_000, Some(32_000_000)));
+    accepted(&with_bus(2_000_000, Some(60_000_000)));
+    assert_eq!(
+        begin_error(T32_CAN0, &with_bus(2_000_000, Some(31_000_000)), &[], &[]),
+        ConfigErrors::BIT_TIMING_FORBIDDEN
+    );
+    // 7 quanta (16 MHz / 7 ≈ 2.29 Mbit/s) and ACAN's 5-quanta 3.2 Mbit/s: refused
+    // whatever the bus clock.
+    let seven = with_bus(2_285_714, Some(60_000_000));
+    assert_eq!(seven.timing.quanta(), 7);
+    assert_eq!(
+        begin_error(T32_CAN0, &seven, &[], &[]),
+        ConfigErrors::BIT_TIMING_FORBIDDEN
+    );
+    let acan_fastest = with_bus(3_200_000, Some(60_000_000));
+    assert_eq!(acan_fastest.timing.quanta(), 5);
+    assert_eq!(
+        begin_error(T32_CAN0, &acan_fastest, &[], &[]),
+        ConfigErrors::BIT_TIMING_FORBIDDEN
+    );
+    // A bus clock below the oscillator clock is refused even at a slow rate.
+    assert_eq!(
+        begin_error(T32_CAN0, &with_bus(125_000, Some(15_999_999)), &[], &[]),
+        ConfigErrors::BIT_TIMING_FORBIDDEN
+    );
+    accepted(&with_bus(125_000, Some(16_000_000)));
+    // Reported together with ACAN's own flags.
+    let mut both = with_bus(3_200_000, None);
+    both.use_alternate_rx_pin = true;
+    assert_eq!(
+        begin_error(T36_CAN1, &both, &[], &[]),
+        ConfigErrors::BIT_TIMING_FORBIDDEN | ConfigErrors::NO_ALTERNATE_RX_PIN
+    );
+}
+
 #[test]
 fn bit_rate_too_far_15_2_1() {
     // `ACANSettings settings (1)`: 1 bit/s; ACAN's error code is exactly bit 0.
@@ -98,7 +168,15 @@ fn bit_rates_out_of_range_are_refused_as_on_every_backend() {
         assert!(sys.written().is_empty());
         assert_eq!(model.mode(), ModelMode::Disabled);
     }
-    for rate in [2_500, 3_200_000] {
+    // In range for the clock: 3.2 Mbit/s (5 quanta) goes on to the manual's rules
+    // (`bit_timing_the_manual_forbids_is_refused`).
+    assert_eq!(
+        begin_error(T32_CAN0, &Settings::new(3_200_000), &[], &[]),
+        ConfigErrors::BIT_TIMING_FORBIDDEN
+    );
+    // The slowest, 2,500 bit/s, and the fastest the manual allows from the least bus
+    // clock, 1 Mbit/s.
+    for rate in [2_500, 1_000_000] {
         let model = model_for(T32_CAN0.board);
         let r = FlexCan::begin(
             twocan_flexcan::IdleClocked::new(model),

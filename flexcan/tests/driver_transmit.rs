@@ -270,3 +270,98 @@ fn listen_only_does_not_transmit() {
     );
     assert_eq!(can.traffic().queued, 0, "an error means not accepted");
 }
+
+/// Issue 14: a remote-frame mailbox becomes a receive mailbox for its identifier after
+/// sending (Kinetis RM "Transmit process"); a frame it catches — one the Rx FIFO's
+/// filters did not take — is counted when the mailbox is made inactive again, not
+/// delivered (it passed none of the user's filters) and not lost without a trace.
+#[test]
+fn a_frame_caught_by_a_remote_frame_mailbox_is_counted() {
+    use twocan_core::{Filter, Format, FrameKind};
+    let mut s = Settings::new(500_000);
+    s.configuration = Configuration::Filters8_0;
+    // The Rx FIFO takes data frames 0x700 only.
+    let only = [Filter::exact(FrameKind::Data, Format::Standard, 0x700)];
+    let (model, mut can) = begin::<32, 16>(&s, &only, &[]).unwrap();
+    let other = SimNode::new().shared();
+    let mut bus = bus_with(500_000, &[&model]);
+    bus.attach("other", other.clone());
+    run1(&mut bus, &mut can, 30);
+    let request = remote(0x123, false);
+    can.try_send_now(&request).unwrap();
+    // The bus runs with the driver's interrupt not serviced: the remote frame leaves,
+    // then the other node sends a remote frame of the same identifier, which only the
+    // (now receiving) remote-frame mailbox accepts.
+    run(&mut bus, &mut [], 200);
+    assert_eq!(other.borrow().received_frames(), [request]);
+    other.borrow_mut().send(request);
+    run(&mut bus, &mut [], 200);
+    let first = s.configuration.first_remote_mailbox() as usize;
+    // The driver's last control-word read (finding the mailbox free) left it locked
+    // (Kinetis RM "Message buffer lock mechanism"): the frame waits in the serial
+    // message buffer until any other access unlocks it, here a read of the timer.
+    assert_eq!(model.locked_mailbox(), Some(first));
+    let _ = twocan_core::Registers::read32(&model, regs::TIMER);
+    assert_eq!(
+        cs::CODE.get(model.peek32(regs::mb_cs(first))),
+        code::RX_FULL,
+        "the mailbox caught it"
+    );
+    assert_eq!(can.hardware().remote_mailbox_catches(), 0);
+    run1(&mut bus, &mut can, 10);
+    assert_eq!(can.hardware().remote_mailbox_catches(), 1);
+    assert!(
+        drain(&mut can).is_empty(),
+        "not delivered: no user filter takes it"
+    );
+    assert_eq!(can.traffic().sent, 1, "the remote frame's completion");
+    assert_eq!(
+        cs::CODE.get(model.peek32(regs::mb_cs(first))),
+        code::TX_INACTIVE
+    );
+    // A data frame 0x700 still goes to the FIFO; nothing more is counted.
+    other.borrow_mut().send(std_data(0x700, &[7]));
+    run1(&mut bus, &mut can, 200);
+    assert_eq!(drain(&mut can).len(), 1);
+    assert_eq!(can.hardware().remote_mailbox_catches(), 1);
+}
+
+/// The same catch while the driver's own control-word read keeps the mailbox locked:
+/// the frame waits in the serial message buffer while the transmit handler settles the
+/// remote frame and makes the mailbox inactive; it moves in at the next unlock (here
+/// the driver reading MB15 to load a data frame), raises the mailbox's flag again, and
+/// the handler counts it then — it is not lost without a trace.
+#[test]
+fn a_frame_caught_behind_the_lock_is_counted_at_the_next_unlock() {
+    use twocan_core::{Filter, Format, FrameKind};
+    let mut s = Settings::new(500_000);
+    s.configuration = Configuration::Filters8_0;
+    let only = [Filter::exact(FrameKind::Data, Format::Standard, 0x700)];
+    let (model, mut can) = begin::<32, 16>(&s, &only, &[]).unwrap();
+    let other = SimNode::new().shared();
+    let mut bus = bus_with(500_000, &[&model]);
+    bus.attach("other", other.clone());
+    run1(&mut bus, &mut can, 30);
+    let request = remote(0x123, false);
+    can.try_send_now(&request).unwrap();
+    run(&mut bus, &mut [], 200);
+    other.borrow_mut().send(request);
+    run(&mut bus, &mut [], 200);
+    let first = s.configuration.first_remote_mailbox() as usize;
+    assert_eq!(model.locked_mailbox(), Some(first));
+    // Settled with the frame still behind the lock: nothing to count yet.
+    run1(&mut bus, &mut can, 10);
+    assert_eq!(can.traffic().sent, 1);
+    assert_eq!(can.hardware().remote_mailbox_catches(), 0);
+    // Loading a data frame reads MB15's control word: MB `first` unlocks, the frame
+    // moves in, and the handler counts it.
+    can.try_send(&std_data(0x10, &[1])).unwrap();
+    run1(&mut bus, &mut can, 300);
+    assert_eq!(can.hardware().remote_mailbox_catches(), 1);
+    assert_eq!(can.traffic().sent, 2);
+    assert!(drain(&mut can).is_empty());
+    assert_eq!(
+        cs::CODE.get(model.peek32(regs::mb_cs(first))),
+        code::TX_INACTIVE
+    );
+}

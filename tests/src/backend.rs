@@ -105,6 +105,10 @@ pub enum TimingRefused {
     TooFar,
     /// The sample point is not strictly between 50 % and 100 %.
     SamplePoint,
+    /// Within the register ranges, but forbidden by a rule of the controller's manual
+    /// (FlexCAN: 8 quanta and 16 bus clocks per bit, Kinetis RM "Arbitration and
+    /// matching timing").
+    ForbiddenByManual,
     /// Another reason.
     Other,
 }
@@ -162,6 +166,10 @@ pub trait Backend {
     const CLOCK_HZ: u32;
     /// The bit-timing register ranges.
     const LIMITS: Limits;
+    /// The fastest bit rate the backend accepts: `CLOCK_HZ / LIMITS.min_quanta()`
+    /// unless a rule beyond the register ranges forbids it (FlexCAN: 1 Mbit/s, 16 bus
+    /// clocks per bit from the least bus clock the manual allows, 16 MHz).
+    const FASTEST_BITRATE: u32;
 
     /// Brings a node up on `h`'s bus at its bit rate.
     fn attach(h: &mut Harness, opts: &NodeOptions) -> Result<Self::Node, Refused> {
@@ -298,6 +306,7 @@ impl Backend for FlexCanBackend {
     const MANUAL_RECOVERY: bool = false;
     const CLOCK_HZ: u32 = 16_000_000;
     const LIMITS: Limits = Limits::FLEXCAN;
+    const FASTEST_BITRATE: u32 = 1_000_000;
 
     fn attach_via(
         h: &mut Harness,
@@ -332,6 +341,8 @@ impl Backend for FlexCanBackend {
         let flags = twocan_flexcan::check(teensy36_can0(), &s, &[], &[]);
         if flags.contains(ConfigErrors::BIT_RATE_TOO_FAR) {
             Err(TimingRefused::TooFar)
+        } else if flags == ConfigErrors::BIT_TIMING_FORBIDDEN {
+            Err(TimingRefused::ForbiddenByManual)
         } else if !flags.is_empty() {
             Err(TimingRefused::Other)
         } else {
@@ -444,6 +455,7 @@ impl Backend for BxCanBackend {
     const MANUAL_RECOVERY: bool = true;
     const CLOCK_HZ: u32 = 54_000_000;
     const LIMITS: Limits = Limits::BXCAN;
+    const FASTEST_BITRATE: u32 = STM32F767_APB1_HZ / Limits::BXCAN.min_quanta();
 
     fn attach_via(
         h: &mut Harness,

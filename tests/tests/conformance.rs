@@ -108,6 +108,51 @@ fn remote_frames_both_ways<B: Backend>() {
     }
 }
 
+/// Issue 17: a DLC code of 9..=15 is kept as written (ISO 11898-1: eight data bytes).
+/// The driver writes the code into its mailbox, the model sends it in the four DLC bits,
+/// the plain ISO node sees it; and a code the node sends comes back out of the driver.
+fn dlc_codes_above_eight_both_ways<B: Backend>() {
+    let (mut h, mut dut, peer) = setup::<B>(&NodeOptions::pass_all());
+    let eight = [0x11, 0x22, 0x33, 0x44, 0x55, 0x66, 0x77, 0x88];
+    let mut twelve = ext_frame(0x1234_5678, &eight);
+    twelve.set_dlc(12).unwrap();
+    dut.driver().try_send(&twelve).unwrap();
+    settle(&mut h, &mut dut, &[&peer], 20_000);
+    let seen = peer.borrow().received_frames();
+    assert_eq!(seen.len(), 1, "{}", B::NAME);
+    assert_eq!(
+        (seen[0].dlc(), seen[0].data()),
+        (12, &eight[..]),
+        "{}",
+        B::NAME
+    );
+    assert_eq!(seen[0], twelve);
+    // In: DLC 15 on a standard data frame, DLC 9 on an extended one, DLC 13 on a
+    // remote frame (it asks for 8 bytes).
+    let mut fifteen = std_frame(0x321, &eight);
+    fifteen.set_dlc(15).unwrap();
+    let mut nine = ext_frame(0x1ABC_DEF0, &[1, 2, 3, 4, 5, 6, 7, 8]);
+    nine.set_dlc(9).unwrap();
+    let mut remote = remote_frame(0x55, false, 8);
+    remote.set_dlc(13).unwrap();
+    let sent = [fifteen, nine, remote];
+    for f in &sent {
+        peer.borrow_mut().send(*f);
+    }
+    settle(&mut h, &mut dut, &[&peer], 50_000);
+    let got: Vec<Frame> = drain(&mut dut).iter().map(|r| r.frame).collect();
+    assert_eq!(got, sent, "{}", B::NAME);
+    assert_eq!(
+        got.iter()
+            .map(|f| (f.dlc(), f.data().len()))
+            .collect::<Vec<_>>(),
+        [(15, 8), (9, 8), (13, 0)],
+        "{}",
+        B::NAME
+    );
+    assert_eq!(dut.hw_lost(), 0);
+}
+
 /// The filter list of the filter tests: exact and masked, both formats, data, remote and
 /// any kind, with an overlap (filter 5 contains 0x123 of filter 0).
 fn filter_list() -> Vec<Filter> {
@@ -275,9 +320,31 @@ fn filter_capacity<B: Backend>() {
 
 fn bit_rate_limits<B: Backend>() {
     let l: Limits = B::LIMITS;
-    // Fastest: prescaler 1 and the fewest quanta (1 + tseg1 min + tseg2 min).
+    // Fastest the registers express: prescaler 1 and the fewest quanta (1 + tseg1 min
+    // + tseg2 min). Accepted unless the manual forbids it (FlexCAN's 5 quanta: fewer
+    // than 8, Kinetis RM "Arbitration and matching timing"); then the fastest accepted
+    // rate is the backend's documented one.
     let fastest = B::CLOCK_HZ / l.min_quanta();
-    assert_eq!(B::check_timing(fastest, 750), Ok(fastest), "{}", B::NAME);
+    if B::FASTEST_BITRATE == fastest {
+        assert_eq!(B::check_timing(fastest, 750), Ok(fastest), "{}", B::NAME);
+    } else {
+        assert!(B::FASTEST_BITRATE < fastest);
+        assert_eq!(
+            B::check_timing(fastest, 750),
+            Err(TimingRefused::ForbiddenByManual),
+            "{}",
+            B::NAME
+        );
+        let top = B::FASTEST_BITRATE;
+        assert_eq!(B::check_timing(top, 750), Ok(top), "{}", B::NAME);
+        // Twice the fastest accepted: exact from the clock, still forbidden.
+        assert_eq!(
+            B::check_timing(2 * top, 750),
+            Err(TimingRefused::ForbiddenByManual),
+            "{}",
+            B::NAME
+        );
+    }
     assert_eq!(
         B::check_timing(fastest + 1, 750),
         Err(TimingRefused::TooHigh),
@@ -565,6 +632,10 @@ macro_rules! suite {
             #[test]
             fn remote_frames_both_ways() {
                 super::remote_frames_both_ways::<$backend>();
+            }
+            #[test]
+            fn dlc_codes_above_eight_both_ways() {
+                super::dlc_codes_above_eight_both_ways::<$backend>();
             }
             #[test]
             fn filters_accept_exactly_their_frames() {

@@ -35,10 +35,21 @@ proptest! {
         let reg = Frame::from_registers(raw, ext, remote, dlc, bytes);
         if let Ok(f) = reg {
             prop_assert_eq!(f.dlc(), dlc);
-            prop_assert_eq!(f.data().len(), if remote { 0 } else { dlc as usize });
+            prop_assert_eq!(f.data().len(), if remote { 0 } else { dlc.min(8) as usize });
+            prop_assert_eq!(embedded_can::Frame::dlc(&f), dlc.min(8) as usize);
             prop_assert_eq!(f.raw_id(), raw);
         } else {
-            prop_assert!(raw > limit || dlc > 8);
+            prop_assert!(raw > limit || dlc > 15);
+        }
+        if let Ok(id) = by_id {
+            let w = Frame::with_dlc(id, &data, dlc);
+            let fits = data.len() <= 8
+                && dlc <= 15
+                && (usize::from(dlc) == data.len() || (dlc > 8 && data.len() == 8));
+            prop_assert_eq!(w.is_ok(), fits);
+            if let Ok(f) = w {
+                prop_assert_eq!((f.dlc(), f.data()), (dlc, &data[..]));
+            }
         }
         if let Ok(id) = by_id {
             let e = <Frame as embedded_can::Frame>::new(id, &data);

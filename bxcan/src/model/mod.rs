@@ -22,9 +22,11 @@
 //! the outcome of the mailbox in transmit state). Debug freeze (`MCR.DBF`) acts on the
 //! simulated debug halt input [`BxCanModel::set_debug_halt`].
 //!
-//! Not modelled: bit timing (`BTR` is stored, the bus runs in bit times), DLC codes 9..15
-//! on the bus (sent as 8 bytes with DLC 8: the simulated bus carries `Frame`, whose DLC
-//! is the data length). The mailbox "transmit" state is the one `poll_tx` offered until
+//! A DLC code of 9..15 is kept as written: it goes on the simulated bus in the four DLC
+//! bits with eight data bytes and lands in `RDTxR.DLC` of the receiver unchanged (the
+//! bxCAN copies the DLC field; ISO 11898-1 reads such codes as eight bytes).
+//!
+//! Not modelled: bit timing (`BTR` is stored, the bus runs in bit times). The mailbox "transmit" state is the one `poll_tx` offered until
 //! the bus reports the attempt; a mode request is acknowledged at once (after a
 //! transmission in progress).
 //!

@@ -63,7 +63,7 @@ impl RxMessage {
         let mut data = [0u8; 8];
         data[..4].copy_from_slice(&rdlr.to_le_bytes());
         data[4..].copy_from_slice(&rdhr.to_le_bytes());
-        let dlc = rdtxr::DLC.get(rdtr).min(8) as u8;
+        let dlc = rdtxr::DLC.get(rdtr) as u8;
         let frame = Frame::from_registers(raw, ide, rir & rixr::RTR != 0, dlc, data).ok()?;
         Some((
             frame,

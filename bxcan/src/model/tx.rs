@@ -25,9 +25,9 @@
 //!   while more than one mailbox is pending (RM0410 40.9.2 "CAN transmit status
 //!   register").
 //! - `TGT` (time-triggered mode, DLC = 8): the time stamp of the start of frame replaces
-//!   data bytes 6 (`TIME[15:8]`) and 7 (`TIME[7:0]`) on the bus.
-//! - A DLC code of 9..15 is sent as 8 (the simulated bus carries classical frames of
-//!   `0..=8` bytes only).
+//!   data bytes 6 (`TIME[15:8]`) and 7 (`TIME[7:0]`) on the bus. RM0410 40.7.7 asks for
+//!   the DLC "programmed as 8": a code of 9..15 sends no time stamp.
+//! - A DLC code of 9..15 is sent as written, with eight data bytes (ISO 11898-1).
 
 use twocan_core::{Frame, MailboxState, Priority};
 
@@ -162,7 +162,7 @@ impl TxUnit {
     pub(crate) fn frame(&self, x: usize, timestamp: u16, ttcm: bool) -> Option<Frame> {
         let b = self.boxes.get(x)?;
         let [tir, tdtr, tdlr, tdhr] = b.regs;
-        let dlc = tdtxr::DLC.get(tdtr).min(8) as u8;
+        let dlc = tdtxr::DLC.get(tdtr) as u8;
         let mut data = [0u8; 8];
         data[..4].copy_from_slice(&tdlr.to_le_bytes());
         data[4..].copy_from_slice(&tdhr.to_le_bytes());

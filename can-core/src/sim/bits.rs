@@ -337,6 +337,14 @@ mod tests {
                 2 => Frame::remote((x >> 20) as u32 & 0x7FF, false, len as u8).unwrap(),
                 _ => Frame::remote((x >> 20) as u32 & 0x1FFF_FFFF, true, len as u8).unwrap(),
             };
+            // Every third frame with eight bytes carries a DLC code 9..=15 as written.
+            let f = if f.data_len() == 8 && x.is_multiple_of(3) {
+                let mut g = f;
+                g.set_dlc(9 + (x >> 40) as u8 % 7).unwrap();
+                g
+            } else {
+                f
+            };
             let mut bits = unstuffed_header_and_data(&f);
             let crc = crc15(bits.iter().copied());
             bits.extend((0..15).rev().map(|i| (crc >> i) & 1 == 1));
@@ -383,6 +391,28 @@ mod tests {
             vec![false, false, false, false, false, true, true, true, true, true, false]
         );
         assert!(stuff(&[true, false, true, false]).len() == 4);
+    }
+
+    #[test]
+    fn a_dlc_code_above_eight_is_sent_as_written_with_eight_bytes() {
+        let data = [0x5A; 8];
+        let eight = Frame::standard(0x123, &data).unwrap();
+        let mut twelve = eight;
+        twelve.set_dlc(12).unwrap();
+        let bits = unstuffed_header_and_data(&twelve);
+        // SOF, 11 identifier bits, RTR, IDE, r0, then the four DLC bits.
+        let dlc: Vec<bool> = bits[15..19].to_vec();
+        assert_eq!(dlc, vec![true, true, false, false]);
+        assert_eq!(bits.len(), 19 + 64, "eight data bytes follow");
+        assert_eq!(&bits[19..], &unstuffed_header_and_data(&eight)[19..]);
+        let (a, b) = (frame_bits(&eight), frame_bits(&twelve));
+        assert_eq!(a.unstuffed, b.unstuffed);
+        assert_ne!(a.crc, b.crc, "the CRC covers the DLC code");
+        let mut r = Frame::remote(0x123, false, 8).unwrap();
+        r.set_dlc(15).unwrap();
+        let bits = unstuffed_header_and_data(&r);
+        assert_eq!(bits.len(), 19, "a remote frame has no data field");
+        assert!(bits[15..19].iter().all(|&b| b));
     }
 
     #[test]

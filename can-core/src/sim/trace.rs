@@ -330,6 +330,8 @@ fn timestamp(us: u64) -> String {
 }
 
 /// A frame in candump's compact form: `123#DEADBEEF`, `1ABCDEF0#00`, `123#R`, `123#R4`.
+/// A DLC code of 9..=15 (eight bytes) follows as `_` and one hex digit, candump's
+/// form for a classical frame's raw DLC: `123#0102030405060708_C`, `123#R8_F`.
 pub fn candump_frame(frame: &Frame) -> String {
     let mut s = if frame.is_extended() {
         format!("{:08X}#", frame.raw_id())
@@ -338,13 +340,16 @@ pub fn candump_frame(frame: &Frame) -> String {
     };
     if frame.is_remote() {
         s.push('R');
-        if frame.dlc() != 0 {
-            s.push_str(&frame.dlc().to_string());
+        if frame.len_from_dlc() != 0 {
+            s.push_str(&frame.len_from_dlc().to_string());
         }
     } else {
         for b in frame.data() {
             s.push_str(&format!("{b:02X}"));
         }
+    }
+    if frame.dlc() > crate::frame::MAX_DLC {
+        s.push_str(&format!("_{:X}", frame.dlc()));
     }
     s
 }
@@ -432,6 +437,12 @@ mod tests {
             candump_frame(&Frame::remote(0x1234, true, 8).unwrap()),
             "00001234#R8"
         );
+        let id = crate::frame::standard_id(0x123).unwrap();
+        let f = Frame::with_dlc(id, &[1, 2, 3, 4, 5, 6, 7, 8], 12).unwrap();
+        assert_eq!(candump_frame(&f), "123#0102030405060708_C");
+        let mut r = Frame::remote(0x123, false, 8).unwrap();
+        r.set_dlc(15).unwrap();
+        assert_eq!(candump_frame(&r), "123#R8_F");
     }
 
     #[test]

@@ -10,11 +10,15 @@
 //!   peripheral clocks per CAN bit: 16 for 16 message buffers, with or without the Rx FIFO
 //!   (17 for 32 MBs with the FIFO, 25 / 30 for 64 MBs).
 //!
+//! - "The peripheral clock frequency can not be smaller than the oscillator clock
+//!   frequency" (the CAN clock of `CTRL1.CLKSRC = 0`, the timing's `clock_hz`).
+//!
 //! ACAN (§16.1) checks only the field ranges, so it accepts 5 quanta per bit (its "fastest
 //! exact bit rate" of 3.2 Mbit/s from the 16 MHz clock is 5 quanta, which it reports
 //! working in loop-back and self-reception mode only). [`Limits::FLEXCAN`](super::Limits::FLEXCAN)
 //! keeps ACAN's ranges so that the solver reproduces ACAN's figures; [`check`] is the
-//! reference manual's stricter rule, for a backend that refuses what the manual forbids.
+//! reference manual's stricter rule, which the FlexCAN backend's `begin` enforces
+//! (`ConfigErrors::BIT_TIMING_FORBIDDEN`; `docs/bit-timing.md`).
 
 use super::Timing;
 
@@ -50,9 +54,44 @@ pub enum FlexcanTimingViolation {
         /// The table's minimum.
         min: u32,
     },
+    /// A peripheral clock slower than the timing's CAN (oscillator) clock.
+    PeripheralClockBelowCanClock {
+        /// The peripheral clock, Hz.
+        peripheral_hz: u32,
+        /// The CAN clock the timing is made from, Hz.
+        can_clock_hz: u32,
+    },
     /// A peripheral clock of 0 Hz, or a timing with a bit rate of 0.
     Zero,
 }
+
+impl core::fmt::Display for FlexcanTimingViolation {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            FlexcanTimingViolation::TooFewQuanta { quanta } => write!(
+                f,
+                "{quanta} time quanta per bit, fewer than the {MIN_QUANTA_PER_BIT} the FlexCAN manual requires"
+            ),
+            FlexcanTimingViolation::TooFewPeripheralClocks {
+                clocks_per_bit,
+                min,
+            } => write!(
+                f,
+                "{clocks_per_bit} peripheral clocks per CAN bit, fewer than the {min} the FlexCAN manual requires"
+            ),
+            FlexcanTimingViolation::PeripheralClockBelowCanClock {
+                peripheral_hz,
+                can_clock_hz,
+            } => write!(
+                f,
+                "peripheral clock {peripheral_hz} Hz below the CAN clock {can_clock_hz} Hz"
+            ),
+            FlexcanTimingViolation::Zero => f.write_str("a clock or bit rate of 0"),
+        }
+    }
+}
+
+impl core::error::Error for FlexcanTimingViolation {}
 
 /// Checks `timing` against the FlexCAN manual's rules, for a module with `mailboxes`
 /// message buffers, the Rx FIFO on or off, and a peripheral (bus) clock of
@@ -70,6 +109,12 @@ pub const fn check(
     let bitrate = timing.actual_bitrate();
     if peripheral_hz == 0 || bitrate == 0 {
         return Err(FlexcanTimingViolation::Zero);
+    }
+    if peripheral_hz < timing.clock_hz {
+        return Err(FlexcanTimingViolation::PeripheralClockBelowCanClock {
+            peripheral_hz,
+            can_clock_hz: timing.clock_hz,
+        });
     }
     let clocks_per_bit = peripheral_hz as u64 / bitrate as u64;
     let min = min_peripheral_clocks_per_bit(mailboxes, rx_fifo);
@@ -113,14 +158,33 @@ mod tests {
         assert!(t.quanta() >= 8);
         // Teensy 3.2 bus clock 48 MHz, 3.6 60 MHz: 48 and 60 clocks per bit.
         assert_eq!(check(&t, 48_000_000, 16, true), Ok(()));
-        // A 15 MHz peripheral clock gives 15 clocks per bit, below 16.
+        // A 16 MHz peripheral clock (the least: not below the oscillator) gives 16
+        // clocks per bit, the edge; at 2 Mbit/s (8 quanta) 8, below 16.
+        assert_eq!(check(&t, 16_000_000, 16, true), Ok(()));
+        let two = flexcan(2_000_000);
+        assert_eq!(two.quanta(), 8);
         assert_eq!(
-            check(&t, 15_000_000, 16, true),
+            check(&two, 16_000_000, 16, true),
             Err(FlexcanTimingViolation::TooFewPeripheralClocks {
-                clocks_per_bit: 15,
+                clocks_per_bit: 8,
                 min: 16
             })
         );
+        assert_eq!(check(&two, 32_000_000, 16, true), Ok(()));
+        // A peripheral clock below the oscillator clock is refused first.
+        assert_eq!(
+            check(&t, 15_000_000, 16, true),
+            Err(FlexcanTimingViolation::PeripheralClockBelowCanClock {
+                peripheral_hz: 15_000_000,
+                can_clock_hz: 16_000_000
+            })
+        );
+        extern crate std;
+        use std::string::ToString;
+        assert!(check(&two, 16_000_000, 16, true)
+            .unwrap_err()
+            .to_string()
+            .contains("8 peripheral clocks per CAN bit"));
         assert_eq!(check(&t, 0, 16, true), Err(FlexcanTimingViolation::Zero));
     }
 

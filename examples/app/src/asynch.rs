@@ -28,15 +28,16 @@ pub fn echo_frame(frame: &Frame) -> Frame {
         (0x7FF, false)
     };
     let id = frame.raw_id().wrapping_add(1) & mask;
-    let echoed = if frame.is_remote() {
-        Frame::remote(id, extended, frame.dlc())
-    } else if extended {
-        Frame::extended(id, frame.data())
-    } else {
-        Frame::standard(id as u16, frame.data())
-    };
-    // The identifier is masked to its format and the length is the received frame's:
-    // the constructors accept both.
+    // The same kind, DLC code (9..=15 kept as written) and data bytes.
+    let echoed = Frame::from_registers(
+        id,
+        extended,
+        frame.is_remote(),
+        frame.dlc(),
+        frame.data_padded(),
+    );
+    // The identifier is masked to its format and the DLC is the received frame's: the
+    // constructor accepts both.
     echoed.unwrap_or(*frame)
 }
 

@@ -32,13 +32,14 @@ pub(crate) fn encode(frame: &Frame, stamp: u16, code: u32, prio: u32) -> [u32; 4
 }
 
 /// The frame a transmit message buffer describes: IDE, RTR and DLC from CS, the identifier
-/// from ID (standard: bits 28–18), the data from WORD0/WORD1. A DLC above 8 sends eight
-/// bytes ("Transmit process": FlexCAN transmits up to eight data bytes) and is clamped.
+/// from ID (standard: bits 28–18), the data from WORD0/WORD1. A DLC code above 8 is kept
+/// as written and sends eight bytes ("Transmit process": FlexCAN transmits up to eight
+/// data bytes; ISO 11898-1 reads codes 9..15 as eight bytes).
 pub(crate) fn decode(words: [u32; 4]) -> Option<Frame> {
     let [c, idw, w0, w1] = words;
     let ext = c & cs::IDE != 0;
     let remote = c & cs::RTR != 0;
-    let dlc = cs::DLC.get(c).min(8) as u8;
+    let dlc = cs::DLC.get(c) as u8;
     let raw = if ext {
         id::EXT_ID.get(idw)
     } else {

@@ -1,12 +1,14 @@
 //! `can-timing`: CAN bit timing calculator for FlexCAN and bxCAN.
 //!
 //! ```text
-//! can-timing --controller flexcan|bxcan [--clock HZ] --bitrate BPS
+//! can-timing --controller flexcan|bxcan [--clock HZ] [--bus-clock HZ] --bitrate BPS
 //!            [--sample-point PCT] [--tolerance PPM] [--json] [--all]
 //! ```
 //!
 //! Exit status: 0 timing found within tolerance, 1 timing printed but outside the
-//! tolerance (ACAN "too far from wished bit rate"), 2 bad options or input.
+//! tolerance (ACAN "too far from wished bit rate") or, for FlexCAN, forbidden by the
+//! Kinetis manual's rules (8 quanta and 16 bus clocks per bit, bus clock not below
+//! the CAN clock: `twocan_core::timing::flexcan_rules`), 2 bad options or input.
 
 use std::process::ExitCode;
 
@@ -15,8 +17,8 @@ use clap::{CommandFactory, Parser, ValueEnum};
 use serde::ser::{SerializeMap, Serializer};
 use serde::Serialize;
 use twocan_core::timing::{
-    cia_sample_point, solve, Controller, Limits, Solutions, Timing, DEFAULT_TOLERANCE_PPM,
-    FLEXCAN_CTRL1_TIMING_MASK,
+    cia_sample_point, flexcan_rules, solve, Controller, Limits, Solutions, Timing,
+    DEFAULT_TOLERANCE_PPM, FLEXCAN_CTRL1_TIMING_MASK,
 };
 
 /// The controller whose bit timing register is computed.
@@ -52,6 +54,10 @@ struct Args {
     /// APB1 clock, e.g. 54000000)
     #[arg(long, value_name = "HZ", value_parser = parse_u32)]
     clock: Option<u32>,
+    /// FlexCAN: the peripheral (bus) clock in Hz, for the Kinetis manual's rule of 16
+    /// bus clocks per CAN bit (default: the CAN clock, the least the manual allows)
+    #[arg(long, value_name = "HZ", value_parser = parse_u32)]
+    bus_clock: Option<u32>,
     /// Wished bit rate in bit/s
     #[arg(long, value_name = "BPS", value_parser = parse_u32)]
     bitrate: u32,
@@ -73,6 +79,7 @@ struct Args {
 struct Options {
     controller: Controller,
     clock: u32,
+    bus_clock: u32,
     bitrate: u32,
     sample_point: Option<u16>,
     tolerance: u32,
@@ -97,6 +104,7 @@ impl Args {
         Ok(Options {
             controller,
             clock,
+            bus_clock: self.bus_clock.unwrap_or(clock),
             bitrate: self.bitrate,
             sample_point: self.sample_point,
             tolerance: self.tolerance,
@@ -144,6 +152,18 @@ fn parse_percent(text: &str) -> Result<u16, String> {
 
 fn permille(v: u16) -> String {
     format!("{}.{}", v / 10, v % 10)
+}
+
+/// Why the controller's manual forbids `t` beyond the register ranges, if it does
+/// (FlexCAN: Kinetis RM "Arbitration and matching timing", 16 message buffers with the
+/// Rx FIFO as the driver configures them; bxCAN: none).
+fn manual_violation(t: &Timing, bus_clock: u32) -> Option<String> {
+    match t.limits.controller {
+        Controller::FlexCan => flexcan_rules::check(t, bus_clock, 16, true)
+            .err()
+            .map(|e| e.to_string()),
+        Controller::BxCan => None,
+    }
 }
 
 /// Register values of a timing: (name, value) pairs, the whole register first.
@@ -218,12 +238,19 @@ struct TimingJson {
     sjw: u8,
     triple_sampling: bool,
     oscillator_tolerance_ppm: u32,
+    /// False when the controller's manual forbids the timing (`manual_rule` says why).
+    manual_ok: bool,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    manual_rule: Option<String>,
     registers: RegistersJson,
 }
 
 impl TimingJson {
-    fn new(t: &Timing, tolerance: u32) -> Self {
+    fn new(t: &Timing, tolerance: u32, bus_clock: u32) -> Self {
+        let manual_rule = manual_violation(t, bus_clock);
         TimingJson {
+            manual_ok: manual_rule.is_none(),
+            manual_rule,
             actual_bitrate: t.actual_bitrate(),
             ppm: t.ppm_from_wished(),
             exact: t.is_exact(),
@@ -269,10 +296,10 @@ fn json(o: &Options, target: u16, t: &Timing, all: &[Timing]) -> String {
         bitrate: o.bitrate,
         tolerance_ppm: o.tolerance,
         sample_point_target_permille: target,
-        chosen: TimingJson::new(t, o.tolerance),
+        chosen: TimingJson::new(t, o.tolerance, o.bus_clock),
         solutions: o.all.then(|| {
             all.iter()
-                .map(|s| TimingJson::new(s, o.tolerance))
+                .map(|s| TimingJson::new(s, o.tolerance, o.bus_clock))
                 .collect()
         }),
     };
@@ -323,6 +350,15 @@ fn print_text(o: &Options, target: u16, t: &Timing, all: &[Timing]) {
         permille(target)
     );
     println!("sjw             {}", t.sjw);
+    if o.controller == Controller::FlexCan {
+        match manual_violation(t, o.bus_clock) {
+            None => println!(
+                "Kinetis RM      ok (8+ quanta, 16+ bus clocks per bit at bus {} Hz)",
+                o.bus_clock
+            ),
+            Some(why) => println!("Kinetis RM      FORBIDDEN: {why}"),
+        }
+    }
     println!("osc. tolerance  {} ppm", t.oscillator_tolerance_ppm());
     let regs = registers(t);
     if let Some(((name, value), fields)) = regs.split_first() {
@@ -397,7 +433,7 @@ fn main() -> ExitCode {
     } else {
         print_text(&o, target, &t, &all);
     }
-    if t.validate(o.tolerance).is_ok() {
+    if t.validate(o.tolerance).is_ok() && manual_violation(&t, o.bus_clock).is_none() {
         ExitCode::SUCCESS
     } else {
         ExitCode::from(1)
@@ -451,6 +487,34 @@ mod tests {
         // Balanced braces and brackets.
         assert_eq!(j.matches('{').count(), j.matches('}').count());
         assert_eq!(j.matches('[').count(), j.matches(']').count());
+    }
+
+    #[test]
+    fn flexcan_manual_rules() {
+        // 1 Mbit/s from 16 MHz: 16 quanta, 16 bus clocks per bit at the default bus
+        // clock (the CAN clock): the edge, allowed.
+        let j = run_json("--controller flexcan --bitrate 1000000 --json");
+        assert!(
+            j.contains("\"manual_ok\":true,") && !j.contains("manual_rule"),
+            "{j}"
+        );
+        // 2 Mbit/s: 8 quanta, but 8 bus clocks per bit from a 16 MHz bus.
+        let j = run_json("--controller flexcan --bitrate 2000000 --json");
+        assert!(j.contains("\"manual_ok\":false,"), "{j}");
+        assert!(j.contains("8 peripheral clocks per CAN bit"), "{j}");
+        let j = run_json("--controller flexcan --bitrate 2000000 --bus-clock 32000000 --json");
+        assert!(j.contains("\"manual_ok\":true,"), "{j}");
+        // ACAN's 3.2 Mbit/s: 5 quanta, whatever the bus clock.
+        let j = run_json("--controller flexcan --bitrate 3200000 --bus-clock 60000000 --json");
+        assert!(j.contains("5 time quanta per bit"), "{j}");
+        // A bus clock below the CAN clock.
+        let j = run_json("--controller flexcan --bitrate 125000 --bus-clock 8000000 --json");
+        assert!(j.contains("below the CAN clock"), "{j}");
+        // bxCAN has no such rule.
+        let j = run_json("--controller bxcan --clock 54000000 --bitrate 1000000 --json");
+        assert!(j.contains("\"manual_ok\":true,"), "{j}");
+        let o = parse_args("--controller flexcan --bitrate 1000000").unwrap();
+        assert_eq!(o.bus_clock, 16_000_000);
     }
 
     #[test]
