@@ -250,6 +250,7 @@ impl<'a> World<'a> {
             let t = (self.now_ps + self.quantum_ps).min(end);
             for m in &mut self.machines {
                 m.run_until(t);
+                m.drain_rtt();
             }
             self.check_bit_rates();
             self.queue_traffic(t);

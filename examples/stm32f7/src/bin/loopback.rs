@@ -46,6 +46,7 @@ mod firmware {
     #[cortex_m_rt::entry]
     fn main() -> ! {
         let mut boot = rt::boot();
+        twocan_stm32f7::info!("stm32f7-loopback: CAN1 in loop-back, a frame every second");
         let apb1 = boot.clocks.pclk1().raw();
         let config = Config::from_bitrate(apb1, 125_000)
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS))
@@ -77,6 +78,10 @@ mod firmware {
             while tx.take_completion().is_some() {}
             while rx.receive().is_ok() {
                 RECEIVED.fetch_add(1, Ordering::Relaxed);
+                twocan_stm32f7::info!(
+                    "loop-back frame {=u32} received",
+                    RECEIVED.load(Ordering::Relaxed)
+                );
                 boot.led.toggle();
             }
             cortex_m::asm::wfi();
