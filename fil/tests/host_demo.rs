@@ -8,7 +8,9 @@
 //! hardware lost, and the bus totals.
 //!
 //! The scenario: 500 kbit/s, 1.5 s, the Teensy as node 1 and the STM32 as node 2, a third
-//! plain node ("other-ecu") sending the demo's unrequested traffic every 5 ms, no faults.
+//! plain node ("other-ecu") sending the demo's unrequested traffic every 5 ms; without
+//! faults, and with the demo's random faults (`--error-rate 0.02 --seed 7`: the bus draws
+//! them per frame attempt from the seed, the same in both runs).
 //!
 //! Aligned, for stated reasons (docs/fil.md, "The app firmware against the host demo"):
 //! - the application period is the firmware's, 10 ms (the demo steps every 1 ms);
@@ -24,7 +26,7 @@ mod common;
 use common::*;
 use twocan_app::App;
 use twocan_bxcan::{Config, FifoPolicy, Recovery};
-use twocan_core::sim::{NodeStats, SimNode};
+use twocan_core::sim::{NodeStats, RandomFaults, SimNode};
 use twocan_core::Frame;
 use twocan_fil::can::Model;
 use twocan_fil::world::World;
@@ -40,6 +42,9 @@ const QUANTUM_US: u64 = 20;
 const RUN_US: u64 = 1_500_000;
 const TEENSY: &str = "teensy36";
 const STM32: &str = "nucleo-f767zi";
+
+/// `can-demo`'s `--seed` and `--error-rate`: random faults on the bus, or none.
+type Faults = Option<(u64, f64)>;
 
 /// `can-demo`'s other node: frame `k` (standard `0x300 + k % 16` for even `k`, extended
 /// `0x0CF0_0400 | k % 8` for odd `k`).
@@ -136,8 +141,11 @@ fn other_traffic(first_us: u64) -> Vec<(u64, Frame)> {
 }
 
 /// The firmware pair under the harness.
-fn run_firmware(first: [u64; 2]) -> Option<(Outcome, World<'static>)> {
+fn run_firmware(first: [u64; 2], faults: Faults) -> Option<(Outcome, World<'static>)> {
     let mut w = fil_world()?;
+    if let Some((seed, rate)) = faults {
+        w.bus.set_random_faults(Some(RandomFaults::new(seed, rate)));
+    }
     let traffic = other_traffic(first[0]);
     let frames: Vec<Frame> = traffic.iter().map(|(_, f)| *f).collect();
     let other = w.add_node_from(
@@ -214,7 +222,7 @@ enum Action {
 /// `twocan_teensy::configs::BUS`; bxCAN `Config::from_bitrate(54 MHz, 500 kbit/s)` with
 /// automatic bus-off recovery and the filters planned into FIFO 0, as `stm32f7-app`),
 /// each `App` stepped with `handle` then `publish` as the firmware does.
-fn run_host(steps: &[Vec<u64>; 2]) -> (Outcome, Vec<(u64, Frame, bool)>) {
+fn run_host(steps: &[Vec<u64>; 2], faults: Faults) -> (Outcome, Vec<(u64, Frame, bool)>) {
     let first = [steps[0][0], steps[1][0]];
     let mut h = Harness::new(BIT_RATE).unwrap();
     let mut apps = [App::new(1, 2), App::new(2, 1)];
@@ -228,6 +236,9 @@ fn run_host(steps: &[Vec<u64>; 2]) -> (Outcome, Vec<(u64, Frame, bool)>) {
     let other_id = {
         let mut bus = h.bus().borrow_mut();
         bus.set_tracing(true);
+        if let Some((seed, rate)) = faults {
+            bus.set_random_faults(Some(RandomFaults::new(seed, rate)));
+        }
         bus.attach("other-ecu", other.clone())
     };
     let bits = |us: u64| us * u64::from(BIT_RATE) / 1_000_000;
@@ -304,6 +315,17 @@ fn trace_of(records: &[twocan_core::sim::trace::TraceRecord]) -> Vec<(u64, Frame
 
 #[test]
 fn app_firmware_counts_what_the_host_demo_counts() {
+    compare(None);
+}
+
+/// The same with `can-demo --error-rate 0.02 --seed 7`: the bus draws a fault for 2 % of
+/// the frame attempts from the same seed in both runs.
+#[test]
+fn app_firmware_counts_what_the_host_demo_counts_with_errors() {
+    compare(Some((7, 0.02)));
+}
+
+fn compare(faults: Faults) {
     let Some(steps) = step_times() else {
         return;
     };
@@ -315,10 +337,10 @@ fn app_firmware_counts_what_the_host_demo_counts() {
             assert!(d.abs_diff(PERIOD_US) <= QUANTUM_US, "step period {d} us");
         }
     }
-    let Some((fil, w)) = run_firmware(first) else {
+    let Some((fil, w)) = run_firmware(first, faults) else {
         return;
     };
-    let (host, host_trace) = run_host(&steps);
+    let (host, host_trace) = run_host(&steps, faults);
     eprintln!(
         "first application steps: Teensy {} us, STM32 {} us",
         first[0], first[1]
@@ -329,6 +351,14 @@ fn app_firmware_counts_what_the_host_demo_counts() {
     assert!(fil.apps.iter().all(|s| s.heartbeats >= hb), "{fil:?}");
     assert!(fil.filtered.iter().all(|f| *f >= 250), "{fil:?}");
     assert!(fil.wire[2].sent >= 290, "{fil:?}");
+    if faults.is_some() {
+        // The faults hit: error frames, retransmissions, errors on every node.
+        assert!(fil.bus.1 + 10 <= fil.bus.0, "{fil:?}");
+        assert!(
+            fil.wire.iter().all(|w| w.tx_errors + w.rx_errors > 0),
+            "{fil:?}"
+        );
+    }
     let fil_trace = trace_of(w.bus.trace().records());
     // Not compared: the frames' start times. The host's bxCAN register wrapper lets bus
     // time pass while the driver reads `CAN_MSR` (`twocan_host::Clocked`, for the
