@@ -27,6 +27,17 @@ for board in nucleo-f767zi disco-f746g; do
         fi
     done
 done
+# The defmt variants (the examples log through defmt-rtt; tests/defmt.rs decodes the log):
+# one board of each family, saved as <example>-defmt. DEFMT_LOG is read at compile time
+# (the examples' .cargo/config.toml sets it when cargo runs in their folders only).
+for spec in twocan-teensy:teensy36:teensy twocan-stm32f7:nucleo-f767zi:stm32f7; do
+    IFS=: read -r pkg board prefix <<<"$spec"
+    DEFMT_LOG=info cargo build --quiet --release --target "$target" -p "$pkg" \
+        --features "$board,defmt" --bin "$prefix-app" --bin "$prefix-loopback"
+    for bin in app loopback; do
+        cp "$rel/$prefix-$bin" "$out/$board/$prefix-$bin-defmt"
+    done
+done
 cargo build --quiet --release --target "$target" --manifest-path fil/firmware/Cargo.toml
 mkdir -p "$out/negative"
 for bin in kinetis-gate kinetis-stuck kinetis-no-wdog core-check stm32-gate stm32-stuck; do

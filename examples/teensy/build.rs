@@ -5,7 +5,8 @@
 //! - writes `device.x`, the weak aliases cortex-m-rt's `device` feature includes for the
 //!   interrupt handlers named in `src/rt.rs`'s `__INTERRUPTS`;
 //! - passes `-Tlink.x` to the bins only (`rustc-link-arg-bins`), so the library, its
-//!   tests and the rest of the workspace are unaffected.
+//!   tests and the rest of the workspace are unaffected; with the `defmt` feature also
+//!   `-Tdefmt.x`.
 //!
 //! On the host nothing is emitted: the bins are stubs there.
 
@@ -76,4 +77,9 @@ fn main() {
 
     println!("cargo:rustc-link-search={}", out.display());
     println!("cargo:rustc-link-arg-bins=-Tlink.x");
+    // defmt's linker script: its interned strings go to the `.defmt` section of the ELF,
+    // which the decoder (probe-rs, can-fil) reads.
+    if env::var_os("CARGO_FEATURE_DEFMT").is_some() {
+        println!("cargo:rustc-link-arg-bins=-Tdefmt.x");
+    }
 }

@@ -34,6 +34,9 @@ pub struct Image {
     pub segments: Vec<Segment>,
     /// Data and function symbols.
     pub symbols: Vec<Symbol>,
+    /// The `defmt` table (from the `.defmt` section and the symbols), when the firmware
+    /// logs with `defmt`.
+    pub defmt: Option<defmt_decoder::Table>,
     /// Addresses of `WFI` (0xBF30) at instruction boundaries of the code sections'
     /// halfwords; the harness hooks them (a hook fires only where an instruction starts).
     pub wfi_sites: Vec<u32>,
@@ -115,10 +118,17 @@ impl Image {
                 i += if hw >> 11 >= 0b11101 { 4 } else { 2 };
             }
         }
+        // defmt-decoder checks that the firmware's defmt wire format is one it knows.
+        let defmt = if file.section_by_name(".defmt").is_some() {
+            defmt_decoder::Table::parse(bytes).map_err(|e| format!("{path}: defmt table: {e}"))?
+        } else {
+            None
+        };
         Ok(Image {
             path: path.to_string(),
             segments,
             symbols,
+            defmt,
             wfi_sites,
         })
     }

@@ -8,4 +8,5 @@ pub mod machine;
 pub mod nvic;
 pub mod profile;
 pub mod report;
+pub mod rtt;
 pub mod world;

@@ -92,6 +92,16 @@ pub fn render(world: &World<'_>) -> String {
         for f in &b.findings {
             let _ = writeln!(out, "  finding: {f}");
         }
+        if let Some(rtt) = &b.rtt {
+            let lines = m.defmt_lines();
+            let _ = writeln!(out, "  defmt log ({} lines):", lines.len());
+            for l in &lines {
+                let _ = writeln!(out, "    | {l}");
+            }
+            if let Some(e) = &rtt.error {
+                let _ = writeln!(out, "  RTT: {e}");
+            }
+        }
         if !b.console.is_empty() {
             let _ = writeln!(out, "  console:");
             for l in b.console.lines() {

@@ -160,7 +160,7 @@ impl<'a> World<'a> {
     }
 
     /// Adds a plain simulated node sending `traffic` in turn every `period_ps` (none if
-    /// empty) at `bit_rate`.
+    /// empty) at `bit_rate`, the first one `period_ps` after time 0.
     pub fn add_node(
         &mut self,
         name: &str,
@@ -168,6 +168,21 @@ impl<'a> World<'a> {
         bit_rate: u32,
         traffic: Vec<Frame>,
         period_ps: u128,
+    ) -> Rc<RefCell<SimNode>> {
+        self.add_node_from(name, node, bit_rate, traffic, period_ps, period_ps)
+    }
+
+    /// Like [`World::add_node`], the first frame at `first_ps`. A frame due at `t` is
+    /// handed to the node at the end of the step that reaches `t`, and the bus plays that
+    /// step from its start: it starts on the wire at the start of that step.
+    pub fn add_node_from(
+        &mut self,
+        name: &str,
+        node: SimNode,
+        bit_rate: u32,
+        traffic: Vec<Frame>,
+        period_ps: u128,
+        first_ps: u128,
     ) -> Rc<RefCell<SimNode>> {
         let shared = node.shared();
         let id = self.bus.attach(name, shared.clone());
@@ -178,7 +193,7 @@ impl<'a> World<'a> {
             bit_rate,
             traffic,
             period_ps: period_ps.max(1),
-            next_ps: period_ps.max(1),
+            next_ps: first_ps,
             sent: 0,
             checked: false,
             misclocked: false,
@@ -235,6 +250,7 @@ impl<'a> World<'a> {
             let t = (self.now_ps + self.quantum_ps).min(end);
             for m in &mut self.machines {
                 m.run_until(t);
+                m.drain_rtt();
             }
             self.check_bit_rates();
             self.queue_traffic(t);

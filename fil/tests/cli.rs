@@ -112,3 +112,33 @@ fn bad_arguments_are_refused_with_usage() {
         assert!(err.contains("can-fil:"), "{args:?}: {err}");
     }
 }
+
+/// A firmware built with `defmt`: its decoded log is in the report, under its board.
+#[test]
+fn the_report_shows_the_decoded_defmt_log() {
+    let Some(t) = path("teensy36", "teensy-loopback-defmt") else {
+        return;
+    };
+    let (code, out, err) = can_fil(&["--board", "teensy36", &t, "--seconds", "1.1"]);
+    assert_eq!(code, 0, "{out}{err}");
+    let log = out
+        .split_once("  defmt log (2 lines):\n")
+        .unwrap_or_else(|| panic!("{out}"))
+        .1;
+    let lines: Vec<&str> = log.lines().take(2).collect();
+    assert!(
+        lines[0].starts_with("    | 0.000 INFO  teensy-loopback: CAN0 in loop-back"),
+        "{out}"
+    );
+    assert!(
+        lines[1].starts_with("    | 1.00")
+            && lines[1].ends_with("INFO  loop-back frame 1 received"),
+        "{out}"
+    );
+    // Without `defmt` there is no log section.
+    let Some(plain) = path("teensy36", "teensy-loopback") else {
+        return;
+    };
+    let (_, out, _) = can_fil(&["--board", "teensy36", &plain, "--seconds", "0.1"]);
+    assert!(!out.contains("defmt log"), "{out}");
+}

@@ -27,6 +27,9 @@ use defmt_rtt as _;
 
 pub mod board;
 pub mod can;
+/// The examples' log (`info!`, `warn!`, `error!`): the very file of `twocan-teensy`.
+#[path = "../../teensy/src/log.rs"]
+pub mod log;
 #[cfg(target_os = "none")]
 pub mod rt;
 #[path = "../../teensy/src/time.rs"]

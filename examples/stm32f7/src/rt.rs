@@ -193,6 +193,7 @@ fn SysTick() {
 /// (5: bxCAN configuration, 6: panic). Interrupts are disabled; delays assume the 16 MHz
 /// HSI (the clock after reset) and run faster once the PLL is on.
 pub fn halt(code: u8) -> ! {
+    crate::error!("halted: blink code {=u8}", code);
     cortex_m::interrupt::disable();
     // SAFETY: interrupts are off and this never returns: nothing else will use the LED's
     // port again, so taking it over here cannot race.

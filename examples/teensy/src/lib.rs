@@ -33,6 +33,10 @@ compile_error!("choose the board: --features teensy32, teensy35 or teensy36");
 ))]
 compile_error!("choose one board feature only");
 
+// `--features defmt`: the RTT transport of the defmt logger (`log`, docs/firmware.md).
+#[cfg(all(target_os = "none", feature = "defmt"))]
+use defmt_rtt as _;
+
 pub mod board;
 pub mod can;
 pub mod clock;
@@ -41,6 +45,7 @@ pub mod filters_example;
 pub mod flash_config;
 pub mod io;
 pub mod led;
+pub mod log;
 pub mod regs;
 #[cfg(target_os = "none")]
 pub mod rt;

@@ -156,6 +156,7 @@ fn SysTick() {
 /// 6: panic). Interrupts are disabled; the delays are counted in core clocks assuming
 /// 16 MHz (after a clock error the core runs at ~21 MHz: a little faster blinking).
 pub fn halt(code: u8) -> ! {
+    crate::error!("halted: blink code {=u8}", code);
     cortex_m::interrupt::disable();
     // SAFETY: interrupts are off and this never returns, so nothing else uses the LED
     // or port C any more.

@@ -96,6 +96,9 @@ pub struct Board {
     pub findings: Vec<String>,
     /// Semihosting console output.
     pub console: String,
+    /// The `defmt` log's RTT up-channel (firmware with a `.defmt` table and
+    /// `_SEGGER_RTT`).
+    pub rtt: Option<crate::rtt::Rtt>,
     /// Exceptions whose next entry should be checked (something changed).
     check_irq: bool,
     /// Semihosting exit requested.
@@ -321,6 +324,11 @@ impl<'a> Machine<'a> {
             unknown: BTreeMap::new(),
             findings: Vec::new(),
             console: String::new(),
+            rtt: image
+                .defmt
+                .as_ref()
+                .and(image.symbol("_SEGGER_RTT"))
+                .map(|s| crate::rtt::Rtt::new(s.address)),
             check_irq: false,
             exited: None,
         };
@@ -612,6 +620,31 @@ impl<'a> Machine<'a> {
         b.systick_catch_up();
         if b.nvic.next_to_take(wake_prio).is_some() {
             b.sleeping = false;
+        }
+    }
+
+    /// Reads what the firmware wrote to its RTT up-channel since the last call (a
+    /// probe's read: the channel's read offset moves on).
+    pub fn drain_rtt(&mut self) {
+        let Some(mut rtt) = self.uc.get_data_mut().rtt.take() else {
+            return;
+        };
+        {
+            let uc = std::cell::RefCell::new(&mut self.uc);
+            rtt.drain(
+                |a, n| uc.borrow().mem_read_as_vec(u64::from(a), n).ok(),
+                |a, b| uc.borrow_mut().mem_write(u64::from(a), b).is_ok(),
+            );
+        }
+        self.uc.get_data_mut().rtt = Some(rtt);
+    }
+
+    /// The `defmt` log decoded so far (empty when the firmware does not log with
+    /// `defmt`).
+    pub fn defmt_lines(&self) -> Vec<crate::rtt::LogLine> {
+        match (&self.image.defmt, &self.board().rtt) {
+            (Some(table), Some(rtt)) => crate::rtt::decode(table, &rtt.bytes),
+            _ => Vec::new(),
         }
     }
 

@@ -54,6 +54,12 @@ mod firmware {
     #[cortex_m_rt::entry]
     fn main() -> ! {
         let mut boot = rt::boot();
+        twocan_stm32f7::info!(
+            "stm32f7-app: node {=u8}, peer {=u8}, CAN1 at {=u32} bit/s",
+            NODE,
+            PEER,
+            BIT_RATE
+        );
         let mut app = App::new(NODE, PEER);
         // The hand-over: CAN1's singleton and pins (AF9), CAN1 clocked through APB1; the
         // bit timing is solved for the APB1 frequency of the HAL's clocks.
@@ -76,6 +82,11 @@ mod firmware {
         let can = init.enable().unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         let (mut tx, mut rx) = can::start(&CAN1, &CAN1_VECTORS, can.into_split(), rt::CAN1_IRQS)
             .unwrap_or_else(|| rt::halt(CAN_BLINKS));
+        twocan_stm32f7::info!(
+            "CAN1 on the bus with the application's {=usize} filters",
+            app.filters().len()
+        );
+        let mut steps: u32 = 0;
 
         let mut period = Every::new(time::millis(), 10);
         let mut shown = 0;
@@ -85,6 +96,29 @@ mod firmware {
                 app.publish(&mut tx);
                 while tx.take_completion().is_some() {}
                 let stats = app.stats();
+                while let Some(c) = rx.take_state_change() {
+                    twocan_stm32f7::warn!(
+                        "CAN1 error state {} (TEC {=u16}, REC {=u16})",
+                        c.state,
+                        c.counters.tec,
+                        c.counters.rec
+                    );
+                }
+                steps = steps.wrapping_add(1);
+                if steps.is_multiple_of(100) {
+                    twocan_stm32f7::info!(
+                        "step {=u32}: sent {=u32}, heartbeats {=u32} (gaps {=u32}, duplicates {=u32}), measurements {=u32}, requests {=u32}, answers {=u32}, queue full {=u32}",
+                        steps,
+                        stats.sent,
+                        stats.heartbeats,
+                        stats.heartbeat_gaps,
+                        stats.heartbeat_duplicates,
+                        stats.measurements,
+                        stats.requests,
+                        stats.answers,
+                        stats.tx_full
+                    );
+                }
                 critical_section::with(|cs| *STATS.borrow_ref_mut(cs) = Some(stats));
                 if stats.heartbeats >= shown + 50 {
                     shown = stats.heartbeats;

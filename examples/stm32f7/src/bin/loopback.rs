@@ -46,6 +46,7 @@ mod firmware {
     #[cortex_m_rt::entry]
     fn main() -> ! {
         let mut boot = rt::boot();
+        twocan_stm32f7::info!("stm32f7-loopback: CAN1 in loop-back, a frame every second");
         // The hand-over: CAN1's singleton and pins (AF9), CAN1 clocked through APB1; the
         // bit timing is solved for the APB1 frequency of the HAL's clocks.
         let (tx_pin, rx_pin) = boot.can1_pins;
@@ -80,6 +81,10 @@ mod firmware {
             while tx.take_completion().is_some() {}
             while rx.receive().is_ok() {
                 RECEIVED.fetch_add(1, Ordering::Relaxed);
+                twocan_stm32f7::info!(
+                    "loop-back frame {=u32} received",
+                    RECEIVED.load(Ordering::Relaxed)
+                );
                 boot.led.toggle();
             }
             cortex_m::asm::wfi();

@@ -39,6 +39,12 @@ mod firmware {
     #[cortex_m_rt::entry]
     fn main() -> ! {
         let mut boot = rt::boot();
+        twocan_teensy::info!(
+            "teensy-app: node {=u8}, peer {=u8}, CAN0 at {=u32} bit/s",
+            NODE,
+            PEER,
+            SETTINGS.actual_bit_rate()
+        );
         let mut app = App::new(NODE, PEER);
         let token = Can0::take().unwrap_or_else(|| rt::halt(CAN_BLINKS));
         // The application's portable filter list, as primary filters.
@@ -48,6 +54,11 @@ mod firmware {
         let (mut tx, mut rx) = CAN0
             .start(can.into_split(), &mut boot.core.NVIC)
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
+        twocan_teensy::info!(
+            "CAN0 on the bus with the application's {=usize} filters",
+            app.filters().len()
+        );
+        let mut steps: u32 = 0;
 
         let mut period = Every::new(time::millis(), 10);
         let mut shown = 0;
@@ -57,6 +68,29 @@ mod firmware {
                 app.publish(&mut tx);
                 while tx.take_completion().is_some() {}
                 let stats = app.stats();
+                while let Some(c) = rx.take_state_change() {
+                    twocan_teensy::warn!(
+                        "CAN0 error state {} (TEC {=u16}, REC {=u16})",
+                        c.state,
+                        c.counters.tec,
+                        c.counters.rec
+                    );
+                }
+                steps = steps.wrapping_add(1);
+                if steps.is_multiple_of(100) {
+                    twocan_teensy::info!(
+                        "step {=u32}: sent {=u32}, heartbeats {=u32} (gaps {=u32}, duplicates {=u32}), measurements {=u32}, requests {=u32}, answers {=u32}, queue full {=u32}",
+                        steps,
+                        stats.sent,
+                        stats.heartbeats,
+                        stats.heartbeat_gaps,
+                        stats.heartbeat_duplicates,
+                        stats.measurements,
+                        stats.requests,
+                        stats.answers,
+                        stats.tx_full
+                    );
+                }
                 critical_section::with(|cs| *STATS.borrow_ref_mut(cs) = Some(stats));
                 if stats.heartbeats >= shown + 50 {
                     shown = stats.heartbeats;

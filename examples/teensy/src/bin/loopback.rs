@@ -31,6 +31,7 @@ mod firmware {
     #[cortex_m_rt::entry]
     fn main() -> ! {
         let mut boot = rt::boot();
+        twocan_teensy::info!("teensy-loopback: CAN0 in loop-back, a frame every second");
         let token = Can0::take().unwrap_or_else(|| rt::halt(CAN_BLINKS));
         let can = token
             .begin_on(Pin3, Pin4, &SETTINGS, &[], &[])
@@ -51,6 +52,10 @@ mod firmware {
             while tx.take_completion().is_some() {}
             while rx.receive().is_ok() {
                 RECEIVED.fetch_add(1, Ordering::Relaxed);
+                twocan_teensy::info!(
+                    "loop-back frame {=u32} received",
+                    RECEIVED.load(Ordering::Relaxed)
+                );
                 boot.led.toggle();
             }
             cortex_m::asm::wfi();
