@@ -22,7 +22,7 @@ use core::sync::atomic::{AtomicU32, AtomicU8, Ordering};
 use twocan_core::hardware::{sort_by_token, Completion, Settled, StatusEvents, Token, TxFailure};
 use twocan_core::{
     AtomicLastError, Error, ErrorCounters, ErrorState, ErrorStatus, Frame, Hardware, LastErrorCode,
-    Mode, Priority, Registers, RxFrame, TxOutcome, TxPolicy,
+    Mode, Priority, Registers, RxFrame, Timestamp, TxOutcome, TxPolicy,
 };
 use twocan_core::{MailboxId, MailboxState};
 
@@ -216,10 +216,10 @@ impl<R: Registers, F: Registers> BxCan<R, F> {
             }
         };
         if t & tsr::txok(x) != 0 {
-            let timestamp = self
-                .config
-                .get_timestamps()
-                .then(|| rdtxr::TIME.get(self.regs.read32(tdtxr(x))) as u16);
+            // The 16-bit TIME (RM0410 §40.9.2 CAN_TDTxR): the driver widens it.
+            let timestamp = self.config.get_timestamps().then(|| {
+                Timestamp::from_parts(0, rdtxr::TIME.get(self.regs.read32(tdtxr(x))) as u16)
+            });
             done(Completion {
                 token,
                 outcome: TxOutcome::Sent,
@@ -536,10 +536,8 @@ unsafe impl<R: Registers, F: Registers> Hardware for BxCan<R, F> {
         Some(RxFrame {
             frame,
             filter,
-            timestamp: self
-                .config
-                .get_timestamps()
-                .then_some(rdtxr::TIME.get(dt) as u16),
+            // Added by the driver from `raw_timestamp`, widened on the interrupt side.
+            timestamp: None,
             hw_match: (rdtxr::FMI.get(dt) as u16) | ((((dt >> 4) & 1) as u16) << 8),
         })
     }
