@@ -573,7 +573,7 @@ fn signed_ticks(t: Timestamp) -> i64 {
 /// between stamps equals the distance between the frames on the bus, in bit times (both
 /// controllers stamp at a fixed point of the frame's start: Kinetis RM "start of the
 /// identifier field", RM0410 "sample point of the Start Of Frame bit"), across three
-/// wraps, with a receive interrupt handled 40,000 bit times after a frame's stamp. A
+/// wraps, with a receive interrupt handled 45,000 bit times after a frame's stamp. A
 /// quiet bus of 200,000 bit times then shows what each controller can do: with a
 /// readable counter (FlexCAN) and a refresh every 40,000 bit times the distance stays
 /// exact; without
@@ -586,12 +586,15 @@ fn time_stamps_extend_beyond_the_counter<B: Backend>() {
             .send(std_frame(0x100 + u16::from(i), &[i]));
         run(&mut h, &mut dut, 20_000);
     }
-    // 2. Two more, 20,000 bit times apart, whose receive interrupt is served 20,000 bit
-    // times after the second: 40,000 bit times after the first frame's stamp.
+    // 2. Two more, 20,000 bit times apart, whose receive interrupt is served 25,000 bit
+    // times after the second: 45,000 bit times after the first frame's stamp, and after
+    // a refresh (a periodic task's) that read the counter while they waited.
     peer.borrow_mut().send(std_frame(0x108, &[8]));
     h.run_for(20_000, &mut []);
     peer.borrow_mut().send(std_frame(0x109, &[9]));
     h.run_for(20_000, &mut []);
+    dut.driver().refresh_timestamps();
+    h.run_for(5_000, &mut []);
     assert!(dut.irq_pending(), "{}", B::NAME);
     run(&mut h, &mut dut, 0);
     // 3. Four transmitted frames, 20,000 bit times apart; then one more received.
