@@ -13,7 +13,12 @@
 //! - transmit handler: `IFLAG1` write-1-to-clear of the transmit mailboxes' bits;
 //! - receive handler: MB0–MB3 (the Rx FIFO output), `RXFIR`, `IFLAG1` write-1-to-clear
 //!   of `BUF5I`/`BUF6I`/`BUF7I`;
-//! - status handler: `ESR1` write-1-to-clear of exactly the bits it read, `ECR` read.
+//! - status handler: `ESR1` write-1-to-clear of exactly the bits it read, `ECR` read;
+//! - any context, inside the driver's critical section: `TIMER` read (time stamp
+//!   widening, [`Hardware::timer_now`]). The read unlocks a locked mailbox (Kinetis RM,
+//!   "Message buffer lock mechanism"): no context relies on a lock, since the Rx FIFO
+//!   output changes only when `BUF5I` is written and transmit mailboxes are not locked
+//!   for reception.
 //!
 //! A raw received frame is the Rx FIFO output's four words (control/status,
 //! identifier, data) and `RXFIR.IDHIT`; the thread side decodes it and maps the hit
