@@ -205,6 +205,11 @@ impl<R: Registers, F: Registers> BxCan<R, F> {
         if displacing {
             self.displacing.fetch_and(!bit, Ordering::Relaxed);
         }
+        // The 16-bit TIME of a sent frame (RM0410 §40.9.2 CAN_TDTxR), read before the
+        // acknowledge frees the mailbox for the next load; the driver widens it.
+        let sent = t & tsr::txok(x) != 0;
+        let timestamp = (sent && self.config.get_timestamps())
+            .then(|| Timestamp::from_parts(0, rdtxr::TIME.get(self.regs.read32(tdtxr(x))) as u16));
         self.regs.write32(TSR, tsr::rqcp(x));
         // Each outcome calls `f` with its own variant, so that an inlined `f` matches
         // on a known variant instead of copying a generic `Settled` around.
@@ -215,11 +220,7 @@ impl<R: Registers, F: Registers> BxCan<R, F> {
                 f(token.0, Settled::Done(c))
             }
         };
-        if t & tsr::txok(x) != 0 {
-            // The 16-bit TIME (RM0410 §40.9.2 CAN_TDTxR): the driver widens it.
-            let timestamp = self.config.get_timestamps().then(|| {
-                Timestamp::from_parts(0, rdtxr::TIME.get(self.regs.read32(tdtxr(x))) as u16)
-            });
+        if sent {
             done(Completion {
                 token,
                 outcome: TxOutcome::Sent,

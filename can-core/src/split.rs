@@ -401,8 +401,8 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
     /// ([`Hardware::timer_now`]: FlexCAN), so that time stamps stay exact across a quiet
     /// bus. The interrupt handlers read it whenever they widen a stamp, and the status
     /// handler on each interrupt and [`StatusIrq::poll_state`]: call this (any context)
-    /// at least once every 65,536 bit times (131 ms at 500 kbit/s) when the bus may
-    /// carry no frame for that long. Nothing to do without a readable counter (bxCAN):
+    /// at intervals shorter than 65,536 bit times (131 ms at 500 kbit/s) when the bus
+    /// may carry no frame for that long. Nothing to do without a readable counter (bxCAN):
     /// see `docs/architecture.md`, "Time stamps".
     pub fn refresh_timestamps(&self) {
         let Some(hw) = self.hardware() else {
