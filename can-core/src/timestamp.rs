@@ -17,6 +17,18 @@
 //! The split driver ([`crate::split`]) widens every 16-bit value to a [`Timestamp`] on the
 //! interrupt side, with one [`Extender`] per controller, shared by the receive and
 //! transmit handlers (see `docs/architecture.md`, "Time stamps", for the guarantee).
+//!
+//! ```
+//! use twocan_core::timestamp::{bit_times_to_micros, Timestamp};
+//!
+//! // Two frames' stamps (`RxFrame::timestamp`), the counter having wrapped between them.
+//! let a = Timestamp::from_parts(0, 65_000);
+//! let b = Timestamp::from_parts(1, 500);
+//! let bits = b.bit_times_since(a).unwrap();
+//! assert_eq!(bits, 1_036);
+//! assert_eq!(bit_times_to_micros(bits, 500_000)?, 2_072); // 2 µs a bit
+//! # Ok::<(), twocan_core::Error>(())
+//! ```
 
 use crate::error::Error;
 use core::num::NonZeroU64;
