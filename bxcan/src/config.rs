@@ -250,8 +250,13 @@ impl Config {
     }
 
     /// Time-triggered communication mode (`CAN_MCR.TTCM`; notes "Time triggered
-    /// communication mode"): the bit-time counter is captured at the start of frame and
-    /// reported in [`twocan_core::RxFrame::timestamp`].
+    /// communication mode", RM0410 §40.7.2): the bit-time counter is captured at the
+    /// start of frame of received and transmitted frames and reported, widened past its
+    /// 16 bits, in [`twocan_core::RxFrame::timestamp`] and
+    /// [`twocan_core::Completion::timestamp`]. Off: both are `None` (the hardware has no
+    /// time stamp). The counter cannot be read by software, so the widening is relative
+    /// to the previous stamp ([`twocan_core::timestamp`]; `docs/architecture.md`, "Time
+    /// stamps").
     pub const fn timestamps(self, on: bool) -> Self {
         Config {
             timestamps: on,

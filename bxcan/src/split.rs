@@ -22,7 +22,7 @@ use core::sync::atomic::{AtomicU32, AtomicU8, Ordering};
 use twocan_core::hardware::{sort_by_token, Completion, Settled, StatusEvents, Token, TxFailure};
 use twocan_core::{
     AtomicLastError, Error, ErrorCounters, ErrorState, ErrorStatus, Frame, Hardware, LastErrorCode,
-    Mode, Priority, Registers, RxFrame, TxOutcome, TxPolicy,
+    Mode, Priority, Registers, RxFrame, Timestamp, TxOutcome, TxPolicy,
 };
 use twocan_core::{MailboxId, MailboxState};
 
@@ -207,6 +207,11 @@ impl<R: Registers, F: Registers, const K: usize> BxCan<R, F, K> {
         if displacing {
             self.displacing.fetch_and(!bit, Ordering::Relaxed);
         }
+        // The 16-bit TIME of a sent frame (RM0410 §40.9.2 CAN_TDTxR), read before the
+        // acknowledge frees the mailbox for the next load; the driver widens it.
+        let sent = t & tsr::txok(x) != 0;
+        let timestamp = (sent && self.config.get_timestamps())
+            .then(|| Timestamp::from_parts(0, rdtxr::TIME.get(self.regs.read32(tdtxr(x))) as u16));
         self.regs.write32(TSR, tsr::rqcp(x));
         // Each outcome calls `f` with its own variant, so that an inlined `f` matches
         // on a known variant instead of copying a generic `Settled` around.
@@ -217,11 +222,7 @@ impl<R: Registers, F: Registers, const K: usize> BxCan<R, F, K> {
                 f(token.0, Settled::Done(c))
             }
         };
-        if t & tsr::txok(x) != 0 {
-            let timestamp = self
-                .config
-                .get_timestamps()
-                .then(|| rdtxr::TIME.get(self.regs.read32(tdtxr(x))) as u16);
+        if sent {
             done(Completion {
                 token,
                 outcome: TxOutcome::Sent,
@@ -538,10 +539,8 @@ unsafe impl<R: Registers, F: Registers, const K: usize> Hardware for BxCan<R, F,
         Some(RxFrame {
             frame,
             filter,
-            timestamp: self
-                .config
-                .get_timestamps()
-                .then_some(rdtxr::TIME.get(dt) as u16),
+            // Added by the driver from `raw_timestamp`, widened on the interrupt side.
+            timestamp: None,
             hw_match: (rdtxr::FMI.get(dt) as u16) | ((((dt >> 4) & 1) as u16) << 8),
         })
     }

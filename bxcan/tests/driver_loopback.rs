@@ -67,7 +67,7 @@ fn time_stamps_with_ttcm() {
     assert_eq!(rx.len(), 2);
     let (t1, t2) = (rx[0].timestamp.unwrap(), rx[1].timestamp.unwrap());
     // The counter runs in bit times: the second frame started ≥ 1000 bits later.
-    assert!(t2.wrapping_sub(t1) >= 1000, "{t1} {t2}");
+    assert!(t2.bit_times_since(t1).unwrap() >= 1000, "{t1:?} {t2:?}");
 }
 
 #[test]

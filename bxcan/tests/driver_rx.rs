@@ -79,7 +79,7 @@ fn time_stamps_keep_arrival_order_across_fifos() {
     assert_eq!(ids, sent.map(u32::from), "arrival order across both FIFOs");
     let filters: Vec<u16> = got.iter().map(|r| r.filter).collect();
     assert_eq!(filters, [0, 0, 4, 0, 4, 4]);
-    let stamps: Vec<u16> = got.iter().map(|r| r.timestamp.unwrap()).collect();
+    let stamps: Vec<u64> = got.iter().map(|r| r.timestamp.unwrap().ticks()).collect();
     assert!(stamps.windows(2).all(|w| w[0] < w[1]), "{stamps:?}");
 }
 

@@ -282,6 +282,14 @@ impl<H: Hardware, const RX: usize, const TX: usize, const RX1: usize> Driver<H, 
         Ok(())
     }
 
+    /// Reads the controller's time stamp counter where software can, so that time
+    /// stamps stay exact across a quiet bus ([`State::refresh_timestamps`]: at least
+    /// once every 65,536 bit times without frames; [`Driver::on_interrupt`] and
+    /// [`Driver::on_status`] do it too).
+    pub fn refresh_timestamps(&self) {
+        self.state.refresh_timestamps()
+    }
+
     /// The shared state (statistics).
     pub fn shared_state(&self) -> &State<H, RX, AnyQueue<TX>, RX1, DRIVER_COMPLETIONS> {
         &self.state

@@ -534,8 +534,11 @@ pub struct RxFrame {
     /// The index of the user's filter that accepted it (after the backend mapped the
     /// hardware match index back to the order in which the user listed filters).
     pub filter: u16,
-    /// The controller's time stamp (free-running bit-time counter) when it has one.
-    pub timestamp: Option<u16>,
+    /// When the frame was on the bus, where the controller records it (FlexCAN always;
+    /// bxCAN with TTCM only, `None` otherwise): the 16-bit bit-time counter at the
+    /// frame's start, extended by the driver on the interrupt side
+    /// ([`crate::timestamp`]).
+    pub timestamp: Option<crate::timestamp::Timestamp>,
     /// The hardware's own match index, for users who want it next to the portable
     /// [`RxFrame::filter`]: bxCAN `CAN_RDTxR.FMI` with the FIFO number in bit 8,
     /// FlexCAN `RXFIR.IDHIT`.

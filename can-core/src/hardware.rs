@@ -20,6 +20,7 @@ use crate::controller::{ErrorStatus, Mode};
 use crate::error::{Error, LastErrorCode};
 use crate::frame::{Frame, RxFrame};
 use crate::mailbox::{MailboxId, MailboxState, TxOutcome, TxPolicy};
+use crate::timestamp::Timestamp;
 
 /// Identifies one frame accepted by [`crate::split::Tx::try_send`]: its sequence number
 /// (wrapping at `u32::MAX`), in acceptance order.
@@ -37,8 +38,13 @@ pub struct Completion {
     pub outcome: TxOutcome,
     /// Why a one-shot transmission failed, where the hardware says.
     pub cause: Option<TxFailure>,
-    /// The transmit time stamp where the hardware has one (16-bit timer).
-    pub timestamp: Option<u16>,
+    /// When the frame was sent, where the hardware records it (`None` for a failed or
+    /// aborted frame, and on bxCAN without TTCM): the counter at the frame's start,
+    /// extended by the driver on the interrupt side ([`crate::timestamp`]). A backend's
+    /// [`Hardware::settle`] fills the hardware's 16-bit value
+    /// ([`Timestamp::from_parts`] with 0 wraps); the driver widens it before the
+    /// completion is delivered.
+    pub timestamp: Option<Timestamp>,
 }
 
 /// Why a transmission failed without retry (one-shot mode).
@@ -194,10 +200,21 @@ pub unsafe trait Hardware {
     /// in the controller, written by [`Hardware::install_filters`] in that context).
     unsafe fn decode(&self, raw: &Self::Raw, map: &Self::FilterMap) -> Option<RxFrame>;
 
-    /// The 16-bit receive time stamp of a raw frame, if the hardware records one (to
-    /// keep arrival order across several receive queues).
+    /// The 16-bit receive time stamp of a raw frame, if the hardware records one. The
+    /// receive interrupt widens it ([`crate::timestamp`]) and the driver reports it in
+    /// [`RxFrame::timestamp`] (whatever [`Hardware::decode`] put there is replaced); it
+    /// also keeps arrival order across several receive queues. Any context.
     fn raw_timestamp(&self, raw: &Self::Raw) -> Option<u16> {
         let _ = raw;
+        None
+    }
+
+    /// The free-running time stamp counter read now, where software can read it
+    /// (FlexCAN `TIMER`; `None` on bxCAN, whose TTCM counter is internal, and whenever
+    /// the counter cannot be read). The driver reads it inside its critical section,
+    /// after the stamps it widens were read, and at [`crate::State::refresh_timestamps`].
+    /// Any context (a read without side effects on the frames).
+    fn timer_now(&self) -> Option<u16> {
         None
     }
 

@@ -49,6 +49,7 @@ pub mod registers;
 pub mod sim;
 pub mod split;
 pub mod spsc;
+pub mod timestamp;
 pub mod timing;
 pub mod txqueue;
 
@@ -74,4 +75,5 @@ pub use split::State;
 pub use split::{AbortRequest, Parts, StateChange};
 pub use spsc::BufferStats;
 pub use spsc::SpscRing;
+pub use timestamp::Timestamp;
 pub use txqueue::{AnyQueue, FifoQueue, PriorityQueue};

@@ -38,7 +38,7 @@
 //! # Ok::<(), twocan_core::Error>(())
 //! ```
 
-use core::cell::UnsafeCell;
+use core::cell::{Cell, UnsafeCell};
 use core::mem::MaybeUninit;
 use core::sync::atomic::{AtomicBool, AtomicU32, AtomicU8, Ordering};
 
@@ -49,6 +49,7 @@ use crate::frame::{Frame, RxFrame};
 use crate::hardware::{Completion, Hardware, Settled, Token};
 use crate::mailbox::{TxOutcome, TxPolicy};
 use crate::spsc::{BufferStats, Counter, SpscRing};
+use crate::timestamp::{Extender, Timestamp};
 use crate::txqueue::{FifoQueue, Queued, TxQueue};
 
 /// Capacity of the error-state change ring.
@@ -87,6 +88,14 @@ pub struct TrafficStats {
     pub completion_overflows: u32,
     /// Error-state transitions observed.
     pub state_changes: u32,
+}
+
+/// One raw frame in a receive ring, with the wraps of its time stamp counted by the
+/// receive interrupt (0 when the hardware records no stamp).
+#[derive(Clone, Copy)]
+pub(crate) struct Stamped<R> {
+    raw: R,
+    wraps: u32,
 }
 
 /// No state recorded yet (0, so that a `static State` is all zeros and lives in `.bss`).
@@ -164,8 +173,11 @@ pub struct State<
 > {
     taken: AtomicBool,
     hw: UnsafeCell<MaybeUninit<H>>,
-    rx0: SpscRing<H::Raw, RX>,
-    rx1: SpscRing<H::Raw, RX1>,
+    rx0: SpscRing<Stamped<H::Raw>, RX>,
+    rx1: SpscRing<Stamped<H::Raw>, RX1>,
+    /// The time stamp extender shared by the receive and transmit interrupt sides (and
+    /// `refresh_timestamps`), touched inside a critical section only.
+    clock: critical_section::Mutex<Cell<Extender>>,
     queue: critical_section::Mutex<UnsafeCell<Q>>,
     /// Entries in `queue` plus displaced frames on their way back into it.
     queue_len: AtomicU32,
@@ -246,6 +258,7 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
             hw: UnsafeCell::new(MaybeUninit::uninit()),
             rx0: SpscRing::new(),
             rx1: SpscRing::new(),
+            clock: critical_section::Mutex::new(Cell::new(Extender::new())),
             queue: critical_section::Mutex::new(UnsafeCell::new(Q::EMPTY)),
             queue_len: AtomicU32::new(0),
             queue_peak: AtomicU32::new(0),
@@ -292,6 +305,7 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
         let hw = unsafe { (*self.hw.get()).assume_init_ref() };
         let map = hw.filter_map();
         let status = hw.error_status();
+        self.refresh_timestamps();
         self.state
             .store(state_code(status.state), Ordering::Release);
         Ok(Parts {
@@ -316,6 +330,7 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
         *self.taken.get_mut() = true;
         let hw = self.hw();
         let status = hw.error_status();
+        self.refresh_timestamps();
         self.state
             .store(state_code(status.state), Ordering::Relaxed);
         (hw.filter_map(), status)
@@ -382,6 +397,48 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
         self.errors.wakeups.get()
     }
 
+    /// Reads the controller's free-running time stamp counter, where software can
+    /// ([`Hardware::timer_now`]: FlexCAN), so that time stamps stay exact across a quiet
+    /// bus. The interrupt handlers read it whenever they widen a stamp, and the status
+    /// handler on each interrupt and [`StatusIrq::poll_state`]: call this (any context)
+    /// at intervals shorter than 65,536 bit times (131 ms at 500 kbit/s) when the bus
+    /// may carry no frame for that long. Nothing to do without a readable counter (bxCAN):
+    /// see `docs/architecture.md`, "Time stamps".
+    pub fn refresh_timestamps(&self) {
+        let Some(hw) = self.hardware() else {
+            return;
+        };
+        critical_section::with(|cs| {
+            if let Some(now) = hw.timer_now() {
+                let c = self.clock.borrow(cs);
+                let mut e = c.get();
+                e.observe(now);
+                c.set(e);
+            }
+        });
+    }
+
+    /// Widens a 16-bit stamp read from the hardware before this call (interrupt side).
+    #[inline]
+    fn widen(&self, stamp: u16) -> Timestamp {
+        let hw = self.hw();
+        critical_section::with(|cs| {
+            let c = self.clock.borrow(cs);
+            let mut e = c.get();
+            // The counter is read after the stamp, inside the section: every stamp
+            // widened is at or before the reading, whichever context read it.
+            let t = match hw.timer_now() {
+                Some(now) => {
+                    e.observe(now);
+                    e.extend_before(stamp)
+                }
+                None => e.extend_near(stamp),
+            };
+            c.set(e);
+            t
+        })
+    }
+
     /// Receive ring figures (queue 0, and queue 1 added when it has room).
     pub fn rx_stats(&self) -> BufferStats {
         let a = self.rx0.stats();
@@ -416,7 +473,10 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
     }
 
     #[inline]
-    fn record(&self, done: Completion) {
+    fn record(&self, mut done: Completion) {
+        if let Some(t) = done.timestamp {
+            done.timestamp = Some(self.widen(t.counter()));
+        }
         match done.outcome {
             TxOutcome::Sent => self.sent.inc(),
             TxOutcome::Failed => self.failed.inc(),
@@ -504,8 +564,14 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
             // SAFETY: the caller is the rings' only consumer.
             let raw = unsafe { self.pop_raw() }.ok_or(nb::Error::WouldBlock)?;
             // SAFETY: the caller is the receive half's context.
-            match unsafe { self.hw().decode(&raw, map) } {
-                Some(frame) => return Ok(frame),
+            match unsafe { self.hw().decode(&raw.raw, map) } {
+                Some(mut frame) => {
+                    frame.timestamp = self
+                        .hw()
+                        .raw_timestamp(&raw.raw)
+                        .map(|t| Timestamp::from_parts(raw.wraps, t));
+                    return Ok(frame);
+                }
                 None => self.dropped.inc(),
             }
         }
@@ -513,7 +579,7 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
 
     /// # Safety
     /// Called from the receive rings' one consumer context.
-    unsafe fn pop_raw(&self) -> Option<H::Raw> {
+    unsafe fn pop_raw(&self) -> Option<Stamped<H::Raw>> {
         // SAFETY: the caller is the rings' only consumer.
         unsafe {
             if RX1 == 0 {
@@ -522,8 +588,8 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
             match (self.rx0.peek(), self.rx1.peek()) {
                 (Some(a), Some(b)) => {
                     let hw = self.hw();
-                    let first = match (hw.raw_timestamp(&a), hw.raw_timestamp(&b)) {
-                        (Some(ta), Some(tb)) => tb.wrapping_sub(ta) < 0x8000,
+                    let first = match (hw.raw_timestamp(&a.raw), hw.raw_timestamp(&b.raw)) {
+                        (Some(ta), Some(tb)) => (a.wraps, ta) <= (b.wraps, tb),
                         _ => true,
                     };
                     if first {
@@ -953,7 +1019,7 @@ unsafe fn drain<
 >(
     s: &State<H, RX, Q, RX1, DONE>,
     q: usize,
-    ring: &SpscRing<H::Raw, N>,
+    ring: &SpscRing<Stamped<H::Raw>, N>,
 ) {
     let hw = s.hw();
     let mut overrun = false;
@@ -963,7 +1029,13 @@ unsafe fn drain<
         while let Some(raw) = hw.read_rx(q, &mut overrun) {
             any = true;
             s.received.inc();
-            let _ = ring.push(raw);
+            // Widened here, on the interrupt side: the counter's wraps are only known
+            // while the frame is fresh.
+            let wraps = match hw.raw_timestamp(&raw) {
+                Some(t) => s.widen(t).wraps(),
+                None => 0,
+            };
+            let _ = ring.push(Stamped { raw, wraps });
         }
     }
     if overrun {
@@ -1010,6 +1082,7 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
         let s = self.s;
         // SAFETY: this handle is the only caller of `take_status`.
         let ev = unsafe { s.hw().take_status() };
+        s.refresh_timestamps();
         if let Some(code) = ev.bus_error {
             s.errors.record(code);
         }
@@ -1044,6 +1117,7 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
     /// bus-off raise none) and records a change.
     pub fn poll_state(&mut self) {
         let now = self.s.hw().error_status();
+        self.s.refresh_timestamps();
         self.note(now);
     }
 

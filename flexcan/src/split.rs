@@ -13,7 +13,12 @@
 //! - transmit handler: `IFLAG1` write-1-to-clear of the transmit mailboxes' bits;
 //! - receive handler: MB0–MB3 (the Rx FIFO output), `RXFIR`, `IFLAG1` write-1-to-clear
 //!   of `BUF5I`/`BUF6I`/`BUF7I`;
-//! - status handler: `ESR1` write-1-to-clear of exactly the bits it read, `ECR` read.
+//! - status handler: `ESR1` write-1-to-clear of exactly the bits it read, `ECR` read;
+//! - any context, inside the driver's critical section: `TIMER` read (time stamp
+//!   widening, [`Hardware::timer_now`]). The read unlocks a locked mailbox (Kinetis RM,
+//!   "Message buffer lock mechanism"): no context relies on a lock, since the Rx FIFO
+//!   output changes only when `BUF5I` is written and transmit mailboxes are not locked
+//!   for reception.
 //!
 //! A raw received frame is the Rx FIFO output's four words (control/status,
 //! identifier, data) and `RXFIR.IDHIT`; the thread side decodes it and maps the hit
@@ -24,7 +29,7 @@ use core::sync::atomic::{AtomicU32, AtomicU8, Ordering};
 use twocan_core::hardware::{sort_by_token, Completion, Settled, StatusEvents, Token};
 use twocan_core::{
     AtomicLastError, Error, ErrorCounters, ErrorState, ErrorStatus, Frame, Hardware, LastErrorCode,
-    Mode, Registers, RxFrame, TxOutcome, TxPolicy,
+    Mode, Registers, RxFrame, Timestamp, TxOutcome, TxPolicy,
 };
 use twocan_core::{MailboxId, MailboxState};
 
@@ -363,7 +368,9 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
             let (outcome, timestamp) = if c == code::TX_ABORT {
                 (TxOutcome::Aborted, None)
             } else {
-                (TxOutcome::Sent, Some(cs::TIME_STAMP.get(control) as u16))
+                // The 16-bit TIME STAMP: the driver widens it.
+                let stamp = cs::TIME_STAMP.get(control) as u16;
+                (TxOutcome::Sent, Some(Timestamp::from_parts(0, stamp)))
             };
             self.regs.write32(IFLAG1, iflag1::buf(mb));
             if c != code::TX_INACTIVE {
@@ -480,8 +487,9 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
         Some(raw)
     }
 
-    /// The frame, the user's filter for `IDHIT` ([`FilterTable::filter_index`];
-    /// [`UNKNOWN_FILTER`] when it maps to none) and the TIME STAMP.
+    /// The frame and the user's filter for `IDHIT` ([`FilterTable::filter_index`];
+    /// [`UNKNOWN_FILTER`] when it maps to none). The driver adds the time stamp, widened
+    /// from [`Hardware::raw_timestamp`] on the interrupt side.
     #[inline]
     unsafe fn decode(&self, raw: &RawFrame, _map: &()) -> Option<RxFrame> {
         // SAFETY: the receive half's context, the only one touching the table.
@@ -509,13 +517,23 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
         Some(RxFrame {
             frame,
             filter,
-            timestamp: Some(MbWords::timestamp_of(control)),
+            timestamp: None,
             hw_match: hit as u16,
         })
     }
 
+    /// The `TIME STAMP` field of the Rx FIFO output's C/S word: the free-running timer
+    /// at the start of the identifier field (Kinetis RM, "Message buffer structure").
     fn raw_timestamp(&self, raw: &RawFrame) -> Option<u16> {
         Some(MbWords::timestamp_of(raw[0]))
+    }
+
+    /// `TIMER` (Kinetis RM, "Free Running Timer (CANx_TIMER)": readable at any time,
+    /// one count per bit time). `None` while disabled (sleep), where the driver touches
+    /// no register but `MCR`. The read also unlocks a locked mailbox (RM "Message buffer
+    /// lock mechanism"); the driver reads it only after the frame's words were read.
+    fn timer_now(&self) -> Option<u16> {
+        (self.mode() != MODE_SLEEP).then(|| self.timer())
     }
 
     /// Freeze, write the table, come back to the mode it was in (the table must be

@@ -52,6 +52,8 @@ pub struct NodeOptions {
     pub filters: Vec<Filter>,
     /// Bus-off recovery.
     pub recovery: Recovery,
+    /// Hardware time stamps wanted (bxCAN: TTCM on; FlexCAN always stamps).
+    pub timestamps: bool,
 }
 
 impl NodeOptions {
@@ -60,6 +62,7 @@ impl NodeOptions {
         NodeOptions {
             filters: filters.to_vec(),
             recovery: Recovery::Automatic,
+            timestamps: false,
         }
     }
 
@@ -71,6 +74,12 @@ impl NodeOptions {
     /// With another recovery mode.
     pub fn recovery(mut self, recovery: Recovery) -> Self {
         self.recovery = recovery;
+        self
+    }
+
+    /// With hardware time stamps on or off (where the backend can turn them off).
+    pub fn timestamps(mut self, on: bool) -> Self {
+        self.timestamps = on;
         self
     }
 }
@@ -170,6 +179,9 @@ pub trait Backend {
     /// unless a rule beyond the register ranges forbids it (FlexCAN: 1 Mbit/s, 16 bus
     /// clocks per bit from the least bus clock the manual allows, 16 MHz).
     const FASTEST_BITRATE: u32;
+    /// Whether software can read the time stamp counter (Kinetis RM "Free Running Timer
+    /// (CANx_TIMER)": yes; RM0410 §40.7.2: the TTCM counter is internal, no).
+    const TIMESTAMP_COUNTER_READABLE: bool;
 
     /// Brings a node up on `h`'s bus at its bit rate.
     fn attach(h: &mut Harness, opts: &NodeOptions) -> Result<Self::Node, Refused> {
@@ -307,6 +319,7 @@ impl Backend for FlexCanBackend {
     const CLOCK_HZ: u32 = 16_000_000;
     const LIMITS: Limits = Limits::FLEXCAN;
     const FASTEST_BITRATE: u32 = 1_000_000;
+    const TIMESTAMP_COUNTER_READABLE: bool = true;
 
     fn attach_via(
         h: &mut Harness,
@@ -456,6 +469,7 @@ impl Backend for BxCanBackend {
     const CLOCK_HZ: u32 = 54_000_000;
     const LIMITS: Limits = Limits::BXCAN;
     const FASTEST_BITRATE: u32 = STM32F767_APB1_HZ / Limits::BXCAN.min_quanta();
+    const TIMESTAMP_COUNTER_READABLE: bool = false;
 
     fn attach_via(
         h: &mut Harness,
@@ -463,8 +477,9 @@ impl Backend for BxCanBackend {
         attach: impl FnOnce(&mut Bus, &str, Box<dyn BusNode>) -> NodeId,
     ) -> Result<BxNode, Refused> {
         let rate = h.bus().borrow().bit_rate();
-        let config =
-            bxcan_config(rate, opts.recovery).map_err(|e| Refused::Other(format!("{e:?}")))?;
+        let config = bxcan_config(rate, opts.recovery)
+            .map_err(|e| Refused::Other(format!("{e:?}")))?
+            .timestamps(opts.timestamps);
         let filters = if opts.filters.is_empty() {
             vec![Filter::pass_all()]
         } else {
@@ -501,8 +516,9 @@ impl Backend for BxCanBackend {
         let mut can = driver.release().into_can();
         can.registers_mut().set_bus(h.bus());
         let rate = h.bus().borrow().bit_rate();
-        let config =
-            bxcan_config(rate, opts.recovery).map_err(|e| Refused::Other(format!("{e:?}")))?;
+        let config = bxcan_config(rate, opts.recovery)
+            .map_err(|e| Refused::Other(format!("{e:?}")))?
+            .timestamps(opts.timestamps);
         let init = can
             .reconfigure(&config)
             .map_err(|f| Refused::Other(format!("reconfigure: {:?}", f.error)))?;

@@ -9,10 +9,11 @@
 //! table cross-checked with the reference filter semantics — never from the drivers.
 
 use twocan_core::sim::{Fault, NodeId, Receivers, SimNode};
+use twocan_core::timestamp::{bit_times_to_micros, COUNTER_PERIOD};
 use twocan_core::timing::Limits;
 use twocan_core::{
     ErrorCounters, ErrorState, Filter, FilterError, Format, Frame, FrameError, FrameKind,
-    LastErrorCode, Mode,
+    LastErrorCode, Mode, Timestamp,
 };
 use twocan_host::Harness;
 use twocan_tests::backend::{
@@ -620,6 +621,150 @@ fn flexcan_is_on_the_bus_when_set_mode_returns() {
     on_the_bus_when_set_mode_returns::<FlexCanBackend>();
 }
 
+// ---------------------------------------------------------------------------------------
+// Issue 12: time stamps an application can use.
+
+/// The distance a widening that sees no counter reading reports for a true distance of
+/// `bits` (docs/architecture.md "Time stamps": the value within −32,768..=32,767 bit
+/// times congruent to it modulo 65,536).
+fn nearest_in_half_period(bits: i64) -> i64 {
+    (bits + 32_768).rem_euclid(65_536) - 32_768
+}
+
+fn signed_ticks(t: Timestamp) -> i64 {
+    t.ticks() as i64
+}
+
+/// Receive and transmit-completion stamps, widened past the 16-bit counter, against the
+/// start-of-frame times the simulated bus reports for the same frames: every distance
+/// between stamps equals the distance between the frames on the bus, in bit times (both
+/// controllers stamp at a fixed point of the frame's start: Kinetis RM "start of the
+/// identifier field", RM0410 "sample point of the Start Of Frame bit"), across three
+/// wraps, with a receive interrupt handled 45,000 bit times after a frame's stamp. A
+/// quiet bus of 200,000 bit times then shows what each controller can do: with a
+/// readable counter (FlexCAN) and a refresh every 40,000 bit times the distance stays
+/// exact; without
+/// (bxCAN) it is known modulo 65,536 only, as documented.
+fn time_stamps_extend_beyond_the_counter<B: Backend>() {
+    let (mut h, mut dut, peer) = setup::<B>(&NodeOptions::pass_all().timestamps(true));
+    // 1. Eight received frames, 20,000 bit times apart, handled as they come.
+    for i in 0..8u8 {
+        peer.borrow_mut()
+            .send(std_frame(0x100 + u16::from(i), &[i]));
+        run(&mut h, &mut dut, 20_000);
+    }
+    // 2. Two more, 20,000 bit times apart, whose receive interrupt is served 25,000 bit
+    // times after the second: 45,000 bit times after the first frame's stamp, and after
+    // a refresh (a periodic task's) that read the counter while they waited.
+    peer.borrow_mut().send(std_frame(0x108, &[8]));
+    h.run_for(20_000, &mut []);
+    peer.borrow_mut().send(std_frame(0x109, &[9]));
+    h.run_for(20_000, &mut []);
+    dut.driver().refresh_timestamps();
+    h.run_for(5_000, &mut []);
+    assert!(dut.irq_pending(), "{}", B::NAME);
+    run(&mut h, &mut dut, 0);
+    // 3. Four transmitted frames, 20,000 bit times apart; then one more received.
+    for i in 0..4u8 {
+        dut.driver()
+            .try_send(&std_frame(0x200 + u16::from(i), &[i]))
+            .unwrap();
+        run(&mut h, &mut dut, 20_000);
+    }
+    peer.borrow_mut().send(std_frame(0x10A, &[10]));
+    run(&mut h, &mut dut, 20_000);
+
+    // Bus times of the frames (start-of-frame bit), from the peer's own records.
+    let sent_by_peer: Vec<(Frame, u64)> = peer
+        .borrow()
+        .tx_reports()
+        .iter()
+        .map(|r| (r.frame, r.time.sof))
+        .collect();
+    let received_by_peer: Vec<(Frame, u64)> = peer
+        .borrow()
+        .received()
+        .iter()
+        .map(|r| (r.frame, r.time.sof))
+        .collect();
+    let rx: Vec<_> = drain(&mut dut)
+        .into_iter()
+        .filter(|r| r.frame.raw_id() < 0x200)
+        .collect();
+    let done: Vec<_> = std::iter::from_fn(|| dut.driver().take_completion()).collect();
+    assert_eq!(rx.len(), 11, "{}", B::NAME);
+    assert_eq!(done.len(), 4, "{}", B::NAME);
+    assert_eq!(sent_by_peer.len(), 11);
+    assert_eq!(received_by_peer.len(), 4);
+
+    let mut events: Vec<(u64, Timestamp)> = Vec::new();
+    for (r, (f, sof)) in rx.iter().zip(&sent_by_peer) {
+        assert_eq!(r.frame, *f);
+        events.push((*sof, r.timestamp.expect("receive stamp")));
+    }
+    for (c, (f, sof)) in done.iter().zip(&received_by_peer) {
+        assert_eq!(f.raw_id(), 0x200 + c.token.0);
+        events.push((*sof, c.timestamp.expect("completion stamp")));
+    }
+    events.sort_by_key(|e| e.0);
+    let (first, last) = (events[0], events[events.len() - 1]);
+    let span = last.0 - first.0;
+    assert!(span > 3 * COUNTER_PERIOD, "{span}: three wraps at least");
+    for w in events.windows(2) {
+        let (bus, stamps) = (w[1].0 - w[0].0, w[1].1.bit_times_since(w[0].1));
+        assert_eq!(stamps, Some(bus), "{}: {w:?}", B::NAME);
+    }
+    // Microseconds from the bit rate: 2 µs a bit at 500 kbit/s.
+    let stamped = last.1.bit_times_since(first.1).unwrap();
+    assert_eq!(bit_times_to_micros(stamped, RATE), Ok(2 * span));
+    assert_eq!(
+        last.1.as_micros(RATE).unwrap() - first.1.as_micros(RATE).unwrap(),
+        2 * span
+    );
+
+    // 4. A quiet bus for 200,000 bit times (refreshed every 40,000, the last reading
+    // having been made 20,000 before), then one frame.
+    let before = h.now();
+    for _ in 0..5 {
+        h.run_for(40_000, &mut []);
+        dut.driver().refresh_timestamps();
+    }
+    assert_eq!(h.now(), before + 200_000);
+    peer.borrow_mut().send(std_frame(0x10B, &[11]));
+    run(&mut h, &mut dut, 1_000);
+    let quiet = drain(&mut dut);
+    assert_eq!(quiet.len(), 1, "{}", B::NAME);
+    let sof = peer.borrow().tx_reports().last().unwrap().time.sof;
+    let bus = (sof - last.0) as i64;
+    assert!(bus > 200_000);
+    let stamped = signed_ticks(quiet[0].timestamp.unwrap()) - signed_ticks(last.1);
+    if B::TIMESTAMP_COUNTER_READABLE {
+        assert_eq!(stamped, bus, "{}", B::NAME);
+    } else {
+        assert_eq!(stamped, nearest_in_half_period(bus), "{}", B::NAME);
+        assert_eq!((bus - stamped) % COUNTER_PERIOD as i64, 0);
+    }
+}
+
+/// Without TTCM bxCAN records no time stamp: the driver says `None`, never a made-up
+/// value; FlexCAN always stamps.
+fn time_stamps_only_where_the_hardware_records_them<B: Backend>() {
+    let (mut h, mut dut, peer) = setup::<B>(&NodeOptions::pass_all());
+    peer.borrow_mut().send(std_frame(0x100, &[]));
+    dut.driver().try_send(&std_frame(0x200, &[])).unwrap();
+    settle(&mut h, &mut dut, &[&peer], 10_000);
+    let rx = drain(&mut dut);
+    let done = dut.driver().take_completion().unwrap();
+    let has = B::TIMESTAMP_COUNTER_READABLE; // FlexCAN: always; bxCAN: TTCM off here.
+    assert!(!rx.is_empty());
+    assert!(
+        rx.iter().all(|r| r.timestamp.is_some() == has),
+        "{}",
+        B::NAME
+    );
+    assert_eq!(done.timestamp.is_some(), has, "{}", B::NAME);
+}
+
 macro_rules! suite {
     ($module:ident, $backend:ty) => {
         mod $module {
@@ -664,6 +809,14 @@ macro_rules! suite {
             #[test]
             fn filters_survive_a_bit_rate_change() {
                 super::filters_survive_a_bit_rate_change::<$backend>();
+            }
+            #[test]
+            fn time_stamps_extend_beyond_the_counter() {
+                super::time_stamps_extend_beyond_the_counter::<$backend>();
+            }
+            #[test]
+            fn time_stamps_only_where_the_hardware_records_them() {
+                super::time_stamps_only_where_the_hardware_records_them::<$backend>();
             }
         }
     };
