@@ -12,6 +12,7 @@
 //! [`TRANSMIT_BUFFER_SIZE`] are ACAN's defaults, [`crate::AcanDriver`] uses them).
 
 use twocan_core::timing::{solve, Consistency, Limits, Timing, DEFAULT_TOLERANCE_PPM};
+use twocan_core::BusOffRecovery;
 
 use crate::configuration::Configuration;
 
@@ -114,6 +115,12 @@ pub struct Settings {
     /// message interrupt only; default `true`. The firmware routes the error, bus-off
     /// and warning vectors of [`crate::Irqs`] to the same handler.
     pub error_interrupts: bool,
+    /// How the module leaves bus-off (not in ACAN, which leaves `CTRL1.BOFFREC` = 0):
+    /// [`BusOffRecovery::Automatic`] (default) after 128 × 11 recessive bits by itself;
+    /// [`BusOffRecovery::Manual`] sets `CTRL1.BOFFREC` (Kinetis RM, CTRL1 field
+    /// descriptions: "automatic recovering from Bus Off state disabled") and the module
+    /// stays bus-off until [`twocan_core::Hardware::recover`].
+    pub bus_off_recovery: BusOffRecovery,
 }
 
 impl Default for Settings {
@@ -152,6 +159,7 @@ impl Settings {
             rx_pin_pull_up: false,
             handshake_polls: handshake_polls_for(bit_rate),
             error_interrupts: true,
+            bus_off_recovery: BusOffRecovery::Automatic,
         }
     }
 
