@@ -22,9 +22,10 @@
 //! - **Filters.** An empty compiled list accepts no frame; accepting every frame is the
 //!   explicit filter [`crate::Filter::pass_all`]. [`Hardware::install_filters`] replaces
 //!   the list atomically for the receive half: once it returns, [`Hardware::decode`]
-//!   reports no frame with an index of the old list (frames the old list accepted that
-//!   are still in the hardware FIFO or in the driver's ring are dropped and counted as
-//!   unresolved, `None` from `decode`).
+//!   reports no frame with an index of the old list: frames the old list accepted that
+//!   are still in the hardware FIFO are discarded while the controller is switched (off
+//!   the bus for it), and those already in the driver's ring are dropped when taken
+//!   (`None` from `decode`, counted in [`crate::TrafficStats::rx_dropped`]).
 //! - **Stop, change, start.** With the controller stopped ([`Mode::Stopped`]),
 //!   [`Hardware::set_timing`] and [`Hardware::set_bus_mode`] change the bit timing and the
 //!   bus mode; the installed filters and their user indices stay. Either is refused with

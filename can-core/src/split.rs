@@ -833,8 +833,9 @@ impl<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE:
     }
 
     /// Installs a new compiled filter list, atomically: once it returns, no frame is
-    /// reported with an index of the old list (frames the old list accepted that are
-    /// still in the hardware FIFO or the ring are dropped, see [`crate::hardware`]).
+    /// reported with an index of the old list (frames the old list accepted are
+    /// discarded from the hardware FIFO, or dropped from the ring and counted in
+    /// [`TrafficStats::rx_dropped`]; see [`crate::hardware`]).
     pub fn set_filters(&mut self, filters: &H::Filters) -> Result<(), Error> {
         // SAFETY: the receive half is the context of `install_filters`.
         self.map = unsafe { self.s.hw().install_filters(filters)? };

@@ -609,7 +609,7 @@ fn bus_off_recovery_both_modes<B: Backend>() {
             }
             // The 128 × 11 were seen long before the request: 11 recessive bits to
             // re-synchronise, then on the bus.
-            (Recovery::Manual, ManualRecoveryCount::FromBusOff) => (t_request, 11, 40),
+            (Recovery::Manual, ManualRecoveryCount::FromBusOff) => (t_request, 0, 11),
         };
         let took = t_back - from;
         assert!(
@@ -787,7 +787,9 @@ fn filter_list_semantics<B: Backend>() {
         Filter::standard(0x100),
     ];
     B::set_filters(&mut dut, &b).unwrap();
-    // No frame with an index of list A after the call: the four are dropped, counted.
+    // No frame with an index of list A after the call: the two in the hardware FIFO were
+    // discarded while the controller was off the bus for the switch, the two in the ring
+    // are dropped when taken (counted as dropped).
     run(&mut h, &mut dut, 100);
     let stale: Vec<(Frame, u16)> = drain(&mut dut)
         .iter()
@@ -796,7 +798,7 @@ fn filter_list_semantics<B: Backend>() {
     assert_eq!(stale, vec![], "{}: frames of the old list", B::NAME);
     assert_eq!(
         dut.driver_ref().traffic().rx_dropped - dropped_before,
-        4,
+        2,
         "{}",
         B::NAME
     );
