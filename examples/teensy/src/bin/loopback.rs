@@ -10,7 +10,7 @@
 mod firmware {
     use core::sync::atomic::{AtomicU32, Ordering};
 
-    use twocan_core::Frame;
+    use twocan_core::{Filter, Frame};
     use twocan_flexcan::{Can0, Settings};
     use twocan_teensy::can::{self, CanState, CAN0_VECTORS};
     use twocan_teensy::rt::{self, CAN_BLINKS};
@@ -32,7 +32,7 @@ mod firmware {
         let mut boot = rt::boot();
         let token = Can0::take().unwrap_or_else(|| rt::halt(CAN_BLINKS));
         let can = token
-            .begin(&SETTINGS, &[], &[])
+            .begin(&SETTINGS, &[Filter::pass_all()], &[])
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         let (mut tx, mut rx) =
             can::start(&CAN0, &CAN0_VECTORS, can.into_split(), &mut boot.core.NVIC)
