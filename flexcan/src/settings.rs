@@ -277,6 +277,8 @@ mod tests {
         assert!(!s.use_alternate_tx_pin && !s.use_alternate_rx_pin);
         assert_eq!(s.message_irq_priority, 64);
         assert!(!s.tx_pin_open_collector && !s.rx_pin_pull_up);
+        // Not in table 7: ACAN leaves CTRL1.BOFFREC = 0.
+        assert_eq!(s.bus_off_recovery, BusOffRecovery::Automatic);
     }
 
     #[test]

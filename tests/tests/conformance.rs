@@ -856,6 +856,45 @@ fn bit_rate_changes_the_same_way_on_both_backends() {
 }
 
 #[test]
+fn capabilities_follow_the_current_configuration() {
+    // FlexCAN 14/18 partition (more than 12 filters): 14 + 18 elements, MB15 and MB14
+    // (ACAN §11 table 4).
+    let mut h = Harness::new(RATE).unwrap();
+    let many: Vec<Filter> = (0..20).map(|i| Filter::standard(0x100 + 3 * i)).collect();
+    let flex = FlexCanBackend::attach(&mut h, &NodeOptions::filters(&many)).unwrap();
+    let caps = flex.driver_ref().capabilities();
+    assert_eq!(
+        (
+            caps.max_standard_filters,
+            caps.max_extended_filters,
+            caps.tx_mailboxes
+        ),
+        (32, 32, 2)
+    );
+    // bxCAN CAN1 with CAN2SB = 14: banks 0..13 (RM0410 §40.7.4); with TTCM: 16-bit
+    // time stamps (§40.7.8).
+    let config = twocan_tests::backend::bxcan_config(RATE, Recovery::Automatic)
+        .unwrap()
+        .can2_start_bank(14)
+        .unwrap()
+        .timestamps(true);
+    let bx = twocan_host::BxNode::with_config(
+        &mut h,
+        &config,
+        &[Filter::pass_all()],
+        twocan_bxcan::FifoPolicy::Fifo0,
+    )
+    .unwrap();
+    let caps = bx.driver_ref().capabilities();
+    assert_eq!(
+        (caps.max_standard_filters, caps.max_extended_filters),
+        (14 * 4, 14 * 2)
+    );
+    assert_eq!(caps.timestamp_bits, Some(16));
+    assert_eq!(caps.clock_hz, 54_000_000);
+}
+
+#[test]
 fn flexcan_last_error_survives_the_interrupt() {
     last_error_survives_the_interrupt::<FlexCanBackend>();
 }
