@@ -10,7 +10,9 @@
 //!   FIFO x output mailbox;
 //! - status interrupt: `CAN_MSR` (`ERRI`, `WKUI`, `SLAKI` write-1-to-clear) and
 //!   `CAN_ESR.LEC` (set to 0b111 after reading);
-//! - receive half: the filter registers (under `CAN_FMR.FINIT`).
+//! - receive half: the filter registers (under `CAN_FMR.FINIT`), and `RFOMx` under it to
+//!   discard the old list's frames;
+//! - control (initialization mode): `CAN_BTR` (timing fields, `SILM`, `LBKM`).
 //!
 //! A raw received frame is the four output-mailbox words (`CAN_RIxR`, `CAN_RDTxR`,
 //! `CAN_RDLxR`, `CAN_RDHxR`) with the FIFO number in the reserved bits 7:4 of the

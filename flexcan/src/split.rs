@@ -13,7 +13,11 @@
 //! - transmit handler: `IFLAG1` write-1-to-clear of the transmit mailboxes' bits;
 //! - receive handler: MB0–MB3 (the Rx FIFO output), `RXFIR`, `IFLAG1` write-1-to-clear
 //!   of `BUF5I`/`BUF6I`/`BUF7I`;
-//! - status handler: `ESR1` write-1-to-clear of exactly the bits it read, `ECR` read.
+//! - status handler: `ESR1` write-1-to-clear of exactly the bits it read, `ECR` read;
+//! - receive half (`install_filters`, in Freeze mode): the ID table, `RXIMR`,
+//!   `RXFGMASK`, `MCR.IDAM`, and `IFLAG1.BUF5I` to discard the old list's frames;
+//! - control (stopped): `CTRL1` timing fields, `LOM`, `LPB`, `MCR.SRXDIS`; `CTRL1.BOFFREC`
+//!   (`recover`, any mode).
 //!
 //! A raw received frame is the Rx FIFO output's four words (control/status,
 //! identifier, data) and `RXFIR.IDHIT`; the thread side decodes it and maps the hit
