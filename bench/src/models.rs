@@ -73,7 +73,7 @@ fn flexcan_driver(model: &FlexCanModel) -> Result<AcanDriver<IdleClocked>> {
         &mut HostSystem::new(),
         target,
         &settings,
-        &[],
+        &[Filter::pass_all()],
         &[],
     )
     .map_err(|e| Error::new(format!("FlexCAN begin: {e:?}")))?;

@@ -31,18 +31,12 @@ impl From<TimingError> for ConfigError {
     }
 }
 
-/// How the controller leaves bus-off (notes "Bus-off recovery"; `CAN_MCR.ABOM`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub enum Recovery {
-    /// `ABOM = 1`: the hardware starts the recovery sequence (128 × 11 recessive bits) by
-    /// itself.
-    Automatic,
-    /// `ABOM = 0`: software starts it by entering and leaving initialization mode
-    /// ([`twocan_core::Hardware::recover`]).
-    #[default]
-    Manual,
-}
+/// How the controller leaves bus-off (notes "Bus-off recovery"; `CAN_MCR.ABOM`): the
+/// portable setting [`twocan_core::BusOffRecovery`]. `Automatic`: `ABOM = 1`, the
+/// hardware starts the recovery sequence (128 × 11 recessive bits) by itself. `Manual`
+/// (the reset value, and this crate's default): `ABOM = 0`, software starts it by
+/// entering and leaving initialization mode ([`twocan_core::Hardware::recover`]).
+pub use twocan_core::BusOffRecovery as Recovery;
 
 /// The `CAN_BTR` timing fields (BRP, TS1, TS2, SJW).
 const BTR_TIMING: u32 = btr::BRP.mask() | btr::TS1.mask() | btr::TS2.mask() | btr::SJW.mask();

@@ -102,10 +102,30 @@ pub(crate) fn program<F: Registers>(
     critical_section::with(|_| program_locked(regs, instance, plan))
 }
 
+/// As [`program`], running `then` still in filter initialization mode (`FINIT` = 1,
+/// nothing enters the FIFOs) after the banks are written.
+pub(crate) fn program_then<F: Registers>(
+    regs: &F,
+    instance: Instance,
+    plan: &FilterPlan,
+    then: impl FnOnce(),
+) -> Result<(), TooManyBanks> {
+    critical_section::with(|_| program_locked_then(regs, instance, plan, then))
+}
+
 fn program_locked<F: Registers>(
     regs: &F,
     instance: Instance,
     plan: &FilterPlan,
+) -> Result<(), TooManyBanks> {
+    program_locked_then(regs, instance, plan, || {})
+}
+
+fn program_locked_then<F: Registers>(
+    regs: &F,
+    instance: Instance,
+    plan: &FilterPlan,
+    then: impl FnOnce(),
 ) -> Result<(), TooManyBanks> {
     let (start, end) = banks_of(regs, instance);
     if plan.bank_count() > end - start {
@@ -147,6 +167,7 @@ fn program_locked<F: Registers>(
         regs.write32(fir2(start + k), bank.fr2);
     }
     regs.modify32(FA1R, |v| v | fa);
+    then();
     regs.modify32(FMR, |v| v & !fmr::FINIT);
     Ok(())
 }

@@ -10,19 +10,24 @@
 //!   FIFO x output mailbox;
 //! - status interrupt: `CAN_MSR` (`ERRI`, `WKUI`, `SLAKI` write-1-to-clear) and
 //!   `CAN_ESR.LEC` (set to 0b111 after reading);
-//! - receive half: the filter registers (under `CAN_FMR.FINIT`).
+//! - receive half: the filter registers (under `CAN_FMR.FINIT`), and `RFOMx` under it to
+//!   discard the old list's frames;
+//! - control (initialization mode): `CAN_BTR` (timing fields, `SILM`, `LBKM`).
 //!
 //! A raw received frame is the four output-mailbox words (`CAN_RIxR`, `CAN_RDTxR`,
 //! `CAN_RDLxR`, `CAN_RDHxR`) with the FIFO number in the reserved bits 7:4 of the
 //! second word; the thread side decodes it and maps `(FIFO, FMI)` to the user's filter.
 
 use core::cell::UnsafeCell;
-use core::sync::atomic::{AtomicU32, AtomicU8, Ordering};
+use core::sync::atomic::{AtomicBool, AtomicU32, AtomicU8, Ordering};
 
 use twocan_core::hardware::{sort_by_token, Completion, Settled, StatusEvents, Token, TxFailure};
+use twocan_core::timing::frame_time::frame_in_flight_wait;
+use twocan_core::timing::{Limits, Timing, BXCAN_BTR_TIMING_MASK};
 use twocan_core::{
-    AtomicLastError, Error, ErrorCounters, ErrorState, ErrorStatus, Frame, Hardware, LastErrorCode,
-    Mode, Priority, Registers, RxFrame, Timestamp, TxOutcome, TxPolicy,
+    AtomicLastError, BusMode, BusOffRecovery, Capabilities, Error, ErrorCounters, ErrorState,
+    ErrorStatus, Frame, Hardware, LastErrorCode, Mode, ModeSupport, Priority, Registers, RxFrame,
+    Timestamp, TxOutcome, TxPolicy,
 };
 use twocan_core::{MailboxId, MailboxState};
 
@@ -34,8 +39,11 @@ use crate::instance::Instance;
 use crate::mailbox;
 use crate::mode;
 use crate::regs::{
-    esr, msr, rdhxr, rdlxr, rdtxr, rfxr, rixr, tdtxr, tsr, ESR, MSR, TSR, TX_MAILBOXES,
+    btr, esr, msr, rdhxr, rdlxr, rdtxr, rfxr, rixr, tdtxr, tsr, BTR, ESR, MSR, TSR, TX_MAILBOXES,
 };
+
+/// Frames one receive FIFO holds (RM0410 §40.7.5).
+const RX_FIFO_DEPTH: usize = 3;
 
 /// `CAN_TSR.TMEx` of the three mailboxes.
 const TME_ALL: u32 = tsr::TME0 | tsr::TME1 | tsr::TME2;
@@ -54,8 +62,9 @@ fn free_of(t: u32, code: usize) -> Option<u8> {
 }
 
 /// One received frame as the receive interrupt copies it: `CAN_RIxR`, `CAN_RDTxR` (FIFO
-/// number in bits 7:4), `CAN_RDLxR`, `CAN_RDHxR`.
-pub type RawFrame = [u32; 4];
+/// number in bits 7:4), `CAN_RDLxR`, `CAN_RDHxR`, and the filter list generation it was
+/// read under.
+pub type RawFrame = [u32; 5];
 
 /// A bxCAN instance shared by the halves and handlers of the split driver.
 ///
@@ -80,6 +89,14 @@ pub struct BxCan<R: Registers, F: Registers = R, const K: usize = LOOKUP_KEYS> {
     /// The last error code latched (`LastErrorCode` as its index), kept after LEC is
     /// set to 0b111.
     last_error: AtomicLastError,
+    /// Acknowledge wait bound (grows when a slower bit rate is set).
+    wait: AtomicU32,
+    /// `CAN_BTR.SILM` without `LBKM` (listen-only): transmission refused.
+    listen_only: AtomicBool,
+    /// Filter list generation, stamped on each raw frame by `read_rx` and compared by
+    /// `decode`: frames read before the last `install_filters` are dropped. Written by
+    /// `install_filters` only.
+    generation: AtomicU32,
 }
 
 // SAFETY: the atomics are shared; `displaced` is touched by the transmit interrupt's
@@ -91,6 +108,7 @@ impl<R: Registers, F: Registers, const K: usize> Can<R, F, K> {
     /// The controller for the split driver (`twocan_core::split::State::split`); the
     /// installed filters come along.
     pub fn into_split(self) -> BxCan<R, F, K> {
+        let listen_only = self.regs.read32(BTR) & (btr::SILM | btr::LBKM) == btr::SILM;
         BxCan {
             regs: self.regs,
             filter_regs: self.filter_regs,
@@ -102,6 +120,9 @@ impl<R: Registers, F: Registers, const K: usize> Can<R, F, K> {
             aborting: AtomicU8::new(0),
             displaced: UnsafeCell::new([Frame::default(); TX_MAILBOXES]),
             last_error: AtomicLastError::new(LastErrorCode::None),
+            wait: AtomicU32::new(self.config.get_wait_iterations()),
+            listen_only: AtomicBool::new(listen_only),
+            generation: AtomicU32::new(0),
         }
     }
 }
@@ -175,6 +196,12 @@ impl<R: Registers, F: Registers, const K: usize> BxCan<R, F, K> {
     /// The registers (for inspection).
     pub fn registers(&self) -> &R {
         &self.regs
+    }
+
+    /// The registers, mutably (a host harness moving a model to another bus; writing
+    /// them behind the driver's back voids its bookkeeping).
+    pub fn registers_mut(&mut self) -> &mut R {
+        &mut self.regs
     }
 
     fn read_frame(&self, x: usize) -> Frame {
@@ -342,11 +369,15 @@ unsafe impl<R: Registers, F: Registers, const K: usize> Hardware for BxCan<R, F,
         self.config.get_tx_policy()
     }
 
-    /// Reads `CAN_TSR` once: `CODE` names an empty mailbox when any `TMEx` is set (RM0410
+    /// Refused with [`Error::WrongMode`] in listen-only mode (`SILM` without `LBKM`,
+    /// the portable [`BusMode::ListenOnly`]). Reads `CAN_TSR` once: `CODE` names an empty mailbox when any `TMEx` is set (RM0410
     /// §40.9.2); it is taken when its last completion was settled (`RQCPx` = 0). With
     /// no `RQCPx` pending (the usual case) that is `CODE` itself, its `TMEx` checked.
     #[inline(always)]
     fn free_mailbox(&self, _frame: &Frame) -> Result<Option<u8>, Error> {
+        if self.listen_only.load(Ordering::Relaxed) {
+            return Err(Error::WrongMode);
+        }
         let t = self.regs.read32(TSR);
         if t & TME_ALL == 0 {
             return Ok(None);
@@ -505,11 +536,15 @@ unsafe impl<R: Registers, F: Registers, const K: usize> Hardware for BxCan<R, F,
         if rfxr::FMP.get(r) == 0 {
             return None;
         }
+        // The generation before the frame: a frame of the old list read while
+        // `install_filters` drains the FIFOs carries the old generation (never the new).
+        let generation = self.generation.load(Ordering::Acquire);
         let raw = [
             self.regs.read32(rixr(x)),
             self.regs.read32(rdtxr(x)) | (x as u32) << 4,
             self.regs.read32(rdlxr(x)),
             self.regs.read32(rdhxr(x)),
+            generation,
         ];
         self.regs.write32(rfxr(x), rfxr::RFOM);
         Some(raw)
@@ -520,7 +555,11 @@ unsafe impl<R: Registers, F: Registers, const K: usize> Hardware for BxCan<R, F,
     /// entry); `None` (dropped and counted) for a frame no user filter accepts.
     #[inline]
     unsafe fn decode(&self, raw: &RawFrame, _map: &()) -> Option<RxFrame> {
-        let [ir, dt, lo, hi] = *raw;
+        let [ir, dt, lo, hi, generation] = *raw;
+        if generation != self.generation.load(Ordering::Relaxed) {
+            // Accepted by a filter list replaced since: dropped (counted by the driver).
+            return None;
+        }
         let frame = mailbox::frame_of(ir, rdtxr::DLC.get(dt), lo, hi);
         let fifo = if (dt >> 4) & 1 == 0 {
             Fifo::Fifo0
@@ -551,16 +590,35 @@ unsafe impl<R: Registers, F: Registers, const K: usize> Hardware for BxCan<R, F,
             .then_some(rdtxr::TIME.get(raw[1]) as u16)
     }
 
+    /// Programs the banks under `CAN_FMR.FINIT` (reception through the block stops,
+    /// RM0410 §40.7.4) and, still under it, releases and discards what the old banks
+    /// accepted into FIFO 0 and FIFO 1 (`RFOMx`); then switches the thread-side map and
+    /// the generation together. Frames of the old list still in the driver's ring carry
+    /// the old generation: `decode` drops them.
     unsafe fn install_filters(&self, filters: &FilterPlan) -> Result<(), Error> {
         // The map first: a plan it cannot hold is refused before any bank changes.
         let fmi = filters.fmi_map::<K>()?;
+        let drain = || {
+            for x in 0..2 {
+                // At most three frames per FIFO (RM0410 §40.7.5); the receive
+                // interrupt may release some too.
+                for _ in 0..2 * RX_FIFO_DEPTH {
+                    if rfxr::FMP.get(self.regs.read32(rfxr(x))) == 0 {
+                        break;
+                    }
+                    self.regs.write32(rfxr(x), rfxr::RFOM);
+                }
+            }
+        };
         let r = match &self.filter_regs {
-            Some(f) => filter_block::program(f, self.instance, filters),
-            None => filter_block::program(&self.regs, self.instance, filters),
+            Some(f) => filter_block::program_then(f, self.instance, filters, drain),
+            None => filter_block::program_then(&self.regs, self.instance, filters, drain),
         };
         r.map_err(|_| Error::InvalidArgument)?;
         // SAFETY: the receive half's context, the only one touching the map.
         unsafe { *self.fmi.get() = fmi };
+        let next = self.generation.load(Ordering::Relaxed).wrapping_add(1);
+        self.generation.store(next, Ordering::Release);
         Ok(())
     }
 
@@ -601,7 +659,7 @@ unsafe impl<R: Registers, F: Registers, const K: usize> Hardware for BxCan<R, F,
     }
 
     fn set_mode(&self, mode: Mode) -> Result<(), Error> {
-        mode::request(&self.regs, mode, self.config.get_wait_iterations())
+        mode::request(&self.regs, mode, self.wait.load(Ordering::Relaxed))
     }
 
     /// Manual recovery (`ABOM` = 0): when bus-off, enter and leave initialization mode;
@@ -614,8 +672,87 @@ unsafe impl<R: Registers, F: Registers, const K: usize> Hardware for BxCan<R, F,
         if self.regs.read32(ESR) & esr::BOFF == 0 {
             return Ok(());
         }
-        let bound = self.config.get_wait_iterations();
+        let bound = self.wait.load(Ordering::Relaxed);
         mode::request(&self.regs, Mode::Stopped, bound)?;
         mode::request(&self.regs, Mode::Normal, bound)
+    }
+
+    /// The APB1 clock of the [`Config`] ([`Config::get_clock_hz`]), [`Limits::BXCAN`];
+    /// the banks this instance owns now (`CAN2SB`, RM0410 §40.7.4): four 16-bit list
+    /// identifiers (standard) or two 32-bit ones (extended) per bank; three transmit
+    /// mailboxes, two receive FIFOs of three (§40.7.3, §40.7.5); no triple sampling;
+    /// 16-bit time stamps only with `TTCM` (§40.7.8, [`Config::get_timestamps`]).
+    fn capabilities(&self) -> Capabilities {
+        let (s, e) = self.bank_range();
+        let banks = (e - s) as u16;
+        Capabilities::new(
+            self.config.get_clock_hz(),
+            Limits::BXCAN,
+            ModeSupport {
+                loop_back: true,
+                listen_only: true,
+                one_shot: true,
+                triple_sampling: false,
+                manual_recovery: true,
+                timestamps: true,
+            },
+            4 * banks,
+            2 * banks,
+            TX_MAILBOXES as u8,
+            2,
+            RX_FIFO_DEPTH as u8,
+            self.config.get_timestamps().then_some(16),
+        )
+    }
+
+    /// `CAN_BTR.LBKM` (loop-back, silent or not) and `SILM`.
+    fn bus_mode(&self) -> BusMode {
+        let b = self.regs.read32(BTR);
+        if b & btr::LBKM != 0 {
+            BusMode::LoopBack
+        } else if b & btr::SILM != 0 {
+            BusMode::ListenOnly
+        } else {
+            BusMode::Normal
+        }
+    }
+
+    fn bus_off_recovery(&self) -> BusOffRecovery {
+        self.config.get_recovery()
+    }
+
+    /// In initialization mode only (`CAN_BTR` is writable only then, RM0410 §40.9.2):
+    /// BRP, TS1, TS2, SJW; the mode bits stay. The acknowledge bound grows for a slower
+    /// rate.
+    fn set_timing(&self, timing: &Timing) -> Result<(), Error> {
+        let stopped = mode::current(&self.regs) == Mode::Stopped;
+        twocan_core::hardware::check_timing_for(&self.capabilities(), timing, stopped)?;
+        let bits = timing.bxcan_btr().map_err(Error::Timing)?;
+        self.regs
+            .modify32(BTR, |v| (v & !BXCAN_BTR_TIMING_MASK) | bits);
+        if let Ok(polls) =
+            frame_in_flight_wait(timing.actual_bitrate(), self.config.get_clock_hz(), 2)
+        {
+            let polls = polls.min(u32::MAX as u64) as u32;
+            self.wait.fetch_max(polls, Ordering::Relaxed);
+        }
+        Ok(())
+    }
+
+    /// In initialization mode only: `CAN_BTR.SILM` (listen-only), `LBKM` (loop-back).
+    fn set_bus_mode(&self, mode: BusMode) -> Result<(), Error> {
+        if mode::current(&self.regs) != Mode::Stopped {
+            return Err(Error::WrongMode);
+        }
+        let bits = match mode {
+            BusMode::Normal => 0,
+            BusMode::ListenOnly => btr::SILM,
+            BusMode::LoopBack => btr::LBKM,
+        };
+        self.regs
+            .modify32(BTR, |v| (v & !(btr::SILM | btr::LBKM)) | bits);
+        self.listen_only
+            .store(mode == BusMode::ListenOnly, Ordering::Relaxed);
+        Ok(())
     }
 }

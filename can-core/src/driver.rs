@@ -17,6 +17,7 @@
 //! # Ok::<(), twocan_core::Error>(())
 //! ```
 
+use crate::capabilities::{BusMode, Capabilities};
 use crate::controller::{ErrorStatus, Mode};
 use crate::dispatch::Dispatcher;
 use crate::error::{Error, ErrorCounters, ErrorState, ErrorStatistics, LastErrorCode};
@@ -25,6 +26,7 @@ use crate::hardware::{Completion, Hardware, Token};
 use crate::mailbox::TxPolicy;
 use crate::split::{AbortRequest, RxIrq, State, StateChange, StatusIrq, Tx, TxIrq};
 use crate::spsc::BufferStats;
+use crate::timing::Timing;
 use crate::txqueue::AnyQueue;
 
 pub use crate::split::TrafficStats;
@@ -275,7 +277,46 @@ impl<H: Hardware, const RX: usize, const TX: usize, const RX1: usize> Driver<H, 
         r
     }
 
-    /// Installs a new compiled filter list.
+    /// What the controller can do, as configured now.
+    pub fn capabilities(&self) -> Capabilities {
+        self.hardware().capabilities()
+    }
+
+    /// The bus mode in force.
+    pub fn bus_mode(&self) -> BusMode {
+        self.hardware().bus_mode()
+    }
+
+    /// Stopped controller only: a new bit timing; the filters stay
+    /// ([`Hardware::set_timing`]).
+    pub fn set_timing(&mut self, timing: &Timing) -> Result<(), Error> {
+        self.hardware().set_timing(timing)
+    }
+
+    /// Stopped controller only: the bit timing for `bitrate` from the controller's clock,
+    /// sample point at `sample_point_permille` ([`Capabilities::timing_for`]); gives
+    /// the timing written. The filters stay.
+    pub fn set_bitrate(
+        &mut self,
+        bitrate: u32,
+        sample_point_permille: u16,
+    ) -> Result<Timing, Error> {
+        let t = self
+            .capabilities()
+            .timing_for(bitrate, sample_point_permille)
+            .map_err(Error::Timing)?;
+        self.hardware().set_timing(&t)?;
+        Ok(t)
+    }
+
+    /// Stopped controller only: the bus mode used from the next start; the filters stay
+    /// ([`Hardware::set_bus_mode`]).
+    pub fn set_bus_mode(&mut self, mode: BusMode) -> Result<(), Error> {
+        self.hardware().set_bus_mode(mode)
+    }
+
+    /// Installs a new compiled filter list, atomically: once it returns, no frame is
+    /// reported with an index of the old list (see [`crate::hardware`]).
     pub fn set_filters(&mut self, filters: &H::Filters) -> Result<(), Error> {
         // SAFETY: the driver plays the receive half, the context of `install_filters`.
         self.map = unsafe { self.hardware().install_filters(filters)? };

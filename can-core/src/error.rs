@@ -171,6 +171,11 @@ pub enum Error {
         /// What the hardware (or planner) has.
         available: u16,
     },
+    /// A bit timing the controller cannot take (wrong clock, out of range, inconsistent).
+    Timing(crate::timing::TimingError),
+    /// The controller does not offer this mode or feature
+    /// ([`crate::Capabilities::modes`]).
+    Unsupported,
 }
 
 impl embedded_can::Error for Error {
@@ -215,6 +220,8 @@ impl core::fmt::Display for Error {
                 f,
                 "the filter list needs {needed} units of filter space, {available} available"
             ),
+            Error::Timing(_) => f.write_str("invalid bit timing for this controller"),
+            Error::Unsupported => f.write_str("the controller does not offer this mode"),
         }
     }
 }
@@ -224,6 +231,7 @@ impl core::error::Error for Error {
         match self {
             Error::Frame(e) => Some(e),
             Error::Filter(e) => Some(e),
+            Error::Timing(e) => Some(e),
             _ => None,
         }
     }

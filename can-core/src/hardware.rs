@@ -14,13 +14,35 @@
 //! | receive half (thread/task) | [`Hardware::decode`], [`Hardware::install_filters`] |
 //! | status interrupt | [`Hardware::take_status`] |
 //! | any (reads only) | [`Hardware::error_status`], [`Hardware::tx_policy`], [`Hardware::on_bus`] |
-//! | control (thread, with the halves idle or tolerant) | [`Hardware::set_mode`], [`Hardware::recover`] |
+//! | any (reads only) | [`Hardware::capabilities`], [`Hardware::bus_mode`], [`Hardware::bus_off_recovery`] |
+//! | control (thread, with the halves idle or tolerant) | [`Hardware::set_mode`], [`Hardware::recover`], [`Hardware::set_timing`], [`Hardware::set_bus_mode`] |
+//!
+//! # Portable semantics every backend keeps
+//!
+//! - **Filters.** An empty compiled list accepts no frame; accepting every frame is the
+//!   explicit filter [`crate::Filter::pass_all`]. [`Hardware::install_filters`] replaces
+//!   the list atomically for the receive half: once it returns, [`Hardware::decode`]
+//!   reports no frame with an index of the old list: frames the old list accepted that
+//!   are still in the hardware FIFO are discarded while the controller is switched (off
+//!   the bus for it), and those already in the driver's ring are dropped when taken
+//!   (`None` from `decode`, counted in [`crate::TrafficStats::rx_dropped`]).
+//! - **Stop, change, start.** With the controller stopped ([`Mode::Stopped`]),
+//!   [`Hardware::set_timing`] and [`Hardware::set_bus_mode`] change the bit timing and the
+//!   bus mode; the installed filters and their user indices stay. Either is refused with
+//!   [`Error::WrongMode`] while the controller is on the bus.
+//! - **Bus-off recovery.** [`BusOffRecovery::Automatic`]: the controller leaves bus-off
+//!   after 128 × 11 recessive bits by itself and [`Hardware::recover`] is refused with
+//!   [`Error::WrongMode`]. [`BusOffRecovery::Manual`]: the controller stays bus-off until
+//!   [`Hardware::recover`] (which succeeds without effect when not bus-off), then leaves
+//!   it after the 128 × 11 recessive bits the hardware requires.
 
+use crate::capabilities::{BusMode, BusOffRecovery, Capabilities};
 use crate::controller::{ErrorStatus, Mode};
 use crate::error::{Error, LastErrorCode};
 use crate::frame::{Frame, RxFrame};
 use crate::mailbox::{MailboxId, MailboxState, TxOutcome, TxPolicy};
 use crate::timestamp::Timestamp;
+use crate::timing::Timing;
 
 /// Identifies one frame accepted by [`crate::split::Tx::try_send`]: its sequence number
 /// (wrapping at `u32::MAX`), in acceptance order.
@@ -242,8 +264,57 @@ pub unsafe trait Hardware {
     /// Changes the operating mode (bounded wait on the acknowledge bit).
     fn set_mode(&self, mode: Mode) -> Result<(), Error>;
 
-    /// Starts bus-off recovery by software.
+    /// Starts bus-off recovery by software ([`BusOffRecovery::Manual`]); refused with
+    /// [`Error::WrongMode`] when the controller recovers by itself.
     fn recover(&self) -> Result<(), Error>;
+
+    /// What this instance can do, as configured now (clock, bit-rate range, modes,
+    /// filter capacity of the current partition, mailboxes, FIFO depth, time stamps).
+    fn capabilities(&self) -> Capabilities;
+
+    /// The bus mode in force (or to be used at the next start).
+    fn bus_mode(&self) -> BusMode;
+
+    /// How the controller leaves bus-off.
+    fn bus_off_recovery(&self) -> BusOffRecovery;
+
+    /// Stopped controller only: writes a new bit timing (computed for
+    /// [`Capabilities::clock_hz`] within [`Capabilities::timing_limits`]); the filters
+    /// stay. [`Error::WrongMode`] while on the bus; [`Error::Timing`] for a timing made
+    /// for another clock or other limits, or inconsistent.
+    fn set_timing(&self, timing: &Timing) -> Result<(), Error>;
+
+    /// Stopped controller only: selects the bus mode used from the next start; the
+    /// filters stay. [`Error::WrongMode`] while on the bus, [`Error::Unsupported`] for a
+    /// mode [`Capabilities::modes`] does not offer.
+    fn set_bus_mode(&self, mode: BusMode) -> Result<(), Error>;
+}
+
+/// The checks [`Hardware::set_timing`] applies before any register is written: the
+/// controller is stopped (`stopped`), the timing was made for `caps`' clock and limits,
+/// and it is consistent.
+pub fn check_timing_for(caps: &Capabilities, timing: &Timing, stopped: bool) -> Result<(), Error> {
+    use crate::timing::TimingError;
+    if !stopped {
+        return Err(Error::WrongMode);
+    }
+    if timing.clock_hz != caps.clock_hz {
+        return Err(Error::Timing(TimingError::WrongClock));
+    }
+    if timing.limits != caps.timing_limits {
+        return Err(Error::Timing(TimingError::WrongController));
+    }
+    caps.timing_limits
+        .check_bitrate(caps.clock_hz, timing.actual_bitrate())
+        .map_err(Error::Timing)?;
+    let consistency = timing.consistency();
+    if !consistency.is_ok() {
+        return Err(Error::Timing(TimingError::Inconsistent(consistency)));
+    }
+    if timing.triple_sampling && !caps.modes.triple_sampling {
+        return Err(Error::Unsupported);
+    }
+    Ok(())
 }
 
 #[cfg(test)]

@@ -29,6 +29,7 @@ extern crate std;
 
 #[cfg(feature = "async")]
 pub mod asynch;
+pub mod capabilities;
 pub mod controller;
 pub mod dispatch;
 pub mod driver;
@@ -55,6 +56,7 @@ pub mod txqueue;
 
 #[cfg(feature = "async")]
 pub use asynch::RxEvent;
+pub use capabilities::{BusMode, BusOffRecovery, Capabilities, ModeSupport};
 pub use controller::{ErrorStatus, Mode};
 pub use dispatch::Dispatcher;
 pub use driver::{Driver, TrafficStats};

@@ -11,6 +11,7 @@ use core::cell::RefCell;
 use critical_section::Mutex;
 use heapless::{Deque, Vec};
 
+use crate::capabilities::{BusMode, BusOffRecovery, Capabilities, ModeSupport};
 use crate::controller::{ErrorStatus, Mode};
 use crate::error::{Error, ErrorCounters, ErrorState, LastErrorCode};
 use crate::filter::Filter;
@@ -20,6 +21,9 @@ use crate::mailbox::{MailboxId, MailboxState, TxOutcome, TxPolicy};
 
 /// Mock filter list: portable filters matched in order (the first match gives the index).
 pub type MockFilterList = Vec<Filter, 16>;
+
+/// The CAN clock the mock reports ([`Hardware::capabilities`]).
+pub const MOCK_CLOCK_HZ: u32 = 8_000_000;
 
 /// Depth of the mock's receive FIFO.
 pub const MOCK_FIFO_DEPTH: usize = 3;
@@ -47,6 +51,7 @@ struct Inner {
     sent: Vec<Frame, 1024>,
     loopback: bool,
     fail_next: bool,
+    bitrate: u32,
 }
 
 /// An in-memory controller (see the [module docs](self)).
@@ -81,6 +86,7 @@ impl MockHardware {
                 sent: Vec::new(),
                 loopback: false,
                 fail_next: false,
+                bitrate: 0,
             })),
         }
     }
@@ -100,6 +106,11 @@ impl MockHardware {
     pub fn with_policy(self, policy: TxPolicy) -> Self {
         self.with(|m| m.policy = policy);
         self
+    }
+
+    /// The bit rate of the last timing [`Hardware::set_timing`] took (0: none yet).
+    pub fn bitrate(&self) -> u32 {
+        self.with(|m| m.bitrate)
     }
 
     /// Received frames come back (loop-back).
@@ -398,5 +409,60 @@ unsafe impl Hardware for MockHardware {
 
     fn recover(&self) -> Result<(), Error> {
         Ok(())
+    }
+
+    /// An 8 MHz clock with the bxCAN timing limits, `MOCK_FIFO_DEPTH`, 16 filters.
+    fn capabilities(&self) -> Capabilities {
+        let count = self.with(|m| m.count) as u8;
+        Capabilities::new(
+            MOCK_CLOCK_HZ,
+            crate::timing::Limits::BXCAN,
+            ModeSupport {
+                loop_back: true,
+                listen_only: false,
+                one_shot: false,
+                triple_sampling: false,
+                manual_recovery: true,
+                timestamps: false,
+            },
+            16,
+            16,
+            count,
+            1,
+            MOCK_FIFO_DEPTH as u8,
+            None,
+        )
+    }
+
+    fn bus_mode(&self) -> BusMode {
+        if self.with(|m| m.loopback) {
+            BusMode::LoopBack
+        } else {
+            BusMode::Normal
+        }
+    }
+
+    fn bus_off_recovery(&self) -> BusOffRecovery {
+        BusOffRecovery::Manual
+    }
+
+    fn set_timing(&self, timing: &crate::timing::Timing) -> Result<(), Error> {
+        let stopped = self.with(|m| m.mode == Mode::Stopped);
+        crate::hardware::check_timing_for(&self.capabilities(), timing, stopped)?;
+        self.with(|m| m.bitrate = timing.actual_bitrate());
+        Ok(())
+    }
+
+    fn set_bus_mode(&self, mode: BusMode) -> Result<(), Error> {
+        if !self.capabilities().modes.supports(mode) {
+            return Err(Error::Unsupported);
+        }
+        self.with(|m| {
+            if m.mode != Mode::Stopped {
+                return Err(Error::WrongMode);
+            }
+            m.loopback = mode == BusMode::LoopBack;
+            Ok(())
+        })
     }
 }

@@ -898,8 +898,10 @@ impl<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE:
         unsafe { self.s.pop_change() }
     }
 
-    /// Installs a new compiled filter list. Frames still in the ring that the old list
-    /// accepted are decoded with the new map: drain the ring first where that matters.
+    /// Installs a new compiled filter list, atomically: once it returns, no frame is
+    /// reported with an index of the old list (frames the old list accepted are
+    /// discarded from the hardware FIFO, or dropped from the ring and counted in
+    /// [`TrafficStats::rx_dropped`]; see [`crate::hardware`]).
     pub fn set_filters(&mut self, filters: &H::Filters) -> Result<(), Error> {
         // SAFETY: the receive half is the context of `install_filters`.
         self.map = unsafe { self.s.hw().install_filters(filters)? };
@@ -1147,5 +1149,20 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
     /// Starts bus-off recovery by software.
     pub fn recover(&self) -> Result<(), Error> {
         self.hardware().ok_or(Error::WrongMode)?.recover()
+    }
+
+    /// What the controller can do, as configured now.
+    pub fn capabilities(&self) -> Option<crate::capabilities::Capabilities> {
+        self.hardware().map(|h| h.capabilities())
+    }
+
+    /// Stopped controller only: a new bit timing, the filters kept.
+    pub fn set_timing(&self, timing: &crate::timing::Timing) -> Result<(), Error> {
+        self.hardware().ok_or(Error::WrongMode)?.set_timing(timing)
+    }
+
+    /// Stopped controller only: the bus mode used from the next start, the filters kept.
+    pub fn set_bus_mode(&self, mode: crate::capabilities::BusMode) -> Result<(), Error> {
+        self.hardware().ok_or(Error::WrongMode)?.set_bus_mode(mode)
     }
 }

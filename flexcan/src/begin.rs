@@ -23,7 +23,7 @@
 //! Every wait is bounded by [`Settings::handshake_polls`]; a missing acknowledge is
 //! [`BeginError::Hardware`]`(`[`Error::Timeout`]`)`.
 
-use twocan_core::{Error, Filter, Registers};
+use twocan_core::{BusMode, BusOffRecovery, Error, Filter, Registers};
 
 use crate::begin_error::{BeginError, ConfigErrors};
 use crate::configuration::{Configuration, DATA_MAILBOX, MESSAGE_BUFFERS};
@@ -134,6 +134,9 @@ fn plan(
             if settings.loop_back {
                 ctrl1 |= ctrl1::LPB;
             }
+            if settings.bus_off_recovery == BusOffRecovery::Manual {
+                ctrl1 |= ctrl1::BOFFREC;
+            }
             if settings.error_interrupts {
                 ctrl1 |= ctrl1::ERRMSK | ctrl1::BOFFMSK | ctrl1::TWRNMSK | ctrl1::RWRNMSK;
                 mcr |= mcr::WRNEN;
@@ -201,8 +204,12 @@ pub fn check(
 impl<R: Registers> FlexCan<R> {
     /// Configures the module `target` over `regs` (ACAN `begin (settings,
     /// primaryFilters, primaryFilterCount, secondaryFilters, secondaryFilterCount)`,
-    /// §15.1; empty lists for the shorter forms — with no filter at all, every frame
-    /// is received with filter index 0).
+    /// §15.1; empty lists for the shorter forms).
+    ///
+    /// **Difference from ACAN:** with no filter at all, *no* frame is received (the ID
+    /// table is switched to format D, "all frames rejected", Kinetis RM `MCR.IDAM`);
+    /// ACAN receives every frame then. Pass [`Filter::pass_all`] to receive everything
+    /// (see `docs/differences.md`).
     ///
     /// `sys` reaches the SIM and PORT registers by absolute address (firmware:
     /// [`crate::regs::SystemRegs`], as `Can0::begin` uses; host: [`crate::HostSystem`]).
@@ -221,11 +228,19 @@ impl<R: Registers> FlexCan<R> {
         let plan = plan(target, settings, primary, secondary).map_err(BeginError::Config)?;
         plan.system.apply(sys);
         configure(&mut regs, &plan, settings.handshake_polls)?;
+        let bus_mode = if settings.listen_only {
+            BusMode::ListenOnly
+        } else if settings.loop_back {
+            BusMode::LoopBack
+        } else {
+            BusMode::Normal
+        };
         Ok(FlexCan::configured(
             regs,
             target,
             plan.table,
-            settings.listen_only,
+            bus_mode,
+            settings.bus_off_recovery,
             settings.handshake_polls,
             settings.message_irq_priority,
             plan.system,

@@ -28,7 +28,7 @@
 
 use core::cell::Cell;
 
-use twocan_core::{LastErrorCode, Mode, Registers};
+use twocan_core::{BusMode, BusOffRecovery, LastErrorCode, Mode, Registers};
 
 use crate::configuration::Configuration;
 use crate::filters::FilterTable;
@@ -43,7 +43,8 @@ pub struct FlexCan<R: Registers> {
     pub(crate) regs: R,
     pub(crate) target: Target,
     pub(crate) table: FilterTable,
-    pub(crate) listen_only: bool,
+    pub(crate) bus_mode: BusMode,
+    pub(crate) recovery: BusOffRecovery,
     pub(crate) polls: u32,
     pub(crate) irq_priority: u8,
     pub(crate) mode: Mode,
@@ -58,7 +59,8 @@ impl<R: Registers> FlexCan<R> {
         regs: R,
         target: Target,
         table: FilterTable,
-        listen_only: bool,
+        bus_mode: BusMode,
+        recovery: BusOffRecovery,
         polls: u32,
         irq_priority: u8,
         system: SystemPlan,
@@ -68,7 +70,8 @@ impl<R: Registers> FlexCan<R> {
             regs,
             target,
             table,
-            listen_only,
+            bus_mode,
+            recovery,
             polls,
             irq_priority,
             mode: Mode::Normal,
@@ -128,7 +131,16 @@ impl<R: Registers> FlexCan<R> {
     }
 
     /// The transmit mailboxes: the remote-frame ones, then MB15.
+    /// Writes the ID table, the masks and `MCR.IDAM` (format A, or format D "all frames
+    /// rejected" for an empty list): Freeze mode only (Kinetis RM, MCR: IDAM is
+    /// writable in Freeze mode only).
     pub(crate) fn write_filters(regs: &R, table: &FilterTable) {
+        let idam = if table.rejects_all() {
+            regs::mcr::IDAM_FORMAT_D
+        } else {
+            regs::mcr::IDAM_FORMAT_A
+        };
+        regs.modify32(regs::MCR, |v| regs::mcr::IDAM.replace(v, idam));
         for (i, e) in table.elements().iter().enumerate() {
             regs.write32(regs::rx_fifo_filter(i), *e);
         }

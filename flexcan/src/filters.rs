@@ -32,8 +32,15 @@
 //! filter's element under the global mask (a subset of what that filter accepts,
 //! after it). With no primary filter, the primary elements repeat the first secondary
 //! filter: they come before it but accept exactly what it accepts, and report its
-//! index. With no filter at all, the list is one pass-all primary filter (§4: "receive
-//! all frames"), index 0.
+//! index.
+//!
+//! # No filter at all
+//!
+//! An empty pair of lists accepts no frame, as on every twocan backend: the table is
+//! switched to format D (`MCR.IDAM` = 0b11, Kinetis RM "Rx FIFO filter: possible
+//! structures": "all frames rejected"), the elements and masks are left as they are.
+//! **ACAN differs** (§4, §15.1: with no filter, every frame is received with index 0);
+//! to receive everything, pass [`Filter::pass_all`] (see `docs/differences.md`).
 //!
 //! # Secondary pass-all
 //!
@@ -95,6 +102,7 @@ pub struct FilterTable {
     secondary_count: u8,
     keys: KeyTable,
     extra: u64,
+    reject_all: bool,
 }
 
 /// Whether `f` conforms as a secondary filter (ACAN §13.4).
@@ -161,12 +169,6 @@ impl FilterTable {
 
     /// Builds a table from lists already checked.
     fn build(configuration: Configuration, primary: &[Filter], secondary: &[Filter]) -> Self {
-        const PASS_ALL: [Filter; 1] = [Filter::pass_all()];
-        let primary = if primary.is_empty() && secondary.is_empty() {
-            &PASS_ALL[..]
-        } else {
-            primary
-        };
         let p = primary.len();
         let s = secondary.len();
         let capacity_p = configuration.primary_filter_capacity();
@@ -203,6 +205,7 @@ impl FilterTable {
             secondary_count: s as u8,
             keys: KeyTable::new(),
             extra: 0,
+            reject_all: primary.is_empty() && secondary.is_empty(),
         };
         t.secondary[..s].copy_from_slice(secondary);
 
@@ -213,8 +216,9 @@ impl FilterTable {
                     (element_of(last), mask_of(last), Hit::Filter((p - 1) as u16))
                 }
                 (None, None, Some(first)) => (element_of(first), global_mask, secondary_hit(0)),
-                // Not reachable: an empty pair of lists became one pass-all filter.
-                (None, None, None) => (0, 0, Hit::Filter(0)),
+                // An empty pair of lists: format D rejects every frame, the element
+                // is never compared.
+                (None, None, None) => (0, FULL_MASK, Hit::Filter(0)),
             };
             t.elements[i] = element;
             t.individual_masks[i] = mask;
@@ -238,7 +242,13 @@ impl FilterTable {
         self.configuration
     }
 
-    /// Number of primary filters (after an empty pair of lists became one pass-all).
+    /// Whether the table accepts no frame at all (an empty pair of lists: `MCR.IDAM`
+    /// format D).
+    pub const fn rejects_all(&self) -> bool {
+        self.reject_all
+    }
+
+    /// Number of primary filters.
     pub const fn primary_count(&self) -> usize {
         self.primary_count as usize
     }
@@ -336,6 +346,7 @@ impl FilterTable {
             secondary_count: 0,
             keys: keys.clone(),
             extra,
+            reject_all: primary.is_empty() && secondary.is_empty(),
         };
         for i in 0..capacity_p {
             let (e, m, h) = match (primary.get(i), primary.last(), secondary.first()) {
@@ -391,6 +402,9 @@ impl FilterTable {
     /// `Some((IDHIT, index))`, index `None` for a frame a superset table accepts that no
     /// user filter does. `None`: the frame is rejected.
     pub fn evaluate(&self, frame: &Frame) -> Option<(usize, Option<u16>)> {
+        if self.reject_all {
+            return None;
+        }
         let word = if frame.is_extended() {
             ELEMENT_IDE | frame.raw_id() << ELEMENT_EXT_SHIFT
         } else {
@@ -433,6 +447,9 @@ mod tests {
 
     /// The hardware's rule on a compiled table: first element whose masked bits agree.
     fn hw_match(t: &FilterTable, frame: &Frame) -> Option<usize> {
+        if t.rejects_all() {
+            return None; // format D
+        }
         let word = if frame.is_extended() {
             ELEMENT_IDE | frame.raw_id() << ELEMENT_EXT_SHIFT
         } else {
@@ -450,9 +467,6 @@ mod tests {
     }
 
     fn reference(primary: &[Filter], secondary: &[Filter], frame: &Frame) -> Option<u16> {
-        if primary.is_empty() && secondary.is_empty() {
-            return Some(0);
-        }
         primary
             .iter()
             .chain(secondary)

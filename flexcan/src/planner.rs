@@ -176,8 +176,7 @@ impl Prepared {
             keys: KeyTable::new(),
         };
         if list.is_empty() {
-            // ACAN §4: no filter receives every frame.
-            p.n_general = 1;
+            // No filter receives nothing (unlike ACAN §4): an empty table, format D.
             return Ok(p);
         }
         for (i, f) in list.iter().enumerate() {

@@ -12,6 +12,7 @@
 //! [`TRANSMIT_BUFFER_SIZE`] are ACAN's defaults, [`crate::AcanDriver`] uses them).
 
 use twocan_core::timing::{solve, Consistency, Limits, Timing, DEFAULT_TOLERANCE_PPM};
+use twocan_core::BusOffRecovery;
 
 use crate::configuration::Configuration;
 
@@ -123,6 +124,12 @@ pub struct Settings {
     /// 2 Mbit/s. `begin` refuses a timing below the rule with
     /// [`crate::ConfigErrors::BIT_TIMING_FORBIDDEN`].
     pub bus_clock_hz: Option<u32>,
+    /// How the module leaves bus-off (not in ACAN, which leaves `CTRL1.BOFFREC` = 0):
+    /// [`BusOffRecovery::Automatic`] (default) after 128 × 11 recessive bits by itself;
+    /// [`BusOffRecovery::Manual`] sets `CTRL1.BOFFREC` (Kinetis RM, CTRL1 field
+    /// descriptions: "automatic recovering from Bus Off state disabled") and the module
+    /// stays bus-off until [`twocan_core::Hardware::recover`].
+    pub bus_off_recovery: BusOffRecovery,
 }
 
 impl Default for Settings {
@@ -162,6 +169,7 @@ impl Settings {
             handshake_polls: handshake_polls_for(bit_rate),
             error_interrupts: true,
             bus_clock_hz: None,
+            bus_off_recovery: BusOffRecovery::Automatic,
         }
     }
 
@@ -279,6 +287,8 @@ mod tests {
         assert!(!s.use_alternate_tx_pin && !s.use_alternate_rx_pin);
         assert_eq!(s.message_irq_priority, 64);
         assert!(!s.tx_pin_open_collector && !s.rx_pin_pull_up);
+        // Not in table 7: ACAN leaves CTRL1.BOFFREC = 0.
+        assert_eq!(s.bus_off_recovery, BusOffRecovery::Automatic);
     }
 
     #[test]

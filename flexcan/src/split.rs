@@ -19,6 +19,10 @@
 //!   "Message buffer lock mechanism"): no context relies on a lock, since the Rx FIFO
 //!   output changes only when `BUF5I` is written and transmit mailboxes are not locked
 //!   for reception.
+//! - receive half (`install_filters`, in Freeze mode): the ID table, `RXIMR`,
+//!   `RXFGMASK`, `MCR.IDAM`, and `IFLAG1.BUF5I` to discard the old list's frames;
+//! - control (stopped): `CTRL1` timing fields, `LOM`, `LPB`, `MCR.SRXDIS`; `CTRL1.BOFFREC`
+//!   (`recover`, any mode).
 //!
 //! A raw received frame is the Rx FIFO output's four words (control/status,
 //! identifier, data) and `RXFIR.IDHIT`; the thread side decodes it and maps the hit
@@ -27,9 +31,11 @@
 use core::sync::atomic::{AtomicU32, AtomicU8, Ordering};
 
 use twocan_core::hardware::{sort_by_token, Completion, Settled, StatusEvents, Token};
+use twocan_core::timing::{Limits, Timing, FLEXCAN_CTRL1_TIMING_MASK};
 use twocan_core::{
-    AtomicLastError, Error, ErrorCounters, ErrorState, ErrorStatus, Frame, Hardware, LastErrorCode,
-    Mode, Registers, RxFrame, Timestamp, TxOutcome, TxPolicy,
+    AtomicLastError, BusMode, BusOffRecovery, Capabilities, Error, ErrorCounters, ErrorState,
+    ErrorStatus, Frame, Hardware, LastErrorCode, Mode, ModeSupport, Registers, RxFrame, Timestamp,
+    TxOutcome, TxPolicy,
 };
 use twocan_core::{MailboxId, MailboxState};
 
@@ -39,7 +45,7 @@ use crate::filters::{FilterTable, UNKNOWN_FILTER};
 use crate::handshake;
 use crate::instance::Target;
 use crate::message_buffer::MbWords;
-use crate::regs::{self, code, cs, esr1, iflag1, rxfir, ECR, ESR1, IFLAG1, RXFIR};
+use crate::regs::{self, code, cs, ctrl1, esr1, iflag1, rxfir, ECR, ESR1, IFLAG1, RXFIR};
 use crate::status;
 use crate::system::SystemPlan;
 
@@ -47,12 +53,26 @@ use crate::system::SystemPlan;
 /// words, and `RXFIR.IDHIT`.
 pub type RawFrame = [u32; 5];
 
+/// Frames the Rx FIFO holds (Kinetis RM, "Rx FIFO": six deep).
+const RX_FIFO_DEPTH: usize = 6;
+
 /// Transmit mailboxes at most (MB15 and up to seven remote-frame mailboxes).
 const MAX_TX: usize = 8;
 
 const MODE_NORMAL: u8 = 0;
 const MODE_STOPPED: u8 = 1;
 const MODE_SLEEP: u8 = 2;
+
+const fn bus_mode_code(m: BusMode) -> u8 {
+    match m {
+        BusMode::Normal => 0,
+        BusMode::ListenOnly => 1,
+        BusMode::LoopBack => 2,
+    }
+}
+
+/// Position of the filter generation in a raw frame's last word (`IDHIT` below it).
+const GENERATION_SHIFT: u32 = 16;
 
 fn mode_code(m: Mode) -> u8 {
     match m {
@@ -72,10 +92,19 @@ pub struct FlexCanHw<R: Registers> {
     table: core::cell::UnsafeCell<FilterTable>,
     /// The table's message-buffer configuration (read from every context).
     configuration: Configuration,
-    listen_only: bool,
-    polls: u32,
+    /// The [`BusMode`] (`CTRL1.LOM`/`LPB`) as its code (read by the transmit half).
+    bus_mode: AtomicU8,
+    /// `MCR.SRXDIS` outside loop-back (loop-back needs self reception).
+    srxdis: bool,
+    recovery: BusOffRecovery,
+    /// Acknowledge wait bound (grows when a slower bit rate is set).
+    polls: AtomicU32,
     irq_priority: u8,
     mode: AtomicU8,
+    /// Filter list generation (low 16 bits), stamped on each raw frame by `read_rx`
+    /// and compared by `decode`: frames read before the last `install_filters` are
+    /// dropped. Written by `install_filters` only.
+    generation: AtomicU32,
     /// Token of the frame in each transmit mailbox, indexed by `15 - MB`.
     tokens: [AtomicU32; MAX_TX],
     last_error: AtomicLastError,
@@ -96,13 +125,18 @@ impl<R: Registers> FlexCan<R> {
     /// installed filter table comes along.
     pub fn into_split(self) -> FlexCanHw<R> {
         let mode = self.mode;
+        let srxdis = self.bus_mode != BusMode::LoopBack
+            && self.regs.read32(regs::MCR) & regs::mcr::SRXDIS != 0;
         FlexCanHw {
             regs: self.regs,
             target: self.target,
             configuration: self.table.configuration(),
             table: core::cell::UnsafeCell::new(self.table),
-            listen_only: self.listen_only,
-            polls: self.polls,
+            bus_mode: AtomicU8::new(bus_mode_code(self.bus_mode)),
+            srxdis,
+            recovery: self.recovery,
+            polls: AtomicU32::new(self.polls),
+            generation: AtomicU32::new(0),
             irq_priority: self.irq_priority,
             mode: AtomicU8::new(mode_code(mode)),
             tokens: [const { AtomicU32::new(0) }; MAX_TX],
@@ -134,6 +168,12 @@ impl<R: Registers> FlexCanHw<R> {
     /// The registers (for inspection).
     pub fn registers(&self) -> &R {
         &self.regs
+    }
+
+    /// The registers, mutably (a host harness moving a model to another bus; writing
+    /// them behind the driver's back voids its bookkeeping).
+    pub fn registers_mut(&mut self) -> &mut R {
+        &mut self.regs
     }
 
     /// The free-running timer (`TIMER`, one tick per bit time).
@@ -182,12 +222,14 @@ impl<R: Registers> FlexCanHw<R> {
             _ => Mode::Normal,
         };
         let last_error = self.last_error();
+        let bus_mode = Hardware::bus_mode(&self);
         let mut controller = FlexCan::configured(
             self.regs,
             self.target,
             self.table.into_inner(),
-            self.listen_only,
-            self.polls,
+            bus_mode,
+            self.recovery,
+            self.polls.load(Ordering::Relaxed),
             self.irq_priority,
             self.system,
         );
@@ -242,7 +284,7 @@ impl<R: Registers> FlexCanHw<R> {
     }
 
     fn mode_change(&self, mode: Mode) -> Result<(), Error> {
-        let polls = self.polls;
+        let polls = self.polls.load(Ordering::Relaxed);
         // From the hardware, not from the last request: a timed-out change may have
         // completed since.
         let disabled = self.regs.read32(regs::MCR) & (regs::mcr::MDIS | regs::mcr::LPMACK) != 0;
@@ -287,7 +329,9 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
     /// [`Error::WrongMode`] in listen-only mode and while disabled (sleep).
     #[inline(always)]
     fn free_mailbox(&self, frame: &Frame) -> Result<Option<u8>, Error> {
-        if self.listen_only || self.mode() == MODE_SLEEP {
+        if self.bus_mode.load(Ordering::Relaxed) == bus_mode_code(BusMode::ListenOnly)
+            || self.mode() == MODE_SLEEP
+        {
             return Err(Error::WrongMode);
         }
         // The control word first, then the flag: a mailbox reading INACTIVE stays so
@@ -475,13 +519,16 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
         if flags & iflag1::BUF5I == 0 {
             return None;
         }
+        // The generation before the frame: a frame of the old list read while
+        // `install_filters` drains the FIFO carries the old generation (never the new).
+        let generation = self.generation.load(Ordering::Acquire) << GENERATION_SHIFT;
         let w = MbWords::read(&self.regs, 0);
         let raw = [
             w.cs,
             w.id,
             w.word0,
             w.word1,
-            rxfir::IDHIT.get(self.regs.read32(RXFIR)),
+            rxfir::IDHIT.get(self.regs.read32(RXFIR)) | generation,
         ];
         self.regs.write32(IFLAG1, iflag1::BUF5I);
         Some(raw)
@@ -494,7 +541,13 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
     unsafe fn decode(&self, raw: &RawFrame, _map: &()) -> Option<RxFrame> {
         // SAFETY: the receive half's context, the only one touching the table.
         let map = unsafe { &*self.table.get() };
-        let [control, id, word0, word1, hit] = *raw;
+        let [control, id, word0, word1, tagged] = *raw;
+        let current = self.generation.load(Ordering::Relaxed) & 0xFFFF;
+        if tagged >> GENERATION_SHIFT != current {
+            // Accepted by a filter list replaced since: dropped (counted by the driver).
+            return None;
+        }
+        let hit = tagged & ((1 << GENERATION_SHIFT) - 1);
         let frame = MbWords {
             cs: control,
             id,
@@ -536,8 +589,11 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
         (self.mode() != MODE_SLEEP).then(|| self.timer())
     }
 
-    /// Freeze, write the table, come back to the mode it was in (the table must be
-    /// compiled for the configuration `begin` chose).
+    /// Freeze (no frame enters the Rx FIFO), write the table, pop and discard what the
+    /// old table accepted into the FIFO, then switch the thread-side table and the
+    /// generation together, and come back to the mode it was in (the table must be
+    /// compiled for the configuration `begin` chose). Frames of the old list still in
+    /// the driver's ring carry the old generation: `decode` drops them.
     unsafe fn install_filters(&self, filters: &FilterTable) -> Result<(), Error> {
         if filters.configuration() != self.configuration() {
             return Err(Error::InvalidArgument);
@@ -549,8 +605,17 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
         };
         self.mode_change(Mode::Stopped)?;
         FlexCan::write_filters(&self.regs, filters);
+        // The FIFO holds at most its depth; the receive interrupt may pop some too.
+        for _ in 0..2 * RX_FIFO_DEPTH {
+            if self.regs.read32(IFLAG1) & iflag1::BUF5I == 0 {
+                break;
+            }
+            self.regs.write32(IFLAG1, iflag1::BUF5I);
+        }
         // SAFETY: the receive half's context, the only one touching the table.
         unsafe { *self.table.get() = filters.clone() };
+        let next = (self.generation.load(Ordering::Relaxed) + 1) & 0xFFFF;
+        self.generation.store(next, Ordering::Release);
         self.mode_change(previous)
     }
 
@@ -590,9 +655,108 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
         self.mode_change(mode)
     }
 
-    /// FlexCAN here recovers from bus-off automatically (`CTRL1.BOFFREC` = 0, as
-    /// ACAN): there is nothing to start, so the request is refused.
+    /// [`BusOffRecovery::Automatic`] (`CTRL1.BOFFREC` = 0, as ACAN): nothing to start,
+    /// refused with [`Error::WrongMode`]. [`BusOffRecovery::Manual`] (`BOFFREC` = 1):
+    /// when bus-off, negates `BOFFREC` — recovery begins (Kinetis RM, CTRL1 BOFFREC:
+    /// before 128 × 11 recessive bits were seen it proceeds "as if the BOFFREC bit had
+    /// never been asserted"; after them the module re-synchronises, 11 recessive bits,
+    /// and joins the bus) — and asserts it again at once, which "will be effective only
+    /// the next time the module enters Bus Off". `CTRL1.BOFFREC` is writable in any
+    /// mode. Not bus-off: nothing to do, `Ok`.
     fn recover(&self) -> Result<(), Error> {
-        Err(Error::WrongMode)
+        if self.recovery == BusOffRecovery::Automatic {
+            return Err(Error::WrongMode);
+        }
+        if self.mode() == MODE_SLEEP {
+            return Ok(());
+        }
+        let esr = self.regs.read32(ESR1);
+        self.latch(esr);
+        if esr1::FLTCONF.get(esr) < esr1::FLTCONF_BUS_OFF {
+            return Ok(());
+        }
+        self.regs.modify32(regs::CTRL1, |v| v & !ctrl1::BOFFREC);
+        self.regs.modify32(regs::CTRL1, |v| v | ctrl1::BOFFREC);
+        Ok(())
+    }
+
+    /// The 16 MHz oscillator, [`Limits::FLEXCAN`]; one ID table element per exact
+    /// filter of either format (format A), as many as the configuration's primary and
+    /// secondary elements (ACAN §11, table 4); MB15 and the remote-frame mailboxes;
+    /// the 6-frame Rx FIFO; the 16-bit free-running timer (Kinetis RM, TIMER).
+    /// No one-shot mode on these modules.
+    fn capabilities(&self) -> Capabilities {
+        let c = self.configuration();
+        let filters = (c.primary_filter_capacity() + c.secondary_filter_capacity()) as u16;
+        Capabilities::new(
+            crate::settings::CAN_CLOCK_HZ,
+            Limits::FLEXCAN,
+            ModeSupport {
+                loop_back: true,
+                listen_only: true,
+                one_shot: false,
+                triple_sampling: true,
+                manual_recovery: true,
+                timestamps: true,
+            },
+            filters,
+            filters,
+            self.mailbox_count(),
+            1,
+            RX_FIFO_DEPTH as u8,
+            Some(16),
+        )
+    }
+
+    fn bus_mode(&self) -> BusMode {
+        match self.bus_mode.load(Ordering::Relaxed) {
+            1 => BusMode::ListenOnly,
+            2 => BusMode::LoopBack,
+            _ => BusMode::Normal,
+        }
+    }
+
+    fn bus_off_recovery(&self) -> BusOffRecovery {
+        self.recovery
+    }
+
+    /// In Freeze mode ([`Mode::Stopped`]): the `CTRL1` timing fields (PRESDIV, RJW,
+    /// PSEG1, PSEG2, SMP, PROPSEG: writable in Freeze mode only, Kinetis RM CTRL1);
+    /// the acknowledge bound grows for a slower rate.
+    fn set_timing(&self, timing: &Timing) -> Result<(), Error> {
+        let stopped = self.mode() == MODE_STOPPED;
+        twocan_core::hardware::check_timing_for(&self.capabilities(), timing, stopped)?;
+        let bits = timing.flexcan_ctrl1().map_err(Error::Timing)?;
+        self.regs
+            .modify32(regs::CTRL1, |v| (v & !FLEXCAN_CTRL1_TIMING_MASK) | bits);
+        let polls = crate::settings::handshake_polls_for(timing.actual_bitrate());
+        self.polls.fetch_max(polls, Ordering::Relaxed);
+        Ok(())
+    }
+
+    /// In Freeze mode ([`Mode::Stopped`]): `CTRL1.LOM` and `CTRL1.LPB` (Freeze mode
+    /// only); loop-back also clears `MCR.SRXDIS` ("In this mode, MCR\[SRXDIS\] cannot
+    /// be asserted"), the other modes restore it.
+    fn set_bus_mode(&self, mode: BusMode) -> Result<(), Error> {
+        if self.mode() != MODE_STOPPED {
+            return Err(Error::WrongMode);
+        }
+        let (lom, lpb) = match mode {
+            BusMode::Normal => (0, 0),
+            BusMode::ListenOnly => (ctrl1::LOM, 0),
+            BusMode::LoopBack => (0, ctrl1::LPB),
+        };
+        self.regs.modify32(regs::CTRL1, |v| {
+            (v & !(ctrl1::LOM | ctrl1::LPB)) | lom | lpb
+        });
+        let srxdis = if mode != BusMode::LoopBack && self.srxdis {
+            regs::mcr::SRXDIS
+        } else {
+            0
+        };
+        self.regs
+            .modify32(regs::MCR, |v| (v & !regs::mcr::SRXDIS) | srxdis);
+        self.bus_mode.store(bus_mode_code(mode), Ordering::Relaxed);
+        Ok(())
     }
 }

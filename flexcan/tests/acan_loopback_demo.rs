@@ -46,3 +46,33 @@ fn loop_back_demo() {
     let t = can.traffic();
     assert_eq!((t.queued, t.sent, t.received), (5, 5, 5));
 }
+
+#[test]
+fn no_filter_at_all_receives_nothing_unlike_acan() {
+    // twocan's portable rule: an empty pair of lists receives nothing (ID table format
+    // D, MCR.IDAM = 0b11); ACAN's demo relies on the opposite (see docs/differences.md).
+    let settings = loop_back(125_000);
+    let (model, mut can) = begin_on_exact::<32, 16>(
+        twocan_flexcan::Target::new(
+            twocan_flexcan::Board::Teensy32,
+            twocan_flexcan::Instance::Can0,
+        ),
+        &settings,
+        &[],
+        &[],
+    )
+    .expect("begin");
+    assert_eq!(
+        twocan_flexcan::regs::mcr::IDAM.get(model.peek32(twocan_flexcan::regs::MCR)),
+        twocan_flexcan::regs::mcr::IDAM_FORMAT_D
+    );
+    let mut bus = bus_with(125_000, &[&model]);
+    for _ in 0..5 {
+        can.try_send(&std_data(0x542, &[])).expect("tryToSend");
+        run1(&mut bus, &mut can, 2_000);
+        assert!(drain(&mut can).is_empty());
+    }
+    let t = can.traffic();
+    assert_eq!((t.queued, t.sent, t.received), (5, 5, 0));
+    assert_eq!(model.frames_discarded(), 5);
+}

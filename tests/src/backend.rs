@@ -11,16 +11,16 @@
 //! filter capacity, overrun policy, clock), not values read back from the drivers.
 
 use twocan_bxcan::model::BxCanModel;
-use twocan_bxcan::{
-    Config as BxConfig, ConfigError, FifoPolicy, PlanError, Recovery as BxRecovery,
-};
+use twocan_bxcan::{Config as BxConfig, ConfigError, FifoPolicy, PlanError};
 use twocan_core::sim::{Bus, BusNode, NodeId};
 use twocan_core::timing::{solve, Limits, TimingError, DEFAULT_TOLERANCE_PPM};
-use twocan_core::{Driver, Filter, Hardware, Registers, TxPolicy};
+use twocan_core::{
+    BusOffRecovery, Driver, Filter, Hardware, Mode, ModeSupport, Registers, TxPolicy,
+};
 use twocan_flexcan::model::FlexCanModel;
 use twocan_flexcan::{
-    BeginError, Board, ConfigErrors, Configuration, FlexCan, FlexCanHw, HostSystem, Instance,
-    Settings, Target, CAN_CLOCK_HZ,
+    BeginError, Board, ConfigErrors, Configuration, FlexCanHw, Instance, Settings, Target,
+    CAN_CLOCK_HZ,
 };
 use twocan_host::{
     attach_plain, BxNode, FlexNode, Harness, Serviced, SetupError, RX_RING, STM32F767_APB1_HZ,
@@ -48,7 +48,8 @@ pub enum OverrunPolicy {
 /// Backend-neutral node options.
 #[derive(Debug, Clone, PartialEq)]
 pub struct NodeOptions {
-    /// The portable filter list (empty: receive everything).
+    /// The portable filter list (empty: receive nothing; [`Filter::pass_all`] receives
+    /// everything).
     pub filters: Vec<Filter>,
     /// Bus-off recovery.
     pub recovery: Recovery,
@@ -125,13 +126,23 @@ pub enum TimingRefused {
 /// How a backend changed its bit rate.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum BitrateChange {
-    /// The controller was reconfigured and kept its installed filters (bxCAN
-    /// `Can::reconfigure`).
+    /// Through the portable API: stop, `Driver::set_bitrate`, start; the controller
+    /// kept its installed filters (no initialisation, no filter list supplied again).
     FiltersKept,
-    /// The backend has no way to change the bit rate of a running controller: it was
-    /// configured again from scratch (FlexCAN `begin`) and the filters were installed
-    /// again from the lists the application kept.
+    /// The controller was configured again from scratch and the filters were installed
+    /// again from the lists the application kept (no backend needs this any more).
     FiltersReinstalledFromLists,
+}
+
+/// Where the 128 × 11 recessive bits of a manual bus-off recovery are counted from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ManualRecoveryCount {
+    /// From the software request (bxCAN: the sequence starts when initialization mode
+    /// is left, RM0410 §40.7.6).
+    FromRequest,
+    /// From bus-off entry; a request after they were seen rejoins after 11 recessive
+    /// bits (Kinetis RM, CTRL1.BOFFREC).
+    FromBusOff,
 }
 
 /// A node of one backend on the harness bus (the device under test).
@@ -170,6 +181,23 @@ pub trait Backend {
     const MAX_EXACT_STD_FILTERS: usize;
     /// Whether software-started bus-off recovery is offered.
     const MANUAL_RECOVERY: bool;
+    /// Where a manual recovery counts its 128 × 11 recessive bits from.
+    const MANUAL_RECOVERY_COUNT: ManualRecoveryCount;
+    /// Transmit mailboxes of the node [`Backend::attach`] brings up with at most 12
+    /// filters (FlexCAN 12/12 partition: MB15 and MB12–MB14, ACAN §11 table 4; bxCAN:
+    /// three, RM0410 §40.7.3).
+    const TX_MAILBOXES: u8;
+    /// Exact standard and extended filters that partition holds (FlexCAN 12/12: 24
+    /// format-A elements, one identifier of either format each; bxCAN CAN1 with all 28
+    /// banks: four 16-bit or two 32-bit list identifiers per bank).
+    const FILTERS_STD_EXT: (u16, u16);
+    /// Optional modes (FlexCAN: no one-shot; bxCAN: no triple sampling).
+    const MODES: ModeSupport;
+    /// Receive queues (FlexCAN: the Rx FIFO; bxCAN: FIFO 0 and FIFO 1).
+    const RX_QUEUES: u8;
+    /// Time stamp width of the node [`Backend::attach`] brings up (FlexCAN: the 16-bit
+    /// free-running timer; bxCAN without TTCM: none).
+    const TIMESTAMP_BITS: Option<u8>;
     /// The CAN clock the bit timing is made from (FlexCAN: 16 MHz oscillator; bxCAN:
     /// APB1 of the STM32F767 at 216 MHz, 54 MHz).
     const CLOCK_HZ: u32;
@@ -198,6 +226,10 @@ pub trait Backend {
     /// Checks a bit timing the way an application would configure it: the wished rate
     /// with a sample point in per mille. Gives the actual bit rate.
     fn check_timing(bitrate: u32, sample_point_permille: u16) -> Result<u32, TimingRefused>;
+
+    /// Replaces the node's filter list through the receive half (`Driver::set_filters`),
+    /// compiled for the partition the node was brought up with.
+    fn set_filters(node: &mut Self::Node, filters: &[Filter]) -> Result<(), Refused>;
 
     /// Moves `node` to the new bus of `h` (at another bit rate, brought to the old bus's
     /// time, `node`'s old bus no longer used) and changes its bit rate to `h`'s.
@@ -315,7 +347,20 @@ impl Backend for FlexCanBackend {
     const RX_FIFO_DEPTH: usize = 6;
     const OVERRUN: OverrunPolicy = OverrunPolicy::DiscardNew;
     const MAX_EXACT_STD_FILTERS: usize = 14 + 18;
-    const MANUAL_RECOVERY: bool = false;
+    const MANUAL_RECOVERY: bool = true;
+    const MANUAL_RECOVERY_COUNT: ManualRecoveryCount = ManualRecoveryCount::FromBusOff;
+    const TX_MAILBOXES: u8 = 4;
+    const FILTERS_STD_EXT: (u16, u16) = (24, 24);
+    const MODES: ModeSupport = ModeSupport {
+        loop_back: true,
+        listen_only: true,
+        one_shot: false,
+        triple_sampling: true,
+        manual_recovery: true,
+        timestamps: true,
+    };
+    const RX_QUEUES: u8 = 1;
+    const TIMESTAMP_BITS: Option<u8> = Some(16);
     const CLOCK_HZ: u32 = 16_000_000;
     const LIMITS: Limits = Limits::FLEXCAN;
     const FASTEST_BITRATE: u32 = 1_000_000;
@@ -326,13 +371,9 @@ impl Backend for FlexCanBackend {
         opts: &NodeOptions,
         attach: impl FnOnce(&mut Bus, &str, Box<dyn BusNode>) -> NodeId,
     ) -> Result<FlexNode, Refused> {
-        if opts.recovery == Recovery::Manual {
-            return Err(Refused::Unsupported(
-                "FlexCAN: the driver leaves CTRL1.BOFFREC = 0, recovery is automatic (ACAN)",
-            ));
-        }
         let rate = h.bus().borrow().bit_rate();
-        let (s, primary, secondary) = flexcan_lists(rate, &opts.filters);
+        let (mut s, primary, secondary) = flexcan_lists(rate, &opts.filters);
+        s.bus_off_recovery = portable_recovery(opts.recovery);
         FlexNode::begin_via(h, teensy36_can0(), &s, &primary, &secondary, attach)
             .map_err(flexcan_refused)
     }
@@ -363,39 +404,30 @@ impl Backend for FlexCanBackend {
         }
     }
 
+    fn set_filters(node: &mut FlexNode, filters: &[Filter]) -> Result<(), Refused> {
+        let c = node.driver.hardware().configuration();
+        let n = filters.len().min(c.primary_filter_capacity());
+        let table = twocan_flexcan::FilterTable::compile(c, &filters[..n], &filters[n..])
+            .map_err(|e| flexcan_refused(SetupError::FlexCan(BeginError::Config(e))))?;
+        node.driver
+            .set_filters(&table)
+            .map_err(|e| Refused::Other(format!("{e:?}")))
+    }
+
     fn change_bitrate(
         node: FlexNode,
-        opts: &NodeOptions,
+        _opts: &NodeOptions,
         h: &mut Harness,
     ) -> Result<(FlexNode, BitrateChange), Refused> {
         let FlexNode { model, driver, .. } = node;
-        let id = h
-            .bus()
-            .borrow_mut()
-            .attach("teensy36-can0-moved", model.clone());
-        let controller = driver.release();
-        let target = controller.target();
-        let mut regs = controller.into_registers();
-        regs.set_bus(h.bus());
         let rate = h.bus().borrow().bit_rate();
-        let (s, primary, secondary) = flexcan_lists(rate, &opts.filters);
-        let controller = FlexCan::begin(
-            regs,
-            &mut HostSystem::new(),
-            target,
-            &s,
-            &primary,
-            &secondary,
-        )
-        .map_err(|e| flexcan_refused(SetupError::FlexCan(e)))?;
-        Ok((
-            FlexNode {
-                model,
-                driver: Driver::new(controller.into_split()),
-                id,
-            },
-            BitrateChange::FiltersReinstalledFromLists,
-        ))
+        let (driver, id) = portable_bitrate_change(driver, rate, h, |hw, h| {
+            hw.registers_mut().set_bus(h.bus());
+            h.bus()
+                .borrow_mut()
+                .attach("teensy36-can0-moved", model.clone())
+        })?;
+        Ok((FlexNode { model, driver, id }, BitrateChange::FiltersKept))
     }
 }
 
@@ -410,10 +442,7 @@ pub struct BxCanBackend;
 pub fn bxcan_config(bit_rate: u32, recovery: Recovery) -> Result<BxConfig, ConfigError> {
     BxConfig::from_bitrate(STM32F767_APB1_HZ, bit_rate)?
         .tx_policy(TxPolicy::Fifo)
-        .recovery(match recovery {
-            Recovery::Automatic => BxRecovery::Automatic,
-            Recovery::Manual => BxRecovery::Manual,
-        })
+        .recovery(portable_recovery(recovery))
         .interrupts(twocan_bxcan::config::DEFAULT_INTERRUPTS)
         .can2_start_bank(28)
 }
@@ -466,6 +495,19 @@ impl Backend for BxCanBackend {
     const OVERRUN: OverrunPolicy = OverrunPolicy::OverwriteNewest;
     const MAX_EXACT_STD_FILTERS: usize = 28 * 4;
     const MANUAL_RECOVERY: bool = true;
+    const MANUAL_RECOVERY_COUNT: ManualRecoveryCount = ManualRecoveryCount::FromRequest;
+    const TX_MAILBOXES: u8 = 3;
+    const FILTERS_STD_EXT: (u16, u16) = (28 * 4, 28 * 2);
+    const MODES: ModeSupport = ModeSupport {
+        loop_back: true,
+        listen_only: true,
+        one_shot: true,
+        triple_sampling: false,
+        manual_recovery: true,
+        timestamps: true,
+    };
+    const RX_QUEUES: u8 = 2;
+    const TIMESTAMP_BITS: Option<u8> = None;
     const CLOCK_HZ: u32 = 54_000_000;
     const LIMITS: Limits = Limits::BXCAN;
     const FASTEST_BITRATE: u32 = STM32F767_APB1_HZ / Limits::BXCAN.min_quanta();
@@ -480,12 +522,7 @@ impl Backend for BxCanBackend {
         let config = bxcan_config(rate, opts.recovery)
             .map_err(|e| Refused::Other(format!("{e:?}")))?
             .timestamps(opts.timestamps);
-        let filters = if opts.filters.is_empty() {
-            vec![Filter::pass_all()]
-        } else {
-            opts.filters.clone()
-        };
-        BxNode::with_config_via(h, &config, &filters, FifoPolicy::Fifo0, attach)
+        BxNode::with_config_via(h, &config, &opts.filters, FifoPolicy::Fifo0, attach)
             .map_err(bxcan_refused)
     }
 
@@ -503,37 +540,66 @@ impl Backend for BxCanBackend {
         Ok(bxcan_btr_bitrate(c.btr_value(), STM32F767_APB1_HZ))
     }
 
+    fn set_filters(node: &mut BxNode, filters: &[Filter]) -> Result<(), Refused> {
+        let plan = node
+            .driver
+            .hardware()
+            .plan(filters, FifoPolicy::Fifo0)
+            .map_err(|e| bxcan_refused(SetupError::BxCanPlan(e)))?;
+        node.driver
+            .set_filters(&plan)
+            .map_err(|e| Refused::Other(format!("{e:?}")))
+    }
+
     fn change_bitrate(
         node: BxNode,
-        opts: &NodeOptions,
+        _opts: &NodeOptions,
         h: &mut Harness,
     ) -> Result<(BxNode, BitrateChange), Refused> {
         let BxNode { model, driver, .. } = node;
-        let id = h
-            .bus()
-            .borrow_mut()
-            .attach("stm32f767-can1-moved", model.clone());
-        let mut can = driver.release().into_can();
-        can.registers_mut().set_bus(h.bus());
         let rate = h.bus().borrow().bit_rate();
-        let config = bxcan_config(rate, opts.recovery)
-            .map_err(|e| Refused::Other(format!("{e:?}")))?
-            .timestamps(opts.timestamps);
-        let init = can
-            .reconfigure(&config)
-            .map_err(|f| Refused::Other(format!("reconfigure: {:?}", f.error)))?;
-        let can = init
-            .enable()
-            .map_err(|f| Refused::Other(format!("enable: {:?}", f.error)))?;
-        Ok((
-            BxNode {
-                model,
-                driver: Driver::new(can.into_split()),
-                id,
-            },
-            BitrateChange::FiltersKept,
-        ))
+        let (driver, id) = portable_bitrate_change(driver, rate, h, |hw, h| {
+            hw.registers_mut().set_bus(h.bus());
+            h.bus()
+                .borrow_mut()
+                .attach("stm32f767-can1-moved", model.clone())
+        })?;
+        Ok((BxNode { model, driver, id }, BitrateChange::FiltersKept))
     }
+}
+
+/// The portable recovery setting of a test's [`Recovery`].
+pub fn portable_recovery(r: Recovery) -> BusOffRecovery {
+    match r {
+        Recovery::Automatic => BusOffRecovery::Automatic,
+        Recovery::Manual => BusOffRecovery::Manual,
+    }
+}
+
+/// Stop → `Driver::set_bitrate` → start, through the portable API only. Between stop and
+/// start the harness moves the model to the new bus (`relocate`: the simulated bus has
+/// one bit rate; the controller is taken out of the driver and put back unchanged).
+#[allow(clippy::type_complexity)]
+fn portable_bitrate_change<H: Hardware>(
+    mut driver: Driver<H, RX_RING, TX_RING, RX_RING>,
+    rate: u32,
+    h: &mut Harness,
+    relocate: impl FnOnce(&mut H, &mut Harness) -> NodeId,
+) -> Result<(Driver<H, RX_RING, TX_RING, RX_RING>, NodeId), Refused> {
+    driver
+        .set_mode(Mode::Stopped)
+        .map_err(|e| Refused::Other(format!("stop: {e:?}")))?;
+    let sp = twocan_core::timing::cia_sample_point(rate);
+    driver
+        .set_bitrate(rate, sp)
+        .map_err(|e| Refused::Other(format!("set_bitrate: {e:?}")))?;
+    let mut hw = driver.release();
+    let id = relocate(&mut hw, h);
+    let mut driver = Driver::new(hw);
+    driver
+        .set_mode(Mode::Normal)
+        .map_err(|e| Refused::Other(format!("start: {e:?}")))?;
+    Ok((driver, id))
 }
 
 /// A new harness at `bit_rate` whose bus time is already `now` (nothing attached yet),

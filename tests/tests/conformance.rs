@@ -11,14 +11,15 @@
 use twocan_core::sim::{Fault, NodeId, Receivers, SimNode};
 use twocan_core::timestamp::{bit_times_to_micros, COUNTER_PERIOD};
 use twocan_core::timing::Limits;
+use twocan_core::timing::TimingError;
 use twocan_core::{
-    ErrorCounters, ErrorState, Filter, FilterError, Format, Frame, FrameError, FrameKind,
-    LastErrorCode, Mode, Timestamp,
+    BusMode, BusOffRecovery, Error, ErrorCounters, ErrorState, Filter, FilterError, Format, Frame,
+    FrameError, FrameKind, Hardware, LastErrorCode, Mode, Timestamp,
 };
 use twocan_host::Harness;
 use twocan_tests::backend::{
-    harness_at, Backend, BitrateChange, BxCanBackend, Dut, FlexCanBackend, NodeOptions, Refused,
-    TimingRefused,
+    harness_at, Backend, BitrateChange, BxCanBackend, Dut, FlexCanBackend, ManualRecoveryCount,
+    NodeOptions, Recovery, Refused, TimingRefused,
 };
 use twocan_tests::support::{
     attach_peer, attach_sim, bytes, drain, ext_frame, first_match, frame_zoo, remote_frame, run,
@@ -534,7 +535,349 @@ fn filters_survive_a_bit_rate_change<B: Backend>() {
     println!("{}: bit rate change: {how:?}", B::NAME);
     let after = run_cases(&mut h2, &mut dut, &peer, &cases);
     assert_eq!(after, before, "{}", B::NAME);
-    let _ = BitrateChange::FiltersKept;
+    assert_eq!(how, BitrateChange::FiltersKept, "{}", B::NAME);
+}
+
+// --- issue 12: one portable behaviour --------------------------------------------------
+
+/// Capabilities: every figure is a fact of the manuals for the configuration the node
+/// was brought up with (the backend's constants), not read back from the driver.
+fn capabilities_are_the_hardware_facts<B: Backend>() {
+    let (_h, dut, _peer) = setup::<B>(&NodeOptions::pass_all());
+    let caps = dut.driver_ref().capabilities();
+    assert_eq!(caps.clock_hz, B::CLOCK_HZ, "{}", B::NAME);
+    assert_eq!(caps.timing_limits, B::LIMITS, "{}", B::NAME);
+    // Slowest: largest prescaler × most quanta (25 for both); fastest: prescaler 1 and
+    // the fewest quanta (FlexCAN 1 + 2 + 2 = 5, ACAN §16.1: 3.2 Mbit/s; bxCAN 1 + 1 + 1).
+    let (slowest, fastest) = match B::CLOCK_HZ {
+        16_000_000 => (16_000_000u32.div_ceil(256 * 25), 3_200_000),
+        54_000_000 => (54_000_000u32.div_ceil(1024 * 25), 18_000_000),
+        c => panic!("unexpected clock {c}"),
+    };
+    assert_eq!(
+        (caps.min_bitrate, caps.max_bitrate),
+        (slowest, fastest),
+        "{}",
+        B::NAME
+    );
+    assert_eq!(caps.modes, B::MODES, "{}", B::NAME);
+    assert_eq!(
+        (caps.max_standard_filters, caps.max_extended_filters),
+        B::FILTERS_STD_EXT,
+        "{}",
+        B::NAME
+    );
+    assert_eq!(caps.tx_mailboxes, B::TX_MAILBOXES, "{}", B::NAME);
+    assert_eq!(caps.rx_queues, B::RX_QUEUES, "{}", B::NAME);
+    assert_eq!(caps.rx_fifo_depth as usize, B::RX_FIFO_DEPTH, "{}", B::NAME);
+    assert_eq!(caps.timestamp_bits, B::TIMESTAMP_BITS, "{}", B::NAME);
+    // The capacity is real: the node's own capacity test fills exactly this many.
+    assert!(caps.max_standard_filters as usize <= B::MAX_EXACT_STD_FILTERS);
+    // The same rule as `Limits::check_bitrate`, and usable to compute a timing.
+    assert!(caps.bitrate_in_range(fastest) && !caps.bitrate_in_range(fastest + 1));
+    assert!(caps.bitrate_in_range(slowest) && !caps.bitrate_in_range(slowest - 1));
+    assert_eq!(
+        caps.timing_for(fastest + 1, 750),
+        Err(TimingError::BitrateTooHigh)
+    );
+    assert_eq!(
+        caps.timing_for(500_000, 875).map(|t| t.actual_bitrate()),
+        Ok(500_000)
+    );
+    assert_eq!(dut.driver_ref().bus_mode(), BusMode::Normal);
+}
+
+/// 32 bit errors on the node's own frame: TEC + 8 each (ISO 11898-1 rule 3) through
+/// warning (96) and passive (128) to bus-off (> 255). Gives the bus time of bus-off and
+/// checks every (TEC, REC, state) step on the way.
+fn to_bus_off<N: Dut>(h: &mut Harness, dut: &mut N, f: &Frame, name: &str) -> u64 {
+    let me = dut.bus_id();
+    h.bus()
+        .borrow_mut()
+        .inject_from(me, 32, Fault::Bit { at: None });
+    dut.driver().try_send(f).unwrap();
+    let seen = watch(h, dut, 20_000, |d| {
+        d.driver_ref().error_status().state == ErrorState::BusOff
+    });
+    let mut expected: Vec<(u16, u16, ErrorState)> = (0..32u16)
+        .map(|k| {
+            let c = ErrorCounters { tec: 8 * k, rec: 0 };
+            (c.tec, 0, ErrorState::from_counters(c))
+        })
+        .collect();
+    expected.push((256, 0, ErrorState::BusOff));
+    assert_eq!(seen, expected, "{name}");
+    h.now()
+}
+
+fn bus_off_recovery_both_modes<B: Backend>() {
+    const RECOVERY_BITS: u64 = 128 * 11;
+    for recovery in [Recovery::Automatic, Recovery::Manual] {
+        let opts = NodeOptions::pass_all().recovery(recovery);
+        let (mut h, mut dut, peer) = setup::<B>(&opts);
+        let what = format!("{} {recovery:?}", B::NAME);
+        let expected = match recovery {
+            Recovery::Automatic => BusOffRecovery::Automatic,
+            Recovery::Manual => BusOffRecovery::Manual,
+        };
+        assert_eq!(dut.driver_ref().hardware().bus_off_recovery(), expected);
+        // Not bus-off: automatic refuses (nothing could ever be started), manual has
+        // nothing to do.
+        let not_needed = dut.driver().recover();
+        match recovery {
+            Recovery::Automatic => assert_eq!(not_needed, Err(Error::WrongMode), "{what}"),
+            Recovery::Manual => assert_eq!(not_needed, Ok(()), "{what}"),
+        }
+        let f = std_frame(0x0B0, &[1, 2]);
+        let t_off = to_bus_off(&mut h, &mut dut, &f, &what);
+        assert_eq!(dut.driver_ref().error_stats().bus_off, 1, "{what}");
+        assert_eq!(dut.driver_ref().error_stats().bit, 32, "{what}");
+        // Bus-off: nothing new is accepted; the frame in flight waits.
+        let g = std_frame(0x0B1, &[3]);
+        assert_eq!(
+            dut.driver().try_send(&g),
+            Err(nb::Error::Other(Error::BusOff)),
+            "{what}"
+        );
+        let t_request = match recovery {
+            Recovery::Automatic => {
+                assert_eq!(dut.driver().recover(), Err(Error::WrongMode), "{what}");
+                t_off
+            }
+            Recovery::Manual => {
+                // Three times the recovery time: still bus-off without software.
+                let seen = watch(&mut h, &mut dut, 3 * RECOVERY_BITS, |d| {
+                    d.driver_ref().error_status().state != ErrorState::BusOff
+                });
+                assert_eq!(
+                    seen.iter().map(|s| s.2).collect::<Vec<_>>(),
+                    vec![ErrorState::BusOff],
+                    "{what}: recovered without software"
+                );
+                assert_eq!(dut.driver_ref().counters().tec, 256, "{what}");
+                dut.driver().recover().unwrap();
+                h.now()
+            }
+        };
+        // Back to error-active, counters 0, after the 128 × 11 recessive bits.
+        let seen = watch(&mut h, &mut dut, RECOVERY_BITS + 200, |d| {
+            d.driver_ref().error_status().state != ErrorState::BusOff
+        });
+        let t_back = h.now();
+        assert_eq!(
+            seen.last(),
+            Some(&(0, 0, ErrorState::Active)),
+            "{what}: {seen:?}"
+        );
+        let (from, at_least, at_most) = match (recovery, B::MANUAL_RECOVERY_COUNT) {
+            (Recovery::Automatic, _) | (_, ManualRecoveryCount::FromRequest) => {
+                // The node's own error delimiter and intermission may count as the
+                // first sequence.
+                (t_request, RECOVERY_BITS - 11 - 20, RECOVERY_BITS + 100)
+            }
+            // The 128 × 11 were seen long before the request: 11 recessive bits to
+            // re-synchronise, then on the bus.
+            (Recovery::Manual, ManualRecoveryCount::FromBusOff) => (t_request, 0, 11),
+        };
+        let took = t_back - from;
+        assert!(
+            (at_least..=at_most).contains(&took),
+            "{what}: back after {took} bits"
+        );
+        // Every state change in order, with the counters at each.
+        let changes: Vec<(ErrorState, u16)> =
+            std::iter::from_fn(|| dut.driver().take_state_change())
+                .map(|c| (c.state, c.counters.tec))
+                .collect();
+        assert_eq!(
+            changes.iter().map(|c| c.0).collect::<Vec<_>>(),
+            vec![
+                ErrorState::Warning,
+                ErrorState::Passive,
+                ErrorState::BusOff,
+                ErrorState::Active
+            ],
+            "{what}"
+        );
+        assert_eq!(changes[2].1, 256, "{what}");
+        assert_eq!(changes[3].1, 0, "{what}");
+        // The frame that waited goes out, once; the node accepts frames again.
+        settle(&mut h, &mut dut, &[&peer], 10_000);
+        dut.driver().try_send(&g).unwrap();
+        settle(&mut h, &mut dut, &[&peer], 10_000);
+        assert_eq!(peer.borrow().received_frames(), vec![f, g], "{what}");
+        assert_eq!(dut.driver_ref().traffic().sent, 2, "{what}");
+        assert_eq!(
+            dut.driver_ref().counters(),
+            ErrorCounters { tec: 0, rec: 0 },
+            "{what}"
+        );
+    }
+}
+
+/// Stop → change the bus mode → start, and stop → change the bit rate → start, through
+/// the portable API; the installed filters and their indices stay.
+fn retiming_and_mode_changes_keep_the_filters<B: Backend>() {
+    let filters = filter_list();
+    let cases = filter_cases();
+    let opts = NodeOptions::filters(&filters);
+    let (mut h, mut dut, peer) = setup::<B>(&opts);
+    let (witness, _) = attach_sim(&h, "witness", SimNode::new());
+    let before = run_cases(&mut h, &mut dut, &peer, &cases);
+    assert_eq!(before, expected_cases(&cases), "{}", B::NAME);
+    // On the bus: refused, nothing changed.
+    assert_eq!(
+        dut.driver().set_bus_mode(BusMode::LoopBack),
+        Err(Error::WrongMode)
+    );
+    assert_eq!(
+        dut.driver().set_bitrate(250_000, 875),
+        Err(Error::WrongMode)
+    );
+    assert_eq!(dut.bitrate_in_registers(), RATE, "{}", B::NAME);
+
+    // Loop-back: the node receives its own frames through the same filters.
+    dut.driver().set_mode(Mode::Stopped).unwrap();
+    dut.driver().set_bus_mode(BusMode::LoopBack).unwrap();
+    assert_eq!(dut.driver_ref().bus_mode(), BusMode::LoopBack);
+    dut.driver().set_mode(Mode::Normal).unwrap();
+    run(&mut h, &mut dut, 20);
+    let own = [
+        (std_frame(0x123, &[0xA]), Some(0u16)),
+        (std_frame(0x223, &[0xB]), None),
+        (ext_frame(0x0ABC_DE01, &[0xC]), Some(3)),
+    ];
+    let sent_before = dut.driver_ref().traffic().sent;
+    for (f, _) in &own {
+        dut.driver().try_send(f).unwrap();
+    }
+    for _ in 0..50 {
+        run(&mut h, &mut dut, 100);
+    }
+    assert_eq!(
+        dut.driver_ref().traffic().sent - sent_before,
+        own.len() as u32,
+        "{}: loop-back acknowledges its own frames",
+        B::NAME
+    );
+    let got: Vec<(Frame, u16)> = drain(&mut dut)
+        .iter()
+        .map(|r| (r.frame, r.filter))
+        .collect();
+    let want: Vec<(Frame, u16)> = own.iter().filter_map(|(f, i)| i.map(|i| (*f, i))).collect();
+    assert_eq!(got, want, "{}: loop-back", B::NAME);
+
+    // Listen-only: receives through the same filters, never transmits.
+    dut.driver().set_mode(Mode::Stopped).unwrap();
+    dut.driver().set_bus_mode(BusMode::ListenOnly).unwrap();
+    dut.driver().set_mode(Mode::Normal).unwrap();
+    run(&mut h, &mut dut, 20);
+    assert_eq!(dut.driver_ref().bus_mode(), BusMode::ListenOnly);
+    assert_eq!(
+        dut.driver().try_send(&std_frame(0x10, &[])),
+        Err(nb::Error::Other(Error::WrongMode)),
+        "{}",
+        B::NAME
+    );
+    let acked_by_witness = witness.borrow().received_frames().len();
+    let listening = run_cases(&mut h, &mut dut, &peer, &cases);
+    assert_eq!(listening, before, "{}: listen-only", B::NAME);
+    // Nobody but the witness acknowledged (the node never drives the bus).
+    assert_eq!(
+        witness.borrow().received_frames().len() - acked_by_witness,
+        cases.len(),
+        "{}",
+        B::NAME
+    );
+
+    // Back to normal, then a new bit rate (stop → set_bitrate → start).
+    dut.driver().set_mode(Mode::Stopped).unwrap();
+    dut.driver().set_bus_mode(BusMode::Normal).unwrap();
+    // A rate out of reach is a typed error and changes nothing.
+    assert_eq!(
+        dut.driver().set_bitrate(B::CLOCK_HZ, 875),
+        Err(Error::Timing(TimingError::BitrateTooHigh))
+    );
+    assert_eq!(dut.bitrate_in_registers(), RATE, "{}", B::NAME);
+    dut.driver().set_mode(Mode::Normal).unwrap();
+    let mut h2 = harness_at(250_000, h.now());
+    h2.bus().borrow_mut().attach("peer", peer.clone());
+    drop(h);
+    let (mut dut, how) = B::change_bitrate(dut, &opts, &mut h2).unwrap();
+    assert_eq!(how, BitrateChange::FiltersKept);
+    assert_eq!(dut.bitrate_in_registers(), 250_000, "{}", B::NAME);
+    assert_eq!(dut.driver_ref().bus_mode(), BusMode::Normal);
+    run(&mut h2, &mut dut, 20);
+    let after = run_cases(&mut h2, &mut dut, &peer, &cases);
+    assert_eq!(after, before, "{}: after the bit-rate change", B::NAME);
+}
+
+/// An empty list receives nothing; `Filter::pass_all` everything; a new list replaces
+/// the old one atomically.
+fn filter_list_semantics<B: Backend>() {
+    let probe = [
+        std_frame(0x100, &[1]),
+        ext_frame(0x0010_0000, &[2]),
+        remote_frame(0x200, false, 1),
+        remote_frame(0x1234, true, 0),
+    ];
+    let (mut h, mut dut, peer) = setup::<B>(&NodeOptions::filters(&[]));
+    let cases: Vec<(Frame, Option<u16>)> = probe.iter().map(|f| (*f, None)).collect();
+    let got = run_cases(&mut h, &mut dut, &peer, &cases);
+    assert_eq!(got, (vec![], probe.len() as u64), "{}: empty list", B::NAME);
+    // The node acknowledged them all (filtering is not refusing on the bus).
+    assert_eq!(peer.borrow().pending(), 0);
+
+    B::set_filters(&mut dut, &[Filter::pass_all()]).unwrap();
+    let cases: Vec<(Frame, Option<u16>)> = probe.iter().map(|f| (*f, Some(0))).collect();
+    let got = run_cases(&mut h, &mut dut, &peer, &cases);
+    assert_eq!(got, expected_cases(&cases), "{}: pass-all", B::NAME);
+
+    // Old list A; frames it accepted wait in the ring (serviced, not taken) and in the
+    // hardware FIFO (not serviced).
+    let a = [Filter::standard(0x100), Filter::standard(0x200)];
+    B::set_filters(&mut dut, &a).unwrap();
+    let dropped_before = dut.driver_ref().traffic().rx_dropped;
+    for id in [0x100, 0x200] {
+        peer.borrow_mut().send(std_frame(id, &[0xA]));
+    }
+    settle(&mut h, &mut dut, &[&peer], 10_000);
+    assert_eq!(dut.driver_ref().available(), 2, "{}", B::NAME);
+    for id in [0x200, 0x100] {
+        peer.borrow_mut().send(std_frame(id, &[0xB]));
+    }
+    h.bus().borrow_mut().run_until_idle(10_000).unwrap();
+    assert_eq!(peer.borrow().pending(), 0);
+    // New list B: the same identifiers under other indices, and one more.
+    let b = [
+        Filter::standard(0x200),
+        Filter::standard(0x300),
+        Filter::standard(0x100),
+    ];
+    B::set_filters(&mut dut, &b).unwrap();
+    // No frame with an index of list A after the call: the two in the hardware FIFO were
+    // discarded while the controller was off the bus for the switch, the two in the ring
+    // are dropped when taken (counted as dropped).
+    run(&mut h, &mut dut, 100);
+    let stale: Vec<(Frame, u16)> = drain(&mut dut)
+        .iter()
+        .map(|r| (r.frame, r.filter))
+        .collect();
+    assert_eq!(stale, vec![], "{}: frames of the old list", B::NAME);
+    assert_eq!(
+        dut.driver_ref().traffic().rx_dropped - dropped_before,
+        2,
+        "{}",
+        B::NAME
+    );
+    let cases = [
+        (std_frame(0x100, &[0xC]), Some(2)),
+        (std_frame(0x300, &[0xD]), Some(1)),
+        (std_frame(0x200, &[0xE]), Some(0)),
+        (std_frame(0x400, &[0xF]), None),
+    ];
+    let got = run_cases(&mut h, &mut dut, &peer, &cases);
+    assert_eq!(got, expected_cases(&cases), "{}: new list", B::NAME);
 }
 
 // ---------------------------------------------------------------------------------------
@@ -566,9 +909,9 @@ fn frames_that_break_the_format_are_typed_errors() {
 }
 
 #[test]
-fn bit_rate_changes_as_each_backend_offers_them() {
-    // bxCAN reconfigures a running controller and keeps its filter banks; FlexCAN has no
-    // such operation (ACAN neither): `begin` again, with the lists the application kept.
+fn bit_rate_changes_the_same_way_on_both_backends() {
+    // Both: stop → `Driver::set_bitrate` → start, the filter banks / ID table kept
+    // (FlexCAN no longer needs `begin` again, as ACAN does).
     let opts = NodeOptions::filters(&filter_list());
     let mut h = Harness::new(RATE).unwrap();
     let bx = BxCanBackend::attach(&mut h, &opts).unwrap();
@@ -577,7 +920,46 @@ fn bit_rate_changes_as_each_backend_offers_them() {
     let (_, how) = BxCanBackend::change_bitrate(bx, &opts, &mut h2).unwrap();
     assert_eq!(how, BitrateChange::FiltersKept);
     let (_, how) = FlexCanBackend::change_bitrate(flex, &opts, &mut h2).unwrap();
-    assert_eq!(how, BitrateChange::FiltersReinstalledFromLists);
+    assert_eq!(how, BitrateChange::FiltersKept);
+}
+
+#[test]
+fn capabilities_follow_the_current_configuration() {
+    // FlexCAN 14/18 partition (more than 12 filters): 14 + 18 elements, MB15 and MB14
+    // (ACAN §11 table 4).
+    let mut h = Harness::new(RATE).unwrap();
+    let many: Vec<Filter> = (0..20).map(|i| Filter::standard(0x100 + 3 * i)).collect();
+    let flex = FlexCanBackend::attach(&mut h, &NodeOptions::filters(&many)).unwrap();
+    let caps = flex.driver_ref().capabilities();
+    assert_eq!(
+        (
+            caps.max_standard_filters,
+            caps.max_extended_filters,
+            caps.tx_mailboxes
+        ),
+        (32, 32, 2)
+    );
+    // bxCAN CAN1 with CAN2SB = 14: banks 0..13 (RM0410 §40.7.4); with TTCM: 16-bit
+    // time stamps (§40.7.8).
+    let config = twocan_tests::backend::bxcan_config(RATE, Recovery::Automatic)
+        .unwrap()
+        .can2_start_bank(14)
+        .unwrap()
+        .timestamps(true);
+    let bx = twocan_host::BxNode::with_config(
+        &mut h,
+        &config,
+        &[Filter::pass_all()],
+        twocan_bxcan::FifoPolicy::Fifo0,
+    )
+    .unwrap();
+    let caps = bx.driver_ref().capabilities();
+    assert_eq!(
+        (caps.max_standard_filters, caps.max_extended_filters),
+        (14 * 4, 14 * 2)
+    );
+    assert_eq!(caps.timestamp_bits, Some(16));
+    assert_eq!(caps.clock_hz, 54_000_000);
 }
 
 #[test]
@@ -817,6 +1199,22 @@ macro_rules! suite {
             #[test]
             fn time_stamps_only_where_the_hardware_records_them() {
                 super::time_stamps_only_where_the_hardware_records_them::<$backend>();
+            }
+            #[test]
+            fn capabilities_are_the_hardware_facts() {
+                super::capabilities_are_the_hardware_facts::<$backend>();
+            }
+            #[test]
+            fn bus_off_recovery_both_modes() {
+                super::bus_off_recovery_both_modes::<$backend>();
+            }
+            #[test]
+            fn retiming_and_mode_changes_keep_the_filters() {
+                super::retiming_and_mode_changes_keep_the_filters::<$backend>();
+            }
+            #[test]
+            fn filter_list_semantics() {
+                super::filter_list_semantics::<$backend>();
             }
         }
     };

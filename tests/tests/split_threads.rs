@@ -165,7 +165,7 @@ fn exchange(per_direction: u32) -> (u32, u32) {
         &mut HostSystem::new(),
         Target::new(Board::Teensy36, Instance::Can0),
         &Settings::new(RATE),
-        &[],
+        &[Filter::pass_all()],
         &[],
     )
     .unwrap();

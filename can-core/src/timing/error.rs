@@ -32,8 +32,12 @@ pub enum TimingError {
     /// configuration", §16.2).
     Inconsistent(Consistency),
     /// A register encoding for the other controller was asked for (e.g. a bxCAN
-    /// BTR from FlexCAN limits).
+    /// BTR from FlexCAN limits), or a timing made for another controller's limits was
+    /// handed to a controller ([`crate::Hardware::set_timing`]).
     WrongController,
+    /// The timing was computed for another CAN clock than the controller's
+    /// ([`crate::Capabilities::clock_hz`]).
+    WrongClock,
 }
 
 impl fmt::Display for TimingError {
@@ -57,6 +61,9 @@ impl fmt::Display for TimingError {
             TimingError::Inconsistent(c) => write!(f, "inconsistent CAN bit setting: {c}"),
             TimingError::WrongController => {
                 f.write_str("register encoding asked for another controller")
+            }
+            TimingError::WrongClock => {
+                f.write_str("timing computed for another clock than the controller's")
             }
         }
     }

@@ -5,7 +5,8 @@
 
 use twocan_flexcan::Settings;
 
-/// `teensy-loopback`: ACAN §4, 125 kbit/s, loop-back and self reception, no filter.
+/// `teensy-loopback`: ACAN §4, 125 kbit/s, loop-back and self reception; the pass-all
+/// filter (ACAN's "no filter": an empty list receives nothing in twocan).
 pub const LOOPBACK: Settings = {
     let mut s = Settings::new(125_000);
     s.loop_back = true;

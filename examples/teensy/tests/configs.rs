@@ -23,7 +23,7 @@ fn examples() -> Vec<Example> {
             "loopback",
             Instance::Can0,
             configs::LOOPBACK,
-            vec![],
+            vec![Filter::pass_all()],
             vec![],
         ),
         (

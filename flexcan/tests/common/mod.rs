@@ -26,7 +26,24 @@ pub fn model_for(board: Board) -> FlexCanModel {
 }
 
 /// `begin` on `target` over a fresh model; gives the model handle and the driver.
+///
+/// These tests follow ACAN's examples, whose "no filter" form receives everything: with
+/// both lists empty the helper passes twocan's explicit [`Filter::pass_all`] (an empty
+/// list receives nothing in twocan, see [`begin_on_exact`]).
 pub fn begin_on<const RX: usize, const TX: usize>(
+    target: Target,
+    settings: &Settings,
+    primary: &[Filter],
+    secondary: &[Filter],
+) -> Result<(FlexCanModel, Can<RX, TX>), BeginError> {
+    if primary.is_empty() && secondary.is_empty() {
+        return begin_on_exact(target, settings, &[Filter::pass_all()], &[]);
+    }
+    begin_on_exact(target, settings, primary, secondary)
+}
+
+/// `begin` with exactly these lists (both empty: nothing is received).
+pub fn begin_on_exact<const RX: usize, const TX: usize>(
     target: Target,
     settings: &Settings,
     primary: &[Filter],

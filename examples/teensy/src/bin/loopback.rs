@@ -10,7 +10,7 @@
 mod firmware {
     use core::sync::atomic::{AtomicU32, Ordering};
 
-    use twocan_core::Frame;
+    use twocan_core::{Filter, Frame};
     use twocan_flexcan::pin::{Pin3, Pin4};
     use twocan_flexcan::{Can0, Settings};
     use twocan_teensy::can::CanState;
@@ -34,7 +34,7 @@ mod firmware {
         twocan_teensy::info!("teensy-loopback: CAN0 in loop-back, a frame every second");
         let token = Can0::take().unwrap_or_else(|| rt::halt(CAN_BLINKS));
         let can = token
-            .begin_on(Pin3, Pin4, &SETTINGS, &[], &[])
+            .begin_on(Pin3, Pin4, &SETTINGS, &[Filter::pass_all()], &[])
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         let (mut tx, mut rx) = CAN0
             .start(can.into_split(), &mut boot.core.NVIC)
