@@ -55,6 +55,7 @@ pub struct FlexCan<R: Registers> {
 }
 
 impl<R: Registers> FlexCan<R> {
+    #[allow(clippy::too_many_arguments)]
     pub(crate) fn configured(
         regs: R,
         target: Target,

@@ -327,10 +327,11 @@ fn a_frame_caught_by_a_remote_frame_mailbox_is_counted() {
 }
 
 /// The same catch while the driver's own control-word read keeps the mailbox locked:
-/// the frame waits in the serial message buffer while the transmit handler settles the
-/// remote frame and makes the mailbox inactive; it moves in at the next unlock (here
-/// the driver reading MB15 to load a data frame), raises the mailbox's flag again, and
-/// the handler counts it then — it is not lost without a trace.
+/// the frame waits in the serial message buffer until the next unlock. The transmit
+/// handler's settle reads `TIMER` after the completion's time stamp (widening), which
+/// unlocks it (Kinetis RM "Message buffer lock mechanism"): the frame moves in, raises
+/// the mailbox's flag, and the handler counts it in the same pass — once, not lost and
+/// not counted again when the driver later reads MB15 to load a data frame.
 #[test]
 fn a_frame_caught_behind_the_lock_is_counted_at_the_next_unlock() {
     use twocan_core::{Filter, Format, FrameKind};
@@ -349,12 +350,12 @@ fn a_frame_caught_behind_the_lock_is_counted_at_the_next_unlock() {
     run(&mut bus, &mut [], 200);
     let first = s.configuration.first_remote_mailbox() as usize;
     assert_eq!(model.locked_mailbox(), Some(first));
-    // Settled with the frame still behind the lock: nothing to count yet.
+    // Settled; the settle's TIMER read unlocked the mailbox and the catch is counted.
     run1(&mut bus, &mut can, 10);
     assert_eq!(can.traffic().sent, 1);
-    assert_eq!(can.hardware().remote_mailbox_catches(), 0);
-    // Loading a data frame reads MB15's control word: MB `first` unlocks, the frame
-    // moves in, and the handler counts it.
+    assert_eq!(can.hardware().remote_mailbox_catches(), 1);
+    assert_eq!(model.locked_mailbox(), None);
+    // Loading a data frame reads MB15's control word: nothing more to count.
     can.try_send(&std_data(0x10, &[1])).unwrap();
     run1(&mut bus, &mut can, 300);
     assert_eq!(can.hardware().remote_mailbox_catches(), 1);

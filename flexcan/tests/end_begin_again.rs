@@ -6,7 +6,7 @@
 mod common;
 
 use common::*;
-use twocan_core::{Driver, Error, Registers};
+use twocan_core::{Driver, Error, Filter, Registers};
 use twocan_flexcan::model::{FlexCanModel, ModelMode};
 use twocan_flexcan::regs::sim;
 use twocan_flexcan::{Board, FlexCan, FlexCanHw, HostSystem, Instance, Settings, Target};
@@ -14,8 +14,8 @@ use twocan_flexcan::{Board, FlexCan, FlexCanHw, HostSystem, Instance, Settings, 
 type Drv = Driver<FlexCanHw<Ticking>, 32, 16>;
 
 fn start(regs: Ticking, sys: &mut HostSystem, target: Target, settings: &Settings) -> Drv {
-    let controller =
-        FlexCan::begin(regs, sys, target, settings, &[], &[]).expect("begin: valid settings");
+    let controller = FlexCan::begin(regs, sys, target, settings, &[Filter::pass_all()], &[])
+        .expect("begin: valid settings");
     Driver::new(controller.into_split())
 }
 
@@ -108,7 +108,15 @@ fn end_of_an_unsplit_controller_and_alternate_pins() {
     assert_eq!(sys.read32(sim::SIM_SCGC6) & sim::SCGC6_FLEXCAN0, 0);
     assert_eq!(model.mode(), ModelMode::Disabled);
     // Again, with the default pins this time.
-    let again = FlexCan::begin(regs, &mut sys, target, &loop_back(125_000), &[], &[]).unwrap();
+    let again = FlexCan::begin(
+        regs,
+        &mut sys,
+        target,
+        &loop_back(125_000),
+        &[Filter::pass_all()],
+        &[],
+    )
+    .unwrap();
     assert_eq!(again.system().tx.0.teensy_pin, 3);
     assert_eq!(
         sys.read32(sim::SIM_SCGC6) & sim::SCGC6_FLEXCAN0,

@@ -8,7 +8,7 @@
 mod common;
 
 use common::*;
-use twocan_core::{Driver, Registers};
+use twocan_core::{Driver, Filter, Registers};
 use twocan_flexcan::pin::{self, RxPin, TxPin};
 use twocan_flexcan::regs::port::PCR_MUX;
 use twocan_flexcan::{Board, Can0, FlexCan, FlexCanHw, HostSystem, Instance, Target};
@@ -23,7 +23,7 @@ fn begin_with<T: TxPin<Can0>, X: RxPin<Can0>>(tx: T, rx: X) {
         &mut sys,
         target,
         &settings,
-        &[],
+        &[Filter::pass_all()],
         &[],
     )
     .expect("begin on typed pins");
