@@ -84,6 +84,11 @@ pub struct FlexCanHw<R: Registers> {
     /// Frames caught by remote-frame mailboxes turned receive mailboxes (written by the
     /// transmit interrupt's `settle` only).
     caught: AtomicU32,
+    /// `ESR1` error bits (clear-on-read) read by a state read (`status_now`) and not yet
+    /// reported: the status handler reports them with its own read, so an error that
+    /// a state read took out of `ESR1` (for example one raised between the handler's
+    /// read and its write-back, whose `ERRINT` the write-back cleared) is still counted.
+    unreported: AtomicU32,
 }
 
 impl<R: Registers> FlexCan<R> {
@@ -106,6 +111,7 @@ impl<R: Registers> FlexCan<R> {
             loaded: AtomicU32::new(0),
             system: self.system,
             caught: AtomicU32::new(0),
+            unreported: AtomicU32::new(0),
         }
     }
 }
@@ -223,6 +229,11 @@ impl<R: Registers> FlexCanHw<R> {
         }
         let esr = self.regs.read32(ESR1);
         self.latch(esr);
+        // The read cleared the error bits: keep them for the status handler to count.
+        if esr & esr1::ERROR_BITS != 0 {
+            self.unreported
+                .fetch_or(esr & esr1::ERROR_BITS, Ordering::Relaxed);
+        }
         let (state, counters) = status::decode(esr, self.regs.read32(ECR));
         let state = if self.mode() == MODE_STOPPED {
             ErrorState::Stopped
@@ -540,6 +551,11 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
 
     /// `ESR1`: the error code latched, the write-1-to-clear interrupt bits read
     /// acknowledged (exactly those), wake-up; the state from `FLTCONF` and `ECR`.
+    ///
+    /// An error raised between the read and the write-back sets `ERRINT` again, which
+    /// the write-back clears (the flag was set when read); its error bits stay in `ESR1`
+    /// and the state read that follows takes them into `unreported`, so the caller's
+    /// next call (the split driver calls again while errors are reported) counts it.
     unsafe fn take_status(&self) -> StatusEvents {
         if self.mode() == MODE_SLEEP {
             return StatusEvents {
@@ -548,10 +564,13 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
                 wakeup: false,
             };
         }
-        let esr = self.regs.read32(ESR1);
+        let read = self.regs.read32(ESR1);
+        // Error bits a state read took out of ESR1 since the last report count now.
+        let esr = read | self.unreported.swap(0, Ordering::Relaxed);
         let bus_error = self.latch(esr);
-        if esr & esr1::W1C_BITS != 0 {
-            self.regs.write32(ESR1, esr & esr1::W1C_BITS);
+        // Exactly the flags read: one raised after the read stays set.
+        if read & esr1::W1C_BITS != 0 {
+            self.regs.write32(ESR1, read & esr1::W1C_BITS);
         }
         StatusEvents {
             bus_error,
