@@ -20,7 +20,7 @@
 //!    is synchronised to the bus (`ESR1.SYNCH`, 11 recessive bits; internal in
 //!    loop-back mode): when `begin` returns, a frame starting on the bus is received.
 //!
-//! Every wait is bounded by [`Settings::handshake_polls`]; a missing acknowledge is
+//! Every wait is bounded by [`Settings::handshake_bound`]; a missing acknowledge is
 //! [`BeginError::Hardware`]`(`[`Error::Timeout`]`)`.
 
 use twocan_core::{Error, Filter, Registers};
@@ -220,13 +220,14 @@ impl<R: Registers> FlexCan<R> {
             .map_err(BeginError::Timing)?;
         let plan = plan(target, settings, primary, secondary).map_err(BeginError::Config)?;
         plan.system.apply(sys);
-        configure(&mut regs, &plan, settings.handshake_polls)?;
+        let polls = settings.handshake_bound();
+        configure(&mut regs, &plan, polls)?;
         Ok(FlexCan::configured(
             regs,
             target,
             plan.table,
             settings.listen_only,
-            settings.handshake_polls,
+            polls,
             settings.message_irq_priority,
             plan.system,
         ))
