@@ -82,12 +82,15 @@ fn abort_before_start_of_frame_completes_as_aborted() {
     assert!(bus.trace().records().is_empty(), "nothing on the wire");
 }
 
+/// An event run once between the driver's read of a register and its write-back.
+type Hook = Rc<RefCell<Option<Box<dyn FnMut()>>>>;
+
 /// Register access to the model that runs `hook` just before a write to `ESR1`, i.e.
 /// between the driver's read of `ESR1` and its write-back.
 #[derive(Clone)]
 struct InjectBeforeEsr1Write {
     inner: Ticking,
-    hook: Rc<RefCell<Option<Box<dyn FnMut()>>>>,
+    hook: Hook,
 }
 
 impl std::fmt::Debug for InjectBeforeEsr1Write {
@@ -115,7 +118,7 @@ impl Registers for InjectBeforeEsr1Write {
 #[test]
 fn an_error_raised_between_the_esr1_read_and_its_write_back_is_counted() {
     let model = FlexCanModel::mk20dx256();
-    let hook: Rc<RefCell<Option<Box<dyn FnMut()>>>> = Rc::new(RefCell::new(None));
+    let hook: Hook = Rc::new(RefCell::new(None));
     let regs = InjectBeforeEsr1Write {
         inner: Ticking::new(model.clone()),
         hook: hook.clone(),
