@@ -4,7 +4,7 @@
 //! §40.4.1 "Initialization mode": `CAN_BTR` can only be written there; the notes'
 //! `CAN_MCR` bit list for TTCM, ABOM, AWUM, NART, RFLM, TXFP, DBF).
 
-use twocan_core::timing::frame_time::frame_in_flight_wait;
+use twocan_core::timing::frame_time::{frame_in_flight_wait, MAX_FRAME_IN_FLIGHT_BITS};
 use twocan_core::timing::{solve, solve_cia, Limits, Timing, TimingError, DEFAULT_TOLERANCE_PPM};
 use twocan_core::TxPolicy;
 
@@ -62,8 +62,30 @@ pub const DEFAULT_INTERRUPTS: u32 = ier::TMEIE
 /// §40.4.1): 11 ms at 1 kbit/s. One read of an APB1 register costs at least 4 CPU cycles,
 /// so 1,000,000 reads last at least 18 ms at 216 MHz — longer than that — and end in
 /// [`twocan_core::Error::Timeout`] when the acknowledge never comes (no transceiver, no
-/// clock).
+/// clock). A frame in flight delays the acknowledge too: configurations built from a bit
+/// rate ([`Config::from_timing`]) or a raw `CAN_BTR` ([`btr_wait_iterations`]) raise the
+/// bound to twice the longest frame in flight at their bit rate when that is longer.
 pub const DEFAULT_WAIT_ITERATIONS: u32 = 1_000_000;
+
+/// The acknowledge-wait bound for a raw `CAN_BTR` value, whatever the APB1 clock.
+///
+/// A bit lasts `(BRP + 1) × (1 + (TS1 + 1) + (TS2 + 1))` APB1 cycles (RM0410 §40.7.7
+/// "Bit timing": tq = (BRP + 1) × tPCLK, one bit = SYNC_SEG + BS1 + BS2), and every poll
+/// reads an APB1 register, at least one APB1 cycle. Twice the longest frame in flight
+/// ([`MAX_FRAME_IN_FLIGHT_BITS`] bits) in APB1 cycles is therefore enough polls at any
+/// clock, with no need to know it; never below [`DEFAULT_WAIT_ITERATIONS`]. The largest
+/// encodable bit (BRP 1024, 25 tq) gives 2 × 191 × 25,600 = 9,779,200 polls.
+pub const fn btr_wait_iterations(btr_value: u32) -> u32 {
+    let brp = btr::BRP.get(btr_value) as u64 + 1;
+    let tq = 1 + (btr::TS1.get(btr_value) as u64 + 1) + (btr::TS2.get(btr_value) as u64 + 1);
+    let polls = 2 * MAX_FRAME_IN_FLIGHT_BITS as u64 * brp * tq;
+    if polls > DEFAULT_WAIT_ITERATIONS as u64 {
+        // At most 9,779,200 (above): fits.
+        polls as u32
+    } else {
+        DEFAULT_WAIT_ITERATIONS
+    }
+}
 
 /// Configuration of one bxCAN instance (builder; every setter is `const`).
 ///
@@ -125,7 +147,10 @@ impl Config {
         if btr_value & !BTR_TIMING != 0 {
             return Err(ConfigError::BtrReservedBits);
         }
-        Ok(Self::with_btr(btr_value))
+        Ok(Config {
+            wait_iterations: btr_wait_iterations(btr_value),
+            ..Self::with_btr(btr_value)
+        })
     }
 
     /// A configuration from a [`Timing`] (for example adjusted by hand), accepted when
@@ -429,6 +454,30 @@ mod tests {
             Config::from_bitrate(54_000_000, 500_000)
                 .unwrap()
                 .get_wait_iterations(),
+            DEFAULT_WAIT_ITERATIONS
+        );
+    }
+
+    #[test]
+    fn raw_btr_waits_cover_a_frame_in_flight_at_its_own_bit_rate() {
+        // The slowest encodable bit: BRP = 1024, TS1 = 16 tq, TS2 = 8 tq (25 tq).
+        let slowest = btr::BRP.val(1023) | btr::TS1.val(15) | btr::TS2.val(7);
+        let c = Config::from_btr(slowest).unwrap();
+        assert_eq!(c.get_wait_iterations(), 2 * 191 * 1024 * 25);
+        assert_eq!(c.get_wait_iterations(), 9_779_200);
+        // At 54 MHz that bit rate is 54e6 / 25,600 = 2,109 bit/s: 191 bits last 90.6 ms,
+        // the polls (one APB1 cycle at least each) at least 181 ms.
+        let polls_us = c.get_wait_iterations() as u64 * 1_000_000 / 54_000_000;
+        let frame_us = 191 * 1_000_000 * 25_600 / 54_000_000;
+        assert!(polls_us >= 2 * frame_us, "{polls_us} us for {frame_us} us");
+        // The same BTR as a solved 2.5 kbit/s configuration: the same bound as the solver
+        // path (the rate is exact, so both count the same APB1 cycles).
+        let solved = Config::from_bitrate(54_000_000, 2_500).unwrap();
+        let raw = Config::from_btr(solved.btr_value()).unwrap();
+        assert_eq!(raw.get_wait_iterations(), solved.get_wait_iterations());
+        // A fast raw BTR keeps the default.
+        assert_eq!(
+            Config::from_btr(0x001C_0005).unwrap().get_wait_iterations(),
             DEFAULT_WAIT_ITERATIONS
         );
     }

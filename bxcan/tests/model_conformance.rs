@@ -9,7 +9,6 @@ mod tiny;
 use conformance::Dut;
 use tiny::{accept_all, enter_init, load};
 use twocan_bxcan::model::BxCanModel;
-use twocan_bxcan::model::REC_AFTER_PASSIVE_RECEPTION;
 use twocan_bxcan::regs::{self, esr, mcr, tsr};
 use twocan_core::sim::{Bus, NodeId};
 use twocan_core::{ErrorCounters, ErrorState, Frame, Registers};
@@ -56,7 +55,8 @@ impl Dut for BxCan {
             ErrorState::Active
         }
     }
-    const REC_AFTER_PASSIVE_RECEPTION: u16 = REC_AFTER_PASSIVE_RECEPTION as u16;
+    /// Written as a literal, not taken from the model: the bxCAN notes (after RM0410 §40.7.6 "Error management"): "reset to 120".
+    const REC_AFTER_PASSIVE_RECEPTION: u16 = 120;
 }
 
 conformance_tests!(BxCan);

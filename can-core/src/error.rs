@@ -105,6 +105,17 @@ impl AtomicLastError {
 }
 
 /// Error statistics counters the driver keeps (saturating).
+///
+/// The per-kind counts (`stuff`, `form`, `acknowledge`, `bit`, `crc`) are taken from the
+/// controller's last-error code when its status interrupt is serviced. On bxCAN that code
+/// (`CAN_ESR.LEC`, RM0410 §40.7.6 "Error management") holds one error only and is re-armed
+/// by writing `0b111` after the read; an error latched between two services, or between
+/// the read and that write, overwrites or is overwritten (no register sequence avoids
+/// it), so there these counts are a **lower bound** of the errors on the bus. FlexCAN
+/// (`ESR1`, its error bits cleared by the read and its `ERRINT` acknowledged exactly as
+/// read) keeps a new error pending, but two errors of one kind between two services
+/// still count once. The error counters and state ([`ErrorCounters`], [`ErrorState`])
+/// come from the hardware's TEC/REC and are exact.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct ErrorStatistics {

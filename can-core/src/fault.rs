@@ -58,6 +58,8 @@ impl core::fmt::Display for RecResetOutOfRange {
     }
 }
 
+impl core::error::Error for RecResetOutOfRange {}
+
 impl Default for FaultConfinement {
     fn default() -> Self {
         Self::new()
@@ -334,6 +336,17 @@ impl FaultConfinement {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn rec_reset_out_of_range_is_an_error_with_a_message() {
+        let e = FaultConfinement::with_rec_after_passive_reception(118).unwrap_err();
+        assert_eq!(e, RecResetOutOfRange(118));
+        let e: &dyn core::error::Error = &e;
+        assert_eq!(
+            std::format!("{e}"),
+            "REC after a successful reception above 127 must be in 119..=127, not 118"
+        );
+    }
 
     #[test]
     fn lone_transmitter_stops_at_error_passive() {

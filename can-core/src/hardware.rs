@@ -251,6 +251,11 @@ pub unsafe trait Hardware {
 
     /// Status interrupt: reads and acknowledges error and wake-up causes.
     ///
+    /// The driver calls it again (a few times at most) while it reports a bus error, so
+    /// an implementation that found a further error it could not report in the same
+    /// call (or whose acknowledge may have cleared the flag of an error raised during
+    /// it) reports that one on the next call; a call with nothing new reports `None`.
+    ///
     /// # Safety
     /// Called from this method's one context only (see the [module docs](self)).
     unsafe fn take_status(&self) -> StatusEvents;

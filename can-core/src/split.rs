@@ -1075,6 +1075,10 @@ pub struct StatusIrq<
     pub(crate) last: ErrorState,
 }
 
+/// Calls of `Hardware::take_status` per status interrupt at most (each after one that
+/// reported an error).
+const MAX_STATUS_ROUNDS: u32 = 4;
+
 impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize>
     StatusIrq<'_, H, RX, Q, RX1, DONE>
 {
@@ -1083,12 +1087,24 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
     pub fn on_interrupt(&mut self) {
         let s = self.s;
         // SAFETY: this handle is the only caller of `take_status`.
-        let ev = unsafe { s.hw().take_status() };
+        let mut ev = unsafe { s.hw().take_status() };
         s.refresh_timestamps();
-        if let Some(code) = ev.bus_error {
+        let mut wakeup = ev.wakeup;
+        // While a call reports an error, call again (bounded): a controller may hold an
+        // error that one call could not report (FlexCAN: one raised between its read
+        // of ESR1 and the write-back, see `Hardware::take_status`).
+        let mut rounds = 0;
+        while let Some(code) = ev.bus_error {
             s.errors.record(code);
+            rounds += 1;
+            if rounds == MAX_STATUS_ROUNDS {
+                break;
+            }
+            // SAFETY: as above.
+            ev = unsafe { s.hw().take_status() };
+            wakeup |= ev.wakeup;
         }
-        if ev.wakeup {
+        if wakeup {
             s.errors.wakeups.inc();
         }
         self.note(ev.status);

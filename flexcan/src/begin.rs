@@ -20,7 +20,7 @@
 //!    is synchronised to the bus (`ESR1.SYNCH`, 11 recessive bits; internal in
 //!    loop-back mode): when `begin` returns, a frame starting on the bus is received.
 //!
-//! Every wait is bounded by [`Settings::handshake_polls`]; a missing acknowledge is
+//! Every wait is bounded by [`Settings::handshake_bound`]; a missing acknowledge is
 //! [`BeginError::Hardware`]`(`[`Error::Timeout`]`)`.
 
 use twocan_core::{BusMode, BusOffRecovery, Error, Filter, Registers};
@@ -227,7 +227,8 @@ impl<R: Registers> FlexCan<R> {
             .map_err(BeginError::Timing)?;
         let plan = plan(target, settings, primary, secondary).map_err(BeginError::Config)?;
         plan.system.apply(sys);
-        configure(&mut regs, &plan, settings.handshake_polls)?;
+        let polls = settings.handshake_bound();
+        configure(&mut regs, &plan, polls)?;
         let bus_mode = if settings.listen_only {
             BusMode::ListenOnly
         } else if settings.loop_back {
@@ -241,7 +242,7 @@ impl<R: Registers> FlexCan<R> {
             plan.table,
             bus_mode,
             settings.bus_off_recovery,
-            settings.handshake_polls,
+            polls,
             settings.message_irq_priority,
             plan.system,
         ))

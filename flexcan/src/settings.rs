@@ -107,7 +107,10 @@ pub struct Settings {
     pub rx_pin_pull_up: bool,
     /// Bound of every acknowledge wait, in register polls (not in ACAN: a controller
     /// that never acknowledges, or never synchronises to the bus, ends in
-    /// [`twocan_core::Error::Timeout`]).
+    /// [`twocan_core::Error::Timeout`]). `0` (the default) derives it from the bit rate
+    /// of [`Settings::timing`] as it is when `begin` runs, so a timing changed after
+    /// [`Settings::new`] cannot leave a bound computed for another rate; see
+    /// [`Settings::handshake_bound`].
     pub handshake_polls: u32,
     /// Also interrupt on bus errors, bus-off and the warning levels (`CTRL1.ERRMSK`,
     /// `BOFFMSK`, `TWRNMSK`, `RWRNMSK`, `MCR.WRNEN`), so that the driver's error
@@ -166,7 +169,7 @@ impl Settings {
             message_irq_priority: DEFAULT_IRQ_PRIORITY,
             tx_pin_open_collector: false,
             rx_pin_pull_up: false,
-            handshake_polls: handshake_polls_for(bit_rate),
+            handshake_polls: 0,
             error_interrupts: true,
             bus_clock_hz: None,
             bus_off_recovery: BusOffRecovery::Automatic,
@@ -191,6 +194,17 @@ impl Settings {
     /// Irrelevant when [`Settings::consistency`] reports an error.
     pub const fn actual_bit_rate(&self) -> u32 {
         self.timing.actual_bitrate()
+    }
+
+    /// The acknowledge-wait bound `begin` uses: [`Settings::handshake_polls`] when set
+    /// (non-zero), else [`handshake_polls_for`] the actual bit rate of the current
+    /// [`Settings::timing`] (computed here, from the final timing, never stored).
+    pub const fn handshake_bound(&self) -> u32 {
+        if self.handshake_polls != 0 {
+            self.handshake_polls
+        } else {
+            handshake_polls_for(self.actual_bit_rate())
+        }
     }
 
     /// Whether the actual bit rate is exactly the wished one (ACAN §16.4).
@@ -258,15 +272,29 @@ mod tests {
         use twocan_core::timing::frame_time::MAX_FRAME_IN_FLIGHT_BITS;
         let s = Settings::new(2_500);
         let frame_ms = MAX_FRAME_IN_FLIGHT_BITS as u64 * 1000 / 2_500;
-        let polls_ms = s.handshake_polls as u64 * 1000 / MAX_BUS_CLOCK_HZ as u64;
+        let polls_ms = s.handshake_bound() as u64 * 1000 / MAX_BUS_CLOCK_HZ as u64;
         assert!(
             polls_ms >= 2 * frame_ms - 1,
             "{polls_ms} ms for {frame_ms} ms"
         );
         assert_eq!(
-            Settings::new(500_000).handshake_polls,
+            Settings::new(500_000).handshake_bound(),
             DEFAULT_HANDSHAKE_POLLS
         );
+    }
+
+    #[test]
+    fn handshake_bound_follows_a_timing_changed_after_new() {
+        // Built for 500 kbit/s, then given the 2.5 kbit/s timing: the bound is the slow
+        // rate's (2 × 191 bits × 60 MHz / 2,500 = 9,168,000 polls), not the default.
+        let mut s = Settings::new(500_000);
+        assert_eq!(s.handshake_bound(), DEFAULT_HANDSHAKE_POLLS);
+        s.timing = Settings::new(2_500).timing;
+        assert_eq!(s.actual_bit_rate(), 2_500);
+        assert_eq!(s.handshake_bound(), 9_168_000);
+        // A bound set by hand is kept whatever the timing.
+        s.handshake_polls = 1_000;
+        assert_eq!(s.handshake_bound(), 1_000);
     }
 
     use super::*;

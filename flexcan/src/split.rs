@@ -118,6 +118,11 @@ pub struct FlexCanHw<R: Registers> {
     /// Frames caught by remote-frame mailboxes turned receive mailboxes (written by the
     /// transmit interrupt's `settle` only).
     caught: AtomicU32,
+    /// `ESR1` error bits (clear-on-read) read by a state read (`status_now`) and not yet
+    /// reported: the status handler reports them with its own read, so an error that
+    /// a state read took out of `ESR1` (for example one raised between the handler's
+    /// read and its write-back, whose `ERRINT` the write-back cleared) is still counted.
+    unreported: AtomicU32,
 }
 
 impl<R: Registers> FlexCan<R> {
@@ -145,6 +150,7 @@ impl<R: Registers> FlexCan<R> {
             loaded: AtomicU32::new(0),
             system: self.system,
             caught: AtomicU32::new(0),
+            unreported: AtomicU32::new(0),
         }
     }
 }
@@ -269,7 +275,22 @@ impl<R: Registers> FlexCanHw<R> {
             };
         }
         let esr = self.regs.read32(ESR1);
+        self.keep_unreported(esr);
+        self.status_of(esr)
+    }
+
+    /// Error bits of an `ESR1` value read outside the status handler's own read (the
+    /// read cleared them): latched as the last error and kept for the handler to count.
+    fn keep_unreported(&self, esr: u32) {
         self.latch(esr);
+        if esr & esr1::ERROR_BITS != 0 {
+            self.unreported
+                .fetch_or(esr & esr1::ERROR_BITS, Ordering::Relaxed);
+        }
+    }
+
+    /// The status from an `ESR1` value just read, and `ECR`.
+    fn status_of(&self, esr: u32) -> ErrorStatus {
         let (state, counters) = status::decode(esr, self.regs.read32(ECR));
         let state = if self.mode() == MODE_STOPPED {
             ErrorState::Stopped
@@ -623,6 +644,14 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
 
     /// `ESR1`: the error code latched, the write-1-to-clear interrupt bits read
     /// acknowledged (exactly those), wake-up; the state from `FLTCONF` and `ECR`.
+    ///
+    /// An error raised between the read and the write-back sets `ERRINT` again, which
+    /// the write-back clears (the flag was set when read); its error bits stay in `ESR1`
+    /// and the read after the write-back takes them into `unreported`, so the caller's
+    /// next call (the split driver calls again while errors are reported) counts it.
+    /// `ESR1` is read once more only after a write-back, so a call with nothing to
+    /// acknowledge reads it once (never twice in a row: a polled-register simulation
+    /// clock would take that for a wait loop).
     unsafe fn take_status(&self) -> StatusEvents {
         if self.mode() == MODE_SLEEP {
             return StatusEvents {
@@ -631,15 +660,24 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
                 wakeup: false,
             };
         }
-        let esr = self.regs.read32(ESR1);
+        let read = self.regs.read32(ESR1);
+        // Error bits a state read took out of ESR1 since the last report count now.
+        let esr = read | self.unreported.swap(0, Ordering::Relaxed);
         let bus_error = self.latch(esr);
-        if esr & esr1::W1C_BITS != 0 {
-            self.regs.write32(ESR1, esr & esr1::W1C_BITS);
+        let mut now = read;
+        if read & esr1::W1C_BITS != 0 {
+            // Exactly the flags read: one raised after the read stays set.
+            self.regs.write32(ESR1, read & esr1::W1C_BITS);
+            // An error raised between the read and the write-back lost its ERRINT to
+            // the write-back if ERRINT was already set; its error bits are still
+            // there: read them (the next call reports them) and the state after it.
+            now = self.regs.read32(ESR1);
+            self.keep_unreported(now);
         }
         StatusEvents {
             bus_error,
-            status: self.status_now(),
-            wakeup: esr & esr1::WAKINT != 0,
+            status: self.status_of(now),
+            wakeup: read & esr1::WAKINT != 0,
         }
     }
 

@@ -47,9 +47,19 @@
 //! not move, except by rule 6. The intermission is played only while something may drive it
 //! (an overload frame in progress, a stuck-dominant bus).
 //!
-//! Not modelled: a dominant bit during an error delimiter (taken as a continuation of the
-//! flag period) or at the last bit of a delimiter, the third intermission bit read dominant
-//! (a start of frame), hard synchronisation effects.
+//! Not modelled (what the engine does instead):
+//! - a dominant bit inside an error or overload delimiter, after its first recessive bit:
+//!   ISO 11898-1 makes it a form error (a fixed-form field, §10.11.4) and a new error flag,
+//!   with the counters of rules 1/3; the engine counts nothing and waits one more recessive
+//!   bit (the delimiter is stretched, `Phase::Delimiter` keeps its count);
+//! - a dominant last delimiter bit: an overload condition (§10.4.5), here the same stretch;
+//! - a dominant third intermission bit: a start of frame for a node with a frame to send
+//!   (§10.4.6.2); here the intermission ends and the next attempt starts at its own time;
+//! - hard synchronisation effects.
+//!
+//! Modelling the first two needs a second error inside one attempt (its own counter
+//! change, +1 for a receiver, which the one-error-plus-penalties outcome cannot carry):
+//! `PartOutcome` and `FaultConfinement` would change with it.
 
 use super::bits::FrameBits;
 use super::inject::{is_stuff_bit, RxFault, TxFault};

@@ -91,6 +91,8 @@ impl core::fmt::Display for FrameTimeError {
     }
 }
 
+impl core::error::Error for FrameTimeError {}
+
 /// Clock cycles of `clock_hz` that `bits` bit times at `bit_rate` bit/s last, rounded up.
 ///
 /// A wait loop that polls a register and gives up after this many iterations lasts at
@@ -167,5 +169,20 @@ mod tests {
         let at = |rate| bits_to_micros(MAX_FRAME_IN_FLIGHT_BITS, rate).unwrap();
         assert!(at(10_000) > 18_000);
         assert!(at(125_000) < 18_000);
+    }
+
+    #[test]
+    fn frame_time_error_is_an_error_with_a_message() {
+        fn as_error(e: &dyn core::error::Error) -> std::string::String {
+            std::format!("{e}")
+        }
+        assert_eq!(
+            as_error(&FrameTimeError::BitRateZero),
+            "bit rate must be above 0 bit/s"
+        );
+        assert_eq!(
+            as_error(&FrameTimeError::ClockZero),
+            "clock must be above 0 Hz"
+        );
     }
 }

@@ -18,7 +18,9 @@ use std::cell::RefCell;
 use std::rc::Rc;
 
 use twocan_core::fault::BUS_OFF_RECOVERY_SEQUENCES;
-use twocan_core::sim::{frame_bits, Bus, BusEvent, Fault, NodeId, Receivers, SimNode, TraceRecord};
+use twocan_core::sim::{
+    frame_bits, Bus, BusEvent, Fault, FormField, NodeId, Receivers, SimNode, TraceRecord,
+};
 use twocan_core::{ErrorCounters, ErrorState, Frame, LastErrorCode};
 
 /// A node kind under test, driven as its users drive it (registers for the models).
@@ -409,6 +411,122 @@ pub fn overload_frame_leaves_the_counters<D: Dut>() {
     assert_eq!(p.borrow().received_frames(), vec![f]);
 }
 
+/// Rule 6 after an overload flag (§12.1.4.2 rule 6 counts the 14th consecutive dominant
+/// bit after an active error flag **or an overload flag**, and each 8 more). The bus is
+/// held dominant from the first intermission bit (ce+10) for 15 bits (ce+10..=ce+24):
+/// every node sends its overload flag ce+11..=ce+16 and reads dominant up to ce+24, the
+/// 14th consecutive dominant bit counted from the start of its flag: +8. The frame was
+/// valid before (at the end of EOF): the success takes the counter from 0 (stays 0).
+/// Played twice: dut transmitter (TEC 0 → 8, the peer's REC 8), dut receiver (REC 8).
+pub fn overload_rule_6_after_overload_flag<D: Dut>() {
+    for dut_sends in [true, false] {
+        let mut bus = Bus::new(500_000).unwrap();
+        let (mut dut, _) = D::join(&mut bus);
+        let p = peer();
+        bus.attach("p", p.clone());
+        let f = frame(0x0F9);
+        let ce = frame_bits(&f).crc_end;
+        bus.try_inject_next(Fault::StuckDominant {
+            at: ce + 10,
+            bits: 15,
+        })
+        .unwrap();
+        if dut_sends {
+            dut.send(&f);
+        } else {
+            p.borrow_mut().send(f);
+        }
+        let r = next_frame(&mut bus);
+        assert!(r.is_error_free(), "the frame itself was valid");
+        if dut_sends {
+            assert_eq!(dut.counters(), ErrorCounters { tec: 8, rec: 0 });
+            assert_eq!(p.borrow().counters(), ErrorCounters { tec: 0, rec: 8 });
+            assert_eq!(p.borrow().received_frames(), vec![f]);
+        } else {
+            assert_eq!(dut.counters(), ErrorCounters { tec: 0, rec: 8 });
+            assert_eq!(p.borrow().counters(), ErrorCounters { tec: 8, rec: 0 });
+        }
+        assert_eq!(dut.state(), ErrorState::Active);
+    }
+}
+
+/// Rules 4 and 5 during an overload flag (§12.1.4.2: a bit error while sending an active
+/// error flag **or an overload flag** adds 8 to TEC for a transmitter, to REC for a
+/// receiver). A dominant first intermission bit (ce+10) starts the overload flags at
+/// ce+11; the dut misreads bit 3 of its flag (ce+14, the fourth bit, counted from 0): +8,
+/// and a new flag. The peer misreads its bit 3 too (so both flags restart together):
+/// new flags ce+15..=ce+20, delimiter ce+21..=ce+28, intermission: the record lasts
+/// ce + 29 + 3 bits. Played twice: dut transmitter (TEC 8), dut receiver (REC 8).
+pub fn overload_rules_4_and_5_bit_error_in_overload_flag<D: Dut>() {
+    for dut_sends in [true, false] {
+        let mut bus = Bus::new(500_000).unwrap();
+        let (mut dut, id) = D::join(&mut bus);
+        let p = peer();
+        let ip = bus.attach("p", p.clone());
+        let f = frame(0x0FA);
+        let ce = u64::from(frame_bits(&f).crc_end);
+        bus.try_inject_next(Fault::StuckDominant {
+            at: ce as u32 + 10,
+            bits: 1,
+        })
+        .unwrap();
+        bus.try_inject_next(Fault::FlagBit { who: id, bit: 3 })
+            .unwrap();
+        bus.try_inject_next(Fault::FlagBit { who: ip, bit: 3 })
+            .unwrap();
+        if dut_sends {
+            dut.send(&f);
+        } else {
+            p.borrow_mut().send(f);
+        }
+        let r = next_frame(&mut bus);
+        assert!(r.is_error_free());
+        assert_eq!(r.end - r.sof, ce + 29 + 3);
+        if dut_sends {
+            assert_eq!(dut.counters(), ErrorCounters { tec: 8, rec: 0 });
+            assert_eq!(p.borrow().counters(), ErrorCounters { tec: 0, rec: 8 });
+        } else {
+            assert_eq!(dut.counters(), ErrorCounters { tec: 0, rec: 8 });
+            assert_eq!(p.borrow().counters(), ErrorCounters { tec: 8, rec: 0 });
+        }
+    }
+}
+
+/// A dominant last EOF bit (§10.4.5 overload condition 3 / §10.4.4.2): the dut is a
+/// receiver that reads the last EOF bit (EOF bit 7, index 6) dominant because another
+/// receiver `b` flags a form error from there (it misread EOF bit 6). For the dut the
+/// frame is already valid (a receiver's frame is valid after the next-to-last EOF bit):
+/// REC stays 0 and it sends an overload flag, not an error flag (no counter moves). `b`:
+/// rule 1 (+1), and its first bit after its flag is dominant (the others' flags): rule 2
+/// (+8): REC 9. The transmitter reads its recessive last EOF bit dominant: bit error,
+/// TEC 8; it sends the frame again, which every node receives: TEC 7, b's REC 8, the
+/// dut's REC still 0.
+pub fn overload_dominant_last_eof_bit<D: Dut>() {
+    let mut bus = Bus::new(500_000).unwrap();
+    let (dut, _) = D::join(&mut bus);
+    let t = peer();
+    let b = peer();
+    bus.attach("t", t.clone());
+    let ib = bus.attach("b", b.clone());
+    let f = frame(0x0FB);
+    t.borrow_mut().send(f);
+    bus.inject_next(Fault::Form {
+        who: Receivers::Node(ib),
+        field: FormField::Eof(5),
+    });
+    let first = next_frame(&mut bus);
+    assert!(!first.is_error_free(), "the transmitter's bit error");
+    assert_eq!(dut.counters(), ErrorCounters { tec: 0, rec: 0 });
+    assert_eq!(b.borrow().counters(), ErrorCounters { tec: 0, rec: 9 });
+    assert_eq!(t.borrow().counters(), ErrorCounters { tec: 8, rec: 0 });
+    let retry = next_frame(&mut bus);
+    assert!(retry.is_error_free());
+    assert_eq!(dut.counters(), ErrorCounters { tec: 0, rec: 0 });
+    assert_eq!(b.borrow().counters(), ErrorCounters { tec: 0, rec: 8 });
+    assert_eq!(t.borrow().counters(), ErrorCounters { tec: 7, rec: 0 });
+    assert_eq!(dut.state(), ErrorState::Active);
+}
+
 /// Bus-off at TEC > 255 (32 bit errors) and recovery after 128 occurrences of 11
 /// consecutive recessive bits (§12.1.4.2, "bus-off"). The error delimiter and intermission
 /// of the last error frame (8 + 3 recessive bits) are the first sequence, so the retry
@@ -493,6 +611,18 @@ macro_rules! conformance_tests {
         #[test]
         fn overload_frame_leaves_the_counters() {
             conformance::overload_frame_leaves_the_counters::<$dut>();
+        }
+        #[test]
+        fn overload_rule_6_after_overload_flag() {
+            conformance::overload_rule_6_after_overload_flag::<$dut>();
+        }
+        #[test]
+        fn overload_rules_4_and_5_bit_error_in_overload_flag() {
+            conformance::overload_rules_4_and_5_bit_error_in_overload_flag::<$dut>();
+        }
+        #[test]
+        fn overload_dominant_last_eof_bit() {
+            conformance::overload_dominant_last_eof_bit::<$dut>();
         }
         #[test]
         fn bus_off_and_recovery() {
