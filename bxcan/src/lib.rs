@@ -67,6 +67,7 @@ pub mod controller;
 mod error;
 pub mod filter_block;
 pub mod filters;
+pub mod fmi;
 // The hand-over from `stm32f7xx-hal`: the one `unsafe` turning a consumed PAC singleton
 // into a register window.
 #[cfg(feature = "hal-stm32f7")]
@@ -83,6 +84,7 @@ pub mod split;
 pub use config::{Config, ConfigError, Recovery};
 pub use controller::{Can, Failed, Init};
 pub use filters::{Bank, BankError, BankKind, Fifo, FilterPlan, PlanError};
+pub use fmi::fmi;
 pub use instance::Instance;
 pub use planner::{plan, plan_dual, DualPlan, FifoPolicy, PlanOptions};
 pub use split::{BxCan, RawFrame};

@@ -581,7 +581,7 @@ pub struct RxFrame {
     pub timestamp: Option<u16>,
     /// The hardware's own match index, for users who want it next to the portable
     /// [`RxFrame::filter`]: bxCAN `CAN_RDTxR.FMI` with the FIFO number in bit 8,
-    /// FlexCAN `RXFIR.IDHIT`.
+    /// FlexCAN `RXFIR.IDHIT` (decoded for bxCAN by `twocan_bxcan::fmi`).
     pub hw_match: u16,
 }
 
