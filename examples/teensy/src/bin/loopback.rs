@@ -14,6 +14,7 @@ mod firmware {
     use twocan_flexcan::pin::{Pin3, Pin4};
     use twocan_flexcan::{Can0, Settings};
     use twocan_teensy::can::CanState;
+    use twocan_teensy::configs::LOOPBACK_FILTERS;
     use twocan_teensy::rt::{self, CAN_BLINKS};
     use twocan_teensy::time::{self, Every};
 
@@ -33,7 +34,7 @@ mod firmware {
         let mut boot = rt::boot();
         let token = Can0::take().unwrap_or_else(|| rt::halt(CAN_BLINKS));
         let can = token
-            .begin_on(Pin3, Pin4, &SETTINGS, &[], &[])
+            .begin_on(Pin3, Pin4, &SETTINGS, &LOOPBACK_FILTERS, &LOOPBACK_FILTERS)
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         let (mut tx, mut rx) = CAN0
             .start(can.into_split(), &mut boot.core.NVIC)
