@@ -4,7 +4,7 @@
 //!
 //! The program owns `stm32f7xx_hal::pac::CAN1` (and `CAN2`, `CAN3`) once, from
 //! `pac::Peripherals::take()`. Giving the singleton **by value** to [`can1`],
-//! [`can1_dual`], [`can2`] or [`can3`] is the proof that nothing else reaches that
+//! [`can1_dual`], [`can2`] or `can3` is the proof that nothing else reaches that
 //! instance's registers; the constructor turns it into the bounded register window of
 //! [`crate::regs`] (the one `unsafe` of the hand-over is here, in this crate). It also:
 //!
@@ -18,7 +18,42 @@
 //!   carry the alternate function number (`Pin<'D', 1, Alternate<9>>`), and only the
 //!   pins of the data sheets' alternate-function tables implement [`TxPin`]/[`RxPin`]
 //!   for an instance — a wrong pin, or the right pin in the wrong function, does not
-//!   compile. The pins stay in that mode: they are not handed back.
+//!   compile.
+//!
+//! # Giving the singleton and the pins back
+//!
+//! [`can1`], [`can2`] and `can3` (feature `hal-stm32f7-can3`) keep the PAC singleton and the two pins in the
+//! handle ([`HalParts`]), as HAL peripherals do:
+//!
+//! - before configuring, [`HandedOver::free`] returns `(CANx, tx, rx)`;
+//! - to get them back after the driver has run, take them out first with
+//!   [`HandedOver::park`] (a [`Parked`] value), configure and run the controller, and
+//!   when its register handle comes back ([`Init::release`], [`Can::release`]), give
+//!   that handle to [`Parked::free`]: the singleton is only returned in exchange for
+//!   the one register window of that instance, so the driver can no longer reach it.
+//!
+//! ```no_run
+//! # use stm32f7xx_hal::{pac, prelude::*};
+//! # use twocan_bxcan::hal;
+//! # let dp = pac::Peripherals::take().unwrap();
+//! # let rcc = dp.RCC.constrain();
+//! # let clocks = rcc.cfgr.freeze();
+//! # let mut apb1 = rcc.apb1;
+//! let gpiob = dp.GPIOB.split();
+//! let (rx, tx) = (gpiob.pb8.into_alternate::<9>(), gpiob.pb9.into_alternate::<9>());
+//! let (can1, parked) = hal::can1(dp.CAN1, tx, rx, &mut apb1, &clocks).park();
+//! let config = can1.config(500_000).unwrap();
+//! let init = can1.configure(&config).map_err(|f| f.error).unwrap();
+//! // ... filters, `enable`, traffic; then back to initialization mode ...
+//! let (regs, _) = init.release();
+//! let (can1_pac, tx, rx) = parked.free(regs).ok().unwrap();
+//! // `can1_pac`, `tx` and `rx` are the program's again (e.g. `tx.into_push_pull_output()`).
+//! ```
+//!
+//! [`HandedOver::configure`] on a handle that still holds its parts drops them (the
+//! pins stay in their CAN function, the singleton is gone for good), as before. CAN1
+//! handed over with [`can1_dual`] keeps nothing: CAN2 may still reach CAN1's filter
+//! block through a [`Can1Filters`] copy, so CAN1's singleton must never come back.
 //!
 //! # CAN2 and the shared filter block
 //!
@@ -220,25 +255,99 @@ impl Registers for Can1Filters {
 }
 
 /// A bxCAN instance handed over by the HAL, clocked, not yet configured: its register
-/// handles and the APB1 frequency. [`HandedOver::configure`] puts it in initialization
-/// mode ([`Init`]).
+/// handles, the APB1 frequency and (`P`) the PAC singleton and pins it was built from
+/// ([`HalParts`], or `()` when they were parked or, for [`can1_dual`], not kept).
+/// [`HandedOver::configure`] puts it in initialization mode ([`Init`]).
 ///
-/// - [`Can1`] (from [`can1`]) and [`Can3`] (from [`can3`]) own a whole register block;
-/// - [`DualCan`] (from [`can1_dual`] and [`can2`]) owns a control block and shares CAN1's
-///   filter block.
+/// - [`Can1`] (from [`can1`]) and `Can3` (from `can3`) own a whole register block;
+/// - [`DualCan`] (from [`can1_dual`]) and [`Can2`] (from [`can2`]) own a control block
+///   and share CAN1's filter block.
 #[derive(Debug)]
-pub struct HandedOver<R: Registers, F: Registers = R> {
+pub struct HandedOver<R: Registers, F: Registers = R, P = ()> {
     regs: R,
     filters: Option<F>,
     instance: Instance,
     apb1_hz: u32,
+    parts: P,
 }
 
-/// CAN1 alone (its whole block, filters included), or CAN3.
-pub type Can1 = HandedOver<CanRegs>;
-/// CAN3 (its whole block, with its own 14 filter banks).
-pub type Can3 = HandedOver<CanRegs>;
-/// CAN1 or CAN2 of a dual set-up: control registers, and CAN1's filter block shared.
+/// The PAC singleton of a bxCAN instance and its TX and RX pins, as handed over.
+#[derive(Debug)]
+pub struct HalParts<CAN, TX, RX> {
+    can: CAN,
+    tx: TX,
+    rx: RX,
+}
+
+/// The singleton and pins taken out of a [`HandedOver`] by [`HandedOver::park`]: given
+/// back by [`Parked::free`] in exchange for the instance's register window.
+#[derive(Debug)]
+pub struct Parked<CAN, TX, RX> {
+    parts: HalParts<CAN, TX, RX>,
+}
+
+/// A PAC singleton type of a bxCAN instance handed over with its parts kept: the
+/// register window the hand-over made of it, and that window's address.
+pub trait PacCan: sealed::Sealed {
+    /// The window [`can1`], [`can2`] or `can3` built: the whole block for CAN1 alone
+    /// and CAN3, the control block for CAN2.
+    type Window;
+    /// Whether `window` is this instance's (its base address is the PAC's).
+    fn is_window(window: &Self::Window) -> bool;
+}
+
+impl sealed::Sealed for pac::CAN1 {}
+impl PacCan for pac::CAN1 {
+    type Window = CanRegs;
+    fn is_window(window: &CanRegs) -> bool {
+        window.base() == pac::CAN1::ptr() as usize
+    }
+}
+impl sealed::Sealed for pac::CAN2 {}
+impl PacCan for pac::CAN2 {
+    type Window = ControlRegs;
+    fn is_window(window: &ControlRegs) -> bool {
+        window.base() == pac::CAN2::ptr() as usize
+    }
+}
+#[cfg(feature = "hal-stm32f7-can3")]
+impl sealed::Sealed for pac::CAN3 {}
+#[cfg(feature = "hal-stm32f7-can3")]
+impl PacCan for pac::CAN3 {
+    type Window = CanRegs;
+    fn is_window(window: &CanRegs) -> bool {
+        window.base() == pac::CAN3::ptr() as usize
+    }
+}
+
+impl<CAN: PacCan, TX, RX> Parked<CAN, TX, RX> {
+    /// Gives back `(CANx, tx, rx)` for the instance's register window `regs` (from
+    /// [`Init::release`] or [`Can::release`]), which it consumes: the window is not
+    /// `Clone`, and its type is the whole window the hand-over made (not a part split
+    /// off it), so once it is here the driver reaches the instance no more.
+    ///
+    /// Errors: the window of another instance is refused and handed back with this
+    /// value.
+    #[allow(clippy::result_large_err)]
+    pub fn free(self, regs: CAN::Window) -> Result<(CAN, TX, RX), (Self, CAN::Window)> {
+        if !CAN::is_window(&regs) {
+            return Err((self, regs));
+        }
+        let HalParts { can, tx, rx } = self.parts;
+        Ok((can, tx, rx))
+    }
+}
+
+/// CAN1 alone (its whole block, filters included), with its singleton and pins.
+pub type Can1<TX, RX> = HandedOver<CanRegs, CanRegs, HalParts<pac::CAN1, TX, RX>>;
+/// CAN2 of a dual set-up: control registers, CAN1's filter block shared; with its
+/// singleton and pins.
+pub type Can2<TX, RX> = HandedOver<ControlRegs, Can1Filters, HalParts<pac::CAN2, TX, RX>>;
+/// CAN3 (its whole block, with its own 14 filter banks), with its singleton and pins.
+#[cfg(feature = "hal-stm32f7-can3")]
+pub type Can3<TX, RX> = HandedOver<CanRegs, CanRegs, HalParts<pac::CAN3, TX, RX>>;
+/// CAN1 of a dual set-up: control registers, and CAN1's filter block shared (its
+/// singleton and pins are not kept: see the module notes).
 pub type DualCan = HandedOver<ControlRegs, Can1Filters>;
 
 /// The APB1 frequency the HAL set (Hz).
@@ -255,22 +364,23 @@ pub fn can1<TX, RX>(
     rx: RX,
     apb1: &mut APB1,
     clocks: &Clocks,
-) -> HandedOver<CanRegs>
+) -> Can1<TX, RX>
 where
     TX: TxPin<pac::CAN1>,
     RX: RxPin<pac::CAN1>,
 {
     let base = pac::CAN1::ptr() as usize;
-    let _ = (can1, tx, rx);
     pac::CAN1::enable(apb1);
     pac::CAN1::reset(apb1);
     HandedOver {
         // SAFETY: `base` is CAN1's register block (the PAC's address), whose singleton
-        // this function consumed: no other handle to these registers exists.
+        // this function took (kept in `parts`, given back only for this window): no
+        // other handle to these registers exists.
         regs: unsafe { CanRegs::new(base) },
         filters: None,
         instance: Instance::Can1,
         apb1_hz: apb1_hz(clocks),
+        parts: HalParts { can: can1, tx, rx },
     }
 }
 
@@ -304,6 +414,7 @@ where
         filters: Some(filters),
         instance: Instance::Can1,
         apb1_hz: apb1_hz(clocks),
+        parts: (),
     };
     (handle, filters)
 }
@@ -317,22 +428,23 @@ pub fn can2<TX, RX>(
     apb1: &mut APB1,
     clocks: &Clocks,
     filters: Can1Filters,
-) -> DualCan
+) -> Can2<TX, RX>
 where
     TX: TxPin<pac::CAN2>,
     RX: RxPin<pac::CAN2>,
 {
     let base = pac::CAN2::ptr() as usize;
-    let _ = (can2, tx, rx);
     pac::CAN2::enable(apb1);
     pac::CAN2::reset(apb1);
     HandedOver {
         // SAFETY: CAN2's control and mailbox registers (the PAC's CAN2 block; CAN2 has
-        // no filter registers of its own), whose singleton this function consumed.
+        // no filter registers of its own), whose singleton this function took (kept in
+        // `parts`, given back only for this window).
         regs: unsafe { ControlRegs::new(base) },
         filters: Some(filters),
         instance: Instance::Can2,
         apb1_hz: apb1_hz(clocks),
+        parts: HalParts { can: can2, tx, rx },
     }
 }
 
@@ -345,26 +457,57 @@ pub fn can3<TX, RX>(
     rx: RX,
     apb1: &mut APB1,
     clocks: &Clocks,
-) -> HandedOver<CanRegs>
+) -> Can3<TX, RX>
 where
     TX: TxPin<pac::CAN3>,
     RX: RxPin<pac::CAN3>,
 {
     let base = pac::CAN3::ptr() as usize;
-    let _ = (can3, tx, rx);
     pac::CAN3::enable(apb1);
     pac::CAN3::reset(apb1);
     HandedOver {
         // SAFETY: `base` is CAN3's register block (the PAC's address), whose singleton
-        // this function consumed.
+        // this function took (kept in `parts`, given back only for this window).
         regs: unsafe { CanRegs::new(base) },
         filters: None,
         instance: Instance::Can3,
         apb1_hz: apb1_hz(clocks),
+        parts: HalParts { can: can3, tx, rx },
     }
 }
 
-impl<R: Registers, F: Registers> HandedOver<R, F> {
+impl<R: Registers, F: Registers, CAN, TX, RX> HandedOver<R, F, HalParts<CAN, TX, RX>> {
+    /// Gives the PAC singleton and the pins back, before configuring (the clock stays
+    /// enabled; the pins stay in their CAN function).
+    pub fn free(self) -> (CAN, TX, RX) {
+        let HalParts { can, tx, rx } = self.parts;
+        (can, tx, rx)
+    }
+
+    /// Takes the singleton and the pins out, to be given back later by [`Parked::free`]
+    /// in exchange for this instance's register window.
+    pub fn park(self) -> (HandedOver<R, F>, Parked<CAN, TX, RX>) {
+        let HandedOver {
+            regs,
+            filters,
+            instance,
+            apb1_hz,
+            parts,
+        } = self;
+        (
+            HandedOver {
+                regs,
+                filters,
+                instance,
+                apb1_hz,
+                parts: (),
+            },
+            Parked { parts },
+        )
+    }
+}
+
+impl<R: Registers, F: Registers, P> HandedOver<R, F, P> {
     /// The instance.
     pub fn instance(&self) -> Instance {
         self.instance
@@ -392,7 +535,7 @@ impl<R: Registers, F: Registers> HandedOver<R, F> {
         Failed { error, value: self }
     }
 
-    fn from_can(can: Can<R, F>, apb1_hz: u32) -> Self {
+    fn from_can(can: Can<R, F>, apb1_hz: u32, parts: P) -> Self {
         let instance = can.instance();
         let (regs, filters) = can.release();
         HandedOver {
@@ -400,13 +543,14 @@ impl<R: Registers, F: Registers> HandedOver<R, F> {
             filters,
             instance,
             apb1_hz,
+            parts,
         }
     }
 }
 
 // The error values hand the whole handle back (nothing is lost).
 #[allow(clippy::result_large_err)]
-impl HandedOver<CanRegs> {
+impl<P> HandedOver<CanRegs, CanRegs, P> {
     /// Configures the instance ([`Can::can1`] or [`Can::can3`]): initialization mode,
     /// options, bit timing.
     ///
@@ -419,7 +563,7 @@ impl HandedOver<CanRegs> {
 }
 
 #[allow(clippy::result_large_err)]
-impl HandedOver<ControlRegs, Can1Filters> {
+impl<P> HandedOver<ControlRegs, Can1Filters, P> {
     /// Configures CAN1 ([`Can::can1_dual`]: `CAN2SB` is written when `config` sets
     /// [`Config::can2_start_bank`]) or CAN2 ([`Can::can2`]); errors as for a whole
     /// block's `configure`.
@@ -434,25 +578,31 @@ impl HandedOver<ControlRegs, Can1Filters> {
 // The register types stay generic below, so that the host tests run the same code over
 // the behavioural model.
 #[allow(clippy::result_large_err)]
-impl<R: Registers> HandedOver<R, R> {
+impl<R: Registers, P> HandedOver<R, R, P> {
     fn configure_single(self, config: &Config) -> Result<Init<R, R>, Failed<Self>> {
         if !self.accepts(config) {
             return Err(self.refuse(Error::InvalidArgument));
         }
-        let apb1_hz = self.apb1_hz;
-        let made = match self.instance {
-            Instance::Can3 => Can::can3(self.regs, config),
-            _ => Can::can1(self.regs, config),
+        let HandedOver {
+            regs,
+            instance,
+            apb1_hz,
+            parts,
+            ..
+        } = self;
+        let made = match instance {
+            Instance::Can3 => Can::can3(regs, config),
+            _ => Can::can1(regs, config),
         };
         made.map_err(|f| Failed {
             error: f.error,
-            value: Self::from_can(f.value, apb1_hz),
+            value: Self::from_can(f.value, apb1_hz, parts),
         })
     }
 }
 
 #[allow(clippy::result_large_err)]
-impl<R: Registers, F: Registers> HandedOver<R, F> {
+impl<R: Registers, F: Registers, P> HandedOver<R, F, P> {
     fn configure_dual(self, config: &Config) -> Result<Init<R, F>, Failed<Self>> {
         let accepted = self.accepts(config);
         let HandedOver {
@@ -460,6 +610,7 @@ impl<R: Registers, F: Registers> HandedOver<R, F> {
             filters,
             instance,
             apb1_hz,
+            parts,
         } = self;
         let filters = match filters {
             Some(f) if accepted => f,
@@ -473,6 +624,7 @@ impl<R: Registers, F: Registers> HandedOver<R, F> {
                         filters,
                         instance,
                         apb1_hz,
+                        parts,
                     },
                 })
             }
@@ -483,7 +635,7 @@ impl<R: Registers, F: Registers> HandedOver<R, F> {
         };
         made.map_err(|f| Failed {
             error: f.error,
-            value: Self::from_can(f.value, apb1_hz),
+            value: Self::from_can(f.value, apb1_hz, parts),
         })
     }
 }
@@ -525,6 +677,7 @@ mod tests {
             filters,
             instance,
             apb1_hz: 54_000_000,
+            parts: (),
         }
     }
 
@@ -620,6 +773,79 @@ mod tests {
             back.value.filters.is_some(),
             "the filter handle comes back too"
         );
+    }
+
+    // Pins stand-ins (real pins come from splitting a GPIO port, which writes its
+    // registers); the singleton is a zero-sized token.
+    #[derive(Debug, PartialEq)]
+    struct TxStub(u8);
+    #[derive(Debug, PartialEq)]
+    struct RxStub(u8);
+
+    fn can1_parts() -> HalParts<pac::CAN1, TxStub, RxStub> {
+        // SAFETY: a zero-sized token; these tests touch no register through it.
+        let dp = unsafe { pac::Peripherals::steal() };
+        HalParts {
+            can: dp.CAN1,
+            tx: TxStub(9),
+            rx: RxStub(8),
+        }
+    }
+
+    fn window(base: usize) -> CanRegs {
+        // SAFETY: never read or written in these tests (host addresses).
+        unsafe { CanRegs::new(base) }
+    }
+
+    #[test]
+    fn free_gives_the_singleton_and_pins_back_before_configuring() {
+        let h = HandedOver {
+            regs: window(CAN1_BASE),
+            filters: None::<CanRegs>,
+            instance: Instance::Can1,
+            apb1_hz: 54_000_000,
+            parts: can1_parts(),
+        };
+        let (_can1, tx, rx) = h.free();
+        assert_eq!((tx, rx), (TxStub(9), RxStub(8)));
+    }
+
+    #[test]
+    fn parked_parts_come_back_only_for_the_instance_s_window() {
+        let h = HandedOver {
+            regs: window(CAN1_BASE),
+            filters: None::<CanRegs>,
+            instance: Instance::Can1,
+            apb1_hz: 54_000_000,
+            parts: can1_parts(),
+        };
+        let (h, parked) = h.park();
+        assert_eq!(h.instance(), Instance::Can1);
+        // The driver would run here; its register window comes back by value.
+        let HandedOver { regs, .. } = h;
+        // Another instance's window is refused, and both are handed back.
+        let (parked, other) = parked.free(window(CAN3_BASE)).unwrap_err();
+        assert_eq!(other.base(), CAN3_BASE);
+        let (_can1, tx, rx) = parked.free(regs).map_err(|_| "refused").unwrap();
+        assert_eq!((tx, rx), (TxStub(9), RxStub(8)));
+    }
+
+    #[test]
+    fn a_failed_configure_hands_the_parts_back_too() {
+        let bus = bus();
+        let model = BxCanModel::can1();
+        let h = HandedOver {
+            regs: PollClock::new(model.clone(), &bus, MSR),
+            filters: None::<Regs>,
+            instance: Instance::Can1,
+            apb1_hz: 54_000_000,
+            parts: can1_parts(),
+        };
+        let other = Config::from_bitrate(48_000_000, 500_000).unwrap();
+        let back = h.configure_single(&other).unwrap_err();
+        assert_eq!(back.error, Error::InvalidArgument);
+        let (_can1, tx, rx) = back.value.free();
+        assert_eq!((tx, rx), (TxStub(9), RxStub(8)));
     }
 
     fn tx<CAN, P: TxPin<CAN>>() {}

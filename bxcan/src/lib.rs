@@ -3,6 +3,12 @@
 //! implementation ([`BxCan`]) behind the portable split driver of
 //! [`twocan_core::split`] and the one-struct [`twocan_core::Driver`].
 //!
+//! **Transmit order:** the hardware resets to identifier priority (`CAN_MCR.TXFP = 0`,
+//! RM0410 §40.9.2); this driver's default is request order (FIFO, `TXFP = 1`), the same
+//! portable order as the FlexCAN backend. Choose identifier priority with
+//! [`Config::tx_policy`]`(`[`twocan_core::TxPolicy::Priority`]`)` and a
+//! [`twocan_core::PriorityQueue`] as the software transmit queue.
+//!
 //! # Quick start
 //!
 //! On the host, over the behavioural model of CAN1 (feature `model`) in loop-back mode;
@@ -67,6 +73,7 @@ pub mod controller;
 mod error;
 pub mod filter_block;
 pub mod filters;
+pub mod fmi;
 // The hand-over from `stm32f7xx-hal`: the one `unsafe` turning a consumed PAC singleton
 // into a register window.
 #[cfg(feature = "hal-stm32f7")]
@@ -83,6 +90,7 @@ pub mod split;
 pub use config::{Config, ConfigError, Recovery};
 pub use controller::{Can, Failed, Init};
 pub use filters::{Bank, BankError, BankKind, Fifo, FilterPlan, PlanError};
+pub use fmi::fmi;
 pub use instance::Instance;
 pub use planner::{plan, plan_dual, DualPlan, FifoPolicy, PlanOptions};
 pub use split::{BxCan, RawFrame};

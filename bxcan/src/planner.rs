@@ -765,6 +765,37 @@ impl Groups {
 /// needed after merging and available) when the plan needs more than `options.banks`
 /// banks (or more than 28) and the superset fallback is off or cannot help (general
 /// filters alone too many).
+///
+/// ```
+/// use twocan_bxcan::{plan, Fifo, PlanError, PlanOptions};
+/// use twocan_core::{Filter, FilterError, Format, Frame, FrameKind};
+///
+/// let filters = [
+///     Filter::standard(0x100),                                              // user 0
+///     Filter::standard(0x101),                                              // user 1
+///     Filter::masked(FrameKind::Data, Format::Extended, 0x1FFF_FF00, 0x0001_2300), // user 2
+/// ];
+/// let p = plan(&filters, PlanOptions::new(14))?;
+/// assert!(p.bank_count() <= 2 && p.is_proven_optimal());
+/// // What the hardware will accept, and the user index the driver reports.
+/// let hit = p.evaluate(&Frame::standard(0x101, &[])?).unwrap();
+/// assert_eq!((hit.fifo, hit.filter), (Fifo::Fifo0, 1));
+/// assert_eq!(p.evaluate(&Frame::extended(0x0001_23AB, &[])?).unwrap().filter, 2);
+/// assert_eq!(p.evaluate(&Frame::standard(0x102, &[])?), None); // rejected in hardware
+///
+/// // Bad input: the failing filter's index, or the banks needed and available.
+/// let bad = [Filter::standard(0x100), Filter::standard(0x800)];
+/// assert_eq!(
+///     plan(&bad, PlanOptions::new(14)).unwrap_err(),
+///     PlanError::Filter { index: 1, error: FilterError::IdOutOfRange }
+/// );
+/// let many: Vec<Filter> = (0..9).map(|i| Filter::extended(i * 0x1357)).collect();
+/// assert!(matches!(
+///     plan(&many, PlanOptions::new(4)),
+///     Err(PlanError::TooManyBanks { needed: 5, available: 4 })
+/// ));
+/// # Ok::<(), Box<dyn core::error::Error>>(())
+/// ```
 pub fn plan(filters: &[Filter], options: PlanOptions) -> Result<FilterPlan, PlanError> {
     let prep = Prepared::new(filters)?;
     let available = options.banks.min(FILTER_BANKS as u8);
@@ -963,6 +994,27 @@ pub struct DualPlan {
 /// Errors: [`PlanError::DualTooManyBanks`] with each list's need when together they
 /// need more than 28 banks (a list that alone needs more than 28 shows as such), or the
 /// first list's [`PlanError::Filter`] / [`PlanError::TooManyFilters`].
+///
+/// ```
+/// use twocan_bxcan::{plan_dual, PlanError, PlanOptions};
+/// use twocan_core::Filter;
+///
+/// // CAN1: 6 extended identifiers (3 banks of two 32-bit list entries);
+/// // CAN2: 4 standard identifiers (one bank of four 16-bit list entries).
+/// let can1: Vec<Filter> = (0..6).map(|i| Filter::extended(0x1000 + i * 0x1357)).collect();
+/// let can2: Vec<Filter> = (0..4).map(|i| Filter::standard(0x100 + i * 0x13)).collect();
+/// let dual = plan_dual(&can1, &can2, PlanOptions::default().merge(false))?;
+/// assert_eq!(dual.can2sb, 3); // CAN1 gets banks 0..3, CAN2 the other 25
+/// assert_eq!((dual.can1.bank_count(), dual.can2.bank_count()), (3, 1));
+///
+/// // Together more than the block's 28 banks: each list's need is reported.
+/// let big: Vec<Filter> = (0..40).map(|i| Filter::extended(i * 0x1357)).collect();
+/// assert_eq!(
+///     plan_dual(&big, &big, PlanOptions::default().merge(false)).unwrap_err(),
+///     PlanError::DualTooManyBanks { can1_needed: 20, can2_needed: 20, available: 28 }
+/// );
+/// # Ok::<(), PlanError>(())
+/// ```
 pub fn plan_dual(
     can1: &[Filter],
     can2: &[Filter],

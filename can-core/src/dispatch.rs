@@ -18,6 +18,38 @@ pub type Callback<Ctx> = fn(&mut Ctx, &RxFrame);
 pub type MatchHook<Ctx> = fn(&mut Ctx, u16);
 
 /// Call-backs for up to `N` filters.
+///
+/// ```
+/// use twocan_core::dispatch::NoSuchFilter;
+/// use twocan_core::mock::MockHardware;
+/// use twocan_core::{Dispatcher, FifoQueue, Filter, Frame, RxFrame, State};
+///
+/// #[derive(Default)]
+/// struct App { speed: u16, hooked: u32 }
+///
+/// static CAN: State<MockHardware, 8, FifoQueue<4>> = State::new();
+/// // Filter 0 takes 0x100, filter 1 takes 0x200 (the index is the list position).
+/// let hw = MockHardware::new(3).with_filters(&[Filter::standard(0x100), Filter::standard(0x200)]);
+/// let mut p = CAN.split(hw).map_err(|(e, _)| e)?;
+///
+/// let mut table: Dispatcher<App, 2> = Dispatcher::new()
+///     .with(0, |app: &mut App, rx: &RxFrame| app.speed = rx.frame.data_u16(0).unwrap_or(0))
+///     .expect("index 0 is in the table");
+/// table.set_match_hook(Some(|app: &mut App, _filter| app.hooked += 1));
+/// // An index beyond the table is refused with the index, not ignored.
+/// assert_eq!(table.set(2, |_, _| {}), Err(NoSuchFilter(2)));
+///
+/// CAN.hardware().unwrap().deliver(Frame::standard(0x100, &[0x34, 0x12])?);
+/// CAN.hardware().unwrap().deliver(Frame::standard(0x200, &[])?); // filter 1: no call-back
+/// p.rx0_irq.on_interrupt();
+///
+/// let mut app = App::default();
+/// while p.rx.dispatch(&mut table, &mut app) {}
+/// assert_eq!((app.speed, app.hooked), (0x1234, 2));
+/// // The frame without a call-back is counted, not lost silently.
+/// assert_eq!((table.handled(), table.unhandled()), (1, 1));
+/// # Ok::<(), twocan_core::Error>(())
+/// ```
 pub struct Dispatcher<Ctx, const N: usize> {
     callbacks: [Option<Callback<Ctx>>; N],
     hook: Option<MatchHook<Ctx>>,

@@ -110,6 +110,49 @@ const ID_BITS: u32 = 0x1FFF_FFFF;
 /// are zero — so the derived equality compares identifier, kind, DLC code and data.
 ///
 /// `Frame::default()` is a standard data frame with identifier 0 and no data.
+///
+/// ```
+/// use twocan_core::{Frame, FrameError};
+///
+/// // Standard and extended data frames; the data length becomes the DLC.
+/// let std_frame = Frame::standard(0x123, &[0xDE, 0xAD])?;
+/// assert_eq!((std_frame.raw_id(), std_frame.is_extended()), (0x123, false));
+/// assert_eq!((std_frame.dlc(), std_frame.data()), (2, &[0xDE, 0xAD][..]));
+/// let ext = Frame::extended(0x1ABC_DEF0, &[1, 2, 3, 4, 5, 6, 7, 8])?;
+/// assert!(ext.is_extended() && !ext.is_remote());
+/// assert_eq!(ext.data_u32(1), Some(0x0807_0605)); // little-endian word 1 (bytes 4..8)
+///
+/// // A remote frame asks for `dlc` bytes and carries none.
+/// let rtr = Frame::remote(0x7FF, false, 4)?;
+/// assert!(rtr.is_remote());
+/// assert_eq!((rtr.dlc(), rtr.data().len()), (4, 0));
+///
+/// // `const` construction.
+/// const PING: Frame = match Frame::standard(0x010, &[]) {
+///     Ok(f) => f,
+///     Err(_) => panic!("bad frame"),
+/// };
+/// assert_eq!((PING.raw_id(), PING.dlc()), (0x010, 0));
+/// assert_eq!(Frame::default(), Frame::standard(0, &[])?);
+///
+/// // Bad input is a typed error, never a panic.
+/// assert_eq!(Frame::standard(0x800, &[]), Err(FrameError::StandardIdOutOfRange(0x800)));
+/// assert_eq!(
+///     Frame::extended(0x2000_0000, &[]),
+///     Err(FrameError::ExtendedIdOutOfRange(0x2000_0000))
+/// );
+/// assert_eq!(Frame::standard(0x100, &[0; 9]), Err(FrameError::TooMuchData(9)));
+/// assert_eq!(Frame::remote(0x100, false, 9), Err(FrameError::DlcTooLarge(9)));
+/// let id = twocan_core::frame::standard_id(0x100)?;
+/// assert_eq!(
+///     Frame::with_dlc(id, &[1, 2], 3),
+///     Err(FrameError::DlcMismatch { dlc: 3, len: 2 })
+/// );
+/// // DLC codes 9..=15 are kept as written, with 8 data bytes (ISO 11898-1).
+/// let long = Frame::with_dlc(id, &[0; 8], 15)?;
+/// assert_eq!((long.dlc(), long.data().len()), (15, 8));
+/// # Ok::<(), FrameError>(())
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 #[repr(C)]
 pub struct Frame {
@@ -541,7 +584,7 @@ pub struct RxFrame {
     pub timestamp: Option<crate::timestamp::Timestamp>,
     /// The hardware's own match index, for users who want it next to the portable
     /// [`RxFrame::filter`]: bxCAN `CAN_RDTxR.FMI` with the FIFO number in bit 8,
-    /// FlexCAN `RXFIR.IDHIT`.
+    /// FlexCAN `RXFIR.IDHIT` (decoded for bxCAN by `twocan_bxcan::fmi`).
     pub hw_match: u16,
 }
 

@@ -628,6 +628,31 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
 }
 
 /// The transmit half: send frames, take their completions, abort them.
+///
+/// ```
+/// use twocan_core::mock::MockHardware;
+/// use twocan_core::split::AbortRequest;
+/// use twocan_core::{FifoQueue, Frame, State, TxOutcome};
+///
+/// static CAN: State<MockHardware, 8, FifoQueue<4>> = State::new();
+/// let mut p = CAN.split(MockHardware::new(1)).map_err(|(e, _)| e)?;
+/// // One mailbox: the first frame goes straight in, the second waits in the queue.
+/// let a = nb::block!(p.tx.try_send(&Frame::standard(0x100, &[1])?))?;
+/// let b = nb::block!(p.tx.try_send(&Frame::standard(0x101, &[2])?))?;
+/// assert_eq!(p.tx.stats().count, 1);
+/// // A queued frame can be taken back; its `Aborted` completion follows at once.
+/// assert_eq!(p.tx.abort(b), AbortRequest::Dequeued);
+/// let done = p.tx.take_completion().unwrap();
+/// assert_eq!((done.token, done.outcome), (b, TxOutcome::Aborted));
+///
+/// CAN.hardware().unwrap().complete_all(); // the mock sends its mailbox
+/// p.tx_irq.on_interrupt();
+/// let done = p.tx.take_completion().unwrap();
+/// assert_eq!((done.token, done.outcome), (a, TxOutcome::Sent));
+/// assert_eq!(p.tx.take_completion(), None); // exactly one completion per token
+/// assert_eq!(p.tx.abort(a), AbortRequest::NotFound);
+/// # Ok::<(), twocan_core::Error>(())
+/// ```
 pub struct Tx<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize> {
     pub(crate) s: &'a State<H, RX, Q, RX1, DONE>,
     pub(crate) next: u32,
@@ -855,6 +880,33 @@ impl<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE:
 
 /// The receive half: take frames with their user filter index, dispatch them, follow
 /// the error state.
+///
+/// ```
+/// use twocan_core::mock::MockHardware;
+/// use twocan_core::{ErrorState, FifoQueue, Filter, Frame, LastErrorCode, State};
+///
+/// static CAN: State<MockHardware, 8, FifoQueue<4>> = State::new();
+/// let hw = MockHardware::new(3).with_filters(&[Filter::standard(0x100), Filter::extended(0x100)]);
+/// let mut p = CAN.split(hw).map_err(|(e, _)| e)?;
+/// assert!(matches!(p.rx.receive(), Err(nb::Error::WouldBlock))); // nothing yet
+///
+/// CAN.hardware().unwrap().deliver(Frame::extended(0x100, &[7])?);
+/// CAN.hardware().unwrap().deliver(Frame::standard(0x100, &[8])?);
+/// p.rx0_irq.on_interrupt();
+/// assert_eq!(p.rx.available(), 2);
+/// // Frames in arrival order, each with the index of the user's filter that took it.
+/// let first = nb::block!(p.rx.receive())?;
+/// assert_eq!((first.frame.data(), first.filter), (&[7][..], 1));
+/// let second = nb::block!(p.rx.receive())?;
+/// assert_eq!((second.frame.data(), second.filter), (&[8][..], 0));
+///
+/// // Error-state changes arrive through the status handler.
+/// CAN.hardware().unwrap().set_status(ErrorState::Warning, 100, 0, LastErrorCode::BitDominant);
+/// p.status_irq.on_interrupt();
+/// let change = p.rx.take_state_change().unwrap();
+/// assert_eq!((change.state, change.counters.tec), (ErrorState::Warning, 100));
+/// # Ok::<(), twocan_core::Error>(())
+/// ```
 pub struct Rx<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize> {
     pub(crate) s: &'a State<H, RX, Q, RX1, DONE>,
     pub(crate) map: H::FilterMap,
@@ -946,6 +998,29 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
 }
 
 /// The transmit interrupt handler.
+///
+/// Its [`TxIrq::on_interrupt`] runs in the transmit interrupt (bxCAN `CANx_TX`, FlexCAN
+/// message-buffer line) or, on a host, wherever the bus is serviced.
+///
+/// ```
+/// use twocan_core::mock::MockHardware;
+/// use twocan_core::{FifoQueue, Frame, State};
+///
+/// static CAN: State<MockHardware, 8, FifoQueue<4>> = State::new();
+/// let mut p = CAN.split(MockHardware::new(1)).map_err(|(e, _)| e)?;
+/// for id in [0x10, 0x11, 0x12] {
+///     nb::block!(p.tx.try_send(&Frame::standard(id, &[])?))?;
+/// }
+/// assert_eq!(p.tx.stats().count, 2); // one mailbox: two frames queued
+/// for _ in 0..3 {
+///     CAN.hardware().unwrap().complete(); // the mailbox's frame goes out
+///     p.tx_irq.on_interrupt(); // settles it and refills the mailbox from the queue
+/// }
+/// assert_eq!(CAN.traffic().sent, 3);
+/// let ids: Vec<u32> = CAN.hardware().unwrap().sent().iter().map(|f| f.raw_id()).collect();
+/// assert_eq!(ids, [0x10, 0x11, 0x12]);
+/// # Ok::<(), twocan_core::Error>(())
+/// ```
 pub struct TxIrq<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize>
 {
     pub(crate) s: &'a State<H, RX, Q, RX1, DONE>,
@@ -974,6 +1049,25 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
 }
 
 /// The receive interrupt handler of one hardware receive queue.
+///
+/// ```
+/// use twocan_core::mock::MockHardware;
+/// use twocan_core::{FifoQueue, Frame, State};
+///
+/// // A receive ring of 2 frames: the handler moves what the hardware holds, and a frame
+/// // the full ring cannot take is counted, not lost silently.
+/// static CAN: State<MockHardware, 2, FifoQueue<4>> = State::new();
+/// let mut p = CAN.split(MockHardware::new(3)).map_err(|(e, _)| e)?;
+/// assert_eq!(p.rx0_irq.queue(), 0);
+/// for id in 1..=3 {
+///     CAN.hardware().unwrap().deliver(Frame::standard(id, &[])?);
+/// }
+/// p.rx0_irq.on_interrupt();
+/// assert_eq!(CAN.hardware().unwrap().fifo_len(), 0); // hardware queue released
+/// assert_eq!(p.rx.available(), 2);
+/// assert_eq!(CAN.rx_stats().overflows, 1);
+/// # Ok::<(), twocan_core::Error>(())
+/// ```
 pub struct RxIrq<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize>
 {
     pub(crate) s: &'a State<H, RX, Q, RX1, DONE>,
@@ -1063,6 +1157,28 @@ fn overrun_counter<
 }
 
 /// The status (error, bus-off, wake-up) interrupt handler.
+///
+/// ```
+/// use twocan_core::mock::MockHardware;
+/// use twocan_core::{ErrorState, FifoQueue, LastErrorCode, State};
+///
+/// static CAN: State<MockHardware, 8, FifoQueue<4>> = State::new();
+/// let mut p = CAN.split(MockHardware::new(3)).map_err(|(e, _)| e)?;
+/// let hw = CAN.hardware().unwrap();
+///
+/// hw.set_status(ErrorState::Passive, 128, 0, LastErrorCode::Acknowledge);
+/// p.status_irq.on_interrupt(); // counts the bus error, records the change
+/// hw.set_status(ErrorState::BusOff, 256, 0, LastErrorCode::BitRecessive);
+/// p.status_irq.on_interrupt();
+/// assert_eq!(p.status_irq.last_state(), ErrorState::BusOff);
+///
+/// let stats = CAN.error_stats();
+/// assert_eq!((stats.acknowledge, stats.bit, stats.bus_off), (1, 1, 1));
+/// let states: Vec<ErrorState> =
+///     core::iter::from_fn(|| p.rx.take_state_change()).map(|c| c.state).collect();
+/// assert_eq!(states, [ErrorState::Passive, ErrorState::BusOff]);
+/// # Ok::<(), twocan_core::Error>(())
+/// ```
 pub struct StatusIrq<
     'a,
     H: Hardware,

@@ -127,6 +127,35 @@ pub enum PlanError {
     },
 }
 
+impl core::fmt::Display for PlanError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            PlanError::Filter { index, .. } => write!(f, "filter {index} does not conform"),
+            PlanError::TooManyFilters { given, max } => {
+                write!(f, "{given} filters given, the planner takes at most {max}")
+            }
+            PlanError::TooManyPrimary {
+                needed,
+                available,
+                secondary,
+            } => write!(
+                f,
+                "the filters need {needed} primary filter elements, the configuration has \
+                 {available} (and {secondary} secondary, all used)"
+            ),
+        }
+    }
+}
+
+impl core::error::Error for PlanError {
+    fn source(&self) -> Option<&(dyn core::error::Error + 'static)> {
+        match self {
+            PlanError::Filter { error, .. } => Some(error),
+            _ => None,
+        }
+    }
+}
+
 impl From<PlanError> for twocan_core::Error {
     /// Keeps the counts ([`twocan_core::Error::FilterSpace`]: primary elements needed
     /// and available, or filters given and the most taken).
@@ -413,6 +442,42 @@ fn plan_for(
 /// Errors: [`PlanError::TooManyFilters`], [`PlanError::Filter`], and
 /// [`PlanError::TooManyPrimary`] when no placement fits and the superset fallback is
 /// off (or general filters alone are too many).
+///
+/// ```
+/// use twocan_core::{Filter, FilterError, Format, Frame, FrameKind};
+/// use twocan_flexcan::planner::{plan, PlanError, PlanOptions};
+/// use twocan_flexcan::Configuration;
+///
+/// let filters = [
+///     Filter::standard(0x100),                                                     // user 0
+///     Filter::standard(0x101),                                                     // user 1
+///     Filter::masked(FrameKind::Data, Format::Extended, 0x1FFF_FF00, 0x0001_2300), // user 2
+/// ];
+/// // "Choose the configuration for me": the smallest table that fits (8 elements, all
+/// // primary), leaving the most remote-frame mailboxes.
+/// let table = plan(&filters, PlanOptions::default())?;
+/// assert_eq!(table.configuration(), Configuration::Filters8_0);
+/// assert!(table.primary_count() <= 3);
+/// // Which element the hardware hits, and the user index the driver reports.
+/// let (_element, user) = table.evaluate(&Frame::standard(0x101, &[])?).unwrap();
+/// assert_eq!(user, Some(1));
+/// let (_, user) = table.evaluate(&Frame::extended(0x0001_23AB, &[])?).unwrap();
+/// assert_eq!(user, Some(2));
+/// assert_eq!(table.evaluate(&Frame::standard(0x102, &[])?), None);
+///
+/// // Bad input: the failing filter's index, or the element counts.
+/// assert_eq!(
+///     plan(&[Filter::extended(0x2000_0000)], PlanOptions::default()).unwrap_err(),
+///     PlanError::Filter { index: 0, error: FilterError::IdOutOfRange }
+/// );
+/// let masks: Vec<Filter> = (0..9)
+///     .map(|i| Filter::masked(FrameKind::Data, Format::Standard, 0x7F0, i << 4))
+///     .collect();
+/// let err = plan(&masks, PlanOptions::new(Configuration::Filters8_0).merge(false)).unwrap_err();
+/// assert_eq!(err, PlanError::TooManyPrimary { needed: 9, available: 8, secondary: 0 });
+/// assert!(err.to_string().starts_with("the filters need 9 primary filter elements"));
+/// # Ok::<(), Box<dyn core::error::Error>>(())
+/// ```
 pub fn plan(filters: &[Filter], options: PlanOptions) -> Result<FilterTable, PlanError> {
     let prep = Prepared::new(filters)?;
     let mut covers = [

@@ -37,9 +37,9 @@ fn setup_with_id<B: Backend>(opts: &NodeOptions) -> (Harness, B::Node, Peer, Nod
     let mut h = Harness::new(RATE).unwrap();
     let dut = B::attach(&mut h, opts).unwrap_or_else(|e| panic!("{}: {e:?}", B::NAME));
     let (peer, id) = attach_peer(&h, "peer");
-    // Let the node synchronise to the idle bus (11 recessive bits) before traffic: the
-    // FlexCAN driver returns from `begin` before it has (see
-    // `flexcan_is_on_the_bus_when_set_mode_returns`).
+    // A little idle bus before traffic. Not needed for synchronisation: both drivers
+    // return from start-up on the bus (FlexCAN waits for `ESR1.SYNCH`, bxCAN for `INAK`
+    // to clear; `flexcan_is_on_the_bus_when_set_mode_returns` and its bxCAN twin check it).
     let mut dut = dut;
     run(&mut h, &mut dut, 20);
     (h, dut, peer, id)

@@ -4,64 +4,35 @@
 //! as a blink code on the board. (The `filters` example once passed masked filters as
 //! secondary filters, which ACAN §13.4 forbids.)
 
-use twocan_app::App;
+use twocan_app::{App, FILTER_COUNT};
 use twocan_core::Filter;
 use twocan_flexcan::model::FlexCanModel;
 use twocan_flexcan::{
-    check, Board, ConfigErrors, FlexCan, HostSystem, IdleClocked, Instance, Settings, Target,
+    check, Board, ConfigErrors, FlexCan, HostSystem, IdleClocked, Instance, Target,
 };
-use twocan_teensy::{configs, filters_example};
+use twocan_teensy::configs::{self, ExampleConfig};
+use twocan_teensy::filters_example;
 
-/// One example's configuration: (example, instance, settings, primary, secondary).
-type Example = (&'static str, Instance, Settings, Vec<Filter>, Vec<Filter>);
+/// The configurations the bins use (`twocan_teensy::configs`: the bins take their
+/// settings and filter lists from the same constants).
+fn examples() -> [ExampleConfig; 6] {
+    configs::every_example()
+}
 
-fn examples() -> Vec<Example> {
-    let node1 = App::new(1, 2);
-    let node2 = App::new(2, 1);
-    vec![
-        (
-            "loopback",
-            Instance::Can0,
-            configs::LOOPBACK,
-            vec![Filter::pass_all()],
-            vec![],
-        ),
-        (
-            "filters",
-            Instance::Can0,
-            filters_example::SETTINGS,
-            filters_example::primary().to_vec(),
-            filters_example::secondary().to_vec(),
-        ),
-        (
-            "app",
-            Instance::Can0,
-            configs::BUS,
-            node1.filters().to_vec(),
-            vec![],
-        ),
-        (
-            "can0-can1 (can0)",
-            Instance::Can0,
-            configs::BUS,
-            node1.filters().to_vec(),
-            vec![],
-        ),
-        (
-            "can0-can1 (can1)",
-            Instance::Can1,
-            configs::BUS,
-            node2.filters().to_vec(),
-            vec![],
-        ),
-        (
-            "async-echo",
-            Instance::Can0,
-            configs::BUS,
-            vec![Filter::pass_all()],
-            vec![],
-        ),
-    ]
+#[test]
+fn the_lists_are_the_sources_in_full() {
+    let [loopback, filters, app, can0, can1, echo] = examples();
+    assert_eq!(&loopback.primary[..], &[Filter::pass_all()][..]);
+    assert!(loopback.secondary.is_empty());
+    assert_eq!(&filters.primary[..], &filters_example::primary()[..]);
+    assert_eq!(&filters.secondary[..], &filters_example::secondary()[..]);
+    let (node, peer) = configs::APP_NODES;
+    assert_eq!(&app.primary[..], &App::new(node, peer).filters()[..]);
+    assert_eq!(app.primary.len(), FILTER_COUNT);
+    for (cfg, (node, peer)) in [can0, can1].iter().zip(configs::CAN0_CAN1_NODES) {
+        assert_eq!(&cfg.primary[..], &App::new(node, peer).filters()[..]);
+    }
+    assert_eq!(&echo.primary[..], &configs::ECHO_FILTERS[..]);
 }
 
 fn model(board: Board) -> FlexCanModel {
@@ -76,7 +47,14 @@ fn model(board: Board) -> FlexCanModel {
 fn every_example_configuration_passes_check_and_begin_on_every_board() {
     let mut ran = 0;
     for board in Board::ALL {
-        for (name, instance, settings, primary, secondary) in examples() {
+        for ExampleConfig {
+            name,
+            instance,
+            settings,
+            primary,
+            secondary,
+        } in examples()
+        {
             // can0-can1 needs FlexCAN1: Teensy 3.6 only (its bin requires teensy36).
             if instance == Instance::Can1 && board != Board::Teensy36 {
                 continue;

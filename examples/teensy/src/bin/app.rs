@@ -24,10 +24,6 @@ mod firmware {
     use twocan_teensy::rt::{self, CAN_BLINKS};
     use twocan_teensy::time::{self, Every};
 
-    /// This node and its peer.
-    const NODE: u8 = 1;
-    const PEER: u8 = 2;
-
     static CAN0: CanState = CanState::new();
 
     /// The application's counters, copied after each step (`None` before the first).
@@ -39,13 +35,14 @@ mod firmware {
     #[cortex_m_rt::entry]
     fn main() -> ! {
         let mut boot = rt::boot();
+        let (node, peer) = twocan_teensy::configs::APP_NODES;
         twocan_teensy::info!(
             "teensy-app: node {=u8}, peer {=u8}, CAN0 at {=u32} bit/s",
-            NODE,
-            PEER,
+            node,
+            peer,
             SETTINGS.actual_bit_rate()
         );
-        let mut app = App::new(NODE, PEER);
+        let mut app = App::new(node, peer);
         let token = Can0::take().unwrap_or_else(|| rt::halt(CAN_BLINKS));
         // The application's portable filter list, as primary filters.
         let can = token

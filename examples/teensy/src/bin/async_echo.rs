@@ -21,7 +21,6 @@ mod firmware {
     use embassy_executor::Executor;
     use static_cell::StaticCell;
     use twocan_app::asynch::{echo, EchoStats};
-    use twocan_core::Filter;
     use twocan_flexcan::pin::{Pin3, Pin4};
     use twocan_flexcan::{Can0, Settings};
     use twocan_teensy::can::{CanRxHalf, CanState, CanTxHalf};
@@ -57,7 +56,13 @@ mod firmware {
         let mut boot = rt::boot();
         let token = Can0::take().unwrap_or_else(|| rt::halt(CAN_BLINKS));
         let can = token
-            .begin_on(Pin3, Pin4, &SETTINGS, &[Filter::pass_all()], &[])
+            .begin_on(
+                Pin3,
+                Pin4,
+                &SETTINGS,
+                &twocan_teensy::configs::ECHO_FILTERS,
+                &[],
+            )
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         let (tx, rx) = CAN0
             .start(can.into_split(), &mut boot.core.NVIC)

@@ -36,8 +36,9 @@ mod firmware {
     #[cortex_m_rt::entry]
     fn main() -> ! {
         let mut boot = rt::boot();
-        let mut node1 = App::new(1, 2);
-        let mut node2 = App::new(2, 1);
+        let [(n1, p1), (n2, p2)] = twocan_teensy::configs::CAN0_CAN1_NODES;
+        let mut node1 = App::new(n1, p1);
+        let mut node2 = App::new(n2, p2);
 
         let can0 = Can0::take()
             .unwrap_or_else(|| rt::halt(CAN_BLINKS))

@@ -10,10 +10,11 @@
 mod firmware {
     use core::sync::atomic::{AtomicU32, Ordering};
 
-    use twocan_core::{Filter, Frame};
+    use twocan_core::Frame;
     use twocan_flexcan::pin::{Pin3, Pin4};
     use twocan_flexcan::{Can0, Settings};
     use twocan_teensy::can::CanState;
+    use twocan_teensy::configs::LOOPBACK_FILTERS;
     use twocan_teensy::rt::{self, CAN_BLINKS};
     use twocan_teensy::time::{self, Every};
 
@@ -34,7 +35,7 @@ mod firmware {
         twocan_teensy::info!("teensy-loopback: CAN0 in loop-back, a frame every second");
         let token = Can0::take().unwrap_or_else(|| rt::halt(CAN_BLINKS));
         let can = token
-            .begin_on(Pin3, Pin4, &SETTINGS, &[Filter::pass_all()], &[])
+            .begin_on(Pin3, Pin4, &SETTINGS, &LOOPBACK_FILTERS, &[])
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         let (mut tx, mut rx) = CAN0
             .start(can.into_split(), &mut boot.core.NVIC)
