@@ -39,6 +39,8 @@ use ram_can::{
     snapshots, DATA, ID, REGS, REPEAT,
 };
 
+/// Configuration attempts after a timed-out mode request (see `configure`).
+const CONFIG_RETRIES: u32 = 20;
 const APB1_HZ: u32 = 54_000_000;
 const BITRATE: u32 = 500_000;
 const RX: usize = 8;
@@ -92,7 +94,18 @@ fn configure() -> Hw {
     // SAFETY: `REGS` is the RAM stand-in for CAN1's registers; this driver is its only
     // user.
     let regs = unsafe { Mmio::new(REGS) };
-    let mut init = match Can::can1(regs, &CONFIG) {
+    // The stand-in acknowledges from SysTick, whose rate under QEMU follows host time:
+    // a wait the driver bounds in polls can run out first on a loaded host. The
+    // configuration is not measured, so a timed-out request is retried (the driver
+    // hands the controller back with the error).
+    let mut attempt = Can::can1(regs, &CONFIG);
+    for _ in 0..CONFIG_RETRIES {
+        match attempt {
+            Err(f) if f.error == Error::Timeout => attempt = f.value.reconfigure(&CONFIG),
+            _ => break,
+        }
+    }
+    let mut init = match attempt {
         Ok(i) => i,
         Err(_) => fail("twocan: can1"),
     };
@@ -103,7 +116,14 @@ fn configure() -> Hw {
     };
     check(plan.set_bank(0, bank).is_ok(), "twocan: set_bank");
     check(init.set_filters(&plan).is_ok(), "twocan: set_filters");
-    match init.enable() {
+    let mut attempt = init.enable();
+    for _ in 0..CONFIG_RETRIES {
+        match attempt {
+            Err(f) if f.error == Error::Timeout => attempt = f.value.enable(),
+            _ => break,
+        }
+    }
+    match attempt {
         Ok(can) => can.into_split(),
         Err(_) => fail("twocan: enable"),
     }
