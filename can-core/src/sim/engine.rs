@@ -141,6 +141,43 @@ pub(crate) struct Resolution {
     pub tx_penalties: Vec<u8>,
     /// Per receiver, the same.
     pub rx_penalties: Vec<u8>,
+    /// Per receiver, errors it detected after its first one (a form error in an error or
+    /// overload delimiter): code, wire bit, and rule 2 for the flag that followed. Empty
+    /// when there are none. A transmitter's such errors are in `tx_penalties` (+8 each).
+    pub rx_more_errors: Vec<Vec<(LastErrorCode, u32, bool)>>,
+    /// Delimiter / intermission faults that found no such bit.
+    pub missed: Vec<Missed>,
+}
+
+/// A delimiter or intermission fault the attempt never reached.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Missed {
+    /// Of transmitter `n` (input order).
+    Tx(usize, Aim),
+    /// Of receiver `n` (input order).
+    Rx(usize, Aim),
+    /// Of the bus.
+    Bus(Aim),
+}
+
+/// Which bit a delimiter or intermission fault aims at.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Aim {
+    /// Delimiter bit n.
+    Delimiter(u8),
+    /// Intermission bit n.
+    Intermission(u8),
+}
+
+/// Dominant bits the wire carries whatever the nodes drive.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct WireFaults {
+    /// Held dominant over these bits.
+    pub stuck: Option<(u32, u32)>,
+    /// Dominant at this bit of the first error or overload delimiter.
+    pub delimiter: Option<u8>,
+    /// Dominant at this intermission bit.
+    pub intermission: Option<u8>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -170,7 +207,7 @@ impl Phase {
     }
 }
 
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 struct Part {
     phase: Phase,
     can_flag: bool,
@@ -185,6 +222,14 @@ struct Part {
     active_flag: bool,
     /// Injected: it misreads this bit of its active error flag (once).
     flag_fault: Option<u8>,
+    /// Injected: it reads dominant at this bit of its first delimiter (once).
+    delim_fault: Option<u8>,
+    /// Injected: it reads dominant at this intermission bit (once).
+    inter_fault: Option<u8>,
+    /// Errors after the first one (form errors in a delimiter): code, bit, rule 2.
+    more_errors: Vec<(LastErrorCode, u32, bool)>,
+    /// It has finished one delimiter (a delimiter fault aims at the first one only).
+    delimited: bool,
     /// Consecutive dominant bits counted for rule 6.
     dominant_run: u32,
     penalties: u8,
@@ -209,6 +254,10 @@ impl Part {
             dominant_in_passive_flag: false,
             active_flag: false,
             flag_fault: None,
+            delim_fault: None,
+            inter_fault: None,
+            more_errors: Vec::new(),
+            delimited: false,
             dominant_run: 0,
             penalties: 0,
             arbitration_stuff_exception: false,
@@ -222,6 +271,20 @@ impl Part {
 
     fn detect(&mut self, code: LastErrorCode, at: u32) {
         self.error = Some((code, at));
+        self.active_flag = self.can_flag;
+        self.dominant_run = 0;
+        self.phase = if self.can_flag {
+            Phase::ActiveFlag(0)
+        } else {
+            Phase::PassiveFlag { last: true, run: 0 }
+        };
+    }
+
+    /// A form error in an error or overload delimiter (ISO 11898-1 §10.11.4): a second
+    /// error in the attempt, with a new error flag from the next bit.
+    fn detect_again(&mut self, code: LastErrorCode, at: u32) {
+        self.more_errors.push((code, at, false));
+        self.overloading = false;
         self.active_flag = self.can_flag;
         self.dominant_run = 0;
         self.phase = if self.can_flag {
@@ -253,7 +316,11 @@ impl Part {
     /// Reads one intermission bit.
     fn intermission(&mut self, wire: bool) {
         if let Phase::Intermission(k) = self.phase {
-            if !wire && k < 2 {
+            let misread = self.inter_fault == Some(k);
+            if misread {
+                self.inter_fault = None;
+            }
+            if (!wire || misread) && k < 2 {
                 self.overload();
             } else if k + 1 >= 3 {
                 self.phase = Phase::Done;
@@ -276,8 +343,8 @@ impl Part {
         }
     }
 
-    /// Reads one bit while in an error phase.
-    fn error_phase(&mut self, wire: bool) {
+    /// Reads wire bit `i` while in an error phase.
+    fn error_phase(&mut self, wire: bool, i: u32) {
         self.phase = match self.phase {
             Phase::ActiveFlag(n) if self.flag_fault == Some(n) => {
                 // Rules 4 / 5: a bit error during its own active error flag; a new flag
@@ -315,7 +382,8 @@ impl Part {
                 }
             }
             Phase::PassiveFlag { last, run } => {
-                if !wire {
+                // Rule 3 exception 1 is about the flag sent for the acknowledge error.
+                if !wire && self.more_errors.is_empty() {
                     self.dominant_in_passive_flag = true;
                 }
                 let run = if run == 0 || wire == last { run + 1 } else { 1 };
@@ -332,19 +400,50 @@ impl Part {
                 } else {
                     // Rule 2 is about error flags only.
                     if first && !self.overloading {
-                        self.dominant_after_flag = true;
+                        match self.more_errors.last_mut() {
+                            Some(e) => e.2 = true,
+                            None => self.dominant_after_flag = true,
+                        }
                     }
                     self.count_dominant();
                     Phase::AfterFlag { first: false }
                 }
             }
-            Phase::Delimiter(n) if wire && n + 1 >= 8 => {
-                self.overloading = false;
-                Phase::Intermission(0)
+            Phase::Delimiter(n) => {
+                let misread = !self.delimited && self.delim_fault == Some(n);
+                if misread {
+                    self.delim_fault = None;
+                }
+                if wire && !misread {
+                    if n + 1 >= 8 {
+                        self.overloading = false;
+                        self.delimited = true;
+                        Phase::Intermission(0)
+                    } else {
+                        Phase::Delimiter(n + 1)
+                    }
+                } else if n >= 7 {
+                    // A dominant last delimiter bit: an overload condition (§10.4.5.2).
+                    self.delimited = true;
+                    self.overload();
+                    self.phase
+                } else {
+                    // Any other delimiter bit: a form error (§10.11.4), a new error flag.
+                    self.delimited = true;
+                    self.detect_again(LastErrorCode::Form, i);
+                    self.phase
+                }
             }
-            Phase::Delimiter(n) if wire => Phase::Delimiter(n + 1),
             other => other,
         };
+    }
+
+    /// The faults aimed at delimiter / intermission bits this node never read.
+    fn missed(&self) -> impl Iterator<Item = Aim> {
+        self.delim_fault
+            .map(Aim::Delimiter)
+            .into_iter()
+            .chain(self.inter_fault.map(Aim::Intermission))
     }
 
     fn outcome(&self, end: u32) -> PartOutcome {
@@ -461,27 +560,36 @@ fn rx_read(rx: &RxSpec, p: &mut Part, wire: bool, i: u32, reference: &[bool], ce
     }
 }
 
-/// The parts' penalties, or an empty vector when all are 0.
-fn penalties(parts: &[Part]) -> Vec<u8> {
-    if parts.iter().all(|p| p.penalties == 0) {
+/// The parts' penalties, or an empty vector when all are 0. `transmitters`: a form error
+/// in a delimiter is one more error flag sent, TEC + 8 (rule 3) — counted here.
+fn penalties(parts: &[Part], transmitters: bool) -> Vec<u8> {
+    let of = |p: &Part| {
+        let more = if transmitters {
+            p.more_errors.len().min(255) as u8
+        } else {
+            0
+        };
+        p.penalties.saturating_add(more)
+    };
+    if parts.iter().all(|p| of(p) == 0) {
         Vec::new()
     } else {
-        parts.iter().map(|p| p.penalties).collect()
+        parts.iter().map(of).collect()
     }
 }
 
 /// Plays one frame attempt. `txs` must not be empty (an empty slice gives an empty result).
 #[cfg(test)]
 pub(crate) fn resolve(txs: &[TxSpec<'_>], rxs: &[RxSpec]) -> Resolution {
-    resolve_with(txs, rxs, None)
+    resolve_with(txs, rxs, WireFaults::default())
 }
 
-/// [`resolve`] with the wire held dominant over bits `stuck.0..stuck.1`.
-pub(crate) fn resolve_with(
-    txs: &[TxSpec<'_>],
-    rxs: &[RxSpec],
-    stuck: Option<(u32, u32)>,
-) -> Resolution {
+/// [`resolve`] with the wire faults `wf`: held dominant over bits `stuck.0..stuck.1`,
+/// dominant at a delimiter or intermission bit.
+pub(crate) fn resolve_with(txs: &[TxSpec<'_>], rxs: &[RxSpec], wf: WireFaults) -> Resolution {
+    let stuck = wf.stuck;
+    let mut bus_delim = wf.delimiter;
+    let mut bus_inter = wf.intermission;
     let reference = (0..txs.len())
         .min_by(|&a, &b| txs[a].stream.cmp(txs[b].stream))
         .unwrap_or(0);
@@ -497,6 +605,8 @@ pub(crate) fn resolve_with(
             reference: 0,
             tx_penalties: Vec::new(),
             rx_penalties: Vec::new(),
+            rx_more_errors: Vec::new(),
+            missed: Vec::new(),
         };
     };
     let ce = ref_tx.bits.crc_end;
@@ -521,6 +631,14 @@ pub(crate) fn resolve_with(
         .iter()
         .map(|t| Part {
             flag_fault: flag_fault(Some(&t.faults), None),
+            delim_fault: t.faults.iter().find_map(|f| match f {
+                TxFault::Delimiter(b) => Some(*b),
+                _ => None,
+            }),
+            inter_fault: t.faults.iter().find_map(|f| match f {
+                TxFault::Intermission(b) => Some(*b),
+                _ => None,
+            }),
             ..Part::new(t.active)
         })
         .collect();
@@ -528,6 +646,14 @@ pub(crate) fn resolve_with(
         .iter()
         .map(|r| Part {
             flag_fault: flag_fault(None, Some(&r.faults)),
+            delim_fault: r.faults.iter().find_map(|f| match f {
+                RxFault::Delimiter(b) => Some(*b),
+                _ => None,
+            }),
+            inter_fault: r.faults.iter().find_map(|f| match f {
+                RxFault::Intermission(b) => Some(*b),
+                _ => None,
+            }),
             can_drive: r.acks,
             ..Part::new(r.active)
         })
@@ -539,7 +665,13 @@ pub(crate) fn resolve_with(
 
     let longest = txs.iter().map(|t| t.bits.crc_end).max().unwrap_or(ce);
     let stuck_len = stuck.map_or(0, |(a, b)| b.saturating_sub(a));
-    let limit = longest + 10 + 64 + stuck_len.min(4096) + 32;
+    // Each delimiter / intermission fault may add an error or overload frame (at most 6 +
+    // 6 echo + 8 delimiter + 3 bits, and its own chain of echoes): a generous margin.
+    let aimed = (txs.iter().map(|t| t.faults.len()).sum::<usize>()
+        + rxs.iter().map(|r| r.faults.len()).sum::<usize>()
+        + 2)
+    .min(64) as u32;
+    let limit = longest + 10 + 64 + stuck_len.min(4096) + 32 + 32 * aimed;
     let mut acked = false;
     let mut last_dominant_end = 0;
     let mut i = 0u32;
@@ -568,6 +700,24 @@ pub(crate) fn resolve_with(
         if stuck.is_some_and(|(a, b)| (a..b).contains(&i)) {
             wire = false;
         }
+        let all_parts = || {
+            tx_parts
+                .iter()
+                .chain(&rx_parts)
+                .chain(core::iter::once(&obs_part))
+        };
+        if let Some(k) = bus_delim {
+            if all_parts().any(|p| !p.delimited && p.phase == Phase::Delimiter(k)) {
+                wire = false;
+                bus_delim = None;
+            }
+        }
+        if let Some(k) = bus_inter {
+            if all_parts().any(|p| p.phase == Phase::Intermission(k)) {
+                wire = false;
+                bus_inter = None;
+            }
+        }
         if !wire {
             last_dominant_end = i + 1;
         }
@@ -579,7 +729,7 @@ pub(crate) fn resolve_with(
                 Phase::Frame => tx_read(t, p, wire, i),
                 Phase::Done => {}
                 Phase::Intermission(_) => p.intermission(wire),
-                _ => p.error_phase(wire),
+                _ => p.error_phase(wire, i),
             }
         }
         for (r, p) in rxs
@@ -591,7 +741,7 @@ pub(crate) fn resolve_with(
                 Phase::Frame => rx_read(r, p, wire, i, ref_stream, ce),
                 Phase::Done => {}
                 Phase::Intermission(_) => p.intermission(wire),
-                _ => p.error_phase(wire),
+                _ => p.error_phase(wire, i),
             }
         }
 
@@ -612,7 +762,17 @@ pub(crate) fn resolve_with(
             .chain(core::iter::once(&obs_part))
             .all(|p| p.phase != Phase::Frame);
         let stuck_over = stuck.is_none_or(|(_, b)| i >= b);
-        if (drivers_done && decided && stuck_over) || i >= limit {
+        // An intermission fault keeps the intermission played while it may still hit.
+        let in_intermission = |p: &Part| matches!(p.phase, Phase::Intermission(_));
+        let parts = || {
+            tx_parts
+                .iter()
+                .chain(&rx_parts)
+                .chain(core::iter::once(&obs_part))
+        };
+        let inter_pending = (bus_inter.is_some() && parts().any(in_intermission))
+            || parts().any(|p| p.inter_fault.is_some() && in_intermission(p));
+        if (drivers_done && decided && stuck_over && !inter_pending) || i >= limit {
             break drivers_end.unwrap_or(i);
         }
     };
@@ -629,8 +789,25 @@ pub(crate) fn resolve_with(
             bus
         },
         reference,
-        tx_penalties: penalties(&tx_parts),
-        rx_penalties: penalties(&rx_parts),
+        tx_penalties: penalties(&tx_parts, true),
+        rx_penalties: penalties(&rx_parts, false),
+        rx_more_errors: if rx_parts.iter().all(|p| p.more_errors.is_empty()) {
+            Vec::new()
+        } else {
+            rx_parts.iter().map(|p| p.more_errors.clone()).collect()
+        },
+        missed: {
+            let mut m: Vec<Missed> = Vec::new();
+            for (n, p) in tx_parts.iter().enumerate() {
+                m.extend(p.missed().map(|a| Missed::Tx(n, a)));
+            }
+            for (n, p) in rx_parts.iter().enumerate() {
+                m.extend(p.missed().map(|a| Missed::Rx(n, a)));
+            }
+            m.extend(bus_delim.map(|b| Missed::Bus(Aim::Delimiter(b))));
+            m.extend(bus_inter.map(|b| Missed::Bus(Aim::Intermission(b))));
+            m
+        },
     }
 }
 
