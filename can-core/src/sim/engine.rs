@@ -47,19 +47,24 @@
 //! not move, except by rule 6. The intermission is played only while something may drive it
 //! (an overload frame in progress, a stuck-dominant bus).
 //!
-//! Not modelled (what the engine does instead):
-//! - a dominant bit inside an error or overload delimiter, after its first recessive bit:
-//!   ISO 11898-1 makes it a form error (a fixed-form field, §10.11.4) and a new error flag,
-//!   with the counters of rules 1/3; the engine counts nothing and waits one more recessive
-//!   bit (the delimiter is stretched, `Phase::Delimiter` keeps its count);
-//! - a dominant last delimiter bit: an overload condition (§10.4.5), here the same stretch;
-//! - a dominant third intermission bit: a start of frame for a node with a frame to send
-//!   (§10.4.6.2); here the intermission ends and the next attempt starts at its own time;
-//! - hard synchronisation effects.
+//! Delimiters (§10.4.4.3 error delimiter, §10.4.5.3 overload delimiter: 8 recessive bits,
+//! a fixed-form field, §10.11.4): a node that reads a dominant bit at delimiter bits 1..=6
+//! (bit 0 is the recessive bit it waited for after its flag) detects a form error and
+//! starts a new error flag at the next bit — a second error of the attempt, reported per
+//! receiver in `Resolution::rx_more_errors` (rule 1, and rule 2 for the new flag) and per
+//! transmitter as one more +8 in `Resolution::tx_penalties` (rule 3; its exceptions concern
+//! acknowledge and arbitration stuff errors only). A dominant last (8th) delimiter bit is
+//! an overload condition (§10.4.5.2): an overload frame, no counter change. Injected
+//! misreads (`Fault::DelimiterBit`, `Fault::IntermissionBit` for one node) and bus-wide
+//! dominant bits ([`WireFaults`]) aim at the first delimiter of each node; a fault whose bit
+//! never comes is listed in `Resolution::missed` (the bus refuses it).
 //!
-//! Modelling the first two needs a second error inside one attempt (its own counter
-//! change, +1 for a receiver, which the one-error-plus-penalties outcome cannot carry):
-//! `PartOutcome` and `FaultConfinement` would change with it.
+//! Not modelled (what the engine does instead):
+//! - a dominant third intermission bit: a start of frame for every node (§10.4.6.2), a new
+//!   attempt one bit early; the injector refuses `Fault::IntermissionBit` there, and a
+//!   stuck-dominant period over it is ignored (the intermission ends and the next attempt
+//!   starts at its own time);
+//! - hard synchronisation effects.
 
 use super::bits::FrameBits;
 use super::inject::{is_stuff_bit, RxFault, TxFault};
@@ -994,5 +999,92 @@ mod tests {
         assert!(
             matches!(r.tx[0], PartOutcome::Error { code: L::BitRecessive, at, .. } if at == ce + 9)
         );
+    }
+
+    /// A lone active transmitter with a listen-only receiver: acknowledge error at ce+1,
+    /// flag ce+2..=ce+7, delimiter bit n at ce+8+n.
+    #[test]
+    fn dominant_error_delimiter_bit_is_a_form_error_and_a_new_flag() {
+        let w = wire_bits(&Frame::standard(0x123, &[]).unwrap());
+        let ce = w.1.crc_end;
+        let wf = WireFaults {
+            delimiter: Some(2),
+            ..WireFaults::default()
+        };
+        let r = resolve_with(&[tx(&w, true)], &[rx(false, false)], wf);
+        assert_eq!(r.tx, vec![err(L::Acknowledge, ce + 1, false)]);
+        // The wire is dominant at ce+10; the transmitter's new flag is ce+11..=ce+16, its
+        // delimiter ce+17..=ce+24.
+        assert!(!r.wire[(ce + 10) as usize]);
+        assert!(r.wire[(ce + 8) as usize] && r.wire[(ce + 9) as usize]);
+        assert!(r.wire[(ce + 11) as usize..=(ce + 16) as usize]
+            .iter()
+            .all(|&b| !b));
+        assert_eq!(r.last_dominant_end, ce + 17);
+        assert_eq!(r.end, ce + 25);
+        assert_eq!(r.tx_penalties, vec![1], "rule 3: one more error flag");
+        // The listen-only receiver: form error at ce+2, passive flag from ce+3 waiting for
+        // 6 equal bits (5 dominant to ce+7, then recessive from ce+8): at ce+10 it is still
+        // in its passive flag, not in a delimiter — no second error for it.
+        assert!(r.rx_more_errors.is_empty());
+        assert!(r.missed.is_empty());
+    }
+
+    #[test]
+    fn dominant_last_delimiter_bit_is_an_overload_frame() {
+        let w = wire_bits(&Frame::standard(0x123, &[]).unwrap());
+        let ce = w.1.crc_end;
+        let mut t = tx(&w, true);
+        t.faults.push(TxFault::Delimiter(7));
+        let r = resolve(&[t], &[rx(false, false)]);
+        // Delimiter bit 7 misread at ce+15: overload flag ce+16..=ce+21, delimiter
+        // ce+22..=ce+29; no counter change for the transmitter.
+        assert_eq!(r.end, ce + 30);
+        assert_eq!(r.last_dominant_end, ce + 22);
+        assert!(r.tx_penalties.is_empty());
+        // The listen-only receiver lags: its passive flag (form error at ce+2) ends with
+        // six recessive bits ce+8..=ce+13, its delimiter starts at ce+14, so the overload
+        // flag at ce+16 is at its delimiter bit 2: a form error (rule 1).
+        assert_eq!(r.rx_more_errors, vec![vec![(L::Form, ce + 16, false)]]);
+    }
+
+    #[test]
+    fn a_delimiter_fault_without_a_delimiter_is_missed() {
+        let w = wire_bits(&Frame::standard(0x123, &[4]).unwrap());
+        let mut t = tx(&w, true);
+        t.faults.push(TxFault::Delimiter(3));
+        let wf = WireFaults {
+            delimiter: Some(5),
+            ..WireFaults::default()
+        };
+        let r = resolve_with(&[t], &[rx(true, true)], wf);
+        assert_eq!(r.tx, vec![PartOutcome::Ok { done: w.1.total }]);
+        assert_eq!(
+            r.missed,
+            vec![
+                Missed::Tx(0, Aim::Delimiter(3)),
+                Missed::Bus(Aim::Delimiter(5))
+            ]
+        );
+    }
+
+    #[test]
+    fn a_receiver_misreading_intermission_bit_1_starts_an_overload_frame() {
+        let w = wire_bits(&Frame::standard(0x123, &[4]).unwrap());
+        let ce = w.1.crc_end;
+        let mut r0 = rx(true, true);
+        r0.faults.push(RxFault::Intermission(1));
+        let r = resolve(&[tx(&w, true)], &[r0, rx(true, true)]);
+        // EOF ends at ce+9; intermission bit 1 is ce+11: overload flag ce+12..=ce+17, the
+        // others read it at their intermission bit 2 (no overload: a start of frame, not
+        // played) — they are done; delimiter ce+18..=ce+25.
+        assert!(r
+            .tx
+            .iter()
+            .chain(&r.rx)
+            .all(|o| matches!(o, PartOutcome::Ok { .. })));
+        assert_eq!(r.last_dominant_end, ce + 18);
+        assert_eq!(r.end, ce + 26);
+        assert!(r.missed.is_empty());
     }
 }
