@@ -775,9 +775,11 @@ pub(crate) fn resolve_with(txs: &[TxSpec<'_>], rxs: &[RxSpec], wf: WireFaults) -
                 .chain(&rx_parts)
                 .chain(core::iter::once(&obs_part))
         };
-        let inter_pending = (bus_inter.is_some() && parts().any(in_intermission))
-            || parts().any(|p| p.inter_fault.is_some() && in_intermission(p));
-        if (drivers_done && decided && stuck_over && !inter_pending) || i >= limit {
+        let inter_pending = || {
+            (bus_inter.is_some() && parts().any(in_intermission))
+                || parts().any(|p| p.inter_fault.is_some() && in_intermission(p))
+        };
+        if (drivers_done && decided && stuck_over && !inter_pending()) || i >= limit {
             break drivers_end.unwrap_or(i);
         }
     };
