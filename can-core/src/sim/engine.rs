@@ -299,6 +299,18 @@ impl Part {
         };
     }
 
+    /// In an error or overload frame (flag, the bits after it, delimiter).
+    fn in_error_frame(&self) -> bool {
+        matches!(
+            self.phase,
+            Phase::ActiveFlag(_)
+                | Phase::PassiveFlag { .. }
+                | Phase::Overload(_)
+                | Phase::AfterFlag { .. }
+                | Phase::Delimiter(_)
+        )
+    }
+
     fn drives_flag(&self) -> bool {
         matches!(self.phase, Phase::ActiveFlag(_) | Phase::Overload(_))
     }
@@ -705,22 +717,41 @@ pub(crate) fn resolve_with(txs: &[TxSpec<'_>], rxs: &[RxSpec], wf: WireFaults) -
         if stuck.is_some_and(|(a, b)| (a..b).contains(&i)) {
             wire = false;
         }
-        let all_parts = || {
-            tx_parts
-                .iter()
-                .chain(&rx_parts)
-                .chain(core::iter::once(&obs_part))
-        };
-        if let Some(k) = bus_delim {
-            if all_parts().any(|p| !p.delimited && p.phase == Phase::Delimiter(k)) {
-                wire = false;
-                bus_delim = None;
+        // A bus-wide delimiter / intermission fault lands where the transmitters and the
+        // error-active receivers (whose flags end together) are at that bit; only when
+        // none of them is in an error or overload frame, where any other node is.
+        if bus_delim.is_some() || bus_inter.is_some() {
+            let leads = || {
+                tx_parts.iter().chain(
+                    rx_parts
+                        .iter()
+                        .zip(rxs)
+                        .filter(|(_, r)| r.active)
+                        .map(|(p, _)| p),
+                )
+            };
+            let others = || rx_parts.iter().chain(core::iter::once(&obs_part));
+            let at = |hit: &dyn Fn(&Part) -> bool, busy: &dyn Fn(&Part) -> bool| {
+                if leads().any(busy) {
+                    leads().any(hit)
+                } else {
+                    others().any(hit)
+                }
+            };
+            if let Some(k) = bus_delim {
+                let hit = |p: &Part| !p.delimited && p.phase == Phase::Delimiter(k);
+                if at(&hit, &|p: &Part| p.in_error_frame()) {
+                    wire = false;
+                    bus_delim = None;
+                }
             }
-        }
-        if let Some(k) = bus_inter {
-            if all_parts().any(|p| p.phase == Phase::Intermission(k)) {
-                wire = false;
-                bus_inter = None;
+            if let Some(k) = bus_inter {
+                let hit = |p: &Part| p.phase == Phase::Intermission(k);
+                let busy = |p: &Part| matches!(p.phase, Phase::Intermission(_));
+                if at(&hit, &busy) {
+                    wire = false;
+                    bus_inter = None;
+                }
             }
         }
         if !wire {
