@@ -697,4 +697,68 @@ mod tests {
             assert_eq!(always.draw(&bits, &[]), Some(Fault::Ack));
         }
     }
+
+    #[test]
+    fn delimiter_and_intermission_faults_are_checked() {
+        let mut bus = crate::sim::Bus::new(500_000).unwrap();
+        let node = bus.attach("a", crate::sim::SimNode::new().shared());
+        let other = bus.attach("b", crate::sim::SimNode::new().shared());
+        for bit in 1..=7 {
+            for who in [Sees::Bus, Sees::Node(node)] {
+                assert_eq!(Fault::DelimiterBit { who, bit }.validate(), Ok(()));
+            }
+        }
+        for (fault, error) in [
+            (
+                Fault::DelimiterBit {
+                    who: Sees::Bus,
+                    bit: 0,
+                },
+                FaultError::DelimiterBitOutOfRange(0),
+            ),
+            (
+                Fault::DelimiterBit {
+                    who: Sees::Bus,
+                    bit: 8,
+                },
+                FaultError::DelimiterBitOutOfRange(8),
+            ),
+            (
+                Fault::IntermissionBit {
+                    who: Sees::Node(node),
+                    bit: 2,
+                },
+                FaultError::IntermissionStartOfFrame,
+            ),
+            (
+                Fault::IntermissionBit {
+                    who: Sees::Bus,
+                    bit: 3,
+                },
+                FaultError::IntermissionBitOutOfRange(3),
+            ),
+        ] {
+            assert_eq!(fault.validate(), Err(error));
+            let e: &dyn std::error::Error = &error;
+            assert!(!std::format!("{e}").is_empty());
+        }
+        assert_eq!(
+            std::format!("{}", FaultError::IntermissionStartOfFrame),
+            "a dominant third intermission bit is a start of frame, not simulated"
+        );
+        // Node faults go to that node only; bus faults to nobody's own list.
+        let bits = super::super::bits::frame_bits(&crate::frame::Frame::standard(1, &[]).unwrap());
+        let f = Fault::DelimiterBit {
+            who: Sees::Node(node),
+            bit: 4,
+        };
+        assert_eq!(f.tx_part(node, &bits), Some(TxFault::Delimiter(4)));
+        assert_eq!(f.rx_part(other, &bits), None);
+        let f = Fault::IntermissionBit {
+            who: Sees::Bus,
+            bit: 1,
+        };
+        assert_eq!(f.bus_intermission(), Some(1));
+        assert_eq!(f.tx_part(node, &bits), None);
+    }
 }
