@@ -57,7 +57,12 @@
 //! an overload condition (§10.4.5.2): an overload frame, no counter change. Injected
 //! misreads (`Fault::DelimiterBit`, `Fault::IntermissionBit` for one node) and bus-wide
 //! dominant bits ([`WireFaults`]) aim at the first delimiter of each node; a fault whose bit
-//! never comes is listed in `Resolution::missed` (the bus refuses it).
+//! never comes is listed in `Resolution::missed` (the bus refuses it). A bus-wide one lands
+//! where the transmitters and error-active receivers are, or, if none of them is in an
+//! error frame, at a passive receiver's delimiter up to their second intermission bit (a
+//! dominant bit after it would be their start of frame). A pending delimiter fault keeps
+//! the attempt played (past the end that the driving nodes give it) until that delimiter
+//! is over.
 //!
 //! Not modelled (what the engine does instead):
 //! - a dominant third intermission bit: a start of frame for every node (§10.4.6.2), a new
@@ -731,11 +736,15 @@ pub(crate) fn resolve_with(txs: &[TxSpec<'_>], rxs: &[RxSpec], wf: WireFaults) -
                 )
             };
             let others = || rx_parts.iter().chain(core::iter::once(&obs_part));
+            // Not past the leads' second intermission bit: a dominant bit there would be a
+            // start of frame for them, which is not played.
+            let early =
+                || leads().all(|p| !matches!(p.phase, Phase::Intermission(2) | Phase::Done));
             let at = |hit: &dyn Fn(&Part) -> bool, busy: &dyn Fn(&Part) -> bool| {
                 if leads().any(busy) {
                     leads().any(hit)
                 } else {
-                    others().any(hit)
+                    early() && others().any(hit)
                 }
             };
             if let Some(k) = bus_delim {
@@ -810,7 +819,18 @@ pub(crate) fn resolve_with(txs: &[TxSpec<'_>], rxs: &[RxSpec], wf: WireFaults) -
             (bus_inter.is_some() && parts().any(in_intermission))
                 || parts().any(|p| p.inter_fault.is_some() && in_intermission(p))
         };
-        if (drivers_done && decided && stuck_over && !inter_pending()) || i >= limit {
+        // A node's own delimiter fault keeps its delimiter played, also for a node that
+        // drives nothing (a passive flag) and so does not hold the end of the attempt.
+        let delim_pending = || {
+            parts().any(|p| {
+                (p.delim_fault.is_some() || bus_delim.is_some())
+                    && !p.delimited
+                    && p.in_error_frame()
+            })
+        };
+        if (drivers_done && decided && stuck_over && !inter_pending() && !delim_pending())
+            || i >= limit
+        {
             break drivers_end.unwrap_or(i);
         }
     };
