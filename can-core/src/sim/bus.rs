@@ -94,7 +94,7 @@ use std::vec::Vec;
 use super::bits::{wire_bits, FrameBits, INTERMISSION_BITS};
 use super::engine::{self, PartOutcome, RxSpec, TxSpec};
 use super::fast;
-use super::inject::{Fault, FaultError, Injector, RandomFaults};
+use super::inject::{Fault, FaultError, Injector, RandomFaults, Sees};
 use super::node::{BusNode, BusTime, ConfinementEvent, TxRequest, TxResult};
 use super::stats::{BusStats, NodeStats};
 use super::trace::{bits_to_micros, ErrorInfo, NodeOutcome, NodeReport, Trace, TraceRecord};
@@ -729,7 +729,11 @@ impl Bus {
             }
         });
         self.refused.extend_from_slice(&refused);
-        let stuck = faults.iter().find_map(Fault::stuck_range);
+        let wire_faults = engine::WireFaults {
+            stuck: faults.iter().find_map(Fault::stuck_range),
+            delimiter: faults.iter().find_map(Fault::bus_delimiter),
+            intermission: faults.iter().find_map(Fault::bus_intermission),
+        };
 
         // The fast path needs only whether someone acknowledges: no per-node specs.
         let fast = if self.fast_path && faults.is_empty() && contenders.len() == 1 {
@@ -774,7 +778,7 @@ impl Bus {
                         }
                     })
                     .collect();
-                engine::resolve_with(&txs, &rxs, stuck)
+                engine::resolve_with(&txs, &rxs, wire_faults)
             }
         };
 
@@ -835,6 +839,13 @@ impl Bus {
                 ),
             };
             schedule.push((at.min(end), 2, k, notice));
+            // Errors after its first one (a form error in a delimiter): each counts as a
+            // receive error (rule 1, rule 2 for its own flag), told after its flag.
+            for &(code, at, dominant_after_flag) in res.rx_more_errors.get(n).into_iter().flatten()
+            {
+                let when = (u64::from(at) + 8).min(end);
+                schedule.push((when, 2, k, Notice::RxError(code, dominant_after_flag)));
+            }
             let penalties = res.rx_penalties.get(n).copied().unwrap_or(0);
             if penalties > 0 {
                 let event = ConfinementEvent::FlagPenalties {
@@ -902,6 +913,30 @@ impl Bus {
                 outcome,
                 error_bit,
             });
+        }
+
+        // A delimiter or intermission fault whose bit never came is refused, not moved.
+        for m in &res.missed {
+            let (who, aim) = match *m {
+                engine::Missed::Tx(n, a) => (Sees::Node(NodeId(contenders[n].0)), a),
+                engine::Missed::Rx(n, a) => (Sees::Node(NodeId(receivers[n])), a),
+                engine::Missed::Bus(a) => (Sees::Bus, a),
+            };
+            let (fault, error) = match aim {
+                engine::Aim::Delimiter(bit) => (
+                    Fault::DelimiterBit { who, bit },
+                    FaultError::DelimiterNotReached(bit),
+                ),
+                engine::Aim::Intermission(bit) => (
+                    Fault::IntermissionBit { who, bit },
+                    FaultError::IntermissionNotReached(bit),
+                ),
+            };
+            if let Some(pos) = faults.iter().position(|f| *f == fault) {
+                faults.remove(pos);
+                refused.push((fault, error));
+                self.refused.push((fault, error));
+            }
         }
 
         let record = TraceRecord {

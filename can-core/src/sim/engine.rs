@@ -47,19 +47,29 @@
 //! not move, except by rule 6. The intermission is played only while something may drive it
 //! (an overload frame in progress, a stuck-dominant bus).
 //!
-//! Not modelled (what the engine does instead):
-//! - a dominant bit inside an error or overload delimiter, after its first recessive bit:
-//!   ISO 11898-1 makes it a form error (a fixed-form field, §10.11.4) and a new error flag,
-//!   with the counters of rules 1/3; the engine counts nothing and waits one more recessive
-//!   bit (the delimiter is stretched, `Phase::Delimiter` keeps its count);
-//! - a dominant last delimiter bit: an overload condition (§10.4.5), here the same stretch;
-//! - a dominant third intermission bit: a start of frame for a node with a frame to send
-//!   (§10.4.6.2); here the intermission ends and the next attempt starts at its own time;
-//! - hard synchronisation effects.
+//! Delimiters (§10.4.4.3 error delimiter, §10.4.5.3 overload delimiter: 8 recessive bits,
+//! a fixed-form field, §10.11.4): a node that reads a dominant bit at delimiter bits 1..=6
+//! (bit 0 is the recessive bit it waited for after its flag) detects a form error and
+//! starts a new error flag at the next bit — a second error of the attempt, reported per
+//! receiver in `Resolution::rx_more_errors` (rule 1, and rule 2 for the new flag) and per
+//! transmitter as one more +8 in `Resolution::tx_penalties` (rule 3; its exceptions concern
+//! acknowledge and arbitration stuff errors only). A dominant last (8th) delimiter bit is
+//! an overload condition (§10.4.5.2): an overload frame, no counter change. Injected
+//! misreads (`Fault::DelimiterBit`, `Fault::IntermissionBit` for one node) and bus-wide
+//! dominant bits ([`WireFaults`]) aim at the first delimiter of each node; a fault whose bit
+//! never comes is listed in `Resolution::missed` (the bus refuses it). A bus-wide one lands
+//! where the transmitters and error-active receivers are, or, if none of them is in an
+//! error frame, at a passive receiver's delimiter up to their second intermission bit (a
+//! dominant bit after it would be their start of frame). A pending delimiter fault keeps
+//! the attempt played (past the end that the driving nodes give it) until that delimiter
+//! is over.
 //!
-//! Modelling the first two needs a second error inside one attempt (its own counter
-//! change, +1 for a receiver, which the one-error-plus-penalties outcome cannot carry):
-//! `PartOutcome` and `FaultConfinement` would change with it.
+//! Not modelled (what the engine does instead):
+//! - a dominant third intermission bit: a start of frame for every node (§10.4.6.2), a new
+//!   attempt one bit early; the injector refuses `Fault::IntermissionBit` there, and a
+//!   stuck-dominant period over it is ignored (the intermission ends and the next attempt
+//!   starts at its own time);
+//! - hard synchronisation effects.
 
 use super::bits::FrameBits;
 use super::inject::{is_stuff_bit, RxFault, TxFault};
@@ -141,6 +151,43 @@ pub(crate) struct Resolution {
     pub tx_penalties: Vec<u8>,
     /// Per receiver, the same.
     pub rx_penalties: Vec<u8>,
+    /// Per receiver, errors it detected after its first one (a form error in an error or
+    /// overload delimiter): code, wire bit, and rule 2 for the flag that followed. Empty
+    /// when there are none. A transmitter's such errors are in `tx_penalties` (+8 each).
+    pub rx_more_errors: Vec<Vec<(LastErrorCode, u32, bool)>>,
+    /// Delimiter / intermission faults that found no such bit.
+    pub missed: Vec<Missed>,
+}
+
+/// A delimiter or intermission fault the attempt never reached.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Missed {
+    /// Of transmitter `n` (input order).
+    Tx(usize, Aim),
+    /// Of receiver `n` (input order).
+    Rx(usize, Aim),
+    /// Of the bus.
+    Bus(Aim),
+}
+
+/// Which bit a delimiter or intermission fault aims at.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Aim {
+    /// Delimiter bit n.
+    Delimiter(u8),
+    /// Intermission bit n.
+    Intermission(u8),
+}
+
+/// Dominant bits the wire carries whatever the nodes drive.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct WireFaults {
+    /// Held dominant over these bits.
+    pub stuck: Option<(u32, u32)>,
+    /// Dominant at this bit of the first error or overload delimiter.
+    pub delimiter: Option<u8>,
+    /// Dominant at this intermission bit.
+    pub intermission: Option<u8>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -170,7 +217,7 @@ impl Phase {
     }
 }
 
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 struct Part {
     phase: Phase,
     can_flag: bool,
@@ -185,6 +232,14 @@ struct Part {
     active_flag: bool,
     /// Injected: it misreads this bit of its active error flag (once).
     flag_fault: Option<u8>,
+    /// Injected: it reads dominant at this bit of its first delimiter (once).
+    delim_fault: Option<u8>,
+    /// Injected: it reads dominant at this intermission bit (once).
+    inter_fault: Option<u8>,
+    /// Errors after the first one (form errors in a delimiter): code, bit, rule 2.
+    more_errors: Vec<(LastErrorCode, u32, bool)>,
+    /// It has finished one delimiter (a delimiter fault aims at the first one only).
+    delimited: bool,
     /// Consecutive dominant bits counted for rule 6.
     dominant_run: u32,
     penalties: u8,
@@ -209,6 +264,10 @@ impl Part {
             dominant_in_passive_flag: false,
             active_flag: false,
             flag_fault: None,
+            delim_fault: None,
+            inter_fault: None,
+            more_errors: Vec::new(),
+            delimited: false,
             dominant_run: 0,
             penalties: 0,
             arbitration_stuff_exception: false,
@@ -229,6 +288,32 @@ impl Part {
         } else {
             Phase::PassiveFlag { last: true, run: 0 }
         };
+    }
+
+    /// A form error in an error or overload delimiter (ISO 11898-1 §10.11.4): a second
+    /// error in the attempt, with a new error flag from the next bit.
+    fn detect_again(&mut self, code: LastErrorCode, at: u32) {
+        self.more_errors.push((code, at, false));
+        self.overloading = false;
+        self.active_flag = self.can_flag;
+        self.dominant_run = 0;
+        self.phase = if self.can_flag {
+            Phase::ActiveFlag(0)
+        } else {
+            Phase::PassiveFlag { last: true, run: 0 }
+        };
+    }
+
+    /// In an error or overload frame (flag, the bits after it, delimiter).
+    fn in_error_frame(&self) -> bool {
+        matches!(
+            self.phase,
+            Phase::ActiveFlag(_)
+                | Phase::PassiveFlag { .. }
+                | Phase::Overload(_)
+                | Phase::AfterFlag { .. }
+                | Phase::Delimiter(_)
+        )
     }
 
     fn drives_flag(&self) -> bool {
@@ -253,7 +338,11 @@ impl Part {
     /// Reads one intermission bit.
     fn intermission(&mut self, wire: bool) {
         if let Phase::Intermission(k) = self.phase {
-            if !wire && k < 2 {
+            let misread = self.inter_fault == Some(k);
+            if misread {
+                self.inter_fault = None;
+            }
+            if (!wire || misread) && k < 2 {
                 self.overload();
             } else if k + 1 >= 3 {
                 self.phase = Phase::Done;
@@ -276,8 +365,8 @@ impl Part {
         }
     }
 
-    /// Reads one bit while in an error phase.
-    fn error_phase(&mut self, wire: bool) {
+    /// Reads wire bit `i` while in an error phase.
+    fn error_phase(&mut self, wire: bool, i: u32) {
         self.phase = match self.phase {
             Phase::ActiveFlag(n) if self.flag_fault == Some(n) => {
                 // Rules 4 / 5: a bit error during its own active error flag; a new flag
@@ -315,7 +404,8 @@ impl Part {
                 }
             }
             Phase::PassiveFlag { last, run } => {
-                if !wire {
+                // Rule 3 exception 1 is about the flag sent for the acknowledge error.
+                if !wire && self.more_errors.is_empty() {
                     self.dominant_in_passive_flag = true;
                 }
                 let run = if run == 0 || wire == last { run + 1 } else { 1 };
@@ -332,19 +422,50 @@ impl Part {
                 } else {
                     // Rule 2 is about error flags only.
                     if first && !self.overloading {
-                        self.dominant_after_flag = true;
+                        match self.more_errors.last_mut() {
+                            Some(e) => e.2 = true,
+                            None => self.dominant_after_flag = true,
+                        }
                     }
                     self.count_dominant();
                     Phase::AfterFlag { first: false }
                 }
             }
-            Phase::Delimiter(n) if wire && n + 1 >= 8 => {
-                self.overloading = false;
-                Phase::Intermission(0)
+            Phase::Delimiter(n) => {
+                let misread = !self.delimited && self.delim_fault == Some(n);
+                if misread {
+                    self.delim_fault = None;
+                }
+                if wire && !misread {
+                    if n + 1 >= 8 {
+                        self.overloading = false;
+                        self.delimited = true;
+                        Phase::Intermission(0)
+                    } else {
+                        Phase::Delimiter(n + 1)
+                    }
+                } else if n >= 7 {
+                    // A dominant last delimiter bit: an overload condition (§10.4.5.2).
+                    self.delimited = true;
+                    self.overload();
+                    self.phase
+                } else {
+                    // Any other delimiter bit: a form error (§10.11.4), a new error flag.
+                    self.delimited = true;
+                    self.detect_again(LastErrorCode::Form, i);
+                    self.phase
+                }
             }
-            Phase::Delimiter(n) if wire => Phase::Delimiter(n + 1),
             other => other,
         };
+    }
+
+    /// The faults aimed at delimiter / intermission bits this node never read.
+    fn missed(&self) -> impl Iterator<Item = Aim> {
+        self.delim_fault
+            .map(Aim::Delimiter)
+            .into_iter()
+            .chain(self.inter_fault.map(Aim::Intermission))
     }
 
     fn outcome(&self, end: u32) -> PartOutcome {
@@ -461,27 +582,36 @@ fn rx_read(rx: &RxSpec, p: &mut Part, wire: bool, i: u32, reference: &[bool], ce
     }
 }
 
-/// The parts' penalties, or an empty vector when all are 0.
-fn penalties(parts: &[Part]) -> Vec<u8> {
-    if parts.iter().all(|p| p.penalties == 0) {
+/// The parts' penalties, or an empty vector when all are 0. `transmitters`: a form error
+/// in a delimiter is one more error flag sent, TEC + 8 (rule 3) — counted here.
+fn penalties(parts: &[Part], transmitters: bool) -> Vec<u8> {
+    let of = |p: &Part| {
+        let more = if transmitters {
+            p.more_errors.len().min(255) as u8
+        } else {
+            0
+        };
+        p.penalties.saturating_add(more)
+    };
+    if parts.iter().all(|p| of(p) == 0) {
         Vec::new()
     } else {
-        parts.iter().map(|p| p.penalties).collect()
+        parts.iter().map(of).collect()
     }
 }
 
 /// Plays one frame attempt. `txs` must not be empty (an empty slice gives an empty result).
 #[cfg(test)]
 pub(crate) fn resolve(txs: &[TxSpec<'_>], rxs: &[RxSpec]) -> Resolution {
-    resolve_with(txs, rxs, None)
+    resolve_with(txs, rxs, WireFaults::default())
 }
 
-/// [`resolve`] with the wire held dominant over bits `stuck.0..stuck.1`.
-pub(crate) fn resolve_with(
-    txs: &[TxSpec<'_>],
-    rxs: &[RxSpec],
-    stuck: Option<(u32, u32)>,
-) -> Resolution {
+/// [`resolve`] with the wire faults `wf`: held dominant over bits `stuck.0..stuck.1`,
+/// dominant at a delimiter or intermission bit.
+pub(crate) fn resolve_with(txs: &[TxSpec<'_>], rxs: &[RxSpec], wf: WireFaults) -> Resolution {
+    let stuck = wf.stuck;
+    let mut bus_delim = wf.delimiter;
+    let mut bus_inter = wf.intermission;
     let reference = (0..txs.len())
         .min_by(|&a, &b| txs[a].stream.cmp(txs[b].stream))
         .unwrap_or(0);
@@ -497,6 +627,8 @@ pub(crate) fn resolve_with(
             reference: 0,
             tx_penalties: Vec::new(),
             rx_penalties: Vec::new(),
+            rx_more_errors: Vec::new(),
+            missed: Vec::new(),
         };
     };
     let ce = ref_tx.bits.crc_end;
@@ -521,6 +653,14 @@ pub(crate) fn resolve_with(
         .iter()
         .map(|t| Part {
             flag_fault: flag_fault(Some(&t.faults), None),
+            delim_fault: t.faults.iter().find_map(|f| match f {
+                TxFault::Delimiter(b) => Some(*b),
+                _ => None,
+            }),
+            inter_fault: t.faults.iter().find_map(|f| match f {
+                TxFault::Intermission(b) => Some(*b),
+                _ => None,
+            }),
             ..Part::new(t.active)
         })
         .collect();
@@ -528,6 +668,14 @@ pub(crate) fn resolve_with(
         .iter()
         .map(|r| Part {
             flag_fault: flag_fault(None, Some(&r.faults)),
+            delim_fault: r.faults.iter().find_map(|f| match f {
+                RxFault::Delimiter(b) => Some(*b),
+                _ => None,
+            }),
+            inter_fault: r.faults.iter().find_map(|f| match f {
+                RxFault::Intermission(b) => Some(*b),
+                _ => None,
+            }),
             can_drive: r.acks,
             ..Part::new(r.active)
         })
@@ -539,7 +687,13 @@ pub(crate) fn resolve_with(
 
     let longest = txs.iter().map(|t| t.bits.crc_end).max().unwrap_or(ce);
     let stuck_len = stuck.map_or(0, |(a, b)| b.saturating_sub(a));
-    let limit = longest + 10 + 64 + stuck_len.min(4096) + 32;
+    // Each delimiter / intermission fault may add an error or overload frame (at most 6 +
+    // 6 echo + 8 delimiter + 3 bits, and its own chain of echoes): a generous margin.
+    let aimed = (txs.iter().map(|t| t.faults.len()).sum::<usize>()
+        + rxs.iter().map(|r| r.faults.len()).sum::<usize>()
+        + 2)
+    .min(64) as u32;
+    let limit = longest + 10 + 64 + stuck_len.min(4096) + 32 + 32 * aimed;
     let mut acked = false;
     let mut last_dominant_end = 0;
     let mut i = 0u32;
@@ -568,6 +722,47 @@ pub(crate) fn resolve_with(
         if stuck.is_some_and(|(a, b)| (a..b).contains(&i)) {
             wire = false;
         }
+        // A bus-wide delimiter / intermission fault lands where the transmitters and the
+        // error-active receivers (whose flags end together) are at that bit; only when
+        // none of them is in an error or overload frame, where any other node is.
+        if bus_delim.is_some() || bus_inter.is_some() {
+            let leads = || {
+                tx_parts.iter().chain(
+                    rx_parts
+                        .iter()
+                        .zip(rxs)
+                        .filter(|(_, r)| r.active)
+                        .map(|(p, _)| p),
+                )
+            };
+            let others = || rx_parts.iter().chain(core::iter::once(&obs_part));
+            // Not past the leads' second intermission bit: a dominant bit there would be a
+            // start of frame for them, which is not played.
+            let early =
+                || leads().all(|p| !matches!(p.phase, Phase::Intermission(2) | Phase::Done));
+            let at = |hit: &dyn Fn(&Part) -> bool, busy: &dyn Fn(&Part) -> bool| {
+                if leads().any(busy) {
+                    leads().any(hit)
+                } else {
+                    early() && others().any(hit)
+                }
+            };
+            if let Some(k) = bus_delim {
+                let hit = |p: &Part| !p.delimited && p.phase == Phase::Delimiter(k);
+                if at(&hit, &|p: &Part| p.in_error_frame()) {
+                    wire = false;
+                    bus_delim = None;
+                }
+            }
+            if let Some(k) = bus_inter {
+                let hit = |p: &Part| p.phase == Phase::Intermission(k);
+                let busy = |p: &Part| matches!(p.phase, Phase::Intermission(_));
+                if at(&hit, &busy) {
+                    wire = false;
+                    bus_inter = None;
+                }
+            }
+        }
         if !wire {
             last_dominant_end = i + 1;
         }
@@ -579,7 +774,7 @@ pub(crate) fn resolve_with(
                 Phase::Frame => tx_read(t, p, wire, i),
                 Phase::Done => {}
                 Phase::Intermission(_) => p.intermission(wire),
-                _ => p.error_phase(wire),
+                _ => p.error_phase(wire, i),
             }
         }
         for (r, p) in rxs
@@ -591,7 +786,7 @@ pub(crate) fn resolve_with(
                 Phase::Frame => rx_read(r, p, wire, i, ref_stream, ce),
                 Phase::Done => {}
                 Phase::Intermission(_) => p.intermission(wire),
-                _ => p.error_phase(wire),
+                _ => p.error_phase(wire, i),
             }
         }
 
@@ -612,7 +807,30 @@ pub(crate) fn resolve_with(
             .chain(core::iter::once(&obs_part))
             .all(|p| p.phase != Phase::Frame);
         let stuck_over = stuck.is_none_or(|(_, b)| i >= b);
-        if (drivers_done && decided && stuck_over) || i >= limit {
+        // An intermission fault keeps the intermission played while it may still hit.
+        let in_intermission = |p: &Part| matches!(p.phase, Phase::Intermission(_));
+        let parts = || {
+            tx_parts
+                .iter()
+                .chain(&rx_parts)
+                .chain(core::iter::once(&obs_part))
+        };
+        let inter_pending = || {
+            (bus_inter.is_some() && parts().any(in_intermission))
+                || parts().any(|p| p.inter_fault.is_some() && in_intermission(p))
+        };
+        // A node's own delimiter fault keeps its delimiter played, also for a node that
+        // drives nothing (a passive flag) and so does not hold the end of the attempt.
+        let delim_pending = || {
+            parts().any(|p| {
+                (p.delim_fault.is_some() || bus_delim.is_some())
+                    && !p.delimited
+                    && p.in_error_frame()
+            })
+        };
+        if (drivers_done && decided && stuck_over && !inter_pending() && !delim_pending())
+            || i >= limit
+        {
             break drivers_end.unwrap_or(i);
         }
     };
@@ -629,8 +847,25 @@ pub(crate) fn resolve_with(
             bus
         },
         reference,
-        tx_penalties: penalties(&tx_parts),
-        rx_penalties: penalties(&rx_parts),
+        tx_penalties: penalties(&tx_parts, true),
+        rx_penalties: penalties(&rx_parts, false),
+        rx_more_errors: if rx_parts.iter().all(|p| p.more_errors.is_empty()) {
+            Vec::new()
+        } else {
+            rx_parts.iter().map(|p| p.more_errors.clone()).collect()
+        },
+        missed: {
+            let mut m: Vec<Missed> = Vec::new();
+            for (n, p) in tx_parts.iter().enumerate() {
+                m.extend(p.missed().map(|a| Missed::Tx(n, a)));
+            }
+            for (n, p) in rx_parts.iter().enumerate() {
+                m.extend(p.missed().map(|a| Missed::Rx(n, a)));
+            }
+            m.extend(bus_delim.map(|b| Missed::Bus(Aim::Delimiter(b))));
+            m.extend(bus_inter.map(|b| Missed::Bus(Aim::Intermission(b))));
+            m
+        },
     }
 }
 
@@ -817,5 +1052,92 @@ mod tests {
         assert!(
             matches!(r.tx[0], PartOutcome::Error { code: L::BitRecessive, at, .. } if at == ce + 9)
         );
+    }
+
+    /// A lone active transmitter with a listen-only receiver: acknowledge error at ce+1,
+    /// flag ce+2..=ce+7, delimiter bit n at ce+8+n.
+    #[test]
+    fn dominant_error_delimiter_bit_is_a_form_error_and_a_new_flag() {
+        let w = wire_bits(&Frame::standard(0x123, &[]).unwrap());
+        let ce = w.1.crc_end;
+        let wf = WireFaults {
+            delimiter: Some(2),
+            ..WireFaults::default()
+        };
+        let r = resolve_with(&[tx(&w, true)], &[rx(false, false)], wf);
+        assert_eq!(r.tx, vec![err(L::Acknowledge, ce + 1, false)]);
+        // The wire is dominant at ce+10; the transmitter's new flag is ce+11..=ce+16, its
+        // delimiter ce+17..=ce+24.
+        assert!(!r.wire[(ce + 10) as usize]);
+        assert!(r.wire[(ce + 8) as usize] && r.wire[(ce + 9) as usize]);
+        assert!(r.wire[(ce + 11) as usize..=(ce + 16) as usize]
+            .iter()
+            .all(|&b| !b));
+        assert_eq!(r.last_dominant_end, ce + 17);
+        assert_eq!(r.end, ce + 25);
+        assert_eq!(r.tx_penalties, vec![1], "rule 3: one more error flag");
+        // The listen-only receiver: form error at ce+2, passive flag from ce+3 waiting for
+        // 6 equal bits (5 dominant to ce+7, then recessive from ce+8): at ce+10 it is still
+        // in its passive flag, not in a delimiter — no second error for it.
+        assert!(r.rx_more_errors.is_empty());
+        assert!(r.missed.is_empty());
+    }
+
+    #[test]
+    fn dominant_last_delimiter_bit_is_an_overload_frame() {
+        let w = wire_bits(&Frame::standard(0x123, &[]).unwrap());
+        let ce = w.1.crc_end;
+        let mut t = tx(&w, true);
+        t.faults.push(TxFault::Delimiter(7));
+        let r = resolve(&[t], &[rx(false, false)]);
+        // Delimiter bit 7 misread at ce+15: overload flag ce+16..=ce+21, delimiter
+        // ce+22..=ce+29; no counter change for the transmitter.
+        assert_eq!(r.end, ce + 30);
+        assert_eq!(r.last_dominant_end, ce + 22);
+        assert!(r.tx_penalties.is_empty());
+        // The listen-only receiver lags: its passive flag (form error at ce+2) ends with
+        // six recessive bits ce+8..=ce+13, its delimiter starts at ce+14, so the overload
+        // flag at ce+16 is at its delimiter bit 2: a form error (rule 1).
+        assert_eq!(r.rx_more_errors, vec![vec![(L::Form, ce + 16, false)]]);
+    }
+
+    #[test]
+    fn a_delimiter_fault_without_a_delimiter_is_missed() {
+        let w = wire_bits(&Frame::standard(0x123, &[4]).unwrap());
+        let mut t = tx(&w, true);
+        t.faults.push(TxFault::Delimiter(3));
+        let wf = WireFaults {
+            delimiter: Some(5),
+            ..WireFaults::default()
+        };
+        let r = resolve_with(&[t], &[rx(true, true)], wf);
+        assert_eq!(r.tx, vec![PartOutcome::Ok { done: w.1.total }]);
+        assert_eq!(
+            r.missed,
+            vec![
+                Missed::Tx(0, Aim::Delimiter(3)),
+                Missed::Bus(Aim::Delimiter(5))
+            ]
+        );
+    }
+
+    #[test]
+    fn a_receiver_misreading_intermission_bit_1_starts_an_overload_frame() {
+        let w = wire_bits(&Frame::standard(0x123, &[4]).unwrap());
+        let ce = w.1.crc_end;
+        let mut r0 = rx(true, true);
+        r0.faults.push(RxFault::Intermission(1));
+        let r = resolve(&[tx(&w, true)], &[r0, rx(true, true)]);
+        // EOF ends at ce+9; intermission bit 1 is ce+11: overload flag ce+12..=ce+17, the
+        // others read it at their intermission bit 2 (no overload: a start of frame, not
+        // played) — they are done; delimiter ce+18..=ce+25.
+        assert!(r
+            .tx
+            .iter()
+            .chain(&r.rx)
+            .all(|o| matches!(o, PartOutcome::Ok { .. })));
+        assert_eq!(r.last_dominant_end, ce + 18);
+        assert_eq!(r.end, ce + 26);
+        assert!(r.missed.is_empty());
     }
 }

@@ -71,6 +71,8 @@ pub(crate) fn resolve(
         reference: 0,
         tx_penalties: Vec::new(),
         rx_penalties: Vec::new(),
+        rx_more_errors: Vec::new(),
+        missed: Vec::new(),
     }
 }
 

@@ -57,6 +57,22 @@ pub enum FaultKind {
     FlagBit,
     /// [`Fault::StuckDominant`] (not among the default random kinds).
     StuckDominant,
+    /// [`Fault::DelimiterBit`] (not among the default random kinds).
+    DelimiterBit,
+    /// [`Fault::IntermissionBit`] (not among the default random kinds).
+    IntermissionBit,
+}
+
+/// Who reads a dominant bit injected into a delimiter or the intermission.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Sees {
+    /// The bus itself is dominant at that bit (a disturbance on the wire): every node
+    /// reads it.
+    Bus,
+    /// One node (transmitter or receiver of the frame) misreads the bit as dominant; the
+    /// wire stays recessive for the others (no effect if the node takes no part in the
+    /// attempt).
+    Node(NodeId),
 }
 
 /// An error injected into one frame attempt.
@@ -124,6 +140,45 @@ pub enum Fault {
         /// How many bits.
         bits: u32,
     },
+    /// A dominant bit at bit `bit` (1..=7) of the first error or overload delimiter of
+    /// the attempt (ISO 11898-1 §10.4.4.3 / §10.4.5.3: 8 recessive bits; bit 0 is the
+    /// first recessive bit after the flag, which a node waits for, so a dominant bit there
+    /// only prolongs the flag: refused, [`FaultError::DelimiterBitOutOfRange`]). For
+    /// [`Sees::Bus`] the wire is dominant at the bit where the nodes are at that delimiter
+    /// bit; for [`Sees::Node`] that node alone misreads it.
+    ///
+    /// - bits 1..=6: a form error (the delimiter is a fixed-form field, §10.11.4 / Bosch
+    ///   §3.2.3): the node starts a new error flag at the next bit; a receiver adds 1 to
+    ///   REC (rule 1, and rule 2 if the first bit after that new flag is dominant), a
+    ///   transmitter adds 8 to TEC (rule 3; neither exception concerns a form error);
+    /// - bit 7 (the last): an overload condition (§10.4.5.2 c: "detection of a dominant bit
+    ///   at the last bit of an error delimiter or overload delimiter"): an overload frame,
+    ///   no counter moves (except by rules 4 to 6 during it).
+    ///
+    /// A fault whose delimiter never comes (no error or overload frame in the attempt, or
+    /// the node leaves before that bit) is refused once the attempt is played
+    /// ([`FaultError::DelimiterNotReached`]), never moved to another bit.
+    DelimiterBit {
+        /// Who reads the dominant bit.
+        who: Sees,
+        /// The delimiter bit, 1..=7.
+        bit: u8,
+    },
+    /// A dominant bit at intermission bit `bit` after the end of frame or after the first
+    /// error / overload delimiter of the attempt (§10.4.6.2: 3 recessive bits). Bits 0
+    /// and 1: an overload condition (§10.4.5.2 b), every node that reads it sends an
+    /// overload frame; no counter moves. Bit 2 is refused
+    /// ([`FaultError::IntermissionStartOfFrame`]): a node reads a dominant third
+    /// intermission bit as the start of frame of the next frame (§10.4.6.2), which the
+    /// simulator does not play (each attempt starts with its own SOF after the whole
+    /// intermission). Refused as [`FaultError::IntermissionNotReached`] once the attempt
+    /// is played if the bit is never read.
+    IntermissionBit {
+        /// Who reads the dominant bit.
+        who: Sees,
+        /// The intermission bit, 0..=1.
+        bit: u8,
+    },
 }
 
 /// Why a fault was refused (see [`Fault`]).
@@ -147,6 +202,18 @@ pub enum FaultError {
     OutsideStuffedRegion(u32),
     /// A stuck-dominant bus inside the arbitration field.
     StuckDuringArbitration(u32),
+    /// [`Fault::DelimiterBit`] outside 1..=7 (bit 0 ends the flag; a delimiter has 8 bits).
+    DelimiterBitOutOfRange(u8),
+    /// [`Fault::IntermissionBit`] beyond bit 2 (the intermission has 3 bits).
+    IntermissionBitOutOfRange(u8),
+    /// [`Fault::IntermissionBit`] at bit 2: a dominant third intermission bit is a start
+    /// of frame (§10.4.6.2), which the simulator does not play.
+    IntermissionStartOfFrame,
+    /// The attempt had no such delimiter bit for the node(s) named (no error or overload
+    /// frame, or the node was not there at that bit).
+    DelimiterNotReached(u8),
+    /// The attempt played no such intermission bit for the node(s) named.
+    IntermissionNotReached(u8),
 }
 
 impl core::fmt::Display for FaultError {
@@ -168,6 +235,21 @@ impl core::fmt::Display for FaultError {
             FaultError::StuckDuringArbitration(i) => {
                 write!(f, "stuck-dominant bus from bit {i}, inside arbitration")
             }
+            FaultError::DelimiterBitOutOfRange(b) => {
+                write!(f, "delimiter bit {b} (1..=7; bit 0 ends the flag)")
+            }
+            FaultError::IntermissionBitOutOfRange(b) => {
+                write!(f, "intermission bit {b} (the intermission has bits 0..=2)")
+            }
+            FaultError::IntermissionStartOfFrame => {
+                f.write_str("a dominant third intermission bit is a start of frame, not simulated")
+            }
+            FaultError::DelimiterNotReached(b) => {
+                write!(f, "no error or overload delimiter reached bit {b}")
+            }
+            FaultError::IntermissionNotReached(b) => {
+                write!(f, "intermission bit {b} was not played")
+            }
         }
     }
 }
@@ -185,6 +267,8 @@ impl Fault {
             Fault::Form { .. } => FaultKind::Form,
             Fault::FlagBit { .. } => FaultKind::FlagBit,
             Fault::StuckDominant { .. } => FaultKind::StuckDominant,
+            Fault::DelimiterBit { .. } => FaultKind::DelimiterBit,
+            Fault::IntermissionBit { .. } => FaultKind::IntermissionBit,
         }
     }
 
@@ -197,6 +281,13 @@ impl Fault {
                 ..
             } if n > 5 => Err(FaultError::EofBitOutOfRange(n)),
             Fault::StuckDominant { bits: 0, .. } => Err(FaultError::EmptyStuckDominant),
+            Fault::DelimiterBit { bit, .. } if bit == 0 || bit > 7 => {
+                Err(FaultError::DelimiterBitOutOfRange(bit))
+            }
+            Fault::IntermissionBit { bit: 2, .. } => Err(FaultError::IntermissionStartOfFrame),
+            Fault::IntermissionBit { bit, .. } if bit > 2 => {
+                Err(FaultError::IntermissionBitOutOfRange(bit))
+            }
             _ => Ok(()),
         }
     }
@@ -237,6 +328,28 @@ impl Fault {
             _ => None,
         }
     }
+
+    /// The bus-wide delimiter bit of a [`Fault::DelimiterBit`] seen by the bus.
+    pub(crate) fn bus_delimiter(&self) -> Option<u8> {
+        match *self {
+            Fault::DelimiterBit {
+                who: Sees::Bus,
+                bit,
+            } => Some(bit),
+            _ => None,
+        }
+    }
+
+    /// The bus-wide intermission bit of a [`Fault::IntermissionBit`] seen by the bus.
+    pub(crate) fn bus_intermission(&self) -> Option<u8> {
+        match *self {
+            Fault::IntermissionBit {
+                who: Sees::Bus,
+                bit,
+            } => Some(bit),
+            _ => None,
+        }
+    }
 }
 
 /// Whether wire bit `pos` of a stuffed stream is a stuff bit: the five bits before it are
@@ -255,6 +368,10 @@ pub(crate) enum TxFault {
     Ack,
     /// It reads recessive at this bit of its own active error flag.
     FlagBit(u8),
+    /// It reads dominant at this bit of its first error or overload delimiter.
+    Delimiter(u8),
+    /// It reads dominant at this intermission bit.
+    Intermission(u8),
 }
 
 /// A receive-side fault at absolute wire-bit positions.
@@ -268,6 +385,10 @@ pub(crate) enum RxFault {
     Form(u32),
     /// It reads recessive at this bit of its own active error flag.
     FlagBit(u8),
+    /// It reads dominant at this bit of its first error or overload delimiter.
+    Delimiter(u8),
+    /// It reads dominant at this intermission bit.
+    Intermission(u8),
 }
 
 impl Fault {
@@ -278,6 +399,14 @@ impl Fault {
             Fault::Bit { at } => Some(TxFault::Bit(at.unwrap_or(bits.arbitration_end))),
             Fault::Ack => Some(TxFault::Ack),
             Fault::FlagBit { who, bit } if who == node => Some(TxFault::FlagBit(bit)),
+            Fault::DelimiterBit {
+                who: Sees::Node(n),
+                bit,
+            } if n == node => Some(TxFault::Delimiter(bit)),
+            Fault::IntermissionBit {
+                who: Sees::Node(n),
+                bit,
+            } if n == node => Some(TxFault::Intermission(bit)),
             _ => None,
         }
     }
@@ -295,6 +424,14 @@ impl Fault {
                 FormField::Eof(n) => bits.crc_end + 3 + u32::from(n),
             })),
             Fault::FlagBit { who, bit } if who == node => Some(RxFault::FlagBit(bit)),
+            Fault::DelimiterBit {
+                who: Sees::Node(n),
+                bit,
+            } if n == node => Some(RxFault::Delimiter(bit)),
+            Fault::IntermissionBit {
+                who: Sees::Node(n),
+                bit,
+            } if n == node => Some(RxFault::Intermission(bit)),
             _ => None,
         }
     }
@@ -441,6 +578,20 @@ impl RandomState {
                 at: bits.arbitration_end + self.rng.below(u64::from(bits.total)) as u32,
                 bits: 1 + self.rng.below(24) as u32,
             },
+            FaultKind::DelimiterBit => Fault::DelimiterBit {
+                who: match who() {
+                    Receivers::Node(n) => Sees::Node(n),
+                    Receivers::All => Sees::Bus,
+                },
+                bit: 1 + self.rng.below(7) as u8,
+            },
+            FaultKind::IntermissionBit => Fault::IntermissionBit {
+                who: match who() {
+                    Receivers::Node(n) => Sees::Node(n),
+                    Receivers::All => Sees::Bus,
+                },
+                bit: self.rng.below(2) as u8,
+            },
         };
         Some(fault)
     }
@@ -545,5 +696,69 @@ mod tests {
             assert!(nan.draw(&bits, &[]).is_none());
             assert_eq!(always.draw(&bits, &[]), Some(Fault::Ack));
         }
+    }
+
+    #[test]
+    fn delimiter_and_intermission_faults_are_checked() {
+        let mut bus = crate::sim::Bus::new(500_000).unwrap();
+        let node = bus.attach("a", crate::sim::SimNode::new().shared());
+        let other = bus.attach("b", crate::sim::SimNode::new().shared());
+        for bit in 1..=7 {
+            for who in [Sees::Bus, Sees::Node(node)] {
+                assert_eq!(Fault::DelimiterBit { who, bit }.validate(), Ok(()));
+            }
+        }
+        for (fault, error) in [
+            (
+                Fault::DelimiterBit {
+                    who: Sees::Bus,
+                    bit: 0,
+                },
+                FaultError::DelimiterBitOutOfRange(0),
+            ),
+            (
+                Fault::DelimiterBit {
+                    who: Sees::Bus,
+                    bit: 8,
+                },
+                FaultError::DelimiterBitOutOfRange(8),
+            ),
+            (
+                Fault::IntermissionBit {
+                    who: Sees::Node(node),
+                    bit: 2,
+                },
+                FaultError::IntermissionStartOfFrame,
+            ),
+            (
+                Fault::IntermissionBit {
+                    who: Sees::Bus,
+                    bit: 3,
+                },
+                FaultError::IntermissionBitOutOfRange(3),
+            ),
+        ] {
+            assert_eq!(fault.validate(), Err(error));
+            let e: &dyn std::error::Error = &error;
+            assert!(!std::format!("{e}").is_empty());
+        }
+        assert_eq!(
+            std::format!("{}", FaultError::IntermissionStartOfFrame),
+            "a dominant third intermission bit is a start of frame, not simulated"
+        );
+        // Node faults go to that node only; bus faults to nobody's own list.
+        let bits = super::super::bits::frame_bits(&crate::frame::Frame::standard(1, &[]).unwrap());
+        let f = Fault::DelimiterBit {
+            who: Sees::Node(node),
+            bit: 4,
+        };
+        assert_eq!(f.tx_part(node, &bits), Some(TxFault::Delimiter(4)));
+        assert_eq!(f.rx_part(other, &bits), None);
+        let f = Fault::IntermissionBit {
+            who: Sees::Bus,
+            bit: 1,
+        };
+        assert_eq!(f.bus_intermission(), Some(1));
+        assert_eq!(f.tx_part(node, &bits), None);
     }
 }

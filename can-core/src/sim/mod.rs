@@ -40,7 +40,7 @@ pub mod trace;
 
 pub use bits::{crc15, frame_bits, FrameBits};
 pub use bus::{Bus, BusEvent, NodeId, SimError, StillBusy};
-pub use inject::{Fault, FaultError, FaultKind, FormField, RandomFaults, Receivers};
+pub use inject::{Fault, FaultError, FaultKind, FormField, RandomFaults, Receivers, Sees};
 pub use node::{BusNode, BusTime, ConfinementEvent, TxRequest, TxResult};
 pub use poll_clock::{PollClock, SharedBus};
 pub use simple_node::SimNode;

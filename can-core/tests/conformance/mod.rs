@@ -19,7 +19,8 @@ use std::rc::Rc;
 
 use twocan_core::fault::BUS_OFF_RECOVERY_SEQUENCES;
 use twocan_core::sim::{
-    frame_bits, Bus, BusEvent, Fault, FormField, NodeId, Receivers, SimNode, TraceRecord,
+    frame_bits, Bus, BusEvent, Fault, FaultError, FormField, NodeId, Receivers, Sees, SimNode,
+    TraceRecord,
 };
 use twocan_core::{ErrorCounters, ErrorState, Frame, LastErrorCode};
 
@@ -527,6 +528,283 @@ pub fn overload_dominant_last_eof_bit<D: Dut>() {
     assert_eq!(dut.state(), ErrorState::Active);
 }
 
+/// The setting of rule 1 with the dut as receiver (`dut_sends` false: a one-shot [`SimNode`]
+/// transmitter `o`) or as transmitter (`dut_sends` true: `o` is the one receiver): the
+/// receiver computes a wrong CRC and does not acknowledge, so the transmitter detects an
+/// acknowledge error at ce+1 (TEC 8) and flags ce+2..=ce+7; the receiver reads the dominant
+/// ACK delimiter (ce+2): form error (REC 1), flag ce+3..=ce+8. Both read ce+9 recessive:
+/// the error delimiter is ce+9..=ce+16, its bit n is ce+9+n. `extra` is injected on the
+/// same attempt. Returns the record, the dut and the other node.
+fn error_delimiter_setting<D: Dut>(
+    dut_sends: bool,
+    extra: impl FnOnce(NodeId, NodeId) -> Fault,
+) -> (Box<TraceRecord>, D, Rc<RefCell<SimNode>>, Frame) {
+    let mut bus = Bus::new(500_000).unwrap();
+    let (mut dut, id) = D::join(&mut bus);
+    let o = SimNode::new().with_one_shot(true).shared();
+    let io = bus.attach("o", o.clone());
+    let f = frame(0x124);
+    let receiver = if dut_sends { io } else { id };
+    bus.inject_next(Fault::Crc {
+        who: Receivers::Node(receiver),
+    });
+    bus.try_inject_next(extra(id, io)).unwrap();
+    if dut_sends {
+        dut.send(&f);
+    } else {
+        o.borrow_mut().send(f);
+    }
+    (next_frame(&mut bus), dut, o, f)
+}
+
+/// The counters of the dut and the other node of [`error_delimiter_setting`]: `(tec, rec)`
+/// as the transmitter and the receiver have them.
+fn tx_rx_counters<D: Dut>(
+    dut_sends: bool,
+    dut: &D,
+    o: &Rc<RefCell<SimNode>>,
+) -> (ErrorCounters, ErrorCounters) {
+    let (d, o) = (dut.counters(), o.borrow().counters());
+    if dut_sends {
+        (d, o)
+    } else {
+        (o, d)
+    }
+}
+
+/// A dominant bit inside an error delimiter, on the bus (ISO 11898-1 §10.4.4.3: the error
+/// delimiter is 8 recessive bits; a dominant bit in it is a form error, §10.11.4; Bosch
+/// CAN 2.0B §3.2.3 / §7). In [`error_delimiter_setting`], delimiter bit 3 (ce+12) is
+/// dominant: both nodes detect a form error there and send a new error flag ce+13..=ce+18:
+/// the transmitter adds 8 (rule 3: it sends an error flag; exception 1 is about acknowledge
+/// errors, exception 2 about arbitration), TEC 8 + 8 = 16; the receiver adds 1 (rule 1;
+/// the dominant bit is not the first bit after its flag, so not rule 2), REC 1 + 1 = 2.
+/// Both read ce+19 recessive after their flags (no rule 2); delimiter ce+19..=ce+26, end
+/// ce+27, intermission: the record lasts ce+30 bits. Played with the dut as transmitter
+/// and as receiver.
+pub fn delimiter_form_error_on_the_bus<D: Dut>() {
+    for dut_sends in [true, false] {
+        let (r, dut, o, f) = error_delimiter_setting::<D>(dut_sends, |_, _| Fault::DelimiterBit {
+            who: Sees::Bus,
+            bit: 3,
+        });
+        assert!(r.refused.is_empty(), "{:?}", r.refused);
+        let (t, rx) = tx_rx_counters(dut_sends, &dut, &o);
+        assert_eq!(
+            t,
+            ErrorCounters { tec: 16, rec: 0 },
+            "dut sends: {dut_sends}"
+        );
+        assert_eq!(
+            rx,
+            ErrorCounters { tec: 0, rec: 2 },
+            "dut sends: {dut_sends}"
+        );
+        assert_eq!(r.end - r.sof, ce_of(&f) + 30);
+        assert_eq!(dut.state(), ErrorState::Active);
+    }
+}
+
+/// One node alone misreads an error delimiter bit as dominant (`Sees::Node`).
+///
+/// Dut receiver in [`error_delimiter_setting`]: it misreads delimiter bit 3 (ce+12): form
+/// error, REC 1 + 1 (rule 1), active flag ce+13..=ce+18. The transmitter reads that flag at
+/// its delimiter bit 4 (ce+13): form error, TEC 8 + 8 (rule 3), flag ce+14..=ce+19. The
+/// first bit after the dut's new flag (ce+19) is dominant: rule 2, REC + 8: 10.
+///
+/// Dut transmitter: it misreads its bit 3 (ce+12): TEC 16, flag ce+13..=ce+18; the
+/// receiver reads that flag at its bit 4 (ce+13): form error, REC 2, flag ce+14..=ce+19,
+/// and the first bit after it (ce+20) is recessive: no rule 2, REC 2.
+///
+/// Either way: delimiter ce+20..=ce+27, end ce+28, +3: ce+31.
+pub fn delimiter_form_error_seen_by_one_node<D: Dut>() {
+    for dut_sends in [true, false] {
+        let (r, dut, o, f) = error_delimiter_setting::<D>(dut_sends, |id, _| Fault::DelimiterBit {
+            who: Sees::Node(id),
+            bit: 3,
+        });
+        assert!(r.refused.is_empty(), "{:?}", r.refused);
+        let (t, rx) = tx_rx_counters(dut_sends, &dut, &o);
+        assert_eq!(
+            t,
+            ErrorCounters { tec: 16, rec: 0 },
+            "dut sends: {dut_sends}"
+        );
+        let rec = if dut_sends { 2 } else { 10 };
+        assert_eq!(rx, ErrorCounters { tec: 0, rec }, "dut sends: {dut_sends}");
+        assert_eq!(r.end - r.sof, ce_of(&f) + 31);
+    }
+}
+
+/// A dominant last bit of an error delimiter (ISO 11898-1 §10.4.5.2: "detection of a
+/// dominant bit at the last bit of an error delimiter or overload delimiter" starts an
+/// overload frame). In [`error_delimiter_setting`], delimiter bit 7 (ce+16) is dominant:
+/// both nodes send an overload flag ce+17..=ce+22 and delimiter ce+23..=ce+30; no counter
+/// moves (TEC 8, REC 1 as after the error alone). End ce+31, +3: ce+34.
+pub fn dominant_last_error_delimiter_bit_is_overload<D: Dut>() {
+    for dut_sends in [true, false] {
+        let (r, dut, o, f) = error_delimiter_setting::<D>(dut_sends, |_, _| Fault::DelimiterBit {
+            who: Sees::Bus,
+            bit: 7,
+        });
+        assert!(r.refused.is_empty(), "{:?}", r.refused);
+        let (t, rx) = tx_rx_counters(dut_sends, &dut, &o);
+        assert_eq!(
+            t,
+            ErrorCounters { tec: 8, rec: 0 },
+            "dut sends: {dut_sends}"
+        );
+        assert_eq!(
+            rx,
+            ErrorCounters { tec: 0, rec: 1 },
+            "dut sends: {dut_sends}"
+        );
+        assert_eq!(r.end - r.sof, ce_of(&f) + 34);
+    }
+}
+
+/// An overload frame from a dominant first intermission bit (`Fault::IntermissionBit`,
+/// bit 0 = ce+10; §10.4.5.2): overload flags ce+11..=ce+16, overload delimiter
+/// ce+17..=ce+24 (bit n at ce+17+n). Then:
+///
+/// - its last bit (ce+24) dominant: a second overload frame (§10.4.5.2), flags
+///   ce+25..=ce+30, delimiter ce+31..=ce+38, end ce+39, +3: ce+42; no counter moves and
+///   the frame (valid at its end of frame) is received;
+/// - its bit 2 (ce+19) dominant: a form error (§10.11.4) for both nodes, error flags
+///   ce+20..=ce+25, delimiter ce+26..=ce+33, end ce+34, +3: ce+37. The transmitter had
+///   succeeded (rule 7: TEC 0 stays 0) and adds 8 (rule 3, still the transmitter until
+///   the bus is idle); the receiver had received the frame (REC 0) and adds 1 (rule 1;
+///   ce+26 is recessive: no rule 2). Played with the dut as transmitter and as receiver.
+pub fn faults_in_an_overload_delimiter<D: Dut>() {
+    for (bit, tec, rec, len) in [(7u8, 0u16, 0u16, 42u64), (2, 8, 1, 37)] {
+        for dut_sends in [true, false] {
+            let mut bus = Bus::new(500_000).unwrap();
+            let (mut dut, _) = D::join(&mut bus);
+            let p = peer();
+            bus.attach("p", p.clone());
+            let f = frame(0x0FC);
+            bus.try_inject_next(Fault::IntermissionBit {
+                who: Sees::Bus,
+                bit: 0,
+            })
+            .unwrap();
+            bus.try_inject_next(Fault::DelimiterBit {
+                who: Sees::Bus,
+                bit,
+            })
+            .unwrap();
+            if dut_sends {
+                dut.send(&f);
+            } else {
+                p.borrow_mut().send(f);
+            }
+            let r = next_frame(&mut bus);
+            assert!(r.refused.is_empty(), "{:?}", r.refused);
+            assert_eq!(r.end - r.sof, ce_of(&f) + len, "bit {bit}");
+            let (d, o) = (dut.counters(), p.borrow().counters());
+            let (t, rx) = if dut_sends { (d, o) } else { (o, d) };
+            assert_eq!(
+                t,
+                ErrorCounters { tec, rec: 0 },
+                "bit {bit}, dut sends {dut_sends}"
+            );
+            assert_eq!(
+                rx,
+                ErrorCounters { tec: 0, rec },
+                "bit {bit}, dut sends {dut_sends}"
+            );
+            if dut_sends {
+                assert_eq!(p.borrow().received_frames(), vec![f]);
+            }
+        }
+    }
+}
+
+/// Rule 3 exception 1 does not cover a later form error. An error-passive dut reads a
+/// recessive ACK slot (acknowledge error at ce+1, exception 1 applies: its passive flag
+/// ce+2..=ce+7 is all recessive, TEC stays 128); its delimiter starts at ce+8 and it
+/// misreads bit 3 (ce+11): form error, rule 3: TEC 136, a new passive flag ce+12..=ce+17,
+/// delimiter ce+18..=ce+25, end ce+26, +3: ce+29 (the peer received the frame at ce+9,
+/// REC - 1 by rule 8, and drives nothing after it).
+pub fn delimiter_form_error_after_passive_ack_error<D: Dut>() {
+    let mut bus = Bus::new(500_000).unwrap();
+    let (mut dut, id) = D::join(&mut bus);
+    let p = peer();
+    bus.attach("p", p.clone());
+    let f = frame(0x0FD);
+    make_passive(&mut bus, &mut dut, id, &f);
+    let rec_before = p.borrow().counters().rec;
+    bus.inject_next(Fault::Ack);
+    bus.try_inject_next(Fault::DelimiterBit {
+        who: Sees::Node(id),
+        bit: 3,
+    })
+    .unwrap();
+    let r = next_frame(&mut bus);
+    assert!(r.refused.is_empty(), "{:?}", r.refused);
+    assert_eq!(dut.counters(), ErrorCounters { tec: 136, rec: 0 });
+    assert_eq!(r.end - r.sof, ce_of(&f) + 29);
+    // The peer received the frame (rule 8) and saw no error: the dut's flag is passive.
+    assert_eq!(p.borrow().counters().rec, rec_before - 1);
+}
+
+/// Faults that cannot happen are refused, never moved: delimiter bit 0 (the recessive bit
+/// that ends the flag) and 8 (a delimiter has 8 bits), a dominant third intermission bit
+/// (a start of frame, §10.4.6.2, not simulated), and — once the attempt is played — a
+/// delimiter bit in an attempt without error or overload frame (the frame is then sent
+/// as if no fault had been injected: 0 errors, TEC 0, length ce+10+3).
+pub fn delimiter_and_intermission_refusals<D: Dut>() {
+    let mut bus = Bus::new(500_000).unwrap();
+    let (mut dut, id) = D::join(&mut bus);
+    let p = peer();
+    bus.attach("p", p.clone());
+    for (fault, error) in [
+        (
+            Fault::DelimiterBit {
+                who: Sees::Bus,
+                bit: 0,
+            },
+            FaultError::DelimiterBitOutOfRange(0),
+        ),
+        (
+            Fault::DelimiterBit {
+                who: Sees::Node(id),
+                bit: 8,
+            },
+            FaultError::DelimiterBitOutOfRange(8),
+        ),
+        (
+            Fault::IntermissionBit {
+                who: Sees::Bus,
+                bit: 2,
+            },
+            FaultError::IntermissionStartOfFrame,
+        ),
+        (
+            Fault::IntermissionBit {
+                who: Sees::Node(id),
+                bit: 3,
+            },
+            FaultError::IntermissionBitOutOfRange(3),
+        ),
+    ] {
+        assert_eq!(bus.try_inject_next(fault), Err(error));
+    }
+    let f = frame(0x0FE);
+    let fault = Fault::DelimiterBit {
+        who: Sees::Node(id),
+        bit: 3,
+    };
+    bus.try_inject_next(fault).unwrap();
+    dut.send(&f);
+    let r = next_frame(&mut bus);
+    assert!(r.is_error_free());
+    assert_eq!(r.refused, vec![(fault, FaultError::DelimiterNotReached(3))]);
+    assert_eq!(r.end - r.sof, ce_of(&f) + 13);
+    assert_eq!(dut.counters(), ErrorCounters { tec: 0, rec: 0 });
+    assert_eq!(p.borrow().received_frames(), vec![f]);
+}
+
 /// Bus-off at TEC > 255 (32 bit errors) and recovery after 128 occurrences of 11
 /// consecutive recessive bits (§12.1.4.2, "bus-off"). The error delimiter and intermission
 /// of the last error frame (8 + 3 recessive bits) are the first sequence, so the retry
@@ -623,6 +901,30 @@ macro_rules! conformance_tests {
         #[test]
         fn overload_dominant_last_eof_bit() {
             conformance::overload_dominant_last_eof_bit::<$dut>();
+        }
+        #[test]
+        fn delimiter_form_error_on_the_bus() {
+            conformance::delimiter_form_error_on_the_bus::<$dut>();
+        }
+        #[test]
+        fn delimiter_form_error_seen_by_one_node() {
+            conformance::delimiter_form_error_seen_by_one_node::<$dut>();
+        }
+        #[test]
+        fn dominant_last_error_delimiter_bit_is_overload() {
+            conformance::dominant_last_error_delimiter_bit_is_overload::<$dut>();
+        }
+        #[test]
+        fn faults_in_an_overload_delimiter() {
+            conformance::faults_in_an_overload_delimiter::<$dut>();
+        }
+        #[test]
+        fn delimiter_form_error_after_passive_ack_error() {
+            conformance::delimiter_form_error_after_passive_ack_error::<$dut>();
+        }
+        #[test]
+        fn delimiter_and_intermission_refusals() {
+            conformance::delimiter_and_intermission_refusals::<$dut>();
         }
         #[test]
         fn bus_off_and_recovery() {
