@@ -93,8 +93,10 @@ pub struct Capabilities {
     /// Slowest bit rate reachable from [`Capabilities::clock_hz`]
     /// ([`Limits::min_bitrate`]).
     pub min_bitrate: u32,
-    /// Fastest bit rate reachable from [`Capabilities::clock_hz`]
-    /// ([`Limits::max_bitrate`]).
+    /// Fastest bit rate the controller accepts: reachable from
+    /// [`Capabilities::clock_hz`] ([`Limits::max_bitrate`]) and, where the controller's
+    /// manual has a stricter rule, allowed by it ([`Capabilities::with_max_bitrate`];
+    /// FlexCAN: [`crate::timing::flexcan_rules::max_bitrate`] with the bus clock in use).
     pub max_bitrate: u32,
     /// The optional modes offered.
     pub modes: ModeSupport,
@@ -142,6 +144,16 @@ impl Capabilities {
         }
     }
 
+    /// The same capabilities with [`Capabilities::max_bitrate`] lowered to `max` (a rule
+    /// of the controller's manual beyond the register ranges); a higher `max` changes
+    /// nothing.
+    pub const fn with_max_bitrate(mut self, max: u32) -> Self {
+        if max < self.max_bitrate {
+            self.max_bitrate = max;
+        }
+        self
+    }
+
     /// Whether `bitrate` lies in [`Capabilities::min_bitrate`] ..=
     /// [`Capabilities::max_bitrate`].
     pub const fn bitrate_in_range(&self, bitrate: u32) -> bool {
@@ -149,8 +161,10 @@ impl Capabilities {
     }
 
     /// A bit timing for `bitrate` from this controller's clock and limits, aiming at
-    /// `sample_point_permille`: [`Limits::check_bitrate`]'s errors, the solver's, and
-    /// [`TimingError::TooFarFromWishedBitrate`] beyond [`DEFAULT_TOLERANCE_PPM`].
+    /// `sample_point_permille`: [`Limits::check_bitrate`]'s errors,
+    /// [`TimingError::BitrateTooHigh`] above [`Capabilities::max_bitrate`], the
+    /// solver's, and [`TimingError::TooFarFromWishedBitrate`] beyond
+    /// [`DEFAULT_TOLERANCE_PPM`].
     pub const fn timing_for(
         &self,
         bitrate: u32,
@@ -158,6 +172,9 @@ impl Capabilities {
     ) -> Result<Timing, TimingError> {
         if let Err(e) = self.timing_limits.check_bitrate(self.clock_hz, bitrate) {
             return Err(e);
+        }
+        if bitrate > self.max_bitrate {
+            return Err(TimingError::BitrateTooHigh);
         }
         match solve(
             self.clock_hz,

@@ -286,7 +286,9 @@ pub unsafe trait Hardware {
     /// Stopped controller only: writes a new bit timing (computed for
     /// [`Capabilities::clock_hz`] within [`Capabilities::timing_limits`]); the filters
     /// stay. [`Error::WrongMode`] while on the bus; [`Error::Timing`] for a timing made
-    /// for another clock or other limits, or inconsistent.
+    /// for another clock or other limits, faster than [`Capabilities::max_bitrate`],
+    /// inconsistent, or forbidden by the controller's manual
+    /// ([`crate::timing::TimingError::ForbiddenByManual`]).
     fn set_timing(&self, timing: &Timing) -> Result<(), Error>;
 
     /// Stopped controller only: selects the bus mode used from the next start; the
@@ -297,7 +299,7 @@ pub unsafe trait Hardware {
 
 /// The checks [`Hardware::set_timing`] applies before any register is written: the
 /// controller is stopped (`stopped`), the timing was made for `caps`' clock and limits,
-/// and it is consistent.
+/// its bit rate is at most [`Capabilities::max_bitrate`], and it is consistent.
 pub fn check_timing_for(caps: &Capabilities, timing: &Timing, stopped: bool) -> Result<(), Error> {
     use crate::timing::TimingError;
     if !stopped {
@@ -312,6 +314,9 @@ pub fn check_timing_for(caps: &Capabilities, timing: &Timing, stopped: bool) -> 
     caps.timing_limits
         .check_bitrate(caps.clock_hz, timing.actual_bitrate())
         .map_err(Error::Timing)?;
+    if timing.actual_bitrate() > caps.max_bitrate {
+        return Err(Error::Timing(TimingError::BitrateTooHigh));
+    }
     let consistency = timing.consistency();
     if !consistency.is_ok() {
         return Err(Error::Timing(TimingError::Inconsistent(consistency)));

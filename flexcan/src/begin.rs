@@ -245,6 +245,7 @@ impl<R: Registers> FlexCan<R> {
             polls,
             settings.message_irq_priority,
             plan.system,
+            settings.bus_clock_hz.unwrap_or(CAN_CLOCK_HZ),
         ))
     }
 }

@@ -123,6 +123,10 @@ pub struct FlexCanHw<R: Registers> {
     /// a state read took out of `ESR1` (for example one raised between the handler's
     /// read and its write-back, whose `ERRINT` the write-back cleared) is still counted.
     unreported: AtomicU32,
+    /// The peripheral (bus) clock `begin` checked the timing against
+    /// ([`crate::Settings::bus_clock_hz`]); [`Hardware::set_timing`] and
+    /// [`Hardware::capabilities`] apply the Kinetis manual's rule with it.
+    bus_clock_hz: u32,
 }
 
 impl<R: Registers> FlexCan<R> {
@@ -149,6 +153,7 @@ impl<R: Registers> FlexCan<R> {
             unresolved: AtomicU32::new(0),
             loaded: AtomicU32::new(0),
             system: self.system,
+            bus_clock_hz: self.bus_clock_hz,
             caught: AtomicU32::new(0),
             unreported: AtomicU32::new(0),
         }
@@ -238,6 +243,7 @@ impl<R: Registers> FlexCanHw<R> {
             self.polls.load(Ordering::Relaxed),
             self.irq_priority,
             self.system,
+            self.bus_clock_hz,
         );
         controller.mode = mode;
         controller.last_error.set(last_error);
@@ -718,7 +724,11 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
         Ok(())
     }
 
-    /// The 16 MHz oscillator, [`Limits::FLEXCAN`]; one ID table element per exact
+    /// The 16 MHz oscillator, [`Limits::FLEXCAN`], the fastest bit rate the Kinetis
+    /// manual allows with the bus clock `begin` was given (FlexCAN chapter,
+    /// "Arbitration and matching timing": 8 quanta, 16 bus clocks per CAN bit,
+    /// [`twocan_core::timing::flexcan_rules::max_bitrate`]; 1 Mbit/s from a 16 MHz bus
+    /// clock, 2 Mbit/s from 32 MHz and above); one ID table element per exact
     /// filter of either format (format A), as many as the configuration's primary and
     /// secondary elements (ACAN §11, table 4); MB15 and the remote-frame mailboxes;
     /// the 6-frame Rx FIFO; the 16-bit free-running timer (Kinetis RM, TIMER).
@@ -744,6 +754,12 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
             RX_FIFO_DEPTH as u8,
             Some(16),
         )
+        .with_max_bitrate(twocan_core::timing::flexcan_rules::max_bitrate(
+            crate::settings::CAN_CLOCK_HZ,
+            self.bus_clock_hz,
+            crate::configuration::MESSAGE_BUFFERS,
+            true,
+        ))
     }
 
     fn bus_mode(&self) -> BusMode {
@@ -761,9 +777,23 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
     /// In Freeze mode ([`Mode::Stopped`]): the `CTRL1` timing fields (PRESDIV, RJW,
     /// PSEG1, PSEG2, SMP, PROPSEG: writable in Freeze mode only, Kinetis RM CTRL1);
     /// the acknowledge bound grows for a slower rate.
+    ///
+    /// Besides the portable checks ([`twocan_core::hardware::check_timing_for`]), the
+    /// Kinetis manual's rule `begin` applies ("Arbitration and matching timing": 8 quanta
+    /// per bit, 16 bus clocks per CAN bit with the bus clock `begin` was given,
+    /// [`twocan_core::timing::flexcan_rules::check`]):
+    /// [`TimingError::ForbiddenByManual`](twocan_core::timing::TimingError::ForbiddenByManual)
+    /// when it is broken, nothing written.
     fn set_timing(&self, timing: &Timing) -> Result<(), Error> {
         let stopped = self.mode() == MODE_STOPPED;
         twocan_core::hardware::check_timing_for(&self.capabilities(), timing, stopped)?;
+        twocan_core::timing::flexcan_rules::check(
+            timing,
+            self.bus_clock_hz,
+            crate::configuration::MESSAGE_BUFFERS,
+            true,
+        )
+        .map_err(|_| Error::Timing(twocan_core::timing::TimingError::ForbiddenByManual))?;
         let bits = timing.flexcan_ctrl1().map_err(Error::Timing)?;
         self.regs
             .modify32(regs::CTRL1, |v| (v & !FLEXCAN_CTRL1_TIMING_MASK) | bits);

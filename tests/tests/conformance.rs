@@ -547,10 +547,13 @@ fn capabilities_are_the_hardware_facts<B: Backend>() {
     let caps = dut.driver_ref().capabilities();
     assert_eq!(caps.clock_hz, B::CLOCK_HZ, "{}", B::NAME);
     assert_eq!(caps.timing_limits, B::LIMITS, "{}", B::NAME);
-    // Slowest: largest prescaler × most quanta (25 for both); fastest: prescaler 1 and
-    // the fewest quanta (FlexCAN 1 + 2 + 2 = 5, ACAN §16.1: 3.2 Mbit/s; bxCAN 1 + 1 + 1).
+    // Slowest: largest prescaler × most quanta (25 for both); fastest: bxCAN prescaler 1
+    // and the fewest quanta (1 + 1 + 1); FlexCAN the Kinetis manual's rule with the
+    // default bus clock of 16 MHz ("Arbitration and matching timing": at least 8 quanta,
+    // 16 MHz / 8 = 2 Mbit/s, and 16 bus clocks per bit, 16 MHz / 16 = 1 Mbit/s), below
+    // the register ranges' 3.2 Mbit/s (5 quanta, ACAN §16.1).
     let (slowest, fastest) = match B::CLOCK_HZ {
-        16_000_000 => (16_000_000u32.div_ceil(256 * 25), 3_200_000),
+        16_000_000 => (16_000_000u32.div_ceil(256 * 25), 1_000_000),
         54_000_000 => (54_000_000u32.div_ceil(1024 * 25), 18_000_000),
         c => panic!("unexpected clock {c}"),
     };
@@ -810,6 +813,45 @@ fn retiming_and_mode_changes_keep_the_filters<B: Backend>() {
     run(&mut h2, &mut dut, 20);
     let after = run_cases(&mut h2, &mut dut, &peer, &cases);
     assert_eq!(after, before, "{}: after the bit-rate change", B::NAME);
+}
+
+/// Re-timing a stopped node applies the rule `begin` applies: twice the fastest rate
+/// is refused with the same error on both backends (bxCAN: above 54 MHz / 3 quanta;
+/// FlexCAN: above the Kinetis manual's 16 bus clocks per bit, though within the register
+/// ranges), nothing is written, and the fastest rate itself is accepted.
+fn retiming_refuses_what_begin_refuses<B: Backend>() {
+    let (_h, mut dut, _peer) = setup::<B>(&NodeOptions::pass_all());
+    // `begin` refuses twice the fastest rate.
+    assert!(
+        B::check_timing(B::FASTEST_BITRATE * 2, 750).is_err(),
+        "{}",
+        B::NAME
+    );
+    dut.driver().set_mode(Mode::Stopped).unwrap();
+    assert_eq!(
+        dut.driver().set_bitrate(B::FASTEST_BITRATE * 2, 750),
+        Err(Error::Timing(TimingError::BitrateTooHigh)),
+        "{}",
+        B::NAME
+    );
+    assert_eq!(dut.bitrate_in_registers(), RATE, "{}", B::NAME);
+    let t = dut
+        .driver()
+        .set_bitrate(B::FASTEST_BITRATE, 750)
+        .unwrap_or_else(|e| panic!("{}: {e:?}", B::NAME));
+    assert_eq!(t.actual_bitrate(), B::FASTEST_BITRATE, "{}", B::NAME);
+    assert_eq!(
+        dut.bitrate_in_registers(),
+        B::FASTEST_BITRATE,
+        "{}",
+        B::NAME
+    );
+    assert_eq!(
+        dut.driver_ref().capabilities().max_bitrate,
+        B::FASTEST_BITRATE,
+        "{}",
+        B::NAME
+    );
 }
 
 /// An empty list receives nothing; `Filter::pass_all` everything; a new list replaces
@@ -1211,6 +1253,10 @@ macro_rules! suite {
             #[test]
             fn retiming_and_mode_changes_keep_the_filters() {
                 super::retiming_and_mode_changes_keep_the_filters::<$backend>();
+            }
+            #[test]
+            fn retiming_refuses_what_begin_refuses() {
+                super::retiming_refuses_what_begin_refuses::<$backend>();
             }
             #[test]
             fn filter_list_semantics() {
