@@ -52,7 +52,9 @@ use crate::spsc::{BufferStats, Counter, SpscRing};
 use crate::timestamp::{Extender, Timestamp};
 use crate::txqueue::{FifoQueue, Queued, TxQueue};
 
-/// Capacity of the error-state change ring.
+/// Capacity of the error-state change ring. Changes the thread side has not taken when
+/// the ring is full are counted in [`TrafficStats::state_change_overflows`], not lost
+/// silently.
 pub const STATE_CHANGES: usize = 8;
 
 /// One error-state change, with the counters read at the change.
@@ -88,6 +90,12 @@ pub struct TrafficStats {
     pub completion_overflows: u32,
     /// Error-state transitions observed.
     pub state_changes: u32,
+    /// Error-state transitions lost because the state-change ring
+    /// ([`STATE_CHANGES`] entries) was full: the thread side did not take them
+    /// ([`Rx::take_state_change`]) before more arrived. Every transition is in
+    /// [`TrafficStats::state_changes`]; the ring keeps the oldest ones not yet taken and
+    /// counts each newer one it could not hold here.
+    pub state_change_overflows: u32,
 }
 
 /// One raw frame in a receive ring, with the wraps of its time stamp counted by the
@@ -375,6 +383,7 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
             rx_dropped: self.dropped.get(),
             completion_overflows: self.done.stats().overflows,
             state_changes: self.state_changes.get(),
+            state_change_overflows: self.changes.stats().overflows,
         }
     }
 
@@ -1235,6 +1244,8 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
             self.last = now.state;
             s.state.store(state_code(now.state), Ordering::Relaxed);
             s.state_changes.inc();
+            // A full ring keeps the older changes; the ring counts this one as lost
+            // (`TrafficStats::state_change_overflows`).
             // SAFETY: this handle is the state-change ring's only producer.
             let _ = unsafe {
                 s.changes.push(StateChange {
