@@ -681,7 +681,8 @@ unsafe impl<R: Registers, F: Registers, const K: usize> Hardware for BxCan<R, F,
     /// the banks this instance owns now (`CAN2SB`, RM0410 §40.7.4): four 16-bit list
     /// identifiers (standard) or two 32-bit ones (extended) per bank; three transmit
     /// mailboxes, two receive FIFOs of three (§40.7.3, §40.7.5); no triple sampling;
-    /// 16-bit time stamps only with `TTCM` (§40.7.8, [`Config::get_timestamps`]).
+    /// 16-bit time stamps only with `TTCM` (§40.7.8, [`Config::get_timestamps`]);
+    /// wake-up events when `CAN_IER.WKUIE` is enabled (§40.8, `CAN_MSR.WKUI`).
     fn capabilities(&self) -> Capabilities {
         let (s, e) = self.bank_range();
         let banks = (e - s) as u16;
@@ -703,6 +704,7 @@ unsafe impl<R: Registers, F: Registers, const K: usize> Hardware for BxCan<R, F,
             RX_FIFO_DEPTH as u8,
             self.config.get_timestamps().then_some(16),
         )
+        .with_wakeup_events(self.config.get_interrupts() & crate::regs::ier::WKUIE != 0)
     }
 
     /// `CAN_BTR.LBKM` (loop-back, silent or not) and `SILM`.

@@ -112,6 +112,14 @@ pub struct Capabilities {
     pub rx_fifo_depth: u8,
     /// Width of the hardware time stamps in bits, when the controller records them now.
     pub timestamp_bits: Option<u8>,
+    /// Whether the controller, as configured, reports a wake-up event (a bus activity
+    /// seen while asleep), which the status handler counts
+    /// ([`crate::Driver::wakeups`], [`crate::State::wakeups`]). `false` from
+    /// [`Capabilities::new`]; [`Capabilities::with_wakeup_events`] sets it.
+    /// FlexCAN as this project configures it: no (`MCR.WAKMSK` and `MCR.SLFWAK` are never
+    /// set, Kinetis RM MCR field descriptions); bxCAN: yes when `CAN_IER.WKUIE` is
+    /// enabled (`CAN_MSR.WKUI`, RM0410 §40.4.3 "Sleep mode", §40.8 "Interrupts").
+    pub wakeup_events: bool,
 }
 
 impl Capabilities {
@@ -141,7 +149,14 @@ impl Capabilities {
             rx_queues,
             rx_fifo_depth,
             timestamp_bits,
+            wakeup_events: false,
         }
+    }
+
+    /// The same capabilities with [`Capabilities::wakeup_events`] set to `on`.
+    pub const fn with_wakeup_events(mut self, on: bool) -> Self {
+        self.wakeup_events = on;
+        self
     }
 
     /// The same capabilities with [`Capabilities::max_bitrate`] lowered to `max` (a rule

@@ -230,6 +230,13 @@ impl<H: Hardware, const RX: usize, const TX: usize, const RX1: usize> Driver<H, 
         self.state.error_stats()
     }
 
+    /// Wake-up events the status handler has seen (bus activity while the controller
+    /// slept; [`Capabilities::wakeup_events`] says whether the controller reports them
+    /// as configured).
+    pub fn wakeups(&self) -> u32 {
+        self.state.wakeups()
+    }
+
     /// Traffic statistics.
     pub fn traffic(&self) -> TrafficStats {
         self.state.traffic()

@@ -732,7 +732,9 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
     /// filter of either format (format A), as many as the configuration's primary and
     /// secondary elements (ACAN §11, table 4); MB15 and the remote-frame mailboxes;
     /// the 6-frame Rx FIFO; the 16-bit free-running timer (Kinetis RM, TIMER).
-    /// No one-shot mode on these modules.
+    /// No one-shot mode on these modules. No wake-up events as configured: `MCR.WAKMSK`
+    /// and `MCR.SLFWAK` are never set (Kinetis RM, MCR field descriptions), so the module
+    /// never raises `ESR1.WAKINT`.
     fn capabilities(&self) -> Capabilities {
         let c = self.configuration();
         let filters = (c.primary_filter_capacity() + c.secondary_filter_capacity()) as u16;

@@ -574,6 +574,8 @@ fn capabilities_are_the_hardware_facts<B: Backend>() {
     assert_eq!(caps.rx_queues, B::RX_QUEUES, "{}", B::NAME);
     assert_eq!(caps.rx_fifo_depth as usize, B::RX_FIFO_DEPTH, "{}", B::NAME);
     assert_eq!(caps.timestamp_bits, B::TIMESTAMP_BITS, "{}", B::NAME);
+    assert_eq!(caps.wakeup_events, B::WAKEUP_EVENTS, "{}", B::NAME);
+    assert_eq!(dut.driver_ref().wakeups(), 0, "{}", B::NAME);
     // The capacity is real: the node's own capacity test fills exactly this many.
     assert!(caps.max_standard_filters as usize <= B::MAX_EXACT_STD_FILTERS);
     // The same rule as `Limits::check_bitrate`, and usable to compute a timing.
