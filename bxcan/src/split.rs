@@ -97,6 +97,8 @@ pub struct BxCan<R: Registers, F: Registers = R, const K: usize = LOOKUP_KEYS> {
     /// `decode`: frames read before the last `install_filters` are dropped. Written by
     /// `install_filters` only.
     generation: AtomicU32,
+    /// FIFO frames released by `install_filters` and not yet taken (receive half only).
+    discarded: AtomicU32,
 }
 
 // SAFETY: the atomics are shared; `displaced` is touched by the transmit interrupt's
@@ -123,6 +125,7 @@ impl<R: Registers, F: Registers, const K: usize> Can<R, F, K> {
             wait: AtomicU32::new(self.config.get_wait_iterations()),
             listen_only: AtomicBool::new(listen_only),
             generation: AtomicU32::new(0),
+            discarded: AtomicU32::new(0),
         }
     }
 }
@@ -607,6 +610,8 @@ unsafe impl<R: Registers, F: Registers, const K: usize> Hardware for BxCan<R, F,
                         break;
                     }
                     self.regs.write32(rfxr(x), rfxr::RFOM);
+                    // Counted (`take_filter_switch_discards`).
+                    self.discarded.fetch_add(1, Ordering::Relaxed);
                 }
             }
         };
@@ -623,6 +628,11 @@ unsafe impl<R: Registers, F: Registers, const K: usize> Hardware for BxCan<R, F,
     }
 
     fn filter_map(&self) {}
+
+    /// The FIFO frames `install_filters` released under `FINIT` (`RFOMx`).
+    fn take_filter_switch_discards(&self) -> u32 {
+        self.discarded.swap(0, Ordering::Relaxed)
+    }
 
     /// `CAN_MSR`: `ERRI`, `WKUI`, `SLAKI` acknowledged; `CAN_ESR.LEC` reported and set
     /// to 0b111 so the next error is seen as new (notes "Error management").

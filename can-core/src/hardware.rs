@@ -24,8 +24,9 @@
 //!   the list atomically for the receive half: once it returns, [`Hardware::decode`]
 //!   reports no frame with an index of the old list: frames the old list accepted that
 //!   are still in the hardware FIFO are discarded while the controller is switched (off
-//!   the bus for it), and those already in the driver's ring are dropped when taken
-//!   (`None` from `decode`, counted in [`crate::TrafficStats::rx_dropped`]).
+//!   the bus for it) and reported by [`Hardware::take_filter_switch_discards`], and
+//!   those already in the driver's ring are dropped when taken (`None` from `decode`);
+//!   both are counted in [`crate::TrafficStats::rx_dropped`].
 //! - **Stop, change, start.** With the controller stopped ([`Mode::Stopped`]),
 //!   [`Hardware::set_timing`] and [`Hardware::set_bus_mode`] change the bit timing and the
 //!   bus mode; the installed filters and their user indices stay. Either is refused with
@@ -245,6 +246,15 @@ pub unsafe trait Hardware {
     /// # Safety
     /// Called from this method's one context only (see the [module docs](self)).
     unsafe fn install_filters(&self, filters: &Self::Filters) -> Result<Self::FilterMap, Error>;
+
+    /// Receive half: the frames the last [`Hardware::install_filters`] calls discarded
+    /// from the hardware FIFO during the switch (accepted by the old list, never read),
+    /// since the previous call; the call resets the count. The driver adds them to
+    /// [`crate::TrafficStats::rx_dropped`], so that a filter switch loses no frame
+    /// silently. The default, 0, is for a controller whose switch discards nothing.
+    fn take_filter_switch_discards(&self) -> u32 {
+        0
+    }
 
     /// The map of the filters installed now (read at split time).
     fn filter_map(&self) -> Self::FilterMap;

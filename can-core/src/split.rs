@@ -84,7 +84,9 @@ pub struct TrafficStats {
     /// Frames lost because a receive ring was full.
     pub rx_ring_overflows: u32,
     /// Frames the hardware accepted that no user filter claims (dropped on the thread
-    /// side, e.g. the extra identifiers of a superset filter plan).
+    /// side, e.g. the extra identifiers of a superset filter plan), and frames the old
+    /// list had accepted that a filter switch discarded (from the hardware FIFO,
+    /// [`Hardware::take_filter_switch_discards`], or from the ring).
     pub rx_dropped: u32,
     /// Completions lost because the completion ring was full.
     pub completion_overflows: u32,
@@ -614,6 +616,14 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
         }
     }
 
+    /// Adds the frames the last filter switch discarded from the hardware FIFO to
+    /// [`TrafficStats::rx_dropped`] (the receive half's context, the counter's writer).
+    pub(crate) fn count_filter_switch_discards(&self) {
+        if let Some(hw) = self.hardware() {
+            self.dropped.add(hw.take_filter_switch_discards());
+        }
+    }
+
     /// # Safety
     /// Called from the state-change ring's one consumer context.
     pub(crate) unsafe fn pop_change(&self) -> Option<StateChange> {
@@ -961,11 +971,12 @@ impl<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE:
 
     /// Installs a new compiled filter list, atomically: once it returns, no frame is
     /// reported with an index of the old list (frames the old list accepted are
-    /// discarded from the hardware FIFO, or dropped from the ring and counted in
-    /// [`TrafficStats::rx_dropped`]; see [`crate::hardware`]).
+    /// discarded from the hardware FIFO or dropped from the ring, and counted in
+    /// [`TrafficStats::rx_dropped`] either way; see [`crate::hardware`]).
     pub fn set_filters(&mut self, filters: &H::Filters) -> Result<(), Error> {
         // SAFETY: the receive half is the context of `install_filters`.
         self.map = unsafe { self.s.hw().install_filters(filters)? };
+        self.s.count_filter_switch_discards();
         Ok(())
     }
 

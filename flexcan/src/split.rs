@@ -127,6 +127,9 @@ pub struct FlexCanHw<R: Registers> {
     /// ([`crate::Settings::bus_clock_hz`]); [`Hardware::set_timing`] and
     /// [`Hardware::capabilities`] apply the Kinetis manual's rule with it.
     bus_clock_hz: u32,
+    /// Rx FIFO frames discarded by `install_filters` and not yet taken (receive half
+    /// only).
+    discarded: AtomicU32,
 }
 
 impl<R: Registers> FlexCan<R> {
@@ -154,6 +157,7 @@ impl<R: Registers> FlexCan<R> {
             loaded: AtomicU32::new(0),
             system: self.system,
             bus_clock_hz: self.bus_clock_hz,
+            discarded: AtomicU32::new(0),
             caught: AtomicU32::new(0),
             unreported: AtomicU32::new(0),
         }
@@ -633,12 +637,16 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
         self.mode_change(Mode::Stopped)?;
         FlexCan::write_filters(&self.regs, filters);
         // The FIFO holds at most its depth; the receive interrupt may pop some too.
+        // Each frame popped here is counted (`take_filter_switch_discards`).
+        let mut popped = 0;
         for _ in 0..2 * RX_FIFO_DEPTH {
             if self.regs.read32(IFLAG1) & iflag1::BUF5I == 0 {
                 break;
             }
             self.regs.write32(IFLAG1, iflag1::BUF5I);
+            popped += 1;
         }
+        self.discarded.fetch_add(popped, Ordering::Relaxed);
         // SAFETY: the receive half's context, the only one touching the table.
         unsafe { *self.table.get() = filters.clone() };
         let next = (self.generation.load(Ordering::Relaxed) + 1) & 0xFFFF;
@@ -647,6 +655,11 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
     }
 
     fn filter_map(&self) {}
+
+    /// The Rx FIFO frames `install_filters` popped in Freeze mode (writing `BUF5I`).
+    fn take_filter_switch_discards(&self) -> u32 {
+        self.discarded.swap(0, Ordering::Relaxed)
+    }
 
     /// `ESR1`: the error code latched, the write-1-to-clear interrupt bits read
     /// acknowledged (exactly those), wake-up; the state from `FLTCONF` and `ECR`.
