@@ -97,6 +97,8 @@ pub struct BxCan<R: Registers, F: Registers = R, const K: usize = LOOKUP_KEYS> {
     /// `decode`: frames read before the last `install_filters` are dropped. Written by
     /// `install_filters` only.
     generation: AtomicU32,
+    /// FIFO frames released by `install_filters` and not yet taken (receive half only).
+    discarded: AtomicU32,
 }
 
 // SAFETY: the atomics are shared; `displaced` is touched by the transmit interrupt's
@@ -123,6 +125,7 @@ impl<R: Registers, F: Registers, const K: usize> Can<R, F, K> {
             wait: AtomicU32::new(self.config.get_wait_iterations()),
             listen_only: AtomicBool::new(listen_only),
             generation: AtomicU32::new(0),
+            discarded: AtomicU32::new(0),
         }
     }
 }
@@ -607,6 +610,8 @@ unsafe impl<R: Registers, F: Registers, const K: usize> Hardware for BxCan<R, F,
                         break;
                     }
                     self.regs.write32(rfxr(x), rfxr::RFOM);
+                    // Counted (`take_filter_switch_discards`).
+                    self.discarded.fetch_add(1, Ordering::Relaxed);
                 }
             }
         };
@@ -623,6 +628,11 @@ unsafe impl<R: Registers, F: Registers, const K: usize> Hardware for BxCan<R, F,
     }
 
     fn filter_map(&self) {}
+
+    /// The FIFO frames `install_filters` released under `FINIT` (`RFOMx`).
+    fn take_filter_switch_discards(&self) -> u32 {
+        self.discarded.swap(0, Ordering::Relaxed)
+    }
 
     /// `CAN_MSR`: `ERRI`, `WKUI`, `SLAKI` acknowledged; `CAN_ESR.LEC` reported and set
     /// to 0b111 so the next error is seen as new (notes "Error management").
@@ -681,7 +691,8 @@ unsafe impl<R: Registers, F: Registers, const K: usize> Hardware for BxCan<R, F,
     /// the banks this instance owns now (`CAN2SB`, RM0410 §40.7.4): four 16-bit list
     /// identifiers (standard) or two 32-bit ones (extended) per bank; three transmit
     /// mailboxes, two receive FIFOs of three (§40.7.3, §40.7.5); no triple sampling;
-    /// 16-bit time stamps only with `TTCM` (§40.7.8, [`Config::get_timestamps`]).
+    /// 16-bit time stamps only with `TTCM` (§40.7.8, [`Config::get_timestamps`]);
+    /// wake-up events when `CAN_IER.WKUIE` is enabled (§40.8, `CAN_MSR.WKUI`).
     fn capabilities(&self) -> Capabilities {
         let (s, e) = self.bank_range();
         let banks = (e - s) as u16;
@@ -703,6 +714,7 @@ unsafe impl<R: Registers, F: Registers, const K: usize> Hardware for BxCan<R, F,
             RX_FIFO_DEPTH as u8,
             self.config.get_timestamps().then_some(16),
         )
+        .with_wakeup_events(self.config.get_interrupts() & crate::regs::ier::WKUIE != 0)
     }
 
     /// `CAN_BTR.LBKM` (loop-back, silent or not) and `SILM`.

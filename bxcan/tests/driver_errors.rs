@@ -179,10 +179,22 @@ fn acknowledge_error_is_reported() {
 }
 
 #[test]
+fn wake_up_events_only_with_wkuie() {
+    use twocan_bxcan::config::DEFAULT_INTERRUPTS;
+    use twocan_bxcan::regs::ier;
+    let cfg = config().interrupts(DEFAULT_INTERRUPTS & !ier::WKUIE);
+    let (can, _regs, _bus, _peer) = can1_and_peer(&cfg, &pass_all());
+    assert!(!driver(can).capabilities().wakeup_events);
+}
+
+#[test]
 fn sleep_and_wake_up() {
     let cfg = config().auto_wakeup(true);
     let (can, _regs, bus, peer) = can1_and_peer(&cfg, &pass_all());
     let mut d = driver(can);
+    // The default interrupts include WKUIE: the controller reports wake-ups.
+    assert!(d.capabilities().wakeup_events);
+    assert_eq!(d.wakeups(), 0);
     d.set_mode(Mode::Sleep).unwrap();
     assert_eq!(d.hardware().mode(), Mode::Sleep);
     assert_eq!(d.error_status().state, ErrorState::Sleeping);
@@ -193,6 +205,7 @@ fn sleep_and_wake_up() {
     run(&bus, 100);
     d.on_status();
     assert_eq!(d.shared_state().wakeups(), 1);
+    assert_eq!(d.wakeups(), 1);
     assert_ne!(d.hardware().mode(), Mode::Sleep);
     d.set_mode(Mode::Sleep).unwrap();
     d.set_mode(Mode::Normal).unwrap();

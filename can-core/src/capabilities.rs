@@ -93,8 +93,10 @@ pub struct Capabilities {
     /// Slowest bit rate reachable from [`Capabilities::clock_hz`]
     /// ([`Limits::min_bitrate`]).
     pub min_bitrate: u32,
-    /// Fastest bit rate reachable from [`Capabilities::clock_hz`]
-    /// ([`Limits::max_bitrate`]).
+    /// Fastest bit rate the controller accepts: reachable from
+    /// [`Capabilities::clock_hz`] ([`Limits::max_bitrate`]) and, where the controller's
+    /// manual has a stricter rule, allowed by it ([`Capabilities::with_max_bitrate`];
+    /// FlexCAN: [`crate::timing::flexcan_rules::max_bitrate`] with the bus clock in use).
     pub max_bitrate: u32,
     /// The optional modes offered.
     pub modes: ModeSupport,
@@ -110,6 +112,14 @@ pub struct Capabilities {
     pub rx_fifo_depth: u8,
     /// Width of the hardware time stamps in bits, when the controller records them now.
     pub timestamp_bits: Option<u8>,
+    /// Whether the controller, as configured, reports a wake-up event (a bus activity
+    /// seen while asleep), which the status handler counts
+    /// ([`crate::Driver::wakeups`], [`crate::State::wakeups`]). `false` from
+    /// [`Capabilities::new`]; [`Capabilities::with_wakeup_events`] sets it.
+    /// FlexCAN as this project configures it: no (`MCR.WAKMSK` and `MCR.SLFWAK` are never
+    /// set, Kinetis RM MCR field descriptions); bxCAN: yes when `CAN_IER.WKUIE` is
+    /// enabled (`CAN_MSR.WKUI`, RM0410 §40.4.3 "Sleep mode", §40.8 "Interrupts").
+    pub wakeup_events: bool,
 }
 
 impl Capabilities {
@@ -139,7 +149,24 @@ impl Capabilities {
             rx_queues,
             rx_fifo_depth,
             timestamp_bits,
+            wakeup_events: false,
         }
+    }
+
+    /// The same capabilities with [`Capabilities::wakeup_events`] set to `on`.
+    pub const fn with_wakeup_events(mut self, on: bool) -> Self {
+        self.wakeup_events = on;
+        self
+    }
+
+    /// The same capabilities with [`Capabilities::max_bitrate`] lowered to `max` (a rule
+    /// of the controller's manual beyond the register ranges); a higher `max` changes
+    /// nothing.
+    pub const fn with_max_bitrate(mut self, max: u32) -> Self {
+        if max < self.max_bitrate {
+            self.max_bitrate = max;
+        }
+        self
     }
 
     /// Whether `bitrate` lies in [`Capabilities::min_bitrate`] ..=
@@ -149,8 +176,10 @@ impl Capabilities {
     }
 
     /// A bit timing for `bitrate` from this controller's clock and limits, aiming at
-    /// `sample_point_permille`: [`Limits::check_bitrate`]'s errors, the solver's, and
-    /// [`TimingError::TooFarFromWishedBitrate`] beyond [`DEFAULT_TOLERANCE_PPM`].
+    /// `sample_point_permille`: [`Limits::check_bitrate`]'s errors,
+    /// [`TimingError::BitrateTooHigh`] above [`Capabilities::max_bitrate`], the
+    /// solver's, and [`TimingError::TooFarFromWishedBitrate`] beyond
+    /// [`DEFAULT_TOLERANCE_PPM`].
     pub const fn timing_for(
         &self,
         bitrate: u32,
@@ -158,6 +187,9 @@ impl Capabilities {
     ) -> Result<Timing, TimingError> {
         if let Err(e) = self.timing_limits.check_bitrate(self.clock_hz, bitrate) {
             return Err(e);
+        }
+        if bitrate > self.max_bitrate {
+            return Err(TimingError::BitrateTooHigh);
         }
         match solve(
             self.clock_hz,

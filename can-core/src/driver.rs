@@ -230,6 +230,13 @@ impl<H: Hardware, const RX: usize, const TX: usize, const RX1: usize> Driver<H, 
         self.state.error_stats()
     }
 
+    /// Wake-up events the status handler has seen (bus activity while the controller
+    /// slept; [`Capabilities::wakeup_events`] says whether the controller reports them
+    /// as configured).
+    pub fn wakeups(&self) -> u32 {
+        self.state.wakeups()
+    }
+
     /// Traffic statistics.
     pub fn traffic(&self) -> TrafficStats {
         self.state.traffic()
@@ -316,10 +323,12 @@ impl<H: Hardware, const RX: usize, const TX: usize, const RX1: usize> Driver<H, 
     }
 
     /// Installs a new compiled filter list, atomically: once it returns, no frame is
-    /// reported with an index of the old list (see [`crate::hardware`]).
+    /// reported with an index of the old list (see [`crate::hardware`]); the old list's
+    /// frames discarded on the way are counted in [`TrafficStats::rx_dropped`].
     pub fn set_filters(&mut self, filters: &H::Filters) -> Result<(), Error> {
         // SAFETY: the driver plays the receive half, the context of `install_filters`.
         self.map = unsafe { self.hardware().install_filters(filters)? };
+        self.state.count_filter_switch_discards();
         Ok(())
     }
 

@@ -24,8 +24,9 @@
 //!   the list atomically for the receive half: once it returns, [`Hardware::decode`]
 //!   reports no frame with an index of the old list: frames the old list accepted that
 //!   are still in the hardware FIFO are discarded while the controller is switched (off
-//!   the bus for it), and those already in the driver's ring are dropped when taken
-//!   (`None` from `decode`, counted in [`crate::TrafficStats::rx_dropped`]).
+//!   the bus for it) and reported by [`Hardware::take_filter_switch_discards`], and
+//!   those already in the driver's ring are dropped when taken (`None` from `decode`);
+//!   both are counted in [`crate::TrafficStats::rx_dropped`].
 //! - **Stop, change, start.** With the controller stopped ([`Mode::Stopped`]),
 //!   [`Hardware::set_timing`] and [`Hardware::set_bus_mode`] change the bit timing and the
 //!   bus mode; the installed filters and their user indices stay. Either is refused with
@@ -246,6 +247,15 @@ pub unsafe trait Hardware {
     /// Called from this method's one context only (see the [module docs](self)).
     unsafe fn install_filters(&self, filters: &Self::Filters) -> Result<Self::FilterMap, Error>;
 
+    /// Receive half: the frames the last [`Hardware::install_filters`] calls discarded
+    /// from the hardware FIFO during the switch (accepted by the old list, never read),
+    /// since the previous call; the call resets the count. The driver adds them to
+    /// [`crate::TrafficStats::rx_dropped`], so that a filter switch loses no frame
+    /// silently. The default, 0, is for a controller whose switch discards nothing.
+    fn take_filter_switch_discards(&self) -> u32 {
+        0
+    }
+
     /// The map of the filters installed now (read at split time).
     fn filter_map(&self) -> Self::FilterMap;
 
@@ -286,7 +296,9 @@ pub unsafe trait Hardware {
     /// Stopped controller only: writes a new bit timing (computed for
     /// [`Capabilities::clock_hz`] within [`Capabilities::timing_limits`]); the filters
     /// stay. [`Error::WrongMode`] while on the bus; [`Error::Timing`] for a timing made
-    /// for another clock or other limits, or inconsistent.
+    /// for another clock or other limits, faster than [`Capabilities::max_bitrate`],
+    /// inconsistent, or forbidden by the controller's manual
+    /// ([`crate::timing::TimingError::ForbiddenByManual`]).
     fn set_timing(&self, timing: &Timing) -> Result<(), Error>;
 
     /// Stopped controller only: selects the bus mode used from the next start; the
@@ -297,7 +309,7 @@ pub unsafe trait Hardware {
 
 /// The checks [`Hardware::set_timing`] applies before any register is written: the
 /// controller is stopped (`stopped`), the timing was made for `caps`' clock and limits,
-/// and it is consistent.
+/// its bit rate is at most [`Capabilities::max_bitrate`], and it is consistent.
 pub fn check_timing_for(caps: &Capabilities, timing: &Timing, stopped: bool) -> Result<(), Error> {
     use crate::timing::TimingError;
     if !stopped {
@@ -312,6 +324,9 @@ pub fn check_timing_for(caps: &Capabilities, timing: &Timing, stopped: bool) -> 
     caps.timing_limits
         .check_bitrate(caps.clock_hz, timing.actual_bitrate())
         .map_err(Error::Timing)?;
+    if timing.actual_bitrate() > caps.max_bitrate {
+        return Err(Error::Timing(TimingError::BitrateTooHigh));
+    }
     let consistency = timing.consistency();
     if !consistency.is_ok() {
         return Err(Error::Timing(TimingError::Inconsistent(consistency)));

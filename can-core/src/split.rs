@@ -52,7 +52,9 @@ use crate::spsc::{BufferStats, Counter, SpscRing};
 use crate::timestamp::{Extender, Timestamp};
 use crate::txqueue::{FifoQueue, Queued, TxQueue};
 
-/// Capacity of the error-state change ring.
+/// Capacity of the error-state change ring. Changes the thread side has not taken when
+/// the ring is full are counted in [`TrafficStats::state_change_overflows`], not lost
+/// silently.
 pub const STATE_CHANGES: usize = 8;
 
 /// One error-state change, with the counters read at the change.
@@ -82,12 +84,20 @@ pub struct TrafficStats {
     /// Frames lost because a receive ring was full.
     pub rx_ring_overflows: u32,
     /// Frames the hardware accepted that no user filter claims (dropped on the thread
-    /// side, e.g. the extra identifiers of a superset filter plan).
+    /// side, e.g. the extra identifiers of a superset filter plan), and frames the old
+    /// list had accepted that a filter switch discarded (from the hardware FIFO,
+    /// [`Hardware::take_filter_switch_discards`], or from the ring).
     pub rx_dropped: u32,
     /// Completions lost because the completion ring was full.
     pub completion_overflows: u32,
     /// Error-state transitions observed.
     pub state_changes: u32,
+    /// Error-state transitions lost because the state-change ring
+    /// ([`STATE_CHANGES`] entries) was full: the thread side did not take them
+    /// ([`Rx::take_state_change`]) before more arrived. Every transition is in
+    /// [`TrafficStats::state_changes`]; the ring keeps the oldest ones not yet taken and
+    /// counts each newer one it could not hold here.
+    pub state_change_overflows: u32,
 }
 
 /// One raw frame in a receive ring, with the wraps of its time stamp counted by the
@@ -375,6 +385,7 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
             rx_dropped: self.dropped.get(),
             completion_overflows: self.done.stats().overflows,
             state_changes: self.state_changes.get(),
+            state_change_overflows: self.changes.stats().overflows,
         }
     }
 
@@ -602,6 +613,14 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
                 (None, Some(_)) => self.rx1.pop(),
                 (None, None) => None,
             }
+        }
+    }
+
+    /// Adds the frames the last filter switch discarded from the hardware FIFO to
+    /// [`TrafficStats::rx_dropped`] (the receive half's context, the counter's writer).
+    pub(crate) fn count_filter_switch_discards(&self) {
+        if let Some(hw) = self.hardware() {
+            self.dropped.add(hw.take_filter_switch_discards());
         }
     }
 
@@ -952,11 +971,12 @@ impl<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE:
 
     /// Installs a new compiled filter list, atomically: once it returns, no frame is
     /// reported with an index of the old list (frames the old list accepted are
-    /// discarded from the hardware FIFO, or dropped from the ring and counted in
-    /// [`TrafficStats::rx_dropped`]; see [`crate::hardware`]).
+    /// discarded from the hardware FIFO or dropped from the ring, and counted in
+    /// [`TrafficStats::rx_dropped`] either way; see [`crate::hardware`]).
     pub fn set_filters(&mut self, filters: &H::Filters) -> Result<(), Error> {
         // SAFETY: the receive half is the context of `install_filters`.
         self.map = unsafe { self.s.hw().install_filters(filters)? };
+        self.s.count_filter_switch_discards();
         Ok(())
     }
 
@@ -1235,6 +1255,8 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
             self.last = now.state;
             s.state.store(state_code(now.state), Ordering::Relaxed);
             s.state_changes.inc();
+            // A full ring keeps the older changes; the ring counts this one as lost
+            // (`TrafficStats::state_change_overflows`).
             // SAFETY: this handle is the state-change ring's only producer.
             let _ = unsafe {
                 s.changes.push(StateChange {

@@ -54,6 +54,14 @@ fn plan(
 ) -> Result<Plan, ConfigErrors> {
     let mut errors = ConfigErrors::NONE;
 
+    // The range every backend applies (`begin` refuses it first, with
+    // `BeginError::Timing`; `check` reports it as a flag).
+    if twocan_core::timing::Limits::FLEXCAN
+        .check_bitrate(CAN_CLOCK_HZ, settings.wished_bit_rate())
+        .is_err()
+    {
+        errors |= ConfigErrors::BIT_RATE_OUT_OF_RANGE;
+    }
     if !settings.bit_rate_close_to_wished() {
         errors |= ConfigErrors::BIT_RATE_TOO_FAR;
     }
@@ -189,6 +197,19 @@ fn configure<R: Registers>(regs: &mut R, plan: &Plan, polls: u32) -> Result<(), 
 
 /// Every error `begin` would report for these arguments (ACAN table 5), found
 /// without touching any register. [`ConfigErrors::NONE`] when `begin` would proceed.
+///
+/// A wished bit rate outside the controller's range, which `begin` refuses with
+/// [`BeginError::Timing`] before any other check, is reported here as
+/// [`ConfigErrors::BIT_RATE_OUT_OF_RANGE`], with every other flag that applies.
+///
+/// ```
+/// use twocan_flexcan::{check, Board, ConfigErrors, Instance, Settings, Target};
+///
+/// let t36 = Target::new(Board::Teensy36, Instance::Can0);
+/// assert_eq!(check(t36, &Settings::new(125_000), &[], &[]), ConfigErrors::NONE);
+/// let slow = check(t36, &Settings::new(2_499), &[], &[]);
+/// assert!(slow.contains(ConfigErrors::BIT_RATE_OUT_OF_RANGE));
+/// ```
 pub fn check(
     target: Target,
     settings: &Settings,
@@ -245,6 +266,7 @@ impl<R: Registers> FlexCan<R> {
             polls,
             settings.message_irq_priority,
             plan.system,
+            settings.bus_clock_hz.unwrap_or(CAN_CLOCK_HZ),
         ))
     }
 }

@@ -54,6 +54,13 @@ bitflags::bitflags! {
         /// oscillator clock ([`twocan_core::timing::flexcan_rules`],
         /// [`crate::Settings::bus_clock_hz`]). ACAN checks only the field ranges.
         const BIT_TIMING_FORBIDDEN = 1 << 9;
+        /// Bit 10 (not in ACAN): the wished bit rate is outside what the 16 MHz CAN
+        /// clock reaches within the CTRL1 field ranges (Kinetis RM, CTRL1 field
+        /// descriptions: PRESDIV up to 256, at most 25 quanta per bit; ACAN §16.1:
+        /// 2,500 bit/s to 3.2 Mbit/s; [`twocan_core::timing::Limits::check_bitrate`]).
+        /// [`crate::check`] reports it; `begin` refuses such a rate before any other
+        /// check, with [`BeginError::Timing`].
+        const BIT_RATE_OUT_OF_RANGE = 1 << 10;
     }
 }
 
@@ -184,7 +191,8 @@ mod tests {
             ConfigErrors::ALL
         );
         assert_eq!(ConfigErrors::BIT_TIMING_FORBIDDEN.bits(), 0x200);
-        assert_eq!(ConfigErrors::ALL.count(), 10);
+        assert_eq!(ConfigErrors::BIT_RATE_OUT_OF_RANGE.bits(), 0x400);
+        assert_eq!(ConfigErrors::ALL.count(), 11);
         assert_eq!(BeginError::Config(e).flags(), e);
         assert_eq!(
             BeginError::from(twocan_core::Error::Timeout).flags(),

@@ -52,6 +52,10 @@ pub struct FlexCan<R: Registers> {
     pub(crate) last_error: Cell<LastErrorCode>,
     /// The clock gate and pins `begin` set up, which [`FlexCan::end`] releases.
     pub(crate) system: SystemPlan,
+    /// The peripheral (bus) clock `begin` checked the timing against
+    /// ([`crate::Settings::bus_clock_hz`], the oscillator clock when not given): the
+    /// Kinetis manual's clocks-per-bit rule is applied with it on every re-timing.
+    pub(crate) bus_clock_hz: u32,
 }
 
 impl<R: Registers> FlexCan<R> {
@@ -65,9 +69,11 @@ impl<R: Registers> FlexCan<R> {
         polls: u32,
         irq_priority: u8,
         system: SystemPlan,
+        bus_clock_hz: u32,
     ) -> Self {
         FlexCan {
             system,
+            bus_clock_hz,
             regs,
             target,
             table,

@@ -123,6 +123,13 @@ pub struct FlexCanHw<R: Registers> {
     /// a state read took out of `ESR1` (for example one raised between the handler's
     /// read and its write-back, whose `ERRINT` the write-back cleared) is still counted.
     unreported: AtomicU32,
+    /// The peripheral (bus) clock `begin` checked the timing against
+    /// ([`crate::Settings::bus_clock_hz`]); [`Hardware::set_timing`] and
+    /// [`Hardware::capabilities`] apply the Kinetis manual's rule with it.
+    bus_clock_hz: u32,
+    /// Rx FIFO frames discarded by `install_filters` and not yet taken (receive half
+    /// only).
+    discarded: AtomicU32,
 }
 
 impl<R: Registers> FlexCan<R> {
@@ -149,6 +156,8 @@ impl<R: Registers> FlexCan<R> {
             unresolved: AtomicU32::new(0),
             loaded: AtomicU32::new(0),
             system: self.system,
+            bus_clock_hz: self.bus_clock_hz,
+            discarded: AtomicU32::new(0),
             caught: AtomicU32::new(0),
             unreported: AtomicU32::new(0),
         }
@@ -238,6 +247,7 @@ impl<R: Registers> FlexCanHw<R> {
             self.polls.load(Ordering::Relaxed),
             self.irq_priority,
             self.system,
+            self.bus_clock_hz,
         );
         controller.mode = mode;
         controller.last_error.set(last_error);
@@ -627,12 +637,16 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
         self.mode_change(Mode::Stopped)?;
         FlexCan::write_filters(&self.regs, filters);
         // The FIFO holds at most its depth; the receive interrupt may pop some too.
+        // Each frame popped here is counted (`take_filter_switch_discards`).
+        let mut popped = 0;
         for _ in 0..2 * RX_FIFO_DEPTH {
             if self.regs.read32(IFLAG1) & iflag1::BUF5I == 0 {
                 break;
             }
             self.regs.write32(IFLAG1, iflag1::BUF5I);
+            popped += 1;
         }
+        self.discarded.fetch_add(popped, Ordering::Relaxed);
         // SAFETY: the receive half's context, the only one touching the table.
         unsafe { *self.table.get() = filters.clone() };
         let next = (self.generation.load(Ordering::Relaxed) + 1) & 0xFFFF;
@@ -641,6 +655,11 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
     }
 
     fn filter_map(&self) {}
+
+    /// The Rx FIFO frames `install_filters` popped in Freeze mode (writing `BUF5I`).
+    fn take_filter_switch_discards(&self) -> u32 {
+        self.discarded.swap(0, Ordering::Relaxed)
+    }
 
     /// `ESR1`: the error code latched, the write-1-to-clear interrupt bits read
     /// acknowledged (exactly those), wake-up; the state from `FLTCONF` and `ECR`.
@@ -718,11 +737,17 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
         Ok(())
     }
 
-    /// The 16 MHz oscillator, [`Limits::FLEXCAN`]; one ID table element per exact
+    /// The 16 MHz oscillator, [`Limits::FLEXCAN`], the fastest bit rate the Kinetis
+    /// manual allows with the bus clock `begin` was given (FlexCAN chapter,
+    /// "Arbitration and matching timing": 8 quanta, 16 bus clocks per CAN bit,
+    /// [`twocan_core::timing::flexcan_rules::max_bitrate`]; 1 Mbit/s from a 16 MHz bus
+    /// clock, 2 Mbit/s from 32 MHz and above); one ID table element per exact
     /// filter of either format (format A), as many as the configuration's primary and
     /// secondary elements (ACAN §11, table 4); MB15 and the remote-frame mailboxes;
     /// the 6-frame Rx FIFO; the 16-bit free-running timer (Kinetis RM, TIMER).
-    /// No one-shot mode on these modules.
+    /// No one-shot mode on these modules. No wake-up events as configured: `MCR.WAKMSK`
+    /// and `MCR.SLFWAK` are never set (Kinetis RM, MCR field descriptions), so the module
+    /// never raises `ESR1.WAKINT`.
     fn capabilities(&self) -> Capabilities {
         let c = self.configuration();
         let filters = (c.primary_filter_capacity() + c.secondary_filter_capacity()) as u16;
@@ -744,6 +769,12 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
             RX_FIFO_DEPTH as u8,
             Some(16),
         )
+        .with_max_bitrate(twocan_core::timing::flexcan_rules::max_bitrate(
+            crate::settings::CAN_CLOCK_HZ,
+            self.bus_clock_hz,
+            crate::configuration::MESSAGE_BUFFERS,
+            true,
+        ))
     }
 
     fn bus_mode(&self) -> BusMode {
@@ -761,9 +792,23 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
     /// In Freeze mode ([`Mode::Stopped`]): the `CTRL1` timing fields (PRESDIV, RJW,
     /// PSEG1, PSEG2, SMP, PROPSEG: writable in Freeze mode only, Kinetis RM CTRL1);
     /// the acknowledge bound grows for a slower rate.
+    ///
+    /// Besides the portable checks ([`twocan_core::hardware::check_timing_for`]), the
+    /// Kinetis manual's rule `begin` applies ("Arbitration and matching timing": 8 quanta
+    /// per bit, 16 bus clocks per CAN bit with the bus clock `begin` was given,
+    /// [`twocan_core::timing::flexcan_rules::check`]):
+    /// [`TimingError::ForbiddenByManual`](twocan_core::timing::TimingError::ForbiddenByManual)
+    /// when it is broken, nothing written.
     fn set_timing(&self, timing: &Timing) -> Result<(), Error> {
         let stopped = self.mode() == MODE_STOPPED;
         twocan_core::hardware::check_timing_for(&self.capabilities(), timing, stopped)?;
+        twocan_core::timing::flexcan_rules::check(
+            timing,
+            self.bus_clock_hz,
+            crate::configuration::MESSAGE_BUFFERS,
+            true,
+        )
+        .map_err(|_| Error::Timing(twocan_core::timing::TimingError::ForbiddenByManual))?;
         let bits = timing.flexcan_ctrl1().map_err(Error::Timing)?;
         self.regs
             .modify32(regs::CTRL1, |v| (v & !FLEXCAN_CTRL1_TIMING_MASK) | bits);

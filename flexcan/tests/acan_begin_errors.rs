@@ -133,10 +133,15 @@ fn bit_timing_the_manual_forbids_is_refused() {
 
 #[test]
 fn bit_rate_too_far_15_2_1() {
-    // `ACANSettings settings (1)`: 1 bit/s; ACAN's error code is exactly bit 0.
+    // `ACANSettings settings (1)`: 1 bit/s; ACAN's error code (bits 0-7) is exactly
+    // bit 0; this driver also flags the rate as outside the clock's range (bit 10,
+    // which `begin` reports as `BeginError::Timing(BitrateTooLow)`).
     let f = twocan_flexcan::check(T32_CAN0, &Settings::new(1), &[], &[]);
-    assert_eq!(f, ConfigErrors::BIT_RATE_TOO_FAR);
-    assert_eq!(f.bits(), 1 << 0);
+    assert_eq!(
+        f,
+        ConfigErrors::BIT_RATE_TOO_FAR | ConfigErrors::BIT_RATE_OUT_OF_RANGE
+    );
+    assert_eq!(f.bits() & 0xFF, 1 << 0);
 }
 
 /// A wished rate outside what the 16 MHz clock reaches is refused by `begin` with the
@@ -167,7 +172,25 @@ fn bit_rates_out_of_range_are_refused_as_on_every_backend() {
         );
         assert!(sys.written().is_empty());
         assert_eq!(model.mode(), ModelMode::Disabled);
+        // `check` finds the same problem, as a flag.
+        let flags = twocan_flexcan::check(T32_CAN0, &Settings::new(rate), &[], &[]);
+        assert!(
+            flags.contains(ConfigErrors::BIT_RATE_OUT_OF_RANGE),
+            "{rate}: {flags:?}"
+        );
     }
+    // In range: no such flag (the slowest and the fastest of the register ranges).
+    for rate in [2_500, 3_200_000, 125_000] {
+        let flags = twocan_flexcan::check(T32_CAN0, &Settings::new(rate), &[], &[]);
+        assert!(
+            !flags.contains(ConfigErrors::BIT_RATE_OUT_OF_RANGE),
+            "{rate}: {flags:?}"
+        );
+    }
+    assert_eq!(
+        twocan_flexcan::check(T32_CAN0, &Settings::new(125_000), &[], &[]),
+        ConfigErrors::NONE
+    );
     // In range for the clock: 3.2 Mbit/s (5 quanta) goes on to the manual's rules
     // (`bit_timing_the_manual_forbids_is_refused`).
     assert_eq!(

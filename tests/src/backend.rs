@@ -207,6 +207,10 @@ pub trait Backend {
     /// unless a rule beyond the register ranges forbids it (FlexCAN: 1 Mbit/s, 16 bus
     /// clocks per bit from the least bus clock the manual allows, 16 MHz).
     const FASTEST_BITRATE: u32;
+    /// Whether the node [`Backend::attach`] brings up reports wake-up events
+    /// (FlexCAN: no, `MCR.WAKMSK`/`SLFWAK` never set, Kinetis RM MCR; bxCAN: yes,
+    /// `CAN_IER.WKUIE` among the interrupts, RM0410 §40.8).
+    const WAKEUP_EVENTS: bool;
     /// Whether software can read the time stamp counter (Kinetis RM "Free Running Timer
     /// (CANx_TIMER)": yes; RM0410 §40.7.2: the TTCM counter is internal, no).
     const TIMESTAMP_COUNTER_READABLE: bool;
@@ -364,6 +368,7 @@ impl Backend for FlexCanBackend {
     const CLOCK_HZ: u32 = 16_000_000;
     const LIMITS: Limits = Limits::FLEXCAN;
     const FASTEST_BITRATE: u32 = 1_000_000;
+    const WAKEUP_EVENTS: bool = false;
     const TIMESTAMP_COUNTER_READABLE: bool = true;
 
     fn attach_via(
@@ -511,6 +516,7 @@ impl Backend for BxCanBackend {
     const CLOCK_HZ: u32 = 54_000_000;
     const LIMITS: Limits = Limits::BXCAN;
     const FASTEST_BITRATE: u32 = STM32F767_APB1_HZ / Limits::BXCAN.min_quanta();
+    const WAKEUP_EVENTS: bool = true;
     const TIMESTAMP_COUNTER_READABLE: bool = false;
 
     fn attach_via(

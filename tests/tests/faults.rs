@@ -393,6 +393,8 @@ fn bxcan_sleep_then_wake_up_on_bus_activity() {
         Some(ErrorState::Active)
     );
     assert_eq!(dut.driver.shared_state().wakeups(), 1);
+    assert_eq!(dut.driver.wakeups(), 1);
+    assert!(dut.driver.capabilities().wakeup_events);
     assert_eq!(witness.borrow().received_frames(), vec![a]);
     assert!(
         drain(&mut dut).is_empty(),

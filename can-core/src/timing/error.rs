@@ -38,6 +38,11 @@ pub enum TimingError {
     /// The timing was computed for another CAN clock than the controller's
     /// ([`crate::Capabilities::clock_hz`]).
     WrongClock,
+    /// The timing is within the register ranges but the controller's reference manual
+    /// forbids it (FlexCAN: fewer than 8 quanta per bit or fewer than 16 peripheral
+    /// clocks per CAN bit, Kinetis RM "Arbitration and matching timing",
+    /// [`super::flexcan_rules`]).
+    ForbiddenByManual,
 }
 
 impl fmt::Display for TimingError {
@@ -64,6 +69,9 @@ impl fmt::Display for TimingError {
             }
             TimingError::WrongClock => {
                 f.write_str("timing computed for another clock than the controller's")
+            }
+            TimingError::ForbiddenByManual => {
+                f.write_str("bit timing forbidden by the controller's reference manual")
             }
         }
     }

@@ -38,6 +38,30 @@ pub const fn min_peripheral_clocks_per_bit(mailboxes: u8, rx_fifo: bool) -> u32 
     }
 }
 
+/// The fastest bit rate the manual's rules allow from the CAN clock `can_clock_hz` and
+/// the peripheral clock `peripheral_hz`: at least [`MIN_QUANTA_PER_BIT`] quanta of at
+/// least one CAN clock each, and at least [`min_peripheral_clocks_per_bit`] peripheral
+/// clocks per bit (`peripheral_hz / rate` rounded down is at least the minimum exactly
+/// when `rate <= peripheral_hz / minimum` rounded down). 0 when no rate is allowed (a
+/// peripheral clock below the CAN clock, or a clock of 0).
+pub const fn max_bitrate(
+    can_clock_hz: u32,
+    peripheral_hz: u32,
+    mailboxes: u8,
+    rx_fifo: bool,
+) -> u32 {
+    if peripheral_hz < can_clock_hz || can_clock_hz == 0 {
+        return 0;
+    }
+    let by_quanta = can_clock_hz / MIN_QUANTA_PER_BIT;
+    let by_clocks = peripheral_hz / min_peripheral_clocks_per_bit(mailboxes, rx_fifo);
+    if by_quanta < by_clocks {
+        by_quanta
+    } else {
+        by_clocks
+    }
+}
+
 /// A timing the FlexCAN reference manual forbids.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -196,5 +220,19 @@ mod tests {
         assert_eq!(min_peripheral_clocks_per_bit(32, true), 17);
         assert_eq!(min_peripheral_clocks_per_bit(64, false), 25);
         assert_eq!(min_peripheral_clocks_per_bit(64, true), 30);
+    }
+
+    #[test]
+    fn fastest_allowed_rate() {
+        // 16 MHz bus: 16 clocks per bit → 1 Mbit/s (below 16 MHz / 8 quanta = 2 Mbit/s).
+        assert_eq!(max_bitrate(16_000_000, 16_000_000, 16, true), 1_000_000);
+        // 60 MHz bus: 3.75 Mbit/s by clocks, 2 Mbit/s by quanta.
+        assert_eq!(max_bitrate(16_000_000, 60_000_000, 16, true), 2_000_000);
+        // 24 MHz bus: 1.5 Mbit/s; 64 MBs with the FIFO: 30 clocks → 800 kbit/s.
+        assert_eq!(max_bitrate(16_000_000, 24_000_000, 16, true), 1_500_000);
+        assert_eq!(max_bitrate(16_000_000, 24_000_000, 64, true), 800_000);
+        // A bus clock below the CAN clock allows nothing.
+        assert_eq!(max_bitrate(16_000_000, 8_000_000, 16, true), 0);
+        assert_eq!(max_bitrate(0, 8_000_000, 16, true), 0);
     }
 }
