@@ -113,6 +113,77 @@ fn teensy_filters_deliver_exactly_the_expected_identifiers() {
     }
 }
 
+/// `async-echo` (both families, on `embassy-executor`): a plain node sends standard
+/// and extended frames; every one comes back once, with its identifier plus one and
+/// the same data, in order.
+#[test]
+fn async_echo_answers_every_frame_with_its_identifier_plus_one() {
+    let boards = TEENSY
+        .iter()
+        .map(|b| (*b, "teensy-async-echo"))
+        .chain(STM32.iter().map(|b| (*b, "stm32f7-async-echo")));
+    for (board, bin) in boards {
+        let Some(mut w) = world(500_000, &[(board, bin)]) else {
+            return;
+        };
+        let sent = [
+            twocan_core::Frame::standard(0x123, &[1]).unwrap(),
+            twocan_core::Frame::extended(0x1234_5678, &[1, 2, 3, 4, 5, 6, 7, 8]).unwrap(),
+            twocan_core::Frame::standard(0x7FE, &[]).unwrap(),
+        ];
+        // Every 5 ms from 50 ms (the firmware is on the bus after about 16 ms): 90
+        // frames by 0.498 s, the last at 495 ms (its echo follows within 0.5 ms).
+        let tester = w.add_node_from(
+            "tester",
+            twocan_core::sim::SimNode::new(),
+            500_000,
+            sent.to_vec(),
+            5_000_000_000,
+            50_000_000_000,
+        );
+        w.run_for(secs(0.498));
+        assert_clean(&w);
+        let records = w.bus.trace().records();
+        assert!(
+            records.iter().all(|r| r.is_error_free()),
+            "{board}: an error on the bus"
+        );
+        let tester_node = w.nodes[0].node;
+        let board_node = w.attached[0].node;
+        let from = |n| {
+            records
+                .iter()
+                .filter(|r| r.transmitters == [n])
+                .map(|r| r.frame)
+                .collect::<Vec<_>>()
+        };
+        let (asked, echoed) = (from(tester_node), from(board_node));
+        assert_eq!(asked.len(), 90, "{board}");
+        assert_eq!(echoed.len(), 90, "{board}");
+        assert_eq!(records.len(), 180, "{board}: nothing else on the bus");
+        for (k, (a, e)) in asked.iter().zip(&echoed).enumerate() {
+            assert_eq!(*a, sent[k % 3], "{board}: frame {k}");
+            let (id, ext) = raw_id(a);
+            assert_eq!(raw_id(e), (id + 1, ext), "{board}: echo {k}");
+            assert_eq!(
+                embedded_can::Frame::data(e),
+                embedded_can::Frame::data(a),
+                "{board}: echo {k}"
+            );
+        }
+        assert_eq!(tester.borrow().received_frames(), echoed, "{board}");
+        assert_eq!(w.machines[0].read_u32_static("ECHOED"), Some(90), "{board}");
+        // The receive interrupt woke the executor for each frame.
+        let b = w.machines[0].board();
+        let rx_line = b.cans[0].instance.irqs[if board.starts_with("teensy") { 0 } else { 1 }].1;
+        assert!(
+            b.taken.get(&(16 + rx_line)).copied().unwrap_or(0) >= 90,
+            "{board}: {:?}",
+            b.taken
+        );
+    }
+}
+
 fn assert_app_pair(a: Stats, b: Stats, b_sent_heartbeats: u32, label: &str) {
     assert_eq!(a.heartbeat_gaps, 0, "{label}: {a:?}");
     assert_eq!(a.heartbeat_duplicates, 0, "{label}: {a:?}");
