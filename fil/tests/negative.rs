@@ -103,6 +103,23 @@ fn the_example_apps_do_not_have_a_stuck_interrupt() {
         };
         w.run_for(secs(0.3));
         assert!(w.machines[0].board().stuck.is_empty(), "{board}");
+        // Not vacuous: the run is clean, the firmware reached its application steps
+        // (frames sent, `STATS`) and took CAN interrupts.
+        assert_clean(&w);
+        let stats = app_stats(&w, 0, 1)[0];
+        assert!(stats.sent > 0, "{board}: {stats:?}");
+        let b = w.machines[0].board();
+        let can_irqs: u64 = b.cans[0]
+            .instance
+            .irqs
+            .iter()
+            .map(|(_, line)| b.taken.get(&(16 + line)).copied().unwrap_or(0))
+            .sum();
+        assert!(
+            can_irqs > 0,
+            "{board}: no CAN interrupt taken {:?}",
+            b.taken
+        );
     }
 }
 
