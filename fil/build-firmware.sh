@@ -12,7 +12,7 @@ rel="target/$target/release"
 for board in teensy32 teensy35 teensy36; do
     cargo build --quiet --release --target "$target" -p twocan-teensy --features "$board" --bins
     mkdir -p "$out/$board"
-    for bin in loopback filters app can0-can1; do
+    for bin in loopback filters app async-echo can0-can1; do
         if [ -f "$rel/teensy-$bin" ] && { [ "$bin" != can0-can1 ] || [ "$board" = teensy36 ]; }; then
             cp "$rel/teensy-$bin" "$out/$board/"
         fi
@@ -21,7 +21,7 @@ done
 for board in nucleo-f767zi disco-f746g; do
     cargo build --quiet --release --target "$target" -p twocan-stm32f7 --features "$board" --bins
     mkdir -p "$out/$board"
-    for bin in loopback filters app can1-can2; do
+    for bin in loopback filters app async-echo can1-can2; do
         if [ -f "$rel/stm32f7-$bin" ] && { [ "$bin" != can1-can2 ] || [ "$board" = nucleo-f767zi ]; }; then
             cp "$rel/stm32f7-$bin" "$out/$board/"
         fi
@@ -38,6 +38,11 @@ for spec in twocan-teensy:teensy36:teensy twocan-stm32f7:nucleo-f767zi:stm32f7; 
         cp "$rel/$prefix-$bin" "$out/$board/$prefix-$bin-defmt"
     done
 done
+# The board at the wrong bit rate (tests/negative.rs): the NUCLEO-F767ZI `app` at
+# 250 kbit/s (feature bus-250k) on the Teensy `app`'s 500 kbit/s bus.
+cargo build --quiet --release --target "$target" -p twocan-stm32f7 \
+    --features nucleo-f767zi,bus-250k --bin stm32f7-app
+cp "$rel/stm32f7-app" "$out/nucleo-f767zi/stm32f7-app-250k"
 cargo build --quiet --release --target "$target" --manifest-path fil/firmware/Cargo.toml
 mkdir -p "$out/negative"
 for bin in kinetis-gate kinetis-stuck kinetis-no-wdog core-check stm32-gate stm32-stuck; do

@@ -40,6 +40,10 @@ pub struct Image {
     /// Addresses of `WFI` (0xBF30) at instruction boundaries of the code sections'
     /// halfwords; the harness hooks them (a hook fires only where an instruction starts).
     pub wfi_sites: Vec<u32>,
+    /// Addresses of `WFE` (0xBF20), found the same way.
+    pub wfe_sites: Vec<u32>,
+    /// Addresses of `SEV` (0xBF40), found the same way.
+    pub sev_sites: Vec<u32>,
 }
 
 impl Image {
@@ -101,6 +105,8 @@ impl Image {
             })
             .collect();
         let mut wfi_sites = Vec::new();
+        let mut wfe_sites = Vec::new();
+        let mut sev_sites = Vec::new();
         for sec in file.sections() {
             if sec.kind() != SectionKind::Text {
                 continue;
@@ -112,8 +118,11 @@ impl Image {
             let mut i = 0;
             while i + 1 < data.len() {
                 let hw = u16::from_le_bytes([data[i], data[i + 1]]);
-                if hw == 0xBF30 {
-                    wfi_sites.push(base + i as u32);
+                match hw {
+                    0xBF30 => wfi_sites.push(base + i as u32),
+                    0xBF20 => wfe_sites.push(base + i as u32),
+                    0xBF40 => sev_sites.push(base + i as u32),
+                    _ => {}
                 }
                 i += if hw >> 11 >= 0b11101 { 4 } else { 2 };
             }
@@ -130,6 +139,8 @@ impl Image {
             symbols,
             defmt,
             wfi_sites,
+            wfe_sites,
+            sev_sites,
         })
     }
 

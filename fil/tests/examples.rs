@@ -92,8 +92,8 @@ fn stm32_filters_deliver_exactly_the_expected_identifiers() {
     }
 }
 
-/// Teensy `filters`: every filter's call-back sees its frames, none reaches the wrong
-/// one. (It used to halt in `begin` with blink code 5: masked filters given as
+/// Teensy `filters`: every filter's call-back sees exactly its frames, none reaches the
+/// wrong one. (It used to halt in `begin` with blink code 5: masked filters given as
 /// secondary filters, which ACAN §13.4 forbids; the example now lists them as primary.)
 #[test]
 fn teensy_filters_deliver_exactly_the_expected_identifiers() {
@@ -101,15 +101,120 @@ fn teensy_filters_deliver_exactly_the_expected_identifiers() {
         let Some(mut w) = world(500_000, &[(board, "teensy-filters")]) else {
             return;
         };
+        // One frame every 100 ms after start-up: twelve by 1.25 s, the last
+        // one at least 30 ms before the end (dispatched by then).
         w.run_for(secs(1.25));
         assert_clean(&w);
+        // FlexCAN loop-back: the frames never reach the wire; the bus records them as
+        // internal frames of the controller.
+        let count = |p: &dyn Fn(u32, bool, bool) -> bool| {
+            w.bus
+                .trace()
+                .records()
+                .iter()
+                .filter(|r| {
+                    let (id, ext) = raw_id(&r.frame);
+                    r.internal && r.is_error_free() && p(id, ext, is_remote(&r.frame))
+                })
+                .count() as u32
+        };
+        // The filters of `examples/teensy/src/filters_example.rs`, by index.
+        let expected = [
+            count(&|id, ext, r| !ext && !r && id & 0x7F0 == 0x300),
+            count(&|id, ext, r| ext && !r && id & 0x1FFF_00FF == 0x18FF_0000),
+            count(&|id, ext, r| !ext && !r && id == 0x234),
+            count(&|id, ext, r| ext && !r && id == 0x12_3456),
+            count(&|id, ext, r| !ext && r && id == 0x542),
+        ];
+        let rejected = count(&|id, ext, _| !ext && id == 0x777);
+        // Two rounds of the six frames: each filter's frame twice, 0x777 twice.
+        assert_eq!(expected, [2; 5], "{board}: frames sent per filter");
+        assert_eq!(rejected, 2, "{board}: the frame no filter accepts was sent");
+        assert_eq!(w.bus.stats().internal_frames, 12, "{board}");
+        assert_eq!(
+            w.bus.stats().frames_started,
+            0,
+            "{board}: nothing on the wire"
+        );
         let m = &w.machines[0];
         let hits = m.read_static("HITS").expect("HITS");
-        for i in 0..5 {
+        assert_eq!(hits.len(), 4 * 5, "{board}: HITS is [AtomicU32; 5]");
+        for (i, want) in expected.iter().enumerate() {
             let got = u32::from_le_bytes(hits[4 * i..4 * i + 4].try_into().unwrap());
-            assert!(got >= 1, "{board}: filter {i}: {got}");
+            assert_eq!(got, *want, "{board}: filter {i}");
         }
         assert_eq!(m.read_u32_static("ERRORS"), Some(0), "{board}");
+    }
+}
+
+/// `async-echo` (both families, on `embassy-executor`): a plain node sends standard
+/// and extended frames; every one comes back once, with its identifier plus one and
+/// the same data, in order.
+#[test]
+fn async_echo_answers_every_frame_with_its_identifier_plus_one() {
+    let boards = TEENSY
+        .iter()
+        .map(|b| (*b, "teensy-async-echo"))
+        .chain(STM32.iter().map(|b| (*b, "stm32f7-async-echo")));
+    for (board, bin) in boards {
+        let Some(mut w) = world(500_000, &[(board, bin)]) else {
+            return;
+        };
+        let sent = [
+            twocan_core::Frame::standard(0x123, &[1]).unwrap(),
+            twocan_core::Frame::extended(0x1234_5678, &[1, 2, 3, 4, 5, 6, 7, 8]).unwrap(),
+            twocan_core::Frame::standard(0x7FE, &[]).unwrap(),
+        ];
+        // Every 5 ms from 50 ms (the firmware is on the bus after about 16 ms): 90
+        // frames by 0.498 s, the last at 495 ms (its echo follows within 0.5 ms).
+        let tester = w.add_node_from(
+            "tester",
+            twocan_core::sim::SimNode::new(),
+            500_000,
+            sent.to_vec(),
+            5_000_000_000,
+            50_000_000_000,
+        );
+        w.run_for(secs(0.498));
+        assert_clean(&w);
+        let records = w.bus.trace().records();
+        assert!(
+            records.iter().all(|r| r.is_error_free()),
+            "{board}: an error on the bus"
+        );
+        let tester_node = w.nodes[0].node;
+        let board_node = w.attached[0].node;
+        let from = |n| {
+            records
+                .iter()
+                .filter(|r| r.transmitters == [n])
+                .map(|r| r.frame)
+                .collect::<Vec<_>>()
+        };
+        let (asked, echoed) = (from(tester_node), from(board_node));
+        assert_eq!(asked.len(), 90, "{board}");
+        assert_eq!(echoed.len(), 90, "{board}");
+        assert_eq!(records.len(), 180, "{board}: nothing else on the bus");
+        for (k, (a, e)) in asked.iter().zip(&echoed).enumerate() {
+            assert_eq!(*a, sent[k % 3], "{board}: frame {k}");
+            let (id, ext) = raw_id(a);
+            assert_eq!(raw_id(e), (id + 1, ext), "{board}: echo {k}");
+            assert_eq!(
+                embedded_can::Frame::data(e),
+                embedded_can::Frame::data(a),
+                "{board}: echo {k}"
+            );
+        }
+        assert_eq!(tester.borrow().received_frames(), echoed, "{board}");
+        assert_eq!(w.machines[0].read_u32_static("ECHOED"), Some(90), "{board}");
+        // The receive interrupt woke the executor for each frame.
+        let b = w.machines[0].board();
+        let rx_line = b.cans[0].instance.irqs[if board.starts_with("teensy") { 0 } else { 1 }].1;
+        assert!(
+            b.taken.get(&(16 + rx_line)).copied().unwrap_or(0) >= 90,
+            "{board}: {:?}",
+            b.taken
+        );
     }
 }
 

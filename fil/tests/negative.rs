@@ -1,7 +1,7 @@
 //! Tests that prove the harness can fail: a firmware that skips a clock gate faults
 //! with its PC reported; one that enables a CAN interrupt with its cause pending and a
-//! handler that does not clear it is caught as a stuck interrupt; a node at the wrong
-//! bit rate produces error frames and error-state changes.
+//! handler that does not clear it is caught as a stuck interrupt; a node or a second
+//! board at the wrong bit rate produces error frames and error-state changes.
 
 mod common;
 
@@ -103,6 +103,23 @@ fn the_example_apps_do_not_have_a_stuck_interrupt() {
         };
         w.run_for(secs(0.3));
         assert!(w.machines[0].board().stuck.is_empty(), "{board}");
+        // Not vacuous: the run is clean, the firmware reached its application steps
+        // (frames sent, `STATS`) and took CAN interrupts.
+        assert_clean(&w);
+        let stats = app_stats(&w, 0, 1)[0];
+        assert!(stats.sent > 0, "{board}: {stats:?}");
+        let b = w.machines[0].board();
+        let can_irqs: u64 = b.cans[0]
+            .instance
+            .irqs
+            .iter()
+            .map(|(_, line)| b.taken.get(&(16 + line)).copied().unwrap_or(0))
+            .sum();
+        assert!(
+            can_irqs > 0,
+            "{board}: no CAN interrupt taken {:?}",
+            b.taken
+        );
     }
 }
 
@@ -163,6 +180,99 @@ fn a_node_at_the_wrong_bit_rate_gives_error_frames_and_error_state_changes() {
         );
         // No firmware fault: the firmware copes with a bad bus.
         assert!(bad.machines[0].board().faults.is_empty());
+    }
+}
+
+/// Two boards on one bus, one at the wrong bit rate: the Teensy 3.6 `app` at 500 kbit/s
+/// and the NUCLEO-F767ZI `app` built with `bus-250k`. The bus carries error frames and
+/// both firmwares' drivers report error-state changes (`STATE_CHANGES`, `WORST_STATE`);
+/// the same pair at the right rate (control) stays error active after both joined.
+#[test]
+fn two_boards_at_different_bit_rates_give_error_frames_and_error_state_changes() {
+    let teensy = ("teensy36", "teensy-app");
+    let run = |stm32_bin: &str| {
+        let mut w = world(500_000, &[teensy, ("nucleo-f767zi", stm32_bin)])?;
+        w.run_for(secs(0.4));
+        Some(w)
+    };
+    let Some(ok) = run("stm32f7-app") else {
+        return;
+    };
+    let Some(bad) = run("stm32f7-app-250k") else {
+        return;
+    };
+    // Both boards joined 16 ms into the run at the latest.
+    let late = |w: &twocan_fil::world::World<'_>| {
+        w.bus
+            .trace()
+            .records()
+            .iter()
+            .filter(|r| !r.is_error_free() && r.sof > 500_000 / 50)
+            .count()
+    };
+    let worst = |w: &twocan_fil::world::World<'_>, i: usize| {
+        w.machines[i]
+            .read_u32_static("WORST_STATE")
+            .expect("WORST_STATE")
+    };
+    let changes = |w: &twocan_fil::world::World<'_>, i: usize| {
+        w.machines[i]
+            .read_u32_static("STATE_CHANGES")
+            .expect("STATE_CHANGES")
+    };
+
+    // The first controller of each board (Teensy 3.6 CAN0, NUCLEO CAN1).
+    let first = |w: &twocan_fil::world::World<'_>, i: usize| {
+        w.attached
+            .iter()
+            .find(|a| a.board == i && a.port == 0)
+            .cloned()
+            .expect("controller")
+    };
+
+    // Control: no error frame once both are on the bus, both stay error active.
+    assert_clean(&ok);
+    assert_eq!(late(&ok), 0, "errors at the right rate");
+    assert_eq!(first(&ok, 0).bit_rate, Some(500_000));
+    assert_eq!(first(&ok, 1).bit_rate, Some(500_000));
+    assert!(ok.attached.iter().all(|a| !a.misclocked));
+    for i in 0..2 {
+        assert_eq!(worst(&ok, i), 0, "board {i}: error active throughout");
+    }
+
+    // The STM32 at 250 kbit/s: the harness decodes its rate from CAN_BTR.
+    assert!(bad.clean(), "no fault: the firmwares cope with a bad bus");
+    let (teensy_can, stm32_can) = (first(&bad, 0), first(&bad, 1));
+    assert_eq!(stm32_can.bit_rate, Some(250_000));
+    assert!(stm32_can.misclocked && !teensy_can.misclocked);
+    assert!(late(&bad) > 100, "error frames: {}", late(&bad));
+    assert!(
+        bad.candump().contains("20000"),
+        "SocketCAN error frames in the trace"
+    );
+    // Nothing either board sent got through, and each side saw errors.
+    for a in [&teensy_can, &stm32_can] {
+        let s = bad.bus.node_stats(a.node).unwrap();
+        assert_eq!(s.sent, 0, "{}: {s:?}", a.name);
+        assert!(s.tx_errors > 0 && s.rx_errors > 0, "{}: {s:?}", a.name);
+    }
+    // The error-state change, as each firmware's driver reported it: error passive
+    // (2) at least, seen by the harness too.
+    for i in 0..2 {
+        assert!(changes(&bad, i) >= 1, "board {i}");
+        assert!(
+            worst(&bad, i) >= 2,
+            "board {i}: worst state {}",
+            worst(&bad, i)
+        );
+        let name = &first(&bad, i).name;
+        assert!(
+            bad.changes
+                .iter()
+                .any(|c| &c.node == name && c.to != "error-active"),
+            "{name}: {:?}",
+            bad.changes
+        );
     }
 }
 

@@ -110,7 +110,13 @@ pub const BOARD: Board = Board::DISCO_F746G;
 
 /// Bit rate of the examples that talk over a bus (the `app` examples of both families
 /// use the same).
+#[cfg(not(feature = "bus-250k"))]
 pub const BIT_RATE: u32 = 500_000;
+/// Bit rate of the examples that talk over a bus: 250 kbit/s with the `bus-250k`
+/// feature, a board at the wrong rate on the others' 500 kbit/s bus (`can-fil`'s
+/// negative test; never flash it on a real 500 kbit/s bus).
+#[cfg(feature = "bus-250k")]
+pub const BIT_RATE: u32 = 250_000;
 
 #[cfg(test)]
 mod tests {

@@ -176,6 +176,8 @@ pub(super) fn exception_return(uc: &mut Unicorn<'_, Board>) {
         b.nvic.deactivate(e);
         b.depth = b.depth.saturating_sub(1);
         b.check_irq = true;
+        // ARMv7-M B1.5.18: an exception return sets the event register.
+        b.event = true;
     }
     let to_psp = exc_return & 0xF == 0xD;
     let fp = exc_return & 0x10 == 0;

@@ -21,6 +21,11 @@
 //!   CFSR, HFSR, BFAR, CPACR), C1.8 DWT CYCCNT with DEMCR.TRCENA.
 //! - B1.5.19 WFI: the core sleeps until an exception would preempt if PRIMASK were 0;
 //!   the harness skips the idle time to the next event instead of executing it.
+//! - B1.5.18 WFE and SEV: the event register is set by `SEV` and by every exception
+//!   return (and cleared at reset); `WFE` clears it and goes on when it is set, and
+//!   otherwise sleeps as WFI does (woken by an exception that would preempt).
+//!   `SCR.SEVONPEND` is not modelled (a pending interrupt that cannot preempt does not
+//!   wake a WFE).
 //!
 //! Time: one instruction is one core clock cycle (the Cortex-M4/M7 average is close to
 //! it for this code; documented in docs/fil.md).
@@ -76,6 +81,9 @@ pub struct Board {
     wfi: bool,
     /// Sleeping in WFI.
     pub sleeping: bool,
+    /// The event register (ARMv7-M B1.5.18): set by SEV and exception return, consumed
+    /// by WFE.
+    event: bool,
     /// Stopped for good (lockup, reset, unsupported).
     pub halted: Option<String>,
     /// Handler nesting depth the harness entered.
@@ -314,6 +322,7 @@ impl<'a> Machine<'a> {
             pending_fault: None,
             wfi: false,
             sleeping: false,
+            event: false,
             halted: None,
             depth: 0,
             thread_instructions: 0,
@@ -440,6 +449,38 @@ impl<'a> Machine<'a> {
                 let _ = uc.emu_stop();
             })
             .map_err(|e| format!("wfi hook: {e:?}"))?;
+        }
+
+        for &site in &image.wfe_sites {
+            uc.add_code_hook(u64::from(site), u64::from(site), |uc, addr, _| {
+                if reg(uc, RegisterARM::PC) & !1 != addr as u32 {
+                    return;
+                }
+                // Unicorn does not execute WFE: the harness does, and stops to move on.
+                let b = uc.get_data_mut();
+                if b.event {
+                    b.event = false;
+                } else {
+                    b.wfi = true;
+                }
+                b.stop_now();
+                set_reg(uc, RegisterARM::PC, (addr as u32 + 2) | 1);
+                let _ = uc.emu_stop();
+            })
+            .map_err(|e| format!("wfe hook: {e:?}"))?;
+        }
+        for &site in &image.sev_sites {
+            uc.add_code_hook(u64::from(site), u64::from(site), |uc, addr, _| {
+                if reg(uc, RegisterARM::PC) & !1 != addr as u32 {
+                    return;
+                }
+                let b = uc.get_data_mut();
+                b.event = true;
+                b.stop_now();
+                set_reg(uc, RegisterARM::PC, (addr as u32 + 2) | 1);
+                let _ = uc.emu_stop();
+            })
+            .map_err(|e| format!("sev hook: {e:?}"))?;
         }
 
         uc.add_intr_hook(|uc, intno| {

@@ -5,7 +5,8 @@
 //!
 //! The application's portable filters are compiled by the bxCAN planner into FIFO 0
 //! (one FIFO keeps the frames in arrival order). It runs every 10 ms; the LED toggles
-//! every 50 heartbeats from the peer. `STATS` mirrors the counters for a debugger.
+//! every 50 heartbeats from the peer. `STATS` mirrors the counters for a debugger,
+//! `STATE_CHANGES` / `WORST_STATE` the error-state changes the driver reports.
 //!
 //! Without a transceiver (or with CANRX not recessive) `enable` times out waiting for 11
 //! recessive bits (RM0410 §40.4.1): blink code 5. 6: panic.
@@ -14,11 +15,13 @@
 #[cfg(target_os = "none")]
 mod firmware {
     use core::cell::RefCell;
+    use core::sync::atomic::{AtomicU32, Ordering};
 
     use critical_section::Mutex;
     use stm32f7xx_hal::pac::interrupt;
     use twocan_app::{App, AppStats};
     use twocan_bxcan::{hal, FifoPolicy, Recovery};
+    use twocan_core::ErrorState;
     use twocan_stm32f7::board::BIT_RATE;
     use twocan_stm32f7::can::{self, CanState, Vectors};
     use twocan_stm32f7::rt::{self, CAN_BLINKS};
@@ -33,6 +36,12 @@ mod firmware {
 
     /// The application's counters, copied after each step (`None` before the first).
     pub static STATS: Mutex<RefCell<Option<AppStats>>> = Mutex::new(RefCell::new(None));
+
+    /// Error-state changes the driver reported (`take_state_change`), for a debugger.
+    pub static STATE_CHANGES: AtomicU32 = AtomicU32::new(0);
+    /// The worst fault-confinement state reported so far: 0 error active, 1 warning,
+    /// 2 error passive, 3 bus-off (`ErrorState` in declaration order).
+    pub static WORST_STATE: AtomicU32 = AtomicU32::new(0);
 
     #[interrupt]
     fn CAN1_TX() {
@@ -97,6 +106,10 @@ mod firmware {
                 while tx.take_completion().is_some() {}
                 let stats = app.stats();
                 while let Some(c) = rx.take_state_change() {
+                    STATE_CHANGES.fetch_add(1, Ordering::Relaxed);
+                    if c.state <= ErrorState::BusOff {
+                        WORST_STATE.fetch_max(c.state as u32, Ordering::Relaxed);
+                    }
                     twocan_stm32f7::warn!(
                         "CAN1 error state {} (TEC {=u16}, REC {=u16})",
                         c.state,

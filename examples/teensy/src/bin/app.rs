@@ -7,7 +7,8 @@
 //! acknowledged and the controller goes error passive: the LED then stays still.
 //!
 //! The application runs every 10 ms; the LED toggles every 50 heartbeats received from
-//! the peer. `STATS` mirrors the application's counters for a debugger.
+//! the peer. `STATS` mirrors the application's counters for a debugger,
+//! `STATE_CHANGES` / `WORST_STATE` the error-state changes the driver reports.
 //!
 //! Blink codes when it stops: 2–4 clock start-up, 5 FlexCAN `begin`, 6 panic.
 #![cfg_attr(target_os = "none", no_std, no_main)]
@@ -15,9 +16,11 @@
 #[cfg(target_os = "none")]
 mod firmware {
     use core::cell::RefCell;
+    use core::sync::atomic::{AtomicU32, Ordering};
 
     use critical_section::Mutex;
     use twocan_app::{App, AppStats};
+    use twocan_core::ErrorState;
     use twocan_flexcan::pin::{Pin3, Pin4};
     use twocan_flexcan::{Can0, Settings};
     use twocan_teensy::can::CanState;
@@ -28,6 +31,12 @@ mod firmware {
 
     /// The application's counters, copied after each step (`None` before the first).
     pub static STATS: Mutex<RefCell<Option<AppStats>>> = Mutex::new(RefCell::new(None));
+
+    /// Error-state changes the driver reported (`take_state_change`), for a debugger.
+    pub static STATE_CHANGES: AtomicU32 = AtomicU32::new(0);
+    /// The worst fault-confinement state reported so far: 0 error active, 1 warning,
+    /// 2 error passive, 3 bus-off (`ErrorState` in declaration order).
+    pub static WORST_STATE: AtomicU32 = AtomicU32::new(0);
 
     /// 500 kbit/s, computed at compile time (the bit-timing solver is `const`).
     const SETTINGS: Settings = twocan_teensy::configs::BUS;
@@ -66,6 +75,10 @@ mod firmware {
                 while tx.take_completion().is_some() {}
                 let stats = app.stats();
                 while let Some(c) = rx.take_state_change() {
+                    STATE_CHANGES.fetch_add(1, Ordering::Relaxed);
+                    if c.state <= ErrorState::BusOff {
+                        WORST_STATE.fetch_max(c.state as u32, Ordering::Relaxed);
+                    }
                     twocan_teensy::warn!(
                         "CAN0 error state {} (TEC {=u16}, REC {=u16})",
                         c.state,

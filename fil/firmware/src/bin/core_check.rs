@@ -1,8 +1,8 @@
 //! Exercises the exception model of the core: preemption by priority, pending a lower
 //! priority from a handler (taken on return, tail-chained), BASEPRI and PRIMASK masking,
-//! SVCall, the DWT cycle counter, SysTick COUNTFLAG and its interrupt, WFI. Each step
-//! appends a code to `LOG`; the harness test compares it with the order the ARMv7-M
-//! rules give (B1.5.4, B1.5.6, B1.5.8, B3.3, B3.4, C1.8).
+//! SVCall, the DWT cycle counter, SysTick COUNTFLAG and its interrupt, WFI, WFE and SEV.
+//! Each step appends a code to `LOG`; the harness test compares it with the order the
+//! ARMv7-M rules give (B1.5.4, B1.5.6, B1.5.8, B1.5.18, B3.3, B3.4, C1.8).
 #![no_std]
 #![cfg_attr(target_os = "none", no_main)]
 
@@ -129,6 +129,20 @@ mod image {
             core::arch::asm!("wfi");
         }
         push(15);
+        // 7. WFE and SEV (B1.5.18): the SysTick handler's return set the event register,
+        // so this WFE goes on at once; so does one after SEV; with the register clear,
+        // WFE sleeps until SysTick interrupts again.
+        // SAFETY: hint instructions and SysTick registers.
+        unsafe {
+            core::arch::asm!("wfe");
+            push(16);
+            core::arch::asm!("sev", "wfe");
+            push(17);
+            write32(SYST_CVR, 0);
+            write32(SYST_CSR, 0b111);
+            core::arch::asm!("wfe");
+        }
+        push(18);
         print(c"core-check: done\n");
         idle()
     }
