@@ -213,9 +213,17 @@ pub fn example_packages(paths: &Paths) -> Result<Vec<ExamplePackage>> {
         if bins.is_empty() || !firmware {
             continue;
         }
+        // A board feature selects the chip or board in a dependency (`stm32f7xx-hal/...`,
+        // `twocan-flexcan/teensy36`); a feature that enables nothing (a firmware variant
+        // such as `bus-250k`) is not a board.
         let features = p["features"]
             .as_object()
-            .map(|m| m.keys().filter(|k| *k != "default").cloned().collect())
+            .map(|m| {
+                m.iter()
+                    .filter(|(k, v)| *k != "default" && v.as_array().is_some_and(|a| !a.is_empty()))
+                    .map(|(k, _)| k.clone())
+                    .collect()
+            })
             .unwrap_or_default();
         found.push(ExamplePackage {
             name: p["name"].as_str().unwrap_or("?").to_string(),
