@@ -45,6 +45,8 @@ use cortex_m::peripheral::{SCB, SYST};
 use cortex_m_rt::{exception, ExceptionFrame};
 use cortex_m_semihosting::{debug, hprintln};
 use twocan_bxcan::regs::{self, mcr, msr, rdtxr, rfxr, rixr, tdtxr, tixr, tsr};
+use twocan_bxcan::{Bank, BxCan, Can, Config, Fifo, FilterPlan};
+use twocan_core::{Error, Filter, Mmio};
 
 /// The bxCAN register block in RAM: above the 1 MiB the linker uses (memory.x), so no
 /// section overlaps it.
@@ -198,6 +200,51 @@ fn SysTick() {
         0
     };
     reg_write(regs::MSR, ack);
+}
+
+/// Configuration attempts after a timed-out mode request (see [`configure_ours`]).
+const CONFIG_RETRIES: u32 = 20;
+
+/// Our driver on the stand-in, configured with `config` and one accept-all bank to
+/// FIFO 0, ready for `State::split` (run with [`responder_on`]).
+///
+/// The stand-in acknowledges from SysTick, whose rate under QEMU follows host time: a
+/// wait the driver bounds in polls can run out first on a loaded host. The configuration
+/// is not measured, so a timed-out request is retried (the driver hands the controller
+/// back with the error).
+pub fn configure_ours(config: &Config) -> BxCan<Mmio> {
+    // SAFETY: `REGS` is the RAM stand-in for CAN1's registers; the caller gives it to
+    // this driver alone from now on (the `bxcan` crate, if it used it, has freed it).
+    let regs = unsafe { Mmio::new(REGS) };
+    let mut attempt = Can::can1(regs, config);
+    for _ in 0..CONFIG_RETRIES {
+        match attempt {
+            Err(f) if f.error == Error::Timeout => attempt = f.value.reconfigure(config),
+            _ => break,
+        }
+    }
+    let mut init = match attempt {
+        Ok(i) => i,
+        Err(_) => fail("twocan: can1"),
+    };
+    let mut plan = FilterPlan::manual();
+    let bank = match Bank::mask32(&Filter::pass_all(), Fifo::Fifo0) {
+        Ok(b) => b,
+        Err(_) => fail("twocan: bank"),
+    };
+    check(plan.set_bank(0, bank).is_ok(), "twocan: set_bank");
+    check(init.set_filters(&plan).is_ok(), "twocan: set_filters");
+    let mut attempt = init.enable();
+    for _ in 0..CONFIG_RETRIES {
+        match attempt {
+            Err(f) if f.error == Error::Timeout => attempt = f.value.enable(),
+            _ => break,
+        }
+    }
+    match attempt {
+        Ok(can) => can.into_split(),
+        Err(_) => fail("twocan: enable"),
+    }
 }
 
 // ------------------------------------------------------------------ measuring

@@ -25,9 +25,9 @@ use core::pin::{pin, Pin};
 use core::task::{Context, Poll};
 
 use cortex_m_rt::entry;
-use twocan_bxcan::{Bank, BxCan, Can, Config, Fifo, FilterPlan};
+use twocan_bxcan::{BxCan, Config};
 use twocan_core::split::{Rx, RxIrq, State};
-use twocan_core::{Error, FifoQueue, Filter, Frame, Mmio, RxFrame, TxPolicy};
+use twocan_core::{Error, FifoQueue, Frame, Mmio, RxFrame, TxPolicy};
 
 #[path = "../../shared/flag_waker.rs"]
 mod flag_waker;
@@ -36,11 +36,9 @@ mod ram_can;
 
 use ram_can::{
     check, fail, measure, released, reset_block, responder_off, responder_on, restore, save,
-    snapshots, DATA, ID, REGS, REPEAT,
+    snapshots, DATA, ID, REPEAT,
 };
 
-/// Configuration attempts after a timed-out mode request (see `configure`).
-const CONFIG_RETRIES: u32 = 20;
 const APB1_HZ: u32 = 54_000_000;
 const BITRATE: u32 = 500_000;
 const RX: usize = 8;
@@ -91,42 +89,7 @@ fn receive(rx: &mut OurRx) -> Option<RxFrame> {
 }
 
 fn configure() -> Hw {
-    // SAFETY: `REGS` is the RAM stand-in for CAN1's registers; this driver is its only
-    // user.
-    let regs = unsafe { Mmio::new(REGS) };
-    // The stand-in acknowledges from SysTick, whose rate under QEMU follows host time:
-    // a wait the driver bounds in polls can run out first on a loaded host. The
-    // configuration is not measured, so a timed-out request is retried (the driver
-    // hands the controller back with the error).
-    let mut attempt = Can::can1(regs, &CONFIG);
-    for _ in 0..CONFIG_RETRIES {
-        match attempt {
-            Err(f) if f.error == Error::Timeout => attempt = f.value.reconfigure(&CONFIG),
-            _ => break,
-        }
-    }
-    let mut init = match attempt {
-        Ok(i) => i,
-        Err(_) => fail("twocan: can1"),
-    };
-    let mut plan = FilterPlan::manual();
-    let bank = match Bank::mask32(&Filter::pass_all(), Fifo::Fifo0) {
-        Ok(b) => b,
-        Err(_) => fail("twocan: bank"),
-    };
-    check(plan.set_bank(0, bank).is_ok(), "twocan: set_bank");
-    check(init.set_filters(&plan).is_ok(), "twocan: set_filters");
-    let mut attempt = init.enable();
-    for _ in 0..CONFIG_RETRIES {
-        match attempt {
-            Err(f) if f.error == Error::Timeout => attempt = f.value.enable(),
-            _ => break,
-        }
-    }
-    match attempt {
-        Ok(can) => can.into_split(),
-        Err(_) => fail("twocan: enable"),
-    }
+    ram_can::configure_ours(&CONFIG)
 }
 
 #[entry]

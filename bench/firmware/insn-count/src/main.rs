@@ -31,12 +31,12 @@ use bxcan::filter::Mask32;
 use cortex_m_rt::entry;
 use heapless::spsc::{Consumer, Producer, Queue};
 use twocan_bxcan::RawFrame;
-use twocan_bxcan::{Bank, BxCan, Can, Config, Fifo, FilterPlan};
+use twocan_bxcan::{BxCan, Config, FilterPlan};
 use twocan_core::split::{Rx, RxIrq, State, StateChange, Tx, TxIrq, STATE_CHANGES};
 use twocan_core::timing::{solve_cia, Limits};
 use twocan_core::txqueue::Queued;
 use twocan_core::Completion;
-use twocan_core::{Error, FifoQueue, Filter, Frame, Mmio, RxFrame, TxOutcome, TxPolicy};
+use twocan_core::{FifoQueue, Frame, Mmio, RxFrame, TxOutcome, TxPolicy};
 
 #[path = "../../shared/ram_can.rs"]
 mod ram_can;
@@ -46,8 +46,6 @@ use ram_can::{
     restore, save, snapshots, Snapshots, DATA, ID, REGS, REPEAT,
 };
 
-/// Configuration attempts after a timed-out mode request (see `configure`).
-const CONFIG_RETRIES: u32 = 20;
 const APB1_HZ: u32 = 54_000_000;
 const BITRATE: u32 = 500_000;
 
@@ -166,42 +164,7 @@ fn ours_receive(rx: &mut OurRx) -> Option<RxFrame> {
 }
 
 fn configure_ours() -> Hw {
-    // SAFETY: `REGS` is the RAM stand-in for CAN1's registers; the `bxcan` crate gave it
-    // up (`free`) before this, and nothing else uses it from now on.
-    let regs = unsafe { Mmio::new(REGS) };
-    // The stand-in acknowledges from SysTick, whose rate under QEMU follows host time:
-    // a wait the driver bounds in polls can run out first on a loaded host. The
-    // configuration is not measured, so a timed-out request is retried (the driver
-    // hands the controller back with the error).
-    let mut attempt = Can::can1(regs, &CONFIG);
-    for _ in 0..CONFIG_RETRIES {
-        match attempt {
-            Err(f) if f.error == Error::Timeout => attempt = f.value.reconfigure(&CONFIG),
-            _ => break,
-        }
-    }
-    let mut init = match attempt {
-        Ok(i) => i,
-        Err(_) => fail("twocan: can1"),
-    };
-    let mut plan = FilterPlan::manual();
-    let bank = match Bank::mask32(&Filter::pass_all(), Fifo::Fifo0) {
-        Ok(b) => b,
-        Err(_) => fail("twocan: bank"),
-    };
-    check(plan.set_bank(0, bank).is_ok(), "twocan: set_bank");
-    check(init.set_filters(&plan).is_ok(), "twocan: set_filters");
-    let mut attempt = init.enable();
-    for _ in 0..CONFIG_RETRIES {
-        match attempt {
-            Err(f) if f.error == Error::Timeout => attempt = f.value.enable(),
-            _ => break,
-        }
-    }
-    match attempt {
-        Ok(can) => can.into_split(),
-        Err(_) => fail("twocan: enable"),
-    }
+    ram_can::configure_ours(&CONFIG)
 }
 
 fn run_ours(snap: &Snapshots, hw: Hw) {
