@@ -9,7 +9,14 @@
 //!   note "When FINIT=1, CAN reception is deactivated").
 //! - The dual-CAN block (CAN1) splits its 28 banks at `CAN2SB`: CAN1 uses `0..CAN2SB`,
 //!   CAN2 `CAN2SB..28` (28 gives every bank to CAN1, 0 every bank to CAN2; values above
-//!   28 are taken as 28). CAN3's block has 14 banks and no `CAN2SB` (reserved).
+//!   28 are taken as 28). A single-CAN block — CAN3's, or CAN1's on a single-CAN part
+//!   such as the STM32F103 ([`super::part`]) — has 14 banks and no `CAN2SB` (reserved:
+//!   writes ignored, reads its reset value 14; RM0008 §24.9.4).
+//! - The block has as many banks as its part gives it: `FM1R`, `FS1R`, `FFA1R`, `FA1R`
+//!   keep only the bits of existing banks (the others are reserved and read 0), and the
+//!   bank registers `FiR1`/`FiR2` of a bank beyond the count read 0 and ignore writes.
+//!   RM0008 §24.9.4 and RM0410 §40.9.4 list them only for `i < banks`; what silicon
+//!   answers there is an assumption (docs/models.md).
 //! - Filter numbers (FMI): each FIFO has its own numbering; the banks assigned to that
 //!   FIFO contribute, in bank order, 1 (32-bit mask), 2 (32-bit list or 16-bit mask) or 4
 //!   (16-bit list) numbers each, whether active or not. Numbering starts at the first
@@ -30,7 +37,7 @@ use core::ops::Range;
 
 use twocan_core::Frame;
 
-use crate::regs::{self, firx, fmr, FILTER_BANKS, FILTER_BANKS_SINGLE};
+use crate::regs::{self, firx, fmr, FILTER_BANKS};
 
 /// The reserved bits of `FMR` read as in its reset value.
 const FMR_RESERVED: u32 = regs::fmr::RESET_VALUE & !(fmr::FINIT | fmr::CAN2SB.mask());
@@ -38,11 +45,11 @@ const FMR_RESERVED: u32 = regs::fmr::RESET_VALUE & !(fmr::FINIT | fmr::CAN2SB.ma
 /// Which filter block a controller has, and which banks of it it uses.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum Owner {
-    /// CAN1: master of the dual block, banks `0..CAN2SB`.
+    /// CAN1 of a dual-CAN part: master of the dual block, banks `0..CAN2SB`.
     Master,
     /// CAN2: slave, banks `CAN2SB..28` of CAN1's block.
     Slave,
-    /// CAN3: its own block of 14 banks.
+    /// The only user of its block: CAN3, or CAN1 of a single-CAN part (every bank).
     Single,
 }
 
@@ -58,7 +65,10 @@ pub(crate) struct Accepted {
 /// One filter bank block (CAN1's shared dual-CAN block, or CAN3's own).
 #[derive(Debug, Clone)]
 pub(crate) struct FilterBlock {
+    /// `CAN2SB` exists (the block is shared by CAN1 and CAN2).
     dual: bool,
+    /// Banks that exist: 14 or 28.
+    nbanks: usize,
     finit: bool,
     can2sb: u32,
     fm1r: u32,
@@ -72,10 +82,12 @@ pub(crate) struct FilterBlock {
 impl FilterBlock {
     /// The block at reset (`FMR` = 0x2A1C_0E01: FINIT = 1, CAN2SB = 14; all banks
     /// inactive, mask mode, 16-bit, FIFO 0). Bank registers reset to undefined values in
-    /// RM0410; the model starts them at 0.
-    pub(crate) fn new(dual: bool) -> Self {
+    /// RM0410; the model starts them at 0. `nbanks` (at most 28) banks exist; `dual`: the
+    /// block has `CAN2SB` and is shared with CAN2.
+    pub(crate) fn new(nbanks: usize, dual: bool) -> Self {
         FilterBlock {
             dual,
+            nbanks: nbanks.min(FILTER_BANKS),
             finit: true,
             can2sb: fmr::CAN2SB.get(fmr::RESET_VALUE),
             fm1r: 0,
@@ -88,11 +100,7 @@ impl FilterBlock {
     }
 
     fn nbanks(&self) -> usize {
-        if self.dual {
-            FILTER_BANKS
-        } else {
-            FILTER_BANKS_SINGLE
-        }
+        self.nbanks
     }
 
     fn bank_mask(&self) -> u32 {
@@ -106,11 +114,12 @@ impl FilterBlock {
 
     /// The banks `owner` uses.
     pub(crate) fn range(&self, owner: Owner) -> Range<usize> {
-        let split = (self.can2sb as usize).min(FILTER_BANKS);
+        let n = self.nbanks();
+        let split = (self.can2sb as usize).min(n);
         match owner {
             Owner::Master => 0..split,
-            Owner::Slave => split..FILTER_BANKS,
-            Owner::Single => 0..FILTER_BANKS_SINGLE,
+            Owner::Slave => split..n,
+            Owner::Single => 0..n,
         }
     }
 

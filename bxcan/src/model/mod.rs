@@ -1,15 +1,22 @@
-//! Behavioural model of the STM32F7 bxCAN peripheral (feature `model`), written from the
-//! rules of RM0410 chapter 40 and the bxCAN lecture notes, for host tests of the driver.
+//! Behavioural model of the STM32 bxCAN peripheral (feature `model`), written from the
+//! rules of RM0410 chapter 40 and the bxCAN lecture notes, for host tests of the driver;
+//! the parts whose bxCAN differs (bank count, instances, `CAN2SB`) are described as data
+//! in [`part`] from their own manuals (RM0008 for the F1, RM0090/RM0390/RM0430 for the
+//! F4, RM0385/RM0410 for the F7).
 //!
 //! [`BxCanModel`] is a cheap, clonable handle on one controller. It implements
 //! [`Registers`] — the driver's side: 32-bit reads and writes at the offsets of
 //! [`crate::regs`] — and [`twocan_core::sim::BusNode`] — the simulated bus's side.
 //!
-//! - [`BxCanModel::can1`]: CAN1 alone, with the dual-CAN filter block (CAN1 uses banks
-//!   `0..CAN2SB` as on the chip; set `CAN2SB = 28` to give it all 28).
-//! - [`BxCanModel::can1_can2`]: CAN1 and CAN2 sharing CAN1's filter block, split at
-//!   `FMR.CAN2SB`; CAN2 has no filter registers of its own.
-//! - [`BxCanModel::can3`]: CAN3 with its own 14-bank filter block (no `CAN2SB`).
+//! - [`BxCanModel::of_part`]: every controller of a [`Part`] out of reset, sharing filter
+//!   blocks as on that chip (e.g. [`part::STM32F103`]: one CAN with 14 banks;
+//!   [`part::STM32F446`]: CAN1 and CAN2 sharing 28).
+//! - [`BxCanModel::can1`]: CAN1 alone on an STM32F76x, with the dual-CAN filter block (CAN1
+//!   uses banks `0..CAN2SB` as on the chip; set `CAN2SB = 28` to give it all 28).
+//! - [`BxCanModel::can1_can2`]: CAN1 and CAN2 of an STM32F76x sharing CAN1's filter
+//!   block, split at `FMR.CAN2SB`; CAN2 has no filter registers of its own.
+//! - [`BxCanModel::can3`]: CAN3 of an STM32F76x with its own 14-bank filter block (no
+//!   `CAN2SB`).
 //!
 //! The rules modelled, and the choices made where RM0410 is silent, are documented in
 //! each source file: `modes.rs` (operating modes), `tx.rs` (mailboxes, `TSR`), `rx.rs`
@@ -42,6 +49,7 @@ mod errors;
 mod filters;
 mod irq;
 mod modes;
+pub mod part;
 mod rx;
 mod timer;
 mod tx;
@@ -52,24 +60,27 @@ use std::vec::Vec;
 
 use twocan_core::{ErrorCounters, Frame, MailboxState, Registers};
 
-use crate::regs::{Instance, FILTER_BANKS, RX_FIFOS, TX_MAILBOXES};
+use crate::regs::{Instance, FILTER_BANKS, FILTER_BANKS_SINGLE, RX_FIFOS, TX_MAILBOXES};
 use controller::Controller;
 use filters::{FilterBlock, Owner};
 
 pub use errors::REC_AFTER_PASSIVE_RECEPTION;
 pub use irq::IrqLines;
 pub use modes::Mode;
+pub use part::Part;
 
 /// A handle on one modelled bxCAN controller; clones share the same controller.
 #[derive(Clone)]
 pub struct BxCanModel {
     inner: Rc<RefCell<Controller>>,
+    part: &'static Part,
 }
 
 impl core::fmt::Debug for BxCanModel {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         let c = self.inner.borrow();
         f.debug_struct("BxCanModel")
+            .field("part", &self.part.name)
             .field("instance", &c.instance)
             .field("mode", &c.mode())
             .finish_non_exhaustive()
@@ -121,32 +132,71 @@ pub struct ModelState {
 }
 
 impl BxCanModel {
-    fn from_controller(c: Controller) -> Self {
+    fn from_controller(c: Controller, part: &'static Part) -> Self {
         BxCanModel {
             inner: Rc::new(RefCell::new(c)),
+            part,
         }
     }
 
-    /// CAN1 alone, out of reset, with the dual-CAN filter block (28 banks split at
-    /// `CAN2SB`, 14 at reset); no CAN2 uses the upper banks.
+    /// Every bxCAN controller of `part`, out of reset, in the order of
+    /// [`Part::instances`]: CAN1 owns a block of [`Part::can1_banks`] banks, shared with
+    /// CAN2 (split at `CAN2SB`) where the part has CAN2; CAN3 has its own 14 banks.
+    pub fn of_part(part: &'static Part) -> Vec<Self> {
+        let dual = part.dual();
+        let can1_block = Rc::new(RefCell::new(FilterBlock::new(part.can1_banks, dual)));
+        part.instances
+            .iter()
+            .map(|i| {
+                let (owner, block) = match i.instance {
+                    Instance::Can1 if dual => (Owner::Master, can1_block.clone()),
+                    Instance::Can1 => (Owner::Single, can1_block.clone()),
+                    Instance::Can2 => (Owner::Slave, can1_block.clone()),
+                    Instance::Can3 => (
+                        Owner::Single,
+                        Rc::new(RefCell::new(FilterBlock::new(FILTER_BANKS_SINGLE, false))),
+                    ),
+                };
+                Self::from_controller(Controller::new(i.instance, owner, block), part)
+            })
+            .collect()
+    }
+
+    /// CAN1 of an STM32F76x alone, out of reset, with the dual-CAN filter block (28 banks
+    /// split at `CAN2SB`, 14 at reset); no CAN2 uses the upper banks.
     pub fn can1() -> Self {
-        let block = Rc::new(RefCell::new(FilterBlock::new(true)));
-        Self::from_controller(Controller::new(Instance::Can1, Owner::Master, block))
+        let block = Rc::new(RefCell::new(FilterBlock::new(FILTER_BANKS, true)));
+        Self::from_controller(
+            Controller::new(Instance::Can1, Owner::Master, block),
+            &part::STM32F76X_F77X,
+        )
     }
 
-    /// CAN3, out of reset, with its own filter block of 14 banks.
+    /// CAN3 of an STM32F76x, out of reset, with its own filter block of 14 banks.
     pub fn can3() -> Self {
-        let block = Rc::new(RefCell::new(FilterBlock::new(false)));
-        Self::from_controller(Controller::new(Instance::Can3, Owner::Single, block))
+        let block = Rc::new(RefCell::new(FilterBlock::new(FILTER_BANKS_SINGLE, false)));
+        Self::from_controller(
+            Controller::new(Instance::Can3, Owner::Single, block),
+            &part::STM32F76X_F77X,
+        )
     }
 
-    /// CAN1 and CAN2, out of reset, sharing CAN1's filter block: CAN1 gets banks
-    /// `0..CAN2SB`, CAN2 banks `CAN2SB..28` (RM0410 40.2, dual CAN).
+    /// CAN1 and CAN2 of an STM32F76x, out of reset, sharing CAN1's filter block: CAN1 gets
+    /// banks `0..CAN2SB`, CAN2 banks `CAN2SB..28` (RM0410 40.2, dual CAN).
     pub fn can1_can2() -> (Self, Self) {
-        let block = Rc::new(RefCell::new(FilterBlock::new(true)));
+        let block = Rc::new(RefCell::new(FilterBlock::new(FILTER_BANKS, true)));
         let can1 = Controller::new(Instance::Can1, Owner::Master, block.clone());
         let can2 = Controller::new(Instance::Can2, Owner::Slave, block);
-        (Self::from_controller(can1), Self::from_controller(can2))
+        let part = &part::STM32F76X_F77X;
+        (
+            Self::from_controller(can1, part),
+            Self::from_controller(can2, part),
+        )
+    }
+
+    /// The part this controller belongs to.
+    pub fn part(&self) -> &'static Part {
+        self.part
     }
 
     /// Which instance this handle models.
