@@ -146,7 +146,7 @@ fn filter_registers_are_as_wide_as_the_bank_count() {
     // RM0008 §24.9.4: FM1R/FS1R/FFA1R/FA1R bits 27:14 are "available in connectivity line
     // devices only and are reserved otherwise"; CAN_FiRx exists for the banks that exist.
     for p in Part::ALL {
-        for mut m in BxCanModel::of_part(p) {
+        for m in BxCanModel::of_part(p) {
             let Some(n) = p
                 .banks_of(m.instance())
                 .filter(|_| m.instance() != Instance::Can2)
