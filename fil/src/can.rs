@@ -116,21 +116,19 @@ pub struct Port {
     pub model: Model,
 }
 
-/// Creates the models of a board's CAN instances (bxCAN CAN1 and CAN2 share the filter
-/// block, as on the chip).
+/// Creates the models of a board's CAN instances: the bxCAN instances of one part come from
+/// one [`BxCanModel::of_part`] (CAN1 and CAN2 share the filter block, as on the chip).
 pub fn ports(instances: &[CanInstance]) -> Vec<Port> {
     let mut out = Vec::new();
-    let mut bx: Option<(BxCanModel, BxCanModel)> = None;
+    let mut bx: Option<Vec<BxCanModel>> = None;
     for inst in instances {
         let model = match inst.kind {
             CanKind::FlexCan(chip) => Model::FlexCan(FlexCanModel::new(chip)),
-            CanKind::BxCan { instance } => {
-                let pair = bx.get_or_insert_with(BxCanModel::can1_can2);
-                Model::BxCan(if instance == 1 {
-                    pair.0.clone()
-                } else {
-                    pair.1.clone()
-                })
+            CanKind::BxCan { instance, part } => {
+                let models = bx.get_or_insert_with(|| BxCanModel::of_part(part));
+                // Instance numbers come from the part's own list (`bxcan_instances`).
+                let index = usize::from(instance.saturating_sub(1));
+                Model::BxCan(models.get(index).cloned().expect("an instance of the part"))
             }
         };
         out.push(Port {

@@ -291,6 +291,10 @@ impl<'a> World<'a> {
                 continue;
             };
             self.attached[i].bit_rate = Some(rate);
+            let (board, port) = (self.attached[i].board, self.attached[i].port);
+            let b = self.machines[board].board_mut();
+            let instance = b.cans[port].instance.clone();
+            b.profile.can_joined(&instance);
             if (rate as f64 - nominal).abs() / nominal > TOLERANCE {
                 self.attached[i].misclocked = true;
                 let me = self.attached[i].node;

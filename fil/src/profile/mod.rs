@@ -8,6 +8,9 @@
 //! peripheral or to unmapped space (a bus error, which the core turns into a fault).
 
 pub mod kinetis;
+pub mod stm32_rcc;
+pub mod stm32f1;
+pub mod stm32f4;
 pub mod stm32f7;
 
 use std::collections::HashMap;
@@ -37,7 +40,48 @@ pub enum CanKind {
     BxCan {
         /// 1 or 2.
         instance: u8,
+        /// The chip's bxCAN facts (bank count, instances sharing a filter block).
+        part: &'static twocan_bxcan::model::Part,
     },
+}
+
+/// The bxCAN instances `numbers` (1 = CAN1, ...) of `part` as CAN instances of a board: their
+/// windows, `RCC_APB1ENR` clock gates and interrupt lines from the part descriptor. CAN2
+/// also needs CAN1's clock: CAN1 is the master that holds the filters and the message SRAM
+/// CAN2 works through (RM0390 §30.2, RM0008 §24.2 "Dual CAN").
+pub fn bxcan_instances(
+    part: &'static twocan_bxcan::model::Part,
+    numbers: &[u8],
+) -> Vec<CanInstance> {
+    use twocan_bxcan::regs::Instance;
+    let can1_bit = part
+        .instance(Instance::Can1)
+        .map_or(0, |c| 1u32 << c.apb1enr_bit);
+    part.instances
+        .iter()
+        .zip(1u8..)
+        .filter(|(_, n)| numbers.contains(n))
+        .map(|(c, n)| CanInstance {
+            name: c.name,
+            base: c.base,
+            size: 0x400,
+            gate: (
+                part.rcc_apb1enr,
+                (1u32 << c.apb1enr_bit)
+                    | if c.instance == Instance::Can2 {
+                        can1_bit
+                    } else {
+                        0
+                    },
+            ),
+            kind: CanKind::BxCan { instance: n, part },
+            irqs: c
+                .irqs
+                .iter()
+                .map(|(name, line)| (*name, u32::from(*line)))
+                .collect(),
+        })
+        .collect()
 }
 
 /// A CAN controller of the chip.
@@ -131,6 +175,10 @@ pub trait Profile {
     fn reset_deadline(&self) -> Option<(u64, String)> {
         None
     }
+    /// A CAN controller joined the bus (left initialization mode, not in internal loop
+    /// back): the profile may check what the chip needs for it outside the controller
+    /// (pins, alternate functions) and report findings through [`Profile::take_findings`].
+    fn can_joined(&mut self, _can: &CanInstance) {}
 }
 
 /// Byte-addressed storage for registers a profile keeps as plain values, with sub-word
@@ -193,17 +241,21 @@ pub fn by_name(name: &str) -> Option<Box<dyn Profile>> {
         "teensy36" => Some(Box::new(kinetis::Kinetis::new(kinetis::Chip::K66))),
         "nucleo-f767zi" => Some(Box::new(stm32f7::Stm32f7::new(stm32f7::Chip::F767))),
         "disco-f746g" => Some(Box::new(stm32f7::Stm32f7::new(stm32f7::Chip::F746))),
+        "bluepill" => Some(Box::new(stm32f1::Stm32f1::new())),
+        "nucleo-f446re" => Some(Box::new(stm32f4::Stm32f4::new())),
         _ => None,
     }
 }
 
 /// Every board name [`by_name`] knows.
-pub const BOARDS: [&str; 5] = [
+pub const BOARDS: [&str; 7] = [
     "teensy32",
     "teensy35",
     "teensy36",
     "nucleo-f767zi",
     "disco-f746g",
+    "bluepill",
+    "nucleo-f446re",
 ];
 
 #[cfg(test)]

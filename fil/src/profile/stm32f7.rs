@@ -8,23 +8,18 @@
 //! "GPIO"; the boards' user manuals UM1974 (NUCLEO-144: HSE = 8 MHz from the ST-LINK in
 //! bypass) and UM1907 (32F746G-DISCO: 25 MHz crystal).
 //!
-//! Rules modelled:
-//! - `HSIRDY` follows `HSION` (on-chip RC). `HSERDY` follows `HSEON` only when `HSEBYP`
-//!   matches the board's source: an external clock signal needs bypass, a crystal needs
-//!   the oscillator.
-//! - `PLLRDY` follows `PLLON` only when the PLL source is ready and the configuration is
-//!   inside the limits of §5.3.2: PLLM 2…63 with a VCO input of 1–2 MHz, PLLN 50…432
-//!   with a VCO output of 100–432 MHz, a P output at most 216 MHz. Writing `PLLCFGR`
-//!   while the PLL is on is reported (the manual: "only when the PLL is disabled").
-//! - `SWS` follows `SW` only when the selected clock is ready; switching to a SYSCLK
-//!   faster than `FLASH_ACR.LATENCY` allows (Table 7, 2.7–3.6 V: 30 MHz per wait state)
-//!   and an APB1 above 54 MHz / APB2 above 108 MHz are reported.
-//! - Enable registers gate the peripherals: GPIOx (`AHB1ENR`), PWR and CAN1/CAN2
-//!   (`APB1ENR`), SYSCFG (`APB2ENR`). A gated STM32 peripheral raises no bus error: it
-//!   reads as zero and ignores writes, so the core goes on; the harness records the
-//!   access as a fault of the firmware all the same (it never works on the board).
+//! The rules of the RCC, flash, PWR, SYSCFG and GPIO registers are those of
+//! [`super::stm32_rcc`] (the F4 and F7 share the layout), with the F7's limits: a PLL P
+//! output and HCLK of at most 216 MHz (180 MHz without over-drive, RM0410 §4.1.4), APB1 at
+//! most 54 MHz and APB2 at most 108 MHz. CAN1/CAN2 are gated by `RCC_APB1ENR` bits 25/26
+//! (the [`twocan_bxcan::model::part::STM32F76X_F77X`] descriptor).
 
-use super::{Access, CanInstance, CanKind, Ctx, Memory, Profile, RegStore};
+use twocan_bxcan::model::part;
+
+use super::stm32_rcc::{Limits, SystemRegs, RCC_AHB1ENR, RCC_APB1ENR, RCC_APB2ENR};
+#[cfg(test)]
+use super::stm32_rcc::{RCC_CFGR, RCC_CR, RCC_PLLCFGR};
+use super::{Access, CanInstance, Ctx, Memory, Profile};
 
 /// The two chips.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -35,225 +30,68 @@ pub enum Chip {
     F746,
 }
 
-const HSI_HZ: u64 = 16_000_000;
-
-const RCC: u32 = 0x4002_3800;
-const RCC_CR: u32 = RCC;
-const RCC_PLLCFGR: u32 = RCC + 0x04;
-const RCC_CFGR: u32 = RCC + 0x08;
-const RCC_AHB1ENR: u32 = RCC + 0x30;
-const RCC_APB1ENR: u32 = RCC + 0x40;
-const RCC_APB2ENR: u32 = RCC + 0x44;
-const FLASH_ACR: u32 = 0x4002_3C00;
-const PWR: u32 = 0x4000_7000;
-const GPIOA: u32 = 0x4002_0000;
-const SYSCFG: u32 = 0x4001_3800;
+/// The F7 limits (RM0410 §5.3.2, §3.3.2 Table 7; datasheet operating conditions), with the
+/// board's HSE: 8 MHz from the ST-LINK in bypass (UM1974) or a 25 MHz crystal (UM1907).
+const fn limits(hse_hz: u64, hse_bypass: bool) -> Limits {
+    Limits {
+        manual: "RM0410",
+        hse_hz,
+        hse_bypass,
+        pll_p_max: 216_000_000,
+        pll_r_sysclk: false,
+        hclk_max: 216_000_000,
+        hclk_max_without_overdrive: 180_000_000,
+        apb1_max: 54_000_000,
+        apb2_max: 108_000_000,
+        gpio_ports: 11,
+        rcc_last: 0x90,
+    }
+}
+static F767_LIMITS: Limits = limits(8_000_000, true);
+static F746_LIMITS: Limits = limits(25_000_000, false);
 
 /// An STM32F7 chip on its board.
 #[derive(Debug, Clone)]
 pub struct Stm32f7 {
     chip: Chip,
-    regs: RegStore,
-    findings: Vec<String>,
+    sys: SystemRegs,
 }
 
 impl Stm32f7 {
     /// The chip out of power-on reset.
     pub fn new(chip: Chip) -> Self {
-        let mut regs = RegStore::default();
-        regs.set(RCC_CR, 0x0000_0083); // HSION, HSIRDY, HSITRIM = 16
-        regs.set(RCC_PLLCFGR, 0x2400_3010);
-        regs.set(RCC_AHB1ENR, 0x0010_0000); // DTCMRAMEN
-        regs.set(RCC + 0x70, 0); // BDCR
-        regs.set(RCC + 0x74, 0x0E00_0000); // CSR: reset flags
-        regs.set(PWR, 0x0000_C000); // CR1: VOS = scale 1
-                                    // GPIO reset values (§6.4): MODER A/B have the debug pins in AF.
-        regs.set(GPIOA, 0xA800_0000);
-        regs.set(GPIOA + 0x400, 0x0000_0280);
-        regs.set(GPIOA + 0x0C, 0x6400_0000);
-        regs.set(GPIOA + 0x400 + 0x0C, 0x0000_0100);
-        regs.set(GPIOA + 0x08, 0x0C00_0000);
-        regs.set(GPIOA + 0x400 + 0x08, 0x0000_00C0);
+        let limits = match chip {
+            Chip::F767 => &F767_LIMITS,
+            Chip::F746 => &F746_LIMITS,
+        };
         Stm32f7 {
             chip,
-            regs,
-            findings: Vec::new(),
+            sys: SystemRegs::new(limits),
         }
-    }
-
-    /// The board's HSE: frequency and whether it is an external clock (bypass).
-    fn hse(&self) -> (u64, bool) {
-        match self.chip {
-            Chip::F767 => (8_000_000, true),
-            Chip::F746 => (25_000_000, false),
-        }
-    }
-
-    fn hse_ready(&self) -> bool {
-        let cr = self.regs.get(RCC_CR);
-        let on = cr & (1 << 16) != 0;
-        let bypass = cr & (1 << 18) != 0;
-        on && bypass == self.hse().1
-    }
-
-    /// PLL output P (Hz) if its configuration is within limits and its source runs.
-    fn pll_p(&self) -> Option<u64> {
-        let cfg = self.regs.get(RCC_PLLCFGR);
-        let m = u64::from(cfg & 0x3F);
-        let n = u64::from((cfg >> 6) & 0x1FF);
-        let p = 2 * (u64::from((cfg >> 16) & 3) + 1);
-        let hse_src = cfg & (1 << 22) != 0;
-        let (src, ready) = if hse_src {
-            (self.hse().0, self.hse_ready())
-        } else {
-            (HSI_HZ, self.regs.get(RCC_CR) & 1 != 0)
-        };
-        if !ready || !(2..=63).contains(&m) || !(50..=432).contains(&n) {
-            return None;
-        }
-        let vin = src / m;
-        let vco = vin * n;
-        let out = vco / p;
-        ((1_000_000..=2_000_000).contains(&vin)
-            && (100_000_000..=432_000_000).contains(&vco)
-            && out <= 216_000_000)
-            .then_some(out)
-    }
-
-    fn pll_ready(&self) -> bool {
-        self.regs.get(RCC_CR) & (1 << 24) != 0 && self.pll_p().is_some()
-    }
-
-    fn source_ready(&self, sw: u32) -> bool {
-        match sw {
-            0 => self.regs.get(RCC_CR) & 1 != 0,
-            1 => self.hse_ready(),
-            2 => self.pll_ready(),
-            _ => false,
-        }
-    }
-
-    fn sysclk_of(&self, sws: u32) -> u64 {
-        match sws {
-            1 => self.hse().0,
-            2 => self.pll_p().unwrap_or(HSI_HZ),
-            _ => HSI_HZ,
-        }
-    }
-
-    fn sysclk(&self) -> u64 {
-        self.sysclk_of((self.regs.get(RCC_CFGR) >> 2) & 3)
-    }
-
-    fn ahb_div(cfgr: u32) -> u64 {
-        let hpre = (cfgr >> 4) & 0xF;
-        if hpre < 8 {
-            1
-        } else {
-            [2, 4, 8, 16, 64, 128, 256, 512][(hpre - 8) as usize]
-        }
-    }
-
-    fn apb_div(bits: u32) -> u64 {
-        if bits < 4 {
-            1
-        } else {
-            1 << (bits - 3)
-        }
-    }
-
-    /// HCLK now.
-    fn hclk(&self) -> u64 {
-        self.sysclk() / Self::ahb_div(self.regs.get(RCC_CFGR))
     }
 
     /// APB1 clock now (bxCAN's clock).
     pub fn pclk1(&self) -> u64 {
-        self.hclk() / Self::apb_div((self.regs.get(RCC_CFGR) >> 10) & 7)
+        self.sys.pclk1()
     }
 
-    /// Recomputes the status bits that follow control bits.
-    fn settle(&mut self) {
-        let mut cr = self.regs.get(RCC_CR);
-        cr = (cr & !(1 << 1)) | ((cr & 1) << 1);
-        cr = (cr & !(1 << 17)) | (u32::from(self.hse_ready()) << 17);
-        cr = (cr & !(1 << 25)) | (u32::from(self.pll_ready()) << 25);
-        self.regs.set(RCC_CR, cr);
-        let cfgr = self.regs.get(RCC_CFGR);
-        let sw = cfgr & 3;
-        let sws = (cfgr >> 2) & 3;
-        if sw != sws && self.source_ready(sw) {
-            self.regs.set(RCC_CFGR, (cfgr & !(3 << 2)) | (sw << 2));
-            self.check_clock_limits();
-        }
-        // PWR_CSR1.VOSRDY (bit 14) once the regulator runs at the selected scale; the
-        // over-drive handshake follows ODEN/ODSWEN when the PLL or HSE/HSI runs.
-        let cr1 = self.regs.get(PWR);
-        let mut csr1 = self.regs.get(PWR + 4) | (1 << 14);
-        csr1 = (csr1 & !(1 << 16)) | (((cr1 >> 16) & 1) << 16);
-        csr1 = (csr1 & !(1 << 17)) | (((cr1 >> 17) & 1) << 17);
-        self.regs.set(PWR + 4, csr1);
-    }
-
-    fn check_clock_limits(&mut self) {
-        let hclk = self.hclk();
-        let latency = u64::from(self.regs.get(FLASH_ACR) & 0xF);
-        let needed = hclk.div_ceil(30_000_000).saturating_sub(1);
-        if latency < needed {
-            self.findings.push(format!(
-                "HCLK {hclk} Hz with FLASH_ACR.LATENCY = {latency}: at least {needed} wait states needed (RM0410 Table 7, 2.7–3.6 V)"
-            ));
-        }
-        let cfgr = self.regs.get(RCC_CFGR);
-        let apb1 = hclk / Self::apb_div((cfgr >> 10) & 7);
-        let apb2 = hclk / Self::apb_div((cfgr >> 13) & 7);
-        if apb1 > 54_000_000 || apb2 > 108_000_000 {
-            self.findings.push(format!(
-                "APB1 {apb1} Hz / APB2 {apb2} Hz above their maxima (54 / 108 MHz)"
-            ));
+    fn part(&self) -> &'static twocan_bxcan::model::Part {
+        match self.chip {
+            Chip::F767 => &part::STM32F76X_F77X,
+            Chip::F746 => &part::STM32F74X_F75X,
         }
     }
+}
 
-    fn peripheral(&self, addr: u32) -> Option<(&'static str, Option<(u32, u32)>)> {
-        const GPIOS: [&str; 11] = [
-            "GPIOA", "GPIOB", "GPIOC", "GPIOD", "GPIOE", "GPIOF", "GPIOG", "GPIOH", "GPIOI",
-            "GPIOJ", "GPIOK",
-        ];
-        if (RCC..RCC + 0x400).contains(&addr) {
-            return Some(("RCC", None));
-        }
-        if (FLASH_ACR..FLASH_ACR + 0x400).contains(&addr) {
-            return Some(("FLASH", None));
-        }
-        if (PWR..PWR + 0x400).contains(&addr) {
-            return Some(("PWR", Some((RCC_APB1ENR, 1 << 28))));
-        }
-        if (SYSCFG..SYSCFG + 0x400).contains(&addr) {
-            return Some(("SYSCFG", Some((RCC_APB2ENR, 1 << 14))));
-        }
-        if (GPIOA..GPIOA + 11 * 0x400).contains(&addr) {
-            let n = (addr - GPIOA) / 0x400;
-            return Some((GPIOS[n as usize], Some((RCC_AHB1ENR, 1 << n))));
-        }
-        None
-    }
-
-    fn known(&self, name: &str, addr: u32) -> bool {
-        let off = addr & 0x3FF & !3;
-        match name {
-            "RCC" => {
-                off <= 0x90
-                    && !matches!(
-                        off,
-                        0x1C | 0x2C | 0x3C | 0x48 | 0x4C | 0x5C | 0x68 | 0x6C | 0x78 | 0x7C
-                    )
-            }
-            "FLASH" => off <= 0x1C,
-            "PWR" => off <= 0x1C,
-            "SYSCFG" => off <= 0x20,
-            _ if name.starts_with("GPIO") => off <= 0x24,
-            _ => false,
-        }
+/// Names of the F7's clock gates.
+fn gate_name(gate: (u32, u32)) -> &'static str {
+    match gate {
+        (RCC_APB1ENR, m) if m == 1 << 25 => "RCC_APB1ENR.CAN1EN",
+        (RCC_APB1ENR, m) if m == 1 << 26 => "RCC_APB1ENR.CAN2EN",
+        (RCC_APB1ENR, _) => "RCC_APB1ENR.PWREN",
+        (RCC_APB2ENR, _) => "RCC_APB2ENR.SYSCFGEN",
+        (RCC_AHB1ENR, _) => "RCC_AHB1ENR.GPIOxEN",
+        _ => "?",
     }
 }
 
@@ -320,88 +158,20 @@ impl Profile for Stm32f7 {
     }
 
     fn can_instances(&self) -> Vec<CanInstance> {
-        let can1 = CanInstance {
-            name: "CAN1",
-            base: 0x4000_6400,
-            size: 0x400,
-            gate: (RCC_APB1ENR, 1 << 25),
-            kind: CanKind::BxCan { instance: 1 },
-            irqs: vec![("TX", 19), ("RX0", 20), ("RX1", 21), ("SCE", 22)],
-        };
-        let can2 = CanInstance {
-            name: "CAN2",
-            base: 0x4000_6800,
-            size: 0x400,
-            gate: (RCC_APB1ENR, 1 << 26),
-            kind: CanKind::BxCan { instance: 2 },
-            irqs: vec![("TX", 63), ("RX0", 64), ("RX1", 65), ("SCE", 66)],
-        };
-        vec![can1, can2]
+        // CAN1 and CAN2 (CAN3 of the F767 is not routed: its own block, another window).
+        super::bxcan_instances(self.part(), &[1, 2])
     }
 
     fn read(&mut self, addr: u32, size: usize, _ctx: Ctx) -> Access {
-        let Some((name, gate)) = self.peripheral(addr) else {
-            return Access::Unmapped;
-        };
-        if let Some(g) = gate {
-            if !self.gate_open(g) {
-                return Access::Gated {
-                    peripheral: name,
-                    gate: self.gate_name(g),
-                };
-            }
-        }
-        self.settle();
-        let v = self.regs.read(addr, size);
-        if self.known(name, addr) {
-            Access::Known(v)
-        } else {
-            Access::Unknown { peripheral: name }
-        }
+        let names = |g| gate_name(g);
+        self.sys.read(addr, size, names).unwrap_or(Access::Unmapped)
     }
 
     fn write(&mut self, addr: u32, size: usize, value: u32, _ctx: Ctx) -> Access {
-        let Some((name, gate)) = self.peripheral(addr) else {
-            return Access::Unmapped;
-        };
-        if let Some(g) = gate {
-            if !self.gate_open(g) {
-                return Access::Gated {
-                    peripheral: name,
-                    gate: self.gate_name(g),
-                };
-            }
-        }
-        let known = self.known(name, addr);
-        let w = addr & !3;
-        if w == RCC_PLLCFGR && self.regs.get(RCC_CR) & (1 << 24) != 0 {
-            let old = self.regs.get(RCC_PLLCFGR);
-            let new = super::insert(old, addr, size, value);
-            if new != old {
-                self.findings
-                    .push("RCC_PLLCFGR changed while PLLON = 1 (RM0410 §5.3.2)".into());
-            }
-        }
-        if name.starts_with("GPIO") && (w & 0x3FF) == 0x18 {
-            // BSRR: set bits 0–15, reset bits 16–31 of ODR (write-only).
-            let v = super::insert(0, addr, size, value);
-            let odr = w - 0x18 + 0x14;
-            let cur = self.regs.get(odr);
-            self.regs.set(odr, (cur | (v & 0xFFFF)) & !(v >> 16));
-        } else if w == RCC_CFGR {
-            // SWS (bits 3:2) is read-only.
-            let sws = self.regs.get(RCC_CFGR) & (3 << 2);
-            let new = super::insert(self.regs.get(RCC_CFGR), addr, size, value);
-            self.regs.set(RCC_CFGR, (new & !(3 << 2)) | sws);
-        } else {
-            self.regs.write(addr, size, value);
-        }
-        self.settle();
-        if known {
-            Access::Known(0)
-        } else {
-            Access::Unknown { peripheral: name }
-        }
+        let names = |g| gate_name(g);
+        self.sys
+            .write(addr, size, value, names)
+            .unwrap_or(Access::Unmapped)
     }
 
     fn gated_access_is_bus_error(&self) -> bool {
@@ -409,21 +179,15 @@ impl Profile for Stm32f7 {
     }
 
     fn gate_open(&self, gate: (u32, u32)) -> bool {
-        self.regs.get(gate.0) & gate.1 != 0
+        self.sys.gate_open(gate)
     }
 
     fn gate_name(&self, gate: (u32, u32)) -> &'static str {
-        match gate {
-            (RCC_APB1ENR, m) if m == 1 << 25 => "RCC_APB1ENR.CAN1EN",
-            (RCC_APB1ENR, m) if m == 1 << 26 => "RCC_APB1ENR.CAN2EN",
-            (RCC_APB1ENR, _) => "RCC_APB1ENR.PWREN",
-            (RCC_APB2ENR, _) => "RCC_APB2ENR.SYSCFGEN",
-            _ => "RCC_AHB1ENR.GPIOxEN",
-        }
+        gate_name(gate)
     }
 
     fn core_hz(&self) -> u64 {
-        self.hclk()
+        self.sys.hclk()
     }
 
     fn can_clock_hz(&self, _can: &CanInstance) -> u64 {
@@ -435,7 +199,7 @@ impl Profile for Stm32f7 {
     }
 
     fn take_findings(&mut self) -> Vec<String> {
-        std::mem::take(&mut self.findings)
+        self.sys.take_findings()
     }
 }
 
