@@ -1,5 +1,5 @@
-//! Each bin gets the linker script of its chip family (flash at 0 for the Kinetis, at
-//! 0x0800_0000 for the STM32F7); nothing is linked for a host build.
+//! Each bin gets the linker script of its chip (flash at 0 for the Kinetis, at 0x0800_0000
+//! for the STM32F7, STM32F103C8 and STM32F446RE); nothing is linked for a host build.
 use std::env;
 use std::path::PathBuf;
 
@@ -7,6 +7,8 @@ fn main() {
     println!("cargo:rerun-if-changed=build.rs");
     println!("cargo:rerun-if-changed=kinetis.ld");
     println!("cargo:rerun-if-changed=stm32f7.ld");
+    println!("cargo:rerun-if-changed=stm32f103c8.ld");
+    println!("cargo:rerun-if-changed=stm32f446re.ld");
     if env::var("CARGO_CFG_TARGET_OS").as_deref() != Ok("none") {
         return;
     }
@@ -18,6 +20,10 @@ fn main() {
         ("core-check", "kinetis.ld"),
         ("stm32-gate", "stm32f7.ld"),
         ("stm32-stuck", "stm32f7.ld"),
+        ("bluepill-can", "stm32f103c8.ld"),
+        ("bluepill-gate", "stm32f103c8.ld"),
+        ("bluepill-stuck", "stm32f103c8.ld"),
+        ("nucleo-f446re-can", "stm32f446re.ld"),
     ] {
         println!(
             "cargo:rustc-link-arg-bin={bin}=-T{}",

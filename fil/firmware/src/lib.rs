@@ -88,6 +88,158 @@ pub unsafe fn kinetis_watchdog_off() {
     }
 }
 
+/// A bounded poll: whether `addr & mask` became non-zero (`set`) or zero (`!set`) within
+/// 1,000,000 reads (several quanta of the harness at any clock the boards run).
+///
+/// # Safety
+/// `addr` must be a readable register of the chip.
+pub unsafe fn wait(addr: u32, mask: u32, set: bool) -> bool {
+    for _ in 0..1_000_000 {
+        // SAFETY: the caller names a register.
+        if (unsafe { read32(addr) } & mask != 0) == set {
+            return true;
+        }
+    }
+    false
+}
+
+/// Sets the bits `bits` of a register (read-modify-write).
+///
+/// # Safety
+/// `addr` must be a readable and writable register of the chip.
+pub unsafe fn set_bits(addr: u32, bits: u32) {
+    // SAFETY: the caller names a register.
+    unsafe { write32(addr, read32(addr) | bits) }
+}
+
+/// The bxCAN register sequences the profile tests need, written from the reference
+/// manuals (RM0008 §24, RM0390 §30: the same registers on the F1 and the F4). No twocan
+/// API: these images stay valid whatever the driver becomes.
+pub mod bxcan {
+    use super::{read32, set_bits, wait, write32};
+
+    /// `CAN_MCR`.
+    pub const MCR: u32 = 0x000;
+    /// `CAN_MSR`.
+    pub const MSR: u32 = 0x004;
+    /// `CAN_TSR`.
+    pub const TSR: u32 = 0x008;
+    /// `CAN_RF0R` (`CAN_RF1R` at +4).
+    pub const RF0R: u32 = 0x00C;
+    /// `CAN_IER`.
+    pub const IER: u32 = 0x014;
+    /// `CAN_BTR`.
+    pub const BTR: u32 = 0x01C;
+    /// `CAN_TI0R`.
+    pub const TI0R: u32 = 0x180;
+    /// `CAN_RI0R` (FIFO 1 at +0x10).
+    pub const RI0R: u32 = 0x1B0;
+    /// `CAN_FMR`.
+    pub const FMR: u32 = 0x200;
+
+    /// Initialization mode from reset or sleep (`INRQ` = 1, `SLEEP` = 0; waits for `INAK`
+    /// and `SLAK` = 0, RM0008 §24.4.1). False on time-out.
+    ///
+    /// # Safety
+    /// `can` must be the base of a clocked bxCAN.
+    pub unsafe fn enter_init(can: u32) -> bool {
+        // SAFETY: bxCAN registers of the caller's controller.
+        unsafe {
+            write32(can + MCR, (read32(can + MCR) | 1) & !2);
+            wait(can + MSR, 1, true) && wait(can + MSR, 2, false)
+        }
+    }
+
+    /// Leaves initialization mode (`INRQ` = 0) and waits for `INAK` = 0, which takes 11
+    /// recessive bits on CANRX (RM0008 §24.4.2). False on time-out.
+    ///
+    /// # Safety
+    /// `can` must be the base of a clocked bxCAN in initialization mode.
+    pub unsafe fn leave_init(can: u32) -> bool {
+        // SAFETY: as above.
+        unsafe {
+            write32(can + MCR, read32(can + MCR) & !1);
+            wait(can + MSR, 1, false)
+        }
+    }
+
+    /// Filter bank `bank` of the block at `filters` (CAN1's) as a 32-bit mask filter that
+    /// accepts every frame into FIFO `fifo`, active (RM0008 §24.7.4, §24.9.4).
+    ///
+    /// # Safety
+    /// `filters` must be the base of a clocked bxCAN that owns a filter block with `bank`.
+    pub unsafe fn accept_all(filters: u32, bank: u32, fifo: u32) {
+        let bit = 1 << bank;
+        // SAFETY: filter registers of the caller's block, in the order §24.7.4 gives.
+        unsafe {
+            set_bits(filters + FMR, 1); // FINIT
+            set_bits(filters + 0x20C, bit); // FS1R: 32-bit
+            write32(filters + 0x204, read32(filters + 0x204) & !bit); // FM1R: mask mode
+            let ffa = read32(filters + 0x214) & !bit;
+            write32(filters + 0x214, ffa | if fifo == 1 { bit } else { 0 });
+            write32(filters + 0x240 + 8 * bank, 0);
+            write32(filters + 0x244 + 8 * bank, 0);
+            set_bits(filters + 0x21C, bit); // FA1R
+            write32(filters + FMR, read32(filters + FMR) & !1);
+        }
+    }
+
+    /// Loads transmit mailbox 0 with a standard data frame and requests it (RM0008
+    /// §24.7.1).
+    ///
+    /// # Safety
+    /// `can` must be the base of a clocked bxCAN whose mailbox 0 is empty.
+    pub unsafe fn send(can: u32, id: u32, data: [u8; 8], dlc: u32) {
+        // SAFETY: mailbox 0 registers of the caller's controller.
+        unsafe {
+            write32(can + TI0R + 4, dlc);
+            write32(
+                can + TI0R + 8,
+                u32::from_le_bytes([data[0], data[1], data[2], data[3]]),
+            );
+            write32(
+                can + TI0R + 12,
+                u32::from_le_bytes([data[4], data[5], data[6], data[7]]),
+            );
+            write32(can + TI0R, (id << 21) | 1);
+        }
+    }
+
+    /// The oldest frame of FIFO `fifo`, released: (standard identifier, first data word).
+    ///
+    /// # Safety
+    /// `can` must be the base of a clocked bxCAN.
+    pub unsafe fn receive(can: u32, fifo: u32) -> Option<(u32, u32)> {
+        let rfr = can + RF0R + 4 * fifo;
+        // SAFETY: FIFO registers of the caller's controller.
+        unsafe {
+            if read32(rfr) & 3 == 0 {
+                return None;
+            }
+            let id = read32(can + RI0R + 0x10 * fifo) >> 21;
+            let data = read32(can + RI0R + 0x10 * fifo + 8);
+            write32(rfr, 1 << 5); // RFOM
+            Some((id, data))
+        }
+    }
+
+    /// Acknowledges mailbox 0's request-completed flag; whether it was sent (`TXOK0`).
+    ///
+    /// # Safety
+    /// `can` must be the base of a clocked bxCAN.
+    pub unsafe fn take_tx0(can: u32) -> Option<bool> {
+        // SAFETY: CAN_TSR of the caller's controller (RQCP0 is rc_w1).
+        unsafe {
+            let tsr = read32(can + TSR);
+            if tsr & 1 == 0 {
+                return None;
+            }
+            write32(can + TSR, 1);
+            Some(tsr & 2 != 0)
+        }
+    }
+}
+
 #[cfg(target_os = "none")]
 #[panic_handler]
 fn panic(_: &core::panic::PanicInfo) -> ! {
