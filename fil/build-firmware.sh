@@ -48,4 +48,14 @@ mkdir -p "$out/negative"
 for bin in kinetis-gate kinetis-stuck kinetis-no-wdog core-check stm32-gate stm32-stuck; do
     cp "fil/firmware/target/$target/release/$bin" "$out/negative/"
 done
+# The board-profile test programs (raw registers, no twocan API): the NUCLEO-F446RE's
+# (Cortex-M4F, the build above) and the Blue Pill's, built for the Cortex-M3.
+mkdir -p "$out/nucleo-f446re" "$out/bluepill"
+cp "fil/firmware/target/$target/release/nucleo-f446re-can" "$out/nucleo-f446re/"
+m3=thumbv7m-none-eabi
+cargo build --quiet --release --target "$m3" --manifest-path fil/firmware/Cargo.toml \
+    --bin bluepill-can --bin bluepill-gate --bin bluepill-stuck
+for bin in bluepill-can bluepill-gate bluepill-stuck; do
+    cp "fil/firmware/target/$m3/release/$bin" "$out/bluepill/"
+done
 echo "firmware for the harness in $out"
