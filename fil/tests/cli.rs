@@ -55,7 +55,7 @@ fn two_boards_on_one_bus_with_a_trace() {
         "[nucleo-f767zi]",
         "instructions: ",
         "IRQ 75 (CAN0 ORed message buffer)",
-        "IRQ 20 (CAN1 RX0)",
+        "IRQ 20 (CAN1 CAN1_RX0)",
         "faults: none",
     ] {
         assert!(out.contains(want), "{want:?} missing in\n{out}");
