@@ -92,7 +92,10 @@ fn every_register_the_model_decodes_is_where_imxrt_ral_puts_it() {
         (Rt1062Can::Can3, can3),
     ] {
         let map = layout::register_map(Chip::Imxrt1062(can).variant());
-        assert_eq!(map.len(), 15 + 2 * 64 + if can == Rt1062Can::Can3 { 6 } else { 5 });
+        assert_eq!(
+            map.len(),
+            15 + 2 * 64 + if can == Rt1062Can::Can3 { 6 } else { 5 }
+        );
         for (name, offset) in &map {
             let ral = lookup(name).unwrap_or_else(|| panic!("{can:?}: {name} not in imxrt-ral"));
             assert_eq!(*offset, ral, "{can:?} {name}");

@@ -134,7 +134,11 @@ fn per_instance_registers() {
     assert_eq!(can1.read32(layout::CBT), 0);
     can3.modify32(regs::MCR, |v| v & !mcr::HALT);
     can3.write32(layout::CBT, 0);
-    assert_eq!(can3.read32(layout::CBT), layout::CBT_BTF | 0x55, "not out of freeze");
+    assert_eq!(
+        can3.read32(layout::CBT),
+        layout::CBT_BTF | 0x55,
+        "not out of freeze"
+    );
     // DBG1 is read-only.
     can1.write32(layout::DBG1, 0);
     assert_eq!(can1.read32(layout::DBG1), 0x0001_0000);
@@ -180,7 +184,13 @@ fn kinetis_has_no_upper_buffers() {
     let k = FlexCanModel::mk66fx1m0();
     k.modify32(regs::MCR, |v| v & !mcr::MDIS);
     assert_eq!(k.mode(), ModelMode::Freeze);
-    for off in [layout::IMASK2, mb_cs(16), mb_cs(16) + 4, rximr(16), layout::GFWR] {
+    for off in [
+        layout::IMASK2,
+        mb_cs(16),
+        mb_cs(16) + 4,
+        rximr(16),
+        layout::GFWR,
+    ] {
         k.write32(off, 0xFFFF_FFFF);
         assert_eq!(k.read32(off), 0, "0x{off:X}");
     }
@@ -237,7 +247,11 @@ fn mailboxes_32_to_63_flag_in_iflag2() {
     assert!(r.m.irq().message_buffer);
     assert!(r.m.irq().any(), "the one RT1062 line per module");
     r.wr(layout::IFLAG2, 1 << 30);
-    assert_eq!(r.rd(layout::IFLAG2), 1 << 31, "write 0/other bits: no change");
+    assert_eq!(
+        r.rd(layout::IFLAG2),
+        1 << 31,
+        "write 0/other bits: no change"
+    );
     r.wr(layout::IFLAG2, 1 << 31);
     assert_eq!(r.rd(layout::IFLAG2), 0);
     assert!(!r.m.irq().any());
@@ -305,7 +319,11 @@ fn upper_mailbox_receives_under_its_individual_mask() {
     assert_eq!(code_of(&r, 45), code::RX_FULL);
     assert_eq!(r.rd(layout::IFLAG2), 1 << 13);
     r.deliver(&std(0x220));
-    assert_eq!(r.m.frames_discarded(), 1, "0x220 differs in the compared bits");
+    assert_eq!(
+        r.m.frames_discarded(),
+        1,
+        "0x220 differs in the compared bits"
+    );
 }
 
 /// With MCR[IRMQ] = 0: RX14MASK for MB14, RX15MASK for MB15, RXMGMASK for every other
@@ -320,7 +338,11 @@ fn global_masks_without_irmq() {
     rx_mb(&mut r, 46, 0x046);
     run(&mut r);
     r.deliver(&std(0x046));
-    assert_eq!(code_of(&r, 14), code::RX_FULL, "MB14 accepts all (RX14MASK = 0)");
+    assert_eq!(
+        code_of(&r, 14),
+        code::RX_FULL,
+        "MB14 accepts all (RX14MASK = 0)"
+    );
     r.deliver(&std(0x046));
     assert_eq!(
         code_of(&r, 14),
@@ -473,7 +495,11 @@ fn soft_reset_clears_the_upper_flags_and_masks() {
     r.wr(layout::IMASK2, u32::MAX);
     assert_eq!(r.rd(layout::IFLAG2), 1 << 8);
     r.set_bits(regs::MCR, mcr::SOFTRST);
-    assert_eq!(r.rd(regs::MCR) & mcr::SOFTRST, 0, "done at once with the clock on");
+    assert_eq!(
+        r.rd(regs::MCR) & mcr::SOFTRST,
+        0,
+        "done at once with the clock on"
+    );
     assert_eq!(r.rd(layout::IFLAG2), 0);
     assert_eq!(r.rd(layout::IMASK2), 0);
     assert_eq!(r.m.mode(), ModelMode::Freeze);
@@ -510,7 +536,10 @@ fn two_modules_exchange_through_upper_buffers() {
     let mut a = rt(Rt1062Can::Can1);
     let b = FlexCanModel::imxrt1062(Rt1062Can::Can2);
     all_buffers(&mut a);
-    let mut rb = Rig { m: b.clone(), now: 0 };
+    let mut rb = Rig {
+        m: b.clone(),
+        now: 0,
+    };
     all_buffers(&mut rb);
     rx_mb(&mut rb, 61, 0x61);
     run(&mut a);
