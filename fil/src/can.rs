@@ -3,7 +3,8 @@
 
 use twocan_bxcan::model::BxCanModel;
 use twocan_core::registers::Registers;
-use twocan_flexcan::model::FlexCanModel;
+use twocan_flexcan::model::layout::{CBT, CBT_BTF};
+use twocan_flexcan::model::{Chip, FlexCanModel};
 
 use crate::profile::{CanInstance, CanKind};
 
@@ -34,11 +35,13 @@ impl Model {
     }
 
     /// Levels of the controller's lines, in the order of the profile's `irqs` list
-    /// (FlexCAN: message buffers, bus off, error, tx warning, rx warning, wake-up; bxCAN:
-    /// TX, RX0, RX1, SCE). The FlexCAN model ORs the two warning requests into one: the
-    /// harness drives the tx-warning vector with it.
+    /// (Kinetis FlexCAN: message buffers, bus off, error, tx warning, rx warning, wake-up;
+    /// i.MX RT1062 FlexCAN: its one line, the OR of all requests; bxCAN: TX, RX0, RX1,
+    /// SCE). The FlexCAN model ORs the two warning requests into one: the harness drives
+    /// the tx-warning vector with it.
     pub fn lines(&self) -> Vec<bool> {
         match self {
+            Model::FlexCan(m) if matches!(m.chip(), Chip::Imxrt1062(_)) => vec![m.irq().any()],
             Model::FlexCan(m) => {
                 let i = m.irq();
                 vec![
@@ -54,6 +57,22 @@ impl Model {
                 let l = m.irq_lines();
                 vec![l.tx, l.rx0, l.rx1, l.sce]
             }
+        }
+    }
+
+    /// `CTRL1[CLKSRC]` of a FlexCAN (false for bxCAN).
+    pub fn clksrc(&self) -> bool {
+        match self {
+            Model::FlexCan(m) => m.peek32(0x04) & (1 << 13) != 0,
+            Model::BxCan(_) => false,
+        }
+    }
+
+    /// Gives a FlexCAN's protocol engine its clock or takes it away (bxCAN: nothing; its
+    /// clock is the register clock).
+    pub fn set_engine_clock(&self, clocked: bool) {
+        if let Model::FlexCan(m) = self {
+            m.set_freeze_ack_stuck(!clocked);
         }
     }
 
@@ -84,17 +103,28 @@ impl Model {
         match self {
             Model::FlexCan(m) => {
                 let ctrl1 = m.peek32(0x04);
-                let presdiv = u64::from(ctrl1 >> 24) + 1;
-                let pseg1 = u64::from((ctrl1 >> 19) & 7) + 1;
-                let pseg2 = u64::from((ctrl1 >> 16) & 7) + 1;
-                let propseg = u64::from(ctrl1 & 7) + 1;
+                // CBT[BTF] = 1 (RT1062 CAN3, IMXRT1060RM "CAN Bit Timing register"):
+                // EPRESDIV (30–21), EPROPSEG (15–10), EPSEG1 (9–5), EPSEG2 (4–0) replace
+                // CTRL1's fields. CBT reads 0 on the modules that lack it.
+                let cbt = m.peek32(CBT);
+                let (presdiv, propseg, pseg1, pseg2) = if cbt & CBT_BTF != 0 {
+                    (
+                        (cbt >> 21) & 0x3FF,
+                        (cbt >> 10) & 0x3F,
+                        (cbt >> 5) & 0x1F,
+                        cbt & 0x1F,
+                    )
+                } else {
+                    (ctrl1 >> 24, ctrl1 & 7, (ctrl1 >> 19) & 7, (ctrl1 >> 16) & 7)
+                };
                 let clk = if ctrl1 & (1 << 13) != 0 {
                     bus_hz
                 } else {
                     can_hz
                 };
-                let tq = 1 + propseg + pseg1 + pseg2;
-                (clk > 0).then(|| clk / (presdiv * tq))
+                let tq =
+                    1 + (u64::from(propseg) + 1) + (u64::from(pseg1) + 1) + (u64::from(pseg2) + 1);
+                (clk > 0).then(|| clk / ((u64::from(presdiv) + 1) * tq))
             }
             Model::BxCan(m) => {
                 let btr = m.read32(0x1C);
