@@ -1,5 +1,6 @@
 //! Each bin gets the linker script of its chip family (flash at 0 for the Kinetis, at
-//! 0x0800_0000 for the STM32F7); nothing is linked for a host build.
+//! 0x0800_0000 for the STM32F7, a FlexSPI boot image at 0x6000_0000 for the i.MX
+//! RT1062); nothing is linked for a host build.
 use std::env;
 use std::path::PathBuf;
 
@@ -7,6 +8,7 @@ fn main() {
     println!("cargo:rerun-if-changed=build.rs");
     println!("cargo:rerun-if-changed=kinetis.ld");
     println!("cargo:rerun-if-changed=stm32f7.ld");
+    println!("cargo:rerun-if-changed=imxrt1062.ld");
     if env::var("CARGO_CFG_TARGET_OS").as_deref() != Ok("none") {
         return;
     }
@@ -18,6 +20,10 @@ fn main() {
         ("core-check", "kinetis.ld"),
         ("stm32-gate", "stm32f7.ld"),
         ("stm32-stuck", "stm32f7.ld"),
+        ("imxrt-boot", "imxrt1062.ld"),
+        ("imxrt-gate", "imxrt1062.ld"),
+        ("imxrt-stuck", "imxrt1062.ld"),
+        ("imxrt-no-can-clock", "imxrt1062.ld"),
     ] {
         println!(
             "cargo:rustc-link-arg-bin={bin}=-T{}",

@@ -508,8 +508,8 @@ fn soft_reset_clears_the_upper_flags_and_masks() {
     assert_eq!(code_of(&r, 40), code::TX_INACTIVE);
 }
 
-/// The RT1062's FlexCAN errata as data (IMXRT1060CE; NXP's MIMXRT1062 feature list marks
-/// 5829, 6032 and 9595, not 5641) and the buffer counts of both families.
+/// The RT1062's FlexCAN errata as data (NXP's MIMXRT1062 feature list marks 5829, 6032
+/// and 9595, not 5641) and the buffer counts of both families.
 #[test]
 fn variant_descriptors() {
     let rt = Chip::Imxrt1062(Rt1062Can::Can3).variant();

@@ -638,7 +638,10 @@ impl<'a> Machine<'a> {
                 b.wfi = false;
                 b.check_irq = true;
             }
-            let result = self.uc.emu_start(u64::from(pc | 1), 0, 0, 0);
+            // `until` is an address Unicorn stops at before executing it: none that a
+            // 32-bit core can reach (0 would stop code placed at address 0, as the
+            // i.MX RT's ITCM code is). The harness stops the CPU itself (`emu_stop`).
+            let result = self.uc.emu_start(u64::from(pc | 1), u64::MAX, 0, 0);
             self.uc.get_data_mut().rebase();
             let pending = self.uc.get_data_mut().pending_fault.take();
             if let Some((kind, fpc, addr)) = pending {

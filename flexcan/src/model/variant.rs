@@ -116,8 +116,9 @@ pub const MK66FX1M0: Variant = Variant {
     ..MK20DX256
 };
 
-/// Errata of the RT1062's FlexCAN modules (IMXRT1060CE; listed as "affected" by NXP's
-/// `MIMXRT1062_features.h`: 5829, 6032 and 9595, not 5641).
+/// Errata of the RT1062's FlexCAN modules, as NXP's `MIMXRT1062_features.h` flags them
+/// ("is affected by errata": 5829, 6032 and 9595, not 5641; the errata sheet IMXRT1060CE
+/// itself not checked).
 const RT1062_ERRATA: &[Erratum] = &[Erratum::E5829, Erratum::E6032, Erratum::E9595];
 
 /// CAN1 and CAN2 of the i.MX RT1062 (Teensy 4.0/4.1): 64 message buffers, classic CAN,
