@@ -186,14 +186,11 @@ mod tests {
         assert_eq!(can3.programmed_bit_rate(24_000_000, 0), Some(400_000));
         // CBT: EPROPSEG 10, EPSEG1 7, EPSEG2 4 → 1 + 11 + 8 + 5 = 25 tq;
         // EPRESDIV 3 (÷4): 80 MHz / (4 × 25) = 800 kbit/s.
-        can3.write32(
-            CBT as usize,
-            CBT_BTF | (3 << 21) | (10 << 10) | (7 << 5) | 4,
-        );
+        can3.write32(CBT, CBT_BTF | (3 << 21) | (10 << 10) | (7 << 5) | 4);
         assert_eq!(can3.programmed_bit_rate(80_000_000, 0), Some(800_000));
         let mut can1 = Model::FlexCan(FlexCanModel::imxrt1062(Rt1062Can::Can1));
         can1.write32(0x04, (4 << 24) | (3 << 19) | (3 << 16) | 2);
-        can1.write32(CBT as usize, CBT_BTF | (3 << 21));
+        can1.write32(CBT, CBT_BTF | (3 << 21));
         assert_eq!(can1.programmed_bit_rate(24_000_000, 0), Some(400_000));
         assert_eq!(can1.lines(), vec![false], "one line per RT1062 module");
     }
