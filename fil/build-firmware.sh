@@ -45,7 +45,8 @@ cargo build --quiet --release --target "$target" -p twocan-stm32f7 \
 cp "$rel/stm32f7-app" "$out/nucleo-f767zi/stm32f7-app-250k"
 cargo build --quiet --release --target "$target" --manifest-path fil/firmware/Cargo.toml
 mkdir -p "$out/negative"
-for bin in kinetis-gate kinetis-stuck kinetis-no-wdog core-check stm32-gate stm32-stuck; do
+for bin in kinetis-gate kinetis-stuck kinetis-no-wdog core-check stm32-gate stm32-stuck \
+    imxrt-boot imxrt-gate imxrt-stuck imxrt-no-can-clock; do
     cp "fil/firmware/target/$target/release/$bin" "$out/negative/"
 done
 # The board-profile test programs (raw registers, no twocan API): the NUCLEO-F446RE's
@@ -58,4 +59,7 @@ cargo build --quiet --release --target "$m3" --manifest-path fil/firmware/Cargo.
 for bin in bluepill-can bluepill-gate bluepill-stuck; do
     cp "fil/firmware/target/$m3/release/$bin" "$out/bluepill/"
 done
+# Teensy 4.1 (i.MX RT1062): the examples' ELFs go to $out/teensy41/ once examples/teensy
+# builds them (issue 24); the teensy41 profile's own test firmwares are the imxrt-* above.
+mkdir -p "$out/teensy41"
 echo "firmware for the harness in $out"

@@ -3,7 +3,8 @@
 
 use twocan_bxcan::model::BxCanModel;
 use twocan_core::registers::Registers;
-use twocan_flexcan::model::FlexCanModel;
+use twocan_flexcan::model::layout::{CBT, CBT_BTF};
+use twocan_flexcan::model::{Chip, FlexCanModel};
 
 use crate::profile::{CanInstance, CanKind};
 
@@ -34,11 +35,13 @@ impl Model {
     }
 
     /// Levels of the controller's lines, in the order of the profile's `irqs` list
-    /// (FlexCAN: message buffers, bus off, error, tx warning, rx warning, wake-up; bxCAN:
-    /// TX, RX0, RX1, SCE). The FlexCAN model ORs the two warning requests into one: the
-    /// harness drives the tx-warning vector with it.
+    /// (Kinetis FlexCAN: message buffers, bus off, error, tx warning, rx warning, wake-up;
+    /// i.MX RT1062 FlexCAN: its one line, the OR of all requests; bxCAN: TX, RX0, RX1,
+    /// SCE). The FlexCAN model ORs the two warning requests into one: the harness drives
+    /// the tx-warning vector with it.
     pub fn lines(&self) -> Vec<bool> {
         match self {
+            Model::FlexCan(m) if matches!(m.chip(), Chip::Imxrt1062(_)) => vec![m.irq().any()],
             Model::FlexCan(m) => {
                 let i = m.irq();
                 vec![
@@ -54,6 +57,22 @@ impl Model {
                 let l = m.irq_lines();
                 vec![l.tx, l.rx0, l.rx1, l.sce]
             }
+        }
+    }
+
+    /// `CTRL1[CLKSRC]` of a FlexCAN (false for bxCAN).
+    pub fn clksrc(&self) -> bool {
+        match self {
+            Model::FlexCan(m) => m.peek32(0x04) & (1 << 13) != 0,
+            Model::BxCan(_) => false,
+        }
+    }
+
+    /// Gives a FlexCAN's protocol engine its clock or takes it away (bxCAN: nothing; its
+    /// clock is the register clock).
+    pub fn set_engine_clock(&self, clocked: bool) {
+        if let Model::FlexCan(m) = self {
+            m.set_freeze_ack_stuck(!clocked);
         }
     }
 
@@ -84,17 +103,28 @@ impl Model {
         match self {
             Model::FlexCan(m) => {
                 let ctrl1 = m.peek32(0x04);
-                let presdiv = u64::from(ctrl1 >> 24) + 1;
-                let pseg1 = u64::from((ctrl1 >> 19) & 7) + 1;
-                let pseg2 = u64::from((ctrl1 >> 16) & 7) + 1;
-                let propseg = u64::from(ctrl1 & 7) + 1;
+                // CBT[BTF] = 1 (RT1062 CAN3, IMXRT1060RM "CAN Bit Timing register"):
+                // EPRESDIV (30–21), EPROPSEG (15–10), EPSEG1 (9–5), EPSEG2 (4–0) replace
+                // CTRL1's fields. CBT reads 0 on the modules that lack it.
+                let cbt = m.peek32(CBT);
+                let (presdiv, propseg, pseg1, pseg2) = if cbt & CBT_BTF != 0 {
+                    (
+                        (cbt >> 21) & 0x3FF,
+                        (cbt >> 10) & 0x3F,
+                        (cbt >> 5) & 0x1F,
+                        cbt & 0x1F,
+                    )
+                } else {
+                    (ctrl1 >> 24, ctrl1 & 7, (ctrl1 >> 19) & 7, (ctrl1 >> 16) & 7)
+                };
                 let clk = if ctrl1 & (1 << 13) != 0 {
                     bus_hz
                 } else {
                     can_hz
                 };
-                let tq = 1 + propseg + pseg1 + pseg2;
-                (clk > 0).then(|| clk / (presdiv * tq))
+                let tq =
+                    1 + (u64::from(propseg) + 1) + (u64::from(pseg1) + 1) + (u64::from(pseg2) + 1);
+                (clk > 0).then(|| clk / ((u64::from(presdiv) + 1) * tq))
             }
             Model::BxCan(m) => {
                 let btr = m.read32(0x1C);
@@ -137,4 +167,29 @@ pub fn ports(instances: &[CanInstance]) -> Vec<Port> {
         });
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use twocan_flexcan::model::Rt1062Can;
+
+    /// CAN3's `CBT` (BTF = 1) replaces `CTRL1`'s timing fields; CAN1 has no `CBT`.
+    #[test]
+    fn flexcan_bit_rate_from_ctrl1_or_cbt() {
+        let mut can3 = Model::FlexCan(FlexCanModel::imxrt1062(Rt1062Can::Can3));
+        // CTRL1 (in Freeze mode out of reset): PRESDIV 4 (÷5), PROPSEG 2, PSEG1 3, PSEG2 3
+        // → 1 + 3 + 4 + 4 = 12 tq: 24 MHz / 60 = 400 kbit/s.
+        can3.write32(0x04, (4 << 24) | (3 << 19) | (3 << 16) | 2);
+        assert_eq!(can3.programmed_bit_rate(24_000_000, 0), Some(400_000));
+        // CBT: EPROPSEG 10, EPSEG1 7, EPSEG2 4 → 1 + 11 + 8 + 5 = 25 tq;
+        // EPRESDIV 3 (÷4): 80 MHz / (4 × 25) = 800 kbit/s.
+        can3.write32(CBT, CBT_BTF | (3 << 21) | (10 << 10) | (7 << 5) | 4);
+        assert_eq!(can3.programmed_bit_rate(80_000_000, 0), Some(800_000));
+        let mut can1 = Model::FlexCan(FlexCanModel::imxrt1062(Rt1062Can::Can1));
+        can1.write32(0x04, (4 << 24) | (3 << 19) | (3 << 16) | 2);
+        can1.write32(CBT, CBT_BTF | (3 << 21));
+        assert_eq!(can1.programmed_bit_rate(24_000_000, 0), Some(400_000));
+        assert_eq!(can1.lines(), vec![false], "one line per RT1062 module");
+    }
 }

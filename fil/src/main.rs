@@ -15,7 +15,7 @@ use twocan_fil::profile::{self, BOARDS};
 use twocan_fil::report;
 use twocan_fil::world::World;
 
-const USAGE: &str = "usage: can-fil --board BOARD ELF [--board BOARD ELF ...] --seconds S [--bitrate B] [--trace FILE] [--quantum-us Q] [--traffic ID,PERIOD_MS[,BITRATE] ...]\nboards: teensy32 teensy35 teensy36 nucleo-f767zi disco-f746g bluepill nucleo-f446re";
+const USAGE: &str = "usage: can-fil --board BOARD ELF [--board BOARD ELF ...] --seconds S [--bitrate B] [--trace FILE] [--quantum-us Q] [--traffic ID,PERIOD_MS[,BITRATE] ...]\nboards: teensy32 teensy35 teensy36 nucleo-f767zi disco-f746g bluepill nucleo-f446re teensy41";
 
 struct Args {
     boards: Vec<(String, String)>,

@@ -286,10 +286,17 @@ impl<'a> World<'a> {
                 continue;
             }
             let can_hz = board.profile.can_clock_hz(&port.instance);
-            let bus_hz = board.profile.core_hz();
+            let bus_hz = board.profile.can_bus_clock_hz(&port.instance);
             let Some(rate) = port.model.programmed_bit_rate(can_hz, bus_hz) else {
                 continue;
             };
+            let pins = board.profile.can_pins(&port.instance);
+            let name = port.instance.name;
+            if let Err(missing) = pins {
+                self.machines[a.board].board_mut().findings.push(format!(
+                    "{name} joined the bus with its pins not routed to it: {missing}"
+                ));
+            }
             self.attached[i].bit_rate = Some(rate);
             let (board, port) = (self.attached[i].board, self.attached[i].port);
             let b = self.machines[board].board_mut();

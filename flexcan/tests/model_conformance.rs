@@ -1,6 +1,7 @@
 //! The fault-confinement conformance table (`can-core/tests/conformance/mod.rs`) on the
 //! FlexCAN model, driven through its registers (automatic bus-off recovery:
-//! CTRL1\[BOFFREC\] = 0).
+//! CTRL1\[BOFFREC\] = 0): as the Kinetis K20 module and as the i.MX RT1062's CAN1
+//! (module `rt1062`; same register procedure, the RT1062 leaves reset in Freeze mode).
 
 #[path = "../../can-core/tests/conformance/mod.rs"]
 mod conformance;
@@ -12,14 +13,19 @@ use support::Rig;
 use twocan_core::registers::Registers;
 use twocan_core::sim::{Bus, NodeId};
 use twocan_core::{ErrorCounters, ErrorState, Frame};
-use twocan_flexcan::model::FlexCanModel;
+use twocan_flexcan::model::{FlexCanModel, Rt1062Can};
 use twocan_flexcan::regs::{self, code, cs, ecr, esr1, mcr};
 
-struct FlexCan(FlexCanModel);
+/// The model as the K20's FlexCAN0 (`RT1062 = false`) or the RT1062's CAN1.
+struct FlexCan<const RT1062: bool>(FlexCanModel);
 
-impl Dut for FlexCan {
+impl<const RT1062: bool> Dut for FlexCan<RT1062> {
     fn join(bus: &mut Bus) -> (Self, NodeId) {
-        let m = FlexCanModel::mk20dx256();
+        let m = if RT1062 {
+            FlexCanModel::imxrt1062(Rt1062Can::Can1)
+        } else {
+            FlexCanModel::mk20dx256()
+        };
         m.modify32(regs::MCR, |v| v & !mcr::MDIS);
         m.modify32(regs::MCR, |v| v | mcr::RFEN | mcr::IRMQ | mcr::SRXDIS);
         for n in 0..8 {
@@ -79,4 +85,10 @@ impl Dut for FlexCan {
     const REC_AFTER_PASSIVE_RECEPTION: u16 = 127;
 }
 
-conformance_tests!(FlexCan);
+conformance_tests!(FlexCan<false>);
+
+mod rt1062 {
+    use super::{conformance, FlexCan};
+
+    crate::conformance_tests!(FlexCan<true>);
+}

@@ -233,6 +233,15 @@ impl Board {
         }
     }
 
+    /// Gives CAN controller `i` its protocol-engine clock or takes it away, as the
+    /// profile's clock tree says now (no clock: no mode handshake completes).
+    fn clock_can_engine(&mut self, i: usize) {
+        let port = &self.cans[i];
+        let clksrc = port.model.clksrc();
+        let clocked = self.profile.can_engine_clocked(&port.instance, clksrc);
+        port.model.set_engine_clock(clocked);
+    }
+
     fn note_unknown(&mut self, addr: u32, peripheral: &'static str, dir: &'static str) {
         let pc = self.pc;
         self.unknown.entry(addr).or_insert((pc, peripheral, dir));
@@ -534,8 +543,30 @@ impl<'a> Machine<'a> {
         Ok(machine)
     }
 
-    /// Reset (B1.5.5): SP and PC from the vector table at the boot address.
+    /// Reset (B1.5.5): SP and PC from the vector table at the boot address — or where
+    /// the chip's boot ROM starts the image ([`Profile::boot`]); an image the ROM refuses
+    /// halts the board with the ROM's reason.
     fn reset(&mut self) -> Result<(), String> {
+        let boot = {
+            let uc = &self.uc;
+            let read = |a: u32| read_u32(uc, a);
+            uc.get_data().profile.boot(&read)
+        };
+        match boot {
+            Ok(Some(b)) => {
+                self.uc.get_data_mut().scb.vtor = b.vtor;
+                set_reg(&mut self.uc, RegisterARM::MSP, b.sp);
+                set_reg(&mut self.uc, RegisterARM::SP, b.sp);
+                set_reg(&mut self.uc, RegisterARM::PC, b.pc | 1);
+                return Ok(());
+            }
+            Ok(None) => {}
+            Err(why) => {
+                let b = self.uc.get_data_mut();
+                b.halted = Some(format!("boot ROM: {why}"));
+                return Ok(());
+            }
+        }
         let vtor = self.uc.get_data().scb.vtor;
         let sp = read_u32(&self.uc, vtor).ok_or("no vector table at the boot address")?;
         let pc = read_u32(&self.uc, vtor + 4).ok_or("no reset vector")?;
@@ -607,7 +638,10 @@ impl<'a> Machine<'a> {
                 b.wfi = false;
                 b.check_irq = true;
             }
-            let result = self.uc.emu_start(u64::from(pc | 1), 0, 0, 0);
+            // `until` is an address Unicorn stops at before executing it: none that a
+            // 32-bit core can reach (0 would stop code placed at address 0, as the
+            // i.MX RT's ITCM code is). The harness stops the CPU itself (`emu_stop`).
+            let result = self.uc.emu_start(u64::from(pc | 1), u64::MAX, 0, 0);
             self.uc.get_data_mut().rebase();
             let pending = self.uc.get_data_mut().pending_fault.take();
             if let Some((kind, fpc, addr)) = pending {

@@ -29,6 +29,7 @@ pub(super) fn periph_read(uc: &mut Unicorn<'_, Board>, addr: u32, size: usize) -
             }
             return 0;
         }
+        b.clock_can_engine(i);
         let off = (addr - b.cans[i].instance.base) as usize;
         let word = b.cans[i].model.read32(off & !3);
         b.refresh_can_lines();
@@ -88,6 +89,7 @@ pub(super) fn periph_write(uc: &mut Unicorn<'_, Board>, addr: u32, size: usize, 
             }
             return;
         }
+        b.clock_can_engine(i);
         let off = (addr - b.cans[i].instance.base) as usize;
         let v = if size == 4 {
             value

@@ -7,6 +7,7 @@
 //! (reported, behaves as plain storage so that the run goes on), an access to a gated
 //! peripheral or to unmapped space (a bus error, which the core turns into a fault).
 
+pub mod imxrt1062;
 pub mod kinetis;
 pub mod stm32_rcc;
 pub mod stm32f1;
@@ -31,10 +32,22 @@ pub struct Memory {
     pub alias_of: Option<u32>,
 }
 
+/// Where the core starts, as a boot ROM leaves it (chips whose ROM reads a boot image
+/// instead of the core reading a vector table at its reset VTOR).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Boot {
+    /// Initial main stack pointer.
+    pub sp: u32,
+    /// First instruction (Thumb bit set or not).
+    pub pc: u32,
+    /// VTOR as the ROM leaves it.
+    pub vtor: u32,
+}
+
 /// The family of CAN controller of an instance.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum CanKind {
-    /// NXP FlexCAN of a Kinetis chip.
+    /// NXP FlexCAN of a Kinetis or i.MX RT chip.
     FlexCan(twocan_flexcan::model::Chip),
     /// ST bxCAN: CAN1 (master of the filter block) or CAN2.
     BxCan {
@@ -141,6 +154,14 @@ pub trait Profile {
     fn memory(&self) -> Vec<Memory>;
     /// Where the vector table is at reset (VTOR's reset value, after the boot aliasing).
     fn boot_address(&self) -> u32;
+    /// What a boot ROM does before the firmware runs, read from the loaded image
+    /// (`read` gives a word of target memory): `Ok(None)` where the core starts from the
+    /// vector table at [`Profile::boot_address`] (ARMv7-M B1.5.5), `Err` with the reason
+    /// where the ROM would refuse the image (the board then halts).
+    fn boot(&self, read: &dyn Fn(u32) -> Option<u32>) -> Result<Option<Boot>, String> {
+        let _ = read;
+        Ok(None)
+    }
     /// Number of external interrupts.
     fn irq_count(&self) -> u32;
     /// Implemented NVIC priority bits.
@@ -166,6 +187,23 @@ pub trait Profile {
     fn core_hz(&self) -> u64;
     /// The clock of a CAN instance's protocol engine now (Hz), for decoding its bit timing.
     fn can_clock_hz(&self, can: &CanInstance) -> u64;
+    /// The peripheral (bus) clock a FlexCAN takes with `CTRL1[CLKSRC]` = 1 (Hz).
+    fn can_bus_clock_hz(&self, can: &CanInstance) -> u64 {
+        let _ = can;
+        self.core_hz()
+    }
+    /// Whether the protocol engine of `can` has a clock now (`clksrc`: its
+    /// `CTRL1[CLKSRC]`). Without one no mode handshake of the controller completes.
+    fn can_engine_clocked(&self, can: &CanInstance, clksrc: bool) -> bool {
+        let _ = (can, clksrc);
+        true
+    }
+    /// Whether the pins of `can` are routed to it (pad multiplexing, input selection);
+    /// `Err` with what is missing. Checked when the controller joins the bus.
+    fn can_pins(&self, can: &CanInstance) -> Result<(), String> {
+        let _ = can;
+        Ok(())
+    }
     /// SysTick's external reference divider from the core clock (`CSR.CLKSOURCE = 0`),
     /// `None` where the chip has none.
     fn systick_external_divider(&self) -> Option<u64>;
@@ -243,12 +281,13 @@ pub fn by_name(name: &str) -> Option<Box<dyn Profile>> {
         "disco-f746g" => Some(Box::new(stm32f7::Stm32f7::new(stm32f7::Chip::F746))),
         "bluepill" => Some(Box::new(stm32f1::Stm32f1::new())),
         "nucleo-f446re" => Some(Box::new(stm32f4::Stm32f4::new())),
+        "teensy41" => Some(Box::new(imxrt1062::Imxrt1062::new())),
         _ => None,
     }
 }
 
 /// Every board name [`by_name`] knows.
-pub const BOARDS: [&str; 7] = [
+pub const BOARDS: [&str; 8] = [
     "teensy32",
     "teensy35",
     "teensy36",
@@ -256,6 +295,7 @@ pub const BOARDS: [&str; 7] = [
     "disco-f746g",
     "bluepill",
     "nucleo-f446re",
+    "teensy41",
 ];
 
 #[cfg(test)]

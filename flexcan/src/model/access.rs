@@ -16,15 +16,22 @@
 //! Read side effects: ESR1 clears its error bits; a C/S word read locks that mailbox;
 //! TIMER read unlocks. Unaligned, reserved and unimplemented offsets read 0 and ignore
 //! writes; reserved bits read 0.
+//!
+//! What the variants add ([`super::variant`]; IMXRT1060RM FlexCAN memory map and field
+//! descriptions):
+//! - RT1062: 64 message buffers (0x80–0x47F), RXIMR0–63 (0x880–0x97F), IMASK2 (any time)
+//!   and IFLAG2 (write 1 to clear) for MB32–MB63; IMASK1/IFLAG1 have 32 bits.
+//! - CAN1/CAN2: DBG1/DBG2 read-only (their reset values: the protocol engine's debug
+//!   state is not modelled), GFWR (8 bits, Freeze mode only), no CTRL1\[CLKSRC\] (reads 0).
+//! - CAN3: CBT (Freeze mode only, stored), FDCTRL/FDCBT/FDCRC read their reset values and
+//!   ignore writes, MCR\[FDEN\] stays 0 (classic CAN only).
 
-use crate::regs::{
-    self, ctrl1, ctrl2, iflag1, imask1, mcr, timer, MB_BASE, MB_STRIDE, NUM_MB, RXIMR_BASE,
-    RX_FIFO_FILTER_BASE,
-};
+use crate::regs::{self, ctrl1, ctrl2, iflag1, mcr, timer};
 
+use super::layout::{self, MB0, MB_BYTES, RXIMR0};
 use super::modes::MCR_STORED;
 use super::state::State;
-use super::Chip;
+use super::variant;
 
 /// MCR bits writable at any time.
 const MCR_ANY_TIME: u32 = mcr::MDIS | mcr::FRZ | mcr::HALT | mcr::WAKMSK | mcr::SLFWAK;
@@ -50,23 +57,71 @@ const CTRL2_BITS: u32 = ctrl2::WRMFRZ
     | ctrl2::MRP
     | ctrl2::RRS
     | ctrl2::EACEN;
-/// IFLAG1/IMASK1 bits that exist (one per MB).
-const MB_BITS: u32 = imask1::IMPLEMENTED;
-
-/// End of the message buffer RAM.
-const MB_END: usize = MB_BASE + NUM_MB * MB_STRIDE;
-/// End of the RXIMR registers.
-const RXIMR_END: usize = RXIMR_BASE + 4 * NUM_MB;
+/// GFWR's field (bits 7–0).
+const GFWR_BITS: u32 = 0xFF;
+/// The Rx FIFO engine's area: MB0–MB5 (0x80–0xDF); the ID filter table starts after it.
+pub(crate) const RX_FIFO_FILTER_BASE: usize = MB0 + 6 * MB_BYTES;
 
 impl State {
     /// MCR bits writable in Freeze mode only, for this chip.
     fn mcr_freeze_bits(&self) -> u32 {
-        let waksrc = if self.chip == Chip::Mk20dx256 {
-            mcr::WAKSRC
-        } else {
-            0
-        };
+        let waksrc = if self.variant.waksrc { 0 } else { mcr::WAKSRC };
         MCR_STORED & !MCR_ANY_TIME & !waksrc
+    }
+
+    /// End of the message buffer RAM.
+    fn mb_end(&self) -> usize {
+        MB0 + self.mbs() * MB_BYTES
+    }
+
+    /// End of the RXIMR registers.
+    fn rximr_end(&self) -> usize {
+        RXIMR0 + 4 * self.mbs()
+    }
+
+    /// Registers only some variants have; `None` if `offset` is not one of them here.
+    fn extra_read(&self, offset: usize) -> Option<u32> {
+        let x = &self.variant.extras;
+        let flags2 = self.variant.flags2_implemented() != 0;
+        Some(match offset {
+            layout::IMASK2 if flags2 => (self.imask >> 32) as u32,
+            layout::IFLAG2 if flags2 => (self.iflag >> 32) as u32,
+            layout::DBG1 if x.debug => variant::DBG1_RESET,
+            layout::DBG2 if x.debug => 0,
+            layout::GFWR if x.gfwr => self.gfwr,
+            layout::CBT if x.cbt => self.cbt,
+            layout::FDCTRL if x.can_fd => variant::FDCTRL_RESET,
+            layout::FDCBT | layout::FDCRC if x.can_fd => 0,
+            _ => return None,
+        })
+    }
+
+    /// Writes to registers only some variants have; false if `offset` is not one of them.
+    fn extra_write(&mut self, offset: usize, value: u32, freeze: bool) -> bool {
+        let x = self.variant.extras;
+        let flags2 = self.variant.flags2_implemented();
+        match offset {
+            layout::IMASK2 if flags2 != 0 => {
+                self.imask = (self.imask & 0xFFFF_FFFF) | (u64::from(value & flags2) << 32);
+            }
+            layout::IFLAG2 if flags2 != 0 => self.iflag &= !(u64::from(value & flags2) << 32),
+            layout::GFWR if x.gfwr => {
+                if freeze {
+                    self.gfwr = value & GFWR_BITS;
+                }
+            }
+            layout::CBT if x.cbt => {
+                if freeze {
+                    self.cbt = value;
+                }
+            }
+            // DBG1/DBG2 and FDCRC are read-only; FDCTRL and FDCBT keep their reset values
+            // (classic CAN only).
+            layout::DBG1 | layout::DBG2 if x.debug => {}
+            layout::FDCTRL | layout::FDCBT | layout::FDCRC if x.can_fd => {}
+            _ => return false,
+        }
+        true
     }
 
     /// Reads the register at `offset`; `side_effects` false peeks without them.
@@ -74,6 +129,10 @@ impl State {
         if !offset.is_multiple_of(4) {
             return 0;
         }
+        if let Some(v) = self.extra_read(offset) {
+            return v;
+        }
+        let (mb_end, rximr_end) = (self.mb_end(), self.rximr_end());
         match offset {
             regs::MCR => self.mcr_value(),
             regs::CTRL1 => self.ctrl1,
@@ -94,13 +153,13 @@ impl State {
                     self.esr1_value()
                 }
             }
-            regs::IMASK1 => self.imask1,
+            regs::IMASK1 => self.imask as u32,
             regs::IFLAG1 => self.iflag1_value(),
             regs::CTRL2 => self.ctrl2,
             regs::RXFGMASK => self.rxfgmask,
             regs::RXFIR => self.rxfir_value(),
-            o if (MB_BASE..MB_END).contains(&o) => self.mb_area_read(o, side_effects),
-            o if (RXIMR_BASE..RXIMR_END).contains(&o) => self.rximr[(o - RXIMR_BASE) / 4],
+            o if (MB0..mb_end).contains(&o) => self.mb_area_read(o, side_effects),
+            o if (RXIMR0..rximr_end).contains(&o) => self.rximr[(o - RXIMR0) / 4],
             // ESR2 and CRCR are not modelled; everything else is reserved.
             _ => 0,
         }
@@ -112,6 +171,10 @@ impl State {
             return;
         }
         let freeze = self.frozen();
+        if self.extra_write(offset, value, freeze) {
+            return;
+        }
+        let (mb_end, rximr_end) = (self.mb_end(), self.rximr_end());
         match offset {
             regs::MCR => self.mcr_write(value),
             regs::CTRL1 => {
@@ -119,7 +182,7 @@ impl State {
                 if freeze {
                     writable |= CTRL1_FREEZE;
                 }
-                if self.disabled() {
+                if self.disabled() && self.variant.clksrc {
                     writable |= ctrl1::CLKSRC;
                 }
                 self.ctrl1 = (self.ctrl1 & !writable) | (value & writable);
@@ -131,13 +194,16 @@ impl State {
             regs::RX15MASK if freeze => self.rx15mask = value,
             regs::ECR if freeze => self.ecr_write(value),
             regs::ESR1 => self.esr1_write(value),
-            regs::IMASK1 => self.imask1 = value & MB_BITS,
+            regs::IMASK1 => {
+                let bits = self.variant.flags1_implemented();
+                self.imask = (self.imask & !0xFFFF_FFFF) | u64::from(value & bits);
+            }
             regs::IFLAG1 => self.iflag1_write(value),
             regs::CTRL2 if freeze => self.ctrl2 = value & CTRL2_BITS,
             regs::RXFGMASK if freeze => self.rxfgmask = value,
-            o if (MB_BASE..MB_END).contains(&o) => self.mb_area_write(o, value),
-            o if (RXIMR_BASE..RXIMR_END).contains(&o) && freeze => {
-                self.rximr[(o - RXIMR_BASE) / 4] = value;
+            o if (MB0..mb_end).contains(&o) => self.mb_area_write(o, value),
+            o if (RXIMR0..rximr_end).contains(&o) && freeze => {
+                self.rximr[(o - RXIMR0) / 4] = value;
             }
             _ => {}
         }
@@ -152,7 +218,7 @@ impl State {
         if (new ^ self.mcr) & mcr::RFEN != 0 {
             // The FIFO engine starts empty; IFLAG1 bits 0–7 change meaning.
             self.fifo.clear();
-            self.iflag1 &= !0xFF;
+            self.iflag &= !0xFF;
         }
         self.mcr = new;
         if value & mcr::SOFTRST != 0 {
@@ -163,27 +229,28 @@ impl State {
 
     /// IFLAG1 as read: with the Rx FIFO on, bit 5 is "frames available", bits 0–4 unused.
     fn iflag1_value(&self) -> u32 {
+        let low = self.iflag as u32;
         if self.rfen() {
-            let mut v = self.iflag1 & !0x3F;
+            let mut v = low & !0x3F;
             if self.fifo.len() > 0 {
                 v |= iflag1::BUF5I;
             }
             v
         } else {
-            self.iflag1
+            low
         }
     }
 
     /// IFLAG1 write: write 1 to clear; with the Rx FIFO on, 1 in bit 5 releases the output.
     fn iflag1_write(&mut self, value: u32) {
-        let value = value & MB_BITS;
+        let value = value & self.variant.flags1_implemented();
         if self.rfen() {
             if value & iflag1::BUF5I != 0 {
                 self.fifo_pop();
             }
-            self.iflag1 &= !(value & !0x3F);
+            self.iflag &= !u64::from(value & !0x3F);
         } else {
-            self.iflag1 &= !value;
+            self.iflag &= !u64::from(value);
         }
     }
 
@@ -193,7 +260,7 @@ impl State {
     }
 
     fn mb_area_read(&mut self, offset: usize, side_effects: bool) -> u32 {
-        let word = (offset - MB_BASE) / 4;
+        let word = (offset - MB0) / 4;
         let (n, w) = (word / 4, word % 4);
         if self.rfen() && offset < RX_FIFO_FILTER_BASE {
             return if n == 0 { self.fifo_output_word(w) } else { 0 };
@@ -205,7 +272,7 @@ impl State {
     }
 
     fn mb_area_write(&mut self, offset: usize, value: u32) {
-        let word = (offset - MB_BASE) / 4;
+        let word = (offset - MB0) / 4;
         let (n, w) = (word / 4, word % 4);
         if self.rfen() && offset < RX_FIFO_FILTER_BASE {
             return;

@@ -2,11 +2,13 @@
 //! RXMGMASK and RXFGMASK field descriptions, table "Rx FIFO filter: possible structures").
 //!
 //! - The table holds 8 × (RFFN + 1) elements from MB6 on (element n at 0xE0 + 4·n); on
-//!   these 16-MB parts only 40 elements fit, elements beyond never match.
+//!   the 16-MB Kinetis parts only 40 elements fit, elements beyond never match; on the
+//!   64-MB RT1062 all 128 (RFFN = 0xF) fit, up to MB37.
 //! - The first elements, as many as the message buffers the FIFO and table occupy
-//!   (RFFN 0 → 8, 1 → 10, 2 → 12, 3 → 14, at most 16), are masked by the individual masks
-//!   RXIMR\[n\] when MCR\[IRMQ\] = 1, by RXMGMASK when IRMQ = 0; the remaining elements are
-//!   masked by RXFGMASK. Masks align bit for bit with the element ("in a perfect
+//!   (RFFN 0 → 8, 1 → 10, 2 → 12, 3 → 14, …, at most the module's MBs and at most 32:
+//!   RFFN ≥ 0xC gives "elements 0–31"), are masked by the individual masks RXIMR\[n\]
+//!   when MCR\[IRMQ\] = 1, by RXMGMASK when IRMQ = 0; the remaining elements are masked
+//!   by RXFGMASK. Masks align bit for bit with the element ("in a perfect
 //!   alignment"); a mask bit 1 means the bit is checked.
 //! - Format A (IDAM = 0): RTR bit 31, IDE bit 30, RXIDA bits 29–1 (standard ID in 29–19;
 //!   for a standard frame only bits 31–19 are compared). One filter per element.
@@ -21,30 +23,36 @@
 
 use twocan_core::frame::Frame;
 
-use crate::regs::{self, mcr, NUM_MB};
+use crate::regs::mcr;
 
+use super::access::RX_FIFO_FILTER_BASE;
+use super::layout::{MB0, MB_BYTES};
 use super::state::State;
+use super::variant::Variant;
 
-/// Elements that fit in the message-buffer RAM after MB5.
-const TABLE_CAPACITY: usize =
-    (NUM_MB * regs::MB_STRIDE - (regs::RX_FIFO_FILTER_BASE - regs::MB_BASE)) / 4;
+/// Word index of filter element 0 in the message-buffer RAM.
+const TABLE_START_WORD: usize = (RX_FIFO_FILTER_BASE - MB0) / 4;
 
 impl State {
+    /// Elements that fit in this module's message-buffer RAM after MB5 (40 with 16 MBs,
+    /// 232 with 64: every table size fits).
+    fn table_capacity(&self) -> usize {
+        (self.mbs() * MB_BYTES - (RX_FIFO_FILTER_BASE - MB0)) / 4
+    }
+
     /// Number of filter elements in use.
     pub fn filter_elements(&self) -> usize {
-        regs::rx_fifo_filter_count(self.rffn()).min(TABLE_CAPACITY)
+        Variant::rx_fifo_filters(self.rffn()).min(self.table_capacity())
     }
 
     /// Number of leading elements under individual (or, with IRMQ = 0, RXMGMASK) masks.
     pub fn individually_masked_elements(&self) -> usize {
-        regs::rx_fifo_occupied_mbs(self.rffn())
-            .min(NUM_MB)
-            .min(regs::rx_fifo_filter_count(self.rffn()))
+        self.variant.rx_fifo_individually_masked(self.rffn())
     }
 
     /// The value of filter element `n`.
     pub fn filter_element(&self, n: usize) -> u32 {
-        self.ram[(regs::RX_FIFO_FILTER_BASE - regs::MB_BASE) / 4 + n]
+        self.ram[TABLE_START_WORD + n]
     }
 
     /// The mask applying to filter element `n`.

@@ -7,10 +7,10 @@
 use twocan_core::frame::Frame;
 use twocan_core::priority::Priority;
 
-use crate::regs::{code, cs, ctrl1, ctrl2, id, mcr, NUM_MB};
+use crate::regs::{code, cs, ctrl1, ctrl2, id, mcr};
 
 use super::codec;
-use super::state::State;
+use super::state::{State, MAX_MBS};
 
 /// A frame waiting in the serial message buffer for a locked mailbox.
 #[derive(Debug, Clone, Copy)]
@@ -21,13 +21,13 @@ struct Pending {
 }
 
 /// Per-mailbox bookkeeping the CPU cannot see directly.
-#[derive(Debug, Default)]
+#[derive(Debug)]
 pub(crate) struct Mailboxes {
     /// The mailbox locked by a read of its C/S word.
     pub locked: Option<usize>,
     /// FULL/OVERRUN mailboxes read and unlocked by the CPU since their last move-in
     /// ("SRV: serviced MB"), hence free to receive again.
-    serviced: [bool; NUM_MB],
+    serviced: [bool; MAX_MBS],
     /// The serial message buffer holding a frame for the locked mailbox.
     smb: Option<Pending>,
     /// Frames written over an unread frame (OVERRUN) or dropped from the SMB.
@@ -52,7 +52,14 @@ pub(crate) struct MbScan {
 
 impl Mailboxes {
     pub fn new() -> Self {
-        Mailboxes::default()
+        Mailboxes {
+            locked: None,
+            serviced: [false; MAX_MBS],
+            smb: None,
+            overruns: 0,
+            in_tx: None,
+            abort_pending: false,
+        }
     }
 
     /// Soft reset: the lock and the serial message buffer are internal state.
@@ -142,7 +149,7 @@ impl State {
         let csw = cs::TIME_STAMP.replace(cs::CODE.replace(csw, next), u32::from(stamp));
         self.ram[4 * n] = csw;
         self.mbx.serviced[n] = false;
-        self.iflag1 |= 1 << n;
+        self.iflag |= 1 << n;
     }
 
     /// Software wrote the C/S word of mailbox `n`. With MCR\[AEN\] = 1, writing ABORT over a
@@ -166,7 +173,7 @@ impl State {
         }
         self.ram[4 * n] = value;
         if aen_abort {
-            self.iflag1 |= 1 << n;
+            self.iflag |= 1 << n;
         }
         self.mbx.serviced[n] = false;
     }
@@ -185,7 +192,7 @@ impl State {
             if core::mem::replace(&mut self.mbx.abort_pending, false) {
                 self.set_mb_code(n, code::TX_ABORT);
                 self.mbx.serviced[n] = false;
-                self.iflag1 |= 1 << n;
+                self.iflag |= 1 << n;
             }
         }
     }
@@ -331,7 +338,7 @@ impl State {
         let prio = id::PRIO.get(self.mb_word(n, 1));
         self.set_mb_words(n, codec::encode(frame, stamp, next, prio));
         self.mbx.serviced[n] = false;
-        self.iflag1 |= 1 << n;
+        self.iflag |= 1 << n;
         // CTRL1[TSYN]: reception in MB0 (or the first mailbox after the Rx FIFO table)
         // resets the free-running timer.
         if self.ctrl1_bit(ctrl1::TSYN) && n == self.first_mb() {

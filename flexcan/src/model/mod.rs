@@ -1,7 +1,11 @@
-//! Behavioural model of the Kinetis FlexCAN module (feature `model`), for host tests.
+//! Behavioural model of the FlexCAN module (feature `model`), for host tests: the Kinetis
+//! K20/K64/K66 modules (16 message buffers) and the i.MX RT1062's CAN1, CAN2 and CAN3
+//! (64 message buffers; CAN3 in classic CAN).
 //!
 //! Written from the reference manuals' FlexCAN chapter (K20P64M72SF1RM, K66P144M180SF5RM,
-//! "CAN (FlexCAN)"), never from a driver: each file cites the sections its rules come from.
+//! "CAN (FlexCAN)"; IMXRT1060RM "Flexible Controller Area Network (FLEXCAN)"), never from
+//! a driver: each file cites the sections its rules come from. What differs between the
+//! modules is data: a [`Variant`] per chip (and RT1062 instance), `variant.rs`.
 //!
 //! [`FlexCanModel`] is a cheap-to-clone handle on one module's state. Software talks to it
 //! through [`Registers`] (offsets of [`crate::regs`]); the simulated bus talks to it
@@ -14,8 +18,12 @@
 //! arbitration (lowest ID or lowest buffer), the Rx FIFO with its ID filter table
 //! (formats A–D, individual and global masks, IDHIT), self reception, loop-back,
 //! listen-only, error counters with ESR1 and bus-off recovery, the free-running timer and
-//! time stamps, and the interrupt lines. Not modelled: ESR2, CRCR, wake-up and stop mode,
-//! the BUSY code bit, TASD and bit timing (time is in bit times).
+//! time stamps, and the interrupt lines; on the RT1062 the 64 message buffers with
+//! IMASK2/IFLAG2, RXIMR0–63, the filter tables up to 128 elements (RFFN = 0xF), reset
+//! into Freeze mode, and the registers one instance has and another lacks. Not
+//! modelled: ESR2, CRCR, DBG1/DBG2 contents, wake-up, stop and doze modes, DMA, CAN FD
+//! (CAN3 stays classic: FDEN reads 0), the BUSY code bit, TASD and bit timing (time is
+//! in bit times), and the silicon errata (listed as data in [`Variant::errata`]).
 
 extern crate std;
 
@@ -24,14 +32,17 @@ mod bus;
 mod codec;
 mod errors;
 mod id_table;
+pub mod layout;
 mod mailboxes;
 mod modes;
 mod reception;
 mod rx_fifo;
 mod state;
 mod timer;
+pub mod variant;
 
 pub use errors::REC_AFTER_PASSIVE_RECEPTION;
+pub use variant::{Erratum, Variant};
 
 use std::cell::RefCell;
 use std::rc::Rc;
@@ -42,11 +53,12 @@ use twocan_core::frame::Frame;
 use twocan_core::registers::Registers;
 use twocan_core::sim::{BusNode, BusTime, ConfinementEvent, TxRequest, TxResult};
 
-use crate::regs::{ctrl1, esr1, NUM_MB};
+use crate::regs::{ctrl1, esr1};
 
 use state::State;
 
-/// The microcontroller the module belongs to. All three have 16 message buffers.
+/// The microcontroller the module belongs to (and, where the instances differ, which
+/// instance). The Kinetis parts have 16 message buffers, the RT1062 64.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Chip {
     /// MK20DX256 (Teensy 3.1/3.2): FlexCAN0.
@@ -55,6 +67,33 @@ pub enum Chip {
     Mk64fx512,
     /// MK66FX1M0 (Teensy 3.6): FlexCAN0 and FlexCAN1 (MCR\[WAKSRC\] exists).
     Mk66fx1m0,
+    /// i.MX RT1062 (Teensy 4.0/4.1): one of its three modules.
+    Imxrt1062(Rt1062Can),
+}
+
+/// A FlexCAN module of the i.MX RT1062.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Rt1062Can {
+    /// CAN1 (0x401D_0000).
+    Can1,
+    /// CAN2 (0x401D_4000).
+    Can2,
+    /// CAN3 (0x401D_8000), CAN FD capable (modelled in classic CAN).
+    Can3,
+}
+
+impl Chip {
+    /// The module's differences, as data.
+    pub const fn variant(self) -> &'static Variant {
+        match self {
+            Chip::Mk20dx256 => &variant::MK20DX256,
+            Chip::Mk64fx512 => &variant::MK64FX512,
+            Chip::Mk66fx1m0 => &variant::MK66FX1M0,
+            Chip::Imxrt1062(Rt1062Can::Can1) => &variant::IMXRT1062_CAN1,
+            Chip::Imxrt1062(Rt1062Can::Can2) => &variant::IMXRT1062_CAN2,
+            Chip::Imxrt1062(Rt1062Can::Can3) => &variant::IMXRT1062_CAN3,
+        }
+    }
 }
 
 /// The module's mode as the acknowledge bits show it.
@@ -70,10 +109,12 @@ pub enum ModelMode {
 
 /// The module's interrupt request lines, as the Kinetis vector table groups them: "CAN0
 /// ORed message buffer" (IRQ 29 on K20, 75 on K66), "Bus Off", "Error", "Tx Warning" and
-/// "Rx Warning" (the two warning vectors are ORed here). Wake-up is not modelled.
+/// "Rx Warning" (the two warning vectors are ORed here). Wake-up is not modelled. The
+/// RT1062 has one line per module (CAN1 = IRQ 36, CAN2 = 37, CAN3 = 154), asserted
+/// while [`FlexCanIrq::any`] is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub struct FlexCanIrq {
-    /// IFLAG1 & IMASK1 ≠ 0.
+    /// (IFLAG2:IFLAG1) & (IMASK2:IMASK1) ≠ 0.
     pub message_buffer: bool,
     /// ESR1\[ERRINT\] with CTRL1\[ERRMSK\].
     pub error: bool,
@@ -98,9 +139,9 @@ pub struct FlexCanModel {
 }
 
 impl FlexCanModel {
-    /// A module of `chip`, fresh from power-on reset (Disable mode). Message-buffer RAM
-    /// and RXIMR are undefined after reset on the real part; the model starts them at 0
-    /// (see [`FlexCanModel::scramble_ram`]).
+    /// A module of `chip`, fresh from power-on reset (Disable mode on the Kinetis parts,
+    /// Freeze mode on the RT1062). Message-buffer RAM and RXIMR are undefined after reset
+    /// on the real part; the model starts them at 0 (see [`FlexCanModel::scramble_ram`]).
     pub fn new(chip: Chip) -> Self {
         FlexCanModel {
             inner: Rc::new(RefCell::new(State::new(chip))),
@@ -122,14 +163,24 @@ impl FlexCanModel {
         Self::new(Chip::Mk66fx1m0)
     }
 
+    /// CAN1 (`Rt1062Can::Can1`), CAN2 or CAN3 of the i.MX RT1062 (Teensy 4.0/4.1).
+    pub fn imxrt1062(can: Rt1062Can) -> Self {
+        Self::new(Chip::Imxrt1062(can))
+    }
+
     /// The chip this module belongs to.
     pub fn chip(&self) -> Chip {
         self.inner.borrow().chip
     }
 
-    /// Number of message buffers (16 on all three chips).
-    pub const fn message_buffers(&self) -> usize {
-        NUM_MB
+    /// The module's differences from the other variants.
+    pub fn variant(&self) -> &'static Variant {
+        self.inner.borrow().variant
+    }
+
+    /// Number of message buffers (16 on the Kinetis parts, 64 on the RT1062).
+    pub fn message_buffers(&self) -> usize {
+        self.inner.borrow().variant.message_buffers
     }
 
     // --- interrupt lines -------------------------------------------------------------------
@@ -137,12 +188,13 @@ impl FlexCanModel {
     /// The interrupt request lines.
     pub fn irq(&self) -> FlexCanIrq {
         let mut s = self.inner.borrow_mut();
-        let iflag = s.read(crate::regs::IFLAG1, false);
+        let iflag1 = s.read(crate::regs::IFLAG1, false);
+        let iflag = (s.iflag & !0xFFFF_FFFF) | u64::from(iflag1);
         let esr = s.esr1_value();
         let c = s.ctrl1;
         let on = |flag: u32, mask: u32| esr & flag != 0 && c & mask != 0;
         FlexCanIrq {
-            message_buffer: iflag & s.imask1 != 0,
+            message_buffer: iflag & s.imask != 0,
             error: on(esr1::ERRINT, ctrl1::ERRMSK),
             bus_off: on(esr1::BOFFINT, ctrl1::BOFFMSK),
             warning: on(esr1::TWRNINT, ctrl1::TWRNMSK) || on(esr1::RWRNINT, ctrl1::RWRNMSK),

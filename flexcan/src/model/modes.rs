@@ -103,11 +103,11 @@ impl State {
     /// The soft reset itself (see the module documentation for what it touches).
     fn soft_reset(&mut self) {
         let mdis = self.mcr & mcr::MDIS;
-        self.mcr = (mcr::RESET & MCR_STORED & !mcr::MDIS) | mdis;
+        self.mcr = (self.variant.reset_mcr & MCR_STORED & !mcr::MDIS) | mdis;
         self.timer.set(0);
         self.errors = Errors::new();
-        self.imask1 = 0;
-        self.iflag1 = 0;
+        self.imask = 0;
+        self.iflag = 0;
         self.fifo.clear();
         self.mbx.reset_locks();
         self.softrst_pending = false;

@@ -66,7 +66,7 @@ impl State {
     pub fn fifo_store(&mut self, frame: &Frame, stamp: u16, idhit: u16) {
         if self.fifo.is_full() {
             self.fifo.overflows += 1;
-            self.iflag1 |= iflag1::BUF7I;
+            self.iflag |= u64::from(iflag1::BUF7I);
             return;
         }
         self.fifo.entries.push_back(FifoEntry {
@@ -75,7 +75,7 @@ impl State {
             idhit,
         });
         if self.fifo.entries.len() == 5 {
-            self.iflag1 |= iflag1::BUF6I;
+            self.iflag |= u64::from(iflag1::BUF6I);
         }
     }
 

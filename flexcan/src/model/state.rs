@@ -1,21 +1,27 @@
 //! The model's state: the register file, the message-buffer RAM and the internal state
 //! machines, with the configuration bits read the way the hardware uses them.
 
-use crate::regs::{self, ctrl1, ctrl2, mcr, NUM_MB};
+use crate::regs::{ctrl1, ctrl2, mcr};
 
 use super::errors::Errors;
 use super::mailboxes::Mailboxes;
 use super::rx_fifo::RxFifo;
 use super::timer::Timer;
+use super::variant::{self, Variant};
 use super::Chip;
 
-/// Words of message-buffer RAM (16 MBs × 4 words).
-pub(crate) const RAM_WORDS: usize = NUM_MB * 4;
+/// The most message buffers a variant has (the RT1062's 64); smaller modules use the
+/// first part of the arrays.
+pub(crate) const MAX_MBS: usize = 64;
+/// Words of message-buffer RAM (64 MBs × 4 words).
+pub(crate) const RAM_WORDS: usize = MAX_MBS * 4;
 
 /// Everything the peripheral holds.
 #[derive(Debug)]
 pub(crate) struct State {
     pub chip: Chip,
+    /// The module's differences from the other variants.
+    pub variant: &'static Variant,
     /// MCR bits software writes (status bits FRZACK, LPMACK, NOTRDY, SOFTRST are derived).
     pub mcr: u32,
     pub ctrl1: u32,
@@ -24,11 +30,17 @@ pub(crate) struct State {
     pub rx14mask: u32,
     pub rx15mask: u32,
     pub rxfgmask: u32,
-    pub imask1: u32,
-    /// IFLAG1 as stored; with the Rx FIFO on, bit 5 is derived from the FIFO occupancy.
-    pub iflag1: u32,
-    /// RXIMR0..15 (RAM: not affected by reset).
-    pub rximr: [u32; NUM_MB],
+    /// IMASK2:IMASK1 (bit n: MB n).
+    pub imask: u64,
+    /// IFLAG2:IFLAG1 as stored (bit n: MB n); with the Rx FIFO on, bit 5 is derived from
+    /// the FIFO occupancy.
+    pub iflag: u64,
+    /// RXIMR0..63 (RAM: not affected by reset).
+    pub rximr: [u32; MAX_MBS],
+    /// GFWR (RT1062 CAN1/CAN2; stored, the wake-up filter is not modelled).
+    pub gfwr: u32,
+    /// CBT (RT1062 CAN3; stored, the model has no bit timing).
+    pub cbt: u32,
     /// Message buffer RAM (not affected by reset).
     pub ram: [u32; RAM_WORDS],
     /// Low-power (disable) mode acknowledged.
@@ -58,21 +70,27 @@ pub(crate) struct State {
 impl State {
     /// A module fresh from power-on reset.
     pub fn new(chip: Chip) -> Self {
+        let v = chip.variant();
+        let status = mcr::FRZACK | mcr::LPMACK | mcr::NOTRDY | mcr::SOFTRST;
         State {
             chip,
-            mcr: mcr::RESET & !(mcr::FRZACK | mcr::LPMACK | mcr::NOTRDY | mcr::SOFTRST),
+            variant: v,
+            mcr: v.reset_mcr & !status,
             ctrl1: ctrl1::RESET,
-            ctrl2: ctrl2::RESET,
-            rxmgmask: u32::MAX,
-            rx14mask: u32::MAX,
-            rx15mask: u32::MAX,
-            rxfgmask: u32::MAX,
-            imask1: 0,
-            iflag1: 0,
-            rximr: [0; NUM_MB],
+            ctrl2: v.reset_ctrl2,
+            rxmgmask: v.reset_masks,
+            rx14mask: v.reset_masks,
+            rx15mask: v.reset_masks,
+            rxfgmask: v.reset_masks,
+            imask: 0,
+            iflag: 0,
+            rximr: [0; MAX_MBS],
+            gfwr: variant::GFWR_RESET,
+            cbt: 0,
             ram: [0; RAM_WORDS],
-            lpmack: true,
-            frzack: false,
+            // Kinetis: Disable mode out of reset (LPMACK); RT1062: Freeze mode (FRZACK).
+            lpmack: v.reset_mcr & mcr::LPMACK != 0,
+            frzack: v.reset_mcr & mcr::FRZACK != 0,
             softrst_pending: false,
             clock_stuck: false,
             synched: false,
@@ -136,18 +154,23 @@ impl State {
         ctrl2::RFFN.get(self.ctrl2)
     }
 
+    /// Number of message buffers of this module.
+    pub fn mbs(&self) -> usize {
+        self.variant.message_buffers
+    }
+
     /// The last message buffer taking part in matching and arbitration: MCR\[MAXMB\], limited
-    /// to the 16 MBs that exist ("MAXMB must be programmed with a value smaller than the
-    /// number of available MBs").
+    /// to the MBs that exist ("MAXMB must be programmed with a value smaller than the
+    /// number of available MBs": 16 on the Kinetis parts, 64 on the RT1062).
     pub fn last_mb(&self) -> usize {
-        (mcr::MAXMB.get(self.mcr) as usize).min(NUM_MB - 1)
+        (mcr::MAXMB.get(self.mcr) as usize).min(self.mbs() - 1)
     }
 
     /// The first message buffer usable as a mailbox: MB0, or the first one after the Rx
     /// FIFO and its ID filter table (table "Rx FIFO filter: possible structures").
     pub fn first_mb(&self) -> usize {
         if self.rfen() {
-            regs::rx_fifo_occupied_mbs(self.rffn()).min(NUM_MB)
+            Variant::rx_fifo_occupied_mbs(self.rffn()).min(self.mbs())
         } else {
             0
         }
