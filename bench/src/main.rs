@@ -53,8 +53,8 @@ use figures::Backend;
 use firmware::Paths;
 use firmware::{variant_elf, VARIANTS};
 use report::{
-    ExampleBuild, ExampleSection, InsnRun, InsnSection, Report, SizeBuild, SizeSection, StateSet,
-    VariantSizes,
+    ExampleBuild, ExampleSection, InsnRun, InsnSection, LoopbackStack, Report, SizeBuild,
+    SizeSection, StateSet, VariantSizes,
 };
 use simspeed::SimRow;
 
@@ -101,6 +101,14 @@ struct Args {
     #[arg(long)]
     install: bool,
 }
+
+/// The variant loop-back firmwares and the board can-fil runs each on.
+const LOOPBACK_BOARDS: [(&str, &str); 4] = [
+    ("loopback-twocan", "nucleo-f767zi"),
+    ("loopback-bxcan-equiv", "nucleo-f767zi"),
+    ("loopback-flexcan", "teensy36"),
+    ("loopback-flexcan-hand", "teensy36"),
+];
 
 /// Profiles of the bench firmware (sizes and instruction counts): (cargo profile, opt-level).
 const COUNT_PROFILES: [(&str, &str); 2] = [("release", "s"), ("release-speed", "3")];
@@ -192,6 +200,19 @@ fn run() -> Result<()> {
         }
     }
 
+    // can-fil (fil/, Unicorn) runs the loop-back firmwares (checked, stack) and the
+    // examples (stack).
+    let can_fil = if skipped("fil") {
+        None
+    } else {
+        lap(started);
+        step("can-fil (fil/), for the stacks and the loop-back check");
+        let t = Instant::now();
+        let f = firmware::can_fil(&paths)?;
+        report.build_secs += t.elapsed().as_secs_f64();
+        Some(f)
+    };
+
     if !skipped("sizes") {
         lap(started);
         step("flash and RAM of the loop-back firmwares");
@@ -240,7 +261,39 @@ fn run() -> Result<()> {
             );
             states.push(set);
         }
-        report.sizes = Some(SizeSection { builds, states });
+        let mut fil = Vec::new();
+        if let Some(can_fil) = &can_fil {
+            step("the loop-back firmwares under can-fil (they must work; their stack)");
+            for ((_, opt), (_, dir)) in COUNT_PROFILES.iter().zip(&firmware_dirs) {
+                let mut elfs: Vec<(String, &str)> = vec![
+                    ("loopback-bxcan".into(), "nucleo-f767zi"),
+                    ("loopback-async".into(), "nucleo-f767zi"),
+                ];
+                for v in VARIANTS {
+                    for (bin, board) in LOOPBACK_BOARDS {
+                        elfs.push((variant_elf(bin, v), board));
+                    }
+                }
+                for (elf, board) in elfs {
+                    let st = stack::measure_loopback(can_fil, board, &dir.join(&elf))?;
+                    eprintln!(
+                        "can-bench: {elf} (opt {opt}) on {board}: works, stack {} B",
+                        st.whole
+                    );
+                    fil.push(LoopbackStack {
+                        opt: opt.to_string(),
+                        elf,
+                        board: board.to_string(),
+                        stack: st,
+                    });
+                }
+            }
+        }
+        report.sizes = Some(SizeSection {
+            builds,
+            states,
+            fil,
+        });
     }
 
     if !skipped("examples") {
@@ -249,23 +302,20 @@ fn run() -> Result<()> {
         let t = Instant::now();
         let mut section = examples(&paths)?;
         report.build_secs += t.elapsed().as_secs_f64();
-        if skipped("fil") {
-            section.stack_skipped = Some("`--skip fil`".into());
-        } else {
+        if let Some(can_fil) = &can_fil {
             lap(started);
             step("stack of the firmware examples under can-fil");
-            let t = Instant::now();
-            let can_fil = firmware::can_fil(&paths)?;
-            report.build_secs += t.elapsed().as_secs_f64();
             for b in &mut section.builds {
                 let Some(board) = &b.board else { continue };
-                let st = stack::measure(&can_fil, board, &b.elf)?;
+                let st = stack::measure(can_fil, board, &b.elf)?;
                 eprintln!(
                     "can-bench: {} on {board}: stack configuration {:?} B, whole run {} B",
                     b.bin, st.configuration, st.whole
                 );
                 b.stack = Some(st);
             }
+        } else {
+            section.stack_skipped = Some("`--skip fil`".into());
         }
         report.examples = Some(section);
     }

@@ -59,14 +59,19 @@ pub struct Size {
     pub sections: Vec<Section>,
     /// Bytes of the shared start-up module's code and constants: the symbols of a module
     /// named `startup` ([`STARTUP_MODULE`]; the bench firmware include
-    /// `shared/stm32f7.rs` or `shared/kinetis.rs` under that name). 0 for an ELF
-    /// without one.
+    /// `shared/stm32f7.rs` or `shared/kinetis.rs` under that name) and a `__pre_init`
+    /// of more than cortex-m-rt's empty default ([`PRE_INIT`]). 0 for an ELF without
+    /// them.
     pub startup: u64,
 }
 
 /// The path component (in legacy Rust symbol mangling, length-prefixed) of the bench
 /// firmware's shared start-up module.
 pub const STARTUP_MODULE: &str = "7startup";
+
+/// cortex-m-rt's hook before RAM initialisation: part of the start-up where a firmware
+/// defines it (the Kinetis watchdog, `shared/kinetis.rs`).
+pub const PRE_INIT: &str = "__pre_init";
 
 /// Sections that are not driver or application code: the vector table and, on the
 /// Kinetis parts, the flash configuration field.
@@ -169,7 +174,7 @@ pub fn measure(path: &Path) -> Result<Size> {
     let mut startup = 0;
     for sym in elf.symbols() {
         let Ok(name) = sym.name() else { continue };
-        if name.contains(STARTUP_MODULE)
+        if (name.contains(STARTUP_MODULE) || name == PRE_INIT)
             && sym.size() > 0
             && matches!(sym.kind(), SymbolKind::Text | SymbolKind::Data)
             && seen.insert(sym.address() & !1)
@@ -258,4 +263,36 @@ pub fn state_figures(loopback: &Path, insn_count: &Path) -> Result<StateFigures>
             .ok()
             .map(u64::from),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn section(name: &str, size: u64, class: Class) -> Section {
+        Section {
+            name: name.into(),
+            size,
+            class,
+        }
+    }
+
+    #[test]
+    fn driver_and_application_flash_leaves_out_vectors_config_field_and_start_up() {
+        let z = Size {
+            sections: vec![
+                section(".vector_table", 1024, Class::Code),
+                section(".flash_config", 16, Class::Code),
+                section(".text", 5000, Class::Code),
+                section(".rodata", 100, Class::Code),
+                section(".data", 8, Class::Data),
+                section(".bss", 700, Class::Bss),
+            ],
+            startup: 150,
+        };
+        assert_eq!(z.flash(), 1024 + 16 + 5000 + 100 + 8);
+        assert_eq!(z.ram(), 708);
+        // The .data image stays: it is the application's.
+        assert_eq!(z.app_flash(), 5000 + 100 + 8 - 150);
+    }
 }

@@ -38,9 +38,30 @@ pub fn command(can_fil: &Path, board: &str, elf: &Path) -> Command {
 /// exit status is not required to be 0 (an example alone on the bus may see no
 /// acknowledgement); a missing stack line is an error.
 pub fn measure(can_fil: &Path, board: &str, elf: &Path) -> Result<FilStack> {
+    measure_checked(can_fil, board, elf, false)
+}
+
+/// Like [`measure`] for a bench loop-back firmware, which must also have done its job:
+/// `can-fil` ends with status 0 (no fault, no halt, no stuck interrupt) and the last
+/// instruction is not in the panic handler (the loop-back firmwares panic when the
+/// frame does not come back with its filter index and, with completions, its
+/// completion).
+pub fn measure_loopback(can_fil: &Path, board: &str, elf: &Path) -> Result<FilStack> {
+    measure_checked(can_fil, board, elf, true)
+}
+
+fn measure_checked(can_fil: &Path, board: &str, elf: &Path, must_pass: bool) -> Result<FilStack> {
     let mut c = command(can_fil, board, elf);
     let out = cmd::run(&mut c, Duration::from_secs(300))
         .context(format!("can-fil --stack {board} {}", elf.display()))?;
+    if must_pass && (out.code != Some(0) || panicked(&out.stdout)) {
+        return Err(Error::new(format!(
+            "the loop-back firmware failed under `{}` (exit {:?}):\n{}",
+            cmd::display(&command(can_fil, board, elf)),
+            out.code,
+            cmd::tail(&out.stdout, 30)
+        )));
+    }
     parse(&out.stdout).ok_or_else(|| {
         Error::new(format!(
             "`{}` printed no stack line (exit {:?}):\n{}\n{}",
@@ -50,6 +71,14 @@ pub fn measure(can_fil: &Path, board: &str, elf: &Path) -> Result<FilStack> {
             cmd::tail(&out.stderr, 20)
         ))
     })
+}
+
+/// Whether the report's last instruction is in the panic handler.
+fn panicked(stdout: &str) -> bool {
+    stdout
+        .lines()
+        .map(str::trim)
+        .any(|l| l.starts_with("last instruction:") && l.contains("rust_begin_unwind"))
 }
 
 /// The number right after `key` in `line`.
@@ -101,5 +130,11 @@ mod tests {
             })
         );
         assert_eq!(parse("no such line\n"), None);
+        assert!(panicked(
+            "  last instruction: 0x08004DFA in __rustc::rust_begin_unwind\n"
+        ));
+        assert!(!panicked(
+            "  last instruction: 0x08001984 in loopback_twocan::main\n"
+        ));
     }
 }

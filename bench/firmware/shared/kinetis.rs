@@ -7,8 +7,10 @@
 //!   Description"): no backdoor key, nothing protected, `FSEC` = 0xFE (unsecured, mass
 //!   erase enabled), `FOPT` = 0xF9 (normal boot, EzPort and NMI pin off);
 //! - the watchdog off (K66 RM, WDOG "Unlocking and updating the watchdog": the unlock
-//!   sequence 0xC520, 0xD928, then `STCTRLH` without `WDOGEN`, within the allowed
-//!   window after reset);
+//!   sequence 0xC520, 0xD928 — the two words within 20 bus clocks — then `STCTRLH`
+//!   without `WDOGEN` within the WCT window of 256 bus clocks after reset): so early
+//!   that it runs as cortex-m-rt's `__pre_init`, before `.bss` is zeroed, in assembly
+//!   (Rust must not run before RAM is initialised);
 //! - the 16 MHz crystal oscillator on (MCG `C2`: very high frequency range, crystal;
 //!   OSC `CR`: `ERCLKEN`, the load capacitors of PJRC's board), waiting for
 //!   `MCG_S.OSCINIT0`: OSCERCLK is FlexCAN's engine clock (`CTRL1.CLKSRC` = 0). The
@@ -37,7 +39,7 @@ const MCG_C2: usize = 0x4006_4001;
 const MCG_S: usize = 0x4006_4006;
 const OSC_CR: usize = 0x4006_5000;
 
-/// `STCTRLH` with `ALLOWUPDATE` and the reset defaults, `WDOGEN` clear.
+/// `STCTRLH` with `ALLOWUPDATE`, `WDOGEN` clear (the rest at 0).
 const STCTRLH_OFF: u16 = 0x0010;
 /// `MCG_C2`: `RANGE0` = 0b10 (very high frequency), `EREFS0` (crystal).
 const C2_RANGE_VERY_HIGH_CRYSTAL: u8 = (0b10 << 4) | (1 << 2);
@@ -47,15 +49,41 @@ const S_OSCINIT0: u8 = 1 << 1;
 /// Bound of the oscillator wait (register reads).
 const WAIT: u32 = 1_000_000;
 
-/// Watchdog off, crystal oscillator on. `Err` if the oscillator never starts.
+// The watchdog off, as the first code after reset (module docs). Uses r0 and r1 only,
+// which a callee may clobber; two `nop`s give the bus clock the manual asks for between
+// the second unlock word and the update.
+core::arch::global_asm!(
+    ".section .text.__pre_init,\"ax\",%progbits",
+    ".global __pre_init",
+    ".type __pre_init,%function",
+    ".thumb_func",
+    "__pre_init:",
+    "ldr r0, ={unlock}",
+    "movw r1, #{key1}",
+    "strh r1, [r0]",
+    "movw r1, #{key2}",
+    "strh r1, [r0]",
+    "nop",
+    "nop",
+    "ldr r0, ={stctrlh}",
+    "movw r1, #{off}",
+    "strh r1, [r0]",
+    "bx lr",
+    ".size __pre_init, . - __pre_init",
+    unlock = const WDOG_UNLOCK,
+    key1 = const 0xC520,
+    key2 = const 0xD928,
+    stctrlh = const WDOG_STCTRLH,
+    off = const STCTRLH_OFF,
+);
+
+/// Crystal oscillator on (the watchdog is off already, `__pre_init`). `Err` if the
+/// oscillator never starts.
 #[inline(never)]
 pub fn init() -> Result<(), ()> {
-    // SAFETY: the WDOG, MCG and OSC registers of the K66 (addresses above), written as
-    // the reference manual prescribes, before anything else runs.
+    // SAFETY: the MCG and OSC registers of the K66 (addresses above), written as the
+    // reference manual prescribes, before anything uses the oscillator clock.
     unsafe {
-        (WDOG_UNLOCK as *mut u16).write_volatile(0xC520);
-        (WDOG_UNLOCK as *mut u16).write_volatile(0xD928);
-        (WDOG_STCTRLH as *mut u16).write_volatile(STCTRLH_OFF);
         (OSC_CR as *mut u8).write_volatile(CR_ERCLKEN_SC10P);
         (MCG_C2 as *mut u8).write_volatile(C2_RANGE_VERY_HIGH_CRYSTAL);
         for _ in 0..WAIT {

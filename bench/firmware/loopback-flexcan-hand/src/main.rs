@@ -44,11 +44,14 @@ fn loop_back() -> bool {
         s.tx_irq.on_interrupt();
         s.rx_irq.on_interrupt();
         if let Some(rx) = s.receiver.take() {
+            // The completion may come after the reception: bounded wait.
             #[cfg(feature = "full")]
-            let sent = s
-                .completions
-                .take()
-                .is_some_and(|c| c.token == token && c.sent);
+            let sent = (0..POLLS).any(|_| {
+                s.tx_irq.on_interrupt();
+                s.completions
+                    .take()
+                    .is_some_and(|c| c.token == token && c.sent)
+            });
             #[cfg(feature = "lean")]
             let sent = token == 0;
             return sent && rx.frame == frame && rx.filter == 0;
