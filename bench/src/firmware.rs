@@ -110,18 +110,47 @@ pub fn ensure_target(install: bool) -> Result<()> {
 }
 
 /// Builds the bench firmware workspace with cargo profile `profile`; returns the
-/// directory holding its ELFs.
+/// directory holding its ELFs. The packages of [`VARIANT_PACKAGES`] are built once per
+/// variant of [`VARIANTS`] (cargo feature of the same name) and their ELFs copied to
+/// `<bin>-<variant>` in that directory.
 pub fn bench_firmware(paths: &Paths, profile: &str) -> Result<PathBuf> {
     let target_dir = paths.scratch("bench-firmware");
     let manifest = paths.firmware().join("Cargo.toml");
-    // Two invocations: the `async` feature of the async firmwares must not reach the
-    // others (cargo unifies features over the packages of one build).
-    let mut selections: Vec<Vec<&str>> = vec![vec!["--workspace"], Vec::new()];
-    for p in ASYNC_PACKAGES {
-        selections[0].extend(["--exclude", p]);
-        selections[1].extend(["-p", p]);
+    let out = target_dir.join(TARGET).join(profile);
+    // One cargo invocation per feature set: cargo unifies features over the packages of
+    // one build, so the `async` feature of the async firmwares and each variant's
+    // features must not meet the other firmwares.
+    let mut selections: Vec<(Vec<String>, Option<&str>)> = Vec::new();
+    let mut rest = vec!["--workspace".to_string()];
+    for p in ASYNC_PACKAGES
+        .iter()
+        .chain(VARIANT_PACKAGES.iter().map(|(p, _)| p))
+    {
+        rest.extend(["--exclude".to_string(), p.to_string()]);
     }
-    for selection in selections {
+    selections.push((rest, None));
+    selections.push((
+        ASYNC_PACKAGES
+            .iter()
+            .flat_map(|p| ["-p".to_string(), p.to_string()])
+            .collect(),
+        None,
+    ));
+    for variant in VARIANTS {
+        let mut sel: Vec<String> = VARIANT_PACKAGES
+            .iter()
+            .flat_map(|(p, _)| ["-p".to_string(), p.to_string()])
+            .collect();
+        let features: Vec<String> = VARIANT_PACKAGES
+            .iter()
+            .map(|(p, _)| format!("{p}/{variant}"))
+            .collect();
+        // Each variant package's default is `full`: the variant is chosen explicitly.
+        sel.push("--no-default-features".to_string());
+        sel.extend(["--features".to_string(), features.join(",")]);
+        selections.push((sel, Some(variant)));
+    }
+    for (selection, variant) in selections {
         let mut c = cargo();
         c.current_dir(paths.firmware())
             .arg("build")
@@ -130,15 +159,48 @@ pub fn bench_firmware(paths: &Paths, profile: &str) -> Result<PathBuf> {
             .arg(&manifest)
             .arg("--target-dir")
             .arg(&target_dir)
-            .args(selection);
+            .args(&selection);
         eprintln!("can-bench: {}", cmd::display(&c));
         cmd::run_ok(&mut c, BUILD_LIMIT).context("building the bench firmware")?;
+        if let Some(v) = variant {
+            for (_, bin) in VARIANT_PACKAGES {
+                let from = out.join(bin);
+                let to = out.join(variant_elf(bin, v));
+                std::fs::copy(&from, &to).context(format!(
+                    "copying {} to {}",
+                    from.display(),
+                    to.display()
+                ))?;
+            }
+        }
     }
-    Ok(target_dir.join(TARGET).join(profile))
+    Ok(out)
+}
+
+/// The ELF name of `bin` built as `variant`.
+pub fn variant_elf(bin: &str, variant: &str) -> String {
+    format!("{bin}-{variant}")
 }
 
 /// The bench firmware packages built with twocan-core's `async` feature.
 pub const ASYNC_PACKAGES: [&str; 2] = ["bench-insn-count-async", "bench-loopback-async"];
+
+/// The variants of issue 21: a **lean** driver configuration (const filter plan,
+/// fire-and-forget transmit, no time stamps, no statistics) and a **full** one
+/// (completions, time stamps, statistics, runtime planner), each against an equivalent
+/// doing the same service. The cargo feature of each package in [`VARIANT_PACKAGES`].
+pub const VARIANTS: [&str; 2] = ["lean", "full"];
+
+/// (package, binary) of the bench firmware built once per variant.
+pub const VARIANT_PACKAGES: [(&str, &str); 7] = [
+    ("bench-insn-count", "insn-count"),
+    ("bench-insn-count-equiv", "insn-count-equiv"),
+    ("bench-insn-count-flexcan", "insn-count-flexcan"),
+    ("bench-loopback-twocan", "loopback-twocan"),
+    ("bench-loopback-bxcan-equiv", "loopback-bxcan-equiv"),
+    ("bench-loopback-flexcan", "loopback-flexcan"),
+    ("bench-loopback-flexcan-hand", "loopback-flexcan-hand"),
+];
 
 /// A firmware example package of the workspace, as `cargo metadata` describes it.
 #[derive(Debug, Clone)]
@@ -256,6 +318,27 @@ pub fn example(paths: &Paths, package: &str, features: &[String]) -> Result<Path
     eprintln!("can-bench: {}", cmd::display(&c));
     cmd::run_ok(&mut c, BUILD_LIMIT).context(format!("building the example {package}"))?;
     Ok(target_dir.join(TARGET).join("release"))
+}
+
+/// Builds `can-fil` (the firmware-in-the-loop harness, `fil/`, its own workspace and
+/// target directory `fil/target`, shared with its tests); returns the binary.
+pub fn can_fil(paths: &Paths) -> Result<PathBuf> {
+    let manifest = paths.root.join("fil").join("Cargo.toml");
+    let mut c = cargo();
+    c.current_dir(paths.root.join("fil"))
+        .args(["build", "--release", "--bin", "can-fil", "--manifest-path"])
+        .arg(&manifest);
+    eprintln!("can-bench: {}", cmd::display(&c));
+    cmd::run_ok(&mut c, BUILD_LIMIT).context(
+        "building can-fil (fil/: Unicorn needs cmake and libclang, \
+         `apt-get install cmake libclang-dev`)",
+    )?;
+    Ok(paths
+        .root
+        .join("fil")
+        .join("target")
+        .join("release")
+        .join("can-fil"))
 }
 
 /// The version of a package in a Cargo.lock file (`None` if absent).

@@ -6,22 +6,24 @@
 //!
 //! It measures, in one run, and writes `docs/benchmarks.md` (also printed):
 //!
-//! 1. flash and RAM of the firmware examples and of a minimal loop-back firmware built
-//!    with our bxCAN backend, with the bare `bxcan` crate 0.8 and with the `bxcan` crate
-//!    plus the service work that makes it feature-equivalent ([`sizes`], [`firmware`]);
-//! 2. instructions per frame on a Cortex-M4 under QEMU, counted by the TCG plugin
-//!    `bench/plugin/insn_count.c` ([`qemu`]);
+//! 1. flash and RAM of the firmware examples and of minimal loop-back firmwares — our
+//!    bxCAN and FlexCAN drivers in a lean and a full variant, the `bxcan` crate 0.8 bare
+//!    and with the service that makes it feature-equivalent, a hand-written FlexCAN
+//!    service ([`sizes`], [`firmware`]); the examples' stack under `can-fil --stack`
+//!    ([`stack`]);
+//! 2. instructions per frame and stack high-water marks on a Cortex-M4 under QEMU,
+//!    counted by the TCG plugin `bench/plugin/insn_count.c` ([`qemu`]);
 //! 3. the bit-timing solver against an exhaustive search ([`timing`]);
 //! 4. the simulator's speed ([`simspeed`], [`models`]).
 //!
 //! With the sizes and the instruction counts measured it also writes
-//! `target/bench/summary.json`: the ratios ours / theirs of issue 10 as numbers, for
-//! scripts (see [`report::Report::summary`]).
+//! `target/bench/summary.json`: the ratios ours / theirs of issues 10 and 21 as numbers,
+//! for scripts (see [`report::Report::summary`], [`figures`]).
 //!
 //! Any step that cannot run ends the command with an error and a non-zero exit code,
-//! without touching `docs/benchmarks.md`. `--skip STEP` (sizes, examples, qemu, timing,
-//! sim; repeatable) leaves a step out for a quicker look: the tables are printed, the
-//! document is not written.
+//! without touching `docs/benchmarks.md`. `--skip STEP` (sizes, examples, fil, qemu,
+//! timing, sim; repeatable) leaves a step out for a quicker look: the tables are
+//! printed, the document is not written.
 //!
 //! can-bench installs nothing by itself: a missing tool (QEMU, gcc, the
 //! `thumbv7em-none-eabihf` target) ends it with a message naming the tool and how to get
@@ -29,6 +31,7 @@
 //! the target with rustup).
 
 mod cmd;
+mod figures;
 mod firmware;
 mod models;
 mod planner;
@@ -36,6 +39,7 @@ mod qemu;
 mod report;
 mod simspeed;
 mod sizes;
+mod stack;
 mod timing;
 
 use std::path::PathBuf;
@@ -45,8 +49,13 @@ use std::time::Instant;
 use clap::{Parser, ValueEnum};
 
 use cmd::{Context, Result};
+use figures::Backend;
 use firmware::Paths;
-use report::{ExampleBuild, ExampleSection, InsnSection, Report, SizeBuild, SizeSection};
+use firmware::{variant_elf, VARIANTS};
+use report::{
+    ExampleBuild, ExampleSection, InsnRun, InsnSection, LoopbackStack, Report, SizeBuild,
+    SizeSection, StateSet, VariantSizes,
+};
 use simspeed::SimRow;
 
 /// A step of the command, for `--skip`.
@@ -56,6 +65,8 @@ enum Step {
     Sizes,
     /// flash and RAM of the firmware examples
     Examples,
+    /// the firmware examples' stack under can-fil (needs the examples step)
+    Fil,
     /// instructions per frame under QEMU
     Qemu,
     /// bit-timing quality
@@ -69,6 +80,7 @@ impl Step {
         match self {
             Step::Sizes => "sizes",
             Step::Examples => "examples",
+            Step::Fil => "fil",
             Step::Qemu => "qemu",
             Step::Timing => "timing",
             Step::Sim => "sim",
@@ -89,6 +101,14 @@ struct Args {
     #[arg(long)]
     install: bool,
 }
+
+/// The variant loop-back firmwares and the board can-fil runs each on.
+const LOOPBACK_BOARDS: [(&str, &str); 4] = [
+    ("loopback-twocan", "nucleo-f767zi"),
+    ("loopback-bxcan-equiv", "nucleo-f767zi"),
+    ("loopback-flexcan", "teensy36"),
+    ("loopback-flexcan-hand", "teensy36"),
+];
 
 /// Profiles of the bench firmware (sizes and instruction counts): (cargo profile, opt-level).
 const COUNT_PROFILES: [(&str, &str); 2] = [("release", "s"), ("release-speed", "3")];
@@ -180,49 +200,161 @@ fn run() -> Result<()> {
         }
     }
 
+    // can-fil (fil/, Unicorn) runs the loop-back firmwares (checked, stack) and the
+    // examples (stack).
+    let can_fil = if skipped("fil") {
+        None
+    } else {
+        lap(started);
+        step("can-fil (fil/), for the stacks and the loop-back check");
+        let t = Instant::now();
+        let f = firmware::can_fil(&paths)?;
+        report.build_secs += t.elapsed().as_secs_f64();
+        Some(f)
+    };
+
     if !skipped("sizes") {
         lap(started);
         step("flash and RAM of the loop-back firmwares");
         let mut builds = Vec::new();
         for ((profile, opt), (_, dir)) in COUNT_PROFILES.iter().zip(&firmware_dirs) {
+            let mut variants = Vec::new();
+            for v in VARIANTS {
+                let elf = |bin: &str| dir.join(variant_elf(bin, v));
+                variants.push(VariantSizes {
+                    variant: v.to_string(),
+                    ours: sizes::measure(&elf("loopback-twocan"))?,
+                    equiv: sizes::measure(&elf("loopback-bxcan-equiv"))?,
+                    flexcan: sizes::measure(&elf("loopback-flexcan"))?,
+                    flexcan_hand: sizes::measure(&elf("loopback-flexcan-hand"))?,
+                });
+            }
             builds.push(SizeBuild {
                 profile: profile.to_string(),
                 opt: opt.to_string(),
-                ours: sizes::measure(&dir.join("loopback-twocan"))?,
-                theirs: sizes::measure(&dir.join("loopback-bxcan"))?,
-                equiv: sizes::measure(&dir.join("loopback-bxcan-equiv"))?,
+                bare: sizes::measure(&dir.join("loopback-bxcan"))?,
                 async_fw: sizes::measure(&dir.join("loopback-async"))?,
+                variants,
             });
         }
         let dir = &firmware_dirs[0].1;
-        let state = sizes::state_figures(&dir.join("loopback-twocan"), &dir.join("insn-count"))?;
-        eprintln!(
-            "can-bench: State static {} B = rings {} B + state {} B",
-            state.static_bytes,
-            state.ring_bytes,
-            state.static_bytes - state.ring_bytes
-        );
-        report.sizes = Some(SizeSection { builds, state });
+        let mut states = Vec::new();
+        for v in VARIANTS {
+            let elf = |bin: &str| dir.join(variant_elf(bin, v));
+            let set = StateSet {
+                variant: v.to_string(),
+                bxcan: sizes::state_figures(&elf("loopback-twocan"), &elf("insn-count"))?,
+                flexcan: sizes::state_figures(
+                    &elf("loopback-flexcan"),
+                    &elf("insn-count-flexcan"),
+                )?,
+            };
+            eprintln!(
+                "can-bench: {v}: bxCAN State {} B = rings {} B + state {} B; FlexCAN State \
+                 {} B = rings {} B + state {} B",
+                set.bxcan.static_bytes,
+                set.bxcan.ring_bytes,
+                set.bxcan.state_bytes(),
+                set.flexcan.static_bytes,
+                set.flexcan.ring_bytes,
+                set.flexcan.state_bytes()
+            );
+            states.push(set);
+        }
+        let mut fil = Vec::new();
+        if let Some(can_fil) = &can_fil {
+            step("the loop-back firmwares under can-fil (they must work; their stack)");
+            for ((_, opt), (_, dir)) in COUNT_PROFILES.iter().zip(&firmware_dirs) {
+                let mut elfs: Vec<(String, &str)> = vec![
+                    ("loopback-bxcan".into(), "nucleo-f767zi"),
+                    ("loopback-async".into(), "nucleo-f767zi"),
+                ];
+                for v in VARIANTS {
+                    for (bin, board) in LOOPBACK_BOARDS {
+                        elfs.push((variant_elf(bin, v), board));
+                    }
+                }
+                for (elf, board) in elfs {
+                    let st = stack::measure_loopback(can_fil, board, &dir.join(&elf))?;
+                    eprintln!(
+                        "can-bench: {elf} (opt {opt}) on {board}: works, stack {} B",
+                        st.whole
+                    );
+                    fil.push(LoopbackStack {
+                        opt: opt.to_string(),
+                        elf,
+                        board: board.to_string(),
+                        stack: st,
+                    });
+                }
+            }
+        }
+        report.sizes = Some(SizeSection {
+            builds,
+            states,
+            fil,
+        });
     }
 
     if !skipped("examples") {
         lap(started);
         step("flash and RAM of the firmware examples");
         let t = Instant::now();
-        report.examples = Some(examples(&paths)?);
+        let mut section = examples(&paths)?;
         report.build_secs += t.elapsed().as_secs_f64();
+        if let Some(can_fil) = &can_fil {
+            lap(started);
+            step("stack of the firmware examples under can-fil");
+            for b in &mut section.builds {
+                let Some(board) = &b.board else { continue };
+                let st = stack::measure(can_fil, board, &b.elf)?;
+                eprintln!(
+                    "can-bench: {} on {board}: stack configuration {:?} B, whole run {} B",
+                    b.bin, st.configuration, st.whole
+                );
+                b.stack = Some(st);
+            }
+        } else {
+            section.stack_skipped = Some("`--skip fil`".into());
+        }
+        report.examples = Some(section);
     }
 
     if let Some(tools) = tools {
         lap(started);
-        step("instructions per frame under QEMU");
+        step("instructions per frame and stack under QEMU");
         let plugin = qemu::build_plugin(&paths, &tools)?;
         let mut runs = Vec::new();
         for ((profile, opt), (_, dir)) in COUNT_PROFILES.iter().zip(&firmware_dirs) {
-            let elf = dir.join("insn-count");
-            let counts = qemu::run(&paths, &tools, &plugin, &elf, profile)
-                .context(format!("instruction counts ({profile} profile)"))?;
-            runs.push((opt.to_string(), counts));
+            for backend in Backend::ALL {
+                for v in VARIANTS {
+                    let mut counts: Option<qemu::Counts> = None;
+                    for fw in backend.images() {
+                        let elf = dir.join(variant_elf(fw, v));
+                        let tag = format!("{profile}-{fw}-{v}");
+                        let c = qemu::run(&paths, &tools, &plugin, &elf, &tag)
+                            .context(format!("{fw} {v} ({profile} profile)"))?;
+                        if c.variant.as_deref() != Some(v) {
+                            return Err(cmd::Error::new(format!(
+                                "{} says it is variant {:?}, built as {v}",
+                                elf.display(),
+                                c.variant
+                            )));
+                        }
+                        match &mut counts {
+                            None => counts = Some(c),
+                            Some(all) => all.merge(c)?,
+                        }
+                    }
+                    let Some(counts) = counts else { continue };
+                    runs.push(InsnRun {
+                        backend,
+                        variant: v.to_string(),
+                        opt: opt.to_string(),
+                        counts,
+                    });
+                }
+            }
         }
         let mut async_runs = Vec::new();
         for ((profile, opt), (_, dir)) in COUNT_PROFILES.iter().zip(&firmware_dirs) {
@@ -233,7 +365,7 @@ fn run() -> Result<()> {
             async_runs.push((opt.to_string(), counts));
         }
         let window = sizes::read_u32_symbol(
-            &firmware_dirs[0].1.join("insn-count"),
+            &firmware_dirs[0].1.join(variant_elf("insn-count", "lean")),
             "BENCH_MARKER_WINDOW",
         )?;
         report.insn = Some(InsnSection {
@@ -284,7 +416,10 @@ fn examples(paths: &Paths) -> Result<ExampleSection> {
             "can-bench: no firmware example under examples/ yet (no package with binaries \
              and a cortex-m-rt dependency): nothing to measure there"
         );
-        return Ok(ExampleSection { builds: Vec::new() });
+        return Ok(ExampleSection {
+            builds: Vec::new(),
+            stack_skipped: None,
+        });
     }
     let mut builds = Vec::new();
     for p in &packages {
@@ -309,7 +444,16 @@ fn examples(paths: &Paths) -> Result<ExampleSection> {
                 if !required.iter().all(|r| features.contains(r)) {
                     continue;
                 }
-                let elf = dir.join(bin);
+                // The boards of a package build binaries of the same name: each ELF is
+                // kept under its board's name (for can-fil after all builds).
+                let kept = paths
+                    .scratch("bench-examples")
+                    .join("elf")
+                    .join(board.as_deref().unwrap_or("no-feature"));
+                std::fs::create_dir_all(&kept).context(format!("creating {}", kept.display()))?;
+                let elf = kept.join(bin);
+                std::fs::copy(dir.join(bin), &elf)
+                    .context(format!("copying {bin} to {}", elf.display()))?;
                 let size = sizes::measure(&elf).context(format!(
                     "{} {bin} ({})",
                     p.name,
@@ -320,12 +464,17 @@ fn examples(paths: &Paths) -> Result<ExampleSection> {
                     dir: p.dir.clone(),
                     board: board.clone(),
                     bin: bin.clone(),
+                    elf,
                     size,
+                    stack: None,
                 });
             }
         }
     }
-    Ok(ExampleSection { builds })
+    Ok(ExampleSection {
+        builds,
+        stack_skipped: None,
+    })
 }
 
 #[cfg(test)]
@@ -347,12 +496,13 @@ mod tests {
             [
                 Step::Sizes,
                 Step::Examples,
+                Step::Fil,
                 Step::Qemu,
                 Step::Timing,
                 Step::Sim
             ]
             .map(Step::name),
-            ["sizes", "examples", "qemu", "timing", "sim"]
+            ["sizes", "examples", "fil", "qemu", "timing", "sim"]
         );
         Args::command().debug_assert();
     }

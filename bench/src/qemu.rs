@@ -178,12 +178,20 @@ pub struct Region {
 }
 
 /// The outcome of one firmware run.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Default)]
 pub struct Counts {
     /// Regions by key (`twocan.try_send.direct`, ... as the firmware names them).
     pub regions: BTreeMap<String, Region>,
     /// Instructions of an empty region (the end marker store), subtracted from the others.
     pub overhead: u64,
+    /// Stack high-water marks by key (`stack <key> <bytes>` lines), bytes.
+    pub stacks: BTreeMap<String, u64>,
+    /// Other figures the firmware reported (`note <key> <value>`).
+    pub notes: BTreeMap<String, u64>,
+    /// The regions each round trip sums (`roundtrip <name> <keys...>`).
+    pub roundtrips: BTreeMap<String, Vec<String>>,
+    /// The build's variant (`variant <name>`), if it said.
+    pub variant: Option<String>,
 }
 
 impl Counts {
@@ -199,6 +207,74 @@ impl Counts {
             min.saturating_sub(self.overhead),
             max.saturating_sub(self.overhead),
         ))
+    }
+
+    /// The round trip `name` (as the firmware composed it): the sum of its regions.
+    pub fn roundtrip(&self, name: &str) -> Result<u64> {
+        let keys = self.roundtrip_keys(name)?;
+        let mut n = 0;
+        for k in keys {
+            n += self.net(k)?.0;
+        }
+        Ok(n)
+    }
+
+    /// The regions of round trip `name`.
+    pub fn roundtrip_keys(&self, name: &str) -> Result<&[String]> {
+        self.roundtrips
+            .get(name)
+            .map(Vec::as_slice)
+            .ok_or_else(|| Error::new(format!("the firmware declared no round trip `{name}`")))
+    }
+
+    /// A stack high-water mark, bytes.
+    pub fn stack(&self, key: &str) -> Result<u64> {
+        self.stacks
+            .get(key)
+            .copied()
+            .ok_or_else(|| Error::new(format!("the firmware reported no stack figure `{key}`")))
+    }
+
+    /// Adds the figures of another run (another image of the same comparison): every
+    /// key must be new, except the calibration region `empty`; measurements keep their
+    /// net value (the other run's marker overhead is taken off, this one's added).
+    pub fn merge(&mut self, other: Counts) -> Result<()> {
+        if self.variant != other.variant {
+            return Err(Error::new(format!(
+                "merging runs of variants {:?} and {:?}",
+                self.variant, other.variant
+            )));
+        }
+        for (k, r) in other.regions {
+            if k == "empty" {
+                continue;
+            }
+            if self.regions.contains_key(&k) {
+                return Err(Error::new(format!("region `{k}` measured by both runs")));
+            }
+            let raw = r
+                .raw
+                .iter()
+                .map(|&c| c.saturating_sub(other.overhead) + self.overhead)
+                .collect();
+            self.regions.insert(k, Region { raw });
+        }
+        for (k, v) in other.stacks {
+            if self.stacks.insert(k.clone(), v).is_some() {
+                return Err(Error::new(format!("stack `{k}` reported by both runs")));
+            }
+        }
+        for (k, v) in other.roundtrips {
+            if self.roundtrips.insert(k.clone(), v).is_some() {
+                return Err(Error::new(format!(
+                    "round trip `{k}` declared by both runs"
+                )));
+            }
+        }
+        for (k, v) in other.notes {
+            self.notes.entry(k).or_insert(v);
+        }
+        Ok(())
     }
 
     /// Measurements per region (the same for every region).
@@ -255,13 +331,18 @@ pub fn run(paths: &Paths, tools: &Tools, plugin: &Path, elf: &Path, tag: &str) -
     parse(&out.stdout, &counts, window)
 }
 
-/// Pairs the firmware's region names (its semihosting output) with the plugin's counts.
+/// Pairs the firmware's region names (its semihosting output) with the plugin's counts,
+/// and collects the firmware's stack figures, notes and round trips.
 fn parse(stdout: &str, counts: &str, window: u32) -> Result<Counts> {
     let mut keys = BTreeMap::new();
+    let mut stacks = BTreeMap::new();
+    let mut notes = BTreeMap::new();
+    let mut roundtrips = BTreeMap::new();
+    let mut variant = None;
     for line in stdout.lines() {
-        let mut w = line.split_whitespace();
-        match (w.next(), w.next(), w.next()) {
-            (Some("window"), Some(addr), None) => {
+        let w: Vec<&str> = line.split_whitespace().collect();
+        match w.as_slice() {
+            ["window", addr] => {
                 let addr = u32::from_str_radix(addr.trim_start_matches("0x"), 16)
                     .context("firmware window line")?;
                 if addr != window {
@@ -271,10 +352,25 @@ fn parse(stdout: &str, counts: &str, window: u32) -> Result<Counts> {
                     )));
                 }
             }
-            (Some("region"), Some(n), Some(key)) => {
+            ["region", n, key] => {
                 let n: u32 = n.parse().context("firmware region line")?;
                 keys.insert(n, key.to_string());
             }
+            ["stack", key, bytes] => {
+                let bytes: u64 = bytes.parse().context("firmware stack line")?;
+                stacks.insert(key.to_string(), bytes);
+            }
+            ["note", key, value] => {
+                let value: u64 = value.parse().context("firmware note line")?;
+                notes.insert(key.to_string(), value);
+            }
+            ["roundtrip", name, parts @ ..] if !parts.is_empty() => {
+                roundtrips.insert(
+                    name.to_string(),
+                    parts.iter().map(|p| p.to_string()).collect::<Vec<_>>(),
+                );
+            }
+            ["variant", name] => variant = Some(name.to_string()),
             _ => {}
         }
     }
@@ -329,7 +425,21 @@ fn parse(stdout: &str, counts: &str, window: u32) -> Result<Counts> {
             empty.raw
         )));
     }
-    Ok(Counts { regions, overhead })
+    for (name, parts) in &roundtrips {
+        if let Some(k) = parts.iter().find(|k| !regions.contains_key(*k)) {
+            return Err(Error::new(format!(
+                "round trip `{name}` sums `{k}`, which the firmware did not measure"
+            )));
+        }
+    }
+    Ok(Counts {
+        regions,
+        overhead,
+        stacks,
+        notes,
+        roundtrips,
+        variant,
+    })
 }
 
 #[cfg(test)]
@@ -355,7 +465,9 @@ mod tests {
         assert!(p.ends_with("sh") && !installed_now);
     }
 
-    const STDOUT: &str = "window 0x20110000\nregion 0 empty\nregion 1 a.b\nregion 2 c\ndone\n";
+    const STDOUT: &str = "window 0x20110000\nregion 0 empty\nregion 1 a.b\nregion 2 c\n\
+                          roundtrip ours a.b c\nvariant lean\nstack a.b 24\n\
+                          note cfg.low 8\ndone\n";
 
     #[test]
     fn pairs_names_and_counts_and_subtracts_the_empty_region() {
@@ -367,6 +479,50 @@ mod tests {
         assert_eq!(c.net("c").unwrap(), (6, 8));
         assert_eq!(c.repeats(), 2);
         assert!(c.net("missing").is_err());
+        // The round trip sums the smallest measurement of each of its regions.
+        assert_eq!(c.roundtrip("ours").unwrap(), 10 + 6);
+        assert!(c.roundtrip("theirs").is_err());
+        assert_eq!(c.stack("a.b").unwrap(), 24);
+        assert!(c.stack("c").is_err());
+        assert_eq!(c.notes.get("cfg.low"), Some(&8));
+        assert_eq!(c.variant.as_deref(), Some("lean"));
+    }
+
+    #[test]
+    fn merges_a_second_run_keeping_net_values() {
+        let a = parse(
+            "region 0 empty\nregion 1 a\nvariant lean\nroundtrip ours a\nstack a 8\n",
+            "region 0 1\nregion 1 11\ntotal 9 completed 2 unmatched 0\n",
+            0x2011_0000,
+        )
+        .unwrap();
+        let b = parse(
+            "region 0 empty\nregion 1 b\nvariant lean\nroundtrip theirs b\nstack b 4\n",
+            "region 0 3\nregion 1 10\ntotal 9 completed 2 unmatched 0\n",
+            0x2011_0000,
+        )
+        .unwrap();
+        let mut m = a.clone();
+        m.merge(b.clone()).unwrap();
+        assert_eq!(m.net("a").unwrap(), (10, 10));
+        assert_eq!(m.net("b").unwrap(), (7, 7));
+        assert_eq!(m.roundtrip("theirs").unwrap(), 7);
+        assert_eq!(m.stack("b").unwrap(), 4);
+        // The same key twice, or two variants, is refused.
+        let mut twice = a.clone();
+        assert!(twice.merge(a.clone()).is_err());
+        let mut other = b;
+        other.variant = Some("full".into());
+        let mut m = a;
+        assert!(m.merge(other).is_err());
+    }
+
+    #[test]
+    fn refuses_a_round_trip_over_an_unmeasured_region() {
+        let stdout = "region 0 empty\nregion 1 a\nroundtrip ours a b\n";
+        let plugin = "region 0 1\nregion 1 3\ntotal 9 completed 2 unmatched 0\n";
+        let e = parse(stdout, plugin, 0x2011_0000).unwrap_err();
+        assert!(e.to_string().contains("`b`"), "{e}");
     }
 
     #[test]

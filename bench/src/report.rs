@@ -1,14 +1,31 @@
 //! `docs/benchmarks.md`: every figure of one run, with the machine, the tools and the
-//! method behind each.
+//! method behind each. The issue-21 targets and `summary.json` come from
+//! [`crate::figures`].
 
 use std::fmt::Write as _;
 
 use crate::cmd::{self, Result};
-use crate::firmware::{self, Paths, TARGET};
+use crate::figures::{self, Backend, Figures, Measured};
+use crate::firmware::{self, Paths, TARGET, VARIANTS};
 use crate::qemu::{self, Counts, Tools};
 use crate::simspeed::{self, SimRow};
 use crate::sizes::{Size, StateFigures};
+use crate::stack::FilStack;
 use crate::timing::{self, Case, ControllerQuality};
+
+/// The loop-back firmwares of one variant, one build profile.
+pub struct VariantSizes {
+    /// `lean` or `full`.
+    pub variant: String,
+    /// `loopback-twocan` (our bxCAN driver).
+    pub ours: Size,
+    /// `loopback-bxcan-equiv` (the `bxcan` crate and the service of the variant).
+    pub equiv: Size,
+    /// `loopback-flexcan` (our FlexCAN driver).
+    pub flexcan: Size,
+    /// `loopback-flexcan-hand` (the hand-written FlexCAN service).
+    pub flexcan_hand: Size,
+}
 
 /// The loop-back comparison of one build profile.
 pub struct SizeBuild {
@@ -16,22 +33,63 @@ pub struct SizeBuild {
     pub profile: String,
     /// Its opt-level.
     pub opt: String,
-    /// `loopback-twocan`.
-    pub ours: Size,
     /// `loopback-bxcan` (the bare `bxcan` crate).
-    pub theirs: Size,
-    /// `loopback-bxcan-equiv` (the `bxcan` crate and the service work of our features).
-    pub equiv: Size,
-    /// `loopback-async` (our driver through its async API).
+    pub bare: Size,
+    /// `loopback-async` (our driver through its async API, full features).
     pub async_fw: Size,
+    /// Per variant.
+    pub variants: Vec<VariantSizes>,
+}
+
+impl SizeBuild {
+    /// The firmwares of `variant`.
+    pub fn variant(&self, variant: &str) -> Option<&VariantSizes> {
+        self.variants.iter().find(|v| v.variant == variant)
+    }
+}
+
+/// What our drivers' `State` statics hold, per variant.
+pub struct StateSet {
+    /// `lean` or `full`.
+    pub variant: String,
+    /// bxCAN (`loopback-twocan` with `insn-count`).
+    pub bxcan: StateFigures,
+    /// FlexCAN (`loopback-flexcan` with `insn-count-flexcan`).
+    pub flexcan: StateFigures,
+}
+
+/// A loop-back firmware run under `can-fil --stack`.
+pub struct LoopbackStack {
+    /// Opt-level of its build.
+    pub opt: String,
+    /// Its ELF name (`loopback-twocan-lean` ...).
+    pub elf: String,
+    /// The board can-fil emulated.
+    pub board: String,
+    /// Its stack over the run.
+    pub stack: FilStack,
 }
 
 /// The loop-back comparison.
 pub struct SizeSection {
     /// One comparison per profile (the first is the headline).
     pub builds: Vec<SizeBuild>,
-    /// What `loopback-twocan`'s `State` static holds.
-    pub state: StateFigures,
+    /// State figures per variant (size-optimised build).
+    pub states: Vec<StateSet>,
+    /// The loop-back firmwares under can-fil (empty with `--skip fil`).
+    pub fil: Vec<LoopbackStack>,
+}
+
+impl SizeSection {
+    /// The build of `opt`.
+    pub fn build(&self, opt: &str) -> Option<&SizeBuild> {
+        self.builds.iter().find(|b| b.opt == opt)
+    }
+
+    /// The state figures of `variant`.
+    pub fn state(&self, variant: &str) -> Option<&StateSet> {
+        self.states.iter().find(|s| s.variant == variant)
+    }
 }
 
 /// One built example binary.
@@ -44,26 +102,71 @@ pub struct ExampleBuild {
     pub board: Option<String>,
     /// Binary.
     pub bin: String,
+    /// The ELF.
+    pub elf: std::path::PathBuf,
     /// Its memory use.
     pub size: Size,
+    /// Its stack under `can-fil --stack` (`None`: not run on can-fil).
+    pub stack: Option<FilStack>,
 }
 
 /// The firmware examples.
 pub struct ExampleSection {
     /// Every binary built.
     pub builds: Vec<ExampleBuild>,
+    /// Why the stacks were not measured, when they were not.
+    pub stack_skipped: Option<String>,
+}
+
+/// One run of an instruction-count firmware.
+pub struct InsnRun {
+    /// Which backend's firmware (`insn-count` or `insn-count-flexcan`).
+    pub backend: Backend,
+    /// `lean` or `full`.
+    pub variant: String,
+    /// Opt-level of its build.
+    pub opt: String,
+    /// What it measured.
+    pub counts: Counts,
 }
 
 /// The instruction counts.
 pub struct InsnSection {
     /// QEMU and gcc.
     pub tools: Tools,
-    /// (opt-level, counts) per firmware build.
-    pub runs: Vec<(String, Counts)>,
+    /// Every run.
+    pub runs: Vec<InsnRun>,
     /// (opt-level, counts) of `insn-count-async` per build.
     pub async_runs: Vec<(String, Counts)>,
     /// The marker window address.
     pub window: u32,
+}
+
+impl InsnSection {
+    /// The counts of `backend`, `variant`, `opt`.
+    pub fn get(&self, backend: Backend, variant: &str, opt: &str) -> Result<&Counts> {
+        self.runs
+            .iter()
+            .find(|r| r.backend == backend && r.variant == variant && r.opt == opt)
+            .map(|r| &r.counts)
+            .ok_or_else(|| {
+                cmd::Error::new(format!(
+                    "no {} {variant} run at opt {opt}",
+                    backend.firmware()
+                ))
+            })
+    }
+
+    /// The opt-levels measured, in build order.
+    pub fn opts(&self) -> Vec<String> {
+        let mut v: Vec<String> = Vec::new();
+        for r in &self.runs {
+            if !v.contains(&r.opt) {
+                v.push(r.opt.clone());
+            }
+        }
+        v
+    }
 }
 
 /// Everything measured.
@@ -71,7 +174,7 @@ pub struct Report {
     paths: Paths,
     /// Loop-back sizes.
     pub sizes: Option<SizeSection>,
-    /// Example sizes.
+    /// Example sizes (and stacks).
     pub examples: Option<ExampleSection>,
     /// Instruction counts.
     pub insn: Option<InsnSection>,
@@ -86,7 +189,7 @@ pub struct Report {
 }
 
 /// `1234567` → `1,234,567`.
-fn thousands(n: u64) -> String {
+pub(crate) fn thousands(n: u64) -> String {
     let s = n.to_string();
     let mut out = String::new();
     for (i, c) in s.chars().enumerate() {
@@ -172,15 +275,27 @@ impl Report {
         }
     }
 
+    /// The issue-21 figures, when both the sizes and the instruction counts were
+    /// measured.
+    pub fn figures(&self) -> Result<Option<Figures>> {
+        match (&self.insn, &self.sizes) {
+            (Some(insn), Some(sizes)) => {
+                Ok(Some(Figures::compute(insn, sizes, self.examples.as_ref())?))
+            }
+            _ => Ok(None),
+        }
+    }
+
     fn render_async(&self, s: &mut String, insn: &InsnSection) -> Result<()> {
         let _ = writeln!(s, "### Async receive path (issue 11)\n");
         let _ = writeln!(
             s,
-            "`bench/firmware/insn-count-async`: the same driver and register stand-in, built \
-             with twocan-core's `async` feature (a cargo invocation of its own, so the \
-             feature does not reach the other firmwares). One frame through the async API \
-             as an executor drives it: the task polls its `Rx::recv` future on an empty ring \
-             (it registers its waker: `Pending`), the RX0 handler moves one frame into the \
+            "`bench/firmware/insn-count-async`: our bxCAN driver (completions, time stamps \
+             off, filters set by hand) on the same register stand-in, built with \
+             twocan-core's `async` feature (a cargo invocation of its own, so the feature \
+             does not reach the other firmwares). One frame through the async API as an \
+             executor drives it: the task polls its `Rx::recv` future on an empty ring (it \
+             registers its waker: `Pending`), the RX0 handler moves one frame into the \
              ring and wakes the waker, the task polls again and gets the frame with its \
              filter index (`Ready`). The waker is a flag and the executor a hand-rolled \
              poll, so what an executor adds around a wake (queueing the task) is not \
@@ -231,10 +346,13 @@ impl Report {
         let sync: Vec<String> = insn
             .runs
             .iter()
-            .map(|(opt, c)| {
+            .filter(|r| r.backend == Backend::BxCan)
+            .map(|r| {
                 Ok(format!(
-                    "{} at opt {opt}",
-                    thousands(sum(c, &["twocan.rx_irq", "twocan.rx.receive"])?)
+                    "{} ({}, opt {})",
+                    thousands(sum(&r.counts, &["twocan.rx_irq", "twocan.rx.receive"])?),
+                    r.variant,
+                    r.opt
                 ))
             })
             .collect::<Result<_>>()?;
@@ -252,25 +370,26 @@ impl Report {
                  polled by a hand-rolled loop with the flag waker; no executor crate):"
             );
             for b in &sz.builds {
+                let full = b.variant("full").map(|v| v.ours.flash()).unwrap_or(0);
                 let _ = writeln!(
                     s,
                     "- opt {}: flash **{}** B (RAM {} B), against {} B for the non-async \
-                     `loopback-twocan`;",
+                     `loopback-twocan` (full);",
                     b.opt,
                     thousands(b.async_fw.flash()),
                     thousands(b.async_fw.ram()),
-                    thousands(b.ours.flash())
+                    thousands(full)
                 );
             }
             let echo: Vec<String> = self
                 .examples
                 .iter()
                 .flat_map(|e| e.builds.iter())
-                .filter(|b| b.bin == "async_echo")
+                .filter(|b| b.bin.ends_with("async-echo"))
                 .map(|b| {
                     format!(
                         "`{}` ({}): flash **{}** B, RAM {} B",
-                        b.package,
+                        b.bin,
                         b.board.as_deref().unwrap_or("no feature"),
                         thousands(b.size.flash()),
                         thousands(b.size.ram())
@@ -280,80 +399,118 @@ impl Report {
             if echo.is_empty() {
                 let _ = writeln!(
                     s,
-                    "- the `async_echo` firmware examples were not among the examples built \
+                    "- the `async-echo` firmware examples were not among the examples built \
                      in this run (section 1, \"Firmware examples\"), so their flash is not \
                      given here.\n"
                 );
             } else {
-                let _ = writeln!(s, "- the `async_echo` examples: {}.\n", echo.join("; "));
+                let _ = writeln!(s, "- the `async-echo` examples: {}.\n", echo.join("; "));
             }
         }
         Ok(())
     }
 
-    /// `target/bench/summary.json` (issue 10): the ratios ours / theirs as floats and the
-    /// driver state's RAM; `None` unless both the sizes and the instruction counts (opt s
-    /// and opt 3) were measured.
+    /// `target/bench/summary.json`: the ratios ours / theirs as floats and byte figures
+    /// as integers; `None` unless both the sizes and the instruction counts (opt s and
+    /// opt 3) were measured.
+    ///
+    /// The fields of issue 10 keep their names and now describe the **full** variant
+    /// (the one with every feature, as the single firmware of issue 10 had):
+    /// `tx_ratio_*` (direct transmit / `Can::transmit`), `rx_isr_ratio_*` (RX0 handler /
+    /// bare `Rx0::receive`), `roundtrip_ratio_*` (round trip / the feature-equivalent
+    /// service), `flash_ratio_equiv_s` and `flash_ratio_bare_s` (whole flash),
+    /// `ram_state_bytes`, `ram_ring_bytes`. The fields of issue 21 follow
+    /// ([`Figures::summary_fields`]).
     pub fn summary(&self) -> Result<Option<serde_json::Value>> {
-        let (Some(sizes), Some(insn)) = (&self.sizes, &self.insn) else {
+        let (Some(sizes), Some(insn), Some(fig)) = (&self.sizes, &self.insn, self.figures()?)
+        else {
             return Ok(None);
         };
-        let run = |opt: &str| insn.runs.iter().find(|(o, _)| o == opt).map(|(_, c)| c);
-        let (Some(s), Some(o3)) = (run("s"), run("3")) else {
+        let (Some(size_s), Some(full_state)) = (sizes.build("s"), sizes.state("full")) else {
             return Ok(None);
         };
-        let Some(size_s) = sizes.builds.iter().find(|b| b.opt == "s") else {
+        let Some(full_s) = size_s.variant("full") else {
             return Ok(None);
         };
-        let r = |c: &Counts, t: &Target| -> Result<f64> {
-            Ok(ratio_f(sum(c, t.ours)?, sum(c, t.theirs)?))
-        };
-        let [tx, rx, rt] = &TARGETS;
+        let b = Backend::BxCan;
+        let v = |key: &str, opt: &str| fig.value(b, "full", key, opt);
         let mut counts = serde_json::Map::new();
-        for (opt, c) in &insn.runs {
-            for t in &TARGETS {
-                let key = |side: &str| {
-                    format!(
-                        "{}_{side}_{opt}",
-                        t.tag.trim_matches(|c| c == '(' || c == ')')
-                    )
-                };
-                counts.insert(key("ours"), sum(c, t.ours)?.into());
-                counts.insert(key("theirs"), sum(c, t.theirs)?.into());
+        for r in insn
+            .runs
+            .iter()
+            .filter(|r| r.backend == b && r.variant == "full")
+        {
+            for (tag, ours, theirs) in [
+                ("a", "twocan.tx.direct", "bxcan.transmit"),
+                ("b", "twocan.rx_irq", "bxcan.rx0.receive"),
+            ] {
+                counts.insert(
+                    format!("{tag}_ours_{}", r.opt),
+                    r.counts.net(ours)?.0.into(),
+                );
+                counts.insert(
+                    format!("{tag}_theirs_{}", r.opt),
+                    r.counts.net(theirs)?.0.into(),
+                );
             }
+            counts.insert(
+                format!("c_ours_{}", r.opt),
+                r.counts.roundtrip("twocan")?.into(),
+            );
+            counts.insert(
+                format!("c_theirs_{}", r.opt),
+                r.counts.roundtrip("equiv")?.into(),
+            );
         }
-        Ok(Some(serde_json::json!({
-            "tx_ratio_s": r(s, tx)?,
-            "tx_ratio_3": r(o3, tx)?,
-            "rx_isr_ratio_s": r(s, rx)?,
-            "rx_isr_ratio_3": r(o3, rx)?,
-            "roundtrip_ratio_s": r(s, rt)?,
-            "roundtrip_ratio_3": r(o3, rt)?,
-            "flash_ratio_equiv_s": ratio_f(size_s.ours.flash(), size_s.equiv.flash()),
-            "flash_ratio_bare_s": ratio_f(size_s.ours.flash(), size_s.theirs.flash()),
-            "ram_state_bytes": sizes.state.static_bytes - sizes.state.ring_bytes,
-            "ram_ring_bytes": sizes.state.ring_bytes,
-            "flash_bytes_s": {
-                "twocan": size_s.ours.flash(),
-                "bxcan": size_s.theirs.flash(),
-                "bxcan_equiv": size_s.equiv.flash(),
-            },
-            "instructions": counts,
-            "async_rx_path": insn
-                .async_runs
-                .iter()
-                .map(|(opt, c)| {
-                    Ok((
-                        format!("opt_{opt}"),
-                        serde_json::Value::from(sum(
-                            c,
-                            &["async.recv.pending", "async.rx_irq", "async.recv.ready"],
-                        )?),
-                    ))
-                })
-                .collect::<Result<serde_json::Map<_, _>>>()?,
-            "flash_bytes_async_s": size_s.async_fw.flash(),
-        })))
+        let mut m = serde_json::Map::new();
+        m.insert("tx_ratio_s".into(), v("tx", "s")?.into());
+        m.insert("tx_ratio_3".into(), v("tx", "3")?.into());
+        m.insert("rx_isr_ratio_s".into(), v("rx_bare", "s")?.into());
+        m.insert("rx_isr_ratio_3".into(), v("rx_bare", "3")?.into());
+        m.insert("roundtrip_ratio_s".into(), v("roundtrip", "s")?.into());
+        m.insert("roundtrip_ratio_3".into(), v("roundtrip", "3")?.into());
+        m.insert(
+            "flash_ratio_equiv_s".into(),
+            ratio_f(full_s.ours.flash(), full_s.equiv.flash()).into(),
+        );
+        m.insert(
+            "flash_ratio_bare_s".into(),
+            ratio_f(full_s.ours.flash(), size_s.bare.flash()).into(),
+        );
+        m.insert(
+            "ram_state_bytes".into(),
+            full_state.bxcan.state_bytes().into(),
+        );
+        m.insert("ram_ring_bytes".into(), full_state.bxcan.ring_bytes.into());
+        m.insert(
+            "flash_bytes_s".into(),
+            serde_json::json!({
+                "twocan": full_s.ours.flash(),
+                "bxcan": size_s.bare.flash(),
+                "bxcan_equiv": full_s.equiv.flash(),
+            }),
+        );
+        m.insert("instructions".into(), serde_json::Value::Object(counts));
+        m.insert(
+            "async_rx_path".into(),
+            serde_json::Value::Object(
+                insn.async_runs
+                    .iter()
+                    .map(|(opt, c)| {
+                        Ok((
+                            format!("opt_{opt}"),
+                            serde_json::Value::from(sum(
+                                c,
+                                &["async.recv.pending", "async.rx_irq", "async.recv.ready"],
+                            )?),
+                        ))
+                    })
+                    .collect::<Result<serde_json::Map<_, _>>>()?,
+            ),
+        );
+        m.insert("flash_bytes_async_s".into(), size_s.async_fw.flash().into());
+        m.extend(fig.summary_fields()?);
+        Ok(Some(serde_json::Value::Object(m)))
     }
 
     /// The markdown document.
@@ -365,16 +522,23 @@ impl Report {
         let _ = writeln!(
             s,
             "Generated by `cargo run --release --bin can-bench` (source: `bench/`) on {date}; \
-             the run took {:.0} s after can-bench itself was built, {:.0} s of it in cargo builds \
-             of firmware (short when they were already built). Every figure in this file comes from that run — none is \
-             written by hand. Run the command again to refresh it; a step that cannot run \
-             stops the command with an error and leaves this file as it was.\n",
-            self.elapsed_secs,
-            self.build_secs
+             the run took {:.0} s after can-bench itself was built, {:.0} s of it in cargo \
+             builds of firmware and of can-fil (short when they were already built). Every \
+             figure in this file comes from that run — none is written by hand. Run the \
+             command again to refresh it; a step that cannot run stops the command with an \
+             error and leaves this file as it was.\n",
+            self.elapsed_secs, self.build_secs
         );
         self.render_machine(&mut s);
+        let figures = self.figures()?;
+        if let Some(f) = &figures {
+            render_targets(&mut s, f);
+        }
         if let Some(sizes) = &self.sizes {
-            self.render_sizes(&mut s, sizes, self.examples.as_ref());
+            self.render_sizes(&mut s, sizes);
+        }
+        if let Some(ex) = &self.examples {
+            render_examples(&mut s, ex);
         }
         if let Some(insn) = &self.insn {
             self.render_insn(&mut s, insn)?;
@@ -387,6 +551,497 @@ impl Report {
         }
         render_sources(&mut s);
         Ok(s)
+    }
+
+    fn render_sizes(&self, s: &mut String, sz: &SizeSection) {
+        let _ = writeln!(s, "## 1. Flash and RAM\n");
+        let _ = writeln!(
+            s,
+            "Read from the ELF section headers (the `object` crate). Only allocated sections \
+             (`SHF_ALLOC`) count:\n\n\
+             - **code**: allocated sections that are neither writable nor `NOBITS` — \
+             `.vector_table`, `.text`, `.rodata` (and `.flash_config` on the Teensy): \
+             flash-resident code and constants;\n\
+             - **data**: writable `PROGBITS` sections (`.data`): in RAM, and their initial \
+             image in flash;\n\
+             - **bss**: `NOBITS` sections (`.bss`, `.uninit`): RAM only.\n\n\
+             **flash = code + data**, **RAM = data + bss**, in bytes. The stack (the rest of \
+             RAM) is not a section and is not counted here (section 2 measures it).\n\n\
+             **Driver + application** (the issue-21 flash figure) is the flash without what \
+             every firmware of a board shares and no CAN service needs: the `.vector_table` \
+             and `.flash_config` sections and the code and constants of the shared start-up \
+             module (the ELF symbols of the module `startup`: `shared/stm32f7.rs` — PLL, \
+             flash wait states, CAN1 clock — or `shared/kinetis.rs` — watchdog, crystal \
+             oscillator; its entry `clocks`/`init` is never inlined, so its code keeps its \
+             symbols). The runtime's reset handler (`.bss`/`.data` set-up) and the panic \
+             handler stay in.\n"
+        );
+        let _ = writeln!(
+            s,
+            "### Minimal loop-back firmware: the lean and full variants\n\n\
+             Each variant is a separate build of the same firmware source, selected by the \
+             cargo feature `lean` or `full` of the bench firmware crates \
+             (`bench/firmware/shared/bxcan_variant.rs`, `flexcan_variant.rs` for our \
+             drivers; `bxcan_equiv.rs`, `flexcan_hand.rs` for the equivalents):\n\n\
+             - **full**: completions (a token per frame, a completion ring of 8), receive \
+             time stamps, traffic statistics, filters from the runtime planner;\n\
+             - **lean**: issue 21's lean driver (const filter plan, fire-and-forget \
+             transmit, no time stamps, no statistics) **is pending**: the lean build is \
+             today's driver in the closest configuration its API allows — no completion \
+             ring (`DONE` = 0); bxCAN: time stamps off, the one bank set by hand \
+             (`FilterPlan::manual`, planner not linked), a filter map with no lookup keys \
+             (`with_lookup_capacity::<0>`); FlexCAN: `begin` still compiles the list and \
+             widens time stamps; statistics stay on in both.\n\n\
+             bxCAN (STM32F767ZI): the same start-up (`shared/stm32f7.rs`: SYSCLK 108 MHz \
+             from the PLL, APB1 54 MHz, CAN1 clock on), CAN1 in loop-back mode at \
+             500 kbit/s (the same `CAN_BTR`, solved at compile time), one accept-all filter \
+             to FIFO 0, one 8-byte frame sent and received by polling, `panic-halt`:\n\n\
+             - `loopback-twocan`: our split driver as an interrupt-driven application keeps \
+             it — a `static State` (all zeros, `.bss`; request-order transmit), `split` \
+             once, `Tx::try_send`, then the TX and RX0 handlers and `Rx::receive` polled in \
+             turn until the frame comes back with its filter index (full: and its \
+             completion);\n\
+             - `loopback-bxcan`: the bare `bxcan` crate (`Can::builder`, `transmit`, \
+             `receive`), the `Can` in a `critical_section::Mutex` static (no variant);\n\
+             - `loopback-bxcan-equiv`: the `bxcan` crate plus the service that gives an \
+             application what the variant of ours does (**feature-equivalent**, \
+             `shared/bxcan_equiv.rs`): split once; an RX0 handler moving FIFO 0 into a \
+             `heapless::spsc` ring with each frame's filter match index (read from \
+             `CAN_RDT0R`, which the crate does not return), counting hardware overruns and \
+             ring overflows; the thread side taking the frame with the user's filter index \
+             (a table from `FMI`); full adds a token per frame, a TX handler that reads \
+             `CAN_TSR` once and, in one loop over the completed mailboxes, pushes (token, \
+             outcome, time stamp) into a completion ring and acknowledges them with one \
+             store, the receive time stamp, counts of frames sent, failed and received.\n\n\
+             FlexCAN (Teensy 3.6, MK66FX1M0): the same start-up (`shared/kinetis.rs`: \
+             flash configuration field, watchdog off, 16 MHz crystal oscillator on), \
+             FlexCAN0 in loop-back mode with self reception at 500 kbit/s from the \
+             oscillator clock, one pass-all filter, one frame by polling:\n\n\
+             - `loopback-flexcan`: our FlexCAN split driver (`begin` with the 8-filter Rx \
+             FIFO partition, `into_split`, a `static State`), as `loopback-twocan`;\n\
+             - `loopback-flexcan-hand`: the hand-written register-level service of \
+             `shared/flexcan_hand.rs` (there is no crate peer for Teensy 3.x): the K66 \
+             manual's initialization sequence, MB15 as the transmit mailbox, an Rx FIFO \
+             handler moving frames into a `heapless::spsc` ring with counts and \
+             `RXFIR.IDHIT`, the thread side mapping `IDHIT` to the user's filter index \
+             through a table; full adds the token, MB15's completion handler and ring, \
+             the time stamps and the counts.\n\n\
+             Both profiles: fat LTO, one codegen unit, `panic = \"abort\"`; the \
+             size-optimised one comes first.\n"
+        );
+        for b in &sz.builds {
+            let _ = writeln!(
+                s,
+                "Profile `{}` (`opt-level = {}`):\n",
+                b.profile,
+                if b.opt == "s" {
+                    "\"s\"".to_string()
+                } else {
+                    b.opt.clone()
+                }
+            );
+            let _ = writeln!(
+                s,
+                "| firmware | code | data | bss | **flash** | **RAM** | **driver + application** |\n\
+                 |---|---:|---:|---:|---:|---:|---:|"
+            );
+            let row = |s: &mut String, name: &str, z: &Size| {
+                let _ = writeln!(
+                    s,
+                    "| {name} | {} | {} | {} | **{}** | **{}** | **{}** |",
+                    thousands(z.code()),
+                    thousands(z.data()),
+                    thousands(z.bss()),
+                    thousands(z.flash()),
+                    thousands(z.ram()),
+                    thousands(z.app_flash())
+                );
+            };
+            for v in &b.variants {
+                row(s, &format!("`loopback-twocan` ({})", v.variant), &v.ours);
+                row(
+                    s,
+                    &format!("`loopback-bxcan-equiv` ({})", v.variant),
+                    &v.equiv,
+                );
+            }
+            row(s, "`loopback-bxcan` (bare crate)", &b.bare);
+            for v in &b.variants {
+                row(
+                    s,
+                    &format!("`loopback-flexcan` ({})", v.variant),
+                    &v.flexcan,
+                );
+                row(
+                    s,
+                    &format!("`loopback-flexcan-hand` ({})", v.variant),
+                    &v.flexcan_hand,
+                );
+            }
+            let _ = writeln!(s);
+            let mut ratios = Vec::new();
+            for v in &b.variants {
+                ratios.push(format!(
+                    "{}: bxCAN {} (whole flash {}), FlexCAN {} (whole flash {})",
+                    v.variant,
+                    ratio(v.ours.app_flash(), v.equiv.app_flash()),
+                    ratio(v.ours.flash(), v.equiv.flash()),
+                    ratio(v.flexcan.app_flash(), v.flexcan_hand.app_flash()),
+                    ratio(v.flexcan.flash(), v.flexcan_hand.flash())
+                ));
+            }
+            let _ = writeln!(
+                s,
+                "Driver + application, ours / the equivalent — {}. Whole flash of the full \
+                 `loopback-twocan` / the bare crate: {}.\n",
+                ratios.join("; "),
+                b.variant("full")
+                    .map(|v| ratio(v.ours.flash(), b.bare.flash()))
+                    .unwrap_or_else(|| "–".into())
+            );
+            let _ = writeln!(s, "Sections and start-up bytes left out:\n");
+            let mut list = |name: &str, z: &Size| {
+                let _ = writeln!(
+                    s,
+                    "- `{name}`: {}; start-up module {} B",
+                    z.section_list(),
+                    z.startup
+                );
+            };
+            for v in &b.variants {
+                list(&format!("loopback-twocan-{}", v.variant), &v.ours);
+                list(&format!("loopback-bxcan-equiv-{}", v.variant), &v.equiv);
+            }
+            list("loopback-bxcan", &b.bare);
+            for v in &b.variants {
+                list(&format!("loopback-flexcan-{}", v.variant), &v.flexcan);
+                list(
+                    &format!("loopback-flexcan-hand-{}", v.variant),
+                    &v.flexcan_hand,
+                );
+            }
+            let _ = writeln!(s);
+        }
+        if sz.fil.is_empty() {
+            let _ = writeln!(
+                s,
+                "The loop-back firmwares were not run under can-fil in this run (`--skip \
+                 fil`).\n"
+            );
+        } else {
+            let _ = writeln!(
+                s,
+                "**Each loop-back firmware works**: every one runs under `can-fil --stack` \
+                 (the firmware-in-the-loop harness, `fil/`: the STM32 ones on the \
+                 NUCLEO-F767ZI profile, the Teensy ones on the Teensy 3.6 profile, CAN on \
+                 the project's models) for {} s of simulated time, and can-bench requires \
+                 that it ends without a fault or a halt and not in its panic handler (each \
+                 panics unless the frame came back with its filter index and, with \
+                 completions, its completion). Its stack over the run (start-up, \
+                 configuration, one frame by polling), painted as for the examples:\n",
+                crate::stack::SECONDS
+            );
+            let mut opts: Vec<&str> = Vec::new();
+            let mut elfs: Vec<&str> = Vec::new();
+            for r in &sz.fil {
+                if !opts.contains(&r.opt.as_str()) {
+                    opts.push(&r.opt);
+                }
+                if !elfs.contains(&r.elf.as_str()) {
+                    elfs.push(&r.elf);
+                }
+            }
+            let mut header = String::from("| firmware | board |");
+            let mut rule = String::from("|---|---|");
+            for o in &opts {
+                let _ = write!(header, " stack, opt {o} |");
+                rule.push_str("---:|");
+            }
+            let _ = writeln!(s, "{header}\n{rule}");
+            for e in elfs {
+                let board = sz
+                    .fil
+                    .iter()
+                    .find(|r| r.elf == e)
+                    .map(|r| r.board.as_str())
+                    .unwrap_or("");
+                let mut line = format!("| `{e}` | {board} |");
+                for o in &opts {
+                    match sz.fil.iter().find(|r| r.elf == e && r.opt == *o) {
+                        Some(r) => {
+                            let _ = write!(line, " {} |", thousands(r.stack.whole));
+                        }
+                        None => line.push_str(" – |"),
+                    }
+                }
+                let _ = writeln!(s, "{line}");
+            }
+            let _ = writeln!(s);
+        }
+        let _ = writeln!(
+            s,
+            "**RAM of our drivers**: the `State` static (symbol size of `BENCH_CAN_STATE` \
+             in the loop-back firmware), its ring and queue slots (receive ring 8 raw \
+             frames, transmit queue 8 entries, completion ring `DONE` entries, state-change \
+             ring 8; the instruction-count firmware of the same variant holds a `State` of \
+             the same type and exports these sizes, checked equal), and the **driver \
+             state** beyond them. The halves and handlers (`split`'s `Parts`) live \
+             wherever the application keeps them.\n"
+        );
+        let _ = writeln!(
+            s,
+            "| backend | variant | `State` | rings and queues | **driver state** | of which the controller value | of which its filter map |\n\
+             |---|---|---:|---:|---:|---:|---:|"
+        );
+        for st in &sz.states {
+            for (name, f) in [("bxCAN", &st.bxcan), ("FlexCAN", &st.flexcan)] {
+                let opt = |v: Option<u64>| v.map(thousands).unwrap_or_else(|| "–".into());
+                let _ = writeln!(
+                    s,
+                    "| {name} | {} | {} | {} | **{}** | {} | {} |",
+                    st.variant,
+                    thousands(f.static_bytes),
+                    thousands(f.ring_bytes),
+                    thousands(f.state_bytes()),
+                    opt(f.hw_bytes),
+                    opt(f.fmi_bytes)
+                );
+            }
+        }
+        let _ = writeln!(s);
+    }
+
+    fn render_insn(&self, s: &mut String, insn: &InsnSection) -> Result<()> {
+        let _ = writeln!(
+            s,
+            "## 2. Instructions per frame and stack on a Cortex-M4 (QEMU)\n"
+        );
+        let _ = writeln!(
+            s,
+            "Guest instructions executed, counted by the TCG plugin \
+             `bench/plugin/insn_count.c` (built at bench time with `gcc {}`) while QEMU \
+             runs the firmwares `bench/firmware/insn-count` (bxCAN: ours and the bare \
+             `bxcan` crate), `bench/firmware/insn-count-equiv` (the feature-equivalent \
+             service, in an image of its own so that the crate's `transmit` is not shared \
+             with the bare measurement and stays inlined, as in a firmware using it alone; \
+             its figures are merged with `insn-count`'s) and \
+             `bench/firmware/insn-count-flexcan` (FlexCAN: ours, the hand-written service), \
+             each built as the lean and as the full variant (section 1), on `-machine {}` (an ARM MPS2 board with a \
+             Cortex-M4). This is an instruction count, not a cycle count: QEMU does not \
+             model pipeline, wait states or bus timing.\n",
+            qemu::PLUGIN_FLAGS.join(" "),
+            qemu::MACHINE
+        );
+        let _ = writeln!(
+            s,
+            "No Debian 12 package ships QEMU's plugin header `qemu-plugin.h` (checked \
+             when the bench was written: `apt-file search qemu-plugin.h` on bookworm finds \
+             nothing, and the qemu-system packages list no header; in this run, {}), so the \
+             plugin declares the few plugin API types and functions it uses itself, from \
+             the documented plugin API (`qemu_plugin_install`, `qemu_plugin_version` = 1, \
+             the translation callback, per-instruction execution callbacks, memory \
+             callbacks on stores, `qemu_plugin_register_atexit_cb`, `qemu_plugin_outs`). \
+             It copies nothing from QEMU's header.\n",
+            insn.tools.header_search
+        );
+        let _ = writeln!(
+            s,
+            "**Register stand-ins.** QEMU's board has neither bxCAN nor FlexCAN, so RAM \
+             blocks outside every linker section stand in for the registers: CAN1's at \
+             `0x2010_0000` (`shared/ram_can.rs`; our driver through \
+             `twocan_core::Mmio::new`, the `bxcan` crate through its \
+             `Instance::REGISTERS`), FlexCAN0's at `0x2010_8000` \
+             (`shared/ram_flexcan.rs`). Every driver is configured through its public API \
+             while a SysTick handler plays the mode handshakes (bxCAN `INRQ` → `INAK`, \
+             `SLEEP` → `SLAK`; FlexCAN `MDIS` → `LPMACK`, `FRZ`+`HALT` → `FRZACK` and \
+             `NOTRDY`, `SOFTRST` clearing itself); SysTick is off before anything is \
+             measured. RAM does not react like the peripheral, so **each measured call does \
+             exactly one frame's work from a freshly restored snapshot** of the register \
+             block, showing what the controller would show, and the firmware checks the \
+             effect afterwards (frame in the mailbox, frame in the ring, FIFO released, \
+             completion taken with its token, filter index); a failed check fails the run. \
+             bxCAN snapshots: all mailboxes empty; mailbox 0 pending with a lower-priority \
+             frame; all three pending with higher-priority frames (our driver queues); \
+             mailbox 0 empty with its completion already acknowledged (refill); mailbox 0 \
+             completed (`RQCP0`, `TXOK0`); FIFO 0 with one frame (`FMP0` = 1; a release \
+             store leaves `FMP0` = 0, as after the last frame). FlexCAN snapshots: MB15 \
+             inactive; MB15 sent (its `IFLAG1` bit set); the Rx FIFO with one frame \
+             (`BUF5I`). FlexCAN's write-1-to-clear flags (`IFLAG1`, `ESR1`) would stay set \
+             on RAM and a receive loop popping the FIFO until `BUF5I` reads 0 would not \
+             end, so **both FlexCAN drivers** reach the block through an accessor that \
+             plays the rule (a write of `v` stores `old & !v`): one extra load and `BIC` \
+             per such write, on both sides alike, that hardware would not execute.\n"
+        );
+        let _ = writeln!(
+            s,
+            "**Counting.** A measurement counts the instructions executed after a start \
+             marker (a store to the plugin's marker window at `{:#010x}`, outside every \
+             linker section) up to and including the end marker store; each measured \
+             function is `#[inline(never)]` and gets its arguments through \
+             `core::hint::black_box`, so a figure includes its call and return. The \
+             instructions of an empty region (start marker directly followed by the end \
+             marker) are subtracted. Each region is measured {} times per build; a figure \
+             is the smallest (the steady state: the first measurement may also raise a \
+             ring's peak figure). The frame is a standard data frame, identifier 0x123, \
+             8 bytes. **Round trips** are summed from the regions the firmware names for \
+             its configuration (the `roundtrip` lines it prints): the send, every handler \
+             the configuration runs per frame (our drivers' transmit handler runs in both \
+             variants, since they enable the transmit interrupt; the lean equivalents have \
+             none — fire-and-forget needs none), the take, and with completions the \
+             completion's take. On FlexCAN one interrupt line runs both handlers; each is \
+             measured on its own, on both sides.\n",
+            insn.window,
+            insn.runs.first().map(|r| r.counts.repeats()).unwrap_or(0)
+        );
+        let _ = writeln!(
+            s,
+            "**Stack.** After the counts each measured call runs once more for its stack \
+             high-water mark, by painting (`shared/qemu.rs`): {} bytes below the stack \
+             pointer are filled with a pattern by one inline-assembly loop that pushes \
+             nothing, the call runs, and the deepest word that lost the pattern gives the \
+             bytes the call used below its caller's stack pointer (its frame and its \
+             callees'; an interrupt handler on hardware adds the 32-byte exception frame, \
+             104 with FP context). The **configuration** figure is the same for the whole \
+             configuration of a driver, from the register handle to the handles of the \
+             split (ours: `Can::can1`/`begin`, filters, `enable`, `into_split`, \
+             `State::split`; the equivalents: the crate's builder or the hand-written \
+             initialization, the split). During it the handshake stand-in's SysTick \
+             interrupts push their 8-word frames on the measured stack (FP context \
+             stacking is turned off meanwhile, and the handler is assembly that pushes \
+             nothing else and records where each frame went): the figure given counts \
+             them (an upper bound), the table notes the lower bound where a frame was the \
+             deepest word.\n",
+            thousands(
+                insn.runs
+                    .first()
+                    .and_then(|r| r.counts.notes.get("stack.painted_bytes").copied())
+                    .unwrap_or(0)
+            )
+        );
+        render_breakdown(s, insn)?;
+        let _ = writeln!(s, "### Every measured region\n");
+        for backend in Backend::ALL {
+            let mut cols = Vec::new();
+            for variant in VARIANTS {
+                for opt in insn.opts() {
+                    if let Ok(c) = insn.get(backend, variant, &opt) {
+                        cols.push((variant, opt.clone(), c));
+                    }
+                }
+            }
+            if cols.is_empty() {
+                continue;
+            }
+            let _ = writeln!(s, "{} (`{}`):\n", backend.name(), backend.firmware());
+            let mut header = String::from("| region | what is measured |");
+            let mut rule = String::from("|---|---|");
+            for (v, opt, _) in &cols {
+                let _ = write!(header, " {v}, opt {opt} |");
+                rule.push_str("---:|");
+            }
+            let _ = writeln!(s, "{header}\n{rule}");
+            let mut keys: Vec<&String> = Vec::new();
+            for (_, _, c) in &cols {
+                for k in c.regions.keys() {
+                    if k != "empty" && !keys.contains(&k) {
+                        keys.push(k);
+                    }
+                }
+            }
+            keys.sort_by_key(|k| region_order(k));
+            for k in keys {
+                let mut line = format!("| `{k}` | {} |", region_note(k));
+                for (_, _, c) in &cols {
+                    match c.net(k) {
+                        Ok((lo, hi)) if lo == hi => {
+                            let _ = write!(line, " {} |", thousands(lo));
+                        }
+                        Ok((lo, hi)) => {
+                            let _ = write!(line, " {} ({lo}–{hi}) |", thousands(lo));
+                        }
+                        Err(_) => line.push_str(" – |"),
+                    }
+                }
+                let _ = writeln!(s, "{line}");
+            }
+            let mut line =
+                String::from("| **round trip, ours** | the regions of `roundtrip twocan` |");
+            for (_, _, c) in &cols {
+                let _ = write!(line, " **{}** |", thousands(c.roundtrip("twocan")?));
+            }
+            let _ = writeln!(s, "{line}");
+            let mut line = format!(
+                "| **round trip, {}** | the regions of `roundtrip {}` |",
+                backend.equivalent(),
+                backend.equivalent()
+            );
+            for (_, _, c) in &cols {
+                let _ = write!(
+                    line,
+                    " **{}** |",
+                    thousands(c.roundtrip(backend.equivalent())?)
+                );
+            }
+            let _ = writeln!(s, "{line}\n");
+            let overheads: Vec<String> = cols
+                .iter()
+                .map(|(v, opt, c)| format!("{} ({v}, opt {opt})", c.overhead))
+                .collect();
+            let _ = writeln!(
+                s,
+                "Marker overhead subtracted: {}. Where a region's measurements differed \
+                 the range is given.\n",
+                overheads.join(", ")
+            );
+
+            let _ = writeln!(s, "Stack high-water marks, bytes ({}):\n", backend.name());
+            let _ = writeln!(s, "{header}\n{rule}");
+            let mut skeys: Vec<&String> = Vec::new();
+            for (_, _, c) in &cols {
+                for k in c.stacks.keys() {
+                    if !skeys.contains(&k) {
+                        skeys.push(k);
+                    }
+                }
+            }
+            skeys.sort_by_key(|k| (!k.ends_with(".config"), region_order(k)));
+            for k in skeys {
+                let what = if k.ends_with(".config") {
+                    "configuration (whole, see above)"
+                } else {
+                    region_note(k)
+                };
+                let mut line = format!("| `{k}` | {what} |");
+                for (_, _, c) in &cols {
+                    match (c.stacks.get(k), c.notes.get(&format!("{k}.low"))) {
+                        (Some(v), Some(low)) if low != v => {
+                            let _ = write!(line, " {} (≥ {}) |", thousands(*v), thousands(*low));
+                        }
+                        (Some(v), _) => {
+                            let _ = write!(line, " {} |", thousands(*v));
+                        }
+                        (None, _) => line.push_str(" – |"),
+                    }
+                }
+                let _ = writeln!(s, "{line}");
+            }
+            let _ = writeln!(s);
+        }
+        self.render_async(s, insn)?;
+        let _ = writeln!(s, "QEMU command line (per build):\n");
+        let example = qemu::command(
+            &insn.tools,
+            std::path::Path::new(
+                "target/bench-firmware/thumbv7em-none-eabihf/release/insn-count-lean",
+            ),
+            std::path::Path::new("target/bench-plugin/insn_count.so"),
+            insn.window,
+            std::path::Path::new("target/bench-plugin/counts-release-bxcan-lean.txt"),
+        );
+        let line = cmd::display(&example)
+            .replace(&insn.tools.qemu.display().to_string(), "qemu-system-arm");
+        let _ = writeln!(s, "```\n{line}\n```\n");
+        Ok(())
     }
 
     fn render_machine(&self, s: &mut String) {
@@ -405,480 +1060,331 @@ impl Report {
             let _ = writeln!(s, "| gcc (plugin) | {} |", i.tools.gcc_version);
         }
         let lock = self.paths.firmware().join("Cargo.lock");
-        for krate in ["bxcan", "cortex-m", "cortex-m-rt", "cortex-m-semihosting"] {
+        for krate in [
+            "bxcan",
+            "heapless",
+            "cortex-m",
+            "cortex-m-rt",
+            "cortex-m-semihosting",
+        ] {
             if let Some(v) = firmware::locked_version(&lock, krate) {
                 let _ = writeln!(s, "| `{krate}` crate (bench firmware) | {v} |");
             }
         }
         let _ = writeln!(s, "| firmware target | `{TARGET}` |\n");
     }
+}
 
-    fn render_sizes(&self, s: &mut String, sz: &SizeSection, ex: Option<&ExampleSection>) {
-        let _ = writeln!(s, "## 1. Flash and RAM\n");
-        let _ = writeln!(
-            s,
-            "Read from the ELF section headers (the `object` crate). Only allocated sections \
-             (`SHF_ALLOC`) count:\n\n\
-             - **code**: allocated sections that are neither writable nor `NOBITS` — \
-             `.vector_table`, `.text`, `.rodata` (and `.flash_config` on the Teensy): \
-             flash-resident code and constants;\n\
-             - **data**: writable `PROGBITS` sections (`.data`): in RAM, and their initial \
-             image in flash;\n\
-             - **bss**: `NOBITS` sections (`.bss`, `.uninit`): RAM only.\n\n\
-             **flash = code + data**, **RAM = data + bss**, in bytes. The stack (the rest of \
-             RAM) is not a section and is not counted.\n"
-        );
-        let _ = writeln!(
-            s,
-            "### Minimal loop-back firmware: our bxCAN backend against the `bxcan` crate\n"
-        );
-        let _ = writeln!(
-            s,
-            "Three firmwares for an STM32F767ZI with the same behaviour (`bench/firmware/`): \
-             the same start-up (`shared/stm32f7.rs`: SYSCLK 108 MHz from the PLL, APB1 \
-             54 MHz, CAN1 clock on), CAN1 in loop-back mode at 500 kbit/s from the 54 MHz \
-             APB1 clock (the same `CAN_BTR`, solved at compile time), one accept-all filter \
-             bank to FIFO 0 set by hand, one 8-byte frame sent and received by polling, \
-             `panic-halt`.\n\n\
-             - `loopback-twocan`: our split driver as an interrupt-driven application keeps \
-             it — a `static State<BxCan<Mmio>, 8, FifoQueue<8>>` (all zeros, `.bss`; \
-             request-order transmit, so no priority queue is linked), `split` once, \
-             `Tx::try_send`, then the TX and RX0 handlers and `Rx::receive` polled in turn \
-             until the frame comes back with its filter index and its completion;\n\
-             - `loopback-bxcan`: the bare `bxcan` crate (`Can::builder`, `transmit`, \
-             `receive`), the `Can` in a `critical_section::Mutex` static;\n\
-             - `loopback-bxcan-equiv`: the `bxcan` crate plus the service work that gives \
-             an application what ours does (**feature-equivalent**): a TX handler clearing \
-             and counting completions (`clear_request_completed_flag` until `None`), an RX0 \
-             handler draining FIFO 0 into a `heapless::Deque` of 8 frames, counting \
-             hardware overruns and ring overflows and reading `CAN_ESR`, the thread side \
-             taking the frame from the ring; the `Can` and the ring in one \
-             `critical_section::Mutex` static.\n\n\
-             Both profiles: fat LTO, one codegen unit, `panic = \"abort\"`; the \
-             size-optimised one comes first.\n"
-        );
-        for b in &sz.builds {
-            let _ = writeln!(
-                s,
-                "Profile `{}` (`opt-level = {}`):\n",
-                b.profile,
-                if b.opt == "s" {
-                    "\"s\"".to_string()
-                } else {
-                    b.opt.clone()
+/// The targets of issue 21 with their verdicts (first in the document: the headline).
+fn render_targets(s: &mut String, f: &Figures) {
+    let _ = writeln!(s, "## Targets of issue 21 (zero-cost by construction)\n");
+    let _ = writeln!(
+        s,
+        "Each line: ours / theirs, per opt-level (instructions from section 2, flash from \
+         section 1, stack from section 2), against the issue's bound; \"met\" or by how \
+         much it is missed. **Lean** is issue 21's lean driver configuration — **still \
+         pending in the driver**: this run measures today's driver in the closest \
+         configuration its API allows (section 1 says which), so the lean lines show the \
+         distance from today's driver to the targets. **Full** has completions, time \
+         stamps, statistics and the runtime planner. The equivalents do the same service \
+         in each variant (section 1). Byte bounds: driver state ≤ the rings + \
+         {} B; configuration stack ≤ {} B.\n",
+        figures::STATE_BOUND,
+        figures::CONFIG_STACK_BOUND
+    );
+    let opts: Vec<String> = {
+        let mut v: Vec<String> = Vec::new();
+        for t in &f.targets {
+            for (o, _) in &t.per_opt {
+                if !v.contains(o) {
+                    v.push(o.clone());
                 }
-            );
-            let _ = writeln!(
-                s,
-                "| firmware | code | data | bss | **flash** | **RAM** |\n\
-                 |---|---:|---:|---:|---:|---:|"
-            );
-            for (name, z) in [
-                ("`loopback-twocan` (twocan-bxcan, split driver)", &b.ours),
-                ("`loopback-bxcan` (bare `bxcan` crate)", &b.theirs),
-                (
-                    "`loopback-bxcan-equiv` (`bxcan` crate, feature-equivalent)",
-                    &b.equiv,
-                ),
-            ] {
-                let _ = writeln!(
-                    s,
-                    "| {name} | {} | {} | {} | **{}** | **{}** |",
-                    thousands(z.code()),
-                    thousands(z.data()),
-                    thousands(z.bss()),
-                    thousands(z.flash()),
-                    thousands(z.ram())
-                );
             }
-            for (label, t) in [("bare", &b.theirs), ("feature-equivalent", &b.equiv)] {
-                let o = &b.ours;
-                let _ = writeln!(
-                    s,
-                    "| ratio twocan / {label} | {} | {} | {} | **{}** | **{}** |",
-                    ratio(o.code(), t.code()),
-                    ratio(o.data(), t.data()),
-                    ratio(o.bss(), t.bss()),
-                    ratio(o.flash(), t.flash()),
-                    ratio(o.ram(), t.ram())
-                );
-            }
-            let _ = writeln!(s);
-            let _ = writeln!(s, "Sections:\n");
-            let _ = writeln!(s, "- `loopback-twocan`: {}", b.ours.section_list());
-            let _ = writeln!(s, "- `loopback-bxcan`: {}", b.theirs.section_list());
-            let _ = writeln!(s, "- `loopback-bxcan-equiv`: {}\n", b.equiv.section_list());
         }
-        let st = &sz.state;
-        let _ = writeln!(
-            s,
-            "**RAM of our driver**: the `State` static is {} B (symbol size of \
-             `BENCH_CAN_STATE`), of which {} B are ring and queue slots (receive ring 8 raw \
-             frames, transmit queue 8 entries, completion ring 8, state-change ring 8; the \
-             same `State` type in `insn-count` reports them with `size_of`) and **{} B \
-             driver state**: the controller value `BxCan<Mmio>` ({} B, of which {} B are \
-             its filter map — user filter index per FIFO and filter match index, 2 × 112 \
-             `u16`), the rest ring indices and statistics, counters and the transmit \
-             queue's indices. The halves and handlers (`split`'s `Parts`) live wherever \
-             the application keeps them; the receive half carries its own copy of the \
-             filter map.\n",
-            thousands(st.static_bytes),
-            thousands(st.ring_bytes),
-            thousands(st.static_bytes - st.ring_bytes),
-            thousands(st.hw_bytes),
-            thousands(st.fmi_bytes)
-        );
-        if let Some(b) = sz.builds.iter().find(|b| b.opt == "s") {
-            let state = st.static_bytes - st.ring_bytes;
-            let fe = ratio_f(b.ours.flash(), b.equiv.flash());
-            let fb = ratio_f(b.ours.flash(), b.theirs.flash());
-            let _ = writeln!(
-                s,
-                "**Target (d)** (opt s): flash ≤ 1.0 × the feature-equivalent firmware — \
-                 {fe:.2} ({}); flash ≤ 1.5 × the bare one — {fb:.2} ({}); RAM = the rings + \
-                 at most 64 B of state — {} B of state ({}).\n",
-                verdict(fe, 1.0),
-                verdict(fb, 1.5),
-                thousands(state),
-                if state <= 64 {
-                    "met".to_string()
-                } else {
-                    format!("missed by {} B", thousands(state - 64))
-                }
-            );
-            let _ = writeln!(
-                s,
-                "Why the flash target is missed (read from `llvm-objdump -d` and \
-                 `llvm-nm --size-sort` of `loopback-twocan`): most of the difference is the \
-                 configuration path, inlined into `main` — `Can::can1` with the `Config` \
-                 checks and mode handshakes, a `FilterPlan` of 28 banks, the filter block \
-                 programming and the filter map built from the plan — where the `bxcan` \
-                 crate writes one bank's registers; then the transmit interrupt's service \
-                 (`service_tx`: completion settling in acceptance order, the queue refill, \
-                 the abort and displacement bookkeeping), and `compiler_builtins`' \
-                 `memcpy`/`memset` (about 1.3 KB), linked because the controller value \
-                 (with its filter map) and the filter plan are moved by value. The filter \
-                 plan and map belong to the filter planner (`bxcan/src/filters.rs`, \
-                 `filter_block.rs`); a plan and map sized for the banks in use, and a \
-                 controller built in place inside the `State` (no move), are what would \
-                 bring the flash and the state down. The state misses for the same reason: \
-                 the filter map is the larger part of it.\n"
-            );
-        }
-
-        let _ = writeln!(s, "### Firmware examples\n");
-        match ex {
-            None => {}
-            Some(e) if e.builds.is_empty() => {
-                let _ = writeln!(
-                    s,
-                    "No firmware example (a package under `examples/` with binaries and a \
-                     `cortex-m-rt` dependency) exists yet, so none was measured.\n"
-                );
-            }
-            Some(e) => {
-                let _ = writeln!(
-                    s,
-                    "Every binary of every firmware package under `examples/` (binaries and a \
-                     `cortex-m-rt` dependency), for each board feature, \
-                     built with `cargo build --release --target {TARGET} -p PACKAGE \
-                     --features BOARD --bins` (the workspace's release profile).\n"
-                );
-                let _ = writeln!(
-                    s,
-                    "| package | board | binary | code | data | bss | **flash** | **RAM** |\n\
-                     |---|---|---|---:|---:|---:|---:|---:|"
-                );
-                for b in &e.builds {
-                    let _ = writeln!(
-                        s,
-                        "| `{}` (`{}`) | {} | `{}` | {} | {} | {} | **{}** | **{}** |",
-                        b.package,
-                        b.dir,
-                        b.board.as_deref().unwrap_or("(no feature)"),
-                        b.bin,
-                        thousands(b.size.code()),
-                        thousands(b.size.data()),
-                        thousands(b.size.bss()),
-                        thousands(b.size.flash()),
-                        thousands(b.size.ram())
+        v
+    };
+    let mut header = String::from("| backend | variant | target |");
+    let mut rule = String::from("|---|---|---|");
+    for o in &opts {
+        let _ = write!(header, " opt {o} |");
+        rule.push_str("---:|");
+    }
+    header.push_str(" bound | verdict |");
+    rule.push_str("---:|---|");
+    let _ = writeln!(s, "{header}\n{rule}");
+    let mut missed = Vec::new();
+    for t in &f.targets {
+        let mut line = format!("| {} | {} | {} |", t.backend.name(), t.variant, t.label);
+        let mut verdicts = Vec::new();
+        for o in &opts {
+            match t.at(o) {
+                Some(m @ Measured::Ratio { ours, theirs }) => {
+                    let _ = write!(
+                        line,
+                        " {} / {} = **{:.2}** |",
+                        thousands(*ours),
+                        thousands(*theirs),
+                        m.value()
                     );
                 }
-                let _ = writeln!(s);
+                Some(Measured::Bytes(b)) => {
+                    let _ = write!(line, " **{}** B |", thousands(*b));
+                }
+                None => line.push_str(" – |"),
+            }
+            if let (Some(m), Some(bound)) = (t.at(o), t.bound) {
+                let v = m.verdict(bound);
+                if v != "met" {
+                    missed.push(format!(
+                        "{} {} {} (opt {o})",
+                        t.backend.name(),
+                        t.variant,
+                        t.key
+                    ));
+                }
+                verdicts.push(format!("opt {o}: {v}"));
             }
         }
+        let bound = match (t.bound, t.key) {
+            (None, _) => "–".to_string(),
+            (Some(b), "state" | "config_stack") => format!("≤ {} B", thousands(b as u64)),
+            (Some(b), _) => format!("≤ {b:.1}"),
+        };
+        let verdict = if verdicts.is_empty() {
+            "(extra line)".to_string()
+        } else {
+            verdicts.join("; ")
+        };
+        let _ = writeln!(s, "{line} {bound} | {verdict} |");
     }
+    let _ = writeln!(s);
+    if let Some((v, what)) = &f.config_stack_max {
+        let _ = writeln!(
+            s,
+            "**Largest configuration stack** (`config_stack_bytes_max`) of every firmware \
+             example (can-fil, up to the first CAN interrupt line unmasked; section 1), \
+             every loop-back bench firmware (can-fil, whole run; section 1) and every \
+             instruction-count bench firmware (QEMU, the configuration call; section 2): \
+             **{} B**, {what} ({}).\n",
+            thousands(*v),
+            Measured::Bytes(*v).verdict(figures::CONFIG_STACK_BOUND as f64)
+        );
+    }
+    let bounded = f
+        .targets
+        .iter()
+        .filter(|t| t.bound.is_some())
+        .map(|t| t.per_opt.len())
+        .sum::<usize>();
+    if !missed.is_empty() {
+        let _ = writeln!(
+            s,
+            "{} of the {bounded} bounded figures miss their bound. Why: the round trips \
+             step by step and the per-region and stack tables of section 2 show where the \
+             instructions and the bytes go; the configuration stack and most of the flash \
+             come from the configuration path (filter plan, filter map and controller \
+             values moved by value; in the full variant the runtime planner); and the lean \
+             lines measure today's driver, whose lean mode (issue 21) is pending.\n",
+            missed.len()
+        );
+    }
+}
 
-    fn render_insn(&self, s: &mut String, insn: &InsnSection) -> Result<()> {
-        let _ = writeln!(s, "## 2. Instructions per frame on a Cortex-M4 (QEMU)\n");
-        let _ = writeln!(
-            s,
-            "Guest instructions executed, counted by the TCG plugin \
-             `bench/plugin/insn_count.c` (built at bench time with `gcc {}`) while QEMU \
-             runs the firmware `bench/firmware/insn-count` on `-machine {}` (an ARM MPS2 \
-             board with a Cortex-M4). This is an instruction count, not a cycle count: \
-             QEMU does not model pipeline, wait states or bus timing.\n",
-            qemu::PLUGIN_FLAGS.join(" "),
-            qemu::MACHINE
-        );
-        let _ = writeln!(
-            s,
-            "No Debian 12 package ships QEMU's plugin header `qemu-plugin.h` (checked \
-             when the bench was written: `apt-file search qemu-plugin.h` on bookworm finds \
-             nothing, and the qemu-system packages list no header; in this run, {}), so the \
-             plugin declares the few plugin API types and functions it uses itself, from \
-             the documented plugin API (`qemu_plugin_install`, `qemu_plugin_version` = 1, \
-             the translation callback, per-instruction execution callbacks, memory \
-             callbacks on stores, `qemu_plugin_register_atexit_cb`, `qemu_plugin_outs`). \
-             It copies nothing from QEMU's header.\n",
-            insn.tools.header_search
-        );
-        let _ = writeln!(
-            s,
-            "**Method.** QEMU's board has no bxCAN, so a RAM block at `0x2010_0000` stands in \
-             for CAN1's registers: our driver reaches it through \
-             `twocan_core::Mmio::new(0x2010_0000)`, the `bxcan` crate through its \
-             `Instance::REGISTERS` pointer set to the same address. Both are configured \
-             through their public APIs (loop-back, 500 kbit/s from 54 MHz, one accept-all \
-             bank; request order for ours, the `bxcan` crate's identifier-priority order) while a SysTick handler plays the mode \
-             handshake (`INRQ` → `INAK`, `SLEEP` → `SLAK`); SysTick is off before anything \
-             is measured. RAM does not react like the peripheral (a write of `RFOM` does \
-             not pop the FIFO, a write-1-to-clear store overwrites the whole word), so \
-             **each measured call does exactly one frame's work from a freshly restored \
-             snapshot** of the register block, showing what a real CAN1 would show, and \
-             the firmware checks the effect afterwards (frame in the expected mailbox, \
-             frame in the ring, FIFO released, completion counted); a failed check fails \
-             the run. Snapshots: all mailboxes empty; mailbox 0 pending with a \
-             lower-priority frame; all three pending with higher-priority frames (the \
-             driver queues); mailbox 0 empty with its completion already acknowledged \
-             (refill: on RAM the `RQCP` store would also clear the read-only `TME` bits); \
-             mailbox 0 completed (`RQCP0`, `TXOK0`); FIFO 0 with one frame (`FMP0` = 1) — \
-             each derived from the block as that driver's own configuration left it.\n"
-        );
-        let _ = writeln!(
-            s,
-            "A measurement counts the instructions executed after a start marker (a store \
-             to the plugin's marker window at `{:#010x}`, outside every linker section) up \
-             to and including the end marker store; each measured function is \
-             `#[inline(never)]` and gets its arguments through `core::hint::black_box`, so \
-             a figure includes its call and return. The instructions of an empty region \
-             (start marker directly followed by the end marker) are subtracted. Each \
-             region is measured {} times per build. The frame is a standard data frame, \
-             identifier 0x123, 8 bytes. Our driver is a `static State<BxCan<Mmio>, 8, \
-             FifoQueue<8>>` split once (`insn-count` exports its size); its handles are \
-             the measured functions' arguments.\n",
-            insn.window,
-            insn.runs.first().map(|(_, c)| c.repeats()).unwrap_or(0)
-        );
-        let _ = writeln!(
-            s,
-            "### The targets of issue 10\n\n\
-             Ratios are twocan / `bxcan`; ≤ 1.00 meets the target. (a) compares our \
-             transmit half's direct path (queue empty, mailbox free: `Tx::try_send` writes \
-             the mailbox) with `bxcan`'s `Can::transmit`; (b) our FIFO 0 receive interrupt \
-             handler (`RxIrq::on_interrupt`: FIFO → raw ring, FIFO released) with \
-             `bxcan`'s `Rx0::receive`, **one frame per interrupt** (the handler's \
-             per-interrupt work is in the figure once); (c) the round trip as an \
-             application sees it, summed over its steps: send, the TX interrupt settling \
-             the completion, the RX0 interrupt, and the thread side taking the decoded \
-             frame with its filter index — ours against the feature-equivalent service \
-             around the `bxcan` crate (`transmit`; TX interrupt: \
-             `clear_request_completed_flag` once with a completion and once without, \
-             counting completions — the two calls of `clear_tx_interrupt`'s loop, each \
-             on its own snapshot because RAM does not clear the flag; RX0 interrupt: \
-             `Rx0::receive` until `WouldBlock` into a `heapless::spsc` ring (lock-free, \
-             as ours), counting hardware overruns and ring overflows, reading `CAN_ESR`; \
-             the thread side dequeuing the frame). The `bxcan` crate reports no filter \
-             index, so its side does less there.\n"
-        );
-        let mut header = String::from("| | path | ");
-        let mut rule = String::from("|---|---|");
-        for (opt, _) in &insn.runs {
-            let _ = write!(
-                header,
-                "twocan (opt {opt}) | bxcan (opt {opt}) | **ratio (opt {opt})** | "
-            );
-            rule.push_str("---:|---:|---:|");
-        }
-        header.push_str("target |");
-        rule.push_str("---:|");
-        let _ = writeln!(s, "{header}\n{rule}");
-        for t in TARGETS {
-            let mut line = format!("| {} | {} |", t.tag, t.label);
-            for (_, counts) in &insn.runs {
-                let (o, th) = (sum(counts, t.ours)?, sum(counts, t.theirs)?);
+/// The step of a round trip a region is (send, handlers, takes), for lining ours up
+/// with the equivalent's.
+fn step_of(key: &str) -> (u8, &'static str) {
+    if key.contains("tx_irq") {
+        (1, "transmit handler (completion)")
+    } else if key.contains("rx_irq") {
+        (2, "receive handler (one frame)")
+    } else if key.contains("take_completion") {
+        (4, "completion taken")
+    } else if key.ends_with(".receive") || key.ends_with(".take") {
+        (3, "frame taken (with filter index)")
+    } else {
+        (0, "send")
+    }
+}
+
+/// The round trips step by step, ours next to the equivalent's.
+fn render_breakdown(s: &mut String, insn: &InsnSection) -> Result<()> {
+    let _ = writeln!(
+        s,
+        "### Round trip by step
+"
+    );
+    for backend in Backend::ALL {
+        for variant in VARIANTS {
+            let runs: Vec<(String, &Counts)> = insn
+                .opts()
+                .into_iter()
+                .filter_map(|o| insn.get(backend, variant, &o).ok().map(|c| (o, c)))
+                .collect();
+            let Some((_, first)) = runs.first() else {
+                continue;
+            };
+            let eq = backend.equivalent();
+            let ours = first.roundtrip_keys("twocan")?;
+            let theirs = first.roundtrip_keys(eq)?;
+            let _ = writeln!(s, "{} {variant}:\n", backend.name());
+            let mut header = String::from("| step | ours | theirs |");
+            let mut rule = String::from("|---|---|---|");
+            for (o, _) in &runs {
+                let _ = write!(header, " ours, opt {o} | theirs, opt {o} |");
+                rule.push_str("---:|---:|");
+            }
+            let _ = writeln!(s, "{header}\n{rule}");
+            let mut steps: Vec<(u8, &'static str)> =
+                ours.iter().chain(theirs).map(|k| step_of(k)).collect();
+            steps.sort();
+            steps.dedup();
+            for (n, what) in steps {
+                let o = ours.iter().find(|k| step_of(k).0 == n);
+                let t = theirs.iter().find(|k| step_of(k).0 == n);
+                let name = |k: Option<&String>| k.map(|k| format!("`{k}`")).unwrap_or("–".into());
+                let mut line = format!("| {what} | {} | {} |", name(o), name(t));
+                for (_, c) in &runs {
+                    let cell = |k: Option<&String>| -> Result<String> {
+                        Ok(match k {
+                            Some(k) => thousands(c.net(k)?.0),
+                            None => "–".into(),
+                        })
+                    };
+                    let _ = write!(line, " {} | {} |", cell(o)?, cell(t)?);
+                }
+                let _ = writeln!(s, "{line}");
+            }
+            let mut line = String::from("| **sum** | | |");
+            for (_, c) in &runs {
                 let _ = write!(
                     line,
-                    " {} | {} | **{}** |",
-                    thousands(o),
-                    thousands(th),
-                    ratio(o, th)
+                    " **{}** | **{}** |",
+                    thousands(c.roundtrip("twocan")?),
+                    thousands(c.roundtrip(eq)?)
                 );
             }
-            let _ = writeln!(s, "{line} ≤ 1.00 |");
+            let _ = writeln!(s, "{line}\n");
         }
-        let _ = writeln!(s);
-        let mut verdicts = Vec::new();
-        for t in TARGETS {
-            let v: Vec<String> = insn
-                .runs
-                .iter()
-                .map(|(opt, c)| {
-                    Ok(format!(
-                        "opt {opt}: {}",
-                        verdict(ratio_f(sum(c, t.ours)?, sum(c, t.theirs)?), 1.0)
-                    ))
-                })
-                .collect::<Result<_>>()?;
-            verdicts.push(format!("{} {}", t.tag, v.join(", ")));
-        }
-        let _ = writeln!(s, "Verdicts: {}.\n", verdicts.join("; "));
+    }
+    Ok(())
+}
+
+fn render_examples(s: &mut String, e: &ExampleSection) {
+    let _ = writeln!(s, "### Firmware examples\n");
+    if e.builds.is_empty() {
         let _ = writeln!(
             s,
-            "Where our instructions go (read from `llvm-objdump -d` of `insn-count`):\n\n\
-             - (a) our direct path does work `Can::transmit` does not: it checks the \
-             recorded error state (bus-off refuses the frame with an error), checks that \
-             the transmit queue is empty (a frame never overtakes queued ones), stores the \
-             frame's token for its completion and counts the accepted frame; and since \
-             the register handle keeps its base address in the shared state, the compiler \
-             reloads it after each volatile mailbox store (a store could alias it).\n\
-             - (b) our handler loops until FIFO 0 is empty (so one frame per interrupt \
-             reads `CAN_RF0R` twice), acknowledges `FULL0`/`FOVR0`, and stores the frame in \
-             the ring: an acquire load of the consumer index and a release store of the \
-             producer index (one `DMB` each on thumbv7em — kept because the ring must stay \
-             sound between host threads and on multi-core parts), the ring's peak figure \
-             and the received counter. `Rx0::receive` returns one frame to its caller and \
-             stores nothing.\n\
-             - (c) the transmit interrupt dominates: a critical section (the transmit \
-             queue is the one structure two contexts modify), the completion — token, \
-             outcome, time stamp — pushed into the completion ring (release/acquire as \
-             above), the outcome counter, the abort and displacement flags, and the check \
-             for queued frames to refill; the equivalent service only clears `RQCP0`. \
-             The thread side decodes the raw words (identifier word, DLC clamp, data \
-             cleared beyond the DLC) and maps the filter match index to the user's filter \
-             index, which the `bxcan` crate does not report.\n"
+            "No firmware example (a package under `examples/` with binaries and a \
+             `cortex-m-rt` dependency) exists yet, so none was measured.\n"
         );
-        let _ = writeln!(s, "### Every measured region\n");
-        let mut header = String::from("| region | what is measured |");
-        let mut rule = String::from("|---|---|");
-        for (opt, _) in &insn.runs {
-            let _ = write!(header, " opt {opt} |");
-            rule.push_str("---:|");
+        return;
+    }
+    let _ = writeln!(
+        s,
+        "Every binary of every firmware package under `examples/` (binaries and a \
+         `cortex-m-rt` dependency), for each board feature, built with `cargo build \
+         --release --target {TARGET} -p PACKAGE --features BOARD --bins` (the workspace's \
+         release profile).\n"
+    );
+    match &e.stack_skipped {
+        None => {
+            let _ = writeln!(
+                s,
+                "**Stack**: each ELF runs for {} s of simulated time under `can-fil --stack \
+                 --board BOARD` (the firmware-in-the-loop harness, `fil/`, with the CAN \
+                 controllers on its models; `fil/src/stack.rs`): the RAM between the end of \
+                 the statics (`_stack_end`) and the initial stack pointer is painted before \
+                 reset; **configuration** is the painted depth when the firmware first \
+                 unmasks a CAN interrupt line in the NVIC (the examples do so once the \
+                 driver is configured and split: start-up, configuration and everything \
+                 `main` holds by then), **whole run** the depth at the end (thread code, \
+                 handlers and their exception frames). An example alone on the bus gets no \
+                 acknowledgement; that does not change its configuration.\n",
+                crate::stack::SECONDS
+            );
         }
-        let _ = writeln!(s, "{header}\n{rule}");
-        let mut varying = Vec::new();
-        for (key, what) in REGION_NOTES {
-            let mut line = format!("| `{key}` | {what} |");
-            for (opt, counts) in &insn.runs {
-                let (lo, hi) = counts.net(key)?;
-                if lo == hi {
-                    let _ = write!(line, " {} |", thousands(lo));
-                } else {
-                    let _ = write!(line, " {} ({}–{}) |", thousands(lo), lo, hi);
-                    varying.push(format!("`{key}` at opt {opt}"));
-                }
-            }
-            let _ = writeln!(s, "{line}");
+        Some(why) => {
+            let _ = writeln!(s, "**Stack**: not measured in this run ({why}).\n");
         }
-        let _ = writeln!(s);
-        let overheads: Vec<String> = insn
-            .runs
-            .iter()
-            .map(|(opt, c)| format!("{} instruction(s) at opt-level {opt}", c.overhead))
-            .collect();
+    }
+    let _ = writeln!(
+        s,
+        "| package | board | binary | code | data | bss | **flash** | **RAM** | stack: configuration | stack: whole run |\n\
+         |---|---|---|---:|---:|---:|---:|---:|---:|---:|"
+    );
+    for b in &e.builds {
+        let (cfg, whole) = match b.stack {
+            Some(st) => (
+                st.configuration
+                    .map(thousands)
+                    .unwrap_or_else(|| "not reached".into()),
+                thousands(st.whole),
+            ),
+            None => ("–".into(), "–".into()),
+        };
         let _ = writeln!(
             s,
-            "Each figure is the smallest of the region's {} measurements (the steady \
-             state); {}. Marker overhead subtracted: {}. The firmware is built twice: \
-             profile `release` (`opt-level = \"s\"`) and `release-speed` \
-             (`opt-level = 3`), both with fat LTO and one codegen unit.\n",
-            insn.runs.first().map(|(_, c)| c.repeats()).unwrap_or(0),
-            if varying.is_empty() {
-                "every measurement of every region was equal".to_string()
-            } else {
-                format!(
-                    "where they differed the range is given ({}: the first measurement \
-                     also raises a ring's peak figure, a store the later ones skip)",
-                    varying.join(", ")
-                )
-            },
-            overheads.join("; ")
+            "| `{}` (`{}`) | {} | `{}` | {} | {} | {} | **{}** | **{}** | {cfg} | {whole} |",
+            b.package,
+            b.dir,
+            b.board.as_deref().unwrap_or("(no feature)"),
+            b.bin,
+            thousands(b.size.code()),
+            thousands(b.size.data()),
+            thousands(b.size.bss()),
+            thousands(b.size.flash()),
+            thousands(b.size.ram())
         );
-        self.render_async(s, insn)?;
-        let _ = writeln!(s, "QEMU command line (per build):\n");
-        let example = qemu::command(
-            &insn.tools,
-            std::path::Path::new("target/bench-firmware/thumbv7em-none-eabihf/release/insn-count"),
-            std::path::Path::new("target/bench-plugin/insn_count.so"),
-            insn.window,
-            std::path::Path::new("target/bench-plugin/counts-release.txt"),
-        );
-        let line = cmd::display(&example)
-            .replace(&insn.tools.qemu.display().to_string(), "qemu-system-arm");
-        let _ = writeln!(s, "```\n{line}\n```\n");
-        Ok(())
+    }
+    let _ = writeln!(s);
+}
+
+/// Sort key of a region: transmit, handlers, takes; ours first.
+fn region_order(key: &str) -> (u8, String) {
+    let side = if key.starts_with("twocan.") { 0 } else { 1 };
+    (side, key.to_string())
+}
+
+/// What a region (or stack figure) measures.
+fn region_note(key: &str) -> &'static str {
+    match key {
+        "twocan.tx.direct" => "`Tx::try_send`, mailbox free, queue empty (direct path)",
+        "twocan.tx.one_busy" => "`Tx::try_send`, mailbox 0 busy (direct path into mailbox 1)",
+        "twocan.tx.queued" => {
+            "`Tx::try_send`, all mailboxes busy: the frame joins the queue (critical section)"
+        }
+        "twocan.tx_irq.refill" => "`TxIrq::on_interrupt`: queue → the mailbox freed",
+        "twocan.tx_irq.done" => "`TxIrq::on_interrupt`: one completion settled, nothing queued",
+        "twocan.tx_irq.done.unloaded" => {
+            "`TxIrq::on_interrupt` with nothing to settle (the handler's fixed cost)"
+        }
+        "twocan.rx_irq" => "`RxIrq::on_interrupt`: one frame into the raw ring, FIFO released",
+        "twocan.rx.receive" => "`Rx::receive`: ring → decoded frame with filter index",
+        "twocan.take_completion" => "`Tx::take_completion`: the frame's completion",
+        "bxcan.transmit" => "`bxcan` `Can::transmit`, all mailboxes empty",
+        "bxcan.transmit.one_busy" => "`bxcan` `Can::transmit`, mailbox 0 busy (lower priority)",
+        "bxcan.receive" => "`bxcan` `Can::receive`, one frame",
+        "bxcan.rx0.receive" => "`bxcan` `Rx0::receive`, one frame",
+        "equiv.tx" => "equivalent transmit: `Tx::transmit` (full: and the token)",
+        "equiv.tx.one_busy" => "equivalent transmit, mailbox 0 busy",
+        "equiv.tx_irq" => {
+            "equivalent TX handler: `CAN_TSR` once, one loop, completion pushed, one \
+             acknowledging store"
+        }
+        "equiv.rx_irq" => {
+            "equivalent RX0 handler: `CAN_RDT0R` + `Rx0::receive` into the ring with counts, \
+             until `WouldBlock`"
+        }
+        "equiv.take" => "equivalent thread side: dequeue, `FMI` → the user's filter index",
+        "equiv.take_completion" => "equivalent thread side: dequeue a completion",
+        "hand.tx" => "hand-written transmit into MB15",
+        "hand.tx_irq" => "hand-written MB15 handler: completion pushed, flag acknowledged",
+        "hand.rx_irq" => "hand-written Rx FIFO handler: one frame into the ring with counts",
+        "hand.take" => "hand-written thread side: decode, `IDHIT` → the user's filter index",
+        "hand.take_completion" => "hand-written thread side: dequeue a completion",
+        _ => "",
     }
 }
-
-/// One target of issue 10: regions summed on each side.
-struct Target {
-    tag: &'static str,
-    label: &'static str,
-    ours: &'static [&'static str],
-    theirs: &'static [&'static str],
-}
-
-/// (a), (b), (c) of issue 10.
-const TARGETS: [Target; 3] = [
-    Target {
-        tag: "(a)",
-        label: "direct transmit: `Tx::try_send` / `Can::transmit`",
-        ours: &["twocan.tx.direct"],
-        theirs: &["bxcan.transmit"],
-    },
-    Target {
-        tag: "(b)",
-        label: "receive interrupt, one frame FIFO 0 → ring: `RxIrq::on_interrupt` / `Rx0::receive`",
-        ours: &["twocan.rx_irq"],
-        theirs: &["bxcan.rx0.receive"],
-    },
-    Target {
-        tag: "(c)",
-        label: "round trip: send + TX interrupt + RX0 interrupt + take the frame / the feature-equivalent `bxcan` service",
-        ours: &[
-            "twocan.tx.direct",
-            "twocan.tx_irq.done",
-            "twocan.rx_irq",
-            "twocan.rx.receive",
-        ],
-        theirs: &[
-            "bxcan.transmit",
-            "equiv.tx_irq.clear",
-            "equiv.tx_irq.idle",
-            "equiv.rx_irq",
-            "equiv.take",
-        ],
-    },
-];
-
-/// Every region of `insn-count` with what it measures.
-const REGION_NOTES: [(&str, &str); 15] = [
-    ("twocan.tx.direct", "`Tx::try_send`, all mailboxes empty, queue empty (direct path)"),
-    ("twocan.tx.one_busy", "`Tx::try_send`, mailbox 0 busy (direct path into mailbox 1)"),
-    ("twocan.tx.queued", "`Tx::try_send`, all mailboxes busy: the frame joins the queue (critical section)"),
-    ("twocan.tx_irq.refill", "`TxIrq::on_interrupt`: queue → the mailbox freed"),
-    ("twocan.tx_irq.done", "`TxIrq::on_interrupt`: one completion settled into the completion ring, nothing queued"),
-    ("twocan.rx_irq", "`RxIrq::on_interrupt` (FIFO 0): one frame into the raw ring, FIFO released"),
-    ("twocan.rx.receive", "`Rx::receive`: ring → decoded frame with filter index"),
-    ("bxcan.transmit", "`bxcan` `Can::transmit`, all mailboxes empty"),
-    ("bxcan.transmit.one_busy", "`bxcan` `Can::transmit`, mailbox 0 busy (lower priority)"),
-    ("bxcan.receive", "`bxcan` `Can::receive`, one frame"),
-    ("bxcan.rx0.receive", "`bxcan` `Rx0::receive`, one frame"),
-    ("equiv.tx_irq.clear", "equivalent TX interrupt: `clear_request_completed_flag` → `Some`, counted"),
-    ("equiv.tx_irq.idle", "equivalent TX interrupt: `clear_request_completed_flag` → `None` (ends the loop)"),
-    ("equiv.rx_irq", "equivalent RX0 interrupt: one frame into the `heapless::spsc` ring, then `WouldBlock`; `CAN_ESR` read"),
-    ("equiv.take", "equivalent thread side: `Consumer::dequeue`"),
-];
 
 /// The smallest measurement of each region, summed.
 fn sum(counts: &Counts, keys: &[&str]) -> Result<u64> {
@@ -887,15 +1393,6 @@ fn sum(counts: &Counts, keys: &[&str]) -> Result<u64> {
         n += counts.net(k)?.0;
     }
     Ok(n)
-}
-
-/// "met" or "missed by N %" for a ratio against its bound.
-fn verdict(ratio: f64, bound: f64) -> String {
-    if ratio <= bound {
-        "met".into()
-    } else {
-        format!("missed by {:.0} %", 100.0 * (ratio / bound - 1.0))
-    }
 }
 
 fn ratio_f(a: u64, b: u64) -> f64 {
@@ -1103,22 +1600,31 @@ fn render_sources(s: &mut String) {
     let _ = writeln!(
         s,
         "| what | source |\n|---|---|\n\
-         | the command, the report, section sizes, bit-timing grid and exhaustive search, \
-         simulator scenarios | `bench/src/` (package `twocan-bench`, binary `can-bench`) |\n\
-         | loop-back firmwares (STM32F7) | `bench/firmware/loopback-twocan`, \
-         `bench/firmware/loopback-bxcan`, `bench/firmware/loopback-bxcan-equiv`, \
-         `bench/firmware/loopback-async`, `bench/firmware/shared/stm32f7.rs` |\n\
-         | instruction-count firmwares (QEMU mps2-an386) | `bench/firmware/insn-count`, \
-         `bench/firmware/insn-count-async`, `bench/firmware/shared/ram_can.rs`, \
-         `bench/firmware/shared/flag_waker.rs` |\n\
+         | the command, the report, section sizes, issue-21 figures, bit-timing grid and \
+         exhaustive search, simulator scenarios | `bench/src/` (package `twocan-bench`, \
+         binary `can-bench`) |\n\
+         | loop-back firmwares (STM32F7, Teensy 3.6), lean and full | \
+         `bench/firmware/loopback-twocan`, `loopback-bxcan`, `loopback-bxcan-equiv`, \
+         `loopback-async`, `loopback-flexcan`, `loopback-flexcan-hand`; start-up \
+         `bench/firmware/shared/stm32f7.rs`, `shared/kinetis.rs` |\n\
+         | the variants and the equivalents | `bench/firmware/shared/bxcan_variant.rs`, \
+         `flexcan_variant.rs`, `bxcan_equiv.rs`, `flexcan_hand.rs` |\n\
+         | instruction-count and stack firmwares (QEMU mps2-an386) | \
+         `bench/firmware/insn-count`, `insn-count-equiv`, `insn-count-flexcan`, \
+         `insn-count-async`; `shared/ram_bxcan_crate.rs`, \
+         `shared/qemu.rs` (markers, stack painting), `shared/ram_can.rs`, \
+         `shared/ram_flexcan.rs`, `shared/flag_waker.rs` |\n\
          | QEMU plugin | `bench/plugin/insn_count.c` |\n\
-         | firmware examples | `examples/*` (see `docs/firmware.md`) |\n\n\
+         | firmware examples | `examples/*` (see `docs/firmware.md`); their stacks: \
+         `can-fil --stack` (`fil/src/stack.rs`) |\n\n\
          The bench firmware is its own cargo workspace (`bench/firmware/Cargo.toml`, \
          excluded from the main workspace, with its own `Cargo.lock`), built by can-bench \
          with `cargo build --profile release|release-speed --target {TARGET} \
-         --manifest-path bench/firmware/Cargo.toml` into `target/bench-firmware/`; the \
+         --manifest-path bench/firmware/Cargo.toml` into `target/bench-firmware/` (one \
+         invocation per feature set: the rest, the async firmwares, the lean variant, the \
+         full variant, whose ELFs are copied to `<name>-lean` and `<name>-full`); the \
          examples are built into `target/bench-examples/`, the plugin into \
-         `target/bench-plugin/`.\n"
+         `target/bench-plugin/`, can-fil into `fil/target/`.\n"
     );
 }
 

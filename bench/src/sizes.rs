@@ -15,7 +15,7 @@ use std::path::Path;
 
 use object::elf::{SHF_ALLOC, SHF_WRITE, SHT_NOBITS};
 use object::read::elf::{ElfFile32, SectionHeader};
-use object::{LittleEndian, Object, ObjectSection, ObjectSymbol};
+use object::{LittleEndian, Object, ObjectSection, ObjectSymbol, SymbolKind};
 
 use crate::cmd::{Context, Error, Result};
 
@@ -57,7 +57,25 @@ pub struct Section {
 pub struct Size {
     /// Allocated sections, in file order (empty ones left out).
     pub sections: Vec<Section>,
+    /// Bytes of the shared start-up module's code and constants: the symbols of a module
+    /// named `startup` ([`STARTUP_MODULE`]; the bench firmware include
+    /// `shared/stm32f7.rs` or `shared/kinetis.rs` under that name) and a `__pre_init`
+    /// of more than cortex-m-rt's empty default ([`PRE_INIT`]). 0 for an ELF without
+    /// them.
+    pub startup: u64,
 }
+
+/// The path component (in legacy Rust symbol mangling, length-prefixed) of the bench
+/// firmware's shared start-up module.
+pub const STARTUP_MODULE: &str = "7startup";
+
+/// cortex-m-rt's hook before RAM initialisation: part of the start-up where a firmware
+/// defines it (the Kinetis watchdog, `shared/kinetis.rs`).
+pub const PRE_INIT: &str = "__pre_init";
+
+/// Sections that are not driver or application code: the vector table and, on the
+/// Kinetis parts, the flash configuration field.
+pub const NOT_APPLICATION: [&str; 2] = [".vector_table", ".flash_config"];
 
 impl Size {
     fn total(&self, class: Class) -> u64 {
@@ -91,6 +109,18 @@ impl Size {
     /// RAM: data + bss.
     pub fn ram(&self) -> u64 {
         self.data() + self.bss()
+    }
+
+    /// Flash of the driver and the application: [`Size::flash`] without the vector
+    /// table, the flash configuration field and the shared start-up module.
+    pub fn app_flash(&self) -> u64 {
+        let left_out: u64 = self
+            .sections
+            .iter()
+            .filter(|s| NOT_APPLICATION.contains(&s.name.as_str()))
+            .map(|s| s.size)
+            .sum();
+        self.flash() - left_out - self.startup
     }
 
     /// `name size, ...` of the non-empty sections, for the report.
@@ -139,7 +169,20 @@ pub fn measure(path: &Path) -> Result<Size> {
             path.display()
         )));
     }
-    Ok(Size { sections })
+    // Symbols of the start-up module, each address once (aliases share one).
+    let mut seen = std::collections::BTreeSet::new();
+    let mut startup = 0;
+    for sym in elf.symbols() {
+        let Ok(name) = sym.name() else { continue };
+        if (name.contains(STARTUP_MODULE) || name == PRE_INIT)
+            && sym.size() > 0
+            && matches!(sym.kind(), SymbolKind::Text | SymbolKind::Data)
+            && seen.insert(sym.address() & !1)
+        {
+            startup += sym.size();
+        }
+    }
+    Ok(Size { sections, startup })
 }
 
 /// The 32-bit little-endian value of the static `symbol` in the ELF at `path`.
@@ -176,18 +219,27 @@ pub fn symbol_size(path: &Path, symbol: &str) -> Result<u64> {
 /// What the driver's shared `State` static of the loop-back firmware holds.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct StateFigures {
-    /// Size of the `State` static (`BENCH_CAN_STATE` of `loopback-twocan`).
+    /// Size of the `State` static (`BENCH_CAN_STATE` of the loop-back firmware).
     pub static_bytes: u64,
     /// Of which ring and queue slots (`BENCH_RING_BYTES` of `insn-count`, which holds a
     /// `State` of the same type and checks its size in `BENCH_STATE_BYTES`).
     pub ring_bytes: u64,
-    /// Of which the controller value `BxCan<Mmio>` (`BENCH_HW_BYTES`).
-    pub hw_bytes: u64,
-    /// Of which, inside the controller value, the filter map (`BENCH_FMI_BYTES`).
-    pub fmi_bytes: u64,
+    /// Of which the controller value (`BENCH_HW_BYTES`, where the firmware exports it).
+    pub hw_bytes: Option<u64>,
+    /// Of which, inside the controller value, the filter map (`BENCH_FMI_BYTES`, bxCAN).
+    pub fmi_bytes: Option<u64>,
 }
 
-/// Reads [`StateFigures`] from the two firmwares; refuses figures of two different types.
+impl StateFigures {
+    /// Driver state beyond the rings.
+    pub fn state_bytes(&self) -> u64 {
+        self.static_bytes - self.ring_bytes
+    }
+}
+
+/// Reads [`StateFigures`] from a loop-back firmware (its `BENCH_CAN_STATE` static) and
+/// the instruction-count firmware of the same variant (which exports the sizes of the
+/// same `State` type); refuses figures of two different sizes.
 pub fn state_figures(loopback: &Path, insn_count: &Path) -> Result<StateFigures> {
     let static_bytes = symbol_size(loopback, "BENCH_CAN_STATE")?;
     let same_type = u64::from(read_u32_symbol(insn_count, "BENCH_STATE_BYTES")?);
@@ -204,7 +256,43 @@ pub fn state_figures(loopback: &Path, insn_count: &Path) -> Result<StateFigures>
     Ok(StateFigures {
         static_bytes,
         ring_bytes,
-        hw_bytes: u64::from(read_u32_symbol(insn_count, "BENCH_HW_BYTES")?),
-        fmi_bytes: u64::from(read_u32_symbol(insn_count, "BENCH_FMI_BYTES")?),
+        hw_bytes: read_u32_symbol(insn_count, "BENCH_HW_BYTES")
+            .ok()
+            .map(u64::from),
+        fmi_bytes: read_u32_symbol(insn_count, "BENCH_FMI_BYTES")
+            .ok()
+            .map(u64::from),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn section(name: &str, size: u64, class: Class) -> Section {
+        Section {
+            name: name.into(),
+            size,
+            class,
+        }
+    }
+
+    #[test]
+    fn driver_and_application_flash_leaves_out_vectors_config_field_and_start_up() {
+        let z = Size {
+            sections: vec![
+                section(".vector_table", 1024, Class::Code),
+                section(".flash_config", 16, Class::Code),
+                section(".text", 5000, Class::Code),
+                section(".rodata", 100, Class::Code),
+                section(".data", 8, Class::Data),
+                section(".bss", 700, Class::Bss),
+            ],
+            startup: 150,
+        };
+        assert_eq!(z.flash(), 1024 + 16 + 5000 + 100 + 8);
+        assert_eq!(z.ram(), 708);
+        // The .data image stays: it is the application's.
+        assert_eq!(z.app_flash(), 5000 + 100 + 8 - 150);
+    }
 }

@@ -9,4 +9,5 @@ pub mod nvic;
 pub mod profile;
 pub mod report;
 pub mod rtt;
+pub mod stack;
 pub mod world;

@@ -3,7 +3,7 @@
 //!
 //! ```text
 //! can-fil --board teensy36 ELF [--board nucleo-f767zi ELF ...] --seconds S
-//!         [--bitrate B] [--trace FILE] [--quantum-us Q]
+//!         [--bitrate B] [--trace FILE] [--quantum-us Q] [--stack]
 //! ```
 //! Exit status 0 only when every firmware ran without a fault, a stuck interrupt or a
 //! halt; 2 on bad arguments.
@@ -15,7 +15,7 @@ use twocan_fil::profile::{self, BOARDS};
 use twocan_fil::report;
 use twocan_fil::world::World;
 
-const USAGE: &str = "usage: can-fil --board BOARD ELF [--board BOARD ELF ...] --seconds S [--bitrate B] [--trace FILE] [--quantum-us Q] [--traffic ID,PERIOD_MS[,BITRATE] ...]\nboards: teensy32 teensy35 teensy36 nucleo-f767zi disco-f746g bluepill nucleo-f446re teensy41";
+const USAGE: &str = "usage: can-fil --board BOARD ELF [--board BOARD ELF ...] --seconds S [--bitrate B] [--trace FILE] [--quantum-us Q] [--traffic ID,PERIOD_MS[,BITRATE] ...] [--stack]\nboards: teensy32 teensy35 teensy36 nucleo-f767zi disco-f746g bluepill nucleo-f446re teensy41";
 
 struct Args {
     boards: Vec<(String, String)>,
@@ -24,6 +24,7 @@ struct Args {
     trace: Option<String>,
     quantum_us: u64,
     traffic: Vec<(u32, u64, u32)>,
+    stack: bool,
 }
 
 fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
@@ -34,6 +35,7 @@ fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
         trace: None,
         quantum_us: 20,
         traffic: Vec::new(),
+        stack: false,
     };
     let mut seconds = false;
     while let Some(arg) = it.next() {
@@ -96,6 +98,8 @@ fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
                 };
                 a.traffic.push((id, period, rate));
             }
+            // Paint each board's stack and report its high-water marks (src/stack.rs).
+            "--stack" => a.stack = true,
             "-h" | "--help" => return Err(String::new()),
             other => return Err(format!("unexpected argument {other:?}")),
         }
@@ -137,9 +141,18 @@ fn main() -> ExitCode {
             }
         };
         let profile = profile::by_name(board).expect("checked by parse");
-        if let Err(e) = world.add_board(profile, image) {
-            eprintln!("can-fil: {board}: {e}");
-            return ExitCode::from(2);
+        let index = match world.add_board(profile, image) {
+            Ok(i) => i,
+            Err(e) => {
+                eprintln!("can-fil: {board}: {e}");
+                return ExitCode::from(2);
+            }
+        };
+        if args.stack {
+            if let Err(e) = world.machines[index].paint_stack() {
+                eprintln!("can-fil: {board}: {e}");
+                return ExitCode::from(2);
+            }
         }
     }
     for (n, (id, period, rate)) in args.traffic.iter().enumerate() {

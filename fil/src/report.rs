@@ -68,6 +68,26 @@ pub fn render(world: &World<'_>) -> String {
                 if a.misclocked { " (OUT OF TOLERANCE)" } else { "" }
             );
         }
+        if let (Some(s), Some(whole)) = (&b.stack, m.stack_high_water()) {
+            let config = match s.configuration {
+                Some((bytes, at_ns)) => format!(
+                    "configuration {bytes} B (until a CAN interrupt line was first unmasked, at {} us)",
+                    at_ns / 1000
+                ),
+                None => "configuration not reached (no CAN interrupt line unmasked)".into(),
+            };
+            let _ = writeln!(
+                out,
+                "  stack: {config}, whole run {whole} B, painted {} B from 0x{:08X}{}",
+                s.painted(),
+                s.bottom,
+                if whole >= s.painted() {
+                    " (ALL OF IT: overflow?)"
+                } else {
+                    ""
+                }
+            );
+        }
         if b.faults.is_empty() {
             let _ = writeln!(out, "  faults: none");
         }

@@ -142,3 +142,31 @@ fn the_report_shows_the_decoded_defmt_log() {
     let (_, out, _) = can_fil(&["--board", "teensy36", &plain, "--seconds", "0.1"]);
     assert!(!out.contains("defmt log"), "{out}");
 }
+
+/// `--stack`: the painted stack's configuration mark (taken when the firmware unmasks its
+/// first CAN line) and the whole run's; without the option there is no stack line.
+#[test]
+fn the_stack_option_reports_the_painted_depths() {
+    let Some(t) = path("teensy36", "teensy-loopback") else {
+        return;
+    };
+    let (code, out, err) = can_fil(&["--stack", "--board", "teensy36", &t, "--seconds", "0.1"]);
+    assert_eq!(code, 0, "{out}{err}");
+    let line = out
+        .lines()
+        .map(str::trim)
+        .find(|l| l.starts_with("stack: configuration "))
+        .unwrap_or_else(|| panic!("{out}"));
+    let number_after = |key: &str| -> u64 {
+        let rest = &line[line.find(key).unwrap_or_else(|| panic!("{line}")) + key.len()..];
+        rest.split(' ').next().unwrap().parse().unwrap()
+    };
+    let config = number_after("stack: configuration ");
+    let whole = number_after("whole run ");
+    let painted = number_after("painted ");
+    // Start-up and `begin` use some stack; the run never uses less than its
+    // configuration; nothing overflows the painted region.
+    assert!(config > 0 && config <= whole && whole < painted, "{line}");
+    let (_, out, _) = can_fil(&["--board", "teensy36", &t, "--seconds", "0.1"]);
+    assert!(!out.contains("stack:"), "{out}");
+}

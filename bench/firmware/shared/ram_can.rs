@@ -1,7 +1,6 @@
-//! The RAM stand-in for CAN1's registers that the instruction-count firmwares
-//! (`insn-count`, `insn-count-async`) run the drivers on under QEMU (mps2-an386), and
-//! the marker stores the counting plugin (`bench/plugin/insn_count.c`) listens to.
-//! Included by both with `#[path]`.
+//! The RAM stand-in for CAN1's registers that the bxCAN instruction-count firmwares
+//! (`insn-count`, `insn-count-async`) run the drivers on under QEMU (mps2-an386).
+//! Included by both with `#[path]`, next to `qemu.rs` (markers, stack painting).
 //!
 //! # The register block
 //!
@@ -11,7 +10,9 @@
 //! pointer set to the same address. Both are configured through their public APIs while
 //! a SysTick handler acknowledges mode requests as the hardware would
 //! (`CAN_MCR.INRQ` → `CAN_MSR.INAK`, `SLEEP` → `SLAK`); the handler is stopped before
-//! anything is measured.
+//! anything is measured. Its interrupts push their 8-word exception frame on the stack
+//! the configuration runs on; it records where (`qemu::IRQ_FRAMES`), so that the
+//! configuration's stack figure leaves those words out (`qemu::config_stack_depth`).
 //!
 //! # One frame's work per measured call
 //!
@@ -38,31 +39,14 @@
 #![allow(dead_code)]
 
 use core::ptr::{read_volatile, write_volatile};
-use core::sync::atomic::{compiler_fence, Ordering};
 
-use cortex_m::peripheral::syst::SystClkSource;
-use cortex_m::peripheral::{SCB, SYST};
-use cortex_m_rt::{exception, ExceptionFrame};
-use cortex_m_semihosting::{debug, hprintln};
 use twocan_bxcan::regs::{self, mcr, msr, rdtxr, rfxr, rixr, tdtxr, tixr, tsr};
-use twocan_bxcan::{Bank, BxCan, Can, Config, Fifo, FilterPlan};
-use twocan_core::{Error, Filter, Mmio};
 
 /// The bxCAN register block in RAM: above the 1 MiB the linker uses (memory.x), so no
 /// section overlaps it.
 pub const REGS: usize = 0x2010_0000;
 /// Words of the register block (up to `CAN_F27R2` at 0x31C).
 pub const BLOCK_WORDS: usize = 0x320 / 4;
-/// The plugin's marker window: start of region `n` at `+ 8n`, end at `+ 8n + 4`.
-pub const MARKERS: usize = 0x2011_0000;
-
-/// The marker window's address, read from the ELF by can-bench and handed to the plugin.
-#[no_mangle]
-#[used]
-static BENCH_MARKER_WINDOW: u32 = MARKERS as u32;
-
-/// Measurements of each region.
-pub const REPEAT: usize = 5;
 
 /// The frame every path sends and receives.
 pub const ID: u16 = 0x123;
@@ -173,111 +157,39 @@ pub fn snapshots(configured: &Block) -> Snapshots {
 
 // ------------------------------------------------------------------ mode handshake stand-in
 
-/// Starts the SysTick handler that acknowledges mode requests (configuration only).
-pub fn responder_on(syst: &mut SYST) {
-    syst.set_clock_source(SystClkSource::Core);
-    syst.set_reload(2_000);
-    syst.clear_current();
-    syst.enable_interrupt();
-    syst.enable_counter();
-}
-
-pub fn responder_off(syst: &mut SYST) {
-    syst.disable_counter();
-    syst.disable_interrupt();
-    SCB::clear_pendst();
-}
-
-/// Acknowledges mode requests while [`responder_on`] runs it.
-#[exception]
-fn SysTick() {
-    let m = reg_read(regs::MCR);
-    let ack = if m & mcr::INRQ != 0 {
-        msr::INAK
-    } else if m & mcr::SLEEP != 0 {
-        msr::SLAK
-    } else {
-        0
-    };
-    reg_write(regs::MSR, ack);
-}
-
-/// Configuration attempts after a timed-out mode request (see [`configure_ours`]).
-const CONFIG_RETRIES: u32 = 20;
-
-/// Our driver on the stand-in, configured with `config` and one accept-all bank to
-/// FIFO 0, ready for `State::split` (run with [`responder_on`]).
+/// Acknowledges mode requests while `qemu::responder_on` runs it: `CAN_MSR.INAK` while
+/// `CAN_MCR.INRQ` is set, else `SLAK` while `SLEEP` is set, else neither (RM0410
+/// §40.4). Written in assembly so that it pushes nothing beyond its exception frame,
+/// which it records for the stack figures (`qemu::record_irq_frame`, reached by a
+/// branch: it returns from the exception).
 ///
-/// The stand-in acknowledges from SysTick, whose rate under QEMU follows host time: a
-/// wait the driver bounds in polls can run out first on a loaded host. The configuration
-/// is not measured, so a timed-out request is retried (the driver hands the controller
-/// back with the error).
-pub fn configure_ours(config: &Config) -> BxCan<Mmio> {
-    // SAFETY: `REGS` is the RAM stand-in for CAN1's registers; the caller gives it to
-    // this driver alone from now on (the `bxcan` crate, if it used it, has freed it).
-    let regs = unsafe { Mmio::new(REGS) };
-    let mut attempt = Can::can1(regs, config);
-    for _ in 0..CONFIG_RETRIES {
-        match attempt {
-            Err(f) if f.error == Error::Timeout => attempt = f.value.reconfigure(config),
-            _ => break,
-        }
-    }
-    let mut init = match attempt {
-        Ok(i) => i,
-        Err(_) => fail("twocan: can1"),
-    };
-    let mut plan = FilterPlan::manual();
-    let bank = match Bank::mask32(&Filter::pass_all(), Fifo::Fifo0) {
-        Ok(b) => b,
-        Err(_) => fail("twocan: bank"),
-    };
-    check(plan.set_bank(0, bank).is_ok(), "twocan: set_bank");
-    check(init.set_filters(&plan).is_ok(), "twocan: set_filters");
-    let mut attempt = init.enable();
-    for _ in 0..CONFIG_RETRIES {
-        match attempt {
-            Err(f) if f.error == Error::Timeout => attempt = f.value.enable(),
-            _ => break,
-        }
-    }
-    match attempt {
-        Ok(can) => can.into_split(),
-        Err(_) => fail("twocan: enable"),
-    }
-}
-
-// ------------------------------------------------------------------ measuring
-
-pub fn marker(offset: usize) {
-    // SAFETY: the marker window is RAM outside every linker section (memory.x); the
-    // store only signals the plugin.
-    unsafe { write_volatile((MARKERS + offset) as *mut u32, 0) }
-}
-
-/// Runs `f` once between the start and end markers of region `N` (of [`REGIONS`]).
-#[inline(always)]
-pub fn measure<const N: usize, T>(f: impl FnOnce() -> T) -> T {
-    marker(8 * N);
-    compiler_fence(Ordering::SeqCst);
-    let r = f();
-    compiler_fence(Ordering::SeqCst);
-    marker(8 * N + 4);
-    r
-}
-
-pub fn fail(what: &str) -> ! {
-    hprintln!("FAIL {}", what);
-    debug::exit(debug::EXIT_FAILURE);
-    loop {
-        cortex_m::asm::bkpt();
-    }
-}
-
-pub fn check(ok: bool, what: &str) {
-    if !ok {
-        fail(what);
-    }
+/// # Safety
+/// The SysTick exception handler only (`cortex-m-rt` links it under this name).
+#[unsafe(naked)]
+#[no_mangle]
+pub unsafe extern "C" fn SysTick() {
+    core::arch::naked_asm!(
+        "ldr r0, ={regs}",
+        "ldr r1, [r0, #{mcr}]",
+        "movs r2, #{inak}",
+        "tst r1, #{inrq}",
+        "bne 1f",
+        "movs r2, #0",
+        "tst r1, #{sleep}",
+        "beq 1f",
+        "movs r2, #{slak}",
+        "1:",
+        "str r2, [r0, #{msr}]",
+        "b {record}",
+        regs = const REGS,
+        mcr = const regs::MCR,
+        msr = const regs::MSR,
+        inrq = const mcr::INRQ,
+        sleep = const mcr::SLEEP,
+        inak = const msr::INAK,
+        slak = const msr::SLAK,
+        record = sym crate::qemu::record_irq_frame,
+    );
 }
 
 /// Whether transmit mailbox `x` holds the frame [`ID`]/[`DATA`] with its request set.
@@ -291,41 +203,4 @@ pub fn loaded(x: usize) -> bool {
 /// Whether FIFO 0's output mailbox was released (`RFOM0` written).
 pub fn released() -> bool {
     reg_read(regs::RF0R) & rfxr::RFOM != 0
-}
-
-/// Prints the marker window and the region names (`region <n> <key>`).
-pub fn announce(regions: &[&str]) {
-    hprintln!("window {:#010x}", MARKERS);
-    for (n, key) in regions.iter().enumerate() {
-        hprintln!("region {} {}", n, key);
-    }
-}
-
-/// Prints `done` and exits QEMU with success.
-pub fn finish() -> ! {
-    hprintln!("done");
-    debug::exit(debug::EXIT_SUCCESS);
-    loop {
-        cortex_m::asm::bkpt();
-    }
-}
-
-/// Reports a fault and fails the run (cortex-m-rt requires the handler to be an
-/// `unsafe fn`; it touches no memory through the frame beyond reading the stacked PC).
-#[exception]
-unsafe fn HardFault(frame: &ExceptionFrame) -> ! {
-    hprintln!("FAIL hard fault at {:#010x}", frame.pc());
-    debug::exit(debug::EXIT_FAILURE);
-    loop {
-        cortex_m::asm::bkpt();
-    }
-}
-
-#[panic_handler]
-fn panic(info: &core::panic::PanicInfo) -> ! {
-    hprintln!("FAIL panic: {}", info);
-    debug::exit(debug::EXIT_FAILURE);
-    loop {
-        cortex_m::asm::bkpt();
-    }
 }

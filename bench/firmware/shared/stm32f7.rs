@@ -1,5 +1,7 @@
-//! STM32F7 start-up shared, byte for byte, by both loop-back firmwares (included with
-//! `#[path]`), so that their size difference is the CAN driver alone.
+//! STM32F7 start-up shared, byte for byte, by the STM32F7 loop-back firmwares (included
+//! with `#[path]` as module `startup`), so that their size difference is the CAN driver
+//! alone; can-bench leaves this module's code out of the "driver + application" flash
+//! figure (`clocks` is never inlined, so its code keeps the module's symbols).
 //!
 //! Clock tree (RM0410 §5 "Reset and clock control"): HSI (16 MHz) → PLL with M = 8,
 //! N = 108, P = 2 → SYSCLK = HCLK = 108 MHz; APB1 = HCLK / 2 = **54 MHz** (the bxCAN
@@ -53,6 +55,7 @@ fn wait(mut done: impl FnMut() -> bool) -> Result<(), ()> {
 
 /// SYSCLK 108 MHz from the PLL, APB1 54 MHz, CAN1 clocked. `Err` if a clock never
 /// becomes ready.
+#[inline(never)]
 pub fn clocks() -> Result<(), ()> {
     write(
         FLASH_ACR,

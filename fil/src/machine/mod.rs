@@ -111,6 +111,8 @@ pub struct Board {
     check_irq: bool,
     /// Semihosting exit requested.
     pub exited: Option<u32>,
+    /// The painted stack and its marks (`--stack`, [`Machine::paint_stack`]).
+    pub stack: Option<crate::stack::StackPaint>,
 }
 
 const S_REGS: [RegisterARM; 16] = [
@@ -349,6 +351,7 @@ impl<'a> Machine<'a> {
                 .map(|s| crate::rtt::Rtt::new(s.address)),
             check_irq: false,
             exited: None,
+            stack: None,
         };
         let mut uc = Unicorn::new_with_data(Arch::ARM, Mode::THUMB | Mode::MCLASS, board)
             .map_err(|e| format!("unicorn: {e:?}"))?;
@@ -574,6 +577,27 @@ impl<'a> Machine<'a> {
         set_reg(&mut self.uc, RegisterARM::SP, sp);
         set_reg(&mut self.uc, RegisterARM::PC, pc | 1);
         Ok(())
+    }
+
+    /// Paints the stack (`crate::stack`): from cortex-m-rt's `_stack_end` up to the
+    /// initial stack pointer of the vector table. Call before running.
+    pub fn paint_stack(&mut self) -> Result<(), String> {
+        let bottom = self
+            .image
+            .symbol("_stack_end")
+            .map(|s| s.address)
+            .ok_or("stack: the ELF has no `_stack_end` symbol (cortex-m-rt 0.7.4 or newer)")?;
+        let vtor = self.uc.get_data().scb.vtor;
+        let top = read_u32(&self.uc, vtor).ok_or("stack: no initial stack pointer")? & !7;
+        let paint = crate::stack::paint(&mut self.uc, bottom, top)?;
+        self.uc.get_data_mut().stack = Some(paint);
+        Ok(())
+    }
+
+    /// The stack's high-water mark now (bytes), when painted.
+    pub fn stack_high_water(&self) -> Option<u32> {
+        let s = self.uc.get_data().stack.as_ref()?;
+        Some(crate::stack::high_water(&self.uc, s))
     }
 
     /// The board state.

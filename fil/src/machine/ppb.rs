@@ -185,12 +185,21 @@ pub(super) fn ppb_write(uc: &mut Unicorn<'_, Board>, addr: u32, size: usize, val
         0xE000_E100..=0xE000_E13C | 0xE000_E180..=0xE000_E1BC => {
             let set = word_addr < 0xE000_E180;
             let n = (word_addr & 0x7F) / 4;
+            let mut can_line = false;
             for bit in 0..32 {
                 if value & (1 << bit) != 0 {
                     b.nvic.set_irq_enabled(n * 32 + bit, set);
+                    can_line |= b
+                        .cans
+                        .iter()
+                        .any(|p| p.instance.irqs.iter().any(|(_, irq)| *irq == n * 32 + bit));
                 }
             }
             b.check_irq = true;
+            if set && can_line {
+                // `--stack`: the configuration mark (crate::stack).
+                crate::stack::mark_configuration(uc);
+            }
         }
         0xE000_E200..=0xE000_E23C | 0xE000_E280..=0xE000_E2BC => {
             let set = word_addr < 0xE000_E280;

@@ -31,13 +31,13 @@ use twocan_core::{Error, FifoQueue, Frame, Mmio, RxFrame, TxPolicy};
 
 #[path = "../../shared/flag_waker.rs"]
 mod flag_waker;
+#[path = "../../shared/qemu.rs"]
+mod qemu;
 #[path = "../../shared/ram_can.rs"]
 mod ram_can;
 
-use ram_can::{
-    check, fail, measure, released, reset_block, responder_off, responder_on, restore, save,
-    snapshots, DATA, ID, REPEAT,
-};
+use qemu::{check, fail, measure, responder_off, responder_on, REPEAT};
+use ram_can::{released, reset_block, restore, save, snapshots, DATA, ID, REGS};
 
 const APB1_HZ: u32 = 54_000_000;
 const BITRATE: u32 = 500_000;
@@ -88,8 +88,41 @@ fn receive(rx: &mut OurRx) -> Option<RxFrame> {
     rx.receive().ok()
 }
 
+/// Our driver on the stand-in, configured with [`CONFIG`] and one accept-all bank to
+/// FIFO 0 (run with the handshake stand-in; a timed-out request is retried, see
+/// `qemu::responder_on`).
 fn configure() -> Hw {
-    ram_can::configure_ours(&CONFIG)
+    use twocan_bxcan::{Bank, Can, Fifo, FilterPlan};
+    use twocan_core::Filter;
+    // SAFETY: `REGS` is the RAM stand-in for CAN1's registers, used by this driver only.
+    let regs = unsafe { Mmio::new(REGS) };
+    let mut attempt = Can::can1(regs, &CONFIG);
+    for _ in 0..20 {
+        match attempt {
+            Err(f) if f.error == Error::Timeout => attempt = f.value.reconfigure(&CONFIG),
+            _ => break,
+        }
+    }
+    let Ok(mut init) = attempt else {
+        fail("twocan: can1");
+    };
+    let mut plan = FilterPlan::manual();
+    let Ok(bank) = Bank::mask32(&Filter::pass_all(), Fifo::Fifo0) else {
+        fail("twocan: bank");
+    };
+    check(plan.set_bank(0, bank).is_ok(), "twocan: set_bank");
+    check(init.set_filters(&plan).is_ok(), "twocan: set_filters");
+    let mut attempt = init.enable();
+    for _ in 0..20 {
+        match attempt {
+            Err(f) if f.error == Error::Timeout => attempt = f.value.enable(),
+            _ => break,
+        }
+    }
+    match attempt {
+        Ok(can) => can.into_split(),
+        Err(_) => fail("twocan: enable"),
+    }
 }
 
 #[entry]
@@ -97,7 +130,7 @@ fn main() -> ! {
     let Some(mut core) = cortex_m::Peripherals::take() else {
         fail("core peripherals");
     };
-    ram_can::announce(&REGIONS);
+    qemu::announce(&REGIONS);
     for _ in 0..REPEAT {
         measure::<EMPTY, _>(|| ());
     }
@@ -141,5 +174,5 @@ fn main() -> ! {
         let got = measure::<RECEIVE, _>(|| receive(r));
         check(got.is_some_and(|g| g.frame == frame), "receive");
     }
-    ram_can::finish()
+    qemu::finish()
 }

@@ -1,76 +1,71 @@
-//! Instructions per frame of the twocan split driver (bxCAN backend) and of the `bxcan`
-//! crate 0.8, on a Cortex-M4 under QEMU (`-machine mps2-an386`), counted by the TCG
-//! plugin `bench/plugin/insn_count.c` between marker stores. The register block stand-in,
-//! its snapshots and the markers are in `shared/ram_can.rs`.
+//! Instructions per frame and stack high-water marks of the twocan split driver (bxCAN
+//! backend) and of the bare `bxcan` crate 0.8, on a Cortex-M4 under QEMU
+//! (`-machine mps2-an386`), counted by the TCG plugin `bench/plugin/insn_count.c`
+//! between marker stores. Built twice, with feature `lean` and with feature `full`
+//! (`shared/bxcan_variant.rs`). The register block stand-in and its snapshots are in
+//! `shared/ram_can.rs`, the markers and the stack painting in `shared/qemu.rs`. The
+//! feature-equivalent service is measured by `insn-count-equiv` (a separate image, so
+//! that the crate's `transmit` is not shared by two callers and stays inlined in each,
+//! as in a firmware using it alone); can-bench merges the two runs.
 //!
-//! Three drivers run on the same block, one after the other:
+//! Two drivers run on the same block, one after the other:
 //!
-//! - **ours**: a `static State<BxCan<Mmio>, 8, FifoQueue<8>>` (zero-initialised, `.bss`),
-//!   split once; the transmit half's `try_send`, the transmit and FIFO 0 receive
-//!   interrupt handlers, and the receive half's `receive` (decoded frame with the user's
-//!   filter index) are measured;
-//! - **bxcan**: the `bxcan` crate's `Can::transmit` and `Can::receive`, bare;
-//! - **equivalent**: what an application needs around the `bxcan` crate to offer what
-//!   ours does — a TX interrupt that clears the completions (`RQCPx`) and counts them, an
-//!   RX0 interrupt that drains FIFO 0 into a `heapless::spsc` ring (lock-free, like ours),
-//!   counting hardware overruns and ring overflows and reading `CAN_ESR` for the error
-//!   state, and the thread side taking the frame from the ring.
+//! - **ours**: a `static State` of the variant's type (zero-initialised, `.bss`), split
+//!   once; the transmit half's `try_send`, the transmit and FIFO 0 receive interrupt
+//!   handlers, the receive half's `receive` (decoded frame with the user's filter index)
+//!   and, full, `take_completion` are measured;
+//! - **bxcan**: the `bxcan` crate's `Can::transmit`, `Can::receive` and `Rx0::receive`,
+//!   bare.
 //!
 //! Every receive-interrupt figure is **one frame per interrupt** (the snapshot holds one
 //! frame; the handler's loop then finds FIFO 0 empty), so it includes the handler's
-//! per-interrupt cost once.
+//! per-interrupt cost once. After the counts, each measured call runs once more between
+//! [`qemu::stack_depth`]'s painting and scan for its stack high-water mark, and so does
+//! each driver's configuration (mode handshakes played by the SysTick stand-in).
 //!
-//! The firmware prints `region <n> <key>` for each measured region and `done` through
-//! semihosting, then exits with the semihosting exit call.
+//! The firmware prints its region names, round trips, stack figures and `done` through
+//! semihosting (`shared/qemu.rs` lists the lines), then exits with the semihosting exit
+//! call.
 #![no_std]
 #![no_main]
 
 use core::hint::black_box;
 
-use bxcan::filter::Mask32;
 use cortex_m_rt::entry;
-use heapless::spsc::{Consumer, Producer, Queue};
+use twocan_bxcan::FilterPlan;
 use twocan_bxcan::RawFrame;
-use twocan_bxcan::{BxCan, Config, FilterPlan};
-use twocan_core::split::{Rx, RxIrq, State, StateChange, Tx, TxIrq, STATE_CHANGES};
-use twocan_core::timing::{solve_cia, Limits};
+use twocan_core::split::{StateChange, STATE_CHANGES};
 use twocan_core::txqueue::Queued;
 use twocan_core::Completion;
-use twocan_core::{FifoQueue, Frame, Mmio, RxFrame, TxOutcome, TxPolicy};
+use twocan_core::{Frame, Mmio, RxFrame, TxOutcome};
 
+#[path = "../../shared/qemu.rs"]
+mod qemu;
+#[path = "../../shared/ram_bxcan_crate.rs"]
+mod ram_bxcan_crate;
 #[path = "../../shared/ram_can.rs"]
 mod ram_can;
+#[path = "../../shared/bxcan_variant.rs"]
+mod variant;
 
+use qemu::{
+    check, config_stack_depth, fail, measure, report_stack, responder_off, responder_on,
+    stack_depth, REPEAT,
+};
+use ram_bxcan_crate::RamCan1;
 use ram_can::{
-    check, fail, loaded, measure, reg_read, released, reset_block, responder_off, responder_on,
-    restore, save, snapshots, Snapshots, DATA, ID, REGS, REPEAT,
+    loaded, reg_read, released, reset_block, restore, save, snapshots, Snapshots, DATA, ID, REGS,
 };
+use variant::{OurParts, OurRx, OurRxIrq, OurState, OurTx, OurTxIrq, DONE, RX, TXQ};
 
-const APB1_HZ: u32 = 54_000_000;
-const BITRATE: u32 = 500_000;
+/// The measured regions, in the order of their numbers; the full variant measures the
+/// completion's take too.
+#[cfg(feature = "lean")]
+const REGIONS: &[&str] = REGIONS_ALL.split_at(13).0;
+#[cfg(feature = "full")]
+const REGIONS: &[&str] = &REGIONS_ALL;
 
-/// Receive ring (frames) and transmit queue capacities of both sides.
-const RX: usize = 8;
-/// See [`RX`].
-const TXQ: usize = 8;
-/// Completion ring capacity (the `State` default).
-const DONE: usize = 8;
-
-/// Loop-back, request-order transmit (TXFP = 1, the FIFO policy of `FifoQueue`).
-const CONFIG: Config = match Config::from_bitrate(APB1_HZ, BITRATE) {
-    Ok(c) => c.loopback(true).tx_policy(TxPolicy::Fifo),
-    Err(_) => panic!("no bit timing"),
-};
-const BTR: u32 = match solve_cia(APB1_HZ, BITRATE, &Limits::BXCAN) {
-    Ok(t) => match t.bxcan_btr() {
-        Ok(v) => v,
-        Err(_) => panic!("no CAN_BTR value"),
-    },
-    Err(_) => panic!("no bit timing"),
-};
-
-/// The measured regions, in the order of their numbers.
-const REGIONS: [&str; 16] = [
+const REGIONS_ALL: [&str; 14] = [
     "empty",
     "twocan.tx.direct",
     "twocan.tx.one_busy",
@@ -82,11 +77,10 @@ const REGIONS: [&str; 16] = [
     "bxcan.transmit",
     "bxcan.transmit.one_busy",
     "bxcan.receive",
-    "equiv.tx_irq.clear",
-    "equiv.tx_irq.idle",
-    "equiv.rx_irq",
-    "equiv.take",
     "bxcan.rx0.receive",
+    "twocan.tx_irq.done.unloaded",
+    // full only
+    "twocan.take_completion",
 ];
 
 const EMPTY: usize = 0;
@@ -100,39 +94,47 @@ const OURS_RECEIVE: usize = 7;
 const THEIRS_TRANSMIT: usize = 8;
 const THEIRS_TRANSMIT_ONE_BUSY: usize = 9;
 const THEIRS_RECEIVE: usize = 10;
-const EQUIV_TX_CLEAR: usize = 11;
-const EQUIV_TX_IDLE: usize = 12;
-const EQUIV_RX_IRQ: usize = 13;
-const EQUIV_TAKE: usize = 14;
-const THEIRS_RX0_RECEIVE: usize = 15;
+const THEIRS_RX0_RECEIVE: usize = 11;
+const OURS_TX_IRQ_UNLOADED: usize = 12;
+#[cfg(feature = "full")]
+const OURS_TAKE_COMPLETION: usize = 13;
 
+/// What a frame's round trip runs, per side: the send, the handlers the configuration
+/// has per frame, the take (and, with completions, the completion's take).
+#[cfg(feature = "lean")]
+const ROUNDTRIP_OURS: &[&str] = &[
+    "twocan.tx.direct",
+    "twocan.tx_irq.done",
+    "twocan.rx_irq",
+    "twocan.rx.receive",
+];
+#[cfg(feature = "full")]
+const ROUNDTRIP_OURS: &[&str] = &[
+    "twocan.tx.direct",
+    "twocan.tx_irq.done",
+    "twocan.rx_irq",
+    "twocan.rx.receive",
+    "twocan.take_completion",
+];
 // ------------------------------------------------------------------ ours
 
-type Hw = BxCan<Mmio>;
-type Q = FifoQueue<TXQ>;
-type OurState = State<Hw, RX, Q, 0, DONE>;
-type OurTx = Tx<'static, Hw, RX, Q, 0, DONE>;
-type OurRx = Rx<'static, Hw, RX, Q, 0, DONE>;
-type OurTxIrq = TxIrq<'static, Hw, RX, Q, 0, DONE>;
-type OurRxIrq = RxIrq<'static, Hw, RX, Q, 0, DONE>;
-
 /// The driver's shared state: all zeros, in `.bss`. The same type as `loopback-twocan`'s.
-static CAN: OurState = State::new();
+static CAN: OurState = OurState::new();
 
 /// Size of [`OurState`], read by can-bench (checked against `loopback-twocan`'s static).
 #[no_mangle]
 #[used]
 static BENCH_STATE_BYTES: u32 = size_of::<OurState>() as u32;
 
-/// Size of the controller value the state holds (`BxCan<Mmio>`), read by can-bench.
+/// Size of the controller value the state holds, read by can-bench.
 #[no_mangle]
 #[used]
-static BENCH_HW_BYTES: u32 = size_of::<Hw>() as u32;
+static BENCH_HW_BYTES: u32 = size_of::<variant::Hw>() as u32;
 
 /// Size of the filter map inside it (`FmiMap`), read by can-bench.
 #[no_mangle]
 #[used]
-static BENCH_FMI_BYTES: u32 = size_of::<twocan_bxcan::filters::FmiMap>() as u32;
+static BENCH_FMI_BYTES: u32 = size_of::<twocan_bxcan::filters::FmiMap<{ variant::KEYS }>>() as u32;
 
 /// Bytes of [`OurState`] that are ring and queue slots (receive ring, transmit queue,
 /// completion ring, state-change ring), read by can-bench: the rest is driver state.
@@ -163,14 +165,37 @@ fn ours_receive(rx: &mut OurRx) -> Option<RxFrame> {
     rx.receive().ok()
 }
 
-fn configure_ours() -> Hw {
-    ram_can::configure_ours(&CONFIG)
+#[cfg(feature = "full")]
+#[inline(never)]
+fn ours_take_completion(tx: &mut OurTx) -> Option<Completion> {
+    tx.take_completion()
 }
 
-fn run_ours(snap: &Snapshots, hw: Hw) {
-    let Ok(mut p) = CAN.split(hw) else {
-        fail("twocan: split");
+/// The application's configuration: the controller configured and started, then split
+/// into the `static` state.
+#[inline(never)]
+fn ours_configure() -> OurParts {
+    // SAFETY: `REGS` is the RAM stand-in for CAN1's registers; this driver alone uses it
+    // from now on (the `bxcan` crate has given it up).
+    let regs = unsafe { Mmio::new(REGS) };
+    let Ok(hw) = variant::configure::<20>(regs) else {
+        fail("twocan: configure");
     };
+    match CAN.split(hw) {
+        Ok(p) => p,
+        Err(_) => fail("twocan: split"),
+    }
+}
+
+/// Prints the configuration's stack figure (the upper bound: the handshake stand-in's
+/// exception frames included) and, as a note, the lower bound
+/// (`qemu::config_stack_depth`).
+fn report_config_stack(key: &str, low: u32, high: u32) {
+    report_stack(key, high);
+    qemu::note(key, ".low", low);
+}
+
+fn run_ours(snap: &Snapshots, p: &mut OurParts) {
     let frame = match Frame::standard(ID, &DATA) {
         Ok(f) => f,
         Err(_) => fail("frame"),
@@ -194,9 +219,23 @@ fn run_ours(snap: &Snapshots, hw: Hw) {
             reg_read(twocan_bxcan::regs::TSR) == twocan_bxcan::regs::tsr::RQCP0,
             "twocan tx irq acknowledged RQCP0",
         );
+        let done = {
+            #[cfg(feature = "full")]
+            {
+                let t = black_box(&mut p.tx);
+                measure::<OURS_TAKE_COMPLETION, _>(|| ours_take_completion(t))
+            }
+            #[cfg(feature = "lean")]
+            {
+                p.tx.take_completion()
+            }
+        };
         check(
-            p.tx.take_completion()
-                .is_some_and(|c| c.token == token && c.outcome == TxOutcome::Sent),
+            if DONE != 0 {
+                done.is_some_and(|c| c.token == token && c.outcome == TxOutcome::Sent)
+            } else {
+                done.is_none()
+            },
             "twocan tx irq completion",
         );
 
@@ -235,6 +274,12 @@ fn run_ours(snap: &Snapshots, hw: Hw) {
             loaded(0) && CAN.tx_stats().count == 0,
             "twocan tx irq refill",
         );
+
+        // A transmit interrupt with nothing to settle (mailbox 0's flag already
+        // acknowledged, as after a refill): the handler's fixed cost.
+        restore(&snap.tx_free);
+        let h = black_box(&mut p.tx_irq);
+        measure::<OURS_TX_IRQ_UNLOADED, _>(|| ours_tx_irq(h));
         // The one-busy and queued frames never complete on this block: their
         // completions are not expected, and none arrived.
         check(
@@ -242,26 +287,32 @@ fn run_ours(snap: &Snapshots, hw: Hw) {
             "twocan no stray completion",
         );
     }
+
+    // Stack high-water marks of the per-frame calls (one run each, outside the markers).
+    restore(&snap.tx_free);
+    let ((), bytes, _) = stack_depth(|| {
+        check(ours_try_send(&mut p.tx, &frame), "twocan stack try_send");
+    });
+    report_stack("twocan.tx.direct", bytes);
+    restore(&snap.tx_done);
+    let ((), bytes, _) = stack_depth(|| ours_tx_irq(&mut p.tx_irq));
+    report_stack("twocan.tx_irq.done", bytes);
+    #[cfg(feature = "full")]
+    {
+        let (c, bytes, _) = stack_depth(|| ours_take_completion(&mut p.tx));
+        check(c.is_some(), "twocan stack take_completion");
+        report_stack("twocan.take_completion", bytes);
+    }
+    let _ = p.tx.take_completion();
+    restore(&snap.rx_one);
+    let ((), bytes, _) = stack_depth(|| ours_rx_irq(&mut p.rx0_irq));
+    report_stack("twocan.rx_irq", bytes);
+    let (r, bytes, _) = stack_depth(|| ours_receive(&mut p.rx));
+    check(r.is_some(), "twocan stack receive");
+    report_stack("twocan.rx.receive", bytes);
 }
 
 // ------------------------------------------------------------------ the bxcan crate
-
-/// The RAM stand-in as a `bxcan` instance.
-struct RamCan1;
-
-// SAFETY: `REGISTERS` points to the RAM block at `REGS`, laid out as bxCAN's register
-// block (0x320 bytes, aligned), used by one driver at a time.
-unsafe impl bxcan::Instance for RamCan1 {
-    const REGISTERS: *mut bxcan::RegisterBlock = REGS as *mut _;
-}
-
-// SAFETY: the stand-in has CAN1's 28 filter banks.
-unsafe impl bxcan::FilterOwner for RamCan1 {
-    const NUM_FILTER_BANKS: u8 = 28;
-}
-
-// SAFETY: the stand-in is CAN1, the master instance.
-unsafe impl bxcan::MasterInstance for RamCan1 {}
 
 type Theirs = bxcan::Can<RamCan1>;
 
@@ -280,90 +331,12 @@ fn theirs_rx0_receive(c: &mut bxcan::Rx0<RamCan1>) -> Option<bxcan::Frame> {
     c.receive().ok()
 }
 
-/// The feature-equivalent application state around the `bxcan` crate.
-struct Equiv {
-    completions: u32,
-    overruns: u32,
-    ring_overflows: u32,
-    esr: u32,
-}
-
-/// `CAN_ESR`, which the `bxcan` crate 0.8 does not expose: read through its register
-/// block pointer (RM0410 §40.9.2, offset 0x18).
-fn esr_of(_: &Theirs) -> u32 {
-    // SAFETY: `REGISTERS` + 0x18 is `CAN_ESR` of the instance the `Can` owns; a read has
-    // no side effect.
-    unsafe {
-        core::ptr::read_volatile(
-            (<RamCan1 as bxcan::Instance>::REGISTERS as *const u8).add(0x18) as *const u32,
-        )
-    }
-}
-
-/// The TX interrupt's step: clears one `RQCPx` and counts the completion
-/// (`Can::clear_tx_interrupt` loops over this until it returns `None`).
-#[inline(never)]
-fn equiv_tx_step(c: &mut Theirs, e: &mut Equiv) -> bool {
-    match c.clear_request_completed_flag() {
-        Some(_) => {
-            e.completions += 1;
-            true
-        }
-        None => false,
-    }
-}
-
-/// The RX0 interrupt: FIFO 0 into the ring, overruns and overflows counted, `CAN_ESR`
-/// read for the error state.
-#[inline(never)]
-fn equiv_rx_irq(c: &mut Theirs, p: &mut Producer<'_, bxcan::Frame>, e: &mut Equiv) {
-    loop {
-        match c.rx0().receive() {
-            Ok(f) => {
-                if p.enqueue(f).is_err() {
-                    e.ring_overflows += 1;
-                }
-            }
-            Err(nb::Error::Other(_)) => e.overruns += 1,
-            Err(nb::Error::WouldBlock) => break,
-        }
-    }
-    e.esr = esr_of(c);
-}
-
-#[inline(never)]
-fn equiv_take(q: &mut Consumer<'_, bxcan::Frame>) -> Option<bxcan::Frame> {
-    q.dequeue()
-}
-
-fn configure_theirs() -> Theirs {
-    let mut can = bxcan::Can::builder(RamCan1)
-        .set_bit_timing(BTR)
-        .set_loopback(true)
-        .leave_disabled();
-    can.modify_filters()
-        .enable_bank(0, bxcan::Fifo::Fifo0, Mask32::accept_all());
-    check(
-        nb::block!(can.enable_non_blocking()).is_ok(),
-        "bxcan enable",
-    );
-    can
-}
-
 fn run_theirs(snap: &Snapshots, can: &mut Theirs) {
     let id = match bxcan::StandardId::new(ID) {
         Some(id) => id,
         None => fail("bxcan id"),
     };
     let frame = bxcan::Frame::new_data(id, DATA);
-    let mut ring: Queue<bxcan::Frame, { RX + 1 }> = Queue::new();
-    let (mut producer, mut consumer) = ring.split();
-    let mut e = Equiv {
-        completions: 0,
-        overruns: 0,
-        ring_overflows: 0,
-        esr: 1,
-    };
     for _ in 0..REPEAT {
         restore(&snap.tx_free);
         let (cc, ff) = (black_box(&mut *can), black_box(&frame));
@@ -387,42 +360,15 @@ fn run_theirs(snap: &Snapshots, can: &mut Theirs) {
             rx.as_ref() == Some(&frame) && released(),
             "bxcan rx0 receive",
         );
-
-        // The feature-equivalent service. TX interrupt: one completion cleared, then
-        // the call that finds none (on RAM the flag does not clear, so the two calls of
-        // `clear_tx_interrupt`'s loop are measured on their own snapshots).
-        restore(&snap.tx_done);
-        let before = e.completions;
-        let (cc, ee) = (black_box(&mut *can), black_box(&mut e));
-        let more = measure::<EQUIV_TX_CLEAR, _>(|| equiv_tx_step(cc, ee));
-        check(
-            more && e.completions == before + 1,
-            "equivalent tx irq clears RQCP0",
-        );
-        restore(&snap.tx_free);
-        let (cc, ee) = (black_box(&mut *can), black_box(&mut e));
-        let more = measure::<EQUIV_TX_IDLE, _>(|| equiv_tx_step(cc, ee));
-        check(!more, "equivalent tx irq ends");
-
-        restore(&snap.rx_one);
-        let (cc, pp, ee) = (
-            black_box(&mut *can),
-            black_box(&mut producer),
-            black_box(&mut e),
-        );
-        measure::<EQUIV_RX_IRQ, _>(|| equiv_rx_irq(cc, pp, ee));
-        check(
-            released() && consumer.len() == 1 && e.esr == 0,
-            "equivalent rx irq",
-        );
-        let cq = black_box(&mut consumer);
-        let rx = measure::<EQUIV_TAKE, _>(|| equiv_take(cq));
-        check(rx.as_ref() == Some(&frame), "equivalent take");
     }
-    check(
-        e.overruns == 0 && e.ring_overflows == 0,
-        "equivalent: no overrun",
-    );
+    restore(&snap.tx_free);
+    let (ok, bytes, _) = stack_depth(|| theirs_transmit(can, &frame));
+    check(ok, "bxcan stack transmit");
+    report_stack("bxcan.transmit", bytes);
+    restore(&snap.rx_one);
+    let (rx, bytes, _) = stack_depth(|| theirs_rx0_receive(can.rx0()));
+    check(rx.is_some(), "bxcan stack rx0 receive");
+    report_stack("bxcan.rx0.receive", bytes);
 }
 
 #[entry]
@@ -430,25 +376,31 @@ fn main() -> ! {
     let Some(mut core) = cortex_m::Peripherals::take() else {
         fail("core peripherals");
     };
-    ram_can::announce(&REGIONS);
+    qemu::announce(REGIONS);
+    qemu::report_roundtrip("twocan", ROUNDTRIP_OURS);
+    qemu::variant(variant::VARIANT);
     for _ in 0..REPEAT {
         measure::<EMPTY, _>(|| ());
     }
 
-    // Theirs: configure with the handshake stand-in, snapshot, measure, give the block up.
+    // The bare crate: configure with the handshake stand-in, snapshot, measure, give
+    // the block up.
     reset_block();
     responder_on(&mut core.SYST);
-    let mut theirs = configure_theirs();
+    let (mut theirs, low, high) =
+        config_stack_depth(|| ram_bxcan_crate::configure(variant::CONFIG.btr_value(), false));
     responder_off(&mut core.SYST);
+    report_config_stack("bxcan.config", low, high);
     run_theirs(&snapshots(&save()), &mut theirs);
     let _ = theirs.free();
 
     // Ours: the same from a fresh reset block.
     reset_block();
     responder_on(&mut core.SYST);
-    let hw = configure_ours();
+    let (mut parts, low, high) = config_stack_depth(ours_configure);
     responder_off(&mut core.SYST);
-    run_ours(&snapshots(&save()), hw);
+    report_config_stack("twocan.config", low, high);
+    run_ours(&snapshots(&save()), &mut parts);
 
-    ram_can::finish()
+    qemu::finish()
 }

@@ -20,7 +20,7 @@ use twocan_core::{Error, FifoQueue, Filter, Frame, Mmio, TxPolicy};
 #[path = "../../shared/flag_waker.rs"]
 mod flag_waker;
 #[path = "../../shared/stm32f7.rs"]
-mod stm32f7;
+mod startup;
 
 const APB1_HZ: u32 = 54_000_000;
 const BITRATE: u32 = 500_000;
@@ -82,7 +82,7 @@ fn loop_back(hw: BxCan<Mmio>) -> Result<bool, Error> {
 
 #[entry]
 fn main() -> ! {
-    let ok = stm32f7::clocks().is_ok() && start().and_then(loop_back) == Ok(true);
+    let ok = startup::clocks().is_ok() && start().and_then(loop_back) == Ok(true);
     if !ok {
         panic!("loop-back failed");
     }

@@ -1,29 +1,25 @@
 //! Minimal loop-back firmware, feature-equivalent `bxcan` side: the behaviour of
 //! `loopback-bxcan` (CAN1 of an STM32F7 in loop-back mode at 500 kbit/s from a 54 MHz
 //! APB1, one accept-all filter bank to FIFO 0, one frame sent and received by polling)
-//! plus the service work an application adds around the `bxcan` crate 0.8 to get what
-//! twocan's driver offers: a transmit interrupt that clears the completions (`RQCPx`) and
-//! counts them, a receive interrupt that drains FIFO 0 into a `heapless::Deque` ring
-//! counting hardware overruns and ring overflows and reads `CAN_ESR` for the error
-//! state, and the thread side taking frames from the ring.
+//! plus the service an application adds around the `bxcan` crate 0.8 to get what our
+//! driver's variant offers (`shared/bxcan_equiv.rs`, the same code `insn-count`
+//! measures): built twice, with feature `lean` and with feature `full`.
 //!
-//! The `Can` value and the ring live in one `critical_section::Mutex` static, as in
-//! `loopback-bxcan`; one context polls the two handlers in place of the interrupt lines.
+//! The service is split once over a `static` storage (`cortex_m::singleton!`); one
+//! context polls the handlers in place of the interrupt lines.
 #![no_std]
 #![no_main]
-
-use core::cell::RefCell;
 
 use bxcan::filter::Mask32;
 use bxcan::{Fifo, Frame, StandardId};
 use cortex_m_rt::entry;
-use critical_section::Mutex;
-use heapless::Deque;
 use panic_halt as _;
 use twocan_core::timing::{solve_cia, Limits};
 
+#[path = "../../shared/bxcan_equiv.rs"]
+mod equiv;
 #[path = "../../shared/stm32f7.rs"]
-mod stm32f7;
+mod startup;
 
 const APB1_HZ: u32 = 54_000_000;
 const BITRATE: u32 = 500_000;
@@ -31,8 +27,6 @@ const ID: u16 = 0x123;
 const DATA: [u8; 8] = [0x01, 0x23, 0x45, 0x67, 0x89, 0xAB, 0xCD, 0xEF];
 /// Bound on the polls for the looped-back frame (a frame lasts ~250 µs at 500 kbit/s).
 const POLLS: u32 = 1_000_000;
-/// Receive ring capacity (frames), as `loopback-twocan`.
-const RX: usize = 8;
 
 /// The same CAN_BTR timing as `loopback-twocan` (computed at compile time; `bxcan` takes
 /// a raw CAN_BTR value).
@@ -49,11 +43,10 @@ struct Can1;
 
 /// CAN1's register block (RM0410 §2.2.2).
 const CAN1_BASE: usize = 0x4000_6400;
-/// `CAN_ESR` (RM0410 §40.9.2), which the `bxcan` crate does not expose.
-const CAN1_ESR: usize = CAN1_BASE + 0x18;
 
 // SAFETY: `REGISTERS` is CAN1's register block, clocked by `stm32f7::clocks`; only the
-// one `bxcan::Can<Can1>` of this firmware accesses it (and `service` reads `CAN_ESR`).
+// one `bxcan::Can<Can1>` of this firmware and its service (`shared/bxcan_equiv.rs`:
+// `CAN_TSR` acknowledgements, reads of `CAN_RDT0R`, `CAN_TDTxR` and `CAN_ESR`) access it.
 unsafe impl bxcan::Instance for Can1 {
     const REGISTERS: *mut bxcan::RegisterBlock = CAN1_BASE as *mut _;
 }
@@ -66,87 +59,50 @@ unsafe impl bxcan::FilterOwner for Can1 {
 // SAFETY: CAN1 is the master instance of the dual CAN.
 unsafe impl bxcan::MasterInstance for Can1 {}
 
-/// The driver and the application's service state.
-struct Service {
-    can: bxcan::Can<Can1>,
-    ring: Deque<Frame, RX>,
-    completions: u32,
-    overruns: u32,
-    ring_overflows: u32,
-    esr: u32,
-}
-
-static CAN: Mutex<RefCell<Option<Service>>> = Mutex::new(RefCell::new(None));
-
-fn start() -> bool {
+fn start() -> Option<bxcan::Can<Can1>> {
     let mut can = bxcan::Can::builder(Can1)
         .set_bit_timing(BTR)
         .set_loopback(true)
         .leave_disabled();
     can.modify_filters()
         .enable_bank(0, Fifo::Fifo0, Mask32::accept_all());
-    if nb::block!(can.enable_non_blocking()).is_err() {
-        return false;
+    #[cfg(feature = "full")]
+    // SAFETY: `CAN_MCR` of CAN1 in initialization mode (`leave_disabled`): TTCM (bit 7)
+    // turns the receive and transmit time stamps on (the crate has no switch for it).
+    unsafe {
+        let mcr = CAN1_BASE as *mut u32;
+        mcr.write_volatile(mcr.read_volatile() | (1 << 7));
     }
-    critical_section::with(|cs| {
-        CAN.borrow_ref_mut(cs).replace(Service {
-            can,
-            ring: Deque::new(),
-            completions: 0,
-            overruns: 0,
-            ring_overflows: 0,
-            esr: 0,
-        })
-    });
-    true
+    nb::block!(can.enable_non_blocking()).ok()?;
+    Some(can)
 }
 
-/// The TX interrupt's work: completions cleared and counted.
-fn on_tx(s: &mut Service) {
-    while s.can.clear_request_completed_flag().is_some() {
-        s.completions += 1;
-    }
-}
-
-/// The RX0 interrupt's work: FIFO 0 into the ring, overruns counted, `CAN_ESR` read.
-fn on_rx0(s: &mut Service) {
-    loop {
-        match s.can.rx0().receive() {
-            Ok(f) => {
-                if s.ring.push_back(f).is_err() {
-                    s.ring_overflows += 1;
-                }
-            }
-            Err(nb::Error::Other(_)) => s.overruns += 1,
-            Err(nb::Error::WouldBlock) => break,
-        }
-    }
-    // SAFETY: `CAN_ESR` of CAN1 (see `Can1`); a read has no side effect.
-    s.esr = unsafe { core::ptr::read_volatile(CAN1_ESR as *const u32) };
-}
-
-fn loop_back() -> bool {
+fn loop_back(can: bxcan::Can<Can1>) -> bool {
     let Some(id) = StandardId::new(ID) else {
         return false;
     };
     let frame = Frame::new_data(id, DATA);
-    let sent = critical_section::with(|cs| {
-        let mut s = CAN.borrow_ref_mut(cs);
-        s.as_mut().is_some_and(|s| s.can.transmit(&frame).is_ok())
-    });
-    if !sent {
+    let Some(storage) = cortex_m::singleton!(: equiv::Storage = equiv::Storage::new()) else {
         return false;
-    }
+    };
+    let mut s = equiv::split(can, storage);
+    let Ok(token) = nb::block!(s.sender.send(&frame));
     for _ in 0..POLLS {
-        let got = critical_section::with(|cs| {
-            let mut s = CAN.borrow_ref_mut(cs);
-            let s = s.as_mut()?;
-            on_tx(s);
-            on_rx0(s);
-            s.ring.pop_front().map(|f| (f, s.completions))
-        });
-        if let Some((rx, completions)) = got {
-            return rx == frame && completions == 1;
+        #[cfg(feature = "full")]
+        s.tx_irq.on_interrupt();
+        s.rx_irq.on_interrupt();
+        if let Some(rx) = s.receiver.take() {
+            // The completion may come after the reception: bounded wait.
+            #[cfg(feature = "full")]
+            let sent = (0..POLLS).any(|_| {
+                s.tx_irq.on_interrupt();
+                s.completions
+                    .take()
+                    .is_some_and(|c| c.token == token && c.sent)
+            });
+            #[cfg(feature = "lean")]
+            let sent = token == 0;
+            return sent && rx.frame == frame && rx.filter == 0;
         }
     }
     false
@@ -154,7 +110,7 @@ fn loop_back() -> bool {
 
 #[entry]
 fn main() -> ! {
-    let ok = stm32f7::clocks().is_ok() && start() && loop_back();
+    let ok = startup::clocks().is_ok() && start().is_some_and(loop_back);
     if !ok {
         panic!("loop-back failed");
     }

@@ -17,7 +17,7 @@ use panic_halt as _;
 use twocan_core::timing::{solve_cia, Limits};
 
 #[path = "../../shared/stm32f7.rs"]
-mod stm32f7;
+mod startup;
 
 const APB1_HZ: u32 = 54_000_000;
 const BITRATE: u32 = 500_000;
@@ -94,7 +94,7 @@ fn loop_back() -> bool {
 
 #[entry]
 fn main() -> ! {
-    let ok = stm32f7::clocks().is_ok() && {
+    let ok = startup::clocks().is_ok() && {
         start();
         loop_back()
     };

@@ -1,0 +1,427 @@
+//! Instructions per frame and stack high-water marks of our FlexCAN split driver and of
+//! a hand-written register-level FlexCAN service (`shared/flexcan_hand.rs`), on a
+//! Cortex-M4 under QEMU (`-machine mps2-an386`), counted by the TCG plugin
+//! `bench/plugin/insn_count.c` between marker stores. Built twice, with feature `lean`
+//! and with feature `full` (`shared/flexcan_variant.rs`). The register block stand-in,
+//! its snapshots and the write-1-to-clear accessor are in `shared/ram_flexcan.rs`, the
+//! markers and the stack painting in `shared/qemu.rs`.
+//!
+//! Both drivers run on the same block, one after the other, each configured while the
+//! SysTick stand-in plays the `MCR` handshakes:
+//!
+//! - **ours**: a `static State` of the variant's type over `FlexCanHw`, split once; the
+//!   transmit half's `try_send` (MB15 free), the transmit handler (MB15's completion),
+//!   the Rx FIFO handler (one frame), the receive half's `receive` and, full,
+//!   `take_completion`;
+//! - **hand-written**: its transmit, Rx FIFO interrupt, take and, full, MB15 interrupt
+//!   and completion take.
+//!
+//! On FlexCAN one interrupt line (ORed message buffers) runs both the transmit and the
+//! receive handler; each is measured on its own, from a snapshot holding only its
+//! event, on both sides.
+#![no_std]
+#![no_main]
+
+use core::hint::black_box;
+
+use cortex_m_rt::entry;
+use twocan_core::{Frame, Registers, RxFrame, TxOutcome};
+
+#[path = "../../shared/flexcan_hand.rs"]
+mod hand;
+#[path = "../../shared/qemu.rs"]
+mod qemu;
+#[path = "../../shared/ram_flexcan.rs"]
+mod ram_flexcan;
+#[path = "../../shared/flexcan_variant.rs"]
+mod variant;
+
+use qemu::{
+    check, config_stack_depth, fail, measure, report_stack, responder_off, responder_on,
+    stack_depth, REPEAT,
+};
+use ram_flexcan::{
+    loaded, popped, reg_read, reg_write, reset_block, restore, save, snapshots, tx_acknowledged,
+    RamFlexCanRegs, Snapshots, DATA, ID,
+};
+
+type R = RamFlexCanRegs;
+
+#[cfg(feature = "lean")]
+const REGIONS: &[&str] = REGIONS_ALL.split_at(8).0;
+#[cfg(feature = "full")]
+const REGIONS: &[&str] = &REGIONS_ALL;
+
+const REGIONS_ALL: [&str; 11] = [
+    "empty",
+    "twocan.tx.direct",
+    "twocan.tx_irq.done",
+    "twocan.rx_irq",
+    "twocan.rx.receive",
+    "hand.tx",
+    "hand.rx_irq",
+    "hand.take",
+    // full only
+    "twocan.take_completion",
+    "hand.tx_irq",
+    "hand.take_completion",
+];
+
+const EMPTY: usize = 0;
+const OURS_SEND: usize = 1;
+const OURS_TX_IRQ: usize = 2;
+const OURS_RX_IRQ: usize = 3;
+const OURS_RECEIVE: usize = 4;
+const HAND_TX: usize = 5;
+const HAND_RX_IRQ: usize = 6;
+const HAND_TAKE: usize = 7;
+#[cfg(feature = "full")]
+const OURS_TAKE_COMPLETION: usize = 8;
+#[cfg(feature = "full")]
+const HAND_TX_IRQ: usize = 9;
+#[cfg(feature = "full")]
+const HAND_TAKE_COMPLETION: usize = 10;
+
+#[cfg(feature = "lean")]
+const ROUNDTRIP_OURS: &[&str] = &[
+    "twocan.tx.direct",
+    "twocan.tx_irq.done",
+    "twocan.rx_irq",
+    "twocan.rx.receive",
+];
+#[cfg(feature = "full")]
+const ROUNDTRIP_OURS: &[&str] = &[
+    "twocan.tx.direct",
+    "twocan.tx_irq.done",
+    "twocan.rx_irq",
+    "twocan.rx.receive",
+    "twocan.take_completion",
+];
+#[cfg(feature = "lean")]
+const ROUNDTRIP_HAND: &[&str] = &["hand.tx", "hand.rx_irq", "hand.take"];
+#[cfg(feature = "full")]
+const ROUNDTRIP_HAND: &[&str] = &[
+    "hand.tx",
+    "hand.tx_irq",
+    "hand.rx_irq",
+    "hand.take",
+    "hand.take_completion",
+];
+
+// ------------------------------------------------------------------ ours
+
+static CAN: variant::OurState<R> = variant::OurState::new();
+
+/// Size of the shared state, read by can-bench.
+#[no_mangle]
+#[used]
+static BENCH_STATE_BYTES: u32 = size_of::<variant::OurState<R>>() as u32;
+
+/// Bytes of the state that are ring and queue slots (receive ring, transmit queue,
+/// completion ring, state-change ring), read by can-bench: the rest is driver state.
+#[no_mangle]
+#[used]
+static BENCH_RING_BYTES: u32 = (variant::RX * size_of::<twocan_flexcan::split::RawFrame>()
+    + variant::TXQ * size_of::<twocan_core::txqueue::Queued>()
+    + variant::DONE * size_of::<twocan_core::Completion>()
+    + twocan_core::split::STATE_CHANGES * size_of::<twocan_core::split::StateChange>())
+    as u32;
+
+/// The SIM and PORT registers on QEMU: the board has none, so writes go nowhere (clock
+/// gates and pin mux are not measured).
+struct NoSystem;
+
+impl Registers for NoSystem {
+    fn read32(&self, _: usize) -> u32 {
+        0
+    }
+    fn write32(&self, _: usize, _: u32) {}
+}
+
+#[inline(never)]
+fn ours_try_send(tx: &mut variant::OurTx<R>, f: &Frame) -> bool {
+    tx.try_send(f).is_ok()
+}
+
+#[inline(never)]
+fn ours_tx_irq(h: &mut variant::OurTxIrq<R>) {
+    h.on_interrupt()
+}
+
+#[inline(never)]
+fn ours_rx_irq(h: &mut variant::OurRxIrq<R>) {
+    h.on_interrupt()
+}
+
+#[inline(never)]
+fn ours_receive(rx: &mut variant::OurRx<R>) -> Option<RxFrame> {
+    rx.receive().ok()
+}
+
+#[cfg(feature = "full")]
+#[inline(never)]
+fn ours_take_completion(tx: &mut variant::OurTx<R>) -> Option<twocan_core::Completion> {
+    tx.take_completion()
+}
+
+/// The application's configuration: `begin`, then the split into the `static` state.
+#[inline(never)]
+fn ours_configure() -> variant::OurParts<R> {
+    // SAFETY: the stand-in is used by this driver alone from now on (the hand-written
+    // service measured before has given it up).
+    let regs = || unsafe { RamFlexCanRegs::new() };
+    let Ok(hw) = variant::configure::<20, _, _>(regs, &mut NoSystem) else {
+        fail("twocan: begin");
+    };
+    match CAN.split(hw) {
+        Ok(p) => p,
+        Err(_) => fail("twocan: split"),
+    }
+}
+
+fn run_ours(snap: &Snapshots, p: &mut variant::OurParts<R>) {
+    let frame = match Frame::standard(ID, &DATA) {
+        Ok(f) => f,
+        Err(_) => fail("frame"),
+    };
+    for _ in 0..REPEAT {
+        restore(&snap.tx_free);
+        let token = p.tx.next_token();
+        let (t, f) = (black_box(&mut p.tx), black_box(&frame));
+        let ok = measure::<OURS_SEND, _>(|| ours_try_send(t, f));
+        check(
+            ok && loaded() && CAN.tx_stats().count == 0,
+            "twocan try_send",
+        );
+
+        restore(&snap.tx_done);
+        let h = black_box(&mut p.tx_irq);
+        measure::<OURS_TX_IRQ, _>(|| ours_tx_irq(h));
+        check(tx_acknowledged(), "twocan tx irq acknowledged MB15");
+        let done = {
+            #[cfg(feature = "full")]
+            {
+                let t = black_box(&mut p.tx);
+                measure::<OURS_TAKE_COMPLETION, _>(|| ours_take_completion(t))
+            }
+            #[cfg(feature = "lean")]
+            {
+                p.tx.take_completion()
+            }
+        };
+        check(
+            if variant::DONE != 0 {
+                done.is_some_and(|c| c.token == token && c.outcome == TxOutcome::Sent)
+            } else {
+                done.is_none()
+            },
+            "twocan tx irq completion",
+        );
+
+        restore(&snap.rx_one);
+        let h = black_box(&mut p.rx0_irq);
+        measure::<OURS_RX_IRQ, _>(|| ours_rx_irq(h));
+        check(popped() && CAN.rx_stats().count == 1, "twocan rx irq");
+
+        let r = black_box(&mut p.rx);
+        let rx = measure::<OURS_RECEIVE, _>(|| ours_receive(r));
+        check(
+            rx.is_some_and(|r| r.frame == frame && r.filter == variant::FILTER_INDEX)
+                && CAN.rx_stats().count == 0,
+            "twocan receive",
+        );
+    }
+
+    restore(&snap.tx_free);
+    let ((), bytes, _) = stack_depth(|| {
+        check(ours_try_send(&mut p.tx, &frame), "twocan stack try_send");
+    });
+    report_stack("twocan.tx.direct", bytes);
+    restore(&snap.tx_done);
+    let ((), bytes, _) = stack_depth(|| ours_tx_irq(&mut p.tx_irq));
+    report_stack("twocan.tx_irq.done", bytes);
+    #[cfg(feature = "full")]
+    {
+        let (c, bytes, _) = stack_depth(|| ours_take_completion(&mut p.tx));
+        check(c.is_some(), "twocan stack take_completion");
+        report_stack("twocan.take_completion", bytes);
+    }
+    let _ = p.tx.take_completion();
+    restore(&snap.rx_one);
+    let ((), bytes, _) = stack_depth(|| ours_rx_irq(&mut p.rx0_irq));
+    report_stack("twocan.rx_irq", bytes);
+    let (r, bytes, _) = stack_depth(|| ours_receive(&mut p.rx));
+    check(r.is_some(), "twocan stack receive");
+    report_stack("twocan.rx.receive", bytes);
+}
+
+// ------------------------------------------------------------------ hand-written
+
+/// The hand-written service's register access on the stand-in (write-1-to-clear played
+/// as `ram_flexcan.rs` says).
+struct RamBus;
+
+impl hand::Bus for RamBus {
+    #[inline(always)]
+    fn read(offset: usize) -> u32 {
+        reg_read(offset)
+    }
+    #[inline(always)]
+    fn write(offset: usize, value: u32) {
+        reg_write(offset, value)
+    }
+    #[inline(always)]
+    fn w1c(offset: usize, bits: u32) {
+        reg_write(offset, reg_read(offset) & !bits)
+    }
+}
+
+type Hand = hand::Service<'static, RamBus>;
+
+#[inline(never)]
+fn hand_send(s: &mut hand::Sender<'_, RamBus>, f: &hand::CanFrame) -> Option<u32> {
+    s.send(f).ok()
+}
+
+#[cfg(feature = "full")]
+#[inline(never)]
+fn hand_tx_irq(h: &mut hand::TxHandler<'_, RamBus>) {
+    h.on_interrupt()
+}
+
+#[inline(never)]
+fn hand_rx_irq(h: &mut hand::RxHandler<'_, RamBus>) {
+    h.on_interrupt()
+}
+
+#[inline(never)]
+fn hand_take(r: &mut hand::Receiver<'_>) -> Option<hand::Received> {
+    r.take()
+}
+
+#[cfg(feature = "full")]
+#[inline(never)]
+fn hand_take_completion(c: &mut hand::Completions<'_>) -> Option<hand::Completion> {
+    c.take()
+}
+
+/// The hand-written configuration (retried after a timed-out handshake, as ours), then
+/// the split over its storage.
+#[inline(never)]
+fn hand_configure(storage: &'static mut hand::Storage) -> Hand {
+    let mut r = hand::configure::<RamBus>();
+    for _ in 0..20 {
+        if r.is_ok() {
+            break;
+        }
+        r = hand::configure::<RamBus>();
+    }
+    check(r.is_ok(), "hand: configure");
+    hand::split(storage)
+}
+
+fn run_hand(snap: &Snapshots, s: &mut Hand) {
+    let frame = hand::CanFrame {
+        id: ID as u32,
+        extended: false,
+        remote: false,
+        dlc: 8,
+        data: DATA,
+    };
+    for _ in 0..REPEAT {
+        restore(&snap.tx_free);
+        let (ss, ff) = (black_box(&mut s.sender), black_box(&frame));
+        let token = measure::<HAND_TX, _>(|| hand_send(ss, ff));
+        check(token.is_some() && loaded(), "hand send");
+
+        #[cfg(feature = "full")]
+        {
+            restore(&snap.tx_done);
+            let h = black_box(&mut s.tx_irq);
+            measure::<HAND_TX_IRQ, _>(|| hand_tx_irq(h));
+            check(tx_acknowledged(), "hand tx irq acknowledged MB15");
+            let c = black_box(&mut s.completions);
+            let done = measure::<HAND_TAKE_COMPLETION, _>(|| hand_take_completion(c));
+            check(
+                done.is_some_and(|c| Some(c.token) == token && c.sent),
+                "hand completion",
+            );
+        }
+
+        restore(&snap.rx_one);
+        let h = black_box(&mut s.rx_irq);
+        measure::<HAND_RX_IRQ, _>(|| hand_rx_irq(h));
+        check(popped(), "hand rx irq");
+        let r = black_box(&mut s.receiver);
+        let rx = measure::<HAND_TAKE, _>(|| hand_take(r));
+        check(
+            rx.is_some_and(|r| r.frame == frame && r.filter == 0),
+            "hand take",
+        );
+    }
+    restore(&snap.tx_free);
+    let (t, bytes, _) = stack_depth(|| hand_send(&mut s.sender, &frame));
+    check(t.is_some(), "hand stack send");
+    report_stack("hand.tx", bytes);
+    #[cfg(feature = "full")]
+    {
+        restore(&snap.tx_done);
+        let ((), bytes, _) = stack_depth(|| hand_tx_irq(&mut s.tx_irq));
+        report_stack("hand.tx_irq", bytes);
+        let (c, bytes, _) = stack_depth(|| hand_take_completion(&mut s.completions));
+        check(c.is_some(), "hand stack take completion");
+        report_stack("hand.take_completion", bytes);
+    }
+    restore(&snap.rx_one);
+    let ((), bytes, _) = stack_depth(|| hand_rx_irq(&mut s.rx_irq));
+    report_stack("hand.rx_irq", bytes);
+    let (r, bytes, _) = stack_depth(|| hand_take(&mut s.receiver));
+    check(r.is_some(), "hand stack take");
+    report_stack("hand.take", bytes);
+    check(
+        s.counts.overruns.get() == 0 && s.counts.ring_overflows.get() == 0,
+        "hand: no overrun, no overflow",
+    );
+}
+
+/// Prints the configuration's stack figure (the upper bound: the handshake stand-in's
+/// exception frames included) and, as a note, the lower bound
+/// (`qemu::config_stack_depth`).
+fn report_config_stack(key: &str, low: u32, high: u32) {
+    report_stack(key, high);
+    qemu::note(key, ".low", low);
+}
+
+#[entry]
+fn main() -> ! {
+    let Some(mut core) = cortex_m::Peripherals::take() else {
+        fail("core peripherals");
+    };
+    qemu::announce(REGIONS);
+    qemu::report_roundtrip("twocan", ROUNDTRIP_OURS);
+    qemu::report_roundtrip("hand", ROUNDTRIP_HAND);
+    qemu::variant(variant::VARIANT);
+    check(variant::VARIANT == hand::VARIANT, "one variant");
+    for _ in 0..REPEAT {
+        measure::<EMPTY, _>(|| ());
+    }
+
+    let Some(storage) = cortex_m::singleton!(: hand::Storage = hand::Storage::new()) else {
+        fail("hand storage");
+    };
+    reset_block();
+    responder_on(&mut core.SYST);
+    let (mut service, low, high) = config_stack_depth(|| hand_configure(storage));
+    responder_off(&mut core.SYST);
+    report_config_stack("hand.config", low, high);
+    run_hand(&snapshots(&save()), &mut service);
+
+    reset_block();
+    responder_on(&mut core.SYST);
+    let (mut parts, low, high) = config_stack_depth(ours_configure);
+    responder_off(&mut core.SYST);
+    report_config_stack("twocan.config", low, high);
+    run_ours(&snapshots(&save()), &mut parts);
+
+    qemu::finish()
+}

@@ -1,0 +1,472 @@
+//! The targets of issue 21 ("zero-cost by construction") computed from one run: each
+//! figure ours against theirs per opt-level, with its bound, for the lean and the full
+//! variant of each backend; and `target/bench/summary.json` built from them.
+
+use crate::cmd::{Error, Result};
+use crate::firmware::VARIANTS;
+use crate::report::{ExampleSection, InsnSection, SizeSection};
+
+/// Which backend a figure is of.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Backend {
+    /// Our bxCAN driver against the `bxcan` crate (bare and feature-equivalent).
+    BxCan,
+    /// Our FlexCAN driver against the hand-written FlexCAN service.
+    FlexCan,
+}
+
+impl Backend {
+    /// Both, in report order.
+    pub const ALL: [Backend; 2] = [Backend::BxCan, Backend::FlexCan];
+
+    /// The instruction-count firmware.
+    pub fn firmware(self) -> &'static str {
+        match self {
+            Backend::BxCan => "insn-count",
+            Backend::FlexCan => "insn-count-flexcan",
+        }
+    }
+
+    /// The instruction-count images whose runs make up its figures (merged).
+    pub fn images(self) -> &'static [&'static str] {
+        match self {
+            Backend::BxCan => &["insn-count", "insn-count-equiv"],
+            Backend::FlexCan => &["insn-count-flexcan"],
+        }
+    }
+
+    /// Its name in the report.
+    pub fn name(self) -> &'static str {
+        match self {
+            Backend::BxCan => "bxCAN",
+            Backend::FlexCan => "FlexCAN",
+        }
+    }
+
+    /// Key prefix in `summary.json` (`""` for bxCAN, the headline backend).
+    pub fn key(self) -> &'static str {
+        match self {
+            Backend::BxCan => "",
+            Backend::FlexCan => "flexcan_",
+        }
+    }
+
+    /// The equivalent's round trip name and region prefix in its firmware.
+    pub fn equivalent(self) -> &'static str {
+        match self {
+            Backend::BxCan => "equiv",
+            Backend::FlexCan => "hand",
+        }
+    }
+
+    /// The equivalent in prose.
+    pub fn equivalent_label(self) -> &'static str {
+        match self {
+            Backend::BxCan => "the feature-equivalent `bxcan` service",
+            Backend::FlexCan => "the hand-written FlexCAN service",
+        }
+    }
+
+    /// The transmit the target compares ours with.
+    fn tx_theirs(self) -> (&'static str, &'static str) {
+        match self {
+            Backend::BxCan => ("bxcan.transmit", "`bxcan` `Can::transmit`"),
+            Backend::FlexCan => ("hand.tx", "the hand-written transmit"),
+        }
+    }
+}
+
+/// What a target measures in one opt-level.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Measured {
+    /// Ours over theirs (instructions or bytes).
+    Ratio {
+        /// Ours.
+        ours: u64,
+        /// Theirs.
+        theirs: u64,
+    },
+    /// Bytes against a byte bound.
+    Bytes(u64),
+}
+
+impl Measured {
+    /// The ratio or the bytes as a number.
+    pub fn value(&self) -> f64 {
+        match *self {
+            Measured::Ratio { ours, theirs } if theirs > 0 => ours as f64 / theirs as f64,
+            Measured::Ratio { .. } => f64::NAN,
+            Measured::Bytes(b) => b as f64,
+        }
+    }
+
+    /// "met" or by how much it is missed against `bound`.
+    pub fn verdict(&self, bound: f64) -> String {
+        let v = self.value();
+        if v <= bound {
+            return "met".into();
+        }
+        match self {
+            Measured::Ratio { .. } => format!("missed by {:.0} %", 100.0 * (v / bound - 1.0)),
+            Measured::Bytes(b) => {
+                format!("missed by {} B", crate::report::thousands(b - bound as u64))
+            }
+        }
+    }
+}
+
+/// One target of issue 21 (or an extra line without a bound).
+#[derive(Debug, Clone)]
+pub struct Target {
+    /// Backend.
+    pub backend: Backend,
+    /// `lean` or `full`.
+    pub variant: &'static str,
+    /// Short key: `tx`, `rx_isr`, `rx_bare`, `roundtrip`, `flash`, `state`,
+    /// `config_stack`.
+    pub key: &'static str,
+    /// What is compared, in prose.
+    pub label: String,
+    /// The bound (a ratio, or bytes for `state` and `config_stack`); `None` for an
+    /// extra line.
+    pub bound: Option<f64>,
+    /// (opt-level, figure).
+    pub per_opt: Vec<(String, Measured)>,
+}
+
+impl Target {
+    /// The figure at `opt`.
+    pub fn at(&self, opt: &str) -> Option<&Measured> {
+        self.per_opt.iter().find(|(o, _)| o == opt).map(|(_, m)| m)
+    }
+}
+
+/// Every figure of issue 21.
+pub struct Figures {
+    /// The targets, by backend and variant.
+    pub targets: Vec<Target>,
+    /// The largest configuration stack of every firmware example and bench firmware,
+    /// and where it was measured.
+    pub config_stack_max: Option<(u64, String)>,
+}
+
+/// The configuration stack bound (1 KB).
+pub const CONFIG_STACK_BOUND: u64 = 1024;
+/// The driver state allowed beyond the rings.
+pub const STATE_BOUND: u64 = 64;
+
+impl Figures {
+    /// Computes every target from the instruction counts, the sizes and the examples.
+    pub fn compute(
+        insn: &InsnSection,
+        sizes: &SizeSection,
+        examples: Option<&ExampleSection>,
+    ) -> Result<Figures> {
+        let mut targets = Vec::new();
+        let opts = insn.opts();
+        for backend in Backend::ALL {
+            let eq = backend.equivalent();
+            for &variant in &VARIANTS {
+                let lean = variant == "lean";
+                let ratio_of = |f: &dyn Fn(&crate::qemu::Counts) -> Result<(u64, u64)>| {
+                    opts.iter()
+                        .map(|opt| {
+                            let c = insn.get(backend, variant, opt)?;
+                            let (ours, theirs) = f(c)?;
+                            Ok((opt.clone(), Measured::Ratio { ours, theirs }))
+                        })
+                        .collect::<Result<Vec<_>>>()
+                };
+                let region = |c: &crate::qemu::Counts, k: &str| -> Result<u64> { Ok(c.net(k)?.0) };
+                let (tx_theirs, tx_label) = backend.tx_theirs();
+                if lean || backend == Backend::BxCan {
+                    targets.push(Target {
+                        backend,
+                        variant,
+                        key: "tx",
+                        label: format!("direct transmit: `Tx::try_send` / {tx_label}"),
+                        bound: lean.then_some(1.0),
+                        per_opt: ratio_of(&|c| {
+                            Ok((region(c, "twocan.tx.direct")?, region(c, tx_theirs)?))
+                        })?,
+                    });
+                    targets.push(Target {
+                        backend,
+                        variant,
+                        key: "rx_isr",
+                        label: format!(
+                            "receive handler, one frame into the ring: `RxIrq::on_interrupt` \
+                             / {}'s handler",
+                            backend.equivalent_label()
+                        ),
+                        bound: lean.then_some(1.0),
+                        per_opt: ratio_of(&|c| {
+                            Ok((
+                                region(c, "twocan.rx_irq")?,
+                                region(c, &format!("{eq}.rx_irq"))?,
+                            ))
+                        })?,
+                    });
+                }
+                if backend == Backend::BxCan {
+                    targets.push(Target {
+                        backend,
+                        variant,
+                        key: "rx_bare",
+                        label: "receive handler / bare `bxcan` `Rx0::receive` (extra line)".into(),
+                        bound: None,
+                        per_opt: ratio_of(&|c| {
+                            Ok((region(c, "twocan.rx_irq")?, region(c, "bxcan.rx0.receive")?))
+                        })?,
+                    });
+                }
+                targets.push(Target {
+                    backend,
+                    variant,
+                    key: "roundtrip",
+                    label: format!(
+                        "round trip (send{}, handlers, take{}) / {}",
+                        if lean { "" } else { " with token" },
+                        if lean { "" } else { ", completion taken" },
+                        backend.equivalent_label()
+                    ),
+                    bound: Some(if lean { 1.0 } else { 1.5 }),
+                    per_opt: ratio_of(&|c| Ok((c.roundtrip("twocan")?, c.roundtrip(eq)?)))?,
+                });
+                let flash = sizes
+                    .builds
+                    .iter()
+                    .map(|b| {
+                        let v = b.variant(variant).ok_or_else(|| {
+                            Error::new(format!("no {variant} loop-back sizes at opt {}", b.opt))
+                        })?;
+                        let (ours, theirs) = match backend {
+                            Backend::BxCan => (&v.ours, &v.equiv),
+                            Backend::FlexCan => (&v.flexcan, &v.flexcan_hand),
+                        };
+                        Ok((
+                            b.opt.clone(),
+                            Measured::Ratio {
+                                ours: ours.app_flash(),
+                                theirs: theirs.app_flash(),
+                            },
+                        ))
+                    })
+                    .collect::<Result<Vec<_>>>()?;
+                targets.push(Target {
+                    backend,
+                    variant,
+                    key: "flash",
+                    label: format!(
+                        "flash, driver + application (vector table and start-up left out) / {}",
+                        backend.equivalent_label()
+                    ),
+                    bound: Some(if lean { 1.3 } else { 3.0 }),
+                    per_opt: flash,
+                });
+                if lean {
+                    let st = sizes
+                        .state(variant)
+                        .ok_or_else(|| Error::new(format!("no {variant} state figures")))?;
+                    let fig = match backend {
+                        Backend::BxCan => &st.bxcan,
+                        Backend::FlexCan => &st.flexcan,
+                    };
+                    targets.push(Target {
+                        backend,
+                        variant,
+                        key: "state",
+                        label: format!(
+                            "driver state beyond the rings ({} B of ring and queue slots)",
+                            fig.ring_bytes
+                        ),
+                        bound: Some(STATE_BOUND as f64),
+                        per_opt: vec![("s".into(), Measured::Bytes(fig.state_bytes()))],
+                    });
+                }
+                targets.push(Target {
+                    backend,
+                    variant,
+                    key: "config_stack",
+                    label: "configuration stack (configure, start, split)".into(),
+                    bound: Some(CONFIG_STACK_BOUND as f64),
+                    per_opt: opts
+                        .iter()
+                        .map(|opt| {
+                            let c = insn.get(backend, variant, opt)?;
+                            Ok((opt.clone(), Measured::Bytes(c.stack("twocan.config")?)))
+                        })
+                        .collect::<Result<Vec<_>>>()?,
+                });
+            }
+        }
+        Ok(Figures {
+            targets,
+            config_stack_max: config_stack_max(insn, sizes, examples),
+        })
+    }
+
+    /// The target `key` of `backend`, `variant`.
+    pub fn get(&self, backend: Backend, variant: &str, key: &str) -> Option<&Target> {
+        self.targets
+            .iter()
+            .find(|t| t.backend == backend && t.variant == variant && t.key == key)
+    }
+
+    /// Its value at `opt`.
+    pub fn value(&self, backend: Backend, variant: &str, key: &str, opt: &str) -> Result<f64> {
+        self.get(backend, variant, key)
+            .and_then(|t| t.at(opt))
+            .map(Measured::value)
+            .ok_or_else(|| {
+                Error::new(format!(
+                    "no figure {key} of {} {variant} at opt {opt}",
+                    backend.name()
+                ))
+            })
+    }
+
+    /// The new `summary.json` fields of issue 21.
+    pub fn summary_fields(&self) -> Result<serde_json::Map<String, serde_json::Value>> {
+        let mut m = serde_json::Map::new();
+        let b = Backend::BxCan;
+        let f = Backend::FlexCan;
+        let float = |v: f64| serde_json::Value::from(v);
+        for (name, backend, variant, key, opt) in [
+            ("lean_tx_ratio_s", b, "lean", "tx", "s"),
+            ("lean_tx_ratio_3", b, "lean", "tx", "3"),
+            ("lean_rx_isr_ratio_s", b, "lean", "rx_isr", "s"),
+            ("lean_rx_isr_ratio_3", b, "lean", "rx_isr", "3"),
+            ("lean_roundtrip_ratio_s", b, "lean", "roundtrip", "s"),
+            ("lean_roundtrip_ratio_3", b, "lean", "roundtrip", "3"),
+            ("lean_flash_ratio_equiv_s", b, "lean", "flash", "s"),
+            ("full_roundtrip_ratio_s", b, "full", "roundtrip", "s"),
+            ("full_roundtrip_ratio_3", b, "full", "roundtrip", "3"),
+            ("full_flash_ratio_equiv_s", b, "full", "flash", "s"),
+            (
+                "flexcan_lean_roundtrip_ratio_s",
+                f,
+                "lean",
+                "roundtrip",
+                "s",
+            ),
+            (
+                "flexcan_lean_roundtrip_ratio_3",
+                f,
+                "lean",
+                "roundtrip",
+                "3",
+            ),
+            (
+                "flexcan_full_roundtrip_ratio_s",
+                f,
+                "full",
+                "roundtrip",
+                "s",
+            ),
+        ] {
+            m.insert(name.into(), float(self.value(backend, variant, key, opt)?));
+        }
+        let bytes = |backend, key| -> Result<serde_json::Value> {
+            Ok(serde_json::Value::from(
+                self.value(backend, "lean", key, "s")? as u64,
+            ))
+        };
+        m.insert("lean_ram_state_bytes".into(), bytes(b, "state")?);
+        m.insert(
+            "config_stack_bytes_max".into(),
+            self.config_stack_max
+                .as_ref()
+                .map(|(v, _)| serde_json::Value::from(*v))
+                .unwrap_or(serde_json::Value::Null),
+        );
+        // The rest of the targets, for scripts: every ratio and byte figure by name.
+        let mut all = serde_json::Map::new();
+        for t in &self.targets {
+            for (opt, v) in &t.per_opt {
+                let key = format!("{}{}_{}_{}", t.backend.key(), t.variant, t.key, opt);
+                let value = match v {
+                    Measured::Ratio { ours, theirs } => serde_json::json!({
+                        "ours": ours, "theirs": theirs, "ratio": v.value(),
+                    }),
+                    Measured::Bytes(b) => serde_json::Value::from(*b),
+                };
+                all.insert(key, value);
+            }
+        }
+        m.insert("issue21".into(), serde_json::Value::Object(all));
+        Ok(m)
+    }
+}
+
+/// The largest configuration stack: every `*.config` stack figure of every run of the
+/// instruction-count firmwares (ours and the equivalents, both variants, both
+/// profiles), every example's configuration figure under can-fil, and every loop-back
+/// firmware's whole run under can-fil (start-up, configuration and one polled frame:
+/// they enable no interrupt line, so their whole run stands for their configuration).
+fn config_stack_max(
+    insn: &InsnSection,
+    sizes: &SizeSection,
+    examples: Option<&ExampleSection>,
+) -> Option<(u64, String)> {
+    let mut best: Option<(u64, String)> = None;
+    let mut consider = |v: u64, what: String| {
+        if best.as_ref().is_none_or(|(b, _)| v > *b) {
+            best = Some((v, what));
+        }
+    };
+    for r in &insn.runs {
+        for (k, v) in &r.counts.stacks {
+            if k.ends_with(".config") {
+                consider(
+                    *v,
+                    format!(
+                        "`{k}` of `{}` ({}, opt {})",
+                        r.backend.firmware(),
+                        r.variant,
+                        r.opt
+                    ),
+                );
+            }
+        }
+    }
+    for r in &sizes.fil {
+        consider(
+            r.stack.whole,
+            format!("loop-back firmware `{}` (opt {}, whole run)", r.elf, r.opt),
+        );
+    }
+    for e in examples.into_iter().flat_map(|e| e.builds.iter()) {
+        if let Some(c) = e.stack.and_then(|s| s.configuration) {
+            consider(
+                c,
+                format!(
+                    "example `{}` ({})",
+                    e.bin,
+                    e.board.as_deref().unwrap_or("no board feature")
+                ),
+            );
+        }
+    }
+    best
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn verdicts_say_by_how_much() {
+        let r = Measured::Ratio {
+            ours: 150,
+            theirs: 100,
+        };
+        assert!((r.value() - 1.5).abs() < 1e-12);
+        assert_eq!(r.verdict(1.5), "met");
+        assert_eq!(r.verdict(1.0), "missed by 50 %");
+        assert_eq!(Measured::Bytes(1100).verdict(1024.0), "missed by 76 B");
+        assert_eq!(Measured::Bytes(3048).verdict(1024.0), "missed by 2,024 B");
+        assert_eq!(Measured::Bytes(64).verdict(64.0), "met");
+        assert!(Measured::Ratio { ours: 1, theirs: 0 }.value().is_nan());
+    }
+}
