@@ -48,6 +48,8 @@ pub mod spsc;
 pub mod timestamp;
 pub mod timing;
 pub mod txqueue;
+#[cfg(feature = "async")]
+mod wakers;
 
 #[cfg(feature = "async")]
 pub use asynch::RxEvent;
