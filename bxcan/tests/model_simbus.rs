@@ -1,4 +1,4 @@
-//! The bxCAN model on can-core's simulated bus (`twocan_sim::Bus`): the `BusNode`
+//! The bxCAN model on the simulated bus (`twocan_sim::Bus`): the `BusNode`
 //! contract end to end — SYNC through `next_wakeup`, arbitration, acknowledgement, error
 //! frames, bus-off recovery, loop back — with the model driven through registers.
 

@@ -2,7 +2,7 @@
 //! path in the same run. Ignored by default (timing is meaningful in release mode only):
 //!
 //! ```text
-//! cargo test --release -p twocan-core --features sim --test sim_speed -- --ignored --nocapture
+//! cargo test --release -p twocan-sim --test sim_speed -- --ignored --nocapture
 //! ```
 
 use std::time::Instant;

@@ -1,4 +1,4 @@
-//! Shared test harness: the real driver over the FlexCAN model on twocan-core's
+//! Shared test harness: the real driver over the FlexCAN model on twocan-sim's
 //! simulated bus, interrupts serviced by the test between bus events.
 #![allow(dead_code)]
 
