@@ -15,13 +15,13 @@ use std::time::Instant;
 
 use twocan_bxcan::model::BxCanModel;
 use twocan_bxcan::{Bank, BxCan, Can, Config, Fifo, FilterPlan};
-use twocan_core::sim::Bus;
 use twocan_core::{Driver, Filter, Frame};
 use twocan_flexcan::model::FlexCanModel;
 use twocan_flexcan::{
     AcanDriver, Board, FlexCan, HostSystem, IdleClocked, Instance, Settings, Target,
 };
 use twocan_host::{BxNode, FlexNode, Harness};
+use twocan_sim::Bus;
 
 use crate::cmd::{Context, Error, Result};
 use crate::simspeed::{Speed, BITRATE, MIN_SECS};

@@ -1551,7 +1551,7 @@ fn render_sim(s: &mut String, sim: &[SimRow]) {
     let _ = writeln!(s, "## 4. Simulator speed\n");
     let _ = writeln!(
         s,
-        "Simulated frames delivered per host second with twocan-core's `sim` feature \
+        "Simulated frames delivered per host second with the `twocan-sim` crate \
          (bus at {}; the bit rate only converts bit times to seconds). Each scenario is run \
          {} times; each trial runs batches until at least {:.1} s of host time have \
          passed. The count is of frames delivered to a receiver (the listener's received \

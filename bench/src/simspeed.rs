@@ -6,14 +6,14 @@
 //!
 //! Every scenario runs twice in the same command, trial by trial: with the bus's fast
 //! path (the default: an attempt that cannot fail is resolved without playing its bits,
-//! `twocan_core::sim` `fast.rs`) and forced onto the bit-level path
+//! `twocan_sim` `fast.rs`) and forced onto the bit-level path
 //! (`Bus::set_fast_path(false)`), so the report gives the fast path's speed as a ratio
 //! to the bit-level path measured in the same run ([`SimRow`]).
 
 use std::time::{Duration, Instant};
 
-use twocan_core::sim::{Bus, SimNode};
 use twocan_core::Frame;
+use twocan_sim::{Bus, SimNode};
 
 use crate::cmd::{Context, Error, Result};
 

@@ -6,7 +6,7 @@ use std::{cell::RefCell, rc::Rc};
 
 use twocan_bxcan::model::BxCanModel;
 use twocan_bxcan::{BxCan, Can, Config, FifoPolicy};
-use twocan_core::sim::{Bus, PollClock};
+use twocan_sim::{Bus, PollClock};
 use twocan_core::split::State;
 use twocan_core::{FifoQueue, Filter, Frame, TxOutcome};
 

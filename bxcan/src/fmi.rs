@@ -31,7 +31,7 @@ pub const HW_MATCH_FIFO_BIT: u16 = 1 << 8;
 ///
 /// use twocan_bxcan::model::BxCanModel;
 /// use twocan_bxcan::{fmi, BxCan, Can, Config, Fifo, FifoPolicy};
-/// use twocan_core::sim::{Bus, PollClock};
+/// use twocan_sim::{Bus, PollClock};
 /// use twocan_core::split::State;
 /// use twocan_core::{FifoQueue, Filter, Frame};
 ///

@@ -658,8 +658,8 @@ mod tests {
     use crate::model::BxCanModel;
     use crate::regs::{BTR, FMR, MCR, MSR};
     use std::{cell::RefCell, rc::Rc};
-    use twocan_core::sim::{Bus, PollClock};
     use twocan_core::Mode;
+    use twocan_sim::{Bus, PollClock};
 
     type Regs = PollClock<BxCanModel>;
 

@@ -9,8 +9,8 @@ use common::*;
 use twocan_bxcan::model::BxCanModel;
 use twocan_bxcan::regs::{esr, ESR};
 use twocan_bxcan::{Can, Recovery};
-use twocan_core::sim::{Fault, NodeId, SimNode};
 use twocan_core::{Error, ErrorState, LastErrorCode, Mode, Registers, TxOutcome, TxPolicy};
+use twocan_sim::{Fault, NodeId, SimNode};
 
 fn bus_off_setup(recovery: Recovery) -> (Drv, Clocked, SharedBus, NodeId) {
     let bus = new_bus();

@@ -48,7 +48,7 @@ fn a_plan_needing_more_lookup_keys_than_the_map_holds_is_refused_with_counts() {
     init.set_filters(&p).unwrap();
     let can = init.enable().map_err(|f| f.error).unwrap();
     let mut d = twocan_core::Driver::<_, 16, 8, 16>::new(can.into_split());
-    let peer = twocan_core::sim::SimNode::new().shared();
+    let peer = twocan_sim::SimNode::new().shared();
     bus.borrow_mut().attach("peer", peer.clone());
     settle(&bus);
     for id in [0x100u16, 0x13F, 0x17F, 0x180, 0x0FF] {

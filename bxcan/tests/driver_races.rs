@@ -149,7 +149,7 @@ impl twocan_core::Registers for InjectBeforeEsrWrite {
 fn an_error_latched_between_the_lec_read_and_its_rearm_is_missing_from_the_kinds_only() {
     use twocan_bxcan::model::BxCanModel;
     use twocan_bxcan::Can;
-    use twocan_core::sim::{Fault, SimNode};
+    use twocan_sim::{Fault, SimNode};
     let bus = new_bus();
     let model = BxCanModel::can1();
     bus.borrow_mut().attach("can1", model.clone());

@@ -8,8 +8,8 @@ mod common;
 use common::*;
 use twocan_bxcan::model::BxCanModel;
 use twocan_bxcan::Can;
-use twocan_core::sim::{Fault, Receivers, SimNode};
 use twocan_core::{ErrorCounters, ErrorState};
+use twocan_sim::{Fault, Receivers, SimNode};
 
 #[test]
 fn rec_after_a_good_reception_above_127_is_120() {

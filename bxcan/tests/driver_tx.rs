@@ -6,13 +6,13 @@
 mod common;
 
 use common::*;
-use twocan_core::sim::Fault;
 use twocan_core::{
     AbortRequest, Completion, MailboxId, MailboxState, TxFailure, TxOutcome, TxPolicy,
 };
+use twocan_sim::Fault;
 
 /// The identifiers the peer received, in bus order.
-fn order(peer: &std::rc::Rc<std::cell::RefCell<twocan_core::sim::SimNode>>) -> Vec<u32> {
+fn order(peer: &std::rc::Rc<std::cell::RefCell<twocan_sim::SimNode>>) -> Vec<u32> {
     peer.borrow()
         .received_frames()
         .iter()
@@ -145,7 +145,7 @@ fn one_shot_failure_is_reported_with_its_cause() {
 /// Puts the scheduled mailbox of `regs` in transmit state, as the bus does when it
 /// offers the frame (the abort of a mailbox in transmit state must wait for the bus).
 fn offer(regs: &Clocked, bus: &SharedBus) {
-    use twocan_core::sim::BusNode;
+    use twocan_sim::BusNode;
     let now = bus.borrow().now();
     let mut model = regs.model.clone();
     assert!(model.poll_tx(now).is_some(), "a frame is offered");

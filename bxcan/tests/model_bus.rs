@@ -1,4 +1,4 @@
-//! A tiny stand-in for the simulated bus (can-core's `sim` bus is written separately) and
+//! A tiny stand-in for the simulated bus (`twocan-sim`'s bus is written separately) and
 //! register-level helpers, shared by the `model_*` tests (`#[path]`-included; its own
 //! tests are in `model_modes.rs`). As a test target of its own it has no tests.
 //!
@@ -15,8 +15,8 @@ use twocan_bxcan::model::BxCanModel;
 use twocan_bxcan::regs::{
     self, fa1r, ffa1r, fm1r, fmr, fs1r, mcr, msr, rdtxr, rfxr, rixr, tdtxr, tixr,
 };
-use twocan_core::sim::{BusNode, BusTime, TxRequest, TxResult};
 use twocan_core::{Frame, LastErrorCode, Registers};
+use twocan_sim::{BusNode, BusTime, TxRequest, TxResult};
 
 /// Bit times of a frame without stuff bits: SOF, arbitration, control, data, CRC, ACK,
 /// EOF.

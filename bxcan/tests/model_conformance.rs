@@ -1,7 +1,7 @@
-//! The fault-confinement conformance table (`can-core/tests/conformance/mod.rs`) on the
+//! The fault-confinement conformance table (`sim/tests/conformance/mod.rs`) on the
 //! bxCAN model, driven through its registers (automatic bus-off recovery: `MCR.ABOM`).
 
-#[path = "../../can-core/tests/conformance/mod.rs"]
+#[path = "../../sim/tests/conformance/mod.rs"]
 mod conformance;
 #[path = "model_bus.rs"]
 mod tiny;
@@ -10,8 +10,8 @@ use conformance::Dut;
 use tiny::{accept_all, enter_init, load};
 use twocan_bxcan::model::BxCanModel;
 use twocan_bxcan::regs::{self, esr, mcr, tsr};
-use twocan_core::sim::{Bus, NodeId};
 use twocan_core::{ErrorCounters, ErrorState, Frame, Registers};
+use twocan_sim::{Bus, NodeId};
 
 struct BxCan(BxCanModel);
 

@@ -8,8 +8,8 @@ mod bus;
 use bus::*;
 use twocan_bxcan::model::BxCanModel;
 use twocan_bxcan::regs::{self, esr, ier, mcr, msr, tsr};
-use twocan_core::sim::BusNode;
 use twocan_core::{LastErrorCode, Registers};
+use twocan_sim::BusNode;
 
 fn esr_of(m: &BxCanModel) -> u32 {
     m.read32(regs::ESR)

@@ -15,8 +15,8 @@ use std::rc::Rc;
 use tiny::{enter_init, load, receive, Received};
 use twocan_bxcan::model::BxCanModel;
 use twocan_bxcan::regs::{self, esr, fa1r, fmr, fs1r, msr, tsr};
-use twocan_core::sim::{Bus, RandomFaults, SimNode};
 use twocan_core::{Frame, Registers};
+use twocan_sim::{Bus, RandomFaults, SimNode};
 
 struct Lcg(u64);
 

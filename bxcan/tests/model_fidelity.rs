@@ -14,8 +14,8 @@ mod tiny;
 use tiny::{enter_init, load, receive, std_frame, tir_of};
 use twocan_bxcan::model::BxCanModel;
 use twocan_bxcan::regs::{self, esr, fa1r, fm1r, fmr, fs1r, ier, mcr, msr, tsr};
-use twocan_core::sim::{Bus, BusEvent, Fault, SimNode};
 use twocan_core::{Frame, Registers};
+use twocan_sim::{Bus, BusEvent, Fault, SimNode};
 
 /// Initialization, bank 0 as a 32-bit filter (`list` or mask) with `fr1`/`fr2` into FIFO 0,
 /// then normal mode with `mcr_bits`; joins `bus` and synchronises.
@@ -251,8 +251,8 @@ fn bits_until(bus: &mut Bus, max: u64, mut done: impl FnMut() -> bool) -> u64 {
 
 #[test]
 fn initialization_request_waits_for_the_frame_in_flight_at_the_lowest_bit_rate() {
-    use twocan_core::sim::frame_bits;
     use twocan_core::timing::frame_time::{bits_to_micros, MAX_FRAME_IN_FLIGHT_BITS};
+    use twocan_sim::frame_bits;
     // 2.5 kbit/s, the slowest exact ACAN rate; a long extended frame with heavy stuffing.
     let mut bus = Bus::new(2_500).unwrap();
     let mut a = accept_all(&mut bus, "a", 0);

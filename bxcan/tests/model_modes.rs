@@ -7,8 +7,8 @@ mod bus;
 use bus::*;
 use twocan_bxcan::model::{BxCanModel, Mode};
 use twocan_bxcan::regs::{self, btr, esr, ier, mcr, msr, tixr};
-use twocan_core::sim::{BusNode, BusTime, TxResult};
 use twocan_core::Registers;
+use twocan_sim::{BusNode, BusTime, TxResult};
 
 fn mode_bits(m: &BxCanModel) -> u32 {
     m.read32(regs::MSR) & (msr::INAK | msr::SLAK)

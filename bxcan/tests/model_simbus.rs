@@ -1,4 +1,4 @@
-//! The bxCAN model on can-core's simulated bus (`twocan_core::sim::Bus`): the `BusNode`
+//! The bxCAN model on the simulated bus (`twocan_sim::Bus`): the `BusNode`
 //! contract end to end — SYNC through `next_wakeup`, arbitration, acknowledgement, error
 //! frames, bus-off recovery, loop back — with the model driven through registers.
 
@@ -8,8 +8,8 @@ mod tiny;
 use tiny::{accept_all, enter_init, load, receive, std_frame};
 use twocan_bxcan::model::{BxCanModel, Mode};
 use twocan_bxcan::regs::{self, btr, esr, mcr, msr, tsr};
-use twocan_core::sim::{Bus, BusEvent, Fault, SimNode};
 use twocan_core::Registers;
+use twocan_sim::{Bus, BusEvent, Fault, SimNode};
 
 /// Initialization, accept-all filter into FIFO 0, extra `MCR` bits, then INRQ cleared.
 fn configure(m: &mut BxCanModel, mcr_bits: u32, btr_bits: u32) {

@@ -7,8 +7,8 @@ mod bus;
 use bus::*;
 use twocan_bxcan::model::BxCanModel;
 use twocan_bxcan::regs::{self, btr, esr, fa1r, fmr, tsr};
-use twocan_core::sim::BusNode;
 use twocan_core::Registers;
+use twocan_sim::BusNode;
 
 /// Two started models; `a` gets the BTR test bits `bits` (set in initialization mode).
 fn pair_with(bits: u32) -> (BxCanModel, BxCanModel, TinyBus) {

@@ -8,8 +8,8 @@ mod bus;
 use bus::*;
 use twocan_bxcan::model::BxCanModel;
 use twocan_bxcan::regs::{self, esr, ier, mcr, tdtxr, tixr, tsr};
-use twocan_core::sim::{BusNode, BusTime, TxResult};
 use twocan_core::{LastErrorCode, MailboxState, Registers};
+use twocan_sim::{BusNode, BusTime, TxResult};
 
 fn pair() -> (BxCanModel, BxCanModel, TinyBus) {
     started_pair(BxCanModel::can1(), BxCanModel::can3())

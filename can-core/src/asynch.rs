@@ -62,29 +62,6 @@ use crate::hardware::{Completion, Hardware, Token};
 use crate::split::{Rx, StateChange, Tx};
 use crate::txqueue::TxQueue;
 
-/// The waker cells of one driver state.
-pub(crate) struct Wakers {
-    /// Receive half waiting for a frame.
-    pub(crate) rx: AtomicWaker,
-    /// Receive half waiting for a state change.
-    pub(crate) state: AtomicWaker,
-    /// Transmit half waiting for room in the queue.
-    pub(crate) tx_room: AtomicWaker,
-    /// Transmit half waiting for a completion.
-    pub(crate) tx_done: AtomicWaker,
-}
-
-impl Wakers {
-    pub(crate) const fn new() -> Self {
-        Wakers {
-            rx: AtomicWaker::new(),
-            state: AtomicWaker::new(),
-            tx_room: AtomicWaker::new(),
-            tx_done: AtomicWaker::new(),
-        }
-    }
-}
-
 /// Takes the waker back out of its cell when a waiting future is dropped.
 struct Unregister<'a>(&'a AtomicWaker);
 

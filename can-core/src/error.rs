@@ -297,20 +297,6 @@ impl core::fmt::Display for crate::dispatch::NoSuchFilter {
 
 impl core::error::Error for crate::dispatch::NoSuchFilter {}
 
-#[cfg(feature = "sim")]
-impl core::fmt::Display for crate::sim::bus::StillBusy {
-    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        write!(
-            f,
-            "the simulated bus was still busy at bit time {} when its budget ran out",
-            self.now
-        )
-    }
-}
-
-#[cfg(feature = "sim")]
-impl core::error::Error for crate::sim::bus::StillBusy {}
-
 #[cfg(test)]
 mod tests {
 

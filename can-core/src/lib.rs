@@ -1,6 +1,7 @@
 //! Portable core of the `twocan` CAN drivers: frames, portable filters, the split driver
 //! (a shared [`State`] and handles per context), the [`Hardware`] seam the backends
-//! implement, dispatch by filter index, bit timing and (feature `sim`) a simulated bus.
+//! implement, dispatch by filter index and bit timing. The simulated bus is the
+//! `twocan-sim` crate (host only), which builds on this one.
 //!
 //! # Quick start
 //!
@@ -19,13 +20,10 @@
 //! on a single-core Cortex-M (Teensy 3.x, STM32F7) enables `cortex-m`'s
 //! `critical-section-single-core` feature (or uses a HAL or RTOS that provides one); host
 //! programs and tests enable `critical-section`'s `std` feature.
-#![cfg_attr(not(any(test, feature = "std")), no_std)]
+#![cfg_attr(not(test), no_std)]
 // docs.rs (nightly rustdoc): mark feature-gated items with the feature they need.
 #![cfg_attr(docsrs, feature(doc_cfg))]
 #![deny(missing_docs)]
-
-#[cfg(feature = "std")]
-extern crate std;
 
 #[cfg(feature = "async")]
 pub mod asynch;
@@ -34,7 +32,6 @@ pub mod controller;
 pub mod dispatch;
 pub mod driver;
 pub mod error;
-pub mod fault;
 pub mod filter;
 pub mod filter_set;
 pub mod frame;
@@ -46,13 +43,13 @@ pub mod mailbox;
 pub mod mock;
 pub mod priority;
 pub mod registers;
-#[cfg(feature = "sim")]
-pub mod sim;
 pub mod split;
 pub mod spsc;
 pub mod timestamp;
 pub mod timing;
 pub mod txqueue;
+#[cfg(feature = "async")]
+mod wakers;
 
 #[cfg(feature = "async")]
 pub use asynch::RxEvent;

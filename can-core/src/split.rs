@@ -205,7 +205,7 @@ pub struct State<
     state_changes: Counter,
     errors: ErrorCounts,
     #[cfg(feature = "async")]
-    pub(crate) wakers: crate::asynch::Wakers,
+    pub(crate) wakers: crate::wakers::Wakers,
     _q: core::marker::PhantomData<Q>,
 }
 
@@ -285,7 +285,7 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
             state_changes: Counter::new(),
             errors: ErrorCounts::new(),
             #[cfg(feature = "async")]
-            wakers: crate::asynch::Wakers::new(),
+            wakers: crate::wakers::Wakers::new(),
             _q: core::marker::PhantomData,
         }
     }

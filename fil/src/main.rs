@@ -166,7 +166,7 @@ fn main() -> ExitCode {
         let rate = if *rate == 0 { args.bitrate } else { *rate };
         world.add_node(
             &format!("node{}", n + 1),
-            twocan_core::sim::SimNode::new(),
+            twocan_sim::SimNode::new(),
             rate,
             vec![frame],
             u128::from(*period) * 1_000_000_000,

@@ -14,8 +14,8 @@
 use std::cell::RefCell;
 use std::rc::Rc;
 
-use twocan_core::sim::{Bus, Fault, NodeId, Receivers, SimNode};
 use twocan_core::Frame;
+use twocan_sim::{Bus, Fault, NodeId, Receivers, SimNode};
 
 use crate::can::Model;
 use crate::elf::Image;

@@ -169,7 +169,7 @@ fn async_echo_answers_every_frame_with_its_identifier_plus_one() {
         // frames by 0.498 s, the last at 495 ms (its echo follows within 0.5 ms).
         let tester = w.add_node_from(
             "tester",
-            twocan_core::sim::SimNode::new(),
+            twocan_sim::SimNode::new(),
             500_000,
             sent.to_vec(),
             5_000_000_000,

@@ -26,11 +26,11 @@ mod common;
 use common::*;
 use twocan_app::App;
 use twocan_bxcan::{Config, FifoPolicy, Recovery};
-use twocan_core::sim::{NodeStats, RandomFaults, SimNode};
 use twocan_core::Frame;
 use twocan_fil::can::Model;
 use twocan_fil::world::World;
 use twocan_host::{BxNode, FlexNode, Harness, Serviced, STM32F767_APB1_HZ};
+use twocan_sim::{NodeStats, RandomFaults, SimNode};
 
 const BIT_RATE: u32 = 500_000;
 /// The firmware's application period (`Every::new(time::millis(), 10)` in both `app`s).
@@ -305,7 +305,7 @@ fn run_host(steps: &[Vec<u64>; 2], faults: Faults) -> (Outcome, Vec<(u64, Frame,
     (outcome, trace)
 }
 
-fn trace_of(records: &[twocan_core::sim::trace::TraceRecord]) -> Vec<(u64, Frame, bool)> {
+fn trace_of(records: &[twocan_sim::trace::TraceRecord]) -> Vec<(u64, Frame, bool)> {
     records
         .iter()
         .filter(|r| !r.internal)

@@ -6,9 +6,9 @@
 mod common;
 
 use common::*;
-use twocan_core::sim::SimNode;
 use twocan_core::Frame;
 use twocan_fil::nvic::exc;
+use twocan_sim::SimNode;
 
 /// The address of the single `LDR` from `base` in function `reset`: found by running
 /// rather than by decoding, the test checks the reported PC lies inside `reset`.

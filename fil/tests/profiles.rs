@@ -8,9 +8,9 @@
 mod common;
 
 use common::*;
-use twocan_core::sim::SimNode;
 use twocan_core::Frame;
 use twocan_fil::world::World;
+use twocan_sim::SimNode;
 
 /// A world with `board` running `elf` and a plain peer sending standard 0x321 every 2 ms.
 fn with_peer(

@@ -1,7 +1,7 @@
 // ACAN §4's LoopBackDemo on the host: FlexCAN's behavioural model (feature `model`) on
 // the simulated bus. This file is the crate documentation's quick start and, verbatim,
 // the workspace test `tests/tests/first_program.rs`.
-use twocan_core::sim::Bus;
+use twocan_sim::Bus;
 use twocan_core::{Filter, Format, Frame, FrameKind};
 use twocan_flexcan::model::FlexCanModel;
 use twocan_flexcan::{

@@ -15,8 +15,8 @@ extern crate std;
 use core::cell::Cell;
 use core::ops::Deref;
 
-use twocan_core::sim::BusNode;
 use twocan_core::Registers;
+use twocan_sim::BusNode;
 
 use crate::model::FlexCanModel;
 use crate::regs::{ESR1, MCR};

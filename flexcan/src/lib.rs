@@ -6,7 +6,7 @@
 //! [`twocan_core::Driver`] for polling code.
 //!
 //! ACAN §4's LoopBackDemo, on the host over the behavioural model of the module
-//! (feature `model`) and twocan-core's simulated bus:
+//! (feature `model`) and twocan-sim's simulated bus:
 //!
 #![doc = concat!("```\n", include_str!("../doc/quick_start.rs"), "```")]
 //!

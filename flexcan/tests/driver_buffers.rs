@@ -6,9 +6,9 @@
 mod common;
 
 use common::*;
-use twocan_core::sim::SimNode;
 use twocan_core::BufferStats;
 use twocan_flexcan::Settings;
+use twocan_sim::SimNode;
 
 #[test]
 fn flood_larger_than_the_receive_ring() {

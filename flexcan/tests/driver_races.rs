@@ -20,11 +20,11 @@ use std::rc::Rc;
 
 use common::*;
 use twocan_core::registers::Registers;
-use twocan_core::sim::{Bus, Fault, SimNode};
 use twocan_core::{AbortRequest, Driver, TxOutcome};
 use twocan_flexcan::model::FlexCanModel;
 use twocan_flexcan::regs;
 use twocan_flexcan::{Board, FlexCan, FlexCanHw, HostSystem, Instance, Settings, Target};
+use twocan_sim::{Bus, Fault, SimNode};
 
 /// Runs bit by bit until the bus is inside a frame (bounded).
 fn until_in_frame(bus: &mut Bus) {

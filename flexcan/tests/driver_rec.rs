@@ -6,9 +6,9 @@
 mod common;
 
 use common::*;
-use twocan_core::sim::{Bus, Fault, Receivers, SimNode};
 use twocan_core::{ErrorCounters, ErrorState};
 use twocan_flexcan::Settings;
+use twocan_sim::{Bus, Fault, Receivers, SimNode};
 
 #[test]
 fn rec_after_a_good_reception_above_127_is_127() {

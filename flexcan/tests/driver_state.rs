@@ -5,12 +5,12 @@
 mod common;
 
 use common::*;
-use twocan_core::sim::{Fault, SimNode};
 use twocan_core::{Error, ErrorCounters, ErrorState, LastErrorCode, Mode};
 use twocan_flexcan::model::{FlexCanModel, ModelMode};
 use twocan_flexcan::regs::port::{Port, PCR_MUX, PCR_ODE, PCR_PE, PCR_PS};
 use twocan_flexcan::regs::sim;
 use twocan_flexcan::{Board, FlexCan, HostSystem, Instance, Settings, Target};
+use twocan_sim::{Fault, SimNode};
 
 #[test]
 fn error_active_after_begin() {
@@ -47,7 +47,7 @@ fn lone_transmitter_becomes_error_passive() {
 fn bus_off_then_automatic_recovery() {
     let (model, mut can) = begin::<32, 16>(&Settings::new(500_000), &[], &[]).unwrap();
     let other = SimNode::new().shared();
-    let mut bus = twocan_core::sim::Bus::new(500_000).unwrap();
+    let mut bus = twocan_sim::Bus::new(500_000).unwrap();
     let me = bus.attach("can0", model.clone());
     bus.attach("other", other.clone());
     // 32 bit errors in a row: TEC 256, bus-off.
@@ -91,7 +91,7 @@ fn receive_errors_count_rec() {
     let (model, mut can) = begin::<32, 16>(&Settings::new(500_000), &[], &[]).unwrap();
     let sender = SimNode::new().shared();
     let witness = SimNode::new().shared();
-    let mut bus = twocan_core::sim::Bus::new(500_000).unwrap();
+    let mut bus = twocan_sim::Bus::new(500_000).unwrap();
     let me = bus.attach("can0", model.clone());
     let sender_id = bus.attach("sender", sender.clone());
     bus.attach("witness", witness.clone());
@@ -102,7 +102,7 @@ fn receive_errors_count_rec() {
         sender_id,
         3,
         Fault::Crc {
-            who: twocan_core::sim::Receivers::Node(me),
+            who: twocan_sim::Receivers::Node(me),
         },
     );
     sender.borrow_mut().send(std_data(0x77, &[]));

@@ -6,12 +6,12 @@
 mod common;
 
 use common::*;
-use twocan_core::sim::SimNode;
 use twocan_core::{
     AbortRequest, Error, Frame, Hardware, MailboxId, MailboxState, TxOutcome, TxPolicy,
 };
 use twocan_flexcan::regs::{self, code, cs};
 use twocan_flexcan::{Configuration, Settings};
+use twocan_sim::SimNode;
 
 /// Identifiers that a priority-ordered transmitter would reorder.
 fn scrambled_id(i: u32) -> u16 {

@@ -20,7 +20,7 @@ fn start(regs: Ticking, sys: &mut HostSystem, target: Target, settings: &Setting
 }
 
 /// Sends one frame in loop-back and checks it comes back.
-fn round_trip(bus: &mut twocan_core::sim::Bus, can: &mut Drv, id: u16) {
+fn round_trip(bus: &mut twocan_sim::Bus, can: &mut Drv, id: u16) {
     can.try_send(&std_data(id, &[id as u8])).unwrap();
     run(bus, &mut [can], 1_000);
     let got: Vec<_> = core::iter::from_fn(|| can.receive().ok()).collect();

@@ -1,14 +1,14 @@
 //! The bus side: self reception, listen-only, loop-back ("Self reception", "Listen-only
-//! mode", "Loop-back mode"), and modules on the simulated bus of `twocan_core::sim`.
+//! mode", "Loop-back mode"), and modules on the simulated bus of `twocan_sim`.
 
 #[path = "model_support.rs"]
 mod support;
 
 use support::*;
 use twocan_core::registers::Registers;
-use twocan_core::sim::{Bus, BusNode, SimNode, TxResult};
 use twocan_flexcan::model::FlexCanModel;
 use twocan_flexcan::regs::{self, code, ctrl1, mcr};
+use twocan_sim::{Bus, BusNode, SimNode, TxResult};
 
 /// A started module with the Rx FIFO accepting everything; `srxdis` and CTRL1 `bits`
 /// as given.
@@ -228,7 +228,7 @@ fn a_lone_module_stops_at_error_passive_on_the_simulated_bus() {
 
 #[test]
 fn extreme_bus_times_do_not_overflow() {
-    use twocan_core::sim::BusTime;
+    use twocan_sim::BusTime;
     let end = BusTime {
         sof: u64::MAX,
         now: u64::MAX,

@@ -1,9 +1,9 @@
-//! The fault-confinement conformance table (`can-core/tests/conformance/mod.rs`) on the
+//! The fault-confinement conformance table (`sim/tests/conformance/mod.rs`) on the
 //! FlexCAN model, driven through its registers (automatic bus-off recovery:
 //! CTRL1\[BOFFREC\] = 0): as the Kinetis K20 module and as the i.MX RT1062's CAN1
 //! (module `rt1062`; same register procedure, the RT1062 leaves reset in Freeze mode).
 
-#[path = "../../can-core/tests/conformance/mod.rs"]
+#[path = "../../sim/tests/conformance/mod.rs"]
 mod conformance;
 #[path = "model_support.rs"]
 mod support;
@@ -11,10 +11,10 @@ mod support;
 use conformance::Dut;
 use support::Rig;
 use twocan_core::registers::Registers;
-use twocan_core::sim::{Bus, NodeId};
 use twocan_core::{ErrorCounters, ErrorState, Frame};
 use twocan_flexcan::model::{FlexCanModel, Rt1062Can};
 use twocan_flexcan::regs::{self, code, cs, ecr, esr1, mcr};
+use twocan_sim::{Bus, NodeId};
 
 /// The model as the K20's FlexCAN0 (`RT1062 = false`) or the RT1062's CAN1.
 struct FlexCan<const RT1062: bool>(FlexCanModel);

@@ -6,10 +6,10 @@
 mod support;
 
 use support::*;
-use twocan_core::sim::{BusNode, BusTime, TxResult};
 use twocan_core::{ErrorCounters, LastErrorCode};
 use twocan_flexcan::model::FlexCanIrq;
 use twocan_flexcan::regs::{self, code, ctrl1, ecr, esr1, mcr};
+use twocan_sim::{BusNode, BusTime, TxResult};
 
 fn rig(wrnen: bool) -> Rig {
     let mut r = Rig::new();

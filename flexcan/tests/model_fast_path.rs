@@ -14,10 +14,10 @@ use std::rc::Rc;
 
 use support::Rig;
 use twocan_core::registers::Registers;
-use twocan_core::sim::{Bus, RandomFaults, SimNode};
 use twocan_core::Frame;
 use twocan_flexcan::model::FlexCanModel;
 use twocan_flexcan::regs::{self, code, ecr, mcr};
+use twocan_sim::{Bus, RandomFaults, SimNode};
 
 const MB: usize = 8;
 

@@ -7,9 +7,9 @@
 mod support;
 
 use support::*;
-use twocan_core::sim::{BusNode, BusTime, TxResult};
 use twocan_core::Frame;
 use twocan_flexcan::regs::{self, code, cs, ctrl1, ctrl2, mcr};
+use twocan_sim::{BusNode, BusTime, TxResult};
 
 /// An enabled module in normal mode without the FIFO (all 16 MBs are mailboxes),
 /// self reception off.

@@ -7,9 +7,9 @@ mod support;
 
 use support::*;
 use twocan_core::registers::Registers;
-use twocan_core::sim::BusNode;
 use twocan_flexcan::model::{Chip, FlexCanModel, ModelMode};
 use twocan_flexcan::regs::{self, code, ctrl1, ctrl2, ecr, esr1, mcr};
+use twocan_sim::BusNode;
 
 #[test]
 fn reset_state_is_disabled_with_freeze_requested() {

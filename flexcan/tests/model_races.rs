@@ -16,10 +16,10 @@ mod support;
 
 use support::Rig;
 use twocan_core::registers::Registers;
-use twocan_core::sim::{Bus, Fault, SimNode};
 use twocan_core::Frame;
 use twocan_flexcan::model::FlexCanModel;
 use twocan_flexcan::regs::{self, code, cs, ecr, esr1, mcr};
+use twocan_sim::{Bus, Fault, SimNode};
 
 const MB: usize = 8;
 
@@ -186,8 +186,8 @@ fn writing_back_every_esr1_flag_loses_one_raised_after_the_read() {
 
 #[test]
 fn freeze_request_waits_for_the_frame_in_flight_at_the_lowest_bit_rate() {
-    use twocan_core::sim::frame_bits;
     use twocan_core::timing::frame_time::{bits_to_micros, MAX_FRAME_IN_FLIGHT_BITS};
+    use twocan_sim::frame_bits;
     let mut bus = Bus::new(2_500).unwrap();
     let m = module(&mut bus, 0, None);
     let peer = SimNode::new().shared();

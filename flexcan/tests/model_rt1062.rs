@@ -11,11 +11,11 @@ mod support;
 
 use support::{Rig, FRAME_BITS};
 use twocan_core::registers::Registers;
-use twocan_core::sim::{BusNode, TxResult};
 use twocan_core::Frame;
 use twocan_flexcan::model::layout::{self, MB0, MB_BYTES, RXIMR0};
 use twocan_flexcan::model::{Chip, Erratum, FlexCanModel, ModelMode, Rt1062Can};
 use twocan_flexcan::regs::{self, code, cs, ctrl1, ctrl2, id, iflag1, mcr};
+use twocan_sim::{BusNode, TxResult};
 
 const ALL: [Rt1062Can; 3] = [Rt1062Can::Can1, Rt1062Can::Can2, Rt1062Can::Can3];
 
@@ -546,7 +546,7 @@ fn two_modules_exchange_through_upper_buffers() {
     run(&mut rb);
     load_tx(&mut a, 60, 0x61);
     let req = a.m.poll_tx(a.now).expect("a transmits");
-    let t = twocan_core::sim::BusTime {
+    let t = twocan_sim::BusTime {
         sof: a.now,
         now: a.now + FRAME_BITS,
     };

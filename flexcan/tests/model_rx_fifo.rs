@@ -40,7 +40,7 @@ fn fifo_output_window_and_table_area_are_not_mailboxes() {
     r.wr(regs::mb_cs(6), code::TX_DATA << 24);
     r.clear_bits(regs::MCR, mcr::HALT);
     r.idle(11);
-    assert!(r.transmit(twocan_core::sim::TxResult::Acked).is_none());
+    assert!(r.transmit(twocan_sim::TxResult::Acked).is_none());
 }
 
 /// Every RFFN value: the split between individually and globally masked elements, and

@@ -4,10 +4,10 @@
 #![allow(dead_code)]
 
 use twocan_core::registers::Registers;
-use twocan_core::sim::{BusNode, BusTime, TxResult};
 use twocan_core::Frame;
 use twocan_flexcan::model::FlexCanModel;
 use twocan_flexcan::regs::{self, code, cs, ctrl1, ctrl2, id, iflag1, mcr, rxfir};
+use twocan_sim::{BusNode, BusTime, TxResult};
 
 /// Bit times a test frame occupies on the simulated wire (any value will do).
 pub const FRAME_BITS: u64 = 100;

@@ -7,9 +7,9 @@ use std::cell::RefCell;
 use std::rc::Rc;
 
 use twocan_app::App;
-use twocan_core::sim::{RandomFaults, SimNode};
 use twocan_core::Frame;
 use twocan_host::{BxNode, FlexNode, Harness, Serviced};
+use twocan_sim::{RandomFaults, SimNode};
 
 /// What the other ECU sends every fifth period: standard, extended and remote frames
 /// no filter of either application takes, cycling through every DLC.

@@ -12,7 +12,6 @@
 
 use twocan_bxcan::model::BxCanModel;
 use twocan_bxcan::{Config as BxConfig, ConfigError, FifoPolicy, PlanError};
-use twocan_core::sim::{Bus, BusNode, NodeId};
 use twocan_core::timing::{solve, Limits, TimingError, DEFAULT_TOLERANCE_PPM};
 use twocan_core::{
     BusOffRecovery, Driver, Filter, Hardware, Mode, ModeSupport, Registers, TxPolicy,
@@ -26,6 +25,7 @@ use twocan_host::{
     attach_plain, BxNode, FlexNode, Harness, Serviced, SetupError, RX_RING, STM32F767_APB1_HZ,
     TX_RING,
 };
+use twocan_sim::{Bus, BusNode, NodeId};
 
 /// How a node leaves bus-off.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -26,9 +26,9 @@ use std::cell::RefCell;
 use std::rc::Rc;
 use std::time::{Duration, Instant};
 
-use twocan_core::sim::{BusNode, BusTime, SimNode, TxRequest, TxResult};
 use twocan_core::{Frame, LastErrorCode};
 use twocan_host::Harness;
+use twocan_sim::{BusNode, BusTime, SimNode, TxRequest, TxResult};
 
 use crate::backend::{Backend, Dut, NodeOptions, OverrunPolicy};
 use crate::rng::XorShift64;

@@ -5,9 +5,9 @@ use std::cell::RefCell;
 use std::fmt::Write as _;
 use std::rc::Rc;
 
-use twocan_core::sim::{NodeId, SimNode, TxResult};
 use twocan_core::{Filter, Frame, RxFrame};
 use twocan_host::{Harness, Serviced};
+use twocan_sim::{NodeId, SimNode, TxResult};
 
 use crate::backend::Dut;
 

@@ -8,7 +8,6 @@
 //! format), from the hardware manuals (FIFO depth, filter capacity) or from a hand-written
 //! table cross-checked with the reference filter semantics — never from the drivers.
 
-use twocan_core::sim::{Fault, NodeId, Receivers, SimNode};
 use twocan_core::timestamp::{bit_times_to_micros, COUNTER_PERIOD};
 use twocan_core::timing::Limits;
 use twocan_core::timing::TimingError;
@@ -17,6 +16,7 @@ use twocan_core::{
     FrameError, FrameKind, Hardware, LastErrorCode, Mode, Timestamp,
 };
 use twocan_host::Harness;
+use twocan_sim::{Fault, NodeId, Receivers, SimNode};
 use twocan_tests::backend::{
     harness_at, Backend, BxCanBackend, Dut, FlexCanBackend, ManualRecoveryCount, NodeOptions,
     Recovery, Refused, TimingRefused,

@@ -6,7 +6,7 @@
 //! heartbeat, a measurement every 4th, a remote status request every 10th.
 
 use twocan_app::AppStats;
-use twocan_core::sim::{FaultKind, RandomFaults, TxResult};
+use twocan_sim::{FaultKind, RandomFaults, TxResult};
 use twocan_tests::app_bus::{run_apps, AppBus};
 
 const RATE: u32 = 500_000;

@@ -4,9 +4,9 @@
 
 use twocan_bxcan::regs::{msr, MSR};
 use twocan_bxcan::FifoPolicy;
-use twocan_core::sim::{Fault, NodeId, SimNode, TxResult};
 use twocan_core::{Error, ErrorState, Filter, Frame, MailboxId, Mode, Priority, Registers};
 use twocan_host::{BxNode, Harness, Serviced};
+use twocan_sim::{Fault, NodeId, SimNode, TxResult};
 use twocan_tests::backend::{
     bxcan_config, Backend, BxCanBackend, Dut, FlexCanBackend, ManualRecoveryCount, NodeOptions,
     OverrunPolicy, Recovery, Refused,
@@ -525,7 +525,7 @@ fn arbitration_between_flexcan_and_bxcan() {
         .iter()
         .all(|r| r.reports.iter().all(|p| !matches!(
             p.outcome,
-            twocan_core::sim::NodeOutcome::Transmitted(TxResult::Error(_))
+            twocan_sim::NodeOutcome::Transmitted(TxResult::Error(_))
         ))));
 }
 

@@ -15,11 +15,11 @@ use std::sync::{Arc, Mutex};
 
 use twocan_bxcan::model::BxCanModel;
 use twocan_bxcan::{BxCan, Can, Config, FifoPolicy, Recovery};
-use twocan_core::sim::Bus;
 use twocan_core::split::State;
 use twocan_core::{FifoQueue, Filter, Frame, Registers, TxOutcome};
 use twocan_flexcan::model::FlexCanModel;
 use twocan_flexcan::{Board, FlexCan, FlexCanHw, HostSystem, Instance, Settings, Target};
+use twocan_sim::Bus;
 
 const RATE: u32 = 1_000_000;
 const APB1: u32 = 54_000_000;

@@ -1,5 +1,5 @@
 //! The bus side of a controller: what it offers to transmit, how it takes the outcome,
-//! what it receives, and how time passes (the `twocan_core::sim::BusNode` contract).
+//! what it receives, and how time passes (the `twocan_sim::BusNode` contract).
 //!
 //! Rules modelled:
 //! - Only normal mode takes part in bus traffic; a bus-off controller neither transmits
@@ -26,8 +26,8 @@
 //!   `FaultConfinement` from the end of the frame or error frame.
 //! - Time stamps are the TTCM timer at the start of frame (`BusTime::sof`).
 
-use twocan_core::sim::{BusNode, BusTime, ConfinementEvent, TxRequest, TxResult};
 use twocan_core::{Frame, LastErrorCode};
+use twocan_sim::{BusNode, BusTime, ConfinementEvent, TxRequest, TxResult};
 
 use super::controller::Controller;
 use super::modes::Mode;

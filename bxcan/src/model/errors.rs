@@ -16,8 +16,8 @@
 //!   `CAN_MCR.ABOM`: "left on software request, once 128 occurrences of 11 recessive bits
 //!   have been monitored and the software has first set and cleared the INRQ bit".
 
-use twocan_core::fault::FaultConfinement;
 use twocan_core::{ErrorCounters, LastErrorCode};
+use twocan_sim::fault::FaultConfinement;
 
 use crate::regs::esr;
 

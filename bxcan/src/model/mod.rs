@@ -6,7 +6,7 @@
 //!
 //! [`BxCanModel`] is a cheap, clonable handle on one controller. It implements
 //! [`Registers`] — the driver's side: 32-bit reads and writes at the offsets of
-//! [`crate::regs`] — and [`twocan_core::sim::BusNode`] — the simulated bus's side.
+//! [`crate::regs`] — and [`twocan_sim::BusNode`] — the simulated bus's side.
 //!
 //! - [`BxCanModel::of_part`]: every controller of a [`Part`] out of reset, sharing filter
 //!   blocks as on that chip (e.g. [`part::STM32F103`]: one CAN with 14 banks;

@@ -10,8 +10,8 @@ use twocan_bxcan::model::BxCanModel;
 use twocan_bxcan::regs::MSR;
 use twocan_bxcan::BxCan;
 use twocan_bxcan::{Can, Config, FilterPlan, Recovery};
-use twocan_core::sim::{Bus, SimNode};
 use twocan_core::{Driver, Filter, Frame, Registers, RxFrame, TxPolicy};
+use twocan_sim::{Bus, SimNode};
 
 pub type SharedBus = Rc<RefCell<Bus>>;
 

@@ -2,7 +2,7 @@
 
 use core::fmt;
 
-use super::segments::Consistency;
+use super::consistency::Consistency;
 
 /// Bit timing errors. Bad input always gives one of these, never a panic.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]

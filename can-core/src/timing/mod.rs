@@ -27,7 +27,7 @@
 //! * [`solver`]: [`solve`] / [`solve_cia`] and the objective they follow;
 //!   [`cia_sample_point`]; [`DEFAULT_TOLERANCE_PPM`].
 //! * [`segments`]: [`Timing`] (the adjustable value and everything derived from
-//!   it) and [`Consistency`] (the rule flags).
+//!   it); [`consistency`]: [`Consistency`] (the rule flags).
 //! * [`encode`]: bxCAN `CAN_BTR` and FlexCAN `CTRL1` values.
 //! * [`iter`]: [`Solutions`], every timing within a tolerance.
 //! * [`frame_time`]: worst-case frame durations and wait bounds at a bit rate.
@@ -36,6 +36,7 @@
 //! All arithmetic is integer (u64/u128 where products would overflow); see
 //! `docs/bit-timing.md` for worked examples.
 
+pub mod consistency;
 pub mod encode;
 pub mod error;
 pub mod flexcan_rules;
@@ -45,6 +46,7 @@ pub mod limits;
 pub mod segments;
 pub mod solver;
 
+pub use consistency::Consistency;
 pub use encode::{
     BxcanBtr, FlexcanCtrl1, BXCAN_BTR_LBKM, BXCAN_BTR_SILM, BXCAN_BTR_TIMING_MASK,
     FLEXCAN_CTRL1_SMP, FLEXCAN_CTRL1_TIMING_MASK,
@@ -52,5 +54,5 @@ pub use encode::{
 pub use error::TimingError;
 pub use iter::Solutions;
 pub use limits::{Bounds, Controller, Limits};
-pub use segments::{Consistency, Timing};
+pub use segments::Timing;
 pub use solver::{cia_sample_point, solve, solve_cia, DEFAULT_TOLERANCE_PPM};

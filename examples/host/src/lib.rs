@@ -25,18 +25,18 @@ use std::rc::Rc;
 
 use twocan_bxcan::model::BxCanModel;
 use twocan_bxcan::{BxCan, Can, Config as BxConfig, FifoPolicy};
-use twocan_core::sim::{Bus, BusNode, NodeId, SimError};
 use twocan_core::{Driver, ErrorState, Filter};
 use twocan_flexcan::model::FlexCanModel;
 use twocan_flexcan::{Board, FlexCan, FlexCanHw, HostSystem, Instance, Settings, Target};
+use twocan_sim::{Bus, BusNode, NodeId, SimError};
 
 /// The simulated bus, shared with the register wrappers that let time pass while a driver
 /// waits for an acknowledge bit.
-pub use twocan_core::sim::SharedBus;
+pub use twocan_sim::SharedBus;
 
 /// Register access to a model that lets bus time pass while a driver spins on a poll
-/// register ([`twocan_core::sim::PollClock`]).
-pub type Clocked<R> = twocan_core::sim::PollClock<R>;
+/// register ([`twocan_sim::PollClock`]).
+pub type Clocked<R> = twocan_sim::PollClock<R>;
 
 /// Receive ring size of the simulated nodes.
 pub const RX_RING: usize = 64;

@@ -1,5 +1,5 @@
 //! The bus side of the model: what the protocol engine does with the simulated bus's
-//! events ([`twocan_core::sim::BusNode`]).
+//! events ([`twocan_sim::BusNode`]).
 //!
 //! - The module takes part in bus traffic when enabled, out of freeze and synchronised
 //!   (11 recessive bits), and not bus-off.
@@ -22,7 +22,7 @@
 
 use twocan_core::error::LastErrorCode;
 use twocan_core::frame::Frame;
-use twocan_core::sim::{BusTime, TxRequest, TxResult};
+use twocan_sim::{BusTime, TxRequest, TxResult};
 
 use crate::regs::mcr;
 

@@ -2,7 +2,7 @@
 //! Status 1 register (CANx_ESR1)", CTRL1\[BOFFREC\]).
 //!
 //! The counter rules are ISO 11898-1's, implemented once in
-//! [`twocan_core::fault::FaultConfinement`]; this file adds what FlexCAN shows of them:
+//! [`twocan_sim::fault::FaultConfinement`]; this file adds what FlexCAN shows of them:
 //! - ESR1 error bits STFERR..BIT1ERR record errors since ESR1 was last read and are
 //!   cleared by the read; ERRINT (set with any of them), BOFFINT (bus-off entered),
 //!   RWRNINT/TWRNINT (RXWRN/TXWRN went 0 → 1, only with MCR\[WRNEN\]) are write-1-to-clear;
@@ -17,7 +17,7 @@
 //!   bits) before joining the bus.
 
 use twocan_core::error::{ErrorState, LastErrorCode};
-use twocan_core::fault::{FaultConfinement, BUS_OFF_RECOVERY_SEQUENCES};
+use twocan_sim::fault::{FaultConfinement, BUS_OFF_RECOVERY_SEQUENCES};
 
 use crate::regs::{ctrl1, ecr, esr1, mcr};
 

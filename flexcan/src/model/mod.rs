@@ -48,10 +48,10 @@ use std::cell::RefCell;
 use std::rc::Rc;
 
 use twocan_core::error::{ErrorCounters, LastErrorCode};
-use twocan_core::fault::FaultConfinement;
 use twocan_core::frame::Frame;
 use twocan_core::registers::Registers;
-use twocan_core::sim::{BusNode, BusTime, ConfinementEvent, TxRequest, TxResult};
+use twocan_sim::fault::FaultConfinement;
+use twocan_sim::{BusNode, BusTime, ConfinementEvent, TxRequest, TxResult};
 
 use crate::regs::{ctrl1, esr1};
 

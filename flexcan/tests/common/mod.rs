@@ -1,13 +1,13 @@
-//! Shared test harness: the real driver over the FlexCAN model on twocan-core's
+//! Shared test harness: the real driver over the FlexCAN model on twocan-sim's
 //! simulated bus, interrupts serviced by the test between bus events.
 #![allow(dead_code)]
 
-use twocan_core::sim::Bus;
 use twocan_core::{Driver, Filter, Frame, RxFrame};
 use twocan_flexcan::model::FlexCanModel;
 use twocan_flexcan::{
     BeginError, Board, FlexCan, FlexCanHw, HostSystem, Instance, Settings, Target,
 };
+use twocan_sim::Bus;
 
 /// The model as the driver sees it: back-to-back reads of `MCR` or `ESR1` (a mode
 /// acknowledge or `SYNCH` wait) let one bit time of idle bus pass for the module.

@@ -21,12 +21,12 @@ use std::rc::Rc;
 use clap::error::ErrorKind;
 use clap::{CommandFactory, Parser};
 use twocan_app::App;
-use twocan_core::sim::bits::{max_stuff_bits, INTERMISSION_BITS};
-use twocan_core::sim::trace::CandumpWriter;
-use twocan_core::sim::{RandomFaults, SimNode};
 use twocan_core::{AsyncCanRx, Frame};
 use twocan_host::asynch::{drive, split_bx, split_flex, BxState, FlexState};
 use twocan_host::{state_name, BxNode, FlexNode, Harness, Serviced};
+use twocan_sim::bits::{max_stuff_bits, INTERMISSION_BITS};
+use twocan_sim::trace::CandumpWriter;
+use twocan_sim::{RandomFaults, SimNode};
 
 /// A simulated Teensy 3.6 (FlexCAN can0) and a simulated STM32F767 (bxCAN CAN1) on one
 /// bus, both running the portable application of `twocan-app`.
@@ -444,7 +444,7 @@ fn report(
         o_stats
             .tx_reports()
             .iter()
-            .filter(|r| matches!(r.result, twocan_core::sim::TxResult::Acked))
+            .filter(|r| matches!(r.result, twocan_sim::TxResult::Acked))
             .count(),
         o_stats.received().len(),
         "-",

@@ -51,7 +51,7 @@
 //! # Arbitration and outcome
 //!
 //! When the bus is idle every node's [`BusNode::poll_tx`] is asked (in attach order). The
-//! smallest [`Priority`](crate::priority::Priority) wins; the other requesters lose
+//! smallest [`Priority`](twocan_core::priority::Priority) wins; the other requesters lose
 //! arbitration and receive the frame like every node that [`BusNode::listens`]. Nodes with the
 //! very same arbitration field all "win" and send together: the wire is the wired-AND of their
 //! bits, so the first one to send recessive where another sends dominant detects a bit error
@@ -59,7 +59,7 @@
 //! others then see a bit error too), if it is error-passive the other frame goes on. Identical
 //! frames simply succeed for every sender.
 //!
-//! The attempt is then played bit by bit (by `sim/engine.rs`, whose module comment lists
+//! The attempt is then played bit by bit (by `sim/src/engine.rs`, whose module comment lists
 //! the rules and what is not modelled): each receiver acknowledges if it [`BusNode::acknowledges`] and
 //! its CRC matched; a transmitter that sees no acknowledgement (and did not ask for
 //! `self_ack`) detects an acknowledge error; a node detecting an error sends an active error
@@ -168,16 +168,28 @@ pub struct StillBusy {
     pub now: u64,
 }
 
+impl core::fmt::Display for StillBusy {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        write!(
+            f,
+            "the simulated bus was still busy at bit time {} when its budget ran out",
+            self.now
+        )
+    }
+}
+
+impl std::error::Error for StillBusy {}
+
 /// A node's transmit request, with the node's index.
 type Request = (usize, TxRequest);
 
 /// What the bus tells a node at the end of (or during) a frame attempt.
 #[derive(Debug, Clone, Copy)]
 enum Notice {
-    Lost(crate::frame::Frame),
-    Tx(crate::frame::Frame, TxResult),
+    Lost(twocan_core::frame::Frame),
+    Tx(twocan_core::frame::Frame, TxResult),
     Rx,
-    RxError(crate::error::LastErrorCode, bool),
+    RxError(twocan_core::error::LastErrorCode, bool),
     /// The end of the attempt for a transmitter; whether it read a dominant bit during its
     /// passive error flag.
     TxEnd(bool),
@@ -199,7 +211,7 @@ struct InFlight {
     wire: Vec<bool>,
     record: TraceRecord,
     receivers: Vec<usize>,
-    frame: crate::frame::Frame,
+    frame: twocan_core::frame::Frame,
 }
 
 struct Slot {
@@ -420,7 +432,7 @@ impl Bus {
     }
 
     /// Uses the fast path for attempts that cannot fail (one transmitter, no injected fault,
-    /// an acknowledgement: `sim/fast.rs`) instead of playing their bits (on by default).
+    /// an acknowledgement: `sim/src/fast.rs`) instead of playing their bits (on by default).
     /// The results are the same either way; turning it off measures the bit-level path.
     pub fn set_fast_path(&mut self, on: bool) {
         self.fast_path = on;

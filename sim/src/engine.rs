@@ -73,7 +73,7 @@
 
 use super::bits::FrameBits;
 use super::inject::{is_stuff_bit, RxFault, TxFault};
-use crate::error::LastErrorCode;
+use twocan_core::error::LastErrorCode;
 
 /// A transmitter of the frame attempt.
 #[derive(Debug, Clone)]
@@ -872,8 +872,8 @@ pub(crate) fn resolve_with(txs: &[TxSpec<'_>], rxs: &[RxSpec], wf: WireFaults) -
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::frame::Frame;
-    use crate::sim::bits::wire_bits;
+    use crate::bits::wire_bits;
+    use twocan_core::frame::Frame;
     use LastErrorCode as L;
 
     fn tx<'a>(w: &'a (Vec<bool>, FrameBits), active: bool) -> TxSpec<'a> {

@@ -34,7 +34,7 @@
 //! on the wire = 44 + 6 = 50 bits, 53 with the intermission.
 //! ```
 
-use crate::frame::Frame;
+use twocan_core::frame::Frame;
 
 /// The CRC-15 generator polynomial of classical CAN (x^15 + x^14 + x^10 + x^8 + x^7 + x^4 + x^3 + 1).
 pub const CRC15_POLYNOMIAL: u16 = 0x4599;
@@ -320,7 +320,7 @@ pub const fn max_stuff_bits(extended: bool, data_len: u8) -> u32 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::frame::Frame;
+    use twocan_core::frame::Frame;
 
     #[test]
     fn wire_bits_equals_stuffing_the_boolean_header_and_crc() {

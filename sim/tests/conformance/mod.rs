@@ -1,5 +1,5 @@
 //! The fault-confinement conformance table, shared by the three node kinds: the simulated
-//! node (`can-core/tests/sim_conformance.rs`), the bxCAN model
+//! node (`sim/tests/sim_conformance.rs`), the bxCAN model
 //! (`bxcan/tests/model_conformance.rs`) and the FlexCAN model
 //! (`flexcan/tests/model_conformance.rs`).
 //!
@@ -8,7 +8,7 @@
 //! test ("dut") and plain [`SimNode`] peers. The expected counters, states and bit times
 //! are worked out by hand in each case's comment from the frame layout
 //! (`ce` = end of the CRC sequence = index of the CRC delimiter, from
-//! [`twocan_core::sim::frame_bits`]) and the rules, not read back from a run.
+//! [`twocan_sim::frame_bits`]) and the rules, not read back from a run.
 //!
 //! A node kind plugs in through [`Dut`]; [`conformance_tests!`] makes one `#[test]` per case.
 
@@ -17,12 +17,12 @@
 use std::cell::RefCell;
 use std::rc::Rc;
 
-use twocan_core::fault::BUS_OFF_RECOVERY_SEQUENCES;
-use twocan_core::sim::{
+use twocan_core::{ErrorCounters, ErrorState, Frame, LastErrorCode};
+use twocan_sim::fault::BUS_OFF_RECOVERY_SEQUENCES;
+use twocan_sim::{
     frame_bits, Bus, BusEvent, Fault, FaultError, FormField, NodeId, Receivers, Sees, SimNode,
     TraceRecord,
 };
-use twocan_core::{ErrorCounters, ErrorState, Frame, LastErrorCode};
 
 /// A node kind under test, driven as its users drive it (registers for the models).
 pub trait Dut: Sized {

@@ -29,8 +29,8 @@ use super::bits::FrameBits;
 use super::bus::NodeId;
 use super::inject::{Fault, FaultError};
 use super::node::TxResult;
-use crate::error::LastErrorCode;
-use crate::frame::Frame;
+use twocan_core::error::LastErrorCode;
+use twocan_core::frame::Frame;
 
 /// What one node saw of a frame attempt.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -218,7 +218,7 @@ impl Trace {
 /// [`Trace`] at the end.
 ///
 /// ```
-/// use twocan_core::sim::{trace::CandumpWriter, Bus, SimNode};
+/// use twocan_sim::{trace::CandumpWriter, Bus, SimNode};
 /// use twocan_core::Frame;
 ///
 /// let mut bus = Bus::new(500_000).unwrap();
@@ -348,7 +348,7 @@ pub fn candump_frame(frame: &Frame) -> String {
             s.push_str(&format!("{b:02X}"));
         }
     }
-    if frame.dlc() > crate::frame::MAX_DLC {
+    if frame.dlc() > twocan_core::frame::MAX_DLC {
         s.push_str(&format!("_{:X}", frame.dlc()));
     }
     s
@@ -437,7 +437,7 @@ mod tests {
             candump_frame(&Frame::remote(0x1234, true, 8).unwrap()),
             "00001234#R8"
         );
-        let id = crate::frame::standard_id(0x123).unwrap();
+        let id = twocan_core::frame::standard_id(0x123).unwrap();
         let f = Frame::with_dlc(id, &[1, 2, 3, 4, 5, 6, 7, 8], 12).unwrap();
         assert_eq!(candump_frame(&f), "123#0102030405060708_C");
         let mut r = Frame::remote(0x123, false, 8).unwrap();

@@ -1,14 +1,13 @@
 //! The injector places a fault at the exact bit it names or refuses it with a typed error;
 //! it never moves it.
-#![cfg(feature = "sim")]
 
-use twocan_core::sim::{frame_bits, Bus, Fault, FaultError, FormField, Receivers, SimNode};
 use twocan_core::{Frame, LastErrorCode};
+use twocan_sim::{frame_bits, Bus, Fault, FaultError, FormField, Receivers, SimNode};
 
 fn bus_with_two() -> (
     Bus,
     std::rc::Rc<std::cell::RefCell<SimNode>>,
-    twocan_core::sim::NodeId,
+    twocan_sim::NodeId,
 ) {
     let mut bus = Bus::new(500_000).unwrap();
     let a = SimNode::new().shared();

@@ -1,8 +1,7 @@
 //! The trace of the simulated bus in candump log format.
-#![cfg(feature = "sim")]
 
-use twocan_core::sim::{frame_bits, Bus, Fault, SimNode};
 use twocan_core::Frame;
+use twocan_sim::{frame_bits, Bus, Fault, SimNode};
 
 fn ts(us: u64) -> String {
     format!("({:010}.{:06})", us / 1_000_000, us % 1_000_000)

@@ -1,13 +1,12 @@
 //! The simulated bus: arbitration, acknowledgement, time, statistics, internal frames.
-#![cfg(feature = "sim")]
 
 use std::cell::RefCell;
 use std::rc::Rc;
 
-use twocan_core::sim::{
+use twocan_core::{ErrorState, Frame, LastErrorCode};
+use twocan_sim::{
     frame_bits, Bus, BusEvent, BusNode, BusTime, NodeOutcome, SimNode, TxRequest, TxResult,
 };
-use twocan_core::{ErrorState, Frame, LastErrorCode};
 
 fn std_frame(id: u16, data: &[u8]) -> Frame {
     Frame::standard(id, data).unwrap()

@@ -2,14 +2,13 @@
 //! path in the same run. Ignored by default (timing is meaningful in release mode only):
 //!
 //! ```text
-//! cargo test --release -p twocan-core --features sim --test sim_speed -- --ignored --nocapture
+//! cargo test --release -p twocan-sim --test sim_speed -- --ignored --nocapture
 //! ```
-#![cfg(feature = "sim")]
 
 use std::time::Instant;
 
-use twocan_core::sim::{Bus, SimNode};
 use twocan_core::Frame;
+use twocan_sim::{Bus, SimNode};
 
 /// Frames per host second for `frames` frames of 8 bytes from one node to another.
 fn frames_per_second(frames: u32, fast: bool) -> f64 {

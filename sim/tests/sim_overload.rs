@@ -1,10 +1,9 @@
 //! Overload frames (ISO 11898-1 §10.4.5): a dominant bit in the first two intermission bits,
 //! or a receiver's dominant last EOF bit, starts an overload flag; the frame stays valid,
 //! the counters do not move (except by rule 6).
-#![cfg(feature = "sim")]
 
-use twocan_core::sim::{frame_bits, Bus, Fault, FormField, Receivers, SimNode};
 use twocan_core::{ErrorCounters, Frame, LastErrorCode};
+use twocan_sim::{frame_bits, Bus, Fault, FormField, Receivers, SimNode};
 
 #[test]
 fn dominant_first_intermission_bit_gives_an_overload_frame() {
@@ -82,7 +81,7 @@ fn dominant_last_eof_bit_is_an_overload_condition_for_the_other_receivers() {
     assert_eq!(b.borrow().received_frames(), vec![f]);
     assert_eq!(
         a.borrow().tx_reports()[0].result,
-        twocan_core::sim::TxResult::Error(LastErrorCode::BitRecessive)
+        twocan_sim::TxResult::Error(LastErrorCode::BitRecessive)
     );
 }
 

@@ -1,16 +1,15 @@
 //! Error injection on the simulated bus: error frames, fault confinement, bus-off, recovery,
 //! reproducible random faults.
-#![cfg(feature = "sim")]
 
 use std::cell::RefCell;
 use std::rc::Rc;
 
-use twocan_core::fault::BUS_OFF_RECOVERY_SEQUENCES;
-use twocan_core::sim::{
+use twocan_core::{ErrorCounters, ErrorState, Frame, LastErrorCode};
+use twocan_sim::fault::BUS_OFF_RECOVERY_SEQUENCES;
+use twocan_sim::{
     frame_bits, Bus, BusEvent, Fault, FaultKind, FormField, NodeOutcome, RandomFaults, Receivers,
     SimNode, TxResult,
 };
-use twocan_core::{ErrorCounters, ErrorState, Frame, LastErrorCode};
 
 fn std_frame(id: u16, data: &[u8]) -> Frame {
     Frame::standard(id, data).unwrap()
@@ -295,7 +294,7 @@ fn error_passive_receiver_does_not_destroy_the_frame() {
     );
 }
 
-fn random_run(seed: u64) -> (String, Vec<twocan_core::sim::TraceRecord>) {
+fn random_run(seed: u64) -> (String, Vec<twocan_sim::TraceRecord>) {
     let mut bus = Bus::new(500_000).unwrap();
     let nodes: Vec<_> = (0..3).map(|_| node()).collect();
     for (i, n) in nodes.iter().enumerate() {

@@ -2,7 +2,7 @@
 //!
 //! A [`Fault`] says which node detects which error where; the bus then plays the rest of
 //! the frame bit by bit (error flags, echoes, delimiters), so what every other node sees
-//! follows from ISO 11898-1 rather than from a table (see [`crate::sim::bus`]).
+//! follows from ISO 11898-1 rather than from a table (see [`crate::bus`]).
 //!
 //! Random injection uses [`SplitMix64`], a small self-contained generator (no `rand`
 //! dependency), so that the same seed gives the same faults and the same trace.
@@ -80,7 +80,7 @@ pub enum Sees {
 /// Bit positions are wire-bit indices from SOF (0 = SOF), as in [`FrameBits`]. A fault
 /// is placed at the exact bit it names, or refused with a [`FaultError`] if it cannot
 /// happen there ([`Fault::validate`] at injection, the frame's layout when the attempt
-/// starts: [`crate::sim::TraceRecord::refused`], [`crate::sim::Bus::refused_faults`]); it
+/// starts: [`crate::TraceRecord::refused`], [`crate::Bus::refused_faults`]); it
 /// is never moved.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Fault {
@@ -687,7 +687,8 @@ mod tests {
 
     #[test]
     fn probability_extremes() {
-        let bits = super::super::bits::frame_bits(&crate::frame::Frame::standard(1, &[]).unwrap());
+        let bits =
+            super::super::bits::frame_bits(&twocan_core::frame::Frame::standard(1, &[]).unwrap());
         let mut never = RandomState::new(&RandomFaults::new(7, 0.0));
         let mut nan = RandomState::new(&RandomFaults::new(7, f64::NAN));
         let mut always = RandomState::new(&RandomFaults::new(7, 1.0).with_kinds(&[FaultKind::Ack]));
@@ -700,9 +701,9 @@ mod tests {
 
     #[test]
     fn delimiter_and_intermission_faults_are_checked() {
-        let mut bus = crate::sim::Bus::new(500_000).unwrap();
-        let node = bus.attach("a", crate::sim::SimNode::new().shared());
-        let other = bus.attach("b", crate::sim::SimNode::new().shared());
+        let mut bus = crate::Bus::new(500_000).unwrap();
+        let node = bus.attach("a", crate::SimNode::new().shared());
+        let other = bus.attach("b", crate::SimNode::new().shared());
         for bit in 1..=7 {
             for who in [Sees::Bus, Sees::Node(node)] {
                 assert_eq!(Fault::DelimiterBit { who, bit }.validate(), Ok(()));
@@ -747,7 +748,8 @@ mod tests {
             "a dominant third intermission bit is a start of frame, not simulated"
         );
         // Node faults go to that node only; bus faults to nobody's own list.
-        let bits = super::super::bits::frame_bits(&crate::frame::Frame::standard(1, &[]).unwrap());
+        let bits =
+            super::super::bits::frame_bits(&twocan_core::frame::Frame::standard(1, &[]).unwrap());
         let f = Fault::DelimiterBit {
             who: Sees::Node(node),
             bit: 4,

@@ -1,4 +1,9 @@
-//! A deterministic simulated CAN bus for host tests and demos (feature `sim`).
+//! A deterministic simulated CAN bus for host tests and demos, and the ISO 11898-1
+//! fault-confinement rules the peripheral models share with it (host only: `std`).
+//!
+//! The portable core (`twocan-core`, `no_std`) knows nothing of this crate; the
+//! backends' behavioural models (feature `model` of `twocan-bxcan` and `twocan-flexcan`)
+//! attach to its bus as [`BusNode`]s.
 //!
 //! Time is counted in bit times and advanced only by the caller.
 //!
@@ -9,9 +14,13 @@
 //! - [`inject`]: faults at chosen frames, on a node's frames, or at random with a seed.
 //! - [`trace`]: the record of every frame attempt and its `candump -l` form.
 //! - [`simple_node`]: [`SimNode`], a bare ISO node.
+//! - [`fault`]: ISO 11898-1 fault confinement (error counters and the rules that move
+//!   them), shared by [`SimNode`] and the peripheral models.
+//! - [`poll_clock`]: [`PollClock`], register access that lets bus time pass while a
+//!   driver spins on an acknowledge bit.
 //!
 //! ```
-//! use twocan_core::sim::{Bus, SimNode};
+//! use twocan_sim::{Bus, SimNode};
 //! use twocan_core::Frame;
 //!
 //! let mut bus = Bus::new(500_000).unwrap();
@@ -27,10 +36,13 @@
 //! assert_eq!(String::from_utf8(log).unwrap(), "(0000000000.000000) can0 123#DEAD\n");
 //! ```
 
+#![deny(missing_docs)]
+
 pub mod bits;
 pub mod bus;
 mod engine;
 mod fast;
+pub mod fault;
 pub mod inject;
 mod node;
 pub mod poll_clock;

@@ -2,12 +2,11 @@
 //! §10.4.5, §10.4.6.2), beyond the hand-computed conformance table: random seeded
 //! placements give the same trace twice, stay bounded, and are either played or refused
 //! as "not reached" — never moved.
-#![cfg(feature = "sim")]
 
-use twocan_core::sim::{
+use twocan_core::Frame;
+use twocan_sim::{
     frame_bits, Bus, BusEvent, Fault, FaultError, Receivers, Sees, SimNode, TraceRecord,
 };
-use twocan_core::Frame;
 
 /// A small xorshift generator for the placements.
 struct Rng(u64);

@@ -13,9 +13,9 @@ use std::rc::Rc;
 use std::vec::Vec;
 
 use super::node::{BusNode, BusTime, ConfinementEvent, TxRequest, TxResult};
-use crate::error::{ErrorCounters, ErrorState, LastErrorCode};
 use crate::fault::{FaultConfinement, BUS_OFF_RECOVERY_SEQUENCES};
-use crate::frame::Frame;
+use twocan_core::error::{ErrorCounters, ErrorState, LastErrorCode};
+use twocan_core::frame::Frame;
 
 /// A frame a [`SimNode`] received.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -1,5 +1,4 @@
 //! The fault-confinement conformance table (`conformance/mod.rs`) on the simulated node.
-#![cfg(feature = "sim")]
 
 #[path = "conformance/mod.rs"]
 mod conformance;
@@ -8,8 +7,8 @@ use std::cell::RefCell;
 use std::rc::Rc;
 
 use conformance::Dut;
-use twocan_core::sim::{Bus, NodeId, SimNode};
 use twocan_core::{ErrorCounters, ErrorState, Frame};
+use twocan_sim::{Bus, NodeId, SimNode};
 
 /// A [`SimNode`] kept by the test while the bus drives a clone.
 struct Sim(Rc<RefCell<SimNode>>);

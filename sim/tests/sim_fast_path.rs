@@ -1,13 +1,12 @@
 //! The simulator's fast path (attempts that cannot fail, resolved in one step) against the
 //! bit-level path: same traces, statistics and node counters on random seeded traffic with
 //! random faults, lone transmitters (acknowledge errors) and error-passive nodes.
-#![cfg(feature = "sim")]
 
 use std::cell::RefCell;
 use std::rc::Rc;
 
-use twocan_core::sim::{Bus, RandomFaults, SimNode};
 use twocan_core::Frame;
+use twocan_sim::{Bus, RandomFaults, SimNode};
 
 struct Lcg(u64);
 

@@ -3,13 +3,13 @@
 //! The bus owns time (in bit times) and the wire; each node owns its controller's rules.
 //! At every point where the bus is idle, the bus asks each node for the frame its
 //! controller would start ([`BusNode::poll_tx`]), resolves arbitration with
-//! [`crate::priority::Priority`], computes the frame's exact length, and reports the
+//! [`twocan_core::priority::Priority`], computes the frame's exact length, and reports the
 //! outcome to everyone: the winner gets [`BusNode::tx_result`], losers get
 //! [`TxResult::ArbitrationLost`], listeners get [`BusNode::rx`] or [`BusNode::rx_error`].
 //! Between frames, [`BusNode::advance`] lets time pass (timers, bus-off recovery).
 
-use crate::error::LastErrorCode;
-use crate::frame::Frame;
+use twocan_core::error::LastErrorCode;
+use twocan_core::frame::Frame;
 
 /// A frame a node wants to start at the next start-of-frame.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -122,7 +122,7 @@ pub trait BusNode {
         let _ = (event, time);
     }
 
-    /// The bus stopped inside a frame attempt at bus time `now` ([`crate::sim::Bus::run_bits`]);
+    /// The bus stopped inside a frame attempt at bus time `now` ([`crate::Bus::run_bits`]);
     /// `recessive` is the level of the last bit on the wire (what the controller's receive
     /// pin shows and last sampled). The default does nothing.
     fn paused_in_frame(&mut self, recessive: bool, now: u64) {

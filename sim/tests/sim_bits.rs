@@ -1,9 +1,8 @@
 //! Frame lengths, bit stuffing and CRC-15 of the simulated bus.
-#![cfg(feature = "sim")]
 
-use twocan_core::sim::bits::{crc15_bytes, max_stuff_bits, stuff, wire_bits, INTERMISSION_BITS};
-use twocan_core::sim::{crc15, frame_bits};
 use twocan_core::Frame;
+use twocan_sim::bits::{crc15_bytes, max_stuff_bits, stuff, wire_bits, INTERMISSION_BITS};
+use twocan_sim::{crc15, frame_bits};
 
 fn std_frame(id: u16, data: &[u8]) -> Frame {
     Frame::standard(id, data).unwrap()

@@ -1,13 +1,12 @@
 //! `Bus::run_bits` can stop inside a frame attempt; the attempt then continues where it
 //! stopped. Cutting the run at arbitrary bits must not change anything the nodes see:
 //! same trace, same counters, same frames, as with the atomic run methods.
-#![cfg(feature = "sim")]
 
 use std::cell::RefCell;
 use std::rc::Rc;
 
-use twocan_core::sim::{Bus, RandomFaults, SimNode};
 use twocan_core::Frame;
+use twocan_sim::{Bus, RandomFaults, SimNode};
 
 struct Lcg(u64);
 

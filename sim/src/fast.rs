@@ -79,9 +79,9 @@ pub(crate) fn resolve(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::frame::Frame;
-    use crate::sim::bits::wire_bits;
-    use crate::sim::engine;
+    use crate::bits::wire_bits;
+    use crate::engine;
+    use twocan_core::frame::Frame;
 
     #[test]
     fn same_resolution_as_the_bit_level_engine() {

@@ -4,11 +4,10 @@
 //! simulated bus share this one implementation of the standard, so that the rule set is
 //! written (and tested) once. The driver never uses it: it reads its controller's counters.
 
-use crate::error::{ErrorCounters, ErrorState, LastErrorCode};
+use twocan_core::error::{ErrorCounters, ErrorState, LastErrorCode};
 
 /// Error counters of one node with the standard's update rules.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct FaultConfinement {
     tec: u16,
     rec: u16,
@@ -45,7 +44,6 @@ pub const SUSPEND_TRANSMISSION_BITS: u64 = 8;
 /// The implementation-defined REC value after a successful reception above 127 is outside
 /// the 119..=127 range that ISO 11898-1 §12.1.4.2 rule 8 allows.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct RecResetOutOfRange(pub u8);
 
 impl core::fmt::Display for RecResetOutOfRange {

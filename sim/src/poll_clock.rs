@@ -7,8 +7,8 @@ use std::cell::{Cell, RefCell};
 use std::rc::Rc;
 use std::vec::Vec;
 
-use crate::registers::Registers;
-use crate::sim::Bus;
+use crate::Bus;
+use twocan_core::registers::Registers;
 
 /// The simulated bus, shared with the register wrappers that let time pass.
 pub type SharedBus = Rc<RefCell<Bus>>;
