@@ -519,14 +519,19 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
                     self.queue_len.fetch_sub(1, Ordering::Release);
                 }
                 Ok(None) => {
+                    // The displaced frame comes back through `settle` while `next` still
+                    // waits in the queue, so a displacement needs one free place: never
+                    // displace into a full queue (the frame then waits for the next
+                    // mailbox that ends; nothing accepted is dropped).
                     if displaced
                         || q.policy() != TxPolicy::Priority
+                        || self.queue_len.load(Ordering::Relaxed) as usize >= Q::CAPACITY
                         || !unsafe { hw.displace(&next.frame) }
                     {
                         break;
                     }
-                    // The displaced frame comes back through `settle`: its room in the
-                    // queue is kept from now on. An abort of a pending mailbox ends at
+                    // That place is kept from now on (counted in `queue_len`, so that the
+                    // transmit half cannot take it). An abort of a pending mailbox ends at
                     // once: settle again so the frame takes the mailbox now; otherwise
                     // the abort's completion interrupt does it.
                     self.queue_len.fetch_add(1, Ordering::Relaxed);
@@ -555,8 +560,18 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
             Settled::Done(c) => self.record(c),
             Settled::Displaced(token, frame) => {
                 // Room was reserved when the displacement was requested (and stays
-                // counted in `queue_len`, now by the frame itself).
-                let _ = q.push(Queued { token, frame });
+                // counted in `queue_len`, now by the frame itself), so the push succeeds.
+                // Were it refused, the frame would still get its one completion.
+                if q.push(Queued { token, frame }).is_err() {
+                    debug_assert!(false, "no room kept for a displaced frame");
+                    self.queue_len.fetch_sub(1, Ordering::Relaxed);
+                    self.record(Completion {
+                        token,
+                        outcome: TxOutcome::Aborted,
+                        cause: None,
+                        timestamp: None,
+                    });
+                }
             }
             Settled::DoneDisplacing(c) => {
                 self.queue_len.fetch_sub(1, Ordering::Relaxed);
