@@ -39,7 +39,8 @@ use crate::instance::Instance;
 use crate::mailbox;
 use crate::mode;
 use crate::regs::{
-    btr, esr, msr, rdhxr, rdlxr, rdtxr, rfxr, rixr, tdtxr, tsr, BTR, ESR, MSR, TSR, TX_MAILBOXES,
+    btr, esr, msr, rdhxr, rdlxr, rdtxr, rfxr, rixr, tdtxr, tixr, tsr, BTR, ESR, MSR, TSR,
+    TX_MAILBOXES,
 };
 
 /// Frames one receive FIFO holds (RM0410 §40.7.5).
@@ -325,6 +326,41 @@ impl<R: Registers, F: Registers, const K: usize> BxCan<R, F, K> {
         }
     }
 
+    /// Under identifier priority (`TXFP` = 0), the free mailbox `frame` may take
+    /// without overtaking a pending frame it ties with: the hardware sends equal
+    /// arbitration keys lowest mailbox number first (RM0410 §40.7.3 "Transmit
+    /// priority": "If the identifier values are equal, the lower mailbox number will be
+    /// scheduled first"), so a tie must go above every pending tie — `first` if it
+    /// already is, else the lowest free and settled mailbox above them, else none (the
+    /// frame waits for the ties to leave). None either while a tie is being displaced:
+    /// its frame may come back to the queue, ahead of `frame`. `t` is `CAN_TSR` as
+    /// read. Frames of one identifier (ISO-TP, CANopen SDO blocks, DroneCAN transfers)
+    /// so leave in request order.
+    #[cold]
+    #[inline(never)]
+    fn after_ties(&self, t: u32, frame: &Frame, first: u8) -> Option<u8> {
+        let key = Priority::of(frame);
+        let displacing = self.displacing.load(Ordering::Relaxed);
+        let mut above = 0;
+        for x in 0..TX_MAILBOXES {
+            let pending = t & tsr::tme(x) == 0;
+            // Being displaced, pending or ended unsettled (`TIxR` keeps the frame).
+            let back = displacing & (1 << x) != 0;
+            if (pending || back) && mailbox::priority_of(self.regs.read32(tixr(x))) == key {
+                if back {
+                    return None;
+                }
+                above = x + 1;
+            }
+        }
+        if first as usize >= above {
+            return Some(first);
+        }
+        (above..TX_MAILBOXES)
+            .find(|&x| t & tsr::tme(x) != 0 && t & tsr::rqcp(x) == 0)
+            .map(|x| x as u8)
+    }
+
     fn status_now(&self) -> ErrorStatus {
         let m = self.regs.read32(MSR);
         let e = self.regs.read32(ESR);
@@ -377,7 +413,7 @@ unsafe impl<R: Registers, F: Registers, const K: usize> Hardware for BxCan<R, F,
     /// §40.9.2); it is taken when its last completion was settled (`RQCPx` = 0). With
     /// no `RQCPx` pending (the usual case) that is `CODE` itself, its `TMEx` checked.
     #[inline(always)]
-    fn free_mailbox(&self, _frame: &Frame) -> Result<Option<u8>, Error> {
+    fn free_mailbox(&self, frame: &Frame) -> Result<Option<u8>, Error> {
         if self.listen_only.load(Ordering::Relaxed) {
             return Err(Error::WrongMode);
         }
@@ -388,10 +424,18 @@ unsafe impl<R: Registers, F: Registers, const K: usize> Hardware for BxCan<R, F,
         let code = tsr::CODE.get(t) as usize;
         // `TMEx` of `CODE` is checked too: a wrong `CODE` must not make a pending
         // mailbox look free (its frame would be overwritten).
-        if t & RQCP_ALL == 0 && code < TX_MAILBOXES && t & tsr::tme(code) != 0 {
-            return Ok(Some(code as u8));
+        let free = if t & RQCP_ALL == 0 && code < TX_MAILBOXES && t & tsr::tme(code) != 0 {
+            Some(code as u8)
+        } else {
+            free_of(t, code)
+        };
+        if self.config.get_tx_policy() == TxPolicy::Priority
+            && (t & TME_ALL != TME_ALL || self.displacing.load(Ordering::Relaxed) != 0)
+        {
+            // Some mailbox is pending (or being displaced): a tie must not overtake it.
+            return Ok(free.and_then(|m| self.after_ties(t, frame, m)));
         }
-        Ok(free_of(t, code))
+        Ok(free)
     }
 
     /// Notes "Transmission handling": DLC, data, then identifier with `TXRQ`.
@@ -435,24 +479,29 @@ unsafe impl<R: Registers, F: Registers, const K: usize> Hardware for BxCan<R, F,
 
     /// With all three mailboxes pending, the one lowest in the hardware's order
     /// (largest arbitration key; ties: higher mailbox number, notes "Transmit
-    /// priority") is aborted (`ABRQx`) when `frame` beats it.
+    /// priority") among those `frame` beats and may replace is aborted (`ABRQx`).
+    /// `frame` may replace a mailbox above every pending mailbox it ties with (it
+    /// leaves after them, see `after_ties`); the victim is the last of its own ties,
+    /// so its frame goes back to the queue ahead of none of them.
     unsafe fn displace(&self, frame: &Frame) -> bool {
         let t = self.regs.read32(TSR);
         if t & TME_ALL != 0 || self.displacing.load(Ordering::Relaxed) != 0 {
             return false;
         }
-        let mut low = 0;
-        let mut low_frame = self.read_frame(0);
-        for x in 1..TX_MAILBOXES {
-            let f = self.read_frame(x);
-            if !Priority::of(&f).beats(Priority::of(&low_frame)) {
-                low = x;
-                low_frame = f;
-            }
-        }
-        if !Priority::of(frame).beats(Priority::of(&low_frame)) {
+        let key = Priority::of(frame);
+        let keys: [Priority; TX_MAILBOXES] =
+            core::array::from_fn(|x| mailbox::priority_of(self.regs.read32(tixr(x))));
+        let above = match (0..TX_MAILBOXES).rev().find(|&x| keys[x] == key) {
+            Some(tie) => tie + 1,
+            None => 0,
+        };
+        let Some(low) = (above..TX_MAILBOXES)
+            .filter(|&x| key.beats(keys[x]))
+            .max_by_key(|&x| (keys[x], x))
+        else {
             return false;
-        }
+        };
+        let low_frame = self.read_frame(low);
         // SAFETY: transmit interrupt context, the only one touching `displaced`.
         unsafe { (*self.displaced.get())[low] = low_frame };
         self.displacing.fetch_or(1 << low, Ordering::Relaxed);

@@ -70,3 +70,64 @@ fn priority_displacement_with_a_full_queue_loses_no_frame() {
     assert_eq!((t.queued, t.sent, t.aborted), (7, 7, 0));
     assert_eq!(d.tx_stats().count, 0, "the queue count comes back to 0");
 }
+
+#[test]
+fn frames_of_one_identifier_leave_in_request_order_under_identifier_priority() {
+    // Issue 22 item 2: TXFP = 0 sends equal identifiers lowest mailbox first; refilling a
+    // freed lower mailbox must not put a newer frame ahead of older ones.
+    let cfg = config().tx_policy(TxPolicy::Priority);
+    let (can, regs, bus, peer) = can1_and_peer(&cfg, &pass_all());
+    regs.ticking.set(false);
+    let mut d = driver(can);
+    let frames: Vec<Frame> = (0..10u8)
+        .map(|k| Frame::standard(0x123, &[k]).unwrap())
+        .collect();
+    for f in &frames {
+        d.try_send(f).unwrap();
+    }
+    regs.ticking.set(true);
+    pump(&mut d, &bus, 40, 60);
+    let order: Vec<u8> = wire(&peer).iter().map(|f| f.data()[0]).collect();
+    assert_eq!(order, (0..10).collect::<Vec<u8>>());
+    assert_eq!(d.traffic().sent, 10);
+}
+
+#[test]
+fn one_identifier_among_others_keeps_its_request_order() {
+    // Mixed identifiers: 0x200 frames interleaved with higher and lower priority ones;
+    // the 0x200 frames must leave in their request order, the others by priority.
+    let cfg = config().tx_policy(TxPolicy::Priority);
+    let (can, regs, bus, peer) = can1_and_peer(&cfg, &pass_all());
+    regs.ticking.set(false);
+    let mut d = driver(can);
+    let mut k = 0u8;
+    let mut next = |id: u16| {
+        k += 1;
+        Frame::standard(id, &[k]).unwrap()
+    };
+    let plan = [0x200, 0x200, 0x300, 0x200, 0x100, 0x200, 0x200, 0x050, 0x200];
+    let frames: Vec<Frame> = plan.iter().map(|&id| next(id)).collect();
+    for f in &frames[..4] {
+        d.try_send(f).unwrap();
+    }
+    regs.ticking.set(true);
+    bus.borrow_mut().step(); // one frame ends: a mailbox is refilled
+    d.on_interrupt();
+    for f in &frames[4..] {
+        d.try_send(f).unwrap();
+    }
+    pump(&mut d, &bus, 40, 60);
+    let got = wire(&peer);
+    assert_eq!(got.len(), frames.len(), "{got:?}");
+    let same: Vec<u8> = got
+        .iter()
+        .filter(|f| f.raw_id() == 0x200)
+        .map(|f| f.data()[0])
+        .collect();
+    let want: Vec<u8> = frames
+        .iter()
+        .filter(|f| f.raw_id() == 0x200)
+        .map(|f| f.data()[0])
+        .collect();
+    assert_eq!(same, want, "0x200 frames in request order: {got:?}");
+}
