@@ -551,26 +551,39 @@ unsafe impl<R: Registers, F: Registers, const K: usize> Hardware for BxCan<R, F,
     }
 
     /// `ABRQx` of the loaded mailbox holding `token` (RM0410 §40.9.2); a mailbox on the
-    /// bus finishes first, so the completion may still say sent.
+    /// bus finishes first, so the completion may still say sent. A mailbox whose
+    /// displacement abort ended but is not settled yet still holds its frame for the
+    /// queue: it is marked aborted, so that `settle` reports it aborted instead of
+    /// queueing it again.
     unsafe fn request_abort(&self, token: Token) -> bool {
         let t = self.regs.read32(TSR);
+        let displacing = self.displacing.load(Ordering::Relaxed);
         for x in 0..TX_MAILBOXES {
             let loaded = t & tsr::tme(x) == 0;
-            if loaded && self.tokens[x].load(Ordering::Acquire) == token.0 {
+            let coming_back = displacing & (1 << x) != 0;
+            if (loaded || coming_back) && self.tokens[x].load(Ordering::Acquire) == token.0 {
                 self.aborting.fetch_or(1 << x, Ordering::Relaxed);
-                self.regs.write32(TSR, tsr::abrq(x));
+                if loaded {
+                    self.regs.write32(TSR, tsr::abrq(x));
+                }
                 return true;
             }
         }
         false
     }
 
+    /// `ABRQx` of every loaded mailbox; mailboxes whose displacement abort ended
+    /// unsettled are marked aborted (see `request_abort`).
     unsafe fn abort_all_mailboxes(&self) {
         let t = self.regs.read32(TSR);
+        let displacing = self.displacing.load(Ordering::Relaxed);
         for x in 0..TX_MAILBOXES {
-            if t & tsr::tme(x) == 0 {
+            let loaded = t & tsr::tme(x) == 0;
+            if loaded || displacing & (1 << x) != 0 {
                 self.aborting.fetch_or(1 << x, Ordering::Relaxed);
-                self.regs.write32(TSR, tsr::abrq(x));
+                if loaded {
+                    self.regs.write32(TSR, tsr::abrq(x));
+                }
             }
         }
     }

@@ -15,7 +15,8 @@ mod common;
 
 use common::*;
 use twocan_bxcan::BxCan;
-use twocan_core::{Completion, Driver, Frame, Token, TxOutcome, TxPolicy};
+use twocan_core::sim::BusNode;
+use twocan_core::{AbortRequest, Completion, Driver, Frame, Token, TxOutcome, TxPolicy};
 
 /// The frames the peer received, in bus order.
 fn wire(peer: &std::rc::Rc<std::cell::RefCell<twocan_core::sim::SimNode>>) -> Vec<Frame> {
@@ -130,4 +131,60 @@ fn one_identifier_among_others_keeps_its_request_order() {
         .map(|f| f.data()[0])
         .collect();
     assert_eq!(same, want, "0x200 frames in request order: {got:?}");
+}
+
+#[test]
+fn aborting_a_displaced_frame_whose_abort_ended_unsettled_aborts_it() {
+    // Issue 26, found by reading: 0x700 is displaced while it is offered to the bus (its
+    // abort waits), the bus resolves the abort (not started: aborted), and before the
+    // transmit interrupt settles it the application aborts 0x700.
+    let cfg = config().tx_policy(TxPolicy::Priority);
+    let (can, regs, bus, peer) = can1_and_peer(&cfg, &pass_all());
+    regs.ticking.set(false);
+    let mut d = driver(can);
+    let t700 = d.try_send(&std(0x700)).unwrap(); // mailbox 0
+    let now = bus.borrow().now();
+    let mut model = regs.model.clone();
+    assert!(model.poll_tx(now).is_some(), "0x700 offered: in transmit state");
+    d.try_send(&std(0x600)).unwrap();
+    d.try_send(&std(0x650)).unwrap();
+    d.try_send(&std(0x100)).unwrap(); // displaces 0x700: the abort waits for the bus
+    model.advance(1, true, now + 1); // nothing started: the abort takes effect
+    assert!(regs.model.irq_lines().tx, "RQCP0 set, not settled yet");
+    assert_eq!(d.abort(t700), AbortRequest::Requested);
+    regs.ticking.set(true);
+    pump(&mut d, &bus, 20, 100);
+    let ids: Vec<u32> = wire(&peer).iter().map(|f| f.raw_id()).collect();
+    assert!(!ids.contains(&0x700), "aborted, never sent: {ids:?}");
+    let done = completions(&mut d);
+    let c: Vec<_> = done.iter().filter(|c| c.token == t700).collect();
+    assert_eq!(c.len(), 1, "{done:?}");
+    assert_eq!(c[0].outcome, TxOutcome::Aborted);
+    let t = d.traffic();
+    assert_eq!((t.queued, t.sent, t.aborted), (4, 3, 1));
+    assert_eq!(d.tx_stats().count, 0);
+}
+
+#[test]
+fn abort_all_reaches_a_displaced_frame_whose_abort_ended_unsettled() {
+    let cfg = config().tx_policy(TxPolicy::Priority);
+    let (can, regs, bus, peer) = can1_and_peer(&cfg, &pass_all());
+    regs.ticking.set(false);
+    let mut d = driver(can);
+    d.try_send(&std(0x700)).unwrap();
+    let now = bus.borrow().now();
+    let mut model = regs.model.clone();
+    assert!(model.poll_tx(now).is_some());
+    d.try_send(&std(0x600)).unwrap();
+    d.try_send(&std(0x650)).unwrap();
+    d.try_send(&std(0x100)).unwrap();
+    model.advance(1, true, now + 1);
+    assert_eq!(d.abort_all(), 1, "0x100 dropped from the queue");
+    regs.ticking.set(true);
+    pump(&mut d, &bus, 20, 100);
+    assert!(wire(&peer).is_empty(), "{:?}", wire(&peer));
+    let t = d.traffic();
+    assert_eq!((t.queued, t.sent, t.aborted), (4, 0, 4));
+    assert_eq!(completions(&mut d).len(), 4);
+    assert_eq!(d.tx_stats().count, 0);
 }
