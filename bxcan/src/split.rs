@@ -80,6 +80,11 @@ pub struct BxCan<R: Registers, F: Registers = R, const K: usize = LOOKUP_KEYS> {
     fmi: UnsafeCell<FmiMap<K>>,
     /// Token of the frame in each mailbox (written before `TXRQ`).
     tokens: [AtomicU32; TX_MAILBOXES],
+    /// When each mailbox was loaded: the count of loads before it (written before
+    /// `TXRQ`), for `mailbox_state`.
+    loads: [AtomicU32; TX_MAILBOXES],
+    /// Loads so far (wrapping).
+    load_count: AtomicU32,
     /// Mailboxes whose abort was requested to make room (displacement).
     displacing: AtomicU8,
     /// Mailboxes whose abort the application requested.
@@ -119,6 +124,8 @@ impl<R: Registers, F: Registers, const K: usize> Can<R, F, K> {
             config: self.config,
             fmi: UnsafeCell::new(self.fmi),
             tokens: [const { AtomicU32::new(0) }; TX_MAILBOXES],
+            loads: [const { AtomicU32::new(0) }; TX_MAILBOXES],
+            load_count: AtomicU32::new(0),
             displacing: AtomicU8::new(0),
             aborting: AtomicU8::new(0),
             displaced: UnsafeCell::new([Frame::default(); TX_MAILBOXES]),
@@ -447,6 +454,8 @@ unsafe impl<R: Registers, F: Registers, const K: usize> Hardware for BxCan<R, F,
         // hardware sets after acting on `TXRQ` (on the host, the model's lock around each
         // register access orders the two).
         self.tokens[x].store(token.0, Ordering::Relaxed);
+        let n = self.load_count.fetch_add(1, Ordering::Relaxed);
+        self.loads[x].store(n, Ordering::Relaxed);
         mailbox::load(&self.regs, x, frame);
     }
 
@@ -513,40 +522,100 @@ unsafe impl<R: Registers, F: Registers, const K: usize> Hardware for BxCan<R, F,
         TX_MAILBOXES as u8
     }
 
-    /// `Empty` when `CAN_TSR.TMEx`; otherwise the mailbox first in the hardware's
-    /// transmit order is `Transmitting` while `CAN_MSR.TXM` is set and `Scheduled`
-    /// before, the others `Pending` (notes "Transmit mailbox states"). The order: the
-    /// identifier priority (ties: lower mailbox number) under `TXFP = 0`, the request
-    /// order (tokens) under `TXFP = 1`.
+    /// `Empty` when `CAN_TSR.TMEx`. Otherwise, from the hardware's transmit order (the
+    /// identifier priority, ties lower mailbox number first, under `TXFP = 0`; the
+    /// request order under `TXFP = 1`; notes "Transmit priority", "Transmit mailbox
+    /// states"): while `CAN_MSR.TXM` is clear, the first mailbox is `Scheduled` and the
+    /// others `Pending`. While it is set, one mailbox is on the bus: the first in the
+    /// hardware's order among those pending when its frame started. No register names
+    /// it, so the driver uses the order of its loads: the mailbox on the bus is the first
+    /// of some earliest-loaded part of the pending ones. When every such part has the
+    /// same first mailbox (always under `TXFP = 1`; under `TXFP = 0` unless a frame of
+    /// higher priority was loaded after an earlier one), that mailbox is
+    /// `Transmitting`, the first of the others `Scheduled`, the rest `Pending`. When
+    /// they differ (a higher-priority frame loaded while an earlier one may have
+    /// started), no mailbox is named `Transmitting`: each one that may be on the bus or
+    /// next to go reads `Scheduled`, the others `Pending`.
     fn mailbox_state(&self, mailbox: MailboxId) -> MailboxState {
         let x = mailbox.0 as usize;
         let t = self.regs.read32(TSR);
         if x >= TX_MAILBOXES || t & tsr::tme(x) != 0 {
             return MailboxState::Empty;
         }
-        let token = |y: usize| self.tokens[y].load(Ordering::Acquire);
-        let mut first = x;
-        for y in (0..TX_MAILBOXES).filter(|&y| y != x && t & tsr::tme(y) == 0) {
-            let ahead = match self.config.get_tx_policy() {
-                TxPolicy::Fifo => (token(y).wrapping_sub(token(first)) as i32) < 0,
-                TxPolicy::Priority => {
-                    let (a, b) = (
-                        Priority::of(&self.read_frame(y)),
-                        Priority::of(&self.read_frame(first)),
-                    );
-                    a.beats(b) || (a == b && y < first)
-                }
+        let priority = self.config.get_tx_policy() == TxPolicy::Priority;
+        let seq: [u32; TX_MAILBOXES] =
+            core::array::from_fn(|y| self.loads[y].load(Ordering::Relaxed));
+        let keys: [Priority; TX_MAILBOXES] = core::array::from_fn(|y| {
+            if priority && t & tsr::tme(y) == 0 {
+                mailbox::priority_of(self.regs.read32(tixr(y)))
+            } else {
+                Priority::from_raw(0, false, false)
+            }
+        });
+        let loaded_before = |a: usize, b: usize| (seq[a].wrapping_sub(seq[b]) as i32) < 0;
+        // Whether mailbox `a` goes before `b` in the hardware's order.
+        let before = |a: usize, b: usize| {
+            if priority {
+                (keys[a], a) < (keys[b], b)
+            } else {
+                loaded_before(a, b)
+            }
+        };
+        // The pending mailboxes in load order.
+        let mut pending = [0usize; TX_MAILBOXES];
+        let mut n = 0;
+        for y in (0..TX_MAILBOXES).filter(|&y| t & tsr::tme(y) == 0) {
+            let mut i = n;
+            while i > 0 && loaded_before(y, pending[i - 1]) {
+                pending[i] = pending[i - 1];
+                i -= 1;
+            }
+            pending[i] = y;
+            n += 1;
+        }
+        let pending = &pending[..n];
+        // The first in the hardware's order among `pending` without `skip`.
+        let first_without = |skip: Option<usize>| {
+            pending
+                .iter()
+                .copied()
+                .filter(|&y| Some(y) != skip)
+                .reduce(|a, b| if before(b, a) { b } else { a })
+        };
+        let first = first_without(None);
+        if self.regs.read32(MSR) & msr::TXM == 0 {
+            return if first == Some(x) {
+                MailboxState::Scheduled
+            } else {
+                MailboxState::Pending
             };
-            if ahead {
-                first = y;
+        }
+        // The mailboxes that may be on the bus: the first of each earliest-loaded part.
+        let mut on_bus = 0u8;
+        let mut best: Option<usize> = None;
+        for &y in pending {
+            if best.is_none_or(|b| before(y, b)) {
+                best = Some(y);
+                on_bus |= 1 << y;
             }
         }
-        if first != x {
-            MailboxState::Pending
-        } else if self.regs.read32(MSR) & msr::TXM != 0 {
-            MailboxState::Transmitting
-        } else {
+        if on_bus.count_ones() == 1 {
+            return if first == Some(x) {
+                MailboxState::Transmitting
+            } else if first_without(first) == Some(x) {
+                MailboxState::Scheduled
+            } else {
+                MailboxState::Pending
+            };
+        }
+        let maybe_next = pending
+            .iter()
+            .filter(|&&y| on_bus & (1 << y) != 0)
+            .any(|&y| first_without(Some(y)) == Some(x));
+        if on_bus & (1 << x) != 0 || maybe_next {
             MailboxState::Scheduled
+        } else {
+            MailboxState::Pending
         }
     }
 
