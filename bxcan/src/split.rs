@@ -726,9 +726,13 @@ unsafe impl<R: Registers, F: Registers, const K: usize> Hardware for BxCan<R, F,
 
     /// Programs the banks under `CAN_FMR.FINIT` (reception through the block stops,
     /// RM0410 §40.7.4) and, still under it, releases and discards what the old banks
-    /// accepted into FIFO 0 and FIFO 1 (`RFOMx`); then switches the thread-side map and
-    /// the generation together. Frames of the old list still in the driver's ring carry
-    /// the old generation: `decode` drops them.
+    /// accepted into FIFO 0 and FIFO 1 (`RFOMx`) and moves to the next generation —
+    /// before `FINIT` is cleared, so that every frame read afterwards, which the new
+    /// banks accepted, carries the new one (a frame read between the end of the switch
+    /// and a later bump would carry the old generation and be dropped). Then the
+    /// thread-side map is switched (`decode` runs in this context only, after this
+    /// returns). Frames of the old list still in the driver's ring carry the old
+    /// generation: `decode` drops them.
     unsafe fn install_filters(&self, filters: &FilterPlan) -> Result<(), Error> {
         // The map first: a plan it cannot hold is refused before any bank changes.
         let fmi = filters.fmi_map::<K>()?;
@@ -745,6 +749,10 @@ unsafe impl<R: Registers, F: Registers, const K: usize> Hardware for BxCan<R, F,
                     self.discarded.fetch_add(1, Ordering::Relaxed);
                 }
             }
+            // Nothing enters the FIFOs under `FINIT`: what the receive interrupt reads
+            // from now on was accepted by the new banks.
+            let next = self.generation.load(Ordering::Relaxed).wrapping_add(1);
+            self.generation.store(next, Ordering::Release);
         };
         let r = match &self.filter_regs {
             Some(f) => filter_block::program_then(f, self.instance, filters, drain),
@@ -753,8 +761,6 @@ unsafe impl<R: Registers, F: Registers, const K: usize> Hardware for BxCan<R, F,
         r.map_err(|_| Error::InvalidArgument)?;
         // SAFETY: the receive half's context, the only one touching the map.
         unsafe { *self.fmi.get() = fmi };
-        let next = self.generation.load(Ordering::Relaxed).wrapping_add(1);
-        self.generation.store(next, Ordering::Release);
         Ok(())
     }
 
