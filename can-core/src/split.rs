@@ -789,8 +789,9 @@ impl<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE:
     /// Loads `frame` into a free mailbox now, or `WouldBlock`: never queued. Unlike
     /// [`Tx::try_send`] it does not wait behind queued frames, so it may overtake them
     /// when it needs another kind of mailbox — ACAN's remote frames, which go straight
-    /// to FlexCAN's remote-frame mailboxes while data frames wait for MB15. (On bxCAN
-    /// all mailboxes are alike: it overtakes the queue whenever a mailbox is free.)
+    /// to FlexCAN's remote-frame mailboxes while [`Tx::try_send`] loads one frame at a
+    /// time ([`Hardware::free_mailbox_now`]). (On bxCAN all mailboxes are alike: it
+    /// overtakes the queue whenever a mailbox is free.)
     pub fn try_send_now(&mut self, frame: &Frame) -> nb::Result<Token, Error> {
         let s = self.s;
         let hw = s.hw();
@@ -798,7 +799,7 @@ impl<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE:
             return Err(nb::Error::Other(Error::BusOff));
         }
         let token = Token(self.next);
-        let load = || match hw.free_mailbox(frame) {
+        let load = || match hw.free_mailbox_now(frame) {
             Ok(Some(m)) => {
                 // SAFETY: either the queue is empty (the direct path of `try_send`), or
                 // the caller holds the critical section, which keeps the interrupt's

@@ -264,6 +264,38 @@ impl<R: Registers> FlexCanHw<R> {
         (0xFFFF_u32 >> first << first) & 0xFFFF
     }
 
+    /// Refused with [`Error::WrongMode`] in listen-only mode and while disabled (sleep).
+    #[inline(always)]
+    fn check_can_send(&self) -> Result<(), Error> {
+        if self.bus_mode.load(Ordering::Relaxed) == bus_mode_code(BusMode::ListenOnly)
+            || self.mode() == MODE_SLEEP
+        {
+            return Err(Error::WrongMode);
+        }
+        Ok(())
+    }
+
+    /// MB15 for a data frame, the first free remote-frame mailbox for a remote frame.
+    #[inline(always)]
+    fn free_now(&self, frame: &Frame) -> Result<Option<u8>, Error> {
+        // The control word first, then the flag: a mailbox reading INACTIVE stays so
+        // until someone loads it, so a clear flag read after it means "settled". (Read
+        // the other way round, a frame ending between the two reads would look free
+        // with its completion unsettled, and the load would overwrite its token.)
+        let free = |mb: usize| {
+            cs::CODE.get(self.regs.read32(regs::mb_cs(mb))) == code::TX_INACTIVE
+                && self.regs.read32(IFLAG1) & iflag1::buf(mb) == 0
+        };
+        if !frame.is_remote() {
+            let mb = DATA_MAILBOX as usize;
+            return Ok(free(mb).then_some(DATA_MAILBOX));
+        }
+        let first = self.configuration().first_remote_mailbox() as usize;
+        Ok((first..DATA_MAILBOX as usize)
+            .find(|&mb| free(mb))
+            .map(|mb| mb as u8))
+    }
+
     fn latch(&self, esr: u32) -> Option<LastErrorCode> {
         let code = status::last_error(esr);
         if let Some(c) = code {
@@ -355,34 +387,30 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
         TxPolicy::Fifo
     }
 
-    /// Data frames: MB15; remote frames: the first free remote-frame mailbox (ACAN §9).
-    /// Free means code `INACTIVE` and its `IFLAG1` bit clear (settled). Refused with
-    /// [`Error::WrongMode`] in listen-only mode and while disabled (sleep).
+    /// As [`Hardware::free_mailbox_now`], but only while no transmit mailbox is loaded
+    /// or unsettled: the request order holds across the data mailbox and the
+    /// remote-frame mailboxes, among which the module picks by identifier, ties lowest
+    /// mailbox first (Kinetis RM, "Arbitration process", `CTRL1[LBUF]` = 0), so one
+    /// frame of the request order is in a mailbox at a time — as data frames always
+    /// were, MB15 being their one mailbox. Refused with [`Error::WrongMode`] in
+    /// listen-only mode and while disabled (sleep).
     #[inline(always)]
     fn free_mailbox(&self, frame: &Frame) -> Result<Option<u8>, Error> {
-        if self.bus_mode.load(Ordering::Relaxed) == bus_mode_code(BusMode::ListenOnly)
-            || self.mode() == MODE_SLEEP
-        {
-            return Err(Error::WrongMode);
+        self.check_can_send()?;
+        if self.loaded.load(Ordering::Relaxed) != 0 {
+            return Ok(None);
         }
-        // The control word first, then the flag: a mailbox reading INACTIVE stays so
-        // until someone loads it, so a clear flag read after it means "settled". (Read
-        // the other way round, a frame ending between the two reads would look free
-        // with its completion unsettled, and the load would overwrite its token.)
-        let free = |mb: usize| {
-            cs::CODE.get(self.regs.read32(regs::mb_cs(mb))) == code::TX_INACTIVE
-                && self.regs.read32(IFLAG1) & iflag1::buf(mb) == 0
-        };
-        if !frame.is_remote() {
-            let mb = DATA_MAILBOX as usize;
-            return Ok(free(mb).then_some(DATA_MAILBOX));
-        }
-        let first = self.configuration().first_remote_mailbox() as usize;
-        Ok((first..DATA_MAILBOX as usize)
-            .find(|&mb| free(mb))
-            .map(|mb| mb as u8))
+        self.free_now(frame)
     }
 
+    /// Data frames: MB15; remote frames: the first free remote-frame mailbox (ACAN §9),
+    /// whatever else is loaded. Free means code `INACTIVE` and its `IFLAG1` bit clear
+    /// (settled). Refused with [`Error::WrongMode`] in listen-only mode and while
+    /// disabled (sleep).
+    fn free_mailbox_now(&self, frame: &Frame) -> Result<Option<u8>, Error> {
+        self.check_can_send()?;
+        self.free_now(frame)
+    }
     /// Identifier and data first, the control word (CODE `DATA`) last (Kinetis RM,
     /// "Transmit process").
     #[inline(always)]
