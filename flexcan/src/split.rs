@@ -11,6 +11,10 @@
 //! - transmit half and transmit handler: `IFLAG1` read, the words of one transmit
 //!   mailbox that is inactive and settled (code `INACTIVE`, its `IFLAG1` bit clear);
 //! - transmit handler: `IFLAG1` write-1-to-clear of the transmit mailboxes' bits;
+//! - transmit half (`abort`) and transmit handler (`settle`), inside the driver's critical
+//!   section: `ESR1` read for `TX` before an ABORT write (its clear-on-read error bits
+//!   are kept for the status handler, as every state read does), ABORT into the control
+//!   word of a pending transmit mailbox;
 //! - receive handler: MB0–MB3 (the Rx FIFO output), `RXFIR`, `IFLAG1` write-1-to-clear
 //!   of `BUF5I`/`BUF6I`/`BUF7I`;
 //! - status handler: `ESR1` write-1-to-clear of exactly the bits it read, `ECR` read;
@@ -113,6 +117,10 @@ pub struct FlexCanHw<R: Registers> {
     /// Transmit mailboxes loaded and not settled yet (bit per MB): a flag raised by a
     /// remote-frame mailbox that became a receive mailbox is not a completion.
     loaded: AtomicU32,
+    /// Transmit mailboxes whose abort was requested while the module was transmitting
+    /// (bit per MB), written inside the driver's critical section only
+    /// (`abort_mailboxes`, `retry_aborts`).
+    abort_wanted: AtomicU32,
     /// The clock gate and pins `begin` set up (for [`FlexCanHw::into_controller`]).
     system: SystemPlan,
     /// Frames caught by remote-frame mailboxes turned receive mailboxes (written by the
@@ -155,6 +163,7 @@ impl<R: Registers> FlexCan<R> {
             last_error: AtomicLastError::new(self.last_error.get()),
             unresolved: AtomicU32::new(0),
             loaded: AtomicU32::new(0),
+            abort_wanted: AtomicU32::new(0),
             system: self.system,
             bus_clock_hz: self.bus_clock_hz,
             discarded: AtomicU32::new(0),
@@ -296,6 +305,72 @@ impl<R: Registers> FlexCanHw<R> {
             .map(|mb| mb as u8))
     }
 
+    /// Requests the abort of the pending mailboxes among `mask` (transmit half or
+    /// transmit interrupt, inside the driver's critical section): code `ABORT` (0b1001)
+    /// into their control word (Kinetis RM, "Transmission abort mechanism", `MCR[AEN]`
+    /// set by `begin`). Pending: code `DATA` and `IFLAG1` bit clear (a mailbox whose
+    /// flag is set ended; its completion is `settle`'s).
+    ///
+    /// The write must not race the end of a transmission: written over a mailbox that
+    /// has just ended (code `INACTIVE`, flag set), `ABORT` is taken as written — the
+    /// manual blocks the write only for a mailbox being transmitted or moved out to the
+    /// serial message buffer — and the mailbox would read aborted although its frame
+    /// was sent (see `docs/models.md`). So the driver reads `ESR1[TX]` first and
+    /// writes only while the module transmits nothing: no frame of ours can then end
+    /// before the write lands (a frame lasts at least 44 bit times; these are a few
+    /// instructions with interrupts off), and a frame that starts meanwhile is in the
+    /// case the manual covers (the abort waits for its outcome). While the module
+    /// transmits, the aborts wait in `abort_wanted` and `settle` tries again (the
+    /// message-buffer interrupt after that transmission, or the transmit half's next
+    /// call that settles: `try_send` with a queue, `poll`, `abort`). Returns the
+    /// mailboxes of `mask` found pending (aborted or waiting to be).
+    fn abort_mailboxes(&self, mask: u32) -> u32 {
+        let esr = self.regs.read32(ESR1);
+        // ESR1's error bits clear on read: kept for the status handler.
+        self.keep_unreported(esr);
+        let transmitting = esr & esr1::TX != 0;
+        let flags = self.regs.read32(IFLAG1);
+        let mut pending = 0;
+        for mb in (0..=DATA_MAILBOX as usize).filter(|&mb| mask & (1 << mb) != 0) {
+            if flags & iflag1::buf(mb) != 0 {
+                continue;
+            }
+            let control = self.regs.read32(regs::mb_cs(mb));
+            if cs::CODE.get(control) != code::TX_DATA {
+                continue;
+            }
+            pending |= 1 << mb;
+            if !transmitting {
+                self.regs
+                    .write32(regs::mb_cs(mb), cs::CODE.replace(control, code::TX_ABORT));
+            }
+        }
+        // Plain load and store: only the critical section's holder touches it.
+        let wanted = self.abort_wanted.load(Ordering::Relaxed);
+        let wanted = if transmitting {
+            wanted | pending
+        } else {
+            wanted & !pending
+        };
+        self.abort_wanted.store(wanted, Ordering::Relaxed);
+        pending
+    }
+
+    /// The aborts that waited for the end of a transmission (`abort_mailboxes`), for
+    /// the mailboxes still loaded.
+    #[inline(always)]
+    fn retry_aborts(&self) {
+        let wanted = self.abort_wanted.load(Ordering::Relaxed);
+        if wanted == 0 {
+            return;
+        }
+        let still = wanted & self.loaded.load(Ordering::Relaxed);
+        self.abort_wanted.store(still, Ordering::Relaxed);
+        if still != 0 {
+            self.abort_mailboxes(still);
+        }
+    }
+
     fn latch(&self, esr: u32) -> Option<LastErrorCode> {
         let code = status::last_error(esr);
         if let Some(c) = code {
@@ -431,6 +506,7 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
         }
         let ended = self.regs.read32(IFLAG1) & self.tx_bits();
         if ended == 0 {
+            self.retry_aborts();
             return;
         }
         let mut out = [(
@@ -496,6 +572,7 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
         for (_, c) in out.iter() {
             f(Settled::Done(*c));
         }
+        self.retry_aborts();
     }
 
     /// MB15 (data) and the remote-frame mailboxes.
@@ -525,40 +602,33 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
         }
     }
 
-    /// Writes code `ABORT` into the loaded mailbox holding `token` (Kinetis RM,
-    /// "Transmission abort mechanism"); the outcome comes with its `IFLAG1` bit.
+    /// Aborts the pending mailbox holding `token` ([`FlexCanHw`]'s `abort_mailboxes`:
+    /// code `ABORT`, Kinetis RM "Transmission abort mechanism", written only while the
+    /// module transmits nothing); the outcome comes with its `IFLAG1` bit. `false` when
+    /// no mailbox holds it pending (never loaded, or ended: its completion comes from
+    /// `settle`).
     unsafe fn request_abort(&self, token: Token) -> bool {
         if self.mode() == MODE_SLEEP {
             return false;
         }
-        let flags = self.regs.read32(IFLAG1);
+        let loaded = self.loaded.load(Ordering::Relaxed);
         let first = self.configuration().first_remote_mailbox() as usize;
-        for mb in first..=DATA_MAILBOX as usize {
-            let control = self.regs.read32(regs::mb_cs(mb));
-            let loaded = flags & iflag1::buf(mb) == 0 && cs::CODE.get(control) == code::TX_DATA;
-            if loaded && self.tokens[DATA_MAILBOX as usize - mb].load(Ordering::Acquire) == token.0
-            {
-                self.regs
-                    .write32(regs::mb_cs(mb), cs::CODE.replace(control, code::TX_ABORT));
-                return true;
-            }
+        let holder = (first..=DATA_MAILBOX as usize).find(|&mb| {
+            loaded & (1 << mb) != 0
+                && self.tokens[DATA_MAILBOX as usize - mb].load(Ordering::Acquire) == token.0
+        });
+        match holder {
+            Some(mb) => self.abort_mailboxes(1 << mb) != 0,
+            None => false,
         }
-        false
     }
 
+    /// Aborts every pending transmit mailbox (see `request_abort`).
     unsafe fn abort_all_mailboxes(&self) {
         if self.mode() == MODE_SLEEP {
             return;
         }
-        let flags = self.regs.read32(IFLAG1);
-        let first = self.configuration().first_remote_mailbox() as usize;
-        for mb in first..=DATA_MAILBOX as usize {
-            let control = self.regs.read32(regs::mb_cs(mb));
-            if flags & iflag1::buf(mb) == 0 && cs::CODE.get(control) == code::TX_DATA {
-                self.regs
-                    .write32(regs::mb_cs(mb), cs::CODE.replace(control, code::TX_ABORT));
-            }
-        }
+        self.abort_mailboxes(self.loaded.load(Ordering::Relaxed) & self.tx_bits());
     }
 
     /// `IFLAG1.BUF5I`: reads the Rx FIFO output (control/status first, Kinetis RM "Rx

@@ -77,3 +77,48 @@ fn try_send_now_still_takes_any_free_remote_mailbox() {
     can.try_send(&std_data(0x11, &[2])).unwrap();
     assert_eq!(can.tx_stats().count, 1);
 }
+
+/// Runs bit by bit until the bus is inside a frame (bounded).
+fn until_in_frame(bus: &mut twocan_core::sim::Bus) {
+    for _ in 0..200 {
+        if bus.in_frame() {
+            return;
+        }
+        bus.run_bits(1);
+    }
+    panic!("no frame started");
+}
+
+#[test]
+fn an_abort_requested_during_arbitration_takes_effect_after_the_loss() {
+    // Issue 26 item 6: while the module transmits, the driver does not write ABORT (the
+    // frame could end before the write lands, and ABORT over a sent mailbox would read
+    // aborted); the abort waits for the transmission's end. Here the frame loses
+    // arbitration: the message-buffer interrupt of the winner's frame applies the
+    // abort, and the frame never goes.
+    let (model, mut can) = begin::<32, 8>(&Settings::new(500_000), &[], &[]).unwrap();
+    let mut bus = bus_with(500_000, &[&model]);
+    let peer = SimNode::new().shared();
+    bus.attach("peer", peer.clone());
+    let ours = std_data(0x123, &[1]);
+    peer.borrow_mut().send(std_data(0x050, &[2]));
+    let t = can.try_send(&ours).unwrap();
+    until_in_frame(&mut bus);
+    bus.run_bits(3); // both in arbitration
+    let esr1 = model.peek32(twocan_flexcan::regs::ESR1);
+    assert_ne!(esr1 & twocan_flexcan::regs::esr1::TX, 0, "transmitting");
+    assert_eq!(can.abort(t), twocan_core::AbortRequest::Requested);
+    run1(&mut bus, &mut can, 2_000);
+    let c = can.take_completion().expect("one completion");
+    assert_eq!((c.token, c.outcome), (t, twocan_core::TxOutcome::Aborted));
+    assert!(can.take_completion().is_none());
+    assert!(
+        !bus.trace()
+            .records()
+            .iter()
+            .any(|r| r.frame == ours && r.is_error_free()),
+        "never sent"
+    );
+    let tr = can.traffic();
+    assert_eq!((tr.queued, tr.sent, tr.aborted), (1, 0, 1));
+}
