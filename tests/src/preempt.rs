@@ -79,7 +79,10 @@ pub struct Preemption {
     fired: Cell<bool>,
     in_handler: Cell<bool>,
     deferred: Cell<bool>,
-    handlers: RefCell<Option<Box<dyn FnMut()>>>,
+    /// Whether a handler had a raised line to service at the preemption point (or when
+    /// it was deferred to).
+    worked: Cell<bool>,
+    handlers: RefCell<Option<Box<dyn FnMut() -> bool>>>,
 }
 
 impl Preemption {
@@ -93,12 +96,14 @@ impl Preemption {
             fired: Cell::new(false),
             in_handler: Cell::new(false),
             deferred: Cell::new(false),
+            worked: Cell::new(false),
             handlers: RefCell::new(None),
         })
     }
 
-    /// The interrupt side: runs the handlers of the lines the model raises.
-    pub fn set_handlers(&self, handlers: impl FnMut() + 'static) {
+    /// The interrupt side: runs the handlers of the lines the model raises; says
+    /// whether any line was raised.
+    pub fn set_handlers(&self, handlers: impl FnMut() -> bool + 'static) {
         *self.handlers.borrow_mut() = Some(Box::new(handlers));
     }
 
@@ -107,6 +112,7 @@ impl Preemption {
         self.seen.set(0);
         self.at.set(at);
         self.fired.set(false);
+        self.worked.set(false);
         self.counting.set(true);
     }
 
@@ -114,9 +120,15 @@ impl Preemption {
     pub fn stop(&self) -> usize {
         self.counting.set(false);
         if self.deferred.replace(false) {
-            self.run_handlers();
+            let worked = self.run_handlers();
+            self.worked.set(worked);
         }
         self.seen.get()
+    }
+
+    /// Whether the preempting handlers found a raised line to service.
+    pub fn worked(&self) -> bool {
+        self.worked.get()
     }
 
     /// Runs `f` with counting paused (hardware progress the script itself makes).
@@ -132,15 +144,18 @@ impl Preemption {
         self.fired.get()
     }
 
-    /// Runs the handlers (interrupt side: their accesses are not counted).
-    pub fn run_handlers(&self) {
+    /// Runs the handlers (interrupt side: their accesses are not counted); whether a
+    /// line was raised.
+    pub fn run_handlers(&self) -> bool {
         if self.in_handler.replace(true) {
-            return;
+            return false;
         }
-        if let Some(h) = self.handlers.borrow_mut().as_mut() {
-            h();
-        }
+        let worked = match self.handlers.borrow_mut().as_mut() {
+            Some(h) => h(),
+            None => false,
+        };
         self.in_handler.set(false);
+        worked
     }
 
     fn before_access(&self) {
@@ -151,7 +166,8 @@ impl Preemption {
         self.seen.set(n + 1);
         let in_cs = in_critical_section();
         if !in_cs && self.deferred.replace(false) {
-            self.run_handlers();
+            let worked = self.run_handlers();
+            self.worked.set(worked);
         }
         let Some((k, progress)) = self.at.get() else {
             return;
@@ -169,7 +185,8 @@ impl Preemption {
         if in_cs {
             self.deferred.set(true);
         } else {
-            self.run_handlers();
+            let worked = self.run_handlers();
+            self.worked.set(worked);
         }
     }
 }
@@ -289,6 +306,7 @@ pub fn bxcan_rig<Q: TxQueue + 'static>(policy: TxPolicy) -> Rig<BxHw, Q> {
         if l.sce {
             status.on_interrupt();
         }
+        l.tx || l.rx0 || l.rx1 || l.sce
     });
     Rig {
         state,
@@ -345,6 +363,7 @@ pub fn flexcan_rig<Q: TxQueue + 'static>() -> Rig<FlexHw, Q> {
         if l.error || l.bus_off || l.warning {
             status.on_interrupt();
         }
+        l.any()
     });
     Rig {
         state,
@@ -390,6 +409,8 @@ pub struct Outcome {
     pub aborts: Vec<AbortRequest>,
     /// Thread-side register accesses the scenario made.
     pub accesses: usize,
+    /// Whether the preempting handlers had a raised line to service.
+    pub preempted_with_work: bool,
 }
 
 /// Plays `steps` on a fresh `rig`, preempting at `at`, then runs the bus with the
@@ -434,6 +455,7 @@ pub fn run_script<H: Hardware + 'static, Q: TxQueue + 'static>(
         }
     }
     let accesses = p.stop();
+    let preempted_with_work = p.fired() && p.worked();
     // The bus runs on, each line serviced after each event.
     for _ in 0..10_000 {
         p.run_handlers();
@@ -454,6 +476,7 @@ pub fn run_script<H: Hardware + 'static, Q: TxQueue + 'static>(
         queue_count: rig.tx.stats().count,
         aborts,
         accesses,
+        preempted_with_work,
     }
 }
 
@@ -525,20 +548,36 @@ impl Outcome {
     }
 }
 
+/// What a [`sweep`] tried.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Swept {
+    /// Thread-side register accesses of the scenario without preemption.
+    pub accesses: usize,
+    /// Preemption points tried (each access with each [`Progress`]; a preempted run may
+    /// make a different number of accesses, the points are those of the plain run).
+    pub points: usize,
+    /// Points where a preempting handler had a raised line to service.
+    pub with_work: usize,
+}
+
 /// Runs `steps` once without preemption to count the thread's accesses, then once per
 /// access and kind of preemption point, each on a fresh rig from `rig`, checking every
-/// outcome. Returns the number of preemption points tried (accesses × kinds).
+/// outcome.
 pub fn sweep<H: Hardware + 'static, Q: TxQueue + 'static>(
     rig: impl Fn() -> Rig<H, Q>,
     policy: TxPolicy,
     steps: &[Step],
     what: &str,
-) -> usize {
+) -> Swept {
     let base = run_script(rig(), steps, None);
     base.check(policy, &format!("{what}, no preemption"));
     let n = base.accesses;
     assert!(n > 0, "{what}: the scenario touches no register");
-    let mut tried = 0;
+    let mut swept = Swept {
+        accesses: n,
+        points: 0,
+        with_work: 0,
+    };
     for k in 0..n {
         for progress in PROGRESS {
             let o = run_script(rig(), steps, Some((k, progress)));
@@ -546,8 +585,9 @@ pub fn sweep<H: Hardware + 'static, Q: TxQueue + 'static>(
                 policy,
                 &format!("{what}, {progress:?} at access {k} of {n}"),
             );
-            tried += 1;
+            swept.points += 1;
+            swept.with_work += o.preempted_with_work as usize;
         }
     }
-    tried
+    swept
 }
