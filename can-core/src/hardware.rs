@@ -204,6 +204,15 @@ pub unsafe trait Hardware {
     /// mailboxes reads [`MailboxState::Empty`]).
     fn mailbox_state(&self, mailbox: MailboxId) -> MailboxState;
 
+    /// Transmit half, before [`Hardware::request_abort`] (`token`) or
+    /// [`Hardware::abort_all_mailboxes`] (`None`) and outside the critical section they
+    /// run in: waits, bounded, until the abort request cannot race the end of a
+    /// transmission (FlexCAN: while the module transmits, see its `request_abort`). The
+    /// default does nothing.
+    fn prepare_abort(&self, token: Option<Token>) {
+        let _ = token;
+    }
+
     /// Transmit half: requests the abort of the mailbox holding `token`, if one does.
     /// Returns whether it did; the outcome arrives through [`Hardware::settle`].
     ///

@@ -831,9 +831,12 @@ impl<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE:
         unsafe { self.s.done.pop() }
     }
 
-    /// Aborts the frame of `token`, queued or in a mailbox.
+    /// Aborts the frame of `token`, queued or in a mailbox. On FlexCAN, the abort of a
+    /// frame in a mailbox while the module transmits is written when that transmission
+    /// ends: the call waits for it, bounded ([`Hardware::prepare_abort`]).
     pub fn abort(&mut self, token: Token) -> AbortRequest {
         let s = self.s;
+        s.hw().prepare_abort(Some(token));
         critical_section::with(|cs| {
             // SAFETY: the queue is only touched inside a critical section.
             let q = unsafe { &mut *s.queue.borrow(cs).get() };
@@ -859,9 +862,11 @@ impl<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE:
     }
 
     /// Drops every queued frame (each gets an `Aborted` completion) and requests the
-    /// abort of every mailbox. Returns the number of queued frames dropped.
+    /// abort of every mailbox (waiting as [`Tx::abort`] does). Returns the number of
+    /// queued frames dropped.
     pub fn abort_all(&mut self) -> usize {
         let s = self.s;
+        s.hw().prepare_abort(None);
         critical_section::with(|cs| {
             // SAFETY: the queue is only touched inside a critical section.
             let q = unsafe { &mut *s.queue.borrow(cs).get() };

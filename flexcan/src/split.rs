@@ -319,10 +319,11 @@ impl<R: Registers> FlexCanHw<R> {
     /// writes only while the module transmits nothing: no frame of ours can then end
     /// before the write lands (a frame lasts at least 44 bit times; these are a few
     /// instructions with interrupts off), and a frame that starts meanwhile is in the
-    /// case the manual covers (the abort waits for its outcome). While the module
-    /// transmits, the aborts wait in `abort_wanted` and `settle` tries again (the
-    /// message-buffer interrupt after that transmission, or the transmit half's next
-    /// call that settles: `try_send` with a queue, `poll`, `abort`). Returns the
+    /// case the manual covers (the abort waits for its outcome). The transmit half
+    /// waits for `ESR1[TX]` to read 0 first (`prepare_abort`); should a transmission
+    /// start in between, the aborts wait in `abort_wanted` and `settle` tries again
+    /// (the message-buffer interrupt after that transmission, or the transmit half's
+    /// next call that settles: `try_send` with a queue, `poll`, `abort`). Returns the
     /// mailboxes of `mask` found pending (aborted or waiting to be).
     fn abort_mailboxes(&self, mask: u32) -> u32 {
         let esr = self.regs.read32(ESR1);
@@ -604,7 +605,8 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
 
     /// Aborts the pending mailbox holding `token` ([`FlexCanHw`]'s `abort_mailboxes`:
     /// code `ABORT`, Kinetis RM "Transmission abort mechanism", written only while the
-    /// module transmits nothing); the outcome comes with its `IFLAG1` bit. `false` when
+    /// module transmits nothing, which [`Hardware::prepare_abort`] waited for); the
+    /// outcome comes with its `IFLAG1` bit. `false` when
     /// no mailbox holds it pending (never loaded, or ended: its completion comes from
     /// `settle`).
     unsafe fn request_abort(&self, token: Token) -> bool {
@@ -620,6 +622,35 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
         match holder {
             Some(mb) => self.abort_mailboxes(1 << mb) != 0,
             None => false,
+        }
+    }
+
+    /// When a transmit mailbox holding `token` (any, for `None`) is loaded: polls
+    /// `ESR1[TX]` until the module transmits nothing, at most the acknowledge bound
+    /// (the time of a frame in flight at the bit rate in force), so that the abort
+    /// written next cannot race the end of a transmission (`abort_mailboxes`). Its error
+    /// bits are kept for the status handler.
+    fn prepare_abort(&self, token: Option<Token>) {
+        if self.mode() == MODE_SLEEP {
+            return;
+        }
+        let loaded = self.loaded.load(Ordering::Relaxed);
+        let ours = match token {
+            None => loaded != 0,
+            Some(t) => (0..=DATA_MAILBOX as usize).any(|mb| {
+                loaded & (1 << mb) != 0
+                    && self.tokens[DATA_MAILBOX as usize - mb].load(Ordering::Acquire) == t.0
+            }),
+        };
+        if !ours {
+            return;
+        }
+        for _ in 0..self.polls.load(Ordering::Relaxed) {
+            let esr = self.regs.read32(ESR1);
+            self.keep_unreported(esr);
+            if esr & esr1::TX == 0 {
+                return;
+            }
         }
     }
 

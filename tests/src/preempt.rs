@@ -325,7 +325,13 @@ pub fn bxcan_rig<Q: TxQueue + 'static>(policy: TxPolicy) -> Rig<BxHw, Q> {
 
 /// FlexCAN can0 of a Teensy 3.6 (ACAN's defaults, receive everything), request order.
 pub fn flexcan_rig<Q: TxQueue + 'static>() -> Rig<FlexHw, Q> {
-    let (bus, peer) = bus_and_peer();
+    flexcan_rig_with(SimNode::new())
+}
+
+/// [`flexcan_rig`] with another peer (a listen-only one acknowledges nothing).
+pub fn flexcan_rig_with<Q: TxQueue + 'static>(peer: SimNode) -> Rig<FlexHw, Q> {
+    let bus = Rc::new(RefCell::new(Bus::new(BIT_RATE).expect("bus")));
+    let peer = peer.shared();
     let model = FlexCanModel::mk66fx1m0();
     bus.borrow_mut().attach("can0", model.clone());
     bus.borrow_mut().attach("peer", peer.clone());
@@ -558,6 +564,8 @@ pub struct Swept {
     pub points: usize,
     /// Points where a preempting handler had a raised line to service.
     pub with_work: usize,
+    /// Frames sent and aborted in the plain run.
+    pub sent_aborted: (u32, u32),
 }
 
 /// Runs `steps` once without preemption to count the thread's accesses, then once per
@@ -577,6 +585,7 @@ pub fn sweep<H: Hardware + 'static, Q: TxQueue + 'static>(
         accesses: n,
         points: 0,
         with_work: 0,
+        sent_aborted: (base.counters.1, base.counters.3),
     };
     for k in 0..n {
         for progress in PROGRESS {

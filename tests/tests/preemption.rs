@@ -8,7 +8,9 @@
 //! priority).
 
 use twocan_core::{FifoQueue, Frame, PriorityQueue, TxPolicy};
-use twocan_tests::preempt::{bxcan_rig, flexcan_rig, sweep, BxHw, FlexHw, Step, Swept};
+use twocan_tests::preempt::{
+    bxcan_rig, flexcan_rig, flexcan_rig_with, sweep, BxHw, FlexHw, Step, Swept,
+};
 
 /// Frames of one identifier, told apart by their data.
 fn one_identifier(n: u8) -> Vec<Frame> {
@@ -86,6 +88,9 @@ fn aborts_on_the_wire(frames: &[Frame]) -> Vec<Step> {
     let mut steps = Vec::new();
     for (i, pair) in frames.chunks(2).enumerate() {
         let first = 2 * i;
+        if i % 2 == 0 {
+            steps.push(Step::Peer(peer_frame(i as u8)));
+        }
         for f in pair {
             steps.push(Step::Send(*f));
         }
@@ -102,8 +107,9 @@ fn aborts_on_the_wire(frames: &[Frame]) -> Vec<Step> {
 /// with work to do (the sweep is not vacuous).
 fn report(what: &str, swept: Swept) {
     eprintln!(
-        "{what}: {} accesses, {} preemption points, {} with a handler servicing a line",
-        swept.accesses, swept.points, swept.with_work
+        "{what}: {} accesses, {} preemption points, {} with a handler servicing a line; \
+         plain run: {} sent, {} aborted",
+        swept.accesses, swept.points, swept.with_work, swept.sent_aborted.0, swept.sent_aborted.1
     );
     assert!(swept.with_work * 10 >= swept.points, "{what}: {swept:?}");
 }
@@ -158,4 +164,35 @@ sweeps! {
     flexcan_data_and_remote_send: flex, Fifo, data_and_remote(N), sends;
     flexcan_data_and_remote_abort: flex, Fifo, data_and_remote(N), sends_and_aborts;
     flexcan_data_and_remote_abort_on_the_wire: flex, Fifo, data_and_remote(N), aborts_on_the_wire;
+}
+
+#[test]
+fn flexcan_abort_during_a_retry_loop_takes_effect() {
+    // Nobody acknowledges: the frame is sent again and again (acknowledge errors), the
+    // module transmitting most of the time and no message-buffer interrupt coming. An
+    // abort asked while the frame is on the wire must still end it, aborted, without a
+    // transmit-half call after it (the split handlers: the error line runs the status
+    // handler only).
+    let mut rig =
+        flexcan_rig_with::<FifoQueue<4>>(twocan_core::sim::SimNode::new().with_listen_only(true));
+    let f = Frame::standard(0x123, &[1]).unwrap();
+    let t = rig.tx.try_send(&f).unwrap();
+    rig.bus.borrow_mut().run_bits(300);
+    rig.preemption.run_handlers();
+    rig.bus.borrow_mut().run_bits(25);
+    assert!(rig.bus.borrow().in_frame(), "on the wire");
+    assert_eq!(rig.tx.abort(t), twocan_core::AbortRequest::Requested);
+    for _ in 0..20 {
+        rig.preemption.run_handlers();
+        rig.bus.borrow_mut().run_bits(100);
+    }
+    rig.preemption.run_handlers();
+    let c = rig.tx.take_completion().expect("the abort took effect");
+    assert_eq!((c.token, c.outcome), (t, twocan_core::TxOutcome::Aborted));
+    let t = rig.state.traffic();
+    assert_eq!((t.queued, t.sent, t.aborted), (1, 0, 1));
+    assert!(
+        !rig.bus.borrow().in_frame() && rig.bus.borrow_mut().step().is_none(),
+        "no more attempts"
+    );
 }
