@@ -3,7 +3,7 @@
 //! `CAN_TDTxR`/`CAN_RDTxR` the DLC (and FMI, TIME), `CAN_TDLxR`/`CAN_RDLxR` data bytes
 //! 0..3 and `CAN_TDHxR`/`CAN_RDHxR` bytes 4..7, byte 0 in the least significant bits.
 
-use twocan_core::{Frame, Registers};
+use twocan_core::{Frame, Priority, Registers};
 
 use crate::regs::{rdtxr, rixr, tdhxr, tdlxr, tdtxr, tixr};
 
@@ -25,6 +25,20 @@ pub(crate) fn id_word(ir: u32) -> u32 {
     let extended = ir & rixr::IDE != 0;
     let raw = if extended { ir >> 3 } else { ir >> 21 };
     Frame::id_word(raw, extended, ir & rixr::RTR != 0)
+}
+
+/// The arbitration key ([`Priority`]) of a `CAN_TIxR` value: identifier, `IDE`, `RTR`
+/// (`TXRQ` ignored). Two mailboxes whose keys are equal tie in the hardware's identifier
+/// order and go lower mailbox number first (RM0410 §40.7.3 "Transmit priority").
+#[inline(always)]
+pub(crate) fn priority_of(tir: u32) -> Priority {
+    let extended = tir & tixr::IDE != 0;
+    let raw = if extended {
+        tir >> 3
+    } else {
+        (tir >> 21) & 0x7FF
+    };
+    Priority::from_raw(raw, extended, tir & tixr::RTR != 0)
 }
 
 /// The data registers' values of `frame`.
@@ -82,8 +96,10 @@ mod tests {
         assert_eq!(lo, 0x0403_0201);
         assert_eq!(hi, 0x05);
         assert_eq!(frame_of(id, 5, lo, hi), f);
+        assert_eq!(priority_of(id | tixr::TXRQ), Priority::of(&f));
         let r = Frame::remote(0x7FF, false, 3).unwrap();
         assert_eq!(id_register(&r), (0x7FF << 21) | 0b10);
+        assert_eq!(priority_of(id_register(&r)), Priority::of(&r));
         assert_eq!(frame_of(id_register(&r), 3, 0xFFFF_FFFF, 0), r);
         // DLC 15 is kept as written and reads as 8 bytes.
         let f = frame_of(0, 15, 0x0403_0201, 0x0807_0605);

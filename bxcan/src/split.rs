@@ -39,7 +39,8 @@ use crate::instance::Instance;
 use crate::mailbox;
 use crate::mode;
 use crate::regs::{
-    btr, esr, msr, rdhxr, rdlxr, rdtxr, rfxr, rixr, tdtxr, tsr, BTR, ESR, MSR, TSR, TX_MAILBOXES,
+    btr, esr, msr, rdhxr, rdlxr, rdtxr, rfxr, rixr, tdtxr, tixr, tsr, BTR, ESR, MSR, TSR,
+    TX_MAILBOXES,
 };
 
 /// Frames one receive FIFO holds (RM0410 §40.7.5).
@@ -79,6 +80,11 @@ pub struct BxCan<R: Registers, F: Registers = R, const K: usize = LOOKUP_KEYS> {
     fmi: UnsafeCell<FmiMap<K>>,
     /// Token of the frame in each mailbox (written before `TXRQ`).
     tokens: [AtomicU32; TX_MAILBOXES],
+    /// When each mailbox was loaded: the count of loads before it (written before
+    /// `TXRQ`), for `mailbox_state`.
+    loads: [AtomicU32; TX_MAILBOXES],
+    /// Loads so far (wrapping).
+    load_count: AtomicU32,
     /// Mailboxes whose abort was requested to make room (displacement).
     displacing: AtomicU8,
     /// Mailboxes whose abort the application requested.
@@ -118,6 +124,8 @@ impl<R: Registers, F: Registers, const K: usize> Can<R, F, K> {
             config: self.config,
             fmi: UnsafeCell::new(self.fmi),
             tokens: [const { AtomicU32::new(0) }; TX_MAILBOXES],
+            loads: [const { AtomicU32::new(0) }; TX_MAILBOXES],
+            load_count: AtomicU32::new(0),
             displacing: AtomicU8::new(0),
             aborting: AtomicU8::new(0),
             displaced: UnsafeCell::new([Frame::default(); TX_MAILBOXES]),
@@ -325,6 +333,41 @@ impl<R: Registers, F: Registers, const K: usize> BxCan<R, F, K> {
         }
     }
 
+    /// Under identifier priority (`TXFP` = 0), the free mailbox `frame` may take
+    /// without overtaking a pending frame it ties with: the hardware sends equal
+    /// arbitration keys lowest mailbox number first (RM0410 §40.7.3 "Transmit
+    /// priority": "If the identifier values are equal, the lower mailbox number will be
+    /// scheduled first"), so a tie must go above every pending tie — `first` if it
+    /// already is, else the lowest free and settled mailbox above them, else none (the
+    /// frame waits for the ties to leave). None either while a tie is being displaced:
+    /// its frame may come back to the queue, ahead of `frame`. `t` is `CAN_TSR` as
+    /// read. Frames of one identifier (ISO-TP, CANopen SDO blocks, DroneCAN transfers)
+    /// so leave in request order.
+    #[cold]
+    #[inline(never)]
+    fn after_ties(&self, t: u32, frame: &Frame, first: u8) -> Option<u8> {
+        let key = Priority::of(frame);
+        let displacing = self.displacing.load(Ordering::Relaxed);
+        let mut above = 0;
+        for x in 0..TX_MAILBOXES {
+            let pending = t & tsr::tme(x) == 0;
+            // Being displaced, pending or ended unsettled (`TIxR` keeps the frame).
+            let back = displacing & (1 << x) != 0;
+            if (pending || back) && mailbox::priority_of(self.regs.read32(tixr(x))) == key {
+                if back {
+                    return None;
+                }
+                above = x + 1;
+            }
+        }
+        if first as usize >= above {
+            return Some(first);
+        }
+        (above..TX_MAILBOXES)
+            .find(|&x| t & tsr::tme(x) != 0 && t & tsr::rqcp(x) == 0)
+            .map(|x| x as u8)
+    }
+
     fn status_now(&self) -> ErrorStatus {
         let m = self.regs.read32(MSR);
         let e = self.regs.read32(ESR);
@@ -377,7 +420,7 @@ unsafe impl<R: Registers, F: Registers, const K: usize> Hardware for BxCan<R, F,
     /// §40.9.2); it is taken when its last completion was settled (`RQCPx` = 0). With
     /// no `RQCPx` pending (the usual case) that is `CODE` itself, its `TMEx` checked.
     #[inline(always)]
-    fn free_mailbox(&self, _frame: &Frame) -> Result<Option<u8>, Error> {
+    fn free_mailbox(&self, frame: &Frame) -> Result<Option<u8>, Error> {
         if self.listen_only.load(Ordering::Relaxed) {
             return Err(Error::WrongMode);
         }
@@ -388,10 +431,18 @@ unsafe impl<R: Registers, F: Registers, const K: usize> Hardware for BxCan<R, F,
         let code = tsr::CODE.get(t) as usize;
         // `TMEx` of `CODE` is checked too: a wrong `CODE` must not make a pending
         // mailbox look free (its frame would be overwritten).
-        if t & RQCP_ALL == 0 && code < TX_MAILBOXES && t & tsr::tme(code) != 0 {
-            return Ok(Some(code as u8));
+        let free = if t & RQCP_ALL == 0 && code < TX_MAILBOXES && t & tsr::tme(code) != 0 {
+            Some(code as u8)
+        } else {
+            free_of(t, code)
+        };
+        if self.config.get_tx_policy() == TxPolicy::Priority
+            && (t & TME_ALL != TME_ALL || self.displacing.load(Ordering::Relaxed) != 0)
+        {
+            // Some mailbox is pending (or being displaced): a tie must not overtake it.
+            return Ok(free.and_then(|m| self.after_ties(t, frame, m)));
         }
-        Ok(free_of(t, code))
+        Ok(free)
     }
 
     /// Notes "Transmission handling": DLC, data, then identifier with `TXRQ`.
@@ -403,6 +454,8 @@ unsafe impl<R: Registers, F: Registers, const K: usize> Hardware for BxCan<R, F,
         // hardware sets after acting on `TXRQ` (on the host, the model's lock around each
         // register access orders the two).
         self.tokens[x].store(token.0, Ordering::Relaxed);
+        let n = self.load_count.fetch_add(1, Ordering::Relaxed);
+        self.loads[x].store(n, Ordering::Relaxed);
         mailbox::load(&self.regs, x, frame);
     }
 
@@ -435,24 +488,29 @@ unsafe impl<R: Registers, F: Registers, const K: usize> Hardware for BxCan<R, F,
 
     /// With all three mailboxes pending, the one lowest in the hardware's order
     /// (largest arbitration key; ties: higher mailbox number, notes "Transmit
-    /// priority") is aborted (`ABRQx`) when `frame` beats it.
+    /// priority") among those `frame` beats and may replace is aborted (`ABRQx`).
+    /// `frame` may replace a mailbox above every pending mailbox it ties with (it
+    /// leaves after them, see `after_ties`); the victim is the last of its own ties,
+    /// so its frame goes back to the queue ahead of none of them.
     unsafe fn displace(&self, frame: &Frame) -> bool {
         let t = self.regs.read32(TSR);
         if t & TME_ALL != 0 || self.displacing.load(Ordering::Relaxed) != 0 {
             return false;
         }
-        let mut low = 0;
-        let mut low_frame = self.read_frame(0);
-        for x in 1..TX_MAILBOXES {
-            let f = self.read_frame(x);
-            if !Priority::of(&f).beats(Priority::of(&low_frame)) {
-                low = x;
-                low_frame = f;
-            }
-        }
-        if !Priority::of(frame).beats(Priority::of(&low_frame)) {
+        let key = Priority::of(frame);
+        let keys: [Priority; TX_MAILBOXES] =
+            core::array::from_fn(|x| mailbox::priority_of(self.regs.read32(tixr(x))));
+        let above = match (0..TX_MAILBOXES).rev().find(|&x| keys[x] == key) {
+            Some(tie) => tie + 1,
+            None => 0,
+        };
+        let Some(low) = (above..TX_MAILBOXES)
+            .filter(|&x| key.beats(keys[x]))
+            .max_by_key(|&x| (keys[x], x))
+        else {
             return false;
-        }
+        };
+        let low_frame = self.read_frame(low);
         // SAFETY: transmit interrupt context, the only one touching `displaced`.
         unsafe { (*self.displaced.get())[low] = low_frame };
         self.displacing.fetch_or(1 << low, Ordering::Relaxed);
@@ -464,64 +522,137 @@ unsafe impl<R: Registers, F: Registers, const K: usize> Hardware for BxCan<R, F,
         TX_MAILBOXES as u8
     }
 
-    /// `Empty` when `CAN_TSR.TMEx`; otherwise the mailbox first in the hardware's
-    /// transmit order is `Transmitting` while `CAN_MSR.TXM` is set and `Scheduled`
-    /// before, the others `Pending` (notes "Transmit mailbox states"). The order: the
-    /// identifier priority (ties: lower mailbox number) under `TXFP = 0`, the request
-    /// order (tokens) under `TXFP = 1`.
+    /// `Empty` when `CAN_TSR.TMEx`. Otherwise, from the hardware's transmit order (the
+    /// identifier priority, ties lower mailbox number first, under `TXFP = 0`; the
+    /// request order under `TXFP = 1`; notes "Transmit priority", "Transmit mailbox
+    /// states"): while `CAN_MSR.TXM` is clear, the first mailbox is `Scheduled` and the
+    /// others `Pending`. While it is set, one mailbox is on the bus: the first in the
+    /// hardware's order among those pending when its frame started. No register names
+    /// it, so the driver uses the order of its loads: the mailbox on the bus is the first
+    /// of some earliest-loaded part of the pending ones. When every such part has the
+    /// same first mailbox (always under `TXFP = 1`; under `TXFP = 0` unless a frame of
+    /// higher priority was loaded after an earlier one), that mailbox is
+    /// `Transmitting`, the first of the others `Scheduled`, the rest `Pending`. When
+    /// they differ (a higher-priority frame loaded while an earlier one may have
+    /// started), no mailbox is named `Transmitting`: each one that may be on the bus or
+    /// next to go reads `Scheduled`, the others `Pending`.
     fn mailbox_state(&self, mailbox: MailboxId) -> MailboxState {
         let x = mailbox.0 as usize;
         let t = self.regs.read32(TSR);
         if x >= TX_MAILBOXES || t & tsr::tme(x) != 0 {
             return MailboxState::Empty;
         }
-        let token = |y: usize| self.tokens[y].load(Ordering::Acquire);
-        let mut first = x;
-        for y in (0..TX_MAILBOXES).filter(|&y| y != x && t & tsr::tme(y) == 0) {
-            let ahead = match self.config.get_tx_policy() {
-                TxPolicy::Fifo => (token(y).wrapping_sub(token(first)) as i32) < 0,
-                TxPolicy::Priority => {
-                    let (a, b) = (
-                        Priority::of(&self.read_frame(y)),
-                        Priority::of(&self.read_frame(first)),
-                    );
-                    a.beats(b) || (a == b && y < first)
-                }
+        let priority = self.config.get_tx_policy() == TxPolicy::Priority;
+        let seq: [u32; TX_MAILBOXES] =
+            core::array::from_fn(|y| self.loads[y].load(Ordering::Relaxed));
+        let keys: [Priority; TX_MAILBOXES] = core::array::from_fn(|y| {
+            if priority && t & tsr::tme(y) == 0 {
+                mailbox::priority_of(self.regs.read32(tixr(y)))
+            } else {
+                Priority::from_raw(0, false, false)
+            }
+        });
+        let loaded_before = |a: usize, b: usize| (seq[a].wrapping_sub(seq[b]) as i32) < 0;
+        // Whether mailbox `a` goes before `b` in the hardware's order.
+        let before = |a: usize, b: usize| {
+            if priority {
+                (keys[a], a) < (keys[b], b)
+            } else {
+                loaded_before(a, b)
+            }
+        };
+        // The pending mailboxes in load order.
+        let mut pending = [0usize; TX_MAILBOXES];
+        let mut n = 0;
+        for y in (0..TX_MAILBOXES).filter(|&y| t & tsr::tme(y) == 0) {
+            let mut i = n;
+            while i > 0 && loaded_before(y, pending[i - 1]) {
+                pending[i] = pending[i - 1];
+                i -= 1;
+            }
+            pending[i] = y;
+            n += 1;
+        }
+        let pending = &pending[..n];
+        // The first in the hardware's order among `pending` without `skip`.
+        let first_without = |skip: Option<usize>| {
+            pending
+                .iter()
+                .copied()
+                .filter(|&y| Some(y) != skip)
+                .reduce(|a, b| if before(b, a) { b } else { a })
+        };
+        let first = first_without(None);
+        if self.regs.read32(MSR) & msr::TXM == 0 {
+            return if first == Some(x) {
+                MailboxState::Scheduled
+            } else {
+                MailboxState::Pending
             };
-            if ahead {
-                first = y;
+        }
+        // The mailboxes that may be on the bus: the first of each earliest-loaded part.
+        let mut on_bus = 0u8;
+        let mut best: Option<usize> = None;
+        for &y in pending {
+            if best.is_none_or(|b| before(y, b)) {
+                best = Some(y);
+                on_bus |= 1 << y;
             }
         }
-        if first != x {
-            MailboxState::Pending
-        } else if self.regs.read32(MSR) & msr::TXM != 0 {
-            MailboxState::Transmitting
-        } else {
+        if on_bus.count_ones() == 1 {
+            return if first == Some(x) {
+                MailboxState::Transmitting
+            } else if first_without(first) == Some(x) {
+                MailboxState::Scheduled
+            } else {
+                MailboxState::Pending
+            };
+        }
+        let maybe_next = pending
+            .iter()
+            .filter(|&&y| on_bus & (1 << y) != 0)
+            .any(|&y| first_without(Some(y)) == Some(x));
+        if on_bus & (1 << x) != 0 || maybe_next {
             MailboxState::Scheduled
+        } else {
+            MailboxState::Pending
         }
     }
 
     /// `ABRQx` of the loaded mailbox holding `token` (RM0410 §40.9.2); a mailbox on the
-    /// bus finishes first, so the completion may still say sent.
+    /// bus finishes first, so the completion may still say sent. A mailbox whose
+    /// displacement abort ended but is not settled yet still holds its frame for the
+    /// queue: it is marked aborted, so that `settle` reports it aborted instead of
+    /// queueing it again.
     unsafe fn request_abort(&self, token: Token) -> bool {
         let t = self.regs.read32(TSR);
+        let displacing = self.displacing.load(Ordering::Relaxed);
         for x in 0..TX_MAILBOXES {
             let loaded = t & tsr::tme(x) == 0;
-            if loaded && self.tokens[x].load(Ordering::Acquire) == token.0 {
+            let coming_back = displacing & (1 << x) != 0;
+            if (loaded || coming_back) && self.tokens[x].load(Ordering::Acquire) == token.0 {
                 self.aborting.fetch_or(1 << x, Ordering::Relaxed);
-                self.regs.write32(TSR, tsr::abrq(x));
+                if loaded {
+                    self.regs.write32(TSR, tsr::abrq(x));
+                }
                 return true;
             }
         }
         false
     }
 
+    /// `ABRQx` of every loaded mailbox; mailboxes whose displacement abort ended
+    /// unsettled are marked aborted (see `request_abort`).
     unsafe fn abort_all_mailboxes(&self) {
         let t = self.regs.read32(TSR);
+        let displacing = self.displacing.load(Ordering::Relaxed);
         for x in 0..TX_MAILBOXES {
-            if t & tsr::tme(x) == 0 {
+            let loaded = t & tsr::tme(x) == 0;
+            if loaded || displacing & (1 << x) != 0 {
                 self.aborting.fetch_or(1 << x, Ordering::Relaxed);
-                self.regs.write32(TSR, tsr::abrq(x));
+                if loaded {
+                    self.regs.write32(TSR, tsr::abrq(x));
+                }
             }
         }
     }
@@ -595,9 +726,13 @@ unsafe impl<R: Registers, F: Registers, const K: usize> Hardware for BxCan<R, F,
 
     /// Programs the banks under `CAN_FMR.FINIT` (reception through the block stops,
     /// RM0410 §40.7.4) and, still under it, releases and discards what the old banks
-    /// accepted into FIFO 0 and FIFO 1 (`RFOMx`); then switches the thread-side map and
-    /// the generation together. Frames of the old list still in the driver's ring carry
-    /// the old generation: `decode` drops them.
+    /// accepted into FIFO 0 and FIFO 1 (`RFOMx`) and moves to the next generation —
+    /// before `FINIT` is cleared, so that every frame read afterwards, which the new
+    /// banks accepted, carries the new one (a frame read between the end of the switch
+    /// and a later bump would carry the old generation and be dropped). Then the
+    /// thread-side map is switched (`decode` runs in this context only, after this
+    /// returns). Frames of the old list still in the driver's ring carry the old
+    /// generation: `decode` drops them.
     unsafe fn install_filters(&self, filters: &FilterPlan) -> Result<(), Error> {
         // The map first: a plan it cannot hold is refused before any bank changes.
         let fmi = filters.fmi_map::<K>()?;
@@ -614,6 +749,10 @@ unsafe impl<R: Registers, F: Registers, const K: usize> Hardware for BxCan<R, F,
                     self.discarded.fetch_add(1, Ordering::Relaxed);
                 }
             }
+            // Nothing enters the FIFOs under `FINIT`: what the receive interrupt reads
+            // from now on was accepted by the new banks.
+            let next = self.generation.load(Ordering::Relaxed).wrapping_add(1);
+            self.generation.store(next, Ordering::Release);
         };
         let r = match &self.filter_regs {
             Some(f) => filter_block::program_then(f, self.instance, filters, drain),
@@ -622,8 +761,6 @@ unsafe impl<R: Registers, F: Registers, const K: usize> Hardware for BxCan<R, F,
         r.map_err(|_| Error::InvalidArgument)?;
         // SAFETY: the receive half's context, the only one touching the map.
         unsafe { *self.fmi.get() = fmi };
-        let next = self.generation.load(Ordering::Relaxed).wrapping_add(1);
-        self.generation.store(next, Ordering::Release);
         Ok(())
     }
 

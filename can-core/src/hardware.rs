@@ -156,10 +156,21 @@ pub unsafe trait Hardware {
     fn tx_policy(&self) -> TxPolicy;
 
     /// A mailbox that is empty and settled (its last completion taken by
-    /// [`Hardware::settle`]) and may carry `frame`. Reads the status register once.
-    /// `Err` when the controller cannot send now or ever in its mode (listen-only,
-    /// sleep): the frame is then not accepted.
+    /// [`Hardware::settle`]) and may carry `frame` **in the transmit order**: loaded
+    /// there, `frame` leaves after every frame loaded before it that the order puts
+    /// first (request order: all of them; identifier priority: those of higher or
+    /// equal priority). `None` when no mailbox allows that now. Reads the status
+    /// register once. `Err` when the controller cannot send now or ever in its mode
+    /// (listen-only, sleep): the frame is then not accepted.
     fn free_mailbox(&self, frame: &Frame) -> Result<Option<u8>, Error>;
+
+    /// A mailbox for [`crate::split::Tx::try_send_now`], which may overtake frames
+    /// loaded or queued before it: any empty and settled mailbox that may carry `frame`
+    /// (FlexCAN: any free remote-frame mailbox, ACAN's path). The default is
+    /// [`Hardware::free_mailbox`].
+    fn free_mailbox_now(&self, frame: &Frame) -> Result<Option<u8>, Error> {
+        self.free_mailbox(frame)
+    }
 
     /// Loads `frame` into `mailbox` (returned by [`Hardware::free_mailbox`]), remembers
     /// `token` for its completion, and requests transmission.
@@ -192,6 +203,15 @@ pub unsafe trait Hardware {
     /// State of one transmit mailbox, read now (any context; an index beyond the
     /// mailboxes reads [`MailboxState::Empty`]).
     fn mailbox_state(&self, mailbox: MailboxId) -> MailboxState;
+
+    /// Transmit half, before [`Hardware::request_abort`] (`token`) or
+    /// [`Hardware::abort_all_mailboxes`] (`None`) and outside the critical section they
+    /// run in: waits, bounded, until the abort request cannot race the end of a
+    /// transmission (FlexCAN: while the module transmits, see its `request_abort`). The
+    /// default does nothing.
+    fn prepare_abort(&self, token: Option<Token>) {
+        let _ = token;
+    }
 
     /// Transmit half: requests the abort of the mailbox holding `token`, if one does.
     /// Returns whether it did; the outcome arrives through [`Hardware::settle`].

@@ -519,14 +519,19 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
                     self.queue_len.fetch_sub(1, Ordering::Release);
                 }
                 Ok(None) => {
+                    // The displaced frame comes back through `settle` while `next` still
+                    // waits in the queue, so a displacement needs one free place: never
+                    // displace into a full queue (the frame then waits for the next
+                    // mailbox that ends; nothing accepted is dropped).
                     if displaced
                         || q.policy() != TxPolicy::Priority
+                        || self.queue_len.load(Ordering::Relaxed) as usize >= Q::CAPACITY
                         || !unsafe { hw.displace(&next.frame) }
                     {
                         break;
                     }
-                    // The displaced frame comes back through `settle`: its room in the
-                    // queue is kept from now on. An abort of a pending mailbox ends at
+                    // That place is kept from now on (counted in `queue_len`, so that the
+                    // transmit half cannot take it). An abort of a pending mailbox ends at
                     // once: settle again so the frame takes the mailbox now; otherwise
                     // the abort's completion interrupt does it.
                     self.queue_len.fetch_add(1, Ordering::Relaxed);
@@ -555,8 +560,18 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
             Settled::Done(c) => self.record(c),
             Settled::Displaced(token, frame) => {
                 // Room was reserved when the displacement was requested (and stays
-                // counted in `queue_len`, now by the frame itself).
-                let _ = q.push(Queued { token, frame });
+                // counted in `queue_len`, now by the frame itself), so the push succeeds.
+                // Were it refused, the frame would still get its one completion.
+                if q.push(Queued { token, frame }).is_err() {
+                    debug_assert!(false, "no room kept for a displaced frame");
+                    self.queue_len.fetch_sub(1, Ordering::Relaxed);
+                    self.record(Completion {
+                        token,
+                        outcome: TxOutcome::Aborted,
+                        cause: None,
+                        timestamp: None,
+                    });
+                }
             }
             Settled::DoneDisplacing(c) => {
                 self.queue_len.fetch_sub(1, Ordering::Relaxed);
@@ -774,8 +789,9 @@ impl<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE:
     /// Loads `frame` into a free mailbox now, or `WouldBlock`: never queued. Unlike
     /// [`Tx::try_send`] it does not wait behind queued frames, so it may overtake them
     /// when it needs another kind of mailbox — ACAN's remote frames, which go straight
-    /// to FlexCAN's remote-frame mailboxes while data frames wait for MB15. (On bxCAN
-    /// all mailboxes are alike: it overtakes the queue whenever a mailbox is free.)
+    /// to FlexCAN's remote-frame mailboxes while [`Tx::try_send`] loads one frame at a
+    /// time ([`Hardware::free_mailbox_now`]). (On bxCAN all mailboxes are alike: it
+    /// overtakes the queue whenever a mailbox is free.)
     pub fn try_send_now(&mut self, frame: &Frame) -> nb::Result<Token, Error> {
         let s = self.s;
         let hw = s.hw();
@@ -783,7 +799,7 @@ impl<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE:
             return Err(nb::Error::Other(Error::BusOff));
         }
         let token = Token(self.next);
-        let load = || match hw.free_mailbox(frame) {
+        let load = || match hw.free_mailbox_now(frame) {
             Ok(Some(m)) => {
                 // SAFETY: either the queue is empty (the direct path of `try_send`), or
                 // the caller holds the critical section, which keeps the interrupt's
@@ -815,9 +831,12 @@ impl<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE:
         unsafe { self.s.done.pop() }
     }
 
-    /// Aborts the frame of `token`, queued or in a mailbox.
+    /// Aborts the frame of `token`, queued or in a mailbox. On FlexCAN, the abort of a
+    /// frame in a mailbox while the module transmits is written when that transmission
+    /// ends: the call waits for it, bounded ([`Hardware::prepare_abort`]).
     pub fn abort(&mut self, token: Token) -> AbortRequest {
         let s = self.s;
+        s.hw().prepare_abort(Some(token));
         critical_section::with(|cs| {
             // SAFETY: the queue is only touched inside a critical section.
             let q = unsafe { &mut *s.queue.borrow(cs).get() };
@@ -843,9 +862,11 @@ impl<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE:
     }
 
     /// Drops every queued frame (each gets an `Aborted` completion) and requests the
-    /// abort of every mailbox. Returns the number of queued frames dropped.
+    /// abort of every mailbox (waiting as [`Tx::abort`] does). Returns the number of
+    /// queued frames dropped.
     pub fn abort_all(&mut self) -> usize {
         let s = self.s;
+        s.hw().prepare_abort(None);
         critical_section::with(|cs| {
             // SAFETY: the queue is only touched inside a critical section.
             let q = unsafe { &mut *s.queue.borrow(cs).get() };

@@ -42,11 +42,13 @@ fn main() {
             can.on_interrupt();
         }
     }
-    // `receive`, with the filter index (ACAN `idx`). The remote frame sits in its own
-    // mailbox and wins arbitration (extended 0x1234 ranks before standard 0x542).
+    // `receive`, with the filter index (ACAN `idx`). `try_send` keeps the request order,
+    // remote frames included (ACAN's direct path to the remote-frame mailboxes, where
+    // the extended 0x1234 would win arbitration over the standard 0x542, is
+    // `try_send_now`).
     let first = can.receive().unwrap();
-    assert_eq!((first.frame.raw_id(), first.filter), (0x1234, 1));
+    assert_eq!((first.frame.raw_id(), first.filter), (0x542, 0));
     let second = can.receive().unwrap();
-    assert_eq!((second.frame.raw_id(), second.filter), (0x542, 0));
+    assert_eq!((second.frame.raw_id(), second.filter), (0x1234, 1));
     assert_eq!(can.rx_stats().peak, 2); // receiveBufferPeakCount
 }

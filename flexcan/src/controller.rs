@@ -8,8 +8,12 @@
 //! transmit queue is first-in first-out ([`twocan_core::TxPolicy::Fifo`]) and holds
 //! the next frame until MB15 is free again, so data frames leave strictly in the order
 //! given to `try_send` (ACAN §3 "sequentiality"). Remote frames go to the first free
-//! remote-frame mailbox of the configuration (7, 5, 3 or 1, ACAN §9); on the bus they
-//! compete with the pending data frame by identifier priority (`CTRL1.LBUF` = 0).
+//! remote-frame mailbox of the configuration (7, 5, 3 or 1, ACAN §9). The module picks
+//! among pending mailboxes by identifier priority, ties lowest mailbox first
+//! (`CTRL1.LBUF` = 0), so `try_send` keeps remote frames in the request order with
+//! data frames by loading one frame at a time, whatever its kind;
+//! `try_send_now` (ACAN's path) loads any free remote-frame mailbox at once, and such
+//! frames compete with the pending ones by identifier.
 //!
 //! After sending a remote frame the hardware turns its mailbox into a receive mailbox
 //! for the answer (Kinetis RM, "Tx CODE 1100 with RTR = 1"); the Rx FIFO is matched

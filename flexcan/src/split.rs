@@ -11,6 +11,10 @@
 //! - transmit half and transmit handler: `IFLAG1` read, the words of one transmit
 //!   mailbox that is inactive and settled (code `INACTIVE`, its `IFLAG1` bit clear);
 //! - transmit handler: `IFLAG1` write-1-to-clear of the transmit mailboxes' bits;
+//! - transmit half (`abort`) and transmit handler (`settle`), inside the driver's critical
+//!   section: `ESR1` read for `TX` before an ABORT write (its clear-on-read error bits
+//!   are kept for the status handler, as every state read does), ABORT into the control
+//!   word of a pending transmit mailbox;
 //! - receive handler: MB0–MB3 (the Rx FIFO output), `RXFIR`, `IFLAG1` write-1-to-clear
 //!   of `BUF5I`/`BUF6I`/`BUF7I`;
 //! - status handler: `ESR1` write-1-to-clear of exactly the bits it read, `ECR` read;
@@ -113,6 +117,10 @@ pub struct FlexCanHw<R: Registers> {
     /// Transmit mailboxes loaded and not settled yet (bit per MB): a flag raised by a
     /// remote-frame mailbox that became a receive mailbox is not a completion.
     loaded: AtomicU32,
+    /// Transmit mailboxes whose abort was requested while the module was transmitting
+    /// (bit per MB), written inside the driver's critical section only
+    /// (`abort_mailboxes`, `retry_aborts`).
+    abort_wanted: AtomicU32,
     /// The clock gate and pins `begin` set up (for [`FlexCanHw::into_controller`]).
     system: SystemPlan,
     /// Frames caught by remote-frame mailboxes turned receive mailboxes (written by the
@@ -155,6 +163,7 @@ impl<R: Registers> FlexCan<R> {
             last_error: AtomicLastError::new(self.last_error.get()),
             unresolved: AtomicU32::new(0),
             loaded: AtomicU32::new(0),
+            abort_wanted: AtomicU32::new(0),
             system: self.system,
             bus_clock_hz: self.bus_clock_hz,
             discarded: AtomicU32::new(0),
@@ -264,6 +273,105 @@ impl<R: Registers> FlexCanHw<R> {
         (0xFFFF_u32 >> first << first) & 0xFFFF
     }
 
+    /// Refused with [`Error::WrongMode`] in listen-only mode and while disabled (sleep).
+    #[inline(always)]
+    fn check_can_send(&self) -> Result<(), Error> {
+        if self.bus_mode.load(Ordering::Relaxed) == bus_mode_code(BusMode::ListenOnly)
+            || self.mode() == MODE_SLEEP
+        {
+            return Err(Error::WrongMode);
+        }
+        Ok(())
+    }
+
+    /// MB15 for a data frame, the first free remote-frame mailbox for a remote frame.
+    #[inline(always)]
+    fn free_now(&self, frame: &Frame) -> Result<Option<u8>, Error> {
+        // The control word first, then the flag: a mailbox reading INACTIVE stays so
+        // until someone loads it, so a clear flag read after it means "settled". (Read
+        // the other way round, a frame ending between the two reads would look free
+        // with its completion unsettled, and the load would overwrite its token.)
+        let free = |mb: usize| {
+            cs::CODE.get(self.regs.read32(regs::mb_cs(mb))) == code::TX_INACTIVE
+                && self.regs.read32(IFLAG1) & iflag1::buf(mb) == 0
+        };
+        if !frame.is_remote() {
+            let mb = DATA_MAILBOX as usize;
+            return Ok(free(mb).then_some(DATA_MAILBOX));
+        }
+        let first = self.configuration().first_remote_mailbox() as usize;
+        Ok((first..DATA_MAILBOX as usize)
+            .find(|&mb| free(mb))
+            .map(|mb| mb as u8))
+    }
+
+    /// Requests the abort of the pending mailboxes among `mask` (transmit half or
+    /// transmit interrupt, inside the driver's critical section): code `ABORT` (0b1001)
+    /// into their control word (Kinetis RM, "Transmission abort mechanism", `MCR[AEN]`
+    /// set by `begin`). Pending: code `DATA` and `IFLAG1` bit clear (a mailbox whose
+    /// flag is set ended; its completion is `settle`'s).
+    ///
+    /// The write must not race the end of a transmission: written over a mailbox that
+    /// has just ended (code `INACTIVE`, flag set), `ABORT` is taken as written — the
+    /// manual blocks the write only for a mailbox being transmitted or moved out to the
+    /// serial message buffer — and the mailbox would read aborted although its frame
+    /// was sent (see `docs/models.md`). So the driver reads `ESR1[TX]` first and
+    /// writes only while the module transmits nothing: no frame of ours can then end
+    /// before the write lands (a frame lasts at least 44 bit times; these are a few
+    /// instructions with interrupts off), and a frame that starts meanwhile is in the
+    /// case the manual covers (the abort waits for its outcome). The transmit half
+    /// waits for `ESR1[TX]` to read 0 first (`prepare_abort`); should a transmission
+    /// start in between, the aborts wait in `abort_wanted` and `settle` tries again
+    /// (the message-buffer interrupt after that transmission, or the transmit half's
+    /// next call that settles: `try_send` with a queue, `poll`, `abort`). Returns the
+    /// mailboxes of `mask` found pending (aborted or waiting to be).
+    fn abort_mailboxes(&self, mask: u32) -> u32 {
+        let esr = self.regs.read32(ESR1);
+        // ESR1's error bits clear on read: kept for the status handler.
+        self.keep_unreported(esr);
+        let transmitting = esr & esr1::TX != 0;
+        let flags = self.regs.read32(IFLAG1);
+        let mut pending = 0;
+        for mb in (0..=DATA_MAILBOX as usize).filter(|&mb| mask & (1 << mb) != 0) {
+            if flags & iflag1::buf(mb) != 0 {
+                continue;
+            }
+            let control = self.regs.read32(regs::mb_cs(mb));
+            if cs::CODE.get(control) != code::TX_DATA {
+                continue;
+            }
+            pending |= 1 << mb;
+            if !transmitting {
+                self.regs
+                    .write32(regs::mb_cs(mb), cs::CODE.replace(control, code::TX_ABORT));
+            }
+        }
+        // Plain load and store: only the critical section's holder touches it.
+        let wanted = self.abort_wanted.load(Ordering::Relaxed);
+        let wanted = if transmitting {
+            wanted | pending
+        } else {
+            wanted & !pending
+        };
+        self.abort_wanted.store(wanted, Ordering::Relaxed);
+        pending
+    }
+
+    /// The aborts that waited for the end of a transmission (`abort_mailboxes`), for
+    /// the mailboxes still loaded.
+    #[inline(always)]
+    fn retry_aborts(&self) {
+        let wanted = self.abort_wanted.load(Ordering::Relaxed);
+        if wanted == 0 {
+            return;
+        }
+        let still = wanted & self.loaded.load(Ordering::Relaxed);
+        self.abort_wanted.store(still, Ordering::Relaxed);
+        if still != 0 {
+            self.abort_mailboxes(still);
+        }
+    }
+
     fn latch(&self, esr: u32) -> Option<LastErrorCode> {
         let code = status::last_error(esr);
         if let Some(c) = code {
@@ -355,34 +463,30 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
         TxPolicy::Fifo
     }
 
-    /// Data frames: MB15; remote frames: the first free remote-frame mailbox (ACAN §9).
-    /// Free means code `INACTIVE` and its `IFLAG1` bit clear (settled). Refused with
-    /// [`Error::WrongMode`] in listen-only mode and while disabled (sleep).
+    /// As [`Hardware::free_mailbox_now`], but only while no transmit mailbox is loaded
+    /// or unsettled: the request order holds across the data mailbox and the
+    /// remote-frame mailboxes, among which the module picks by identifier, ties lowest
+    /// mailbox first (Kinetis RM, "Arbitration process", `CTRL1[LBUF]` = 0), so one
+    /// frame of the request order is in a mailbox at a time — as data frames always
+    /// were, MB15 being their one mailbox. Refused with [`Error::WrongMode`] in
+    /// listen-only mode and while disabled (sleep).
     #[inline(always)]
     fn free_mailbox(&self, frame: &Frame) -> Result<Option<u8>, Error> {
-        if self.bus_mode.load(Ordering::Relaxed) == bus_mode_code(BusMode::ListenOnly)
-            || self.mode() == MODE_SLEEP
-        {
-            return Err(Error::WrongMode);
+        self.check_can_send()?;
+        if self.loaded.load(Ordering::Relaxed) != 0 {
+            return Ok(None);
         }
-        // The control word first, then the flag: a mailbox reading INACTIVE stays so
-        // until someone loads it, so a clear flag read after it means "settled". (Read
-        // the other way round, a frame ending between the two reads would look free
-        // with its completion unsettled, and the load would overwrite its token.)
-        let free = |mb: usize| {
-            cs::CODE.get(self.regs.read32(regs::mb_cs(mb))) == code::TX_INACTIVE
-                && self.regs.read32(IFLAG1) & iflag1::buf(mb) == 0
-        };
-        if !frame.is_remote() {
-            let mb = DATA_MAILBOX as usize;
-            return Ok(free(mb).then_some(DATA_MAILBOX));
-        }
-        let first = self.configuration().first_remote_mailbox() as usize;
-        Ok((first..DATA_MAILBOX as usize)
-            .find(|&mb| free(mb))
-            .map(|mb| mb as u8))
+        self.free_now(frame)
     }
 
+    /// Data frames: MB15; remote frames: the first free remote-frame mailbox (ACAN §9),
+    /// whatever else is loaded. Free means code `INACTIVE` and its `IFLAG1` bit clear
+    /// (settled). Refused with [`Error::WrongMode`] in listen-only mode and while
+    /// disabled (sleep).
+    fn free_mailbox_now(&self, frame: &Frame) -> Result<Option<u8>, Error> {
+        self.check_can_send()?;
+        self.free_now(frame)
+    }
     /// Identifier and data first, the control word (CODE `DATA`) last (Kinetis RM,
     /// "Transmit process").
     #[inline(always)]
@@ -403,6 +507,7 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
         }
         let ended = self.regs.read32(IFLAG1) & self.tx_bits();
         if ended == 0 {
+            self.retry_aborts();
             return;
         }
         let mut out = [(
@@ -468,6 +573,7 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
         for (_, c) in out.iter() {
             f(Settled::Done(*c));
         }
+        self.retry_aborts();
     }
 
     /// MB15 (data) and the remote-frame mailboxes.
@@ -497,40 +603,63 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
         }
     }
 
-    /// Writes code `ABORT` into the loaded mailbox holding `token` (Kinetis RM,
-    /// "Transmission abort mechanism"); the outcome comes with its `IFLAG1` bit.
+    /// Aborts the pending mailbox holding `token` ([`FlexCanHw`]'s `abort_mailboxes`:
+    /// code `ABORT`, Kinetis RM "Transmission abort mechanism", written only while the
+    /// module transmits nothing, which [`Hardware::prepare_abort`] waited for); the
+    /// outcome comes with its `IFLAG1` bit. `false` when
+    /// no mailbox holds it pending (never loaded, or ended: its completion comes from
+    /// `settle`).
     unsafe fn request_abort(&self, token: Token) -> bool {
         if self.mode() == MODE_SLEEP {
             return false;
         }
-        let flags = self.regs.read32(IFLAG1);
+        let loaded = self.loaded.load(Ordering::Relaxed);
         let first = self.configuration().first_remote_mailbox() as usize;
-        for mb in first..=DATA_MAILBOX as usize {
-            let control = self.regs.read32(regs::mb_cs(mb));
-            let loaded = flags & iflag1::buf(mb) == 0 && cs::CODE.get(control) == code::TX_DATA;
-            if loaded && self.tokens[DATA_MAILBOX as usize - mb].load(Ordering::Acquire) == token.0
-            {
-                self.regs
-                    .write32(regs::mb_cs(mb), cs::CODE.replace(control, code::TX_ABORT));
-                return true;
-            }
+        let holder = (first..=DATA_MAILBOX as usize).find(|&mb| {
+            loaded & (1 << mb) != 0
+                && self.tokens[DATA_MAILBOX as usize - mb].load(Ordering::Acquire) == token.0
+        });
+        match holder {
+            Some(mb) => self.abort_mailboxes(1 << mb) != 0,
+            None => false,
         }
-        false
     }
 
+    /// When a transmit mailbox holding `token` (any, for `None`) is loaded: polls
+    /// `ESR1[TX]` until the module transmits nothing, at most the acknowledge bound
+    /// (the time of a frame in flight at the bit rate in force), so that the abort
+    /// written next cannot race the end of a transmission (`abort_mailboxes`). Its error
+    /// bits are kept for the status handler.
+    fn prepare_abort(&self, token: Option<Token>) {
+        if self.mode() == MODE_SLEEP {
+            return;
+        }
+        let loaded = self.loaded.load(Ordering::Relaxed);
+        let ours = match token {
+            None => loaded != 0,
+            Some(t) => (0..=DATA_MAILBOX as usize).any(|mb| {
+                loaded & (1 << mb) != 0
+                    && self.tokens[DATA_MAILBOX as usize - mb].load(Ordering::Acquire) == t.0
+            }),
+        };
+        if !ours {
+            return;
+        }
+        for _ in 0..self.polls.load(Ordering::Relaxed) {
+            let esr = self.regs.read32(ESR1);
+            self.keep_unreported(esr);
+            if esr & esr1::TX == 0 {
+                return;
+            }
+        }
+    }
+
+    /// Aborts every pending transmit mailbox (see `request_abort`).
     unsafe fn abort_all_mailboxes(&self) {
         if self.mode() == MODE_SLEEP {
             return;
         }
-        let flags = self.regs.read32(IFLAG1);
-        let first = self.configuration().first_remote_mailbox() as usize;
-        for mb in first..=DATA_MAILBOX as usize {
-            let control = self.regs.read32(regs::mb_cs(mb));
-            if flags & iflag1::buf(mb) == 0 && cs::CODE.get(control) == code::TX_DATA {
-                self.regs
-                    .write32(regs::mb_cs(mb), cs::CODE.replace(control, code::TX_ABORT));
-            }
-        }
+        self.abort_mailboxes(self.loaded.load(Ordering::Relaxed) & self.tx_bits());
     }
 
     /// `IFLAG1.BUF5I`: reads the Rx FIFO output (control/status first, Kinetis RM "Rx

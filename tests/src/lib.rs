@@ -4,6 +4,8 @@
 //! - [`backend`]: one trait ([`backend::Backend`], [`backend::Dut`]) over a FlexCAN node
 //!   and a bxCAN node of the host harness, so that the cross-controller suites are written
 //!   once and run on both controllers;
+//! - [`preempt`]: the transmit interrupt (and the others) preempting the thread at every
+//!   register access of `try_send` and `abort`, on both controllers;
 //! - [`load`]: the full-load runner (back-to-back frames, interrupt serviced after a
 //!   random latency, losses predicted from the FIFO depth and checked exactly);
 //! - [`rng`]: a tiny seeded generator;
@@ -12,6 +14,7 @@
 pub mod app_bus;
 pub mod backend;
 pub mod load;
+pub mod preempt;
 pub mod rng;
 pub mod support;
 
