@@ -14,8 +14,8 @@ use common::*;
 use twocan_bxcan::model::BxCanModel;
 use twocan_bxcan::regs::{fmr, FMR};
 use twocan_bxcan::{BxCan, Can, PlanOptions};
-use twocan_core::sim::SimNode;
 use twocan_core::{FifoQueue, Filter, Frame, Registers, State};
+use twocan_sim::SimNode;
 
 type Hook = Rc<RefCell<Option<Box<dyn FnMut()>>>>;
 

@@ -15,13 +15,13 @@ mod common;
 
 use common::*;
 use twocan_bxcan::BxCan;
-use twocan_core::sim::BusNode;
 use twocan_core::{
     AbortRequest, Completion, Driver, Frame, MailboxId, MailboxState, Token, TxOutcome, TxPolicy,
 };
+use twocan_sim::BusNode;
 
 /// The frames the peer received, in bus order.
-fn wire(peer: &std::rc::Rc<std::cell::RefCell<twocan_core::sim::SimNode>>) -> Vec<Frame> {
+fn wire(peer: &std::rc::Rc<std::cell::RefCell<twocan_sim::SimNode>>) -> Vec<Frame> {
     peer.borrow().received_frames()
 }
 

@@ -7,9 +7,9 @@
 mod common;
 
 use common::*;
-use twocan_core::sim::SimNode;
 use twocan_core::Frame;
 use twocan_flexcan::Settings;
+use twocan_sim::SimNode;
 
 /// Submits `frames` through `try_send` (waiting for room as needed) to a peer on the
 /// bus and gives what the peer received, in bus order.
@@ -79,7 +79,7 @@ fn try_send_now_still_takes_any_free_remote_mailbox() {
 }
 
 /// Runs bit by bit until the bus is inside a frame (bounded).
-fn until_in_frame(bus: &mut twocan_core::sim::Bus) {
+fn until_in_frame(bus: &mut twocan_sim::Bus) {
     for _ in 0..200 {
         if bus.in_frame() {
             return;

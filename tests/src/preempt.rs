@@ -40,7 +40,6 @@ use std::rc::Rc;
 
 use twocan_bxcan::model::BxCanModel;
 use twocan_bxcan::{BxCan, Can, Config as BxConfig, PlanOptions};
-use twocan_core::sim::{Bus, PollClock, SharedBus, SimNode};
 use twocan_core::split::{Rx, Tx};
 use twocan_core::txqueue::TxQueue;
 use twocan_core::{
@@ -49,6 +48,7 @@ use twocan_core::{
 };
 use twocan_flexcan::model::FlexCanModel;
 use twocan_flexcan::{FlexCan, FlexCanHw, HostSystem, Settings};
+use twocan_sim::{Bus, PollClock, SharedBus, SimNode};
 
 /// Receive ring capacity (both queues) of the rigs.
 pub const RX: usize = 16;

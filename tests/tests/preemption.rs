@@ -174,7 +174,7 @@ fn flexcan_abort_during_a_retry_loop_takes_effect() {
     // transmit-half call after it (the split handlers: the error line runs the status
     // handler only).
     let mut rig =
-        flexcan_rig_with::<FifoQueue<4>>(twocan_core::sim::SimNode::new().with_listen_only(true));
+        flexcan_rig_with::<FifoQueue<4>>(twocan_sim::SimNode::new().with_listen_only(true));
     let f = Frame::standard(0x123, &[1]).unwrap();
     let t = rig.tx.try_send(&f).unwrap();
     rig.bus.borrow_mut().run_bits(300);
