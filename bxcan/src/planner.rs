@@ -774,7 +774,11 @@ const fn add(s: u8, c: usize, count: u8) -> (u32, u8) {
 /// the one with the smallest tie-break weight ([`WEIGHT`]) is chosen.
 const fn solve(p: &Problem, s: &mut SolveScratch, best_classes: &mut [u8; ITEMS]) -> (u16, bool) {
     let n = p.n;
-    s.relax[n] = [0; STATES];
+    let mut st = 0;
+    while st < STATES {
+        s.relax[n][st] = 0;
+        st += 1;
+    }
     let mut j = n;
     while j > 0 {
         j -= 1;
@@ -803,13 +807,17 @@ const fn solve(p: &Problem, s: &mut SolveScratch, best_classes: &mut [u8; ITEMS]
     }
 
     // Seed: every filter in a 32-bit mask bank (always valid).
-    *best_classes = [M32 as u8; ITEMS];
+    let mut i = 0;
+    while i < ITEMS {
+        best_classes[i] = M32 as u8;
+        s.classes[i] = 0;
+        i += 1;
+    }
     let mut best_cost = n as u32 * (SCALE + WEIGHT[M32]);
     if best_cost == bound {
         return (banks(best_cost), true);
     }
 
-    s.classes = [0; ITEMS];
     s.tried[0] = 0;
     s.state[0] = 0;
     s.cost[0] = 0;
@@ -961,8 +969,12 @@ const fn layout<const K: usize>(
 ) -> Result<(), PlanError> {
     let p = &a.problem;
     out.reset();
-    lay.bank_of = [[0; 4]; ITEMS];
-    lay.bank_count_of = [0; ITEMS];
+    let mut j = 0;
+    while j < ITEMS {
+        lay.bank_of[j] = [0; 4];
+        lay.bank_count_of[j] = 0;
+        j += 1;
+    }
     let mut c = 0;
     while c < CLASSES {
         let cap = CAP[c] as usize;
@@ -1926,5 +1938,93 @@ mod tests {
             .collect();
         assert_eq!(words, want);
         assert!(e[..n].iter().all(|e| e.user == 7));
+    }
+}
+
+/// The run-time planner's stack: every value [`plan_in`] and the functions it calls
+/// hold by value is small (the tables are in the [`Scratch`]).
+#[cfg(test)]
+mod stack {
+    use super::*;
+    use core::mem::size_of;
+    use twocan_core::filter_set::Key;
+
+    #[test]
+    fn by_value_types_on_the_run_time_path_are_small() {
+        let sizes: [(&str, usize); 22] = [
+            ("&[Filter]", size_of::<&[Filter]>()),
+            ("PlanOptions", size_of::<PlanOptions>()),
+            ("PlanError", size_of::<PlanError>()),
+            (
+                "Result<&FilterPlan, PlanError>",
+                size_of::<Result<&FilterPlan, PlanError>>(),
+            ),
+            ("Filter", size_of::<Filter>()),
+            ("Item", size_of::<Item>()),
+            ("Entry", size_of::<Entry>()),
+            ("([Entry; 4], usize)", size_of::<([Entry; 4], usize)>()),
+            ("[Entry; 4] (pending)", size_of::<[Entry; 4]>()),
+            ("Cube", size_of::<Cube>()),
+            ("Option<Cube>", size_of::<Option<Cube>>()),
+            ("Option<(u64, Cube)>", size_of::<Option<(u64, Cube)>>()),
+            ("Bank", size_of::<Bank>()),
+            ("[u16; STATES] (relaxed)", size_of::<[u16; STATES]>()),
+            ("[u8; CLASSES]", size_of::<[u8; CLASSES]>()),
+            (
+                "Option<(u32, usize, u32, u8)> (search pick)",
+                size_of::<Option<(u32, usize, u32, u8)>>(),
+            ),
+            (
+                "Option<(Fifo, u8, u16)>",
+                size_of::<Option<(Fifo, u8, u16)>>(),
+            ),
+            ("PlanRef", size_of::<crate::filters::PlanRef<'static>>()),
+            ("([Key; 2], usize)", size_of::<([Key; 2], usize)>()),
+            ("[u16; 4] (users)", size_of::<[u16; 4]>()),
+            ("[usize; 2] (fmi counters)", size_of::<[usize; 2]>()),
+            (
+                "Result<u16, PlanError>",
+                size_of::<Result<u16, PlanError>>(),
+            ),
+        ];
+        for (name, size) in sizes {
+            println!("{name}: {size} B");
+            assert!(size <= 128, "{name}: {size} B");
+        }
+        // What is not by value: the scratch (in a `static`) and the plan (in it).
+        println!("Scratch<64>: {} B", size_of::<Scratch>());
+        println!("FilterPlan<64>: {} B", size_of::<FilterPlan>());
+        assert!(size_of::<FilterPlan>() < 1024);
+    }
+
+    /// The largest list of the DBC corpus (367 identifiers, 365 extended) in superset
+    /// mode, the scratch boxed, on a thread with a 64 KiB stack (debug builds' frames
+    /// included): the planning call's stack does not grow with the list.
+    #[test]
+    fn plan_in_runs_on_a_small_stack() {
+        let list: Vec<Filter> = (0..367u32)
+            .map(|i| Filter::extended(0x0C00_0000 + i * 0x1_0203))
+            .collect();
+        // Made here (a `static` in firmware): `Box::default` builds it on this stack.
+        // Room for every key: the superset plan looks all of them up.
+        let mut scratch: Box<Scratch<MAX_LOOKUP_KEYS>> = Box::default();
+        let t = std::thread::Builder::new()
+            .stack_size(64 * 1024)
+            .spawn(move || {
+                let p = plan_in(&list, PlanOptions::new(28).superset(true), &mut scratch);
+                p.map(|p| p.bank_count())
+            })
+            .unwrap();
+        let r = t.join().unwrap();
+        assert!(matches!(r, Ok(b) if b <= 28), "{r:?}");
+        // With the default capacity the same list is refused, naming the keys.
+        let list: Vec<Filter> = (0..367u32)
+            .map(|i| Filter::extended(0x0C00_0000 + i * 0x1_0203))
+            .collect();
+        let mut small: Box<Scratch> = Box::default();
+        assert!(matches!(
+            plan_in(&list, PlanOptions::new(28).superset(true), &mut small),
+            Err(PlanError::TooManyLookupKeys { max: 64, .. })
+        ));
     }
 }

@@ -66,7 +66,12 @@ pub const fn id_bits(k: Key) -> u32 {
 
 /// The first index of the ascending `keys` whose key is `>= x` (`keys.len()` if none).
 pub const fn lower_bound(keys: &[Key], x: Key) -> usize {
-    let (mut lo, mut hi) = (0, keys.len());
+    lower_bound_in(keys, keys.len(), x)
+}
+
+/// [`lower_bound`] over `keys[..n]` (no sub-slice made: cheaper in `const` code).
+const fn lower_bound_in(keys: &[Key], n: usize, x: Key) -> usize {
+    let (mut lo, mut hi) = (0, n);
     while lo < hi {
         let mid = lo + (hi - lo) / 2;
         if keys[mid] < x {
@@ -80,7 +85,12 @@ pub const fn lower_bound(keys: &[Key], x: Key) -> usize {
 
 /// The first index of the ascending `keys` whose key is `> x` (`keys.len()` if none).
 pub const fn upper_bound(keys: &[Key], x: Key) -> usize {
-    let (mut lo, mut hi) = (0, keys.len());
+    upper_bound_in(keys, keys.len(), x)
+}
+
+/// [`upper_bound`] over `keys[..n]`.
+const fn upper_bound_in(keys: &[Key], n: usize, x: Key) -> usize {
+    let (mut lo, mut hi) = (0, n);
     while lo < hi {
         let mid = lo + (hi - lo) / 2;
         if keys[mid] <= x {
@@ -248,7 +258,7 @@ impl<const N: usize> KeyTable<N> {
     /// Adds `k` for `user`; a key already present keeps its first user.
     pub const fn insert(&mut self, k: Key, user: u16) -> Result<(), Full> {
         let n = self.len();
-        let at = lower_bound(self.keys(), k);
+        let at = lower_bound_in(&self.keys, n, k);
         if at < n && self.keys[at] == k {
             return Ok(());
         }
@@ -301,9 +311,9 @@ impl<const N: usize> KeyTable<N> {
 
     /// The position of `k` in [`KeyTable::keys`], `None` if absent.
     pub const fn position(&self, k: Key) -> Option<usize> {
-        let keys = self.keys();
-        let at = lower_bound(keys, k);
-        if at < keys.len() && keys[at] == k {
+        let n = self.len as usize;
+        let at = lower_bound_in(&self.keys, n, k);
+        if at < n && self.keys[at] == k {
             Some(at)
         } else {
             None
@@ -326,8 +336,11 @@ impl<const N: usize> KeyTable<N> {
     /// The range of [`KeyTable::keys`] between `c`'s lowest and highest key: every key
     /// of the table that `c` may hold is in it.
     pub const fn span(&self, c: &Cube) -> (usize, usize) {
-        let keys = self.keys();
-        (lower_bound(keys, c.base), upper_bound(keys, c.base | c.dc))
+        let n = self.len as usize;
+        (
+            lower_bound_in(&self.keys, n, c.base),
+            upper_bound_in(&self.keys, n, c.base | c.dc),
+        )
     }
 
     /// How many keys of the table `c` holds (a scan of the keys between the cube's
@@ -336,7 +349,7 @@ impl<const N: usize> KeyTable<N> {
         let (mut i, end) = self.span(c);
         let mut n = 0;
         while i < end {
-            if c.contains(self.keys[i]) {
+            if self.keys[i] & !c.dc == c.base {
                 n += 1;
             }
             i += 1;
@@ -346,7 +359,23 @@ impl<const N: usize> KeyTable<N> {
 
     /// Whether every key of `c` is in the table.
     pub const fn holds(&self, c: &Cube) -> bool {
-        c.size() <= self.len() as u64 && self.count_in(c) == c.size()
+        let size = c.size();
+        if size > self.len() as u64 {
+            return false;
+        }
+        let (mut i, end) = self.span(c);
+        // Fewer keys between its lowest and highest than it has: not all there.
+        if ((end - i) as u64) < size {
+            return false;
+        }
+        let mut n = 0;
+        while i < end {
+            if self.keys[i] & !c.dc == c.base {
+                n += 1;
+            }
+            i += 1;
+        }
+        n == size
     }
 
     /// Whether the users of `c`'s keys in the table are all one user (returned).
@@ -618,6 +647,8 @@ impl WalkFrame {
 struct SearchFrame {
     /// The uncovered key branched on (index in the key table).
     key: u16,
+    /// Its position in the branching order (every key before it is covered here).
+    pos: u16,
     /// The next candidate cube to try.
     next: u16,
     /// The branch in progress: a candidate, [`SINGLE_CHILD`] or [`NO_CHILD`].
@@ -629,6 +660,7 @@ struct SearchFrame {
 impl SearchFrame {
     const ZERO: SearchFrame = SearchFrame {
         key: 0,
+        pos: 0,
         next: 0,
         child: 0,
         cost: 0,
@@ -641,6 +673,9 @@ const SINGLE_CHILD: u16 = u16::MAX - 1;
 /// Marker in `chosen` for "this key alone" (a single), as `SINGLE_BASE + key index`.
 const SINGLE_BASE: u16 = 0x8000;
 
+/// Room for the (key, candidate) incidences of [`min_cover`]'s search.
+const INCIDENCE: usize = 4096;
+
 /// Working memory of [`exact_cover`], [`min_cover`] and [`CubeList::extra`]: the
 /// candidate cubes, the search's per-key tables and the stacks of the (formerly
 /// recursive) searches. All zeros when new: a `static` of it takes no flash.
@@ -650,10 +685,18 @@ pub struct CoverScratch {
     covered: [u64; MAX_KEYS / 64],
     share: [u32; MIN_COVER_KEYS],
     options: [u16; MIN_COVER_KEYS],
+    order: [u16; MIN_COVER_KEYS],
     count: [u16; MIN_COVER_KEYS],
     chosen: [u16; MIN_COVER_KEYS],
     best_set: [u16; MIN_COVER_KEYS],
     frames: [SearchFrame; MIN_COVER_KEYS],
+    /// Each candidate's keys lie in `keys[cand_lo..cand_hi]`.
+    cand_lo: [u16; MAX_CUBES],
+    cand_hi: [u16; MAX_CUBES],
+    /// The candidates holding key `i`, ascending: `incidence[start[i]..start[i + 1]]`
+    /// (when they fit; the search scans the candidates otherwise).
+    incidence_start: [u16; MIN_COVER_KEYS + 1],
+    incidence: [u16; INCIDENCE],
     walk: [WalkFrame; 32],
     split: [(Cube, u16); SPLIT_DEPTH],
 }
@@ -672,10 +715,15 @@ impl CoverScratch {
             covered: [0; MAX_KEYS / 64],
             share: [0; MIN_COVER_KEYS],
             options: [0; MIN_COVER_KEYS],
+            order: [0; MIN_COVER_KEYS],
             count: [0; MIN_COVER_KEYS],
             chosen: [0; MIN_COVER_KEYS],
             best_set: [0; MIN_COVER_KEYS],
             frames: [SearchFrame::ZERO; MIN_COVER_KEYS],
+            cand_lo: [0; MAX_CUBES],
+            cand_hi: [0; MAX_CUBES],
+            incidence_start: [0; MIN_COVER_KEYS + 1],
+            incidence: [0; INCIDENCE],
             walk: [WalkFrame::ZERO; 32],
             split: [(Cube::ZERO, 0); SPLIT_DEPTH],
         }
@@ -760,26 +808,42 @@ pub const fn exact_cover<const N: usize>(
         covered[w] = 0;
         w += 1;
     }
+    // Each candidate's keys lie in `k[lo..hi]`. A candidate's gain only falls as keys
+    // are covered: one below `min_gain` (a taken one among them) is out for good, its
+    // range emptied.
+    let nc = cands.len();
+    let mut ci = 0;
+    while ci < nc {
+        let (lo, hi) = keys.span(&cands.cubes[ci]);
+        scratch.cand_lo[ci] = lo as u16;
+        scratch.cand_hi[ci] = hi as u16;
+        ci += 1;
+    }
     loop {
         // (gain, candidate) of the first candidate covering the most uncovered keys.
         let mut best: Option<(u64, usize)> = None;
         let mut ci = 0;
-        while ci < cands.len() {
-            let c = cands.get(ci);
-            let (mut i, end) = keys.span(&c);
+        while ci < nc {
+            let c = cands.cubes[ci];
+            let mut i = scratch.cand_lo[ci] as usize;
+            let end = scratch.cand_hi[ci] as usize;
             let mut gain = 0u64;
             while i < end {
-                if c.contains(k[i]) && !is_covered(covered, i) {
+                if k[i] & !c.dc == c.base && !is_covered(covered, i) {
                     gain += 1;
                 }
                 i += 1;
             }
-            let better = match best {
-                None => true,
-                Some((g, _)) => gain > g,
-            };
-            if gain >= min_gain && better {
-                best = Some((gain, ci));
+            if gain < min_gain {
+                scratch.cand_hi[ci] = scratch.cand_lo[ci];
+            } else {
+                let better = match best {
+                    None => true,
+                    Some((g, _)) => gain > g,
+                };
+                if better {
+                    best = Some((gain, ci));
+                }
             }
             ci += 1;
         }
@@ -787,14 +851,13 @@ pub const fn exact_cover<const N: usize>(
             Some((_, ci)) => ci,
             None => break,
         };
-        let c = cands.get(ci);
-        cands.remove(ci);
+        let c = cands.cubes[ci];
         if let Err(e) = out.push(c) {
             return Err(e);
         }
-        let (mut i, end) = keys.span(&c);
-        while i < end {
-            if c.contains(k[i]) {
+        let mut i = scratch.cand_lo[ci] as usize;
+        while i < scratch.cand_hi[ci] as usize {
+            if k[i] & !c.dc == c.base {
                 covered[i / 64] |= 1 << (i % 64);
             }
             i += 1;
@@ -873,21 +936,32 @@ const fn maximal_cubes_of<const N: usize>(
     }
 }
 
-/// Adds (`add`) or removes one cover count of every key of `c`.
+/// Adds (`add`) or removes one cover count of every key of `c` (whose keys lie in
+/// `keys[lo..hi]`), keeping `bound` (the shares of the uncovered keys) up to date.
+#[allow(clippy::too_many_arguments)]
 const fn mark<const N: usize>(
     keys: &KeyTable<N>,
     c: &Cube,
+    lo: usize,
+    hi: usize,
     count: &mut [u16; MIN_COVER_KEYS],
+    share: &[u32; MIN_COVER_KEYS],
+    bound: &mut u32,
     add: bool,
 ) {
-    let k = keys.keys();
-    let (mut i, end) = keys.span(c);
-    while i < end {
-        if c.contains(k[i]) {
+    let mut i = lo;
+    while i < hi {
+        if keys.keys[i] & !c.dc == c.base {
             if add {
+                if count[i] == 0 {
+                    *bound -= share[i];
+                }
                 count[i] += 1;
             } else {
                 count[i] -= 1;
+                if count[i] == 0 {
+                    *bound += share[i];
+                }
             }
         }
         i += 1;
@@ -932,24 +1006,85 @@ pub const fn min_cover<const N: usize>(
     // candidates hold it (the search branches on the key with the fewest).
     let mut i = 0;
     while i < n {
-        let mut share = single * 1024;
-        let mut options = 0u16;
+        s.share[i] = single * 1024;
+        s.options[i] = 0;
+        s.count[i] = 0;
+        i += 1;
+    }
+    let mut ci = 0;
+    while ci < nc {
+        let c = s.cands.cubes[ci];
+        let (lo, hi) = keys.span(&c);
+        s.cand_lo[ci] = lo as u16;
+        s.cand_hi[ci] = hi as u16;
+        let held = keys.count_in(&c);
+        let per = (block * 1024) / if held == 0 { 1 } else { held as u32 };
+        let mut x = lo;
+        while x < hi {
+            if keys.keys[x] & !c.dc == c.base {
+                if per < s.share[x] {
+                    s.share[x] = per;
+                }
+                s.options[x] += 1;
+            }
+            x += 1;
+        }
+        ci += 1;
+    }
+    // The candidates of each key, ascending.
+    let mut total = 0usize;
+    let mut i = 0;
+    while i < n {
+        s.incidence_start[i] = if total > u16::MAX as usize {
+            u16::MAX
+        } else {
+            total as u16
+        };
+        total += s.options[i] as usize;
+        i += 1;
+    }
+    let listed = total <= INCIDENCE;
+    if listed {
+        s.incidence_start[n] = total as u16;
+        // `count` is the fill of each key's list here (zero again below).
         let mut ci = 0;
         while ci < nc {
-            let c = s.cands.get(ci);
-            if c.contains(k[i]) {
-                let held = keys.count_in(&c);
-                let per = (block * 1024) / if held == 0 { 1 } else { held as u32 };
-                if per < share {
-                    share = per;
+            let c = s.cands.cubes[ci];
+            let mut x = s.cand_lo[ci] as usize;
+            while x < s.cand_hi[ci] as usize {
+                if keys.keys[x] & !c.dc == c.base {
+                    s.incidence[s.incidence_start[x] as usize + s.count[x] as usize] = ci as u16;
+                    s.count[x] += 1;
                 }
-                options += 1;
+                x += 1;
             }
             ci += 1;
         }
-        s.share[i] = share;
-        s.options[i] = options;
-        s.count[i] = 0;
+        let mut i = 0;
+        while i < n {
+            s.count[i] = 0;
+            i += 1;
+        }
+    }
+    // The search branches on the uncovered key held by the fewest candidates (the
+    // lowest index among equals): the first uncovered key in this order.
+    let mut i = 0;
+    while i < n {
+        let x = i as u16;
+        let mut j = i;
+        while j > 0 && s.options[s.order[j - 1] as usize] > s.options[i] {
+            s.order[j] = s.order[j - 1];
+            j -= 1;
+        }
+        s.order[j] = x;
+        i += 1;
+    }
+    // The least weight the uncovered keys can still add (scaled by 1024), kept up to
+    // date as keys are covered and uncovered.
+    let mut bound = 0u32;
+    let mut i = 0;
+    while i < n {
+        bound += s.share[i];
         i += 1;
     }
     let mut best = seed_weight;
@@ -957,52 +1092,39 @@ pub const fn min_cover<const N: usize>(
     let mut depth = 0usize;
     let mut nodes = 0u32;
     let mut sp = 0usize;
-    // The pending call of the search (its cost), as the recursion `go(cost)` was.
-    let mut call: Option<u32> = Some(0);
+    // The pending call of the search (its cost, and where its scan for an uncovered
+    // key starts: every key before the caller's is covered), as the recursion
+    // `go(cost)` was.
+    let mut call: Option<(u32, usize)> = Some((0, 0));
     loop {
-        if let Some(cost) = call {
+        if let Some((cost, start)) = call {
             call = None;
             nodes += 1;
             if nodes > budget {
                 // Every later call would return at once: nothing changes any more.
                 break;
             }
-            let mut bound = 0u32;
-            let mut pick: Option<(usize, u16)> = None;
-            let mut i = 0;
-            while i < n {
-                if s.count[i] == 0 {
-                    bound += s.share[i];
-                    let o = s.options[i];
-                    let fewer = match pick {
-                        None => true,
-                        Some((_, p)) => o < p,
-                    };
-                    if fewer {
-                        pick = Some((i, o));
-                    }
-                }
-                i += 1;
+            let mut p = start;
+            while p < n && s.count[s.order[p] as usize] != 0 {
+                p += 1;
             }
             if cost * 1024 + bound < best * 1024 {
-                match pick {
-                    None => {
-                        best = cost;
-                        s.best_set
-                            .split_at_mut(depth)
-                            .0
-                            .copy_from_slice(s.chosen.split_at(depth).0);
-                        best_len = depth;
-                    }
-                    Some((i, _)) => {
-                        s.frames[sp] = SearchFrame {
-                            key: i as u16,
-                            next: 0,
-                            child: NO_CHILD,
-                            cost,
-                        };
-                        sp += 1;
-                    }
+                if p == n {
+                    best = cost;
+                    s.best_set
+                        .split_at_mut(depth)
+                        .0
+                        .copy_from_slice(s.chosen.split_at(depth).0);
+                    best_len = depth;
+                } else {
+                    s.frames[sp] = SearchFrame {
+                        key: s.order[p],
+                        pos: p as u16,
+                        next: 0,
+                        child: NO_CHILD,
+                        cost,
+                    };
+                    sp += 1;
                 }
             }
         }
@@ -1016,32 +1138,56 @@ pub const fn min_cover<const N: usize>(
             // Both kinds of branch done: this level returns.
             depth -= 1;
             s.count[ki] -= 1;
+            bound += s.share[ki];
             sp -= 1;
             continue;
         }
         if f.child != NO_CHILD {
             depth -= 1;
-            let c = s.cands.get(f.child as usize);
-            mark(keys, &c, &mut s.count, false);
+            let ci = f.child as usize;
+            let c = s.cands.cubes[ci];
+            let (lo, hi) = (s.cand_lo[ci] as usize, s.cand_hi[ci] as usize);
+            mark(keys, &c, lo, hi, &mut s.count, &s.share, &mut bound, false);
         }
-        let mut ci = f.next as usize;
-        while ci < nc && !s.cands.get(ci).contains(k[ki]) {
-            ci += 1;
-        }
-        if ci < nc {
-            let c = s.cands.get(ci);
-            mark(keys, &c, &mut s.count, true);
+        // The next candidate holding the key: from its list, or by a scan.
+        let mut next = f.next as usize;
+        let found = if listed {
+            if next < s.options[ki] as usize {
+                let ci = s.incidence[s.incidence_start[ki] as usize + next] as usize;
+                next += 1;
+                Some(ci)
+            } else {
+                None
+            }
+        } else {
+            let mut ci = next;
+            while ci < nc && !s.cands.cubes[ci].contains(k[ki]) {
+                ci += 1;
+            }
+            next = ci + 1;
+            if ci < nc {
+                Some(ci)
+            } else {
+                None
+            }
+        };
+        if let Some(ci) = found {
+            let c = s.cands.cubes[ci];
+            let (lo, hi) = (s.cand_lo[ci] as usize, s.cand_hi[ci] as usize);
+            mark(keys, &c, lo, hi, &mut s.count, &s.share, &mut bound, true);
             s.chosen[depth] = ci as u16;
             depth += 1;
-            s.frames[top].next = (ci + 1) as u16;
+            s.frames[top].next = next as u16;
             s.frames[top].child = ci as u16;
-            call = Some(f.cost + block);
+            call = Some((f.cost + block, f.pos as usize));
         } else {
+            // The key was uncovered when picked, and its blocks are undone.
             s.count[ki] += 1;
+            bound -= s.share[ki];
             s.chosen[depth] = SINGLE_BASE + ki as u16;
             depth += 1;
             s.frames[top].child = SINGLE_CHILD;
-            call = Some(f.cost + single);
+            call = Some((f.cost + single, f.pos as usize));
         }
     }
     let finished = nodes <= budget && complete;

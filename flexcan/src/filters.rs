@@ -405,19 +405,30 @@ impl<const K: usize> FilterTable<K> {
         let capacity_s = configuration.secondary_filter_capacity();
         let (np, ns) = (primary.len(), secondary.len());
         let global_mask = if ns == 0 { FULL_MASK } else { global_mask };
-        *self = FilterTable {
-            configuration,
-            elements: [0; MAX_TABLE_ELEMENTS],
-            individual_masks: [FULL_MASK; MAX_PRIMARY_FILTERS],
-            global_mask,
-            hits: [Hit::Filter(0); MAX_TABLE_ELEMENTS],
-            secondary: [Filter::pass_all(); MAX_SECONDARY_FILTERS],
-            primary_count: np as u8,
-            secondary_count: 0,
-            keys: KeyTable::new(),
-            extra,
-            reject_all: np == 0 && ns == 0,
-        };
+        // Field by field: no table-sized value on the stack.
+        self.configuration = configuration;
+        self.global_mask = global_mask;
+        self.primary_count = np as u8;
+        self.secondary_count = 0;
+        self.keys.clear();
+        self.extra = extra;
+        self.reject_all = np == 0 && ns == 0;
+        let mut i = 0;
+        while i < MAX_TABLE_ELEMENTS {
+            self.elements[i] = 0;
+            self.hits[i] = Hit::Filter(0);
+            i += 1;
+        }
+        let mut i = 0;
+        while i < MAX_PRIMARY_FILTERS {
+            self.individual_masks[i] = FULL_MASK;
+            i += 1;
+        }
+        let mut i = 0;
+        while i < MAX_SECONDARY_FILTERS {
+            self.secondary[i] = Filter::pass_all();
+            i += 1;
+        }
         let mut i = 0;
         while i < capacity_p {
             let (e, m, h) = if i < np {

@@ -815,29 +815,36 @@ const fn plan_into<const K: usize>(
     }
     // The configuration with the fewest extra identifiers.
     let mut best: Option<usize> = None;
+    let mut keys_refused: Option<PlanError> = None;
     let mut i = 0;
     while i < Configuration::ALL.len() {
         let t = match best {
             Some(b) => 1 - b,
             None => 0,
         };
-        if plan_for_configuration(s, Configuration::ALL[i], true, t).is_ok() {
-            let fewer = match best {
-                None => true,
-                Some(b) => s.tables[t].superset_extra() < s.tables[b].superset_extra(),
-            };
-            if fewer {
-                best = Some(t);
+        match plan_for_configuration(s, Configuration::ALL[i], true, t) {
+            Ok(()) => {
+                let fewer = match best {
+                    None => true,
+                    Some(b) => s.tables[t].superset_extra() < s.tables[b].superset_extra(),
+                };
+                if fewer {
+                    best = Some(t);
+                }
             }
+            Err(e @ PlanError::TooManyLookupKeys { .. }) => keys_refused = Some(e),
+            Err(_) => {}
         }
         i += 1;
     }
-    match best {
-        Some(b) => {
+    match (best, keys_refused) {
+        (Some(b), _) => {
             s.result = b;
             Ok(())
         }
-        None => plan_for_configuration(s, largest, false, 0),
+        // A superset fits the elements but not the lookup capacity: say so.
+        (None, Some(e)) => Err(e),
+        (None, None) => plan_for_configuration(s, largest, false, 0),
     }
 }
 
@@ -1183,5 +1190,78 @@ mod tests {
             }
         }
         assert_eq!(dropped, t.superset_extra());
+    }
+}
+
+/// The run-time planner's stack: every value [`plan_in`] and the functions it calls
+/// hold by value is small (the tables are in the [`Scratch`]).
+#[cfg(test)]
+mod stack {
+    use super::*;
+    use core::mem::size_of;
+
+    #[test]
+    fn by_value_types_on_the_run_time_path_are_small() {
+        let sizes: [(&str, usize); 12] = [
+            ("&[Filter]", size_of::<&[Filter]>()),
+            ("PlanOptions", size_of::<PlanOptions>()),
+            ("PlanError", size_of::<PlanError>()),
+            (
+                "Result<&FilterTable, PlanError>",
+                size_of::<Result<&FilterTable, PlanError>>(),
+            ),
+            ("Filter", size_of::<Filter>()),
+            ("Cube", size_of::<Cube>()),
+            ("Primary", size_of::<Primary>()),
+            ("PlannedPrimary", size_of::<PlannedPrimary>()),
+            ("(u32, Hit)", size_of::<(u32, Hit)>()),
+            (
+                "Option<(usize, usize)> (tune pick)",
+                size_of::<Option<(usize, usize)>>(),
+            ),
+            ("Configuration", size_of::<Configuration>()),
+            ("Result<(), PlanError>", size_of::<Result<(), PlanError>>()),
+        ];
+        for (name, size) in sizes {
+            println!("{name}: {size} B");
+            assert!(size <= 128, "{name}: {size} B");
+        }
+        println!("Scratch<64>: {} B", size_of::<Scratch>());
+        println!("FilterTable<64>: {} B", size_of::<FilterTable>());
+        assert!(size_of::<FilterTable>() < 1024);
+    }
+
+    fn filters_367() -> Vec<Filter> {
+        (0..367u32)
+            .map(|i| Filter::extended(0x0C00_0000 + i * 0x1_0203))
+            .collect()
+    }
+
+    /// The largest list of the DBC corpus's size (367 identifiers, 365 extended) in
+    /// superset mode, the scratch boxed, on a thread with a 64 KiB stack (debug builds'
+    /// frames included).
+    #[test]
+    fn plan_in_runs_on_a_small_stack() {
+        let list = filters_367();
+        // Room for every key: the superset table looks all of them up.
+        let mut scratch: Box<Scratch<MAX_LOOKUP_KEYS>> = Box::default();
+        let t = std::thread::Builder::new()
+            .stack_size(64 * 1024)
+            .spawn(move || {
+                plan_in(&list, PlanOptions::choose().superset(true), &mut scratch)
+                    .map(|t| (t.configuration(), t.superset_extra() > 0))
+            })
+            .unwrap();
+        assert_eq!(t.join().unwrap(), Ok((Configuration::Filters14_18, true)));
+        // With the default capacity the same list is refused, naming the keys.
+        let mut small: Box<Scratch> = Box::default();
+        assert!(matches!(
+            plan_in(
+                &filters_367(),
+                PlanOptions::choose().superset(true),
+                &mut small
+            ),
+            Err(PlanError::TooManyLookupKeys { max: 64, .. })
+        ));
     }
 }
