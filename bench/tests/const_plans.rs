@@ -147,7 +147,7 @@ const fn random_list<const N: usize>(seed: u64) -> [Filter; N] {
                     FrameKind::Data,
                     Format::Standard,
                     mask,
-                    (r >> 12) % 0x800 & mask,
+                    ((r >> 12) % 0x800) & mask,
                 )
             }
             8 => Filter::extended((r >> 4) & 0x1FFF_FFFF),

@@ -1995,6 +1995,12 @@ mod stack {
         println!("Scratch<64>: {} B", size_of::<Scratch>());
         println!("FilterPlan<64>: {} B", size_of::<FilterPlan>());
         assert!(size_of::<FilterPlan>() < 1024);
+        // A `const` plan: its banks, their slot users and its keys.
+        use crate::filters::SizedPlan;
+        println!("SizedPlan<1, 0>: {} B", size_of::<SizedPlan<1, 0>>());
+        println!("SizedPlan<2, 8>: {} B", size_of::<SizedPlan<2, 8>>());
+        println!("SizedPlan<28, 64>: {} B", size_of::<SizedPlan<28, 64>>());
+        assert_eq!(size_of::<SizedPlan<1, 0>>(), 32);
     }
 
     /// The largest list of the DBC corpus (367 identifiers, 365 extended) in superset

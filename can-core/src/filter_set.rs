@@ -204,11 +204,30 @@ pub struct Full;
 /// plan keeps only the keys its merged filters need to resolve, in a table sized for
 /// that (e.g. `twocan_bxcan::filters::LOOKUP_KEYS`, or exactly the keys of a `const`
 /// plan).
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Clone)]
 pub struct KeyTable<const N: usize = MAX_KEYS> {
     keys: [Key; N],
     users: [u16; N],
     len: u16,
+}
+
+/// Tables are equal when their keys and users are (whatever their capacities held
+/// before).
+impl<const N: usize> PartialEq for KeyTable<N> {
+    fn eq(&self, other: &Self) -> bool {
+        self.keys() == other.keys() && self.users() == other.users()
+    }
+}
+
+impl<const N: usize> Eq for KeyTable<N> {}
+
+impl<const N: usize> core::fmt::Debug for KeyTable<N> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("KeyTable")
+            .field("keys", &self.keys())
+            .field("users", &self.users())
+            .finish()
+    }
 }
 
 impl<const N: usize> Default for KeyTable<N> {
@@ -417,10 +436,25 @@ impl<const N: usize> KeyTable<N> {
 }
 
 /// A list of cubes.
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Clone)]
 pub struct CubeList {
     cubes: [Cube; MAX_CUBES],
     len: u16,
+}
+
+/// Lists are equal when their cubes are.
+impl PartialEq for CubeList {
+    fn eq(&self, other: &Self) -> bool {
+        self.as_slice() == other.as_slice()
+    }
+}
+
+impl Eq for CubeList {}
+
+impl core::fmt::Debug for CubeList {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_list().entries(self.as_slice()).finish()
+    }
 }
 
 impl Default for CubeList {

@@ -539,11 +539,7 @@ const fn tune(prep: &Prepared, cubes: &mut CubeList, capacity_s: usize) {
         }
         i += 1;
     }
-    let mut free = if capacity_s > singles {
-        capacity_s - singles
-    } else {
-        0
-    };
+    let mut free = capacity_s.saturating_sub(singles);
     let keys = prep.keys.keys();
     loop {
         // The block whose keys covered by no other cube are fewest (and fit).
@@ -1229,6 +1225,19 @@ mod stack {
         println!("Scratch<64>: {} B", size_of::<Scratch>());
         println!("FilterTable<64>: {} B", size_of::<FilterTable>());
         assert!(size_of::<FilterTable>() < 1024);
+        use crate::filters::SizedTable;
+        println!(
+            "SizedTable<8, 8, 0>: {} B",
+            size_of::<SizedTable<8, 8, 0>>()
+        );
+        println!(
+            "SizedTable<16, 10, 4>: {} B",
+            size_of::<SizedTable<16, 10, 4>>()
+        );
+        println!(
+            "SizedTable<32, 14, 64>: {} B",
+            size_of::<SizedTable<32, 14, 64>>()
+        );
     }
 
     fn filters_367() -> Vec<Filter> {
