@@ -50,7 +50,13 @@
 //!    [`FilterPlan::is_proven_optimal`] is `false`; the plan is still exact). Among
 //!    plans with equally few banks the narrowest entries win.
 //! 8. The merged plan is kept only if it needs fewer banks than the plan of single
-//!    entries (so merging never costs a bank).
+//!    entries (so merging never costs a bank). **Lookup capacity**: the plan may leave
+//!    at most `K` keys to the thread-side lookup (`K` of the [`FilterPlan<K>`] filled,
+//!    the driver's). When the fewest-banks plan needs more, the covers are tried again
+//!    with their multi-user blocks split
+//!    ([`twocan_core::filter_set::split_multi_user_blocks`]) and the list-only plan
+//!    (no key); the one with the fewest banks is kept, or the list is refused with
+//!    [`PlanError::TooManyLookupKeys`] (the keys needed and `K`).
 //! 9. **Superset** ([`PlanOptions::superset`]): when the exact plan needs more banks
 //!    than available, cubes are merged pairwise, each time the pair whose join adds
 //!    the fewest identifiers outside the set ([`twocan_core::filter_set::merge_step`];
@@ -60,6 +66,15 @@
 //! 10. **Layout**: per class, entries in item order, filling banks; the last bank of a
 //!     list class is padded by repeating its last entry. Banks are assigned to FIFOs
 //!     ([`FifoPolicy`]) and the FMI → user-index map is computed from the layout.
+//!
+//! # At compile time and at run time
+//!
+//! Every step is a `const fn` (loops, explicit indices, hand-written searches and
+//! insertion sorts), with its working memory in a [`Scratch`] passed by `&mut`: one
+//! implementation for [`crate::const_plan!`] (a `const` list planned during constant
+//! evaluation, the result cut to its size), [`plan_in`] (a list known at run time, the
+//! scratch in a `static`: the planning call's stack stays small) and [`plan`] /
+//! [`plan_for`] (the scratch on the stack: host and `const` code).
 //!
 //! # Guarantees
 //!
