@@ -6,10 +6,10 @@ use twocan_core::{Error, LastErrorCode, Mode, Registers};
 
 use crate::config::Config;
 use crate::filter_block;
-use crate::filters::{Fifo, FilterPlan, FmiMap, LOOKUP_KEYS};
+use crate::filters::{Fifo, FilterPlan, FmiMap, PlanRef, LOOKUP_KEYS};
 use crate::instance::Instance;
 use crate::mode;
-use crate::planner::{self, FifoPolicy, PlanOptions};
+use crate::planner::{self, FifoPolicy, PlanOptions, Scratch};
 use crate::regs::{esr, ier, mcr, BTR, IER, MCR};
 
 /// Register reads spent waiting for an aborted mailbox to become empty (notes "Abort":
@@ -256,20 +256,34 @@ impl<R: Registers, F: Registers, const K: usize> Can<R, F, K> {
         PlanOptions::new((e - s) as u8).fifo(fifo)
     }
 
-    /// Compiles `filters` for this instance's banks ([`planner::plan`]).
+    /// Compiles `filters` for this instance's banks and its lookup capacity `K`
+    /// ([`planner::plan_for`]): the plan installs, or the list is refused with the
+    /// counts. The planner's working memory is on the stack (about 90 KB): on a host;
+    /// firmware uses [`Can::plan_in`] (or a `const` plan, [`crate::const_plan!`]).
     pub fn plan(
         &self,
         filters: &[twocan_core::Filter],
         fifo: FifoPolicy,
-    ) -> Result<FilterPlan, crate::filters::PlanError> {
-        planner::plan(filters, self.plan_options(fifo))
+    ) -> Result<FilterPlan<K>, crate::filters::PlanError> {
+        planner::plan_for::<K>(filters, self.plan_options(fifo))
+    }
+
+    /// [`Can::plan`] with the working memory in `scratch` (kept in a `static` by
+    /// firmware that plans at run time, see [`Scratch`]); the plan stays in it.
+    pub fn plan_in<'s>(
+        &self,
+        filters: &[twocan_core::Filter],
+        fifo: FifoPolicy,
+        scratch: &'s mut Scratch<K>,
+    ) -> Result<&'s FilterPlan<K>, crate::filters::PlanError> {
+        planner::plan_in(filters, self.plan_options(fifo), scratch)
     }
 
     fn bound(&self) -> u32 {
         self.config.get_wait_iterations()
     }
 
-    fn write_filters(&mut self, plan: &FilterPlan) -> Result<(), Error> {
+    fn write_filters(&mut self, plan: PlanRef<'_>) -> Result<(), Error> {
         // The map first: a plan the map cannot hold is refused before any bank changes.
         let fmi = plan.fmi_map::<K>()?;
         let instance = self.instance;
@@ -316,9 +330,14 @@ impl<R: Registers, F: Registers, const K: usize> Init<R, F, K> {
         }
     }
 
-    /// Installs filters before going on the bus (the receive half's `set_filters` installs later lists).
-    pub fn set_filters(&mut self, plan: &FilterPlan) -> Result<(), Error> {
-        self.can.write_filters(plan)
+    /// Installs filters before going on the bus (the receive half's `set_filters` installs later lists):
+    /// a run-time plan (`&FilterPlan<K>`) or a `const` one (`&SizedPlan`,
+    /// [`crate::const_plan!`]), read in place.
+    ///
+    /// Errors: [`Error::FilterSpace`] when the plan needs more lookup keys than this
+    /// controller keeps (`K`), [`Error::InvalidArgument`] with more banks than it owns.
+    pub fn set_filters<'p>(&mut self, plan: impl Into<PlanRef<'p>>) -> Result<(), Error> {
+        self.can.write_filters(plan.into())
     }
 
     /// The controller, still in initialization mode (to plan filters for its banks).

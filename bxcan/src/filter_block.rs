@@ -1,4 +1,4 @@
-//! Writing a [`FilterPlan`] to the filter registers (notes "Filter bank scale and mode
+//! Writing a filter plan ([`crate::FilterPlan`], [`crate::filters::SizedPlan`]) to the filter registers (notes "Filter bank scale and mode
 //! configuration"; RM0410 §40.7.4, §40.9.4):
 //!
 //! 1. `CAN_FMR.FINIT = 1` (filter initialization mode: reception through the block stops,
@@ -20,7 +20,7 @@
 
 use twocan_core::Registers;
 
-use crate::filters::FilterPlan;
+use crate::filters::PlanRef;
 use crate::instance::{bank_range, Instance};
 use crate::regs::{fa1r, ffa1r, fir1, fir2, fm1r, fmr, fs1r, FA1R, FFA1R, FM1R, FMR, FS1R};
 
@@ -91,32 +91,36 @@ pub(crate) fn set_can2sb<F: Registers>(regs: &F, start: u8) -> Result<(), StartB
 /// Error: the plan has more banks than the instance owns.
 pub(crate) struct TooManyBanks;
 
-/// Writes `plan` to the banks `instance` owns, in a critical section (the registers are
-/// shared with the other instance's driver, see the module notes; `CAN2SB` is read
-/// inside it too, so the bank range cannot change under the programming).
-pub(crate) fn program<F: Registers>(
+/// Writes `plan` (a run-time [`crate::FilterPlan`] or a `const`
+/// [`crate::filters::SizedPlan`], read through their [`PlanRef`]) to the banks
+/// `instance` owns, in a critical section (the registers are shared with the other
+/// instance's driver, see the module notes; `CAN2SB` is read inside it too, so the bank
+/// range cannot change under the programming).
+pub(crate) fn program<'p, F: Registers>(
     regs: &F,
     instance: Instance,
-    plan: &FilterPlan,
+    plan: impl Into<PlanRef<'p>>,
 ) -> Result<(), TooManyBanks> {
+    let plan = plan.into();
     critical_section::with(|_| program_locked(regs, instance, plan))
 }
 
 /// As [`program`], running `then` still in filter initialization mode (`FINIT` = 1,
 /// nothing enters the FIFOs) after the banks are written.
-pub(crate) fn program_then<F: Registers>(
+pub(crate) fn program_then<'p, F: Registers>(
     regs: &F,
     instance: Instance,
-    plan: &FilterPlan,
+    plan: impl Into<PlanRef<'p>>,
     then: impl FnOnce(),
 ) -> Result<(), TooManyBanks> {
+    let plan = plan.into();
     critical_section::with(|_| program_locked_then(regs, instance, plan, then))
 }
 
 fn program_locked<F: Registers>(
     regs: &F,
     instance: Instance,
-    plan: &FilterPlan,
+    plan: PlanRef<'_>,
 ) -> Result<(), TooManyBanks> {
     program_locked_then(regs, instance, plan, || {})
 }
@@ -124,7 +128,7 @@ fn program_locked<F: Registers>(
 fn program_locked_then<F: Registers>(
     regs: &F,
     instance: Instance,
-    plan: &FilterPlan,
+    plan: PlanRef<'_>,
     then: impl FnOnce(),
 ) -> Result<(), TooManyBanks> {
     let (start, end) = banks_of(regs, instance);

@@ -23,7 +23,7 @@
 //! [`Filter`]s; [`FilterPlan::manual`] and [`FilterPlan::set_bank`] configure banks
 //! directly.
 
-use twocan_core::filter_set::{key, key_parts, KeyTable, MAX_KEYS};
+use twocan_core::filter_set::{key, key_parts, lower_bound, Key, KeyTable};
 use twocan_core::{Filter, FilterError, Format, Frame, FrameKind};
 
 use crate::regs::{firx, FILTER_BANKS};
@@ -447,15 +447,123 @@ pub enum PlanError {
         available: u8,
     },
     /// The plan's merged or superset slots leave more identifiers to the thread-side
-    /// lookup than the driver keeps ([`LOOKUP_KEYS`]).
+    /// lookup than the plan or the driver keeps (`K` of [`FilterPlan<K>`] or of the
+    /// controller, [`LOOKUP_KEYS`] by default): refused at planning time when no plan
+    /// within the capacity fits the banks, or when a plan is installed in a controller
+    /// with less room.
     TooManyLookupKeys {
         /// Identifiers that would need the lookup.
         needed: u16,
-        /// [`LOOKUP_KEYS`].
+        /// The lookup capacity.
         max: u16,
     },
     /// A bank index beyond the filter block (0..28).
     BankOutOfRange,
+}
+
+/// A message built in `const` code (for a compile-time error that names the counts).
+struct Message {
+    buf: [u8; 160],
+    len: usize,
+}
+
+impl Message {
+    const fn new() -> Self {
+        Message {
+            buf: [0; 160],
+            len: 0,
+        }
+    }
+
+    const fn text(mut self, s: &str) -> Self {
+        let b = s.as_bytes();
+        let mut i = 0;
+        while i < b.len() && self.len < self.buf.len() {
+            self.buf[self.len] = b[i];
+            self.len += 1;
+            i += 1;
+        }
+        self
+    }
+
+    const fn number(mut self, mut n: u32) -> Self {
+        let mut digits = [0u8; 10];
+        let mut k = 0;
+        loop {
+            digits[k] = b'0' + (n % 10) as u8;
+            k += 1;
+            n /= 10;
+            if n == 0 {
+                break;
+            }
+        }
+        while k > 0 && self.len < self.buf.len() {
+            k -= 1;
+            self.buf[self.len] = digits[k];
+            self.len += 1;
+        }
+        self
+    }
+
+    const fn as_str(&self) -> &str {
+        match core::str::from_utf8(self.buf.split_at(self.len).0) {
+            Ok(s) => s,
+            Err(_) => "twocan_bxcan::const_plan!: the filters cannot be planned",
+        }
+    }
+}
+
+const fn filter_error_name(e: FilterError) -> &'static str {
+    match e {
+        FilterError::IdOutOfRange => "the identifier is wider than its format",
+        FilterError::MaskOutOfRange => "the mask is wider than the format",
+        FilterError::AcceptanceOutsideMask => "the acceptance value has bits outside the mask",
+        FilterError::AnyFormatWithIdentifier => "Format::Any with a non-zero mask",
+    }
+}
+
+impl PlanError {
+    /// Panics with a message naming the error and its counts: in `const` code (as in
+    /// [`crate::const_plan!`]) a compile-time error that says why the list cannot be
+    /// planned.
+    pub const fn panic(self) -> ! {
+        let m = Message::new().text("twocan_bxcan::const_plan!: ");
+        let m = match self {
+            PlanError::Filter { index, error } => m
+                .text("filter ")
+                .number(index as u32)
+                .text(" does not conform: ")
+                .text(filter_error_name(error)),
+            PlanError::TooManyFilters { given, max } => m
+                .number(given as u32)
+                .text(" filters given, the planner takes at most ")
+                .number(max as u32),
+            PlanError::TooManyBanks { needed, available } => m
+                .text("the filters need ")
+                .number(needed as u32)
+                .text(" banks, ")
+                .number(available as u32)
+                .text(" are available"),
+            PlanError::DualTooManyBanks {
+                can1_needed,
+                can2_needed,
+                available,
+            } => m
+                .text("CAN1's filters need ")
+                .number(can1_needed as u32)
+                .text(" banks and CAN2's ")
+                .number(can2_needed as u32)
+                .text(", the block has ")
+                .number(available as u32),
+            PlanError::TooManyLookupKeys { needed, max } => m
+                .text("the plan needs ")
+                .number(needed as u32)
+                .text(" lookup keys, the capacity is ")
+                .number(max as u32),
+            PlanError::BankOutOfRange => m.text("a bank index above 27"),
+        };
+        panic!("{}", m.as_str())
+    }
 }
 
 impl From<PlanError> for twocan_core::Error {
@@ -508,13 +616,20 @@ pub const MAX_FMI: usize = FILTER_BANKS * 4;
 ///
 /// The map lives in the driver's state (6 bytes a key), so the default is sized for
 /// firmware with a modest filter list, not for the planner's
-/// [`crate::planner::MAX_FILTERS`]. Of the project's DBC corpus (`bench/data/`), the
-/// largest exact plan needs 122 keys and the superset plans of the largest sets up to 365:
-/// give such a controller room with [`crate::Init::with_lookup_capacity`] (e.g. 512).
-/// A plan that needs more than the map holds is refused when installed
-/// ([`PlanError::TooManyLookupKeys`], [`twocan_core::Error::FilterSpace`] with both
-/// counts); [`FilterPlan::key_table`] tells how many it needs.
+/// [`crate::planner::MAX_FILTERS`]. The planner plans within the capacity of the plan
+/// type it fills ([`FilterPlan<K>`]: `K` lookup keys, this by default): a merged plan
+/// that would need more keys gives way to one that needs fewer (blocks split back into
+/// list entries), or the list is refused at planning time with both counts
+/// ([`PlanError::TooManyLookupKeys`]). Of the project's DBC corpus (`bench/data/`), the
+/// largest exact plan needs 122 keys and the superset plans of the largest sets up to
+/// 365: give such a controller room with [`crate::Init::with_lookup_capacity`] (e.g. 512)
+/// and plan with the same `K` ([`crate::planner::plan_for`]). A `const` plan
+/// ([`crate::const_plan!`]) carries exactly the keys it needs.
 pub const LOOKUP_KEYS: usize = 64;
+
+/// The most lookup keys any plan needs (every key of the largest list): the capacity a
+/// `const` plan is computed with before it is cut to its size ([`SizedPlan`]).
+pub const MAX_LOOKUP_KEYS: usize = twocan_core::filter_set::MAX_KEYS;
 
 /// What the hardware does with a frame under a plan (see [`FilterPlan::evaluate`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -529,34 +644,306 @@ pub struct Acceptance {
     pub filter: u16,
 }
 
-/// The banks of one instance's share of the filter block, relative to its first bank,
-/// with the user index of every slot: the compiled filter list that
-/// [`twocan_core::Hardware::install_filters`] writes.
-///
-/// Bank `k` of a plan is written to hardware bank `first + k`, where `first` is 0 for
-/// CAN1 and CAN3 and `CAN2SB` for CAN2. Match indices are numbered from the instance's
-/// first bank (see `docs/filters.md` on CAN2).
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct FilterPlan {
-    banks: [Bank; FILTER_BANKS],
-    users: [[u16; 4]; FILTER_BANKS],
-    len: u8,
+/// A bank with every field zero (a deactivated 32-bit mask bank): the content of a
+/// fresh planner scratch, so that a `static` of it takes no flash.
+const ZERO_BANK: Bank = Bank {
+    kind: BankKind::Mask32,
+    fifo: Fifo::Fifo0,
+    active: false,
+    fr1: 0,
+    fr2: 0,
+};
+
+/// A compiled filter list as the driver and the queries read it, whatever holds it: a
+/// run-time [`FilterPlan`] or a `const` [`SizedPlan`] (their `as_ref`). The banks
+/// (relative to the instance's first bank), the user index of every bank slot, and the
+/// keys (identifier, format, kind) that reach a slot standing for several user filters,
+/// with their user indices.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct PlanRef<'a> {
+    banks: &'a [Bank],
+    users: &'a [[u16; 4]],
+    keys: &'a [Key],
+    key_users: &'a [u16],
     optimal: bool,
-    keys: KeyTable,
     extra: u64,
     list_only_banks: u16,
 }
 
-impl Default for FilterPlan {
+impl<'a> PlanRef<'a> {
+    /// The banks in use (relative to the instance's first bank).
+    pub const fn banks(&self) -> &'a [Bank] {
+        self.banks
+    }
+
+    /// Number of banks in use.
+    pub const fn bank_count(&self) -> usize {
+        self.banks.len()
+    }
+
+    /// The user index of every slot of every bank ([`NO_FILTER`] beyond the bank's
+    /// slots).
+    pub const fn slot_users(&self) -> &'a [[u16; 4]] {
+        self.users
+    }
+
+    /// The keys that reach a slot standing for several user filters (ascending), and
+    /// their user indices (see [`FilterPlan::key_table`]).
+    pub const fn lookup_keys(&self) -> (&'a [Key], &'a [u16]) {
+        (self.keys, self.key_users)
+    }
+
+    /// See [`FilterPlan::is_proven_optimal`].
+    pub const fn is_proven_optimal(&self) -> bool {
+        self.optimal
+    }
+
+    /// See [`FilterPlan::superset_extra`].
+    pub const fn superset_extra(&self) -> u64 {
+        self.extra
+    }
+
+    /// See [`FilterPlan::list_only_banks`].
+    pub const fn list_only_banks(&self) -> u16 {
+        self.list_only_banks
+    }
+
+    /// The user index of key `k` in the lookup keys.
+    pub const fn lookup(&self, k: Key) -> Option<u16> {
+        let at = lower_bound(self.keys, k);
+        if at < self.keys.len() && self.keys[at] == k {
+            Some(self.key_users[at])
+        } else {
+            None
+        }
+    }
+
+    /// See [`FilterPlan::slot_user`].
+    pub const fn slot_user(&self, bank: usize, slot: usize) -> u16 {
+        if bank < self.banks.len() && slot < 4 {
+            self.users[bank][slot]
+        } else {
+            NO_FILTER
+        }
+    }
+
+    /// See [`FilterPlan::fmi_of`].
+    pub const fn fmi_of(&self, bank: usize, slot: usize) -> Option<(Fifo, u8)> {
+        if bank >= self.banks.len() {
+            return None;
+        }
+        let b = self.banks[bank];
+        if slot >= b.kind.slots() {
+            return None;
+        }
+        let mut before = 0;
+        let mut i = 0;
+        while i < bank {
+            if self.banks[i].fifo as u8 == b.fifo as u8 {
+                before += self.banks[i].kind.slots();
+            }
+            i += 1;
+        }
+        Some((b.fifo, (before + slot) as u8))
+    }
+
+    /// See [`FilterPlan::user_index`].
+    pub const fn user_index(&self, fifo: Fifo, fmi: u8) -> u16 {
+        let mut next = 0usize;
+        let mut b = 0;
+        while b < self.banks.len() {
+            let bank = self.banks[b];
+            if bank.fifo as u8 == fifo as u8 {
+                let slots = bank.kind.slots();
+                if (fmi as usize) < next + slots {
+                    return self.users[b][fmi as usize - next];
+                }
+                next += slots;
+            }
+            b += 1;
+        }
+        NO_FILTER
+    }
+
+    /// See [`FilterPlan::resolve`].
+    pub const fn resolve(
+        &self,
+        fifo: Fifo,
+        fmi: u8,
+        raw_id: u32,
+        extended: bool,
+        remote: bool,
+    ) -> Option<u16> {
+        match self.user_index(fifo, fmi) {
+            NO_FILTER => None,
+            LOOKUP => self.lookup(key(raw_id, extended, remote)),
+            user => Some(user),
+        }
+    }
+
+    /// See [`FilterPlan::uses_fifo`].
+    pub const fn uses_fifo(&self, fifo: Fifo) -> bool {
+        let mut i = 0;
+        while i < self.banks.len() {
+            if self.banks[i].active && self.banks[i].fifo as u8 == fifo as u8 {
+                return true;
+            }
+            i += 1;
+        }
+        false
+    }
+
+    /// The hardware's decision for `(id, ext, rtr)` before the key lookup: FIFO, match
+    /// index and the slot's user entry (a user index, [`LOOKUP`] or [`NO_FILTER`]); see
+    /// [`FilterPlan::evaluate`] for the rules.
+    pub const fn decide(&self, id: u32, ext: bool, rtr: bool) -> Option<(Fifo, u8, u16)> {
+        // (class, bank, slot): the winner so far.
+        let mut best: Option<(u8, usize, usize)> = None;
+        let mut i = 0;
+        while i < self.banks.len() {
+            let b = self.banks[i];
+            let mut slot = 0;
+            while b.active && slot < b.kind.slots() {
+                if b.slot_matches(slot, id, ext, rtr) {
+                    let class = b.kind.priority_class();
+                    let better = match best {
+                        None => true,
+                        // Banks and slots are visited in ascending order: only a
+                        // better class wins.
+                        Some((c, _, _)) => class < c,
+                    };
+                    if better {
+                        best = Some((class, i, slot));
+                    }
+                }
+                slot += 1;
+            }
+            i += 1;
+        }
+        match best {
+            None => None,
+            Some((_, bank, slot)) => match self.fmi_of(bank, slot) {
+                Some((fifo, fmi)) => Some((fifo, fmi, self.users[bank][slot])),
+                None => None,
+            },
+        }
+    }
+
+    /// See [`FilterPlan::evaluate`].
+    pub const fn evaluate(&self, frame: &Frame) -> Option<Acceptance> {
+        let (id, ext, rtr) = (frame.raw_id(), frame.is_extended(), frame.is_remote());
+        match self.decide(id, ext, rtr) {
+            None => None,
+            Some((fifo, fmi, user)) => Some(Acceptance {
+                fifo,
+                fmi,
+                filter: match user {
+                    LOOKUP => match self.lookup(key(id, ext, rtr)) {
+                        Some(u) => u,
+                        None => NO_FILTER,
+                    },
+                    user => user,
+                },
+            }),
+        }
+    }
+
+    /// The lookup keys it needs, its banks: what [`SizedPlan`] holds.
+    pub const fn sizes(&self) -> PlanSizes {
+        PlanSizes {
+            banks: self.banks.len(),
+            keys: self.keys.len(),
+        }
+    }
+
+    /// See [`FilterPlan::fmi_map`].
+    pub const fn fmi_map<const K: usize>(&self) -> Result<FmiMap<K>, PlanError> {
+        let mut map = FmiMap::<K>::empty();
+        if map.keys.copy_from(self.keys, self.key_users).is_err() {
+            return Err(PlanError::TooManyLookupKeys {
+                needed: self.keys.len() as u16,
+                max: K as u16,
+            });
+        }
+        let mut next = [0usize; 2];
+        let mut b = 0;
+        while b < self.banks.len() {
+            let f = self.banks[b].fifo.index();
+            let mut s = 0;
+            while s < self.banks[b].kind.slots() {
+                if next[f] < MAX_FMI {
+                    map.map[f][next[f]] = self.users[b][s];
+                }
+                next[f] += 1;
+                s += 1;
+            }
+            b += 1;
+        }
+        Ok(map)
+    }
+}
+
+/// The banks of one instance's share of the filter block, relative to its first bank,
+/// with the user index of every slot and room for `K` lookup keys: the compiled filter
+/// list that [`twocan_core::Hardware::install_filters`] writes (the driver's `K`, its
+/// merged-filter lookup capacity, [`LOOKUP_KEYS`] by default).
+///
+/// Bank `k` of a plan is written to hardware bank `first + k`, where `first` is 0 for
+/// CAN1 and CAN3 and `CAN2SB` for CAN2. Match indices are numbered from the instance's
+/// first bank (see `docs/filters.md` on CAN2).
+///
+/// Built by the planner ([`crate::planner::plan`] in `const` code or on the host,
+/// [`crate::planner::plan_in`] at run time with the working memory in a `static`), by
+/// [`FilterPlan::manual`] and [`FilterPlan::set_bank`], or from a `const` plan
+/// ([`FilterPlan::from_ref`]).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct FilterPlan<const K: usize = LOOKUP_KEYS> {
+    banks: [Bank; FILTER_BANKS],
+    users: [[u16; 4]; FILTER_BANKS],
+    len: u8,
+    optimal: bool,
+    keys: KeyTable<K>,
+    extra: u64,
+    list_only_banks: u16,
+}
+
+impl<const K: usize> Default for FilterPlan<K> {
     fn default() -> Self {
-        Self::manual()
+        Self::empty()
     }
 }
 
 impl FilterPlan {
     /// An empty plan: no bank, nothing is received. Add banks with
-    /// [`FilterPlan::set_bank`] for direct configuration.
+    /// [`FilterPlan::set_bank`] for direct configuration. (For a controller with
+    /// another lookup capacity, `FilterPlan::<K>::empty()`.)
     pub const fn manual() -> Self {
+        Self::empty()
+    }
+
+    /// The user index a manual plan reports for `slot` of bank `index` (`4 × index +
+    /// slot`).
+    pub const fn slot_index(index: usize, slot: usize) -> u16 {
+        (4 * index + slot) as u16
+    }
+}
+
+impl<'a, const K: usize> From<&'a FilterPlan<K>> for PlanRef<'a> {
+    fn from(p: &'a FilterPlan<K>) -> Self {
+        p.as_ref()
+    }
+}
+
+impl<'a, const K: usize> From<&'a mut FilterPlan<K>> for PlanRef<'a> {
+    fn from(p: &'a mut FilterPlan<K>) -> Self {
+        p.as_ref()
+    }
+}
+
+impl<const K: usize> FilterPlan<K> {
+    /// An empty plan with room for `K` lookup keys: no bank, nothing is received
+    /// ([`FilterPlan::manual`] for the default capacity).
+    pub const fn empty() -> Self {
         FilterPlan {
             banks: [Bank::unused(); FILTER_BANKS],
             users: [[NO_FILTER; 4]; FILTER_BANKS],
@@ -568,18 +955,104 @@ impl FilterPlan {
         }
     }
 
+    /// All zeros (no bank): a planner scratch's output before its first plan.
+    pub(crate) const fn zeroed() -> Self {
+        FilterPlan {
+            banks: [ZERO_BANK; FILTER_BANKS],
+            users: [[0; 4]; FILTER_BANKS],
+            len: 0,
+            optimal: false,
+            keys: KeyTable::new(),
+            extra: 0,
+            list_only_banks: 0,
+        }
+    }
+
+    /// Back to [`FilterPlan::manual`], in place.
+    pub(crate) const fn reset(&mut self) {
+        let mut i = 0;
+        while i < FILTER_BANKS {
+            self.banks[i] = Bank::unused();
+            self.users[i] = [NO_FILTER; 4];
+            i += 1;
+        }
+        self.len = 0;
+        self.optimal = true;
+        self.keys.clear();
+        self.extra = 0;
+        self.list_only_banks = 0;
+    }
+
+    /// The plan as the driver reads it (borrowed: no copy).
+    pub const fn as_ref(&self) -> PlanRef<'_> {
+        PlanRef {
+            banks: self.banks.split_at(self.len as usize).0,
+            users: self.users.split_at(self.len as usize).0,
+            keys: self.keys.keys(),
+            key_users: self.keys.users(),
+            optimal: self.optimal,
+            extra: self.extra,
+            list_only_banks: self.list_only_banks,
+        }
+    }
+
+    /// A plan with the content of `plan` (e.g. a `const` [`SizedPlan`]'s, for the split
+    /// driver's `set_filters`), in place.
+    ///
+    /// Errors: [`PlanError::TooManyLookupKeys`] when `plan` needs more lookup keys than
+    /// `K`; [`PlanError::BankOutOfRange`] with more than 28 banks.
+    pub const fn copy_from(&mut self, plan: PlanRef<'_>) -> Result<(), PlanError> {
+        if plan.banks.len() > FILTER_BANKS || plan.users.len() != plan.banks.len() {
+            return Err(PlanError::BankOutOfRange);
+        }
+        if plan.keys.len() > K {
+            return Err(PlanError::TooManyLookupKeys {
+                needed: plan.keys.len() as u16,
+                max: K as u16,
+            });
+        }
+        self.reset();
+        let mut i = 0;
+        while i < plan.banks.len() {
+            self.banks[i] = plan.banks[i];
+            self.users[i] = plan.users[i];
+            i += 1;
+        }
+        self.len = plan.banks.len() as u8;
+        if self.keys.copy_from(plan.keys, plan.key_users).is_err() {
+            return Err(PlanError::BankOutOfRange);
+        }
+        self.optimal = plan.optimal;
+        self.extra = plan.extra;
+        self.list_only_banks = plan.list_only_banks;
+        Ok(())
+    }
+
+    /// A plan with the content of `plan` (see [`FilterPlan::copy_from`]); by value, so
+    /// about 1 KB moves: prefer passing `plan` itself where a [`PlanRef`] is taken
+    /// ([`crate::Init::set_filters`]).
+    pub const fn from_ref(plan: PlanRef<'_>) -> Result<Self, PlanError> {
+        let mut p = Self::empty();
+        match p.copy_from(plan) {
+            Ok(()) => Ok(p),
+            Err(e) => Err(e),
+        }
+    }
+
     /// Sets bank `index` (relative to the instance's first bank). Its slots report user
     /// indices `4 × index + slot`, so that every slot of a manual plan has its own index
     /// (use [`FilterPlan::slot_index`]). Banks below `index` not set yet stay
     /// [`Bank::unused`] (they count in the numbering as deactivated 16-bit mask banks).
-    pub fn set_bank(&mut self, index: usize, bank: Bank) -> Result<(), PlanError> {
+    pub const fn set_bank(&mut self, index: usize, bank: Bank) -> Result<(), PlanError> {
         if index >= FILTER_BANKS {
             return Err(PlanError::BankOutOfRange);
         }
         self.banks[index] = bank;
         let mut users = [NO_FILTER; 4];
-        for (slot, u) in users.iter_mut().enumerate().take(bank.kind.slots()) {
-            *u = (4 * index + slot) as u16;
+        let mut slot = 0;
+        while slot < bank.kind.slots() {
+            users[slot] = (4 * index + slot) as u16;
+            slot += 1;
         }
         self.users[index] = users;
         if index >= self.len as usize {
@@ -589,14 +1062,8 @@ impl FilterPlan {
         Ok(())
     }
 
-    /// The user index a manual plan reports for `slot` of bank `index` (`4 × index +
-    /// slot`).
-    pub const fn slot_index(index: usize, slot: usize) -> u16 {
-        (4 * index + slot) as u16
-    }
-
     /// Built by the planner (crate-internal).
-    pub(crate) fn push(&mut self, bank: Bank, users: [u16; 4]) -> Result<(), PlanError> {
+    pub(crate) const fn push(&mut self, bank: Bank, users: [u16; 4]) -> Result<(), PlanError> {
         let i = self.len as usize;
         if i >= FILTER_BANKS {
             return Err(PlanError::BankOutOfRange);
@@ -607,40 +1074,63 @@ impl FilterPlan {
         Ok(())
     }
 
-    pub(crate) fn set_fifo(&mut self, index: usize, fifo: Fifo) {
+    pub(crate) const fn set_fifo(&mut self, index: usize, fifo: Fifo) {
         self.banks[index].fifo = fifo;
     }
 
-    pub(crate) fn set_optimal(&mut self, optimal: bool) {
+    pub(crate) const fn set_optimal(&mut self, optimal: bool) {
         self.optimal = optimal;
     }
 
     /// Keeps, of the user's keys, those the hardware routes to a slot that stands for
     /// several user filters ([`LOOKUP`]): the only ones [`FmiMap::resolve`] searches.
     /// Call after every bank and its users are in place.
-    pub(crate) fn set_resolution(
+    ///
+    /// Errors: [`PlanError::TooManyLookupKeys`] with the keys needed when they are more
+    /// than `K` (the plan keeps none).
+    pub(crate) const fn set_resolution<const N: usize>(
         &mut self,
-        keys: &KeyTable,
+        keys: &KeyTable<N>,
         extra: u64,
         list_only_banks: u16,
     ) -> Result<(), PlanError> {
-        let mut lookup = KeyTable::new();
-        for (&k, &user) in keys.keys().iter().zip(keys.users()) {
-            let (id, ext, rtr) = key_parts(k);
-            if let Some((_, _, LOOKUP)) = self.decide(id, ext, rtr) {
-                // A subset of `keys`, which has the same capacity: it fits.
-                lookup
-                    .insert(k, user)
-                    .map_err(|_| PlanError::TooManyLookupKeys {
-                        needed: keys.len() as u16,
-                        max: MAX_KEYS as u16,
-                    })?;
-            }
-        }
-        self.keys = lookup;
         self.extra = extra;
         self.list_only_banks = list_only_banks;
+        self.keys.clear();
+        let needed = self.lookup_need(keys);
+        if needed > K {
+            return Err(PlanError::TooManyLookupKeys {
+                needed: needed as u16,
+                max: K as u16,
+            });
+        }
+        let k = keys.keys();
+        let u = keys.users();
+        let mut i = 0;
+        while i < k.len() {
+            let (id, ext, rtr) = key_parts(k[i]);
+            if let Some((_, _, LOOKUP)) = self.as_ref().decide(id, ext, rtr) {
+                // Counted above: room for every one.
+                let _ = self.keys.insert(k[i], u[i]);
+            }
+            i += 1;
+        }
         Ok(())
+    }
+
+    /// How many of `keys` the banks route to a slot standing for several user filters.
+    pub(crate) const fn lookup_need<const N: usize>(&self, keys: &KeyTable<N>) -> usize {
+        let k = keys.keys();
+        let mut needed = 0;
+        let mut i = 0;
+        while i < k.len() {
+            let (id, ext, rtr) = key_parts(k[i]);
+            if let Some((_, _, LOOKUP)) = self.as_ref().decide(id, ext, rtr) {
+                needed += 1;
+            }
+            i += 1;
+        }
+        needed
     }
 
     /// Identifiers the hardware accepts beyond the user's filters (0 for an exact plan;
@@ -663,14 +1153,14 @@ impl FilterPlan {
 
     /// The keys (identifier, format, kind) that reach a slot standing for several user
     /// filters, with their user indices: the table [`FmiMap::resolve`] searches (empty
-    /// for a plan without merged or superset slots).
-    pub fn key_table(&self) -> &KeyTable {
+    /// for a plan without merged or superset slots; never more than `K`).
+    pub const fn key_table(&self) -> &KeyTable<K> {
         &self.keys
     }
 
     /// The user index of a frame the hardware stored in `fifo` with match index `fmi`
     /// (see [`FmiMap::resolve`]).
-    pub fn resolve(
+    pub const fn resolve(
         &self,
         fifo: Fifo,
         fmi: u8,
@@ -678,11 +1168,7 @@ impl FilterPlan {
         extended: bool,
         remote: bool,
     ) -> Option<u16> {
-        match self.user_index(fifo, fmi) {
-            NO_FILTER => None,
-            LOOKUP => self.keys.lookup(key(raw_id, extended, remote)),
-            user => Some(user),
-        }
+        self.as_ref().resolve(fifo, fmi, raw_id, extended, remote)
     }
 
     /// Of `traffic` (frames with a weight each, e.g. their rate on the bus), the weight
@@ -707,8 +1193,8 @@ impl FilterPlan {
     }
 
     /// The banks in use (relative to the instance's first bank).
-    pub fn banks(&self) -> &[Bank] {
-        &self.banks[..self.len as usize]
+    pub const fn banks(&self) -> &[Bank] {
+        self.banks.split_at(self.len as usize).0
     }
 
     /// Number of banks in use.
@@ -723,74 +1209,30 @@ impl FilterPlan {
     }
 
     /// User filter index of slot `slot` of bank `bank` ([`NO_FILTER`] if none).
-    pub fn slot_user(&self, bank: usize, slot: usize) -> u16 {
-        if bank < self.len as usize && slot < 4 {
-            self.users[bank][slot]
-        } else {
-            NO_FILTER
-        }
+    pub const fn slot_user(&self, bank: usize, slot: usize) -> u16 {
+        self.as_ref().slot_user(bank, slot)
     }
 
     /// The FIFO and filter match index of slot `slot` of bank `bank` (notes "Filter
     /// match index": per FIFO, in bank order, every bank counting whether active or not).
-    pub fn fmi_of(&self, bank: usize, slot: usize) -> Option<(Fifo, u8)> {
-        let b = self.banks().get(bank)?;
-        if slot >= b.kind.slots() {
-            return None;
-        }
-        let before: usize = self.banks[..bank]
-            .iter()
-            .filter(|x| x.fifo == b.fifo)
-            .map(|x| x.kind.slots())
-            .sum();
-        Some((b.fifo, (before + slot) as u8))
+    pub const fn fmi_of(&self, bank: usize, slot: usize) -> Option<(Fifo, u8)> {
+        self.as_ref().fmi_of(bank, slot)
     }
 
     /// The map from each FIFO's match index to the user's filter index, with room for
-    /// `K` lookup keys (the driver's map: [`LOOKUP_KEYS`] unless the controller was
+    /// `K2` lookup keys (the driver's map: [`LOOKUP_KEYS`] unless the controller was
     /// given another capacity).
     ///
     /// Errors: [`PlanError::TooManyLookupKeys`] when the plan's merged or superset slots
-    /// leave more identifiers to the lookup than `K` ([`FilterPlan::key_table`]).
-    pub fn fmi_map<const K: usize>(&self) -> Result<FmiMap<K>, PlanError> {
-        let mut map = FmiMap::<K>::empty();
-        for (&k, &user) in self.keys.keys().iter().zip(self.keys.users()) {
-            map.keys
-                .insert(k, user)
-                .map_err(|_| PlanError::TooManyLookupKeys {
-                    needed: self.keys.len() as u16,
-                    max: K as u16,
-                })?;
-        }
-        let mut next = [0usize; 2];
-        for (b, users) in self.banks().iter().zip(self.users.iter()) {
-            let f = b.fifo.index();
-            for &u in users.iter().take(b.kind.slots()) {
-                if next[f] < MAX_FMI {
-                    map.map[f][next[f]] = u;
-                }
-                next[f] += 1;
-            }
-        }
-        Ok(map)
+    /// leave more identifiers to the lookup than `K2` ([`FilterPlan::key_table`]).
+    pub const fn fmi_map<const K2: usize>(&self) -> Result<FmiMap<K2>, PlanError> {
+        self.as_ref().fmi_map::<K2>()
     }
 
     /// The user index reported for a frame stored in `fifo` with match index `fmi`
     /// ([`NO_FILTER`] if no slot has it, [`LOOKUP`] if it depends on the identifier).
-    pub fn user_index(&self, fifo: Fifo, fmi: u8) -> u16 {
-        let mut next = 0usize;
-        for (b, users) in self.banks().iter().zip(self.users.iter()) {
-            if b.fifo != fifo {
-                continue;
-            }
-            for &u in users.iter().take(b.kind.slots()) {
-                if next == fmi as usize {
-                    return u;
-                }
-                next += 1;
-            }
-        }
-        NO_FILTER
+    pub const fn user_index(&self, fifo: Fifo, fmi: u8) -> u16 {
+        self.as_ref().user_index(fifo, fmi)
     }
 
     /// The hardware's decision for a frame, by the notes' rules: among the active banks'
@@ -806,58 +1248,176 @@ impl FilterPlan {
     ///
     /// [`Acceptance::filter`] is the resolved user index ([`FmiMap::resolve`]):
     /// [`NO_FILTER`] for a frame a superset plan accepts that no user filter does.
-    pub fn evaluate(&self, frame: &Frame) -> Option<Acceptance> {
-        let (id, ext, rtr) = (frame.raw_id(), frame.is_extended(), frame.is_remote());
-        self.decide(id, ext, rtr)
-            .map(|(fifo, fmi, user)| Acceptance {
-                fifo,
-                fmi,
-                filter: match user {
-                    LOOKUP => self.keys.lookup(key(id, ext, rtr)).unwrap_or(NO_FILTER),
-                    user => user,
-                },
-            })
-    }
-
-    /// [`FilterPlan::evaluate`] before the key lookup: FIFO, match index and the slot's
-    /// user entry (a user index, [`LOOKUP`] or [`NO_FILTER`]).
-    fn decide(&self, id: u32, ext: bool, rtr: bool) -> Option<(Fifo, u8, u16)> {
-        // (class, bank, slot, FIFO, FMI, user index)
-        let mut best: Option<(u8, usize, usize, Fifo, u8, u16)> = None;
-        for (i, b) in self.banks().iter().enumerate() {
-            if !b.active {
-                continue;
-            }
-            for slot in 0..b.kind.slots() {
-                if !b.slot_matches(slot, id, ext, rtr) {
-                    continue;
-                }
-                let Some((fifo, fmi)) = self.fmi_of(i, slot) else {
-                    continue;
-                };
-                let key = (
-                    b.kind.priority_class(),
-                    i,
-                    slot,
-                    fifo,
-                    fmi,
-                    self.users[i][slot],
-                );
-                let better = match best {
-                    None => true,
-                    Some(bk) => (key.0, key.1, key.2) < (bk.0, bk.1, bk.2),
-                };
-                if better {
-                    best = Some(key);
-                }
-            }
-        }
-        best.map(|(_, _, _, fifo, fmi, user)| (fifo, fmi, user))
+    pub const fn evaluate(&self, frame: &Frame) -> Option<Acceptance> {
+        self.as_ref().evaluate(frame)
     }
 
     /// Whether any bank of the plan sends frames to `fifo`.
-    pub fn uses_fifo(&self, fifo: Fifo) -> bool {
-        self.banks().iter().any(|b| b.active && b.fifo == fifo)
+    pub const fn uses_fifo(&self, fifo: Fifo) -> bool {
+        self.as_ref().uses_fifo(fifo)
+    }
+
+    /// Its banks and the lookup keys it needs: the sizes of its [`SizedPlan`].
+    pub const fn sizes(&self) -> PlanSizes {
+        self.as_ref().sizes()
+    }
+
+    /// The same plan in a [`SizedPlan`] of exactly its banks and lookup keys (`B` and
+    /// `KEYS` from [`FilterPlan::sizes`]; other sizes panic — in `const` code, a
+    /// compile-time error). See [`crate::const_plan!`].
+    pub const fn sized<const B: usize, const KEYS: usize>(&self) -> SizedPlan<B, KEYS> {
+        let s = self.sizes();
+        if s.banks != B || s.keys != KEYS {
+            panic!("SizedPlan sizes differ from the plan's (use FilterPlan::sizes)");
+        }
+        let mut out = SizedPlan {
+            banks: [ZERO_BANK; B],
+            users: [[0; 4]; B],
+            keys: [0; KEYS],
+            key_users: [0; KEYS],
+            optimal: self.optimal,
+            extra: self.extra,
+            list_only_banks: self.list_only_banks,
+        };
+        let mut i = 0;
+        while i < B {
+            out.banks[i] = self.banks[i];
+            out.users[i] = self.users[i];
+            i += 1;
+        }
+        let (k, u) = (self.keys.keys(), self.keys.users());
+        let mut i = 0;
+        while i < KEYS {
+            out.keys[i] = k[i];
+            out.key_users[i] = u[i];
+            i += 1;
+        }
+        out
+    }
+}
+
+/// The sizes of a plan: its banks and the lookup keys its merged or superset slots need
+/// (the const parameters of its [`SizedPlan`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct PlanSizes {
+    /// Banks in use.
+    pub banks: usize,
+    /// Lookup keys needed.
+    pub keys: usize,
+}
+
+/// A plan sized to itself: `B` banks and exactly the `K` lookup keys its merged or
+/// superset slots need — what [`crate::const_plan!`] gives for a `const` filter list, a
+/// `&'static` value with nothing the installed filters do not use.
+///
+/// It holds the bank register values ([`Bank`]: `FSCi`, `FBMi`, `FFAi`, `FACTi`,
+/// `FiR1`, `FiR2`), the user index of every bank slot (the map from each FIFO's filter
+/// match index back to the user's filter, [`SizedPlan::user_index`]) and the lookup
+/// keys ([`SizedPlan::resolve`]). [`crate::Init::set_filters`] installs it as it is;
+/// the split driver's `set_filters` takes a [`FilterPlan`] ([`FilterPlan::from_ref`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct SizedPlan<const B: usize, const K: usize> {
+    banks: [Bank; B],
+    users: [[u16; 4]; B],
+    keys: [Key; K],
+    key_users: [u16; K],
+    optimal: bool,
+    extra: u64,
+    list_only_banks: u16,
+}
+
+impl<'a, const B: usize, const K: usize> From<&'a SizedPlan<B, K>> for PlanRef<'a> {
+    fn from(p: &'a SizedPlan<B, K>) -> Self {
+        p.as_ref()
+    }
+}
+
+impl<const B: usize, const K: usize> SizedPlan<B, K> {
+    /// The plan as the driver reads it.
+    pub const fn as_ref(&self) -> PlanRef<'_> {
+        PlanRef {
+            banks: &self.banks,
+            users: &self.users,
+            keys: &self.keys,
+            key_users: &self.key_users,
+            optimal: self.optimal,
+            extra: self.extra,
+            list_only_banks: self.list_only_banks,
+        }
+    }
+
+    /// The banks (relative to the instance's first bank).
+    pub const fn banks(&self) -> &[Bank; B] {
+        &self.banks
+    }
+
+    /// Number of banks.
+    pub const fn bank_count(&self) -> usize {
+        B
+    }
+
+    /// The lookup keys (ascending) and their user indices.
+    pub const fn lookup_keys(&self) -> (&[Key; K], &[u16; K]) {
+        (&self.keys, &self.key_users)
+    }
+
+    /// See [`FilterPlan::is_proven_optimal`].
+    pub const fn is_proven_optimal(&self) -> bool {
+        self.optimal
+    }
+
+    /// See [`FilterPlan::superset_extra`].
+    pub const fn superset_extra(&self) -> u64 {
+        self.extra
+    }
+
+    /// See [`FilterPlan::list_only_banks`].
+    pub const fn list_only_banks(&self) -> u16 {
+        self.list_only_banks
+    }
+
+    /// See [`FilterPlan::slot_user`].
+    pub const fn slot_user(&self, bank: usize, slot: usize) -> u16 {
+        self.as_ref().slot_user(bank, slot)
+    }
+
+    /// See [`FilterPlan::fmi_of`].
+    pub const fn fmi_of(&self, bank: usize, slot: usize) -> Option<(Fifo, u8)> {
+        self.as_ref().fmi_of(bank, slot)
+    }
+
+    /// See [`FilterPlan::user_index`].
+    pub const fn user_index(&self, fifo: Fifo, fmi: u8) -> u16 {
+        self.as_ref().user_index(fifo, fmi)
+    }
+
+    /// The user's filter index of a frame stored in `fifo` with match index `fmi` (see
+    /// [`FmiMap::resolve`]).
+    pub const fn resolve(
+        &self,
+        fifo: Fifo,
+        fmi: u8,
+        raw_id: u32,
+        extended: bool,
+        remote: bool,
+    ) -> Option<u16> {
+        self.as_ref().resolve(fifo, fmi, raw_id, extended, remote)
+    }
+
+    /// See [`FilterPlan::evaluate`].
+    pub const fn evaluate(&self, frame: &Frame) -> Option<Acceptance> {
+        self.as_ref().evaluate(frame)
+    }
+
+    /// See [`FilterPlan::uses_fifo`].
+    pub const fn uses_fifo(&self, fifo: Fifo) -> bool {
+        self.as_ref().uses_fifo(fifo)
+    }
+
+    /// See [`FilterPlan::fmi_map`].
+    pub const fn fmi_map<const K2: usize>(&self) -> Result<FmiMap<K2>, PlanError> {
+        self.as_ref().fmi_map::<K2>()
     }
 }
 
@@ -885,9 +1445,9 @@ impl<const K: usize> FmiMap<K> {
     /// - a slot of one user filter: that index (a table lookup);
     /// - a mask slot standing for several user filters (merged identifiers) or for a
     ///   superset: the user filter of the frame's identifier, by binary search in the
-    ///   plan's key table (at most ⌈log₂ 256⌉ = 8 steps); `None` for an identifier no
-    ///   user filter accepts — a frame the hardware took only because of a superset
-    ///   plan, which the driver drops and counts;
+    ///   plan's key table (at most ⌈log₂ K⌉ steps); `None` for an identifier no user
+    ///   filter accepts — a frame the hardware took only because of a superset plan,
+    ///   which the driver drops and counts;
     /// - an FMI no slot has (not produced by the hardware for this plan): `None`.
     pub fn resolve(
         &self,

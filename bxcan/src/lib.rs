@@ -89,7 +89,7 @@ pub mod split;
 
 pub use config::{Config, ConfigError, Recovery};
 pub use controller::{Can, Failed, Init};
-pub use filters::{Bank, BankError, BankKind, Fifo, FilterPlan, PlanError};
+pub use filters::{Bank, BankError, BankKind, Fifo, FilterPlan, PlanError, PlanRef, SizedPlan};
 pub use fmi::fmi;
 pub use instance::Instance;
 pub use planner::{plan, plan_dual, DualPlan, FifoPolicy, PlanOptions};

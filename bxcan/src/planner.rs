@@ -50,7 +50,13 @@
 //!    [`FilterPlan::is_proven_optimal`] is `false`; the plan is still exact). Among
 //!    plans with equally few banks the narrowest entries win.
 //! 8. The merged plan is kept only if it needs fewer banks than the plan of single
-//!    entries (so merging never costs a bank).
+//!    entries (so merging never costs a bank). **Lookup capacity**: the plan may leave
+//!    at most `K` keys to the thread-side lookup (`K` of the [`FilterPlan<K>`] filled,
+//!    the driver's). When the fewest-banks plan needs more, the covers are tried again
+//!    with their multi-user blocks split
+//!    ([`twocan_core::filter_set::split_multi_user_blocks`]) and the list-only plan
+//!    (no key); the one with the fewest banks is kept, or the list is refused with
+//!    [`PlanError::TooManyLookupKeys`] (the keys needed and `K`).
 //! 9. **Superset** ([`PlanOptions::superset`]): when the exact plan needs more banks
 //!    than available, cubes are merged pairwise, each time the pair whose join adds
 //!    the fewest identifiers outside the set ([`twocan_core::filter_set::merge_step`];
@@ -60,6 +66,15 @@
 //! 10. **Layout**: per class, entries in item order, filling banks; the last bank of a
 //!     list class is padded by repeating its last entry. Banks are assigned to FIFOs
 //!     ([`FifoPolicy`]) and the FMI → user-index map is computed from the layout.
+//!
+//! # At compile time and at run time
+//!
+//! Every step is a `const fn` (loops, explicit indices, hand-written searches and
+//! insertion sorts), with its working memory in a [`Scratch`] passed by `&mut`: one
+//! implementation for [`crate::const_plan!`] (a `const` list planned during constant
+//! evaluation, the result cut to its size), [`plan_in`] (a list known at run time, the
+//! scratch in a `static`: the planning call's stack stays small) and [`plan`] /
+//! [`plan_for`] (the scratch on the stack: host and `const` code).
 //!
 //! # Guarantees
 //!
@@ -75,15 +90,16 @@
 //! distance to the exact lower bound).
 
 use twocan_core::filter_set::{
-    exact_cover, key, keys_of, merge_step, min_cover, narrow, Cube, CubeList, KeyTable,
+    exact_cover, key, key_parts, keys_of, merge_step, min_cover, narrow, split_multi_user_blocks,
+    CoverScratch, Cube, CubeList, KeyTable,
 };
-use twocan_core::{Filter, FilterError, Format, FrameKind};
+use twocan_core::{Filter, Format, FrameKind};
 
 pub use twocan_core::filter_set::{contains, overlaps};
 
 use crate::filters::{
-    frame_word16, list16_of, list32_of, mask16_of, mask32_of, Bank, BankKind, Fifo, FilterPlan,
-    PlanError, EXT_BITS_IN_16BIT, LOOKUP, NO_FILTER,
+    list16_of, list32_of, mask16_of, mask32_of, Bank, BankKind, Fifo, FilterPlan, PlanError,
+    PlanSizes, EXT_BITS_IN_16BIT, LOOKUP, LOOKUP_KEYS, MAX_LOOKUP_KEYS, NO_FILTER,
 };
 use crate::regs::FILTER_BANKS;
 
@@ -97,8 +113,8 @@ const ITEMS: usize = 128;
 /// Nodes of the minimum-weight cover search ([`min_cover`]).
 pub const COVER_BUDGET: u32 = 20_000;
 
-/// Keys up to which the minimum-weight cover search runs (its recursion is as deep as
-/// the keys it covers one by one).
+/// Keys up to which the minimum-weight cover search runs (its search stack is as deep
+/// as the keys it covers one by one).
 pub const COVER_SEARCH_KEYS: usize = 256;
 
 /// Branch-and-bound nodes explored before the planner settles for the best plan found.
@@ -121,6 +137,10 @@ pub enum FifoPolicy {
 
 /// Planner options: `PlanOptions::new(banks)` and the builder methods, or
 /// `PlanOptions { banks: 14, ..Default::default() }`.
+///
+/// The lookup capacity is not an option: it is the `K` of the plan filled
+/// ([`FilterPlan<K>`], the controller's, [`LOOKUP_KEYS`] by default), so a plan always
+/// fits the driver it is made for.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct PlanOptions {
@@ -128,9 +148,12 @@ pub struct PlanOptions {
     pub banks: u8,
     /// FIFO assignment.
     pub fifo: FifoPolicy,
-    /// Merge identifiers into exact mask entries (default `false` until the driver
-    /// resolves merged entries with [`crate::filters::FmiMap::resolve`]: a merged slot's
-    /// [`crate::filters::FmiMap::get`] is [`LOOKUP`], not a user index).
+    /// Merge identifiers into exact mask entries (default `true`): a merged entry
+    /// standing for several user filters reports [`LOOKUP`] in
+    /// [`crate::filters::FmiMap::get`], and the driver resolves its frames' user indices
+    /// with [`crate::filters::FmiMap::resolve`] (one binary search in the plan's lookup
+    /// keys, at most `K` of them). `false`: one list or mask entry per user filter, each
+    /// slot naming its user filter.
     pub merge: bool,
     /// When the exact plan does not fit, accept a superset in hardware and let the
     /// driver drop the extra frames (default `false`: refuse with the bank counts).
@@ -200,7 +223,7 @@ const WEIGHT: [u32; CLASSES] = [3, 4, 1, 2];
 /// Residue state: n₀ mod 2 (bit 0), n₂ mod 4 (bits 1..2), n₃ mod 2 (bit 3).
 const STATES: usize = 16;
 
-fn residue(s: u8, class: usize) -> u8 {
+const fn residue(s: u8, class: usize) -> u8 {
     match class {
         L32 => s & 1,
         L16 => (s >> 1) & 3,
@@ -209,7 +232,7 @@ fn residue(s: u8, class: usize) -> u8 {
     }
 }
 
-fn with_residue(s: u8, class: usize, r: u8) -> u8 {
+const fn with_residue(s: u8, class: usize, r: u8) -> u8 {
     match class {
         L32 => (s & !1) | r,
         L16 => (s & !0b110) | (r << 1),
@@ -219,7 +242,7 @@ fn with_residue(s: u8, class: usize, r: u8) -> u8 {
 }
 
 /// Banks opened and the next state when `count` entries of `class` are added in state `s`.
-fn step(s: u8, class: usize, count: u8) -> (u16, u8) {
+const fn step(s: u8, class: usize, count: u8) -> (u16, u8) {
     let cap = CAP[class];
     if class == M32 {
         return (count as u16, s);
@@ -231,42 +254,37 @@ fn step(s: u8, class: usize, count: u8) -> (u16, u8) {
 }
 
 /// Don't-care bit positions of `mask` within `range`.
-fn dont_care(mask: u32, range: u32) -> u32 {
+const fn dont_care(mask: u32, range: u32) -> u32 {
     !mask & range
 }
 
-/// The identifiers of the cells (values of the `care` bits) `f` covers, spread over the
-/// don't-care bits `dc`: calls `out` with each identifier.
-fn spread(id: u32, dc: u32, mut out: impl FnMut(u32)) {
-    // Enumerate every subset of dc (Gosper-free: the standard sub-mask walk).
-    let mut sub: u32 = 0;
-    loop {
-        out(id | sub);
-        if sub == dc {
-            break;
-        }
-        sub = (sub.wrapping_sub(dc)) & dc;
+/// How many frame kinds (data, remote) `kind` accepts.
+const fn kinds_len(kind: FrameKind) -> u32 {
+    match kind {
+        FrameKind::Any => 2,
+        _ => 1,
     }
 }
 
-fn kinds_of(kind: FrameKind) -> &'static [bool] {
+/// Whether the `i`-th kind `kind` accepts is remote (data first).
+const fn kind_remote(kind: FrameKind, i: u32) -> bool {
     match kind {
-        FrameKind::Data => &[false],
-        FrameKind::Remote => &[true],
-        FrameKind::Any => &[false, true],
+        FrameKind::Data => false,
+        FrameKind::Remote => true,
+        FrameKind::Any => i == 1,
     }
 }
 
 /// Step 5: number of entries of each class that represent `item` exactly (0 =
 /// impossible).
-fn options(item: &Item) -> [u8; CLASSES] {
+const fn options(item: &Item) -> [u8; CLASSES] {
     let f = &item.filter;
     let mut o = [0u8; CLASSES];
     o[M32] = 1;
     if mask16_of(f).is_some() {
         o[M16] = 1;
     }
-    let kinds = kinds_of(f.kind).len() as u32;
+    let kinds = kinds_len(f.kind);
     match f.format {
         Format::Standard => {
             let n = (1u32 << dont_care(f.mask, 0x7FF).count_ones()) * kinds;
@@ -301,7 +319,7 @@ fn options(item: &Item) -> [u8; CLASSES] {
         o[L32] = 0;
         o[L16] = 0;
     }
-    if item.user == LOOKUP && f.format == Format::Extended {
+    if item.user == LOOKUP && matches!(f.format, Format::Extended) {
         // A 16-bit list entry of extended identifiers holds a 14-bit prefix: the keys
         // behind it cannot be told apart by entry.
         o[L16] = 0;
@@ -318,60 +336,60 @@ struct Entry {
     user: u16,
 }
 
-/// Calls `out` with the entries of class `class` for `item` (consistent with
-/// [`options`]); a list entry of a cube of several users reports its key's user.
-fn entries(item: &Item, class: usize, keys: &KeyTable, mut out: impl FnMut(Entry)) {
+impl Entry {
+    /// An unused slot.
+    const NONE: Entry = Entry {
+        v: 0,
+        m: 0,
+        user: NO_FILTER,
+    };
+}
+
+/// The entries of class `class` for `item` (consistent with [`options`]: at most four);
+/// a list entry of a cube of several users reports its key's user.
+const fn entries<const N: usize>(
+    item: &Item,
+    class: usize,
+    keys: &KeyTable<N>,
+) -> ([Entry; 4], usize) {
     let f = &item.filter;
     let user = item.user;
-    let user_of = |id: u32, ext: bool, remote: bool| {
-        if user == LOOKUP {
-            keys.lookup(key(id, ext, remote)).unwrap_or(NO_FILTER)
-        } else {
-            user
-        }
-    };
+    let mut out = [Entry::NONE; 4];
+    let mut n = 0;
     match class {
         M32 => {
             let (v, m) = mask32_of(f);
-            out(Entry { v, m, user });
+            out[0] = Entry { v, m, user };
+            n = 1;
         }
         M16 => {
             if let Some((v, m)) = mask16_of(f) {
-                out(Entry {
+                out[0] = Entry {
                     v: v as u32,
                     m: m as u32,
                     user,
-                });
-            }
-        }
-        L32 => {
-            let range = f.format.id_mask();
-            for &remote in kinds_of(f.kind) {
-                spread(f.id, dont_care(f.mask, range), |id| {
-                    let single = Filter {
-                        kind: if remote {
-                            FrameKind::Remote
-                        } else {
-                            FrameKind::Data
-                        },
-                        format: f.format,
-                        id,
-                        mask: range,
-                    };
-                    if let Some(w) = list32_of(&single) {
-                        let user = user_of(id, f.format == Format::Extended, remote);
-                        out(Entry { v: w, m: 0, user });
-                    }
-                });
+                };
+                n = 1;
             }
         }
         _ => {
-            let (range, ext) = match f.format {
-                Format::Extended => (EXT_BITS_IN_16BIT, true),
-                _ => (0x7FF, false),
+            let ext = matches!(f.format, Format::Extended);
+            let range = if class == L32 {
+                f.format.id_mask()
+            } else if ext {
+                EXT_BITS_IN_16BIT
+            } else {
+                0x7FF
             };
-            for &remote in kinds_of(f.kind) {
-                spread(f.id, dont_care(f.mask, range), |id| {
+            let dc = dont_care(f.mask, range);
+            let mut r = 0;
+            while r < kinds_len(f.kind) {
+                let remote = kind_remote(f.kind, r);
+                r += 1;
+                // Every identifier of the cell: the sub-masks of the don't-care bits.
+                let mut sub: u32 = 0;
+                loop {
+                    let id = f.id | sub;
                     let single = Filter {
                         kind: if remote {
                             FrameKind::Remote
@@ -382,19 +400,51 @@ fn entries(item: &Item, class: usize, keys: &KeyTable, mut out: impl FnMut(Entry
                         id,
                         mask: range,
                     };
-                    if let Some(w) = list16_of(&single) {
-                        debug_assert_eq!(w, frame_word16(id, ext, remote));
-                        out(Entry {
-                            v: w as u32,
-                            m: 0,
-                            user: user_of(id, ext, remote),
-                        });
+                    let word = if class == L32 {
+                        list32_of(&single)
+                    } else {
+                        match list16_of(&single) {
+                            Some(w) => Some(w as u32),
+                            None => None,
+                        }
+                    };
+                    if let Some(w) = word {
+                        let u = if user == LOOKUP {
+                            match keys.lookup(key(id, ext, remote)) {
+                                Some(u) => u,
+                                None => NO_FILTER,
+                            }
+                        } else {
+                            user
+                        };
+                        if n < 4 {
+                            out[n] = Entry {
+                                v: w,
+                                m: 0,
+                                user: u,
+                            };
+                            n += 1;
+                        }
                     }
-                });
+                    if sub == dc {
+                        break;
+                    }
+                    sub = sub.wrapping_sub(dc) & dc;
+                }
             }
         }
     }
+    (out, n)
 }
+
+/// A filter with every field zero (standard data, identifier and mask 0): the content
+/// of a fresh scratch.
+const ZERO_FILTER: Filter = Filter {
+    kind: FrameKind::Data,
+    format: Format::Standard,
+    id: 0,
+    mask: 0,
+};
 
 /// One thing the bank search places: a general filter or a cube of keys.
 #[derive(Debug, Clone, Copy)]
@@ -412,13 +462,28 @@ struct Item {
 }
 
 impl Item {
-    const NONE: Item = Item {
-        filter: Filter::pass_all(),
-        user: NO_FILTER,
+    const ZERO: Item = Item {
+        filter: ZERO_FILTER,
+        user: 0,
         pos: 0,
         cube: false,
         list: false,
     };
+
+    /// The search order: by place in the order constraint, general filters before
+    /// cubes, then identifier and mask.
+    const fn before(&self, other: &Item) -> bool {
+        if self.pos != other.pos {
+            return self.pos < other.pos;
+        }
+        if self.cube != other.cube {
+            return !self.cube;
+        }
+        if self.filter.id != other.filter.id {
+            return self.filter.id < other.filter.id;
+        }
+        self.filter.mask < other.filter.mask
+    }
 }
 
 /// Steps 1–3: the checked, narrowed list split into general filters and keys.
@@ -430,113 +495,152 @@ struct Prepared {
 }
 
 impl Prepared {
-    fn new(list: &[Filter]) -> Result<Self, PlanError> {
+    const ZERO: Prepared = Prepared {
+        general: [ZERO_FILTER; MAX_FILTERS],
+        general_users: [0; MAX_FILTERS],
+        n_general: 0,
+        keys: KeyTable::new(),
+    };
+
+    const fn fill(&mut self, list: &[Filter]) -> Result<(), PlanError> {
+        self.n_general = 0;
+        self.keys.clear();
         if list.len() > MAX_FILTERS {
             return Err(PlanError::TooManyFilters {
-                given: list.len().min(u16::MAX as usize) as u16,
+                given: if list.len() > u16::MAX as usize {
+                    u16::MAX
+                } else {
+                    list.len() as u16
+                },
                 max: MAX_FILTERS as u16,
             });
         }
-        for (i, f) in list.iter().enumerate() {
-            f.check().map_err(|error: FilterError| PlanError::Filter {
-                index: i as u16,
-                error,
-            })?;
-        }
-        let mut p = Prepared {
-            general: [Filter::pass_all(); MAX_FILTERS],
-            general_users: [0; MAX_FILTERS],
-            n_general: 0,
-            keys: KeyTable::new(),
-        };
-        for (i, f) in list.iter().enumerate() {
-            let Some(g) = narrow(*f, &list[..i]) else {
-                continue;
-            };
-            if let Some((keys, n)) = keys_of(&g) {
-                for &k in &keys[..n] {
-                    // 2 × MAX_FILTERS keys at most: the table holds them all.
-                    p.keys
-                        .insert(k, i as u16)
-                        .map_err(|_| PlanError::BankOutOfRange)?;
-                }
-            } else {
-                p.general[p.n_general] = g;
-                p.general_users[p.n_general] = i as u16;
-                p.n_general += 1;
+        let mut i = 0;
+        while i < list.len() {
+            if let Err(error) = list[i].check() {
+                return Err(PlanError::Filter {
+                    index: i as u16,
+                    error,
+                });
             }
+            i += 1;
         }
-        Ok(p)
+        let mut i = 0;
+        while i < list.len() {
+            let g = match narrow(list[i], list.split_at(i).0) {
+                Some(g) => g,
+                None => {
+                    i += 1;
+                    continue;
+                }
+            };
+            match keys_of(&g) {
+                Some((keys, n)) => {
+                    let mut j = 0;
+                    while j < n {
+                        // 2 × MAX_FILTERS keys at most: the table holds them all.
+                        if self.keys.insert(keys[j], i as u16).is_err() {
+                            return Err(PlanError::BankOutOfRange);
+                        }
+                        j += 1;
+                    }
+                }
+                None => {
+                    self.general[self.n_general] = g;
+                    self.general_users[self.n_general] = i as u16;
+                    self.n_general += 1;
+                }
+            }
+            i += 1;
+        }
+        Ok(())
     }
 
-    fn general(&self) -> &[Filter] {
-        &self.general[..self.n_general]
+    const fn general(&self) -> &[Filter] {
+        self.general.split_at(self.n_general).0
     }
 
-    /// The items of a cover: general filters, then cubes (unsorted).
-    fn items<'a>(&'a self, cubes: &'a [Cube]) -> impl Iterator<Item = Item> + 'a {
-        let general = self
-            .general()
-            .iter()
-            .zip(self.general_users.iter())
-            .map(|(f, &u)| Item {
-                filter: *f,
+    /// Item `idx` of a cover: general filters, then cubes (unsorted).
+    const fn item(&self, cubes: &CubeList, idx: usize) -> Item {
+        if idx < self.n_general {
+            let u = self.general_users[idx];
+            return Item {
+                filter: self.general[idx],
                 user: u,
                 pos: u,
                 cube: false,
                 list: true,
-            });
-        let cubes = cubes.iter().map(move |c| {
-            let exact = self.keys.count_in(c) == c.size();
-            let user = if exact {
-                self.keys.single_user(c).unwrap_or(LOOKUP)
-            } else {
-                LOOKUP
             };
-            Item {
-                filter: c.filter(),
-                user,
-                pos: self.keys.first_user(c).unwrap_or(u16::MAX),
-                cube: true,
-                list: exact,
+        }
+        let c = cubes.get(idx - self.n_general);
+        let exact = self.keys.count_in(&c) == c.size();
+        let user = if exact {
+            match self.keys.single_user(&c) {
+                Some(u) => u,
+                None => LOOKUP,
             }
-        });
-        general.chain(cubes)
+        } else {
+            LOOKUP
+        };
+        Item {
+            filter: c.filter(),
+            user,
+            pos: match self.keys.first_user(&c) {
+                Some(u) => u,
+                None => u16::MAX,
+            },
+            cube: true,
+            list: exact,
+        }
     }
 }
 
-/// The bank count of the best class choice for `items` with the order constraint
-/// ignored (a lower bound; exact when no item overlaps a later general filter).
-fn relaxed_banks(items: impl Iterator<Item = Item>) -> u16 {
+/// The bank count of the best class choice for the items of `cubes` with the order
+/// constraint ignored (a lower bound; exact when no item overlaps a later general
+/// filter).
+const fn relaxed_banks(prep: &Prepared, cubes: &CubeList) -> u16 {
     let mut cost = [u16::MAX; STATES];
     cost[0] = 0;
-    for item in items {
-        let o = options(&item);
+    let n = prep.n_general + cubes.len();
+    let mut idx = 0;
+    while idx < n {
+        let o = options(&prep.item(cubes, idx));
+        idx += 1;
         let mut next = [u16::MAX; STATES];
-        for s in 0..STATES as u8 {
-            if cost[s as usize] == u16::MAX {
-                continue;
-            }
-            for (c, &count) in o.iter().enumerate() {
-                if count == 0 {
-                    continue;
+        let mut s = 0;
+        while s < STATES {
+            if cost[s] != u16::MAX {
+                let mut c = 0;
+                while c < CLASSES {
+                    if o[c] != 0 {
+                        let (open, to) = step(s as u8, c, o[c]);
+                        let v = cost[s].saturating_add(open);
+                        if v < next[to as usize] {
+                            next[to as usize] = v;
+                        }
+                    }
+                    c += 1;
                 }
-                let (open, n) = step(s, c, count);
-                let v = cost[s as usize].saturating_add(open);
-                if v < next[n as usize] {
-                    next[n as usize] = v;
-                }
             }
+            s += 1;
         }
         cost = next;
     }
-    cost.iter().copied().min().unwrap_or(0)
+    let mut best = cost[0];
+    let mut s = 1;
+    while s < STATES {
+        if cost[s] < best {
+            best = cost[s];
+        }
+        s += 1;
+    }
+    best
 }
 
 /// Quarter banks a cube needs at least (std single 1, std block 2, ext single 2, ext
 /// block 4): the trigger of the superset loop.
-fn quarters(c: &Cube) -> u32 {
-    let ext = twocan_core::filter_set::key_parts(c.base).1;
+const fn quarters(c: &Cube) -> u32 {
+    let ext = key_parts(c.base).1;
     match (ext, c.is_block()) {
         (false, false) => 1,
         (false, true) => 2,
@@ -545,48 +649,26 @@ fn quarters(c: &Cube) -> u32 {
     }
 }
 
-/// Items placed by the search, with their classes.
-struct Attempt {
-    problem: Problem,
-    classes: [u8; ITEMS],
-    banks: u16,
-    proven: bool,
-}
-
-/// Steps 5–7 for one cover: the solved attempt, or the banks needed when there are too
-/// many items to search (more than fit 28 banks anyway).
-fn attempt(prep: &Prepared, cubes: &[Cube]) -> Result<Attempt, u16> {
-    let problem = problem(prep, cubes)?;
-    let (classes, banks, proven) = problem.solve();
-    Ok(Attempt {
-        problem,
-        classes,
-        banks,
-        proven,
-    })
-}
-
-/// The search problem of a cover: items sorted by their place in the order
-/// constraint; `Err(banks needed)` when there are too many items to search.
-fn problem(prep: &Prepared, cubes: &[Cube]) -> Result<Problem, u16> {
-    let n = prep.n_general + cubes.len();
-    if n > ITEMS {
-        return Err(relaxed_banks(prep.items(cubes)));
+/// The fewest quarter banks one item's options take.
+const fn options_quarters(o: &[u8; CLASSES]) -> u8 {
+    // Quarter banks per entry of each class: 32-bit list 2, 32-bit mask 4, 16-bit list
+    // 1, 16-bit mask 2.
+    const Q: [u8; CLASSES] = [2, 4, 1, 2];
+    let mut best = u8::MAX;
+    let mut c = 0;
+    while c < CLASSES {
+        if o[c] != 0 && o[c] * Q[c] < best {
+            best = o[c] * Q[c];
+        }
+        c += 1;
     }
-    let mut items = [Item::NONE; ITEMS];
-    for (slot, item) in items.iter_mut().zip(prep.items(cubes)) {
-        *slot = item;
-    }
-    items[..n].sort_unstable_by_key(|i| (i.pos, i.cube, i.filter.id, i.filter.mask));
-    Ok(Problem::new(&items[..n]))
-}
-
-fn banks_of(a: &Result<Attempt, u16>) -> u16 {
-    match a {
-        Ok(a) => a.banks,
-        Err(needed) => *needed,
+    if best == u8::MAX {
+        4
+    } else {
+        best
     }
 }
+
 /// Items in search order, with their options and earlier overlaps.
 struct Problem {
     n: usize,
@@ -596,175 +678,782 @@ struct Problem {
     earlier: [u128; ITEMS],
 }
 
-impl Problem {
-    fn new(items: &[Item]) -> Self {
-        let mut p = Problem {
-            n: items.len(),
-            items: [Item::NONE; ITEMS],
+/// Items placed by the search, with their classes (or, when there are too many items
+/// to search, the banks they need at least).
+struct Attempt {
+    /// Searched (`false`: more items than fit 28 banks anyway; `banks` is a bound).
+    ok: bool,
+    banks: u16,
+    proven: bool,
+    problem: Problem,
+    classes: [u8; ITEMS],
+}
+
+impl Attempt {
+    const ZERO: Attempt = Attempt {
+        ok: false,
+        banks: 0,
+        proven: false,
+        problem: Problem {
+            n: 0,
+            items: [Item::ZERO; ITEMS],
             options: [[0; CLASSES]; ITEMS],
             earlier: [0; ITEMS],
-        };
-        for (j, item) in items.iter().enumerate() {
-            p.items[j] = *item;
-            p.options[j] = options(item);
-            let mut bits = 0u128;
-            for (k, other) in items[..j].iter().enumerate() {
-                if !(other.cube && item.cube) && overlaps(&other.filter, &item.filter) {
-                    bits |= 1 << k;
-                }
-            }
-            p.earlier[j] = bits;
-        }
-        p
+        },
+        classes: [0; ITEMS],
+    };
+}
+
+/// Working memory of the bank search.
+struct SolveScratch {
+    /// `relax[j][s]`: cheapest plan for items `j..` from state `s`, order constraint
+    /// ignored.
+    relax: [[u32; STATES]; ITEMS + 1],
+    classes: [u8; ITEMS],
+    tried: [u8; ITEMS + 1],
+    state: [u8; ITEMS + 1],
+    cost: [u32; ITEMS + 1],
+}
+
+impl SolveScratch {
+    const ZERO: SolveScratch = SolveScratch {
+        relax: [[0; STATES]; ITEMS + 1],
+        classes: [0; ITEMS],
+        tried: [0; ITEMS + 1],
+        state: [0; ITEMS + 1],
+        cost: [0; ITEMS + 1],
+    };
+}
+
+/// Steps 5–7 for one cover, into `a`.
+const fn attempt(prep: &Prepared, cubes: &CubeList, a: &mut Attempt, s: &mut SolveScratch) {
+    let n = prep.n_general + cubes.len();
+    if n > ITEMS {
+        a.ok = false;
+        a.banks = relaxed_banks(prep, cubes);
+        a.proven = false;
+        a.problem.n = 0;
+        return;
     }
-    /// Step 5: the class of each filter in a plan with the fewest banks, the bank count,
-    /// and whether the search proved it optimal.
-    ///
-    /// Costs are `banks × SCALE + tie-break`, so that among plans with the fewest banks
-    /// the one with the smallest tie-break weight ([`WEIGHT`]) is chosen.
-    fn solve(&self) -> ([u8; ITEMS], u16, bool) {
-        let n = self.n;
-        let add = |s: u8, c: usize, count: u8| -> (u32, u8) {
-            let (open, next) = step(s, c, count);
-            (open as u32 * SCALE + count as u32 * WEIGHT[c], next)
-        };
-        // relax[j][s]: cheapest plan for filters j.. from state s, order constraint ignored.
-        let mut relax = [[0u32; STATES]; ITEMS + 1];
-        for j in (0..n).rev() {
-            for s in 0..STATES as u8 {
-                let mut best = u32::MAX;
-                for c in 0..CLASSES {
-                    let count = self.options[j][c];
-                    if count == 0 {
-                        continue;
-                    }
-                    let (cost, next) = add(s, c, count);
-                    best = best.min(cost + relax[j + 1][next as usize]);
-                }
-                relax[j][s as usize] = best;
+    let p = &mut a.problem;
+    p.n = n;
+    let mut idx = 0;
+    while idx < n {
+        p.items[idx] = prep.item(cubes, idx);
+        idx += 1;
+    }
+    // Sorted by their place in the order constraint (insertion sort: stable).
+    let mut i = 1;
+    while i < n {
+        let x = p.items[i];
+        let mut j = i;
+        while j > 0 && x.before(&p.items[j - 1]) {
+            p.items[j] = p.items[j - 1];
+            j -= 1;
+        }
+        p.items[j] = x;
+        i += 1;
+    }
+    let mut j = 0;
+    while j < n {
+        let item = p.items[j];
+        p.options[j] = options(&item);
+        let mut bits = 0u128;
+        let mut k = 0;
+        while k < j {
+            let other = p.items[k];
+            if !(other.cube && item.cube) && overlaps(&other.filter, &item.filter) {
+                bits |= 1 << k;
             }
+            k += 1;
         }
-        let bound = relax[0][0];
+        p.earlier[j] = bits;
+        j += 1;
+    }
+    let (banks, proven) = solve(&a.problem, s, &mut a.classes);
+    a.ok = true;
+    a.banks = banks;
+    a.proven = proven;
+}
 
-        // Seed: every filter in a 32-bit mask bank (always valid).
-        let mut best_classes = [M32 as u8; ITEMS];
-        let mut best_cost = n as u32 * (SCALE + WEIGHT[M32]);
-        let banks = |cost: u32| (cost / SCALE) as u16;
-        if best_cost == bound {
-            return (best_classes, banks(best_cost), true);
-        }
+/// The combined cost and next state of `count` entries of class `c` in state `s`.
+const fn add(s: u8, c: usize, count: u8) -> (u32, u8) {
+    let (open, next) = step(s, c, count);
+    (open as u32 * SCALE + count as u32 * WEIGHT[c], next)
+}
 
-        let mut classes = [0u8; ITEMS];
-        let mut tried = [0u8; ITEMS + 1];
-        let mut state = [0u8; ITEMS + 1];
-        let mut cost = [0u32; ITEMS + 1];
-        let mut j = 0usize;
-        let mut nodes = 0u32;
-        let mut proven = true;
-        loop {
-            if j == n {
-                if cost[n] < best_cost {
-                    best_cost = cost[n];
-                    best_classes = classes;
-                    // Fewest banks reached: stop (the tie-break is best effort, the
-                    // depth-first order tries the cheapest classes first).
-                    if banks(best_cost) == banks(bound) {
-                        break;
+/// Step 7: the class of each item in a plan with the fewest banks (into `best_classes`),
+/// the bank count, and whether the search proved it optimal.
+///
+/// Costs are `banks × SCALE + tie-break`, so that among plans with the fewest banks
+/// the one with the smallest tie-break weight ([`WEIGHT`]) is chosen.
+const fn solve(p: &Problem, s: &mut SolveScratch, best_classes: &mut [u8; ITEMS]) -> (u16, bool) {
+    let n = p.n;
+    let mut st = 0;
+    while st < STATES {
+        s.relax[n][st] = 0;
+        st += 1;
+    }
+    let mut j = n;
+    while j > 0 {
+        j -= 1;
+        let mut st = 0;
+        while st < STATES {
+            let mut best = u32::MAX;
+            let mut c = 0;
+            while c < CLASSES {
+                let count = p.options[j][c];
+                if count != 0 {
+                    let (cost, next) = add(st as u8, c, count);
+                    let v = cost + s.relax[j + 1][next as usize];
+                    if v < best {
+                        best = v;
                     }
+                }
+                c += 1;
+            }
+            s.relax[j][st] = best;
+            st += 1;
+        }
+    }
+    let bound = s.relax[0][0];
+    const fn banks(cost: u32) -> u16 {
+        (cost / SCALE) as u16
+    }
+
+    // Seed: every filter in a 32-bit mask bank (always valid).
+    let mut i = 0;
+    while i < ITEMS {
+        best_classes[i] = M32 as u8;
+        s.classes[i] = 0;
+        i += 1;
+    }
+    let mut best_cost = n as u32 * (SCALE + WEIGHT[M32]);
+    if best_cost == bound {
+        return (banks(best_cost), true);
+    }
+
+    s.tried[0] = 0;
+    s.state[0] = 0;
+    s.cost[0] = 0;
+    let mut j = 0usize;
+    let mut nodes = 0u32;
+    let mut proven = true;
+    loop {
+        if j == n {
+            if s.cost[n] < best_cost {
+                best_cost = s.cost[n];
+                *best_classes = s.classes;
+                // Fewest banks reached: stop (the tie-break is best effort, the
+                // depth-first order tries the cheapest classes first).
+                if banks(best_cost) == banks(bound) {
+                    break;
+                }
+            }
+            j -= 1;
+            continue;
+        }
+        let mut floor = 0u8;
+        let mut bits = p.earlier[j];
+        while bits != 0 {
+            let i = bits.trailing_zeros() as usize;
+            if s.classes[i] > floor {
+                floor = s.classes[i];
+            }
+            bits &= bits - 1;
+        }
+        // (estimate, class, increment, next state)
+        let mut pick: Option<(u32, usize, u32, u8)> = None;
+        let mut c = floor as usize;
+        while c < CLASSES {
+            let count = p.options[j][c];
+            if count != 0 && s.tried[j] & (1 << c) == 0 {
+                let (inc, next) = add(s.state[j], c, count);
+                let estimate = s.cost[j] + inc + s.relax[j + 1][next as usize];
+                if estimate < best_cost {
+                    let better = match pick {
+                        None => true,
+                        Some(q) => estimate < q.0,
+                    };
+                    if better {
+                        pick = Some((estimate, c, inc, next));
+                    }
+                }
+            }
+            c += 1;
+        }
+        match pick {
+            None => {
+                if j == 0 {
+                    break;
                 }
                 j -= 1;
-                continue;
             }
-            let floor = {
-                let mut f = 0u8;
-                let mut bits = self.earlier[j];
-                while bits != 0 {
-                    let i = bits.trailing_zeros() as usize;
-                    f = f.max(classes[i]);
-                    bits &= bits - 1;
+            Some((_, c, inc, next)) => {
+                nodes += 1;
+                if nodes > SEARCH_BUDGET {
+                    proven = false;
+                    break;
                 }
-                f
-            };
-            let mut pick: Option<(u32, usize, u32, u8)> = None;
-            for c in (floor as usize)..CLASSES {
-                let count = self.options[j][c];
-                if count == 0 || tried[j] & (1 << c) != 0 {
-                    continue;
-                }
-                let (inc, next) = add(state[j], c, count);
-                let estimate = cost[j] + inc + relax[j + 1][next as usize];
-                if estimate >= best_cost {
-                    continue;
-                }
-                if pick.is_none_or(|p| estimate < p.0) {
-                    pick = Some((estimate, c, inc, next));
-                }
-            }
-            match pick {
-                None => {
-                    if j == 0 {
-                        break;
-                    }
-                    j -= 1;
-                }
-                Some((_, c, inc, next)) => {
-                    nodes += 1;
-                    if nodes > SEARCH_BUDGET {
-                        proven = false;
-                        break;
-                    }
-                    tried[j] |= 1 << c;
-                    classes[j] = c as u8;
-                    state[j + 1] = next;
-                    cost[j + 1] = cost[j] + inc;
-                    j += 1;
-                    tried[j] = 0;
-                }
+                s.tried[j] |= 1 << c;
+                s.classes[j] = c as u8;
+                s.state[j + 1] = next;
+                s.cost[j + 1] = s.cost[j] + inc;
+                j += 1;
+                s.tried[j] = 0;
             }
         }
-        // Fewest banks is proven when the search ran to its end, or when the bank count
-        // met the bound's (the tie-break alone may be unproven).
-        let proven = proven || banks(best_cost) == banks(bound);
-        (best_classes, banks(best_cost), proven)
     }
+    // Fewest banks is proven when the search ran to its end, or when the bank count
+    // met the bound's (the tie-break alone may be unproven).
+    let proven = proven || banks(best_cost) == banks(bound);
+    (banks(best_cost), proven)
 }
 
-/// Union-find over filters and banks, for FIFO balancing.
-struct Groups {
+/// Working memory of the layout: the banks each item's entries went to, and the
+/// union-find of FIFO balancing.
+struct LayoutScratch {
+    bank_of: [[u8; 4]; ITEMS],
+    bank_count_of: [u8; ITEMS],
     parent: [u16; ITEMS + FILTER_BANKS],
+    weight: [u16; ITEMS + FILTER_BANKS],
+    /// 0: no FIFO yet; 1 + the FIFO's index.
+    fifo_of_root: [u8; ITEMS + FILTER_BANKS],
 }
 
-impl Groups {
-    fn new() -> Self {
-        let mut parent = [0u16; ITEMS + FILTER_BANKS];
-        for (i, p) in parent.iter_mut().enumerate() {
-            *p = i as u16;
-        }
-        Groups { parent }
+impl LayoutScratch {
+    const ZERO: LayoutScratch = LayoutScratch {
+        bank_of: [[0; 4]; ITEMS],
+        bank_count_of: [0; ITEMS],
+        parent: [0; ITEMS + FILTER_BANKS],
+        weight: [0; ITEMS + FILTER_BANKS],
+        fifo_of_root: [0; ITEMS + FILTER_BANKS],
+    };
+}
+
+/// Completes the bank of class `c` with the `fill` pending entries (the last repeated
+/// to its capacity) and appends it to `out`.
+const fn flush<const K: usize>(
+    c: usize,
+    pending: &mut [Entry; 4],
+    fill: &mut usize,
+    out: &mut FilterPlan<K>,
+) -> Result<(), PlanError> {
+    if *fill == 0 {
+        return Ok(());
     }
-    fn find(&mut self, mut x: usize) -> usize {
-        while self.parent[x] as usize != x {
-            let up = self.parent[self.parent[x] as usize];
-            self.parent[x] = up;
-            x = up as usize;
-        }
-        x
+    let cap = CAP[c] as usize;
+    // Pad by repeating the last entry (same user index).
+    let last = pending[*fill - 1];
+    let mut i = *fill;
+    while i < cap {
+        pending[i] = last;
+        i += 1;
     }
-    fn union(&mut self, a: usize, b: usize) {
-        let (ra, rb) = (self.find(a), self.find(b));
-        if ra != rb {
-            self.parent[ra.max(rb)] = ra.min(rb) as u16;
+    let e = *pending;
+    let (fr1, fr2) = match c {
+        M32 => (e[0].v, e[0].m),
+        L32 => (e[0].v, e[1].v),
+        L16 => (e[0].v | (e[1].v << 16), e[2].v | (e[3].v << 16)),
+        _ => (e[0].v | (e[0].m << 16), e[1].v | (e[1].m << 16)),
+    };
+    let mut users = [NO_FILTER; 4];
+    let mut i = 0;
+    while i < cap {
+        users[i] = e[i].user;
+        i += 1;
+    }
+    if let Err(err) = out.push(Bank::raw(KINDS[c], Fifo::Fifo0, fr1, fr2), users) {
+        return Err(err);
+    }
+    *pending = [Entry::NONE; 4];
+    *fill = 0;
+    Ok(())
+}
+
+/// Step 10: the banks of an attempt, in class order, entries in item order, into `out`;
+/// then the lookup keys (refused with the counts when more than `K`) and the FIFOs.
+const fn layout<const K: usize>(
+    prep: &Prepared,
+    a: &Attempt,
+    extra: u64,
+    list_only_banks: u16,
+    options: PlanOptions,
+    lay: &mut LayoutScratch,
+    out: &mut FilterPlan<K>,
+) -> Result<(), PlanError> {
+    let p = &a.problem;
+    out.reset();
+    let mut j = 0;
+    while j < ITEMS {
+        lay.bank_of[j] = [0; 4];
+        lay.bank_count_of[j] = 0;
+        j += 1;
+    }
+    let mut c = 0;
+    while c < CLASSES {
+        let cap = CAP[c] as usize;
+        let mut pending = [Entry::NONE; 4];
+        let mut fill = 0usize;
+        let mut j = 0;
+        while j < p.n {
+            if a.classes[j] as usize == c {
+                let (es, ne) = entries(&p.items[j], c, &prep.keys);
+                let mut x = 0;
+                while x < ne {
+                    pending[fill] = es[x];
+                    fill += 1;
+                    x += 1;
+                    let bank = out.bank_count();
+                    let k = lay.bank_count_of[j] as usize;
+                    if k < 4 && (k == 0 || lay.bank_of[j][k - 1] as usize != bank) {
+                        lay.bank_of[j][k] = bank as u8;
+                        lay.bank_count_of[j] += 1;
+                    }
+                    if fill == cap {
+                        if let Err(e) = flush(c, &mut pending, &mut fill, out) {
+                            return Err(e);
+                        }
+                    }
+                }
+            }
+            j += 1;
+        }
+        if let Err(e) = flush(c, &mut pending, &mut fill, out) {
+            return Err(e);
+        }
+        c += 1;
+    }
+    out.set_optimal(a.proven);
+    if let Err(e) = out.set_resolution(&prep.keys, extra, list_only_banks) {
+        return Err(e);
+    }
+    match options.fifo {
+        FifoPolicy::Fifo0 => {}
+        FifoPolicy::Fifo1 => {
+            let mut b = 0;
+            while b < out.bank_count() {
+                out.set_fifo(b, Fifo::Fifo1);
+                b += 1;
+            }
+        }
+        FifoPolicy::Balanced => balance(p, lay, out),
+    }
+    Ok(())
+}
+
+/// Union-find root of `x`, with path halving.
+const fn find(parent: &mut [u16; ITEMS + FILTER_BANKS], mut x: usize) -> usize {
+    while parent[x] as usize != x {
+        let up = parent[parent[x] as usize];
+        parent[x] = up;
+        x = up as usize;
+    }
+    x
+}
+
+const fn union(parent: &mut [u16; ITEMS + FILTER_BANKS], a: usize, b: usize) {
+    let (ra, rb) = (find(parent, a), find(parent, b));
+    if ra != rb {
+        if ra < rb {
+            parent[rb] = ra as u16;
+        } else {
+            parent[ra] = rb as u16;
         }
     }
 }
 
-/// Compiles `filters` into the fewest banks (see the module documentation).
+/// Assigns tied groups of banks to FIFOs, largest first, to the FIFO with fewer filters.
+const fn balance<const K: usize>(p: &Problem, lay: &mut LayoutScratch, out: &mut FilterPlan<K>) {
+    let mut i = 0;
+    while i < ITEMS + FILTER_BANKS {
+        lay.parent[i] = i as u16;
+        lay.weight[i] = 0;
+        lay.fifo_of_root[i] = 0;
+        i += 1;
+    }
+    let mut j = 0;
+    while j < p.n {
+        let mut k = 0;
+        while k < lay.bank_count_of[j] as usize {
+            union(&mut lay.parent, j, ITEMS + lay.bank_of[j][k] as usize);
+            k += 1;
+        }
+        let mut bits = p.earlier[j];
+        while bits != 0 {
+            let i = bits.trailing_zeros() as usize;
+            union(&mut lay.parent, i, j);
+            bits &= bits - 1;
+        }
+        // Overlapping cubes do not constrain each other's class, but share a FIFO too:
+        // a frame they both accept must have one FIFO whichever entry wins.
+        let mut i = 0;
+        while i < j {
+            if p.items[i].cube
+                && p.items[j].cube
+                && overlaps(&p.items[i].filter, &p.items[j].filter)
+            {
+                union(&mut lay.parent, i, j);
+            }
+            i += 1;
+        }
+        j += 1;
+    }
+    // Weight of each group root: number of user filters.
+    let mut j = 0;
+    while j < p.n {
+        let r = find(&mut lay.parent, j);
+        lay.weight[r] += 1;
+        j += 1;
+    }
+    let mut load = [0u16; 2];
+    loop {
+        // Heaviest unassigned group.
+        let mut heaviest: Option<usize> = None;
+        let mut r = 0;
+        while r < p.n {
+            if find(&mut lay.parent, r) == r && lay.fifo_of_root[r] == 0 && lay.weight[r] > 0 {
+                let heavier = match heaviest {
+                    None => true,
+                    Some(h) => lay.weight[r] > lay.weight[h],
+                };
+                if heavier {
+                    heaviest = Some(r);
+                }
+            }
+            r += 1;
+        }
+        let r = match heaviest {
+            Some(r) => r,
+            None => break,
+        };
+        let fifo = if load[1] < load[0] { 1 } else { 0 };
+        load[fifo] += lay.weight[r];
+        lay.fifo_of_root[r] = 1 + fifo as u8;
+    }
+    let mut b = 0;
+    while b < out.bank_count() {
+        let r = find(&mut lay.parent, ITEMS + b);
+        let fifo = if lay.fifo_of_root[r] == 2 {
+            Fifo::Fifo1
+        } else {
+            Fifo::Fifo0
+        };
+        out.set_fifo(b, fifo);
+        b += 1;
+    }
+}
+
+/// The working memory of [`plan_in`] (about 90 KB, every field zero when new: a `static`
+/// of it takes RAM but no flash) and its result, a [`FilterPlan<K>`].
+///
+/// A firmware that plans at run time keeps it in a `static` place it owns: an RTIC
+/// `#[local]` resource, a `cortex_m::singleton!` (`&'static mut`), or any static cell
+/// that lends `&mut` to one context at a time. The planning call itself then needs a
+/// small stack frame (a few hundred bytes, see `bxcan/tests/planner_stack.rs`).
+pub struct Scratch<const K: usize = LOOKUP_KEYS> {
+    prep: Prepared,
+    /// The best cover so far and the cover being tried (roles swap by index).
+    cubes: [CubeList; 2],
+    cover: CoverScratch,
+    /// The best attempt so far and the attempt being tried (roles swap by index).
+    attempts: [Attempt; 2],
+    search: SolveScratch,
+    layout: LayoutScratch,
+    out: FilterPlan<K>,
+}
+
+impl<const K: usize> Default for Scratch<K> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<const K: usize> Scratch<K> {
+    /// Fresh working memory (all zeros).
+    pub const fn new() -> Self {
+        Scratch {
+            prep: Prepared::ZERO,
+            cubes: [CubeList::new(), CubeList::new()],
+            cover: CoverScratch::new(),
+            attempts: [Attempt::ZERO, Attempt::ZERO],
+            search: SolveScratch::ZERO,
+            layout: LayoutScratch::ZERO,
+            out: FilterPlan::zeroed(),
+        }
+    }
+
+    /// The plan of the last successful [`plan_in`] call.
+    pub const fn plan(&self) -> &FilterPlan<K> {
+        &self.out
+    }
+}
+
+/// The cover `which` (0: greedy, blocks of three or more keys; 1: greedy, blocks of
+/// two or more; 2: the lightest, by branch and bound) into `out`; `false` when there is
+/// none new (the search skipped or no lighter than the first).
+const fn cover_of(
+    prep: &Prepared,
+    which: usize,
+    seed_weight: u32,
+    out: &mut CubeList,
+    scratch: &mut CoverScratch,
+) -> Result<bool, PlanError> {
+    match which {
+        0 | 1 => {
+            let min_gain = if which == 0 { 3 } else { 2 };
+            if exact_cover(&prep.keys, min_gain, out, scratch).is_err() {
+                return Err(PlanError::BankOutOfRange);
+            }
+            Ok(true)
+        }
+        _ => {
+            if prep.keys.len() > COVER_SEARCH_KEYS {
+                return Ok(false);
+            }
+            min_cover(&prep.keys, 2, 1, seed_weight, COVER_BUDGET, out, scratch);
+            // Empty: not lighter than the greedy cover, whose attempt was made.
+            Ok(!out.is_empty())
+        }
+    }
+}
+
+/// The steps of the module documentation, into `s.out`.
+const fn plan_into<const K: usize>(
+    filters: &[Filter],
+    options: PlanOptions,
+    s: &mut Scratch<K>,
+) -> Result<(), PlanError> {
+    let Scratch {
+        prep,
+        cubes,
+        cover,
+        attempts,
+        search,
+        layout: lay,
+        out,
+    } = s;
+    out.reset();
+    if let Err(e) = prep.fill(filters) {
+        return Err(e);
+    }
+    let available = if options.banks < FILTER_BANKS as u8 {
+        options.banks
+    } else {
+        FILTER_BANKS as u8
+    };
+    if cubes[0].set_singles(prep.keys.keys()).is_err() {
+        return Err(PlanError::BankOutOfRange);
+    }
+    attempt(prep, &cubes[0], &mut attempts[0], search);
+    let list_only_banks = attempts[0].banks;
+    // Indices of the best attempt and of its cover.
+    let (mut best, mut best_cubes) = (0usize, 0usize);
+    let mut seed_weight = 0;
+    if options.merge {
+        // Blocks of three or more keys save entries; blocks of two save none but can
+        // fill a half-used 16-bit mask bank; the lightest cover (a block weighs two
+        // single entries): each is tried.
+        let mut which = 0;
+        while which < 3 {
+            let t = 1 - best_cubes;
+            let fresh = match cover_of(prep, which, seed_weight, &mut cubes[t], cover) {
+                Ok(f) => f,
+                Err(e) => return Err(e),
+            };
+            if which == 0 {
+                seed_weight = cubes[t].weight(2, 1);
+            }
+            if fresh {
+                let ta = 1 - best;
+                attempt(prep, &cubes[t], &mut attempts[ta], search);
+                if attempts[ta].banks < attempts[best].banks {
+                    best = ta;
+                    best_cubes = t;
+                }
+            }
+            which += 1;
+        }
+    }
+    let needed = attempts[best].banks;
+    if attempts[best].ok && needed <= available as u16 {
+        return match layout(prep, &attempts[best], 0, list_only_banks, options, lay, out) {
+            Err(PlanError::TooManyLookupKeys { needed: keys, .. }) => within_capacity(
+                prep,
+                cubes,
+                cover,
+                attempts,
+                search,
+                lay,
+                out,
+                options,
+                available,
+                list_only_banks,
+                seed_weight,
+                keys,
+            ),
+            other => other,
+        };
+    }
+    if !options.superset {
+        return Err(PlanError::TooManyBanks { needed, available });
+    }
+    // Step 9: merge cubes into supersets until the plan fits.
+    let grown = &mut cubes[best_cubes];
+    let mut general_quarters = 0u32;
+    let mut g = 0;
+    while g < prep.n_general {
+        general_quarters += options_quarters(&self::options(&prep.item(grown, g))) as u32;
+        g += 1;
+    }
+    loop {
+        let mut q = general_quarters;
+        let mut i = 0;
+        while i < grown.len() {
+            q += quarters(&grown.get(i));
+            i += 1;
+        }
+        if q <= 4 * available as u32 && relaxed_banks(prep, grown) <= available as u16 {
+            attempt(prep, grown, &mut attempts[0], search);
+            if attempts[0].ok && attempts[0].banks <= available as u16 {
+                let extra = grown.extra(&prep.keys, cover);
+                return layout(
+                    prep,
+                    &attempts[0],
+                    extra,
+                    list_only_banks,
+                    options,
+                    lay,
+                    out,
+                );
+            }
+        }
+        if !merge_step(grown, prep.general()) {
+            return Err(PlanError::TooManyBanks { needed, available });
+        }
+    }
+}
+
+/// Step 8 within the lookup capacity: the plan with the fewest banks needed more than
+/// `K` lookup keys (`keys_needed`). Tried instead: the list-only plan (no key), and each
+/// merged cover with its multi-user blocks split until they hold at most `K` keys
+/// ([`split_multi_user_blocks`]); the one with the fewest banks is laid out, or the list is refused with
+/// [`PlanError::TooManyLookupKeys`] (the keys the best plan needs, and `K`).
+#[allow(clippy::too_many_arguments)]
+const fn within_capacity<const K: usize>(
+    prep: &Prepared,
+    cubes: &mut [CubeList; 2],
+    cover: &mut CoverScratch,
+    attempts: &mut [Attempt; 2],
+    search: &mut SolveScratch,
+    lay: &mut LayoutScratch,
+    out: &mut FilterPlan<K>,
+    options: PlanOptions,
+    available: u8,
+    list_only_banks: u16,
+    seed_weight: u32,
+    keys_needed: u16,
+) -> Result<(), PlanError> {
+    if cubes[0].set_singles(prep.keys.keys()).is_err() {
+        return Err(PlanError::BankOutOfRange);
+    }
+    attempt(prep, &cubes[0], &mut attempts[0], search);
+    let (mut best, mut best_cubes) = (0usize, 0usize);
+    let mut which = 0;
+    while which < 3 {
+        let t = 1 - best_cubes;
+        let fresh = match cover_of(prep, which, seed_weight, &mut cubes[t], cover) {
+            Ok(f) => f,
+            Err(e) => return Err(e),
+        };
+        if fresh {
+            split_multi_user_blocks(&prep.keys, &mut cubes[t], K);
+            let ta = 1 - best;
+            attempt(prep, &cubes[t], &mut attempts[ta], search);
+            if attempts[ta].banks < attempts[best].banks {
+                best = ta;
+                best_cubes = t;
+            }
+        }
+        which += 1;
+    }
+    if attempts[best].ok && attempts[best].banks <= available as u16 {
+        layout(prep, &attempts[best], 0, list_only_banks, options, lay, out)
+    } else {
+        out.reset();
+        Err(PlanError::TooManyLookupKeys {
+            needed: keys_needed,
+            max: if K > u16::MAX as usize {
+                u16::MAX
+            } else {
+                K as u16
+            },
+        })
+    }
+}
+
+/// Compiles `filters` into the fewest banks (see the module documentation), with the
+/// working memory in `scratch` and the plan left there: the run-time planner of a
+/// firmware, whose `scratch` lives in a `static` (see [`Scratch`]). The plan needs at
+/// most `K` lookup keys (the capacity of the driver it is for).
+///
+/// The same `const fn` as [`plan`] and [`crate::const_plan!`]: one implementation, at
+/// compile time and at run time.
+///
+/// Errors: as [`plan`].
+///
+/// ```
+/// use twocan_bxcan::planner::{plan_in, PlanOptions, Scratch};
+/// use twocan_core::Filter;
+///
+/// // In firmware: `let scratch: &'static mut Scratch = cortex_m::singleton!(: Scratch =
+/// // Scratch::new()).unwrap();` or an RTIC local resource; a box on the host.
+/// let mut scratch: Box<Scratch> = Box::default();
+/// let filters = [Filter::standard(0x100), Filter::standard(0x101)];
+/// let plan = plan_in(&filters, PlanOptions::new(14), &mut scratch)?;
+/// assert_eq!(plan.bank_count(), 1);
+/// # Ok::<(), twocan_bxcan::PlanError>(())
+/// ```
+pub const fn plan_in<'s, const K: usize>(
+    filters: &[Filter],
+    options: PlanOptions,
+    scratch: &'s mut Scratch<K>,
+) -> Result<&'s FilterPlan<K>, PlanError> {
+    match plan_into(filters, options, scratch) {
+        Ok(()) => Ok(&scratch.out),
+        Err(e) => Err(e),
+    }
+}
+
+/// [`plan`] for a driver with room for `K` lookup keys ([`crate::Init::with_lookup_capacity`]):
+/// the plan needs at most `K`. Builds its own [`Scratch`] (on the stack at run time:
+/// for `const` code and the host; firmware uses [`plan_in`]).
+pub const fn plan_for<const K: usize>(
+    filters: &[Filter],
+    options: PlanOptions,
+) -> Result<FilterPlan<K>, PlanError> {
+    let mut s = Scratch::<K>::new();
+    match plan_into(filters, options, &mut s) {
+        Ok(()) => Ok(s.out),
+        Err(e) => Err(e),
+    }
+}
+
+/// Compiles `filters` into the fewest banks (see the module documentation), for the
+/// default driver ([`LOOKUP_KEYS`] lookup keys: a merged plan that would need more
+/// gives way to one that needs fewer, or the list is refused with both counts).
+///
+/// A `const fn`: with a `const` list, [`crate::const_plan!`] plans it at compile time
+/// and keeps only what the plan needs. At run time it builds its working memory
+/// ([`Scratch`], about 90 KB) on the stack: fine on a host; firmware plans with
+/// [`plan_in`] and the scratch in a `static`.
 ///
 /// Errors: [`PlanError::TooManyFilters`] beyond [`MAX_FILTERS`] (given and maximum),
 /// [`PlanError::Filter`] for a non-conforming filter, [`PlanError::TooManyBanks`] (banks
 /// needed after merging and available) when the plan needs more than `options.banks`
 /// banks (or more than 28) and the superset fallback is off or cannot help (general
-/// filters alone too many).
+/// filters alone too many), [`PlanError::TooManyLookupKeys`] when every plan that fits
+/// the banks needs more lookup keys than the driver keeps.
 ///
 /// ```
 /// use twocan_bxcan::{plan, Fifo, PlanError, PlanOptions};
@@ -796,204 +1485,172 @@ impl Groups {
 /// ));
 /// # Ok::<(), Box<dyn core::error::Error>>(())
 /// ```
-pub fn plan(filters: &[Filter], options: PlanOptions) -> Result<FilterPlan, PlanError> {
-    let prep = Prepared::new(filters)?;
-    let available = options.banks.min(FILTER_BANKS as u8);
-    let mut singles = CubeList::new();
-    for &k in prep.keys.keys() {
-        // No more keys than the cube list holds (MAX_KEYS = MAX_CUBES).
-        singles
-            .push(Cube::single(k))
-            .map_err(|_| PlanError::BankOutOfRange)?;
-    }
-    let list_only = attempt(&prep, singles.as_slice());
-    let list_only_banks = banks_of(&list_only);
-    let mut covers = [CubeList::new(), CubeList::new(), CubeList::new()];
-    let (mut best, mut cubes) = (list_only, &singles);
-    if options.merge {
-        // Blocks of three or more keys save entries; blocks of two save none but can
-        // fill a half-used 16-bit mask bank: both covers are tried.
-        for (cover, min_gain) in covers.iter_mut().zip([3, 2]) {
-            exact_cover(&prep.keys, min_gain, cover).map_err(|_| PlanError::BankOutOfRange)?;
-        }
-        // The lightest cover (a block weighs two single entries), by branch and bound.
-        if prep.keys.len() <= COVER_SEARCH_KEYS {
-            let (head, tail) = covers.split_at_mut(2);
-            min_cover(&prep.keys, 2, 1, &head[0], COVER_BUDGET, &mut tail[0]);
-        }
-        if covers[2].is_empty() {
-            // Not lighter than the greedy cover (or not searched): no new candidate.
-            covers[2] = covers[0].clone();
-        }
-        for cover in covers.iter() {
-            let merged = attempt(&prep, cover.as_slice());
-            if banks_of(&merged) < banks_of(&best) {
-                best = merged;
-                cubes = cover;
-            }
-        }
-    }
-    let needed = banks_of(&best);
-    if let Ok(a) = best {
-        if a.banks <= available as u16 {
-            return layout(&prep, a, 0, list_only_banks, options);
-        }
-    }
-    if !options.superset {
-        return Err(PlanError::TooManyBanks { needed, available });
-    }
-    // Step 9: merge cubes into supersets until the plan fits.
-    let mut grown = cubes.clone();
-    let general_quarters: u32 = prep
-        .items(&[])
-        .map(|item| {
-            let o = options_quarters(&self::options(&item));
-            o as u32
-        })
-        .sum();
-    let allowed = |c: &Cube| {
-        let f = c.filter();
-        !prep.general().iter().any(|g| overlaps(g, &f))
-    };
-    loop {
-        let q: u32 = general_quarters + grown.as_slice().iter().map(quarters).sum::<u32>();
-        if q <= 4 * available as u32
-            && relaxed_banks(prep.items(grown.as_slice())) <= available as u16
-        {
-            if let Ok(a) = attempt(&prep, grown.as_slice()) {
-                if a.banks <= available as u16 {
-                    let extra = grown.extra(&prep.keys);
-                    return layout(&prep, a, extra, list_only_banks, options);
-                }
-            }
-        }
-        if !merge_step(&mut grown, allowed) {
-            return Err(PlanError::TooManyBanks { needed, available });
-        }
-    }
+pub const fn plan(filters: &[Filter], options: PlanOptions) -> Result<FilterPlan, PlanError> {
+    plan_for::<LOOKUP_KEYS>(filters, options)
 }
 
-/// The fewest quarter banks one item's options take.
-fn options_quarters(o: &[u8; CLASSES]) -> u8 {
-    // Quarter banks per entry of each class: 32-bit list 2, 32-bit mask 4, 16-bit list
-    // 1, 16-bit mask 2.
-    const Q: [u8; CLASSES] = [2, 4, 1, 2];
-    (0..CLASSES)
-        .filter(|&c| o[c] != 0)
-        .map(|c| o[c] * Q[c])
-        .min()
-        .unwrap_or(4)
-}
-
-/// Step 10: the banks of an attempt, in class order, entries in item order.
-fn layout(
-    prep: &Prepared,
-    a: Attempt,
-    extra: u64,
-    list_only_banks: u16,
+/// [`plan_for`] with room for every key ([`MAX_LOOKUP_KEYS`]), or a compile-time error
+/// with a readable message: the first step of [`crate::const_plan!`].
+#[doc(hidden)]
+pub const fn plan_or_panic(
+    filters: &[Filter],
     options: PlanOptions,
-) -> Result<FilterPlan, PlanError> {
-    let p = &a.problem;
-    let classes = &a.classes;
-    let mut out = FilterPlan::manual();
-    let mut bank_of = [[0u8; 4]; ITEMS]; // banks holding each item's entries (≤ 4)
-    let mut bank_count_of = [0u8; ITEMS];
-    for c in 0..CLASSES {
-        let cap = CAP[c] as usize;
-        let mut pending: [Option<Entry>; 4] = [None; 4];
-        let mut fill = 0usize;
-        let flush = |pending: &mut [Option<Entry>; 4], fill: &mut usize, out: &mut FilterPlan| {
-            if *fill == 0 {
-                return Ok(());
-            }
-            // Pad by repeating the last entry (same user index).
-            let last = pending[*fill - 1];
-            for slot in pending.iter_mut().take(cap).skip(*fill) {
-                *slot = last;
-            }
-            let e: [Entry; 4] = core::array::from_fn(|i| {
-                pending[i].unwrap_or(Entry {
-                    v: 0,
-                    m: 0,
-                    user: NO_FILTER,
-                })
-            });
-            let (fr1, fr2) = match c {
-                M32 => (e[0].v, e[0].m),
-                L32 => (e[0].v, e[1].v),
-                L16 => (e[0].v | (e[1].v << 16), e[2].v | (e[3].v << 16)),
-                _ => (e[0].v | (e[0].m << 16), e[1].v | (e[1].m << 16)),
-            };
-            let mut users = [NO_FILTER; 4];
-            for (u, x) in users.iter_mut().zip(e.iter()).take(cap) {
-                *u = x.user;
-            }
-            out.push(Bank::raw(KINDS[c], Fifo::Fifo0, fr1, fr2), users)?;
-            *pending = [None; 4];
-            *fill = 0;
-            Ok::<(), PlanError>(())
-        };
-        for j in 0..p.n {
-            if classes[j] as usize != c {
-                continue;
-            }
-            let mut result = Ok(());
-            entries(&p.items[j], c, &prep.keys, |e| {
-                if result.is_err() {
-                    return;
-                }
-                pending[fill] = Some(e);
-                fill += 1;
-                let bank = out.bank_count();
-                let k = bank_count_of[j] as usize;
-                if k < 4 && (k == 0 || bank_of[j][k - 1] as usize != bank) {
-                    bank_of[j][k] = bank as u8;
-                    bank_count_of[j] += 1;
-                }
-                if fill == cap {
-                    result = flush(&mut pending, &mut fill, &mut out);
-                }
-            });
-            result?;
-        }
-        flush(&mut pending, &mut fill, &mut out)?;
+) -> FilterPlan<MAX_LOOKUP_KEYS> {
+    match plan_for::<MAX_LOOKUP_KEYS>(filters, options) {
+        Ok(p) => p,
+        Err(e) => e.panic(),
     }
-    debug_assert_eq!(out.bank_count(), a.banks as usize);
-    out.set_optimal(a.proven);
-    out.set_resolution(&prep.keys, extra, list_only_banks)?;
-
-    match options.fifo {
-        FifoPolicy::Fifo0 => {}
-        FifoPolicy::Fifo1 => {
-            for b in 0..out.bank_count() {
-                out.set_fifo(b, Fifo::Fifo1);
-            }
-        }
-        FifoPolicy::Balanced => balance(p, &bank_of, &bank_count_of, &mut out),
-    }
-    Ok(out)
 }
 
 /// Plans of a two-bus application sharing the CAN1/CAN2 filter block, and the
 /// `CAN2SB` that gives each instance the banks it needs.
 #[derive(Debug, Clone, PartialEq, Eq)]
-pub struct DualPlan {
+pub struct DualPlan<const K: usize = LOOKUP_KEYS> {
     /// The first bank of CAN2 (`CAN_FMR.CAN2SB`): CAN1 owns banks `0..can2sb`.
     pub can2sb: u8,
     /// CAN1's plan (banks `0..can2sb`).
-    pub can1: FilterPlan,
+    pub can1: FilterPlan<K>,
     /// CAN2's plan (banks `can2sb..28`).
-    pub can2: FilterPlan,
+    pub can2: FilterPlan<K>,
+}
+
+/// The working memory of [`plan_dual_in`] and its result.
+pub struct DualScratch<const K: usize = LOOKUP_KEYS> {
+    scratch: Scratch<K>,
+    plan: DualPlan<K>,
+}
+
+impl<const K: usize> Default for DualScratch<K> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<const K: usize> DualScratch<K> {
+    /// Fresh working memory (all zeros).
+    pub const fn new() -> Self {
+        DualScratch {
+            scratch: Scratch::new(),
+            plan: DualPlan {
+                can2sb: 0,
+                can1: FilterPlan::zeroed(),
+                can2: FilterPlan::zeroed(),
+            },
+        }
+    }
+}
+
+/// Banks `list` needs with the whole block and no superset.
+const fn need<const K: usize>(
+    list: &[Filter],
+    exact: PlanOptions,
+    s: &mut Scratch<K>,
+) -> Result<u16, PlanError> {
+    match plan_into(list, exact, s) {
+        Ok(()) => Ok(s.out.bank_count() as u16),
+        Err(PlanError::TooManyBanks { needed, .. }) => Ok(needed),
+        Err(e) => Err(e),
+    }
+}
+
+const fn plan_dual_into<const K: usize>(
+    can1: &[Filter],
+    can2: &[Filter],
+    options: PlanOptions,
+    d: &mut DualScratch<K>,
+) -> Result<(), PlanError> {
+    let exact = PlanOptions {
+        banks: FILTER_BANKS as u8,
+        superset: false,
+        ..options
+    };
+    let n1 = match need(can1, exact, &mut d.scratch) {
+        Ok(n) => n,
+        Err(e) => return Err(e),
+    };
+    let n2 = match need(can2, exact, &mut d.scratch) {
+        Ok(n) => n,
+        Err(e) => return Err(e),
+    };
+    let total = FILTER_BANKS as u16;
+    let can2sb = if n1 + n2 <= total {
+        n1 as u8
+    } else if options.superset {
+        // Share the block in proportion to the needs; each list is merged down.
+        let share = (n1 as u32 * total as u32) / (n1 as u32 + n2 as u32);
+        if share < 1 {
+            1
+        } else if share > 27 {
+            27
+        } else {
+            share as u8
+        }
+    } else {
+        return Err(PlanError::DualTooManyBanks {
+            can1_needed: n1,
+            can2_needed: n2,
+            available: FILTER_BANKS as u8,
+        });
+    };
+    let one = PlanOptions {
+        banks: can2sb,
+        ..options
+    };
+    if let Err(e) = plan_into(can1, one, &mut d.scratch) {
+        return Err(e);
+    }
+    if let Err(e) = d.plan.can1.copy_from(d.scratch.out.as_ref()) {
+        return Err(e);
+    }
+    let two = PlanOptions {
+        banks: FILTER_BANKS as u8 - can2sb,
+        ..options
+    };
+    if let Err(e) = plan_into(can2, two, &mut d.scratch) {
+        return Err(e);
+    }
+    if let Err(e) = d.plan.can2.copy_from(d.scratch.out.as_ref()) {
+        return Err(e);
+    }
+    d.plan.can2sb = can2sb;
+    Ok(())
+}
+
+/// [`plan_dual`] with the working memory and the result in `scratch` (see [`plan_in`]).
+pub const fn plan_dual_in<'s, const K: usize>(
+    can1: &[Filter],
+    can2: &[Filter],
+    options: PlanOptions,
+    scratch: &'s mut DualScratch<K>,
+) -> Result<&'s DualPlan<K>, PlanError> {
+    match plan_dual_into(can1, can2, options, scratch) {
+        Ok(()) => Ok(&scratch.plan),
+        Err(e) => Err(e),
+    }
+}
+
+/// [`plan_dual`] for drivers with room for `K` lookup keys (see [`plan_for`]).
+pub const fn plan_dual_for<const K: usize>(
+    can1: &[Filter],
+    can2: &[Filter],
+    options: PlanOptions,
+) -> Result<DualPlan<K>, PlanError> {
+    let mut d = DualScratch::<K>::new();
+    match plan_dual_into(can1, can2, options, &mut d) {
+        Ok(()) => Ok(d.plan),
+        Err(e) => Err(e),
+    }
 }
 
 /// Plans CAN1's and CAN2's lists together and chooses `CAN2SB` so that both fit the 28
 /// banks of the shared block: CAN1 gets the banks its plan needs, CAN2 the rest (with
 /// the spare banks left to CAN2). `options.banks` is ignored; the other options apply
-/// to both lists.
+/// to both lists. A `const fn`, as [`plan`].
 ///
 /// Errors: [`PlanError::DualTooManyBanks`] with each list's need when together they
 /// need more than 28 banks (a list that alone needs more than 28 shows as such), or the
-/// first list's [`PlanError::Filter`] / [`PlanError::TooManyFilters`].
+/// first list's [`PlanError::Filter`] / [`PlanError::TooManyFilters`] /
+/// [`PlanError::TooManyLookupKeys`].
 ///
 /// ```
 /// use twocan_bxcan::{plan_dual, PlanError, PlanOptions};
@@ -1015,116 +1672,78 @@ pub struct DualPlan {
 /// );
 /// # Ok::<(), PlanError>(())
 /// ```
-pub fn plan_dual(
+pub const fn plan_dual(
     can1: &[Filter],
     can2: &[Filter],
     options: PlanOptions,
 ) -> Result<DualPlan, PlanError> {
-    let exact = PlanOptions {
-        banks: FILTER_BANKS as u8,
-        superset: false,
-        ..options
-    };
-    let need = |list: &[Filter]| -> Result<u16, PlanError> {
-        match plan(list, exact) {
-            Ok(p) => Ok(p.bank_count() as u16),
-            Err(PlanError::TooManyBanks { needed, .. }) => Ok(needed),
-            Err(e) => Err(e),
-        }
-    };
-    let (n1, n2) = (need(can1)?, need(can2)?);
-    let total = FILTER_BANKS as u16;
-    let can2sb = if n1 + n2 <= total {
-        n1 as u8
-    } else if options.superset {
-        // Share the block in proportion to the needs; each list is merged down.
-        let share = ((n1 as u32 * total as u32) / (n1 as u32 + n2 as u32)).clamp(1, 27);
-        share as u8
-    } else {
-        return Err(PlanError::DualTooManyBanks {
-            can1_needed: n1,
-            can2_needed: n2,
-            available: FILTER_BANKS as u8,
-        });
-    };
-    let one = plan(
-        can1,
-        PlanOptions {
-            banks: can2sb,
-            ..options
-        },
-    )?;
-    let two = plan(
-        can2,
-        PlanOptions {
-            banks: FILTER_BANKS as u8 - can2sb,
-            ..options
-        },
-    )?;
-    Ok(DualPlan {
-        can2sb,
-        can1: one,
-        can2: two,
-    })
+    plan_dual_for::<LOOKUP_KEYS>(can1, can2, options)
 }
 
-/// Assigns tied groups of banks to FIFOs, largest first, to the FIFO with fewer filters.
-fn balance(p: &Problem, bank_of: &[[u8; 4]; ITEMS], counts: &[u8; ITEMS], out: &mut FilterPlan) {
-    let mut g = Groups::new();
-    for j in 0..p.n {
-        for &bank in bank_of[j].iter().take(counts[j] as usize) {
-            g.union(j, ITEMS + bank as usize);
-        }
-        let mut bits = p.earlier[j];
-        while bits != 0 {
-            let i = bits.trailing_zeros() as usize;
-            g.union(i, j);
-            bits &= bits - 1;
-        }
-        // Overlapping cubes do not constrain each other's class, but share a FIFO too:
-        // a frame they both accept must have one FIFO whichever entry wins.
-        for i in 0..j {
-            if p.items[i].cube
-                && p.items[j].cube
-                && overlaps(&p.items[i].filter, &p.items[j].filter)
-            {
-                g.union(i, j);
-            }
-        }
-    }
-    // Weight of each group root: number of user filters.
-    let mut weight = [0u16; ITEMS + FILTER_BANKS];
-    for j in 0..p.n {
-        let r = g.find(j);
-        weight[r] += 1;
-    }
-    let mut load = [0u16; 2];
-    let mut fifo_of_root = [None::<Fifo>; ITEMS + FILTER_BANKS];
-    loop {
-        // Heaviest unassigned group.
-        let mut heaviest: Option<usize> = None;
-        for r in 0..p.n {
-            if g.find(r) == r
-                && fifo_of_root[r].is_none()
-                && weight[r] > 0
-                && heaviest.is_none_or(|h| weight[r] > weight[h])
-            {
-                heaviest = Some(r);
-            }
-        }
-        let Some(r) = heaviest else { break };
-        let fifo = if load[1] < load[0] {
-            Fifo::Fifo1
-        } else {
-            Fifo::Fifo0
-        };
-        load[fifo.index()] += weight[r];
-        fifo_of_root[r] = Some(fifo);
-    }
-    for b in 0..out.bank_count() {
-        let r = g.find(ITEMS + b);
-        out.set_fifo(b, fifo_of_root[r].unwrap_or(Fifo::Fifo0));
-    }
+/// The sizes a `const` plan of `filters` needs ([`crate::filters::SizedPlan`]): its
+/// banks and its lookup keys (a compile-time error for a list that does not fit).
+pub const fn plan_sizes(filters: &[Filter], options: PlanOptions) -> PlanSizes {
+    plan_or_panic(filters, options).sizes()
+}
+
+/// Plans a `const` filter list at compile time: `const_plan!(FILTERS, options)` gives a
+/// `&'static` [`SizedPlan`](crate::filters::SizedPlan) of exactly the banks and lookup
+/// keys the plan needs, computed by the same `const fn` as the run-time planner
+/// ([`planner::plan_in`](crate::planner::plan_in)). `FILTERS` is a `const` (or any
+/// constant expression) of type `[Filter; N]` or `&[Filter]`; `options` a constant
+/// [`PlanOptions`](crate::PlanOptions). Install it with
+/// [`Init::set_filters`](crate::Init::set_filters).
+///
+/// A list that does not fit is a compile-time error naming the counts, e.g. "the
+/// filters need 5 banks, 4 are available".
+///
+/// ```
+/// use twocan_bxcan::{const_plan, Fifo, PlanOptions};
+/// use twocan_core::{Filter, Format, Frame, FrameKind};
+///
+/// const FILTERS: [Filter; 3] = [
+///     Filter::standard(0x100),
+///     Filter::standard(0x101),
+///     Filter::masked(FrameKind::Data, Format::Extended, 0x1FFF_FF00, 0x0001_2300),
+/// ];
+/// let plan = const_plan!(FILTERS, PlanOptions::new(14));
+/// assert_eq!(plan.bank_count(), 2); // one 16-bit list bank, one 32-bit mask bank
+/// assert_eq!(plan.lookup_keys().0.len(), 0); // no merged slot: no lookup key
+/// let hit = plan.evaluate(&Frame::standard(0x101, &[]).unwrap()).unwrap();
+/// assert_eq!((hit.fifo, hit.filter), (Fifo::Fifo0, 1));
+/// // Sized to the plan: two banks and their slot users, nothing else.
+/// assert!(core::mem::size_of_val(plan) < 100);
+/// ```
+///
+/// A list that needs more banks than given does not compile:
+///
+/// ```compile_fail
+/// use twocan_bxcan::{const_plan, PlanOptions};
+/// use twocan_core::Filter;
+///
+/// const MANY: [Filter; 9] = {
+///     let mut f = [Filter::extended(0); 9];
+///     let mut i = 0;
+///     while i < 9 {
+///         f[i] = Filter::extended(i as u32 * 0x1357);
+///         i += 1;
+///     }
+///     f
+/// };
+/// // error: evaluation panicked: twocan_bxcan::const_plan!: the filters need 5 banks,
+/// // 4 are available
+/// let plan = const_plan!(MANY, PlanOptions::new(4));
+/// ```
+#[macro_export]
+macro_rules! const_plan {
+    ($filters:expr, $options:expr $(,)?) => {{
+        #[allow(long_running_const_eval)]
+        const FULL: $crate::FilterPlan<{ $crate::filters::MAX_LOOKUP_KEYS }> =
+            $crate::planner::plan_or_panic(&$filters, $options);
+        const SIZES: $crate::filters::PlanSizes = FULL.sizes();
+        const PLAN: $crate::filters::SizedPlan<{ SIZES.banks }, { SIZES.keys }> = FULL.sized();
+        &PLAN
+    }};
 }
 
 #[cfg(test)]
@@ -1215,23 +1834,36 @@ mod tests {
         }
     }
 
+    fn prepared(list: &[Filter]) -> Box<Prepared> {
+        let mut p = Box::new(Prepared::ZERO);
+        p.fill(list).unwrap();
+        p
+    }
+
+    /// The solved attempt of `cubes` (a list of the cubes).
+    fn attempt_of(prep: &Prepared, cubes: &[Cube]) -> Box<Attempt> {
+        let mut list = Box::new(CubeList::new());
+        for &c in cubes {
+            list.push(c).unwrap();
+        }
+        let mut a = Box::new(Attempt::ZERO);
+        let mut s = Box::new(SolveScratch::ZERO);
+        attempt(prep, &list, &mut a, &mut s);
+        a
+    }
+
     #[test]
     fn branch_and_bound_matches_exhaustive_search() {
         let mut r = Lcg(7);
         for _ in 0..400 {
             let n = 1 + (r.next() % 7) as usize;
             let list: [Filter; 7] = core::array::from_fn(|_| random_filter(&mut r));
-            let p = list_only_problem(&list[..n]);
-            let (_, cost, proven) = p.solve();
-            assert!(proven);
-            assert_eq!(cost, brute_force(&p), "{:?}", &list[..n]);
+            let prep = prepared(&list[..n]);
+            let singles: Vec<Cube> = prep.keys.keys().iter().map(|&k| Cube::single(k)).collect();
+            let a = attempt_of(&prep, &singles);
+            assert!(a.ok && a.proven);
+            assert_eq!(a.banks, brute_force(&a.problem), "{:?}", &list[..n]);
         }
-    }
-
-    fn list_only_problem(list: &[Filter]) -> Problem {
-        let prep = Prepared::new(list).unwrap();
-        let singles: Vec<Cube> = prep.keys.keys().iter().map(|&k| Cube::single(k)).collect();
-        problem(&prep, &singles).unwrap()
     }
 
     /// Every exact cube of two or more keys of `keys`.
@@ -1259,7 +1891,7 @@ mod tests {
     /// Exhaustive search over every cover (any set of exact blocks, singles for the
     /// rest): the fewest banks any of them takes.
     fn exhaustive_banks(list: &[Filter]) -> u16 {
-        let prep = Prepared::new(list).unwrap();
+        let prep = prepared(list);
         let blocks = all_blocks(&prep.keys);
         assert!(blocks.len() <= 14, "{}", blocks.len());
         let mut best = u16::MAX;
@@ -1273,7 +1905,7 @@ mod tests {
                     cubes.push(Cube::single(k));
                 }
             }
-            best = best.min(banks_of(&attempt(&prep, &cubes)));
+            best = best.min(attempt_of(&prep, &cubes).banks);
         }
         best
     }
@@ -1302,13 +1934,118 @@ mod tests {
     }
 
     #[test]
-    fn spread_enumerates_subsets() {
-        let mut v = [0u32; 8];
-        let mut n = 0;
-        spread(0x100, 0b101, |x| {
-            v[n] = x;
-            n += 1;
-        });
-        assert_eq!(&v[..n], &[0x100, 0x101, 0x104, 0x105]);
+    fn list_entries_enumerate_the_cell() {
+        // A standard mask ignoring bits 0 and 2: four identifiers, ascending.
+        let f = Filter::masked(FrameKind::Data, Format::Standard, 0x7FA, 0x100);
+        let item = Item {
+            filter: f,
+            user: 7,
+            pos: 7,
+            cube: false,
+            list: true,
+        };
+        assert_eq!(options(&item)[L16], 4);
+        let (e, n) = entries(&item, L16, &KeyTable::<4>::new());
+        let words: Vec<u32> = e[..n].iter().map(|e| e.v).collect();
+        let want: Vec<u32> = [0x100, 0x101, 0x104, 0x105]
+            .iter()
+            .map(|&id| crate::filters::frame_word16(id, false, false) as u32)
+            .collect();
+        assert_eq!(words, want);
+        assert!(e[..n].iter().all(|e| e.user == 7));
+    }
+}
+
+/// The run-time planner's stack: every value [`plan_in`] and the functions it calls
+/// hold by value is small (the tables are in the [`Scratch`]).
+#[cfg(test)]
+mod stack {
+    use super::*;
+    use core::mem::size_of;
+    use twocan_core::filter_set::Key;
+
+    #[test]
+    fn by_value_types_on_the_run_time_path_are_small() {
+        let sizes: [(&str, usize); 22] = [
+            ("&[Filter]", size_of::<&[Filter]>()),
+            ("PlanOptions", size_of::<PlanOptions>()),
+            ("PlanError", size_of::<PlanError>()),
+            (
+                "Result<&FilterPlan, PlanError>",
+                size_of::<Result<&FilterPlan, PlanError>>(),
+            ),
+            ("Filter", size_of::<Filter>()),
+            ("Item", size_of::<Item>()),
+            ("Entry", size_of::<Entry>()),
+            ("([Entry; 4], usize)", size_of::<([Entry; 4], usize)>()),
+            ("[Entry; 4] (pending)", size_of::<[Entry; 4]>()),
+            ("Cube", size_of::<Cube>()),
+            ("Option<Cube>", size_of::<Option<Cube>>()),
+            ("Option<(u64, Cube)>", size_of::<Option<(u64, Cube)>>()),
+            ("Bank", size_of::<Bank>()),
+            ("[u16; STATES] (relaxed)", size_of::<[u16; STATES]>()),
+            ("[u8; CLASSES]", size_of::<[u8; CLASSES]>()),
+            (
+                "Option<(u32, usize, u32, u8)> (search pick)",
+                size_of::<Option<(u32, usize, u32, u8)>>(),
+            ),
+            (
+                "Option<(Fifo, u8, u16)>",
+                size_of::<Option<(Fifo, u8, u16)>>(),
+            ),
+            ("PlanRef", size_of::<crate::filters::PlanRef<'static>>()),
+            ("([Key; 2], usize)", size_of::<([Key; 2], usize)>()),
+            ("[u16; 4] (users)", size_of::<[u16; 4]>()),
+            ("[usize; 2] (fmi counters)", size_of::<[usize; 2]>()),
+            (
+                "Result<u16, PlanError>",
+                size_of::<Result<u16, PlanError>>(),
+            ),
+        ];
+        for (name, size) in sizes {
+            println!("{name}: {size} B");
+            assert!(size <= 128, "{name}: {size} B");
+        }
+        // What is not by value: the scratch (in a `static`) and the plan (in it).
+        println!("Scratch<64>: {} B", size_of::<Scratch>());
+        println!("FilterPlan<64>: {} B", size_of::<FilterPlan>());
+        assert!(size_of::<FilterPlan>() < 1024);
+        // A `const` plan: its banks, their slot users and its keys.
+        use crate::filters::SizedPlan;
+        println!("SizedPlan<1, 0>: {} B", size_of::<SizedPlan<1, 0>>());
+        println!("SizedPlan<2, 8>: {} B", size_of::<SizedPlan<2, 8>>());
+        println!("SizedPlan<28, 64>: {} B", size_of::<SizedPlan<28, 64>>());
+        assert_eq!(size_of::<SizedPlan<1, 0>>(), 32);
+    }
+
+    /// The largest list of the DBC corpus (367 identifiers, 365 extended) in superset
+    /// mode, the scratch boxed, on a thread with a 64 KiB stack (debug builds' frames
+    /// included): the planning call's stack does not grow with the list.
+    #[test]
+    fn plan_in_runs_on_a_small_stack() {
+        let list: Vec<Filter> = (0..367u32)
+            .map(|i| Filter::extended(0x0C00_0000 + i * 0x1_0203))
+            .collect();
+        // Made here (a `static` in firmware): `Box::default` builds it on this stack.
+        // Room for every key: the superset plan looks all of them up.
+        let mut scratch: Box<Scratch<MAX_LOOKUP_KEYS>> = Box::default();
+        let t = std::thread::Builder::new()
+            .stack_size(64 * 1024)
+            .spawn(move || {
+                let p = plan_in(&list, PlanOptions::new(28).superset(true), &mut scratch);
+                p.map(|p| p.bank_count())
+            })
+            .unwrap();
+        let r = t.join().unwrap();
+        assert!(matches!(r, Ok(b) if b <= 28), "{r:?}");
+        // With the default capacity the same list is refused, naming the keys.
+        let list: Vec<Filter> = (0..367u32)
+            .map(|i| Filter::extended(0x0C00_0000 + i * 0x1_0203))
+            .collect();
+        let mut small: Box<Scratch> = Box::default();
+        assert!(matches!(
+            plan_in(&list, PlanOptions::new(28).superset(true), &mut small),
+            Err(PlanError::TooManyLookupKeys { max: 64, .. })
+        ));
     }
 }

@@ -186,9 +186,9 @@ impl<R: Registers, F: Registers, const K: usize> BxCan<R, F, K> {
         &self,
         filters: &[twocan_core::Filter],
         fifo: crate::planner::FifoPolicy,
-    ) -> Result<FilterPlan, crate::filters::PlanError> {
+    ) -> Result<FilterPlan<K>, crate::filters::PlanError> {
         let (s, e) = self.bank_range();
-        crate::planner::plan(
+        crate::planner::plan_for::<K>(
             filters,
             crate::planner::PlanOptions::new((e - s) as u8).fifo(fifo),
         )
@@ -408,7 +408,7 @@ impl<R: Registers, F: Registers, const K: usize> BxCan<R, F, K> {
 unsafe impl<R: Registers, F: Registers, const K: usize> Hardware for BxCan<R, F, K> {
     type Raw = RawFrame;
     type FilterMap = ();
-    type Filters = FilterPlan;
+    type Filters = FilterPlan<K>;
     const RX_QUEUES: usize = 2;
 
     fn tx_policy(&self) -> TxPolicy {
@@ -733,7 +733,7 @@ unsafe impl<R: Registers, F: Registers, const K: usize> Hardware for BxCan<R, F,
     /// thread-side map is switched (`decode` runs in this context only, after this
     /// returns). Frames of the old list still in the driver's ring carry the old
     /// generation: `decode` drops them.
-    unsafe fn install_filters(&self, filters: &FilterPlan) -> Result<(), Error> {
+    unsafe fn install_filters(&self, filters: &FilterPlan<K>) -> Result<(), Error> {
         // The map first: a plan it cannot hold is refused before any bank changes.
         let fmi = filters.fmi_map::<K>()?;
         let drain = || {

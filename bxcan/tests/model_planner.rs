@@ -10,10 +10,16 @@
 mod bus;
 
 use bus::*;
+use twocan_bxcan::filters::MAX_LOOKUP_KEYS;
 use twocan_bxcan::model::BxCanModel;
+use twocan_bxcan::planner::plan_for;
 use twocan_bxcan::regs::{self, fa1r, ffa1r, fm1r, fmr, fs1r};
-use twocan_bxcan::{plan, Fifo, FifoPolicy, FilterPlan, PlanOptions};
+use twocan_bxcan::{plan, Fifo, FifoPolicy, PlanError, PlanOptions};
 use twocan_core::{Filter, Format, Frame, FrameKind, Registers};
+
+/// Plans with room for every lookup key (the driver's capacity is the subject of
+/// `driver_lookup.rs`).
+type FilterPlan = twocan_bxcan::FilterPlan<MAX_LOOKUP_KEYS>;
 
 /// Programs the plan's banks (FINIT, deactivate, configure, activate).
 fn install(m: &mut BxCanModel, p: &FilterPlan) {
@@ -99,7 +105,7 @@ fn run(p: &FilterPlan, frames: &[Frame]) -> (Vec<(Frame, u16)>, usize) {
 }
 
 fn check(filters: &[Filter], options: PlanOptions, r: &mut Lcg) -> FilterPlan {
-    let p = plan(filters, options).unwrap();
+    let p = plan_for::<MAX_LOOKUP_KEYS>(filters, options).unwrap();
     let frames = frames(filters, r);
     let (delivered, dropped) = run(&p, &frames);
     let want: Vec<(Frame, u16)> = frames
@@ -160,6 +166,15 @@ fn superset_plan_delivers_exactly_and_drops_the_rest() {
     let f = std_ids(ids);
     assert!(plan(&f, PlanOptions::new(14)).is_err());
     let p = check(&f, PlanOptions::new(14).merge(true).superset(true), &mut r);
+    // Every identifier of a superset slot is looked up: more keys than the default
+    // driver keeps, refused at planning time with both counts.
+    assert_eq!(
+        plan(&f, PlanOptions::new(14).superset(true)),
+        Err(PlanError::TooManyLookupKeys {
+            needed: p.key_table().len() as u16,
+            max: 64
+        })
+    );
     assert!(p.is_superset());
     assert!(p.bank_count() <= 14);
     // The drops the model saw are the plan's superset identifiers (data frames only:

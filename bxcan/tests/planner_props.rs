@@ -3,11 +3,20 @@
 //! and kind-any filters mixed in. Every plan must be exact (in superset mode: accept a
 //! superset whose extra frames resolve to `None`), report for every delivered frame the
 //! index of the first user filter that matches it, and never take more banks than the
-//! list-only plan.
+//! list-only plan. Plans for the default driver (at most [`LOOKUP_KEYS`] lookup keys)
+//! are exact too, and fit whenever the list-only plan does.
 
 use proptest::prelude::*;
-use twocan_bxcan::filters::NO_FILTER;
-use twocan_bxcan::{plan, FifoPolicy, FilterPlan, PlanError, PlanOptions};
+use twocan_bxcan::filters::{LOOKUP_KEYS, MAX_LOOKUP_KEYS, NO_FILTER};
+use twocan_bxcan::planner::plan_for;
+use twocan_bxcan::{FifoPolicy, PlanError, PlanOptions};
+
+/// Plans with room for every lookup key: the planner unconstrained by a driver.
+type FilterPlan = twocan_bxcan::FilterPlan<MAX_LOOKUP_KEYS>;
+
+fn plan(filters: &[Filter], options: PlanOptions) -> Result<FilterPlan, PlanError> {
+    plan_for::<MAX_LOOKUP_KEYS>(filters, options)
+}
 use twocan_core::{Filter, Format, Frame, FrameKind};
 
 /// A filter list: blocks (dense runs), scattered identifiers, some masks and kind-any.
@@ -82,7 +91,11 @@ fn probes(filters: &[Filter], seed: u32) -> Vec<Frame> {
     out
 }
 
-fn check(filters: &[Filter], p: &FilterPlan, frames: &[Frame]) -> Result<(), TestCaseError> {
+fn check<const K: usize>(
+    filters: &[Filter],
+    p: &twocan_bxcan::FilterPlan<K>,
+    frames: &[Frame],
+) -> Result<(), TestCaseError> {
     for f in frames {
         let want = first_match(filters, f);
         let got = p.evaluate(f).map(|a| a.filter);
@@ -120,6 +133,23 @@ proptest! {
         if let Ok(p) = &merged {
             prop_assert!(!p.is_superset());
             check(&filters, p, &frames)?;
+        }
+        // For the default driver: exact, within its lookup keys, never more banks than
+        // the list-only plan (which needs no key), refused only when that does not fit.
+        match twocan_bxcan::plan(&filters, PlanOptions::new(28)) {
+            Ok(p) => {
+                prop_assert!(p.key_table().len() <= LOOKUP_KEYS);
+                prop_assert!(p.bank_count() as u16 <= banks(&list_only));
+                prop_assert!(p.bank_count() as u16 >= banks(&merged));
+                check(&filters, &p, &frames)?;
+            }
+            Err(PlanError::TooManyLookupKeys { needed, max }) => {
+                prop_assert!(list_only.is_err());
+                prop_assert!(merged.is_ok());
+                prop_assert_eq!(max as usize, LOOKUP_KEYS);
+                prop_assert!(needed as usize > LOOKUP_KEYS);
+            }
+            Err(e) => prop_assert_eq!(Err(e), merged.map(|_| ())),
         }
         // Both FIFOs: exact, and a frame's matching entries all in one FIFO (RM0410 does
         // not say how filters of different FIFOs compare).

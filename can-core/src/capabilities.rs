@@ -100,9 +100,14 @@ pub struct Capabilities {
     pub max_bitrate: u32,
     /// The optional modes offered.
     pub modes: ModeSupport,
-    /// Most filters of one exact standard identifier the current configuration holds.
+    /// Filters of one exact standard identifier the current configuration always holds,
+    /// whatever the identifiers (the worst case: none merge into a mask entry). More
+    /// may fit when identifiers merge; planning the list for the controller is the
+    /// exact check (bxCAN `Can::plan`, FlexCAN `planner::plan`: `Ok`, or an error with
+    /// the counts).
     pub max_standard_filters: u16,
-    /// Most filters of one exact extended identifier the current configuration holds.
+    /// Filters of one exact extended identifier the current configuration always holds
+    /// (the worst case, as [`Capabilities::max_standard_filters`]).
     pub max_extended_filters: u16,
     /// Transmit mailboxes.
     pub tx_mailboxes: u8,

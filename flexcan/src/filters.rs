@@ -51,13 +51,14 @@
 //! matches first in software ([`Filter::matches`], the reference semantics), so the
 //! reported index is still the one §13.3 describes.
 
-use twocan_core::filter_set::{key, KeyTable};
+use twocan_core::filter_set::{key, key_parts, lower_bound, Key, KeyTable};
 use twocan_core::{Filter, Format, Frame, FrameKind};
 
 use crate::begin_error::ConfigErrors;
 use crate::configuration::{
     Configuration, MAX_PRIMARY_FILTERS, MAX_SECONDARY_FILTERS, MAX_TABLE_ELEMENTS,
 };
+use crate::planner::PlanError;
 
 /// Format A element / mask bit 31: remote frame.
 pub const ELEMENT_RTR: u32 = 1 << 31;
@@ -87,11 +88,13 @@ pub enum Hit {
 }
 
 /// A filter list compiled for one [`Configuration`]: the ID filter table, the masks
-/// and the map from `RXFIR.IDHIT` back to the user's filter index.
+/// and the map from `RXFIR.IDHIT` back to the user's filter index, with room for `K`
+/// lookup keys (the identifiers of merged or superset elements, [`LOOKUP_KEYS`] by
+/// default).
 ///
-/// This is the FlexCAN [`twocan_core::Hardware::Filters`] type.
+/// This is the FlexCAN [`twocan_core::Hardware::Filters`] type (with the default `K`).
 #[derive(Debug, Clone, PartialEq, Eq)]
-pub struct FilterTable {
+pub struct FilterTable<const K: usize = LOOKUP_KEYS> {
     configuration: Configuration,
     elements: [u32; MAX_TABLE_ELEMENTS],
     individual_masks: [u32; MAX_PRIMARY_FILTERS],
@@ -100,10 +103,30 @@ pub struct FilterTable {
     secondary: [Filter; MAX_SECONDARY_FILTERS],
     primary_count: u8,
     secondary_count: u8,
-    keys: KeyTable,
+    keys: KeyTable<K>,
     extra: u64,
     reject_all: bool,
 }
+
+/// How many identifiers a [`FilterTable`] keeps by default for the thread-side lookup
+/// of merged or superset elements ([`Hit::Lookup`]): the keys (identifier, format,
+/// kind) the hardware routes to such an element. Elements of one user filter need no
+/// key. The table lives in the driver's state (6 bytes a key); the planner plans within
+/// the capacity of the table it fills ([`crate::planner`]), and a `const` plan
+/// ([`crate::const_plan!`]) carries exactly the keys it needs.
+pub const LOOKUP_KEYS: usize = 64;
+
+/// The most lookup keys any plan needs: the capacity a `const` plan is computed with
+/// before it is cut to its size ([`SizedTable`]).
+pub const MAX_LOOKUP_KEYS: usize = twocan_core::filter_set::MAX_KEYS;
+
+/// A filter with every field zero: the content of a fresh planner scratch.
+const ZERO_FILTER: Filter = Filter {
+    kind: FrameKind::Data,
+    format: Format::Standard,
+    id: 0,
+    mask: 0,
+};
 
 /// Whether `f` conforms as a secondary filter (ACAN §13.4).
 pub fn secondary_conforms(f: &Filter) -> bool {
@@ -236,7 +259,9 @@ impl FilterTable {
         }
         t
     }
+}
 
+impl<const K: usize> FilterTable<K> {
     /// The configuration the table was compiled for.
     pub const fn configuration(&self) -> Configuration {
         self.configuration
@@ -264,13 +289,29 @@ impl FilterTable {
     }
 
     /// The table elements, in hardware order (`8 × (RFFN + 1)` of them).
-    pub fn elements(&self) -> &[u32] {
-        &self.elements[..self.configuration.table_elements()]
+    pub const fn elements(&self) -> &[u32] {
+        self.elements
+            .split_at(self.configuration.table_elements())
+            .0
     }
 
     /// The individual masks `RXIMR0…`, one per primary element.
-    pub fn individual_masks(&self) -> &[u32] {
-        &self.individual_masks[..self.configuration.primary_filter_capacity()]
+    pub const fn individual_masks(&self) -> &[u32] {
+        self.individual_masks
+            .split_at(self.configuration.primary_filter_capacity())
+            .0
+    }
+
+    /// What each table element's hit means, in hardware order.
+    pub const fn hits(&self) -> &[Hit] {
+        self.hits.split_at(self.configuration.table_elements()).0
+    }
+
+    /// The keys (identifier, format, kind) the hardware routes to a merged or
+    /// superset element ([`Hit::Lookup`]), with their user indices: the table
+    /// [`FilterTable::filter_index`] searches (never more than `K`).
+    pub const fn key_table(&self) -> &KeyTable<K> {
+        &self.keys
     }
 
     /// The global mask `RXFGMASK` of the secondary elements.
@@ -310,8 +351,37 @@ impl FilterTable {
     }
 }
 
-impl FilterTable {
-    /// A table from planned elements (crate-internal: [`crate::planner`]).
+/// The format A word a frame is compared as (identifier, IDE, RTR in element layout).
+pub const fn frame_word(raw_id: u32, extended: bool, remote: bool) -> u32 {
+    (if extended {
+        ELEMENT_IDE | raw_id << ELEMENT_EXT_SHIFT
+    } else {
+        raw_id << ELEMENT_STD_SHIFT
+    }) | if remote { ELEMENT_RTR } else { 0 }
+}
+
+/// One planned primary element: (element, individual mask, hit).
+pub(crate) type PlannedPrimary = (u32, u32, Hit);
+
+impl<const K: usize> FilterTable<K> {
+    /// All zeros: a planner scratch's table before its first plan.
+    pub(crate) const fn zeroed() -> Self {
+        FilterTable {
+            configuration: Configuration::Filters8_0,
+            elements: [0; MAX_TABLE_ELEMENTS],
+            individual_masks: [0; MAX_PRIMARY_FILTERS],
+            global_mask: 0,
+            hits: [Hit::Filter(0); MAX_TABLE_ELEMENTS],
+            secondary: [ZERO_FILTER; MAX_SECONDARY_FILTERS],
+            primary_count: 0,
+            secondary_count: 0,
+            keys: KeyTable::new(),
+            extra: 0,
+            reject_all: false,
+        }
+    }
+
+    /// A table from planned elements (crate-internal: [`crate::planner`]), in place.
     ///
     /// `primary`: (element, individual mask, hit) for the first `primary.len()` primary
     /// elements; `secondary`: (element, hit) under `global_mask`. Unused elements repeat
@@ -319,55 +389,135 @@ impl FilterTable {
     /// element the primaries repeat the first secondary element under the global mask,
     /// with no secondary element the secondaries repeat the last primary element under
     /// the global mask (which then compares everything: a subset of that element).
-    #[allow(clippy::too_many_arguments)]
-    pub(crate) fn planned(
+    /// Of `keys`, those the table routes to a [`Hit::Lookup`] element are kept.
+    ///
+    /// Errors: [`PlanError::TooManyLookupKeys`] when those are more than `K`.
+    pub(crate) const fn set_planned<const N: usize>(
+        &mut self,
         configuration: Configuration,
-        primary: &[(u32, u32, Hit)],
+        primary: &[PlannedPrimary],
         secondary: &[(u32, Hit)],
         global_mask: u32,
-        keys: &KeyTable,
+        keys: &KeyTable<N>,
         extra: u64,
-    ) -> Self {
+    ) -> Result<(), PlanError> {
         let capacity_p = configuration.primary_filter_capacity();
         let capacity_s = configuration.secondary_filter_capacity();
-        let global_mask = if secondary.is_empty() {
-            FULL_MASK
-        } else {
-            global_mask
-        };
-        let mut t = FilterTable {
-            configuration,
-            elements: [0; MAX_TABLE_ELEMENTS],
-            individual_masks: [FULL_MASK; MAX_PRIMARY_FILTERS],
-            global_mask,
-            hits: [Hit::Filter(0); MAX_TABLE_ELEMENTS],
-            secondary: [Filter::pass_all(); MAX_SECONDARY_FILTERS],
-            primary_count: primary.len() as u8,
-            secondary_count: 0,
-            keys: keys.clone(),
-            extra,
-            reject_all: primary.is_empty() && secondary.is_empty(),
-        };
-        for i in 0..capacity_p {
-            let (e, m, h) = match (primary.get(i), primary.last(), secondary.first()) {
-                (Some(x), _, _) | (None, Some(x), _) => *x,
-                (None, None, Some(&(e, h))) => (e, global_mask, h),
-                (None, None, None) => (0, FULL_MASK, Hit::Filter(0)),
-            };
-            t.elements[i] = e;
-            t.individual_masks[i] = m;
-            t.hits[i] = h;
+        let (np, ns) = (primary.len(), secondary.len());
+        let global_mask = if ns == 0 { FULL_MASK } else { global_mask };
+        // Field by field: no table-sized value on the stack.
+        self.configuration = configuration;
+        self.global_mask = global_mask;
+        self.primary_count = np as u8;
+        self.secondary_count = 0;
+        self.keys.clear();
+        self.extra = extra;
+        self.reject_all = np == 0 && ns == 0;
+        let mut i = 0;
+        while i < MAX_TABLE_ELEMENTS {
+            self.elements[i] = 0;
+            self.hits[i] = Hit::Filter(0);
+            i += 1;
         }
-        for j in 0..capacity_s {
-            let (e, h) = match (secondary.get(j), secondary.last(), primary.last()) {
-                (Some(x), _, _) | (None, Some(x), _) => *x,
-                (None, None, Some(&(e, _, h))) => (e, h),
-                (None, None, None) => (0, Hit::Filter(0)),
-            };
-            t.elements[capacity_p + j] = e;
-            t.hits[capacity_p + j] = h;
+        let mut i = 0;
+        while i < MAX_PRIMARY_FILTERS {
+            self.individual_masks[i] = FULL_MASK;
+            i += 1;
         }
-        t
+        let mut i = 0;
+        while i < MAX_SECONDARY_FILTERS {
+            self.secondary[i] = Filter::pass_all();
+            i += 1;
+        }
+        let mut i = 0;
+        while i < capacity_p {
+            let (e, m, h) = if i < np {
+                primary[i]
+            } else if np > 0 {
+                primary[np - 1]
+            } else if ns > 0 {
+                (secondary[0].0, global_mask, secondary[0].1)
+            } else {
+                (0, FULL_MASK, Hit::Filter(0))
+            };
+            self.elements[i] = e;
+            self.individual_masks[i] = m;
+            self.hits[i] = h;
+            i += 1;
+        }
+        let mut j = 0;
+        while j < capacity_s {
+            let (e, h) = if j < ns {
+                secondary[j]
+            } else if ns > 0 {
+                secondary[ns - 1]
+            } else if np > 0 {
+                (primary[np - 1].0, primary[np - 1].2)
+            } else {
+                (0, Hit::Filter(0))
+            };
+            self.elements[capacity_p + j] = e;
+            self.hits[capacity_p + j] = h;
+            j += 1;
+        }
+        // The keys a lookup element receives.
+        let k = keys.keys();
+        let u = keys.users();
+        let mut needed = 0;
+        let mut pass = 0;
+        while pass < 2 {
+            let mut x = 0;
+            while x < k.len() {
+                let (id, ext, rtr) = key_parts(k[x]);
+                if let Some(e) = self.first_hit(frame_word(id, ext, rtr)) {
+                    if matches!(self.hits[e], Hit::Lookup) {
+                        if pass == 0 {
+                            needed += 1;
+                        } else {
+                            // Counted in the first pass: room for each.
+                            let _ = self.keys.insert(k[x], u[x]);
+                        }
+                    }
+                }
+                x += 1;
+            }
+            if pass == 0 && needed > K {
+                return Err(PlanError::TooManyLookupKeys {
+                    needed: needed as u16,
+                    max: if K > u16::MAX as usize {
+                        u16::MAX
+                    } else {
+                        K as u16
+                    },
+                });
+            }
+            pass += 1;
+        }
+        Ok(())
+    }
+
+    /// The element the hardware hits for a frame compared as `word` (format A, the
+    /// first element whose masked bits agree; Kinetis RM "Rx FIFO structure"), `None`
+    /// when it is rejected.
+    pub const fn first_hit(&self, word: u32) -> Option<usize> {
+        if self.reject_all {
+            return None;
+        }
+        let p = self.configuration.primary_filter_capacity();
+        let n = self.configuration.table_elements();
+        let mut i = 0;
+        while i < n {
+            let m = if i < p {
+                self.individual_masks[i]
+            } else {
+                self.global_mask
+            };
+            if (word ^ self.elements[i]) & m == 0 {
+                return Some(i);
+            }
+            i += 1;
+        }
+        None
     }
 
     /// Identifiers the hardware accepts beyond the user's filters (0 unless the table
@@ -402,24 +552,219 @@ impl FilterTable {
     /// `Some((IDHIT, index))`, index `None` for a frame a superset table accepts that no
     /// user filter does. `None`: the frame is rejected.
     pub fn evaluate(&self, frame: &Frame) -> Option<(usize, Option<u16>)> {
+        let word = frame_word(frame.raw_id(), frame.is_extended(), frame.is_remote());
+        let hit = self.first_hit(word)?;
+        Some((hit, self.filter_index(hit, frame)))
+    }
+
+    /// The lookup keys it needs and its table's size: the sizes of its
+    /// [`SizedTable`].
+    pub const fn sizes(&self) -> TableSizes {
+        TableSizes {
+            elements: self.configuration.table_elements(),
+            primary: self.configuration.primary_filter_capacity(),
+            keys: self.keys.len(),
+        }
+    }
+
+    /// The same planned table in a [`SizedTable`] of exactly its elements and lookup
+    /// keys (sizes from [`FilterTable::sizes`]; other sizes, or a table with secondary
+    /// filters found in software ([`Hit::ScanSecondary`], a compiled ACAN list), panic
+    /// — in `const` code, a compile-time error). See [`crate::const_plan!`].
+    pub const fn sized<const E: usize, const P: usize, const KEYS: usize>(
+        &self,
+    ) -> SizedTable<E, P, KEYS> {
+        let s = self.sizes();
+        if s.elements != E || s.primary != P || s.keys != KEYS {
+            panic!("SizedTable sizes differ from the table's (use FilterTable::sizes)");
+        }
+        if self.secondary_count != 0 {
+            panic!("a table with ACAN secondary filters has no SizedTable");
+        }
+        let mut out = SizedTable {
+            configuration: self.configuration,
+            elements: [0; E],
+            individual_masks: [0; P],
+            global_mask: self.global_mask,
+            hits: [Hit::Filter(0); E],
+            keys: [0; KEYS],
+            key_users: [0; KEYS],
+            extra: self.extra,
+            reject_all: self.reject_all,
+        };
+        let mut i = 0;
+        while i < E {
+            out.elements[i] = self.elements[i];
+            out.hits[i] = self.hits[i];
+            i += 1;
+        }
+        let mut i = 0;
+        while i < P {
+            out.individual_masks[i] = self.individual_masks[i];
+            i += 1;
+        }
+        let (k, u) = (self.keys.keys(), self.keys.users());
+        let mut i = 0;
+        while i < KEYS {
+            out.keys[i] = k[i];
+            out.key_users[i] = u[i];
+            i += 1;
+        }
+        out
+    }
+
+    /// The driver's table for a `const` [`SizedTable`] (for the split driver's
+    /// `set_filters`; about 1 KB by value).
+    ///
+    /// Errors: [`PlanError::TooManyLookupKeys`] when it needs more lookup keys than `K`.
+    pub const fn from_sized<const E: usize, const P: usize, const K2: usize>(
+        t: &SizedTable<E, P, K2>,
+    ) -> Result<Self, PlanError> {
+        let mut out = Self::zeroed();
+        out.configuration = t.configuration;
+        out.individual_masks = [FULL_MASK; MAX_PRIMARY_FILTERS];
+        out.secondary = [Filter::pass_all(); MAX_SECONDARY_FILTERS];
+        out.global_mask = t.global_mask;
+        out.extra = t.extra;
+        out.reject_all = t.reject_all;
+        let mut i = 0;
+        while i < E {
+            out.elements[i] = t.elements[i];
+            out.hits[i] = t.hits[i];
+            i += 1;
+        }
+        let mut i = 0;
+        while i < P {
+            out.individual_masks[i] = t.individual_masks[i];
+            i += 1;
+        }
+        // The primary filters' count is not kept by a sized table (only ACAN's
+        // secondary numbering uses it, which a planned table has none of).
+        out.primary_count = P as u8;
+        if out.keys.copy_from(&t.keys, &t.key_users).is_err() {
+            return Err(PlanError::TooManyLookupKeys {
+                needed: K2 as u16,
+                max: K as u16,
+            });
+        }
+        Ok(out)
+    }
+}
+
+/// The sizes of a planned table: its elements, its primary (individual-mask) elements
+/// and the lookup keys it needs (the const parameters of its [`SizedTable`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct TableSizes {
+    /// Table elements (`8 × (RFFN + 1)`).
+    pub elements: usize,
+    /// Primary elements (individual masks).
+    pub primary: usize,
+    /// Lookup keys needed.
+    pub keys: usize,
+}
+
+/// A planned table sized to itself: the `E` elements and `P` individual masks of its
+/// configuration, the global mask, what a hit on each element means (the map from
+/// `RXFIR.IDHIT` back to the user's filter) and exactly the `K` lookup keys its merged
+/// or superset elements need — what [`crate::const_plan!`] gives for a `const` filter
+/// list. The split driver's `set_filters` takes a [`FilterTable`]
+/// ([`FilterTable::from_sized`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct SizedTable<const E: usize, const P: usize, const K: usize> {
+    configuration: Configuration,
+    elements: [u32; E],
+    individual_masks: [u32; P],
+    global_mask: u32,
+    hits: [Hit; E],
+    keys: [Key; K],
+    key_users: [u16; K],
+    extra: u64,
+    reject_all: bool,
+}
+
+impl<const E: usize, const P: usize, const K: usize> SizedTable<E, P, K> {
+    /// The configuration the table is planned for.
+    pub const fn configuration(&self) -> Configuration {
+        self.configuration
+    }
+
+    /// The table elements, in hardware order.
+    pub const fn elements(&self) -> &[u32; E] {
+        &self.elements
+    }
+
+    /// The individual masks `RXIMR0…`.
+    pub const fn individual_masks(&self) -> &[u32; P] {
+        &self.individual_masks
+    }
+
+    /// The global mask `RXFGMASK`.
+    pub const fn global_mask(&self) -> u32 {
+        self.global_mask
+    }
+
+    /// What a hit on each element means.
+    pub const fn hits(&self) -> &[Hit; E] {
+        &self.hits
+    }
+
+    /// Whether the table accepts no frame (format D).
+    pub const fn rejects_all(&self) -> bool {
+        self.reject_all
+    }
+
+    /// The lookup keys (ascending) and their user indices.
+    pub const fn lookup_keys(&self) -> (&[Key; K], &[u16; K]) {
+        (&self.keys, &self.key_users)
+    }
+
+    /// See [`FilterTable::superset_extra`].
+    pub const fn superset_extra(&self) -> u64 {
+        self.extra
+    }
+
+    /// The user's filter index for a frame the hardware accepted with `RXFIR.IDHIT` =
+    /// `element` (see [`FilterTable::filter_index`]).
+    pub const fn filter_index(&self, element: usize, frame: &Frame) -> Option<u16> {
+        if element >= E {
+            return None;
+        }
+        match self.hits[element] {
+            Hit::Filter(i) => Some(i),
+            Hit::Lookup => {
+                let k = key(frame.raw_id(), frame.is_extended(), frame.is_remote());
+                let at = lower_bound(&self.keys, k);
+                if at < K && self.keys[at] == k {
+                    Some(self.key_users[at])
+                } else {
+                    None
+                }
+            }
+            // Never planned.
+            Hit::ScanSecondary => None,
+        }
+    }
+
+    /// See [`FilterTable::evaluate`].
+    pub const fn evaluate(&self, frame: &Frame) -> Option<(usize, Option<u16>)> {
         if self.reject_all {
             return None;
         }
-        let word = if frame.is_extended() {
-            ELEMENT_IDE | frame.raw_id() << ELEMENT_EXT_SHIFT
-        } else {
-            frame.raw_id() << ELEMENT_STD_SHIFT
-        } | if frame.is_remote() { ELEMENT_RTR } else { 0 };
-        let p = self.configuration.primary_filter_capacity();
-        let hit = self.elements().iter().enumerate().position(|(i, e)| {
-            let m = if i < p {
+        let word = frame_word(frame.raw_id(), frame.is_extended(), frame.is_remote());
+        let mut i = 0;
+        while i < E {
+            let m = if i < P {
                 self.individual_masks[i]
             } else {
                 self.global_mask
             };
-            (word ^ e) & m == 0
-        })?;
-        Some((hit, self.filter_index(hit, frame)))
+            if (word ^ self.elements[i]) & m == 0 {
+                return Some((i, self.filter_index(i, frame)));
+            }
+            i += 1;
+        }
+        None
     }
 }
 

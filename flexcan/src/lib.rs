@@ -119,7 +119,7 @@ pub use begin_error::{BeginError, ConfigErrors};
 pub use board::{Board, Chip, InstancePins};
 pub use configuration::Configuration;
 pub use controller::FlexCan;
-pub use filters::{FilterTable, UNKNOWN_FILTER};
+pub use filters::{FilterTable, SizedTable, UNKNOWN_FILTER};
 #[cfg(any(feature = "teensy32", feature = "teensy35", feature = "teensy36"))]
 pub use instance::Can0;
 #[cfg(feature = "teensy36")]

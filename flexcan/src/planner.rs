@@ -38,14 +38,33 @@
 //! The thread side resolves a frame's index with [`FilterTable::filter_index`] (a
 //! table lookup, or a binary search for a merged or superset element).
 
+//!
+//! # Lookup capacity
+//!
+//! A merged or superset element standing for several user filters ([`Hit::Lookup`])
+//! leaves its frames' user indices to a binary search in the table's lookup keys, at
+//! most `K` of them ([`FilterTable<K>`], [`LOOKUP_KEYS`] by default). When the cover
+//! with the fewest primary elements would need more, its multi-user blocks are split
+//! ([`twocan_core::filter_set::split_multi_user_blocks`]) and the covers tried again;
+//! if no placement within the capacity fits, the list is refused with both counts
+//! ([`PlanError::TooManyLookupKeys`]).
+//!
+//! # At compile time and at run time
+//!
+//! Every step is a `const fn` with its working memory in a [`Scratch`]: [`plan`] (and
+//! [`crate::const_plan!`], which keeps only what the table needs) for `const` lists,
+//! [`plan_in`] with the scratch in a `static` for lists known at run time.
+
 use twocan_core::filter_set::{
-    exact_cover, keys_of, merge_step, min_cover, narrow, overlaps, Cube, CubeList, KeyTable,
+    exact_cover, keys_of, meets_any, merge_step, min_cover, narrow, split_multi_user_blocks,
+    CoverScratch, Cube, CubeList, KeyTable,
 };
-use twocan_core::{Filter, FilterError, Format};
+use twocan_core::{Filter, FilterError, Format, FrameKind};
 
 use crate::configuration::{Configuration, MAX_PRIMARY_FILTERS, MAX_SECONDARY_FILTERS};
 use crate::filters::{
-    element_of, mask_of, FilterTable, Hit, ELEMENT_IDE, ELEMENT_RTR, ELEMENT_STD_SHIFT, FULL_MASK,
+    element_of, mask_of, FilterTable, Hit, PlannedPrimary, TableSizes, ELEMENT_IDE, ELEMENT_RTR,
+    ELEMENT_STD_SHIFT, FULL_MASK, LOOKUP_KEYS, MAX_LOOKUP_KEYS,
 };
 
 /// The largest user filter list the planner takes.
@@ -67,11 +86,7 @@ pub struct PlanOptions {
 impl Default for PlanOptions {
     /// Choose the configuration, merging, no superset.
     fn default() -> Self {
-        PlanOptions {
-            configuration: None,
-            merge: true,
-            superset: false,
-        }
+        Self::choose()
     }
 }
 
@@ -80,6 +95,16 @@ impl PlanOptions {
     pub const fn new(configuration: Configuration) -> Self {
         PlanOptions {
             configuration: Some(configuration),
+            merge: true,
+            superset: false,
+        }
+    }
+
+    /// Choose the configuration (the default, usable in `const` code), merging, no
+    /// superset.
+    pub const fn choose() -> Self {
+        PlanOptions {
+            configuration: None,
             merge: true,
             superset: false,
         }
@@ -125,6 +150,14 @@ pub enum PlanError {
         /// Secondary elements of the configuration (all used).
         secondary: u8,
     },
+    /// Every placement that fits leaves more identifiers to the thread-side lookup than
+    /// the table keeps (`K` of [`FilterTable<K>`], [`LOOKUP_KEYS`] by default).
+    TooManyLookupKeys {
+        /// Identifiers the best placement would look up.
+        needed: u16,
+        /// The lookup capacity.
+        max: u16,
+    },
 }
 
 impl core::fmt::Display for PlanError {
@@ -143,6 +176,10 @@ impl core::fmt::Display for PlanError {
                 "the filters need {needed} primary filter elements, the configuration has \
                  {available} (and {secondary} secondary, all used)"
             ),
+            PlanError::TooManyLookupKeys { needed, max } => write!(
+                f,
+                "the table needs {needed} lookup keys for its merged elements, it keeps {max}"
+            ),
         }
     }
 }
@@ -157,8 +194,8 @@ impl core::error::Error for PlanError {
 }
 
 impl From<PlanError> for twocan_core::Error {
-    /// Keeps the counts ([`twocan_core::Error::FilterSpace`]: primary elements needed
-    /// and available, or filters given and the most taken).
+    /// Keeps the counts ([`twocan_core::Error::FilterSpace`]: primary elements or lookup
+    /// keys needed and available, or filters given and the most taken).
     fn from(e: PlanError) -> Self {
         match e {
             PlanError::Filter { error, .. } => twocan_core::Error::Filter(error),
@@ -172,9 +209,118 @@ impl From<PlanError> for twocan_core::Error {
                 needed,
                 available: available as u16,
             },
+            PlanError::TooManyLookupKeys { needed, max } => twocan_core::Error::FilterSpace {
+                needed,
+                available: max,
+            },
         }
     }
 }
+
+/// A message built in `const` code (for a compile-time error that names the counts).
+struct Message {
+    buf: [u8; 160],
+    len: usize,
+}
+
+impl Message {
+    const fn new() -> Self {
+        Message {
+            buf: [0; 160],
+            len: 0,
+        }
+    }
+
+    const fn text(mut self, s: &str) -> Self {
+        let b = s.as_bytes();
+        let mut i = 0;
+        while i < b.len() && self.len < self.buf.len() {
+            self.buf[self.len] = b[i];
+            self.len += 1;
+            i += 1;
+        }
+        self
+    }
+
+    const fn number(mut self, mut n: u32) -> Self {
+        let mut digits = [0u8; 10];
+        let mut k = 0;
+        loop {
+            digits[k] = b'0' + (n % 10) as u8;
+            k += 1;
+            n /= 10;
+            if n == 0 {
+                break;
+            }
+        }
+        while k > 0 && self.len < self.buf.len() {
+            k -= 1;
+            self.buf[self.len] = digits[k];
+            self.len += 1;
+        }
+        self
+    }
+
+    const fn as_str(&self) -> &str {
+        match core::str::from_utf8(self.buf.split_at(self.len).0) {
+            Ok(s) => s,
+            Err(_) => "twocan_flexcan::const_plan!: the filters cannot be planned",
+        }
+    }
+}
+
+impl PlanError {
+    /// Panics with a message naming the error and its counts: in `const` code (as in
+    /// [`crate::const_plan!`]) a compile-time error that says why the list cannot be
+    /// planned.
+    pub const fn panic(self) -> ! {
+        let m = Message::new().text("twocan_flexcan::const_plan!: ");
+        let m = match self {
+            PlanError::Filter { index, error } => m
+                .text("filter ")
+                .number(index as u32)
+                .text(" does not conform: ")
+                .text(match error {
+                    FilterError::IdOutOfRange => "the identifier is wider than its format",
+                    FilterError::MaskOutOfRange => "the mask is wider than the format",
+                    FilterError::AcceptanceOutsideMask => {
+                        "the acceptance value has bits outside the mask"
+                    }
+                    FilterError::AnyFormatWithIdentifier => "Format::Any with a non-zero mask",
+                }),
+            PlanError::TooManyFilters { given, max } => m
+                .number(given as u32)
+                .text(" filters given, the planner takes at most ")
+                .number(max as u32),
+            PlanError::TooManyPrimary {
+                needed,
+                available,
+                secondary,
+            } => m
+                .text("the filters need ")
+                .number(needed as u32)
+                .text(" primary filter elements, the configuration has ")
+                .number(available as u32)
+                .text(" (and ")
+                .number(secondary as u32)
+                .text(" secondary, all used)"),
+            PlanError::TooManyLookupKeys { needed, max } => m
+                .text("the table needs ")
+                .number(needed as u32)
+                .text(" lookup keys, the capacity is ")
+                .number(max as u32),
+        };
+        panic!("{}", m.as_str())
+    }
+}
+
+/// A filter with every field zero: the content of a fresh scratch.
+const ZERO_FILTER: Filter = Filter {
+    kind: FrameKind::Data,
+    format: Format::Standard,
+    id: 0,
+    mask: 0,
+};
 
 /// Step 1: the checked, narrowed list split into general filters and keys.
 struct Prepared {
@@ -185,263 +331,563 @@ struct Prepared {
 }
 
 impl Prepared {
-    fn new(list: &[Filter]) -> Result<Self, PlanError> {
+    const ZERO: Prepared = Prepared {
+        general: [ZERO_FILTER; MAX_FILTERS],
+        general_users: [0; MAX_FILTERS],
+        n_general: 0,
+        keys: KeyTable::new(),
+    };
+
+    const fn fill(&mut self, list: &[Filter]) -> Result<(), PlanError> {
+        self.n_general = 0;
+        self.keys.clear();
         if list.len() > MAX_FILTERS {
             return Err(PlanError::TooManyFilters {
-                given: list.len().min(u16::MAX as usize) as u16,
+                given: if list.len() > u16::MAX as usize {
+                    u16::MAX
+                } else {
+                    list.len() as u16
+                },
                 max: MAX_FILTERS as u16,
             });
         }
-        for (i, f) in list.iter().enumerate() {
-            f.check().map_err(|error| PlanError::Filter {
-                index: i as u16,
-                error,
-            })?;
+        let mut i = 0;
+        while i < list.len() {
+            if let Err(error) = list[i].check() {
+                return Err(PlanError::Filter {
+                    index: i as u16,
+                    error,
+                });
+            }
+            i += 1;
         }
-        let mut p = Prepared {
-            general: [Filter::pass_all(); MAX_FILTERS],
-            general_users: [0; MAX_FILTERS],
-            n_general: 0,
-            keys: KeyTable::new(),
-        };
-        if list.is_empty() {
-            // No filter receives nothing (unlike ACAN §4): an empty table, format D.
-            return Ok(p);
-        }
-        for (i, f) in list.iter().enumerate() {
-            let Some(g) = narrow(*f, &list[..i]) else {
-                continue;
-            };
-            match keys_of(&g) {
-                Some((keys, n)) => {
-                    for &k in &keys[..n] {
-                        // At most 2 × MAX_FILTERS = MAX_KEYS keys.
-                        let _ = p.keys.insert(k, i as u16);
+        // No filter receives nothing (unlike ACAN §4): an empty table, format D.
+        let mut i = 0;
+        while i < list.len() {
+            if let Some(g) = narrow(list[i], list.split_at(i).0) {
+                match keys_of(&g) {
+                    Some((keys, n)) => {
+                        let mut j = 0;
+                        while j < n {
+                            // At most 2 × MAX_FILTERS = MAX_KEYS keys.
+                            let _ = self.keys.insert(keys[j], i as u16);
+                            j += 1;
+                        }
+                    }
+                    None => {
+                        self.general[self.n_general] = g;
+                        self.general_users[self.n_general] = i as u16;
+                        self.n_general += 1;
                     }
                 }
-                None => {
-                    p.general[p.n_general] = g;
-                    p.general_users[p.n_general] = i as u16;
-                    p.n_general += 1;
-                }
             }
+            i += 1;
         }
-        Ok(p)
+        Ok(())
     }
 
-    fn general(&self) -> &[Filter] {
-        &self.general[..self.n_general]
+    const fn general(&self) -> &[Filter] {
+        self.general.split_at(self.n_general).0
     }
 
     /// Whether a key or cube must be primary (it overlaps a general filter).
-    fn must_be_primary(&self, c: &Cube) -> bool {
-        let f = c.filter();
-        self.general().iter().any(|g| overlaps(g, &f))
+    const fn must_be_primary(&self, c: &Cube) -> bool {
+        meets_any(c, self.general())
+    }
+
+    /// Whether a single key may take a secondary element.
+    const fn secondary_eligible(&self, c: &Cube) -> bool {
+        !c.is_block() && self.keys.count_in(c) == 1 && !self.must_be_primary(c)
     }
 }
 
 /// Nodes of the minimum-cover search ([`min_cover`]).
 pub const COVER_BUDGET: u32 = 20_000;
 
-/// Keys up to which the minimum-cover search runs (its recursion is as deep as the
+/// Keys up to which the minimum-cover search runs (its search stack is as deep as the
 /// keys it covers one by one).
 pub const COVER_SEARCH_KEYS: usize = 256;
 
 /// Primary elements a cover needs once the secondary elements are full.
-#[derive(Debug, Clone, Copy)]
-struct Need {
-    primary: usize,
-}
-
-fn need(prep: &Prepared, cubes: &[Cube], capacity_s: usize) -> Need {
+const fn need(prep: &Prepared, cubes: &CubeList, capacity_s: usize) -> usize {
     let mut primary = prep.n_general;
     let mut singles = 0;
-    for c in cubes {
-        if c.is_block() || prep.must_be_primary(c) || prep.keys.count_in(c) != c.size() {
+    let mut i = 0;
+    while i < cubes.len() {
+        let c = cubes.get(i);
+        if c.is_block() || prep.must_be_primary(&c) || prep.keys.count_in(&c) != c.size() {
             primary += 1;
         } else {
             singles += 1;
         }
+        i += 1;
     }
-    Need {
-        primary: primary + singles - singles.min(capacity_s),
-    }
+    primary + singles
+        - if singles < capacity_s {
+            singles
+        } else {
+            capacity_s
+        }
 }
 
-/// One primary element: (position in user order, element, mask, hit).
+/// One primary element while placing: (position in user order, element, mask, hit).
 type Primary = (u16, u32, u32, Hit);
 
-/// Step 3: the table of a cover that fits `configuration`.
-fn place(prep: &Prepared, cubes: &[Cube], configuration: Configuration, extra: u64) -> FilterTable {
+/// Working memory of [`place`].
+struct PlaceScratch {
+    primary: [Primary; MAX_PRIMARY_FILTERS],
+    planned: [PlannedPrimary; MAX_PRIMARY_FILTERS],
+    secondary: [(u32, Hit); MAX_SECONDARY_FILTERS],
+}
+
+impl PlaceScratch {
+    const ZERO: PlaceScratch = PlaceScratch {
+        primary: [(0, 0, 0, Hit::Filter(0)); MAX_PRIMARY_FILTERS],
+        planned: [(0, 0, Hit::Filter(0)); MAX_PRIMARY_FILTERS],
+        secondary: [(0, Hit::Filter(0)); MAX_SECONDARY_FILTERS],
+    };
+}
+
+/// Step 3: the table of a cover that fits `configuration`, into `out`.
+const fn place<const K: usize>(
+    prep: &Prepared,
+    cubes: &CubeList,
+    configuration: Configuration,
+    extra: u64,
+    ps: &mut PlaceScratch,
+    out: &mut FilterTable<K>,
+) -> Result<(), PlanError> {
     let capacity_s = configuration.secondary_filter_capacity();
-    let mut primary: [Primary; MAX_PRIMARY_FILTERS] =
-        [(0, 0, FULL_MASK, Hit::Filter(0)); MAX_PRIMARY_FILTERS];
     let mut np = 0;
-    let mut secondary = [(0u32, Hit::Filter(0)); MAX_SECONDARY_FILTERS];
     let mut ns = 0;
     let mut all_std = true;
-    for (f, &u) in prep.general().iter().zip(prep.general_users.iter()) {
-        primary[np] = (u, element_of(f), mask_of(f), Hit::Filter(u));
+    let mut g = 0;
+    while g < prep.n_general {
+        let f = prep.general[g];
+        let u = prep.general_users[g];
+        ps.primary[np] = (u, element_of(&f), mask_of(&f), Hit::Filter(u));
         np += 1;
+        g += 1;
     }
-    for c in cubes {
-        let exact = prep.keys.count_in(c) == c.size();
-        let user = prep.keys.first_user(c).unwrap_or(0);
-        let hit = match (exact, prep.keys.single_user(c)) {
+    let mut i = 0;
+    while i < cubes.len() {
+        let c = cubes.get(i);
+        i += 1;
+        let exact = prep.keys.count_in(&c) == c.size();
+        let user = match prep.keys.first_user(&c) {
+            Some(u) => u,
+            None => 0,
+        };
+        let hit = match (exact, prep.keys.single_user(&c)) {
             (true, Some(u)) => Hit::Filter(u),
             _ => Hit::Lookup,
         };
         let f = c.filter();
-        if !c.is_block() && exact && !prep.must_be_primary(c) && ns < capacity_s {
-            secondary[ns] = (element_of(&f), hit);
-            all_std &= f.format == Format::Standard;
+        if !c.is_block() && exact && !prep.must_be_primary(&c) && ns < capacity_s {
+            ps.secondary[ns] = (element_of(&f), hit);
+            all_std &= matches!(f.format, Format::Standard);
             ns += 1;
         } else {
-            primary[np] = (user, element_of(&f), mask_of(&f), hit);
+            ps.primary[np] = (user, element_of(&f), mask_of(&f), hit);
             np += 1;
         }
     }
-    primary[..np].sort_unstable_by_key(|p| (p.0, p.1));
+    // In user order (a block at its first key's index): insertion sort, stable.
+    let mut i = 1;
+    while i < np {
+        let x = ps.primary[i];
+        let mut j = i;
+        while j > 0
+            && (x.0 < ps.primary[j - 1].0
+                || (x.0 == ps.primary[j - 1].0 && x.1 < ps.primary[j - 1].1))
+        {
+            ps.primary[j] = ps.primary[j - 1];
+            j -= 1;
+        }
+        ps.primary[j] = x;
+        i += 1;
+    }
+    let mut i = 0;
+    while i < np {
+        ps.planned[i] = (ps.primary[i].1, ps.primary[i].2, ps.primary[i].3);
+        i += 1;
+    }
     let global_mask = if all_std {
         ELEMENT_RTR | ELEMENT_IDE | (0x7FF << ELEMENT_STD_SHIFT)
     } else {
         FULL_MASK
     };
-    let prim: [(u32, u32, Hit); MAX_PRIMARY_FILTERS] =
-        core::array::from_fn(|i| (primary[i].1, primary[i].2, primary[i].3));
-    FilterTable::planned(
+    out.set_planned(
         configuration,
-        &prim[..np],
-        &secondary[..ns],
+        ps.planned.split_at(np).0,
+        ps.secondary.split_at(ns).0,
         global_mask,
         &prep.keys,
         extra,
     )
 }
 
-/// Whether a single key may take a secondary element.
-fn secondary_eligible(prep: &Prepared, c: &Cube) -> bool {
-    !c.is_block() && prep.keys.count_in(c) == 1 && !prep.must_be_primary(c)
-}
-
-/// `cover` with blocks split back into single keys while the secondary elements have
+/// `cubes` with blocks split back into single keys while the secondary elements have
 /// room for them, smallest blocks first: a block of `k` keys costs one primary element,
-/// its keys cost none while `k` secondary elements are free.
-fn tuned(prep: &Prepared, cover: &CubeList, capacity_s: usize) -> CubeList {
-    let mut out = cover.clone();
-    let singles = out
-        .as_slice()
-        .iter()
-        .filter(|c| secondary_eligible(prep, c))
-        .count();
+/// its keys cost none while `k` secondary elements are free. In place.
+const fn tune(prep: &Prepared, cubes: &mut CubeList, capacity_s: usize) {
+    let mut singles = 0;
+    let mut i = 0;
+    while i < cubes.len() {
+        if prep.secondary_eligible(&cubes.get(i)) {
+            singles += 1;
+        }
+        i += 1;
+    }
     let mut free = capacity_s.saturating_sub(singles);
+    let keys = prep.keys.keys();
     loop {
         // The block whose keys covered by no other cube are fewest (and fit).
-        let cubes = out.as_slice();
         let mut pick: Option<(usize, usize)> = None;
-        for (i, c) in cubes.iter().enumerate() {
-            if !c.is_block() || prep.keys.count_in(c) != c.size() {
-                continue;
-            }
-            let mut own = 0;
-            let mut ok = true;
-            for &k in prep.keys.keys() {
-                if c.contains(k)
-                    && !cubes
-                        .iter()
-                        .enumerate()
-                        .any(|(j, o)| j != i && o.contains(k))
-                {
-                    own += 1;
-                    ok &= secondary_eligible(prep, &Cube::single(k));
+        let mut i = 0;
+        while i < cubes.len() {
+            let c = cubes.get(i);
+            if c.is_block() && prep.keys.count_in(&c) == c.size() {
+                let mut own = 0;
+                let mut ok = true;
+                let (mut x, end) = prep.keys.span(&c);
+                while x < end {
+                    let k = keys[x];
+                    if c.contains(k) {
+                        let mut other = false;
+                        let mut j = 0;
+                        while j < cubes.len() {
+                            if j != i && cubes.get(j).contains(k) {
+                                other = true;
+                                break;
+                            }
+                            j += 1;
+                        }
+                        if !other {
+                            own += 1;
+                            ok &= prep.secondary_eligible(&Cube::single(k));
+                        }
+                    }
+                    x += 1;
+                }
+                let fewer = match pick {
+                    None => true,
+                    Some((_, n)) => own < n,
+                };
+                if ok && own <= free && fewer {
+                    pick = Some((i, own));
                 }
             }
-            if ok && own <= free && pick.is_none_or(|(_, n)| own < n) {
-                pick = Some((i, own));
-            }
+            i += 1;
         }
-        let Some((i, own)) = pick else {
-            return out;
+        let (i, own) = match pick {
+            Some(p) => p,
+            None => return,
         };
-        let c = out.as_slice()[i];
-        let mut next = CubeList::new();
-        for (j, o) in out.as_slice().iter().enumerate() {
-            if j != i {
-                // Room: the list only shrinks or trades a block for its own keys.
-                let _ = next.push(*o);
+        let c = cubes.get(i);
+        cubes.remove(i);
+        let (mut x, end) = prep.keys.span(&c);
+        while x < end {
+            let k = keys[x];
+            if c.contains(k) {
+                let mut other = false;
+                let mut j = 0;
+                while j < cubes.len() {
+                    if cubes.get(j).contains(k) {
+                        other = true;
+                        break;
+                    }
+                    j += 1;
+                }
+                if !other {
+                    // Room: the list only trades a block for its own keys.
+                    let _ = cubes.push(Cube::single(k));
+                }
             }
+            x += 1;
         }
-        for &k in prep.keys.keys() {
-            if c.contains(k) && !next.as_slice().iter().any(|o| o.contains(k)) {
-                let _ = next.push(Cube::single(k));
-            }
-        }
-        out = next;
         free -= own;
     }
 }
 
-/// The best exact cover for `configuration` (fewest primary elements needed) and its
-/// need: each cover as found and with blocks split back into secondary singles.
-fn best_cover(
-    prep: &Prepared,
-    covers: &[CubeList; 4],
-    configuration: Configuration,
-) -> (CubeList, Need) {
-    let capacity_s = configuration.secondary_filter_capacity();
-    let mut best = (
-        covers[0].clone(),
-        need(prep, covers[0].as_slice(), capacity_s),
-    );
-    for c in covers.iter() {
-        for candidate in [c.clone(), tuned(prep, c, capacity_s)] {
-            let n = need(prep, candidate.as_slice(), capacity_s);
-            if n.primary < best.1.primary {
-                best = (candidate, n);
-            }
-        }
-    }
-    best
+/// The working memory of [`plan_in`] (about 70 KB, every field zero when new: a
+/// `static` of it takes RAM but no flash) and its result, a [`FilterTable<K>`].
+///
+/// A firmware that plans at run time keeps it in a `static` place it owns (an RTIC
+/// `#[local]` resource, a `cortex_m::singleton!`, any static cell lending `&mut` to one
+/// context at a time); the planning call then needs a small stack frame.
+pub struct Scratch<const K: usize = LOOKUP_KEYS> {
+    prep: Prepared,
+    /// The merged covers: greedy with blocks of two or more, greedy with blocks of
+    /// three or more, and the fewest cubes (the list of singles is made on demand).
+    covers: [CubeList; 3],
+    /// Merged covers in `covers` (0 without merging, 2 when the search found nothing
+    /// lighter).
+    n_covers: usize,
+    best: CubeList,
+    cand: CubeList,
+    cover: CoverScratch,
+    place: PlaceScratch,
+    tables: [FilterTable<K>; 2],
+    /// The table of the last successful plan.
+    result: usize,
 }
 
-/// Plans one configuration: the table, or the primary elements needed.
-fn plan_for(
+impl<const K: usize> Default for Scratch<K> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<const K: usize> Scratch<K> {
+    /// Fresh working memory (all zeros).
+    pub const fn new() -> Self {
+        Scratch {
+            prep: Prepared::ZERO,
+            covers: [CubeList::new(), CubeList::new(), CubeList::new()],
+            n_covers: 0,
+            best: CubeList::new(),
+            cand: CubeList::new(),
+            cover: CoverScratch::new(),
+            place: PlaceScratch::ZERO,
+            tables: [FilterTable::zeroed(), FilterTable::zeroed()],
+            result: 0,
+        }
+    }
+
+    /// The table of the last successful [`plan_in`] call.
+    pub const fn table(&self) -> &FilterTable<K> {
+        &self.tables[self.result]
+    }
+}
+
+/// Cover `idx` into `out`: 0 the single keys, then the merged covers.
+const fn load_cover(prep: &Prepared, covers: &[CubeList; 3], idx: usize, out: &mut CubeList) {
+    if idx == 0 {
+        // No more keys than cubes fit (MAX_KEYS = MAX_CUBES).
+        let _ = out.set_singles(prep.keys.keys());
+    } else {
+        out.copy_from(&covers[idx - 1]);
+    }
+}
+
+/// The best exact cover for `capacity_s` secondary elements (fewest primary elements
+/// needed) into `best`, and its need: each cover as found and with blocks split back
+/// into secondary singles; with `max_keys`, each cover's multi-user blocks split first
+/// so that it needs at most that many lookup keys.
+const fn best_cover(
     prep: &Prepared,
-    covers: &[CubeList; 4],
+    covers: &[CubeList; 3],
+    n_covers: usize,
+    capacity_s: usize,
+    max_keys: Option<usize>,
+    best: &mut CubeList,
+    cand: &mut CubeList,
+) -> usize {
+    load_cover(prep, covers, 0, best);
+    let mut best_need = need(prep, best, capacity_s);
+    let mut idx = 0;
+    while idx <= n_covers {
+        let mut variant = 0;
+        while variant < 2 {
+            load_cover(prep, covers, idx, cand);
+            if let Some(k) = max_keys {
+                split_multi_user_blocks(&prep.keys, cand, k);
+            }
+            if variant == 1 {
+                tune(prep, cand, capacity_s);
+            }
+            let n = need(prep, cand, capacity_s);
+            if n < best_need {
+                best.copy_from(cand);
+                best_need = n;
+            }
+            variant += 1;
+        }
+        idx += 1;
+    }
+    best_need
+}
+
+/// Plans one configuration into `tables[t]`.
+const fn plan_for_configuration<const K: usize>(
+    s: &mut Scratch<K>,
     configuration: Configuration,
     superset: bool,
-) -> Result<FilterTable, PlanError> {
+    t: usize,
+) -> Result<(), PlanError> {
+    let Scratch {
+        prep,
+        covers,
+        n_covers,
+        best,
+        cand,
+        cover,
+        place: ps,
+        tables,
+        ..
+    } = s;
     let capacity_p = configuration.primary_filter_capacity();
     let capacity_s = configuration.secondary_filter_capacity();
-    let (cover, n) = best_cover(prep, covers, configuration);
-    if n.primary <= capacity_p {
-        return Ok(place(prep, cover.as_slice(), configuration, 0));
+    let n = best_cover(prep, covers, *n_covers, capacity_s, None, best, cand);
+    if n <= capacity_p {
+        let keys = match place(prep, best, configuration, 0, ps, &mut tables[t]) {
+            Err(PlanError::TooManyLookupKeys { needed, .. }) => needed,
+            other => return other,
+        };
+        // Within the lookup capacity: blocks split, the covers tried again.
+        let n = best_cover(prep, covers, *n_covers, capacity_s, Some(K), best, cand);
+        if n <= capacity_p {
+            return place(prep, best, configuration, 0, ps, &mut tables[t]);
+        }
+        return Err(PlanError::TooManyLookupKeys {
+            needed: keys,
+            max: if K > u16::MAX as usize {
+                u16::MAX
+            } else {
+                K as u16
+            },
+        });
     }
     let refused = PlanError::TooManyPrimary {
-        needed: n.primary.min(u16::MAX as usize) as u16,
+        needed: if n > u16::MAX as usize {
+            u16::MAX
+        } else {
+            n as u16
+        },
         available: capacity_p as u8,
         secondary: capacity_s as u8,
     };
     if !superset || prep.n_general > capacity_p {
         return Err(refused);
     }
-    let mut grown = cover;
-    let allowed = |c: &Cube| !prep.must_be_primary(c);
-    while need(prep, grown.as_slice(), capacity_s).primary > capacity_p {
-        if !merge_step(&mut grown, allowed) {
+    while need(prep, best, capacity_s) > capacity_p {
+        if !merge_step(best, prep.general()) {
             return Err(refused);
         }
     }
-    let extra = grown.extra(&prep.keys);
-    Ok(place(prep, grown.as_slice(), configuration, extra))
+    let extra = best.extra(&prep.keys, cover);
+    place(prep, best, configuration, extra, ps, &mut tables[t])
 }
 
-/// Compiles `filters` into an ID filter table (see the module documentation). An empty
-/// list receives every frame (ACAN §4).
+/// The steps of the module documentation, into `s`.
+const fn plan_into<const K: usize>(
+    filters: &[Filter],
+    options: PlanOptions,
+    s: &mut Scratch<K>,
+) -> Result<(), PlanError> {
+    if let Err(e) = s.prep.fill(filters) {
+        return Err(e);
+    }
+    s.n_covers = 0;
+    if options.merge {
+        let _ = exact_cover(&s.prep.keys, 2, &mut s.covers[0], &mut s.cover);
+        let _ = exact_cover(&s.prep.keys, 3, &mut s.covers[1], &mut s.cover);
+        s.n_covers = 2;
+        // The fewest cubes (every element costs one): exact search when small.
+        if s.prep.keys.len() <= COVER_SEARCH_KEYS {
+            let seed = s.covers[0].weight(1, 1);
+            let [_, _, min] = &mut s.covers;
+            min_cover(&s.prep.keys, 1, 1, seed, COVER_BUDGET, min, &mut s.cover);
+            if !s.covers[2].is_empty() {
+                s.n_covers = 3;
+            }
+        }
+    }
+    s.result = 0;
+    if let Some(c) = options.configuration {
+        return plan_for_configuration(s, c, options.superset, 0);
+    }
+    let mut i = 0;
+    while i < Configuration::ALL.len() {
+        if plan_for_configuration(s, Configuration::ALL[i], false, 0).is_ok() {
+            return Ok(());
+        }
+        i += 1;
+    }
+    let largest = Configuration::Filters14_18;
+    if !options.superset {
+        return plan_for_configuration(s, largest, false, 0);
+    }
+    // The configuration with the fewest extra identifiers.
+    let mut best: Option<usize> = None;
+    let mut keys_refused: Option<PlanError> = None;
+    let mut i = 0;
+    while i < Configuration::ALL.len() {
+        let t = match best {
+            Some(b) => 1 - b,
+            None => 0,
+        };
+        match plan_for_configuration(s, Configuration::ALL[i], true, t) {
+            Ok(()) => {
+                let fewer = match best {
+                    None => true,
+                    Some(b) => s.tables[t].superset_extra() < s.tables[b].superset_extra(),
+                };
+                if fewer {
+                    best = Some(t);
+                }
+            }
+            Err(e @ PlanError::TooManyLookupKeys { .. }) => keys_refused = Some(e),
+            Err(_) => {}
+        }
+        i += 1;
+    }
+    match (best, keys_refused) {
+        (Some(b), _) => {
+            s.result = b;
+            Ok(())
+        }
+        // A superset fits the elements but not the lookup capacity: say so.
+        (None, Some(e)) => Err(e),
+        (None, None) => plan_for_configuration(s, largest, false, 0),
+    }
+}
+
+/// Compiles `filters` into an ID filter table with the working memory in `scratch` and
+/// the table left there: the run-time planner of a firmware, whose scratch lives in a
+/// `static` (see [`Scratch`]). The table needs at most `K` lookup keys.
 ///
-/// Errors: [`PlanError::TooManyFilters`], [`PlanError::Filter`], and
+/// The same `const fn` as [`plan`] and [`crate::const_plan!`]. Errors: as [`plan`].
+pub const fn plan_in<'s, const K: usize>(
+    filters: &[Filter],
+    options: PlanOptions,
+    scratch: &'s mut Scratch<K>,
+) -> Result<&'s FilterTable<K>, PlanError> {
+    match plan_into(filters, options, scratch) {
+        Ok(()) => Ok(&scratch.tables[scratch.result]),
+        Err(e) => Err(e),
+    }
+}
+
+/// [`plan`] for a table with room for `K` lookup keys. Builds its own [`Scratch`] (on
+/// the stack at run time: for `const` code and the host; firmware uses [`plan_in`]).
+pub const fn plan_for<const K: usize>(
+    filters: &[Filter],
+    options: PlanOptions,
+) -> Result<FilterTable<K>, PlanError> {
+    let mut s = Scratch::<K>::new();
+    match plan_into(filters, options, &mut s) {
+        Ok(()) => {
+            let [a, b] = s.tables;
+            Ok(if s.result == 0 { a } else { b })
+        }
+        Err(e) => Err(e),
+    }
+}
+
+/// Compiles `filters` into an ID filter table (see the module documentation), with the
+/// default lookup capacity ([`LOOKUP_KEYS`]). An empty list receives nothing (format
+/// D).
+///
+/// A `const fn`: with a `const` list, [`crate::const_plan!`] plans it at compile time.
+/// At run time it builds its working memory ([`Scratch`], about 70 KB) on the stack:
+/// fine on a host; firmware plans with [`plan_in`] and the scratch in a `static`.
+///
+/// Errors: [`PlanError::TooManyFilters`], [`PlanError::Filter`],
 /// [`PlanError::TooManyPrimary`] when no placement fits and the superset fallback is
-/// off (or general filters alone are too many).
+/// off (or general filters alone are too many), [`PlanError::TooManyLookupKeys`] when
+/// every placement that fits needs more lookup keys than the table keeps.
 ///
 /// ```
 /// use twocan_core::{Filter, FilterError, Format, Frame, FrameKind};
@@ -478,59 +924,92 @@ fn plan_for(
 /// assert!(err.to_string().starts_with("the filters need 9 primary filter elements"));
 /// # Ok::<(), Box<dyn core::error::Error>>(())
 /// ```
-pub fn plan(filters: &[Filter], options: PlanOptions) -> Result<FilterTable, PlanError> {
-    let prep = Prepared::new(filters)?;
-    let mut covers = [
-        CubeList::new(),
-        CubeList::new(),
-        CubeList::new(),
-        CubeList::new(),
-    ];
-    for &k in prep.keys.keys() {
-        // MAX_KEYS = MAX_CUBES: room for every key.
-        let _ = covers[0].push(Cube::single(k));
+pub const fn plan(filters: &[Filter], options: PlanOptions) -> Result<FilterTable, PlanError> {
+    plan_for::<LOOKUP_KEYS>(filters, options)
+}
+
+/// [`plan_for`] with room for every key ([`MAX_LOOKUP_KEYS`]), or a compile-time error
+/// with a readable message: the first step of [`crate::const_plan!`].
+#[doc(hidden)]
+pub const fn plan_or_panic(
+    filters: &[Filter],
+    options: PlanOptions,
+) -> FilterTable<MAX_LOOKUP_KEYS> {
+    match plan_for::<MAX_LOOKUP_KEYS>(filters, options) {
+        Ok(t) => t,
+        Err(e) => e.panic(),
     }
-    if options.merge {
-        let _ = exact_cover(&prep.keys, 2, &mut covers[1]);
-        let _ = exact_cover(&prep.keys, 3, &mut covers[2]);
-        // The fewest cubes (every element costs one): exact search when small.
-        if prep.keys.len() <= COVER_SEARCH_KEYS {
-            let (head, tail) = covers.split_at_mut(3);
-            min_cover(&prep.keys, 1, 1, &head[1], COVER_BUDGET, &mut tail[0]);
-        }
-        if covers[3].is_empty() {
-            covers[3] = covers[1].clone();
-        }
-    } else {
-        let singles = covers[0].clone();
-        for c in covers.iter_mut().skip(1) {
-            *c = singles.clone();
-        }
-    }
-    if let Some(c) = options.configuration {
-        return plan_for(&prep, &covers, c, options.superset);
-    }
-    for c in Configuration::ALL {
-        if let Ok(t) = plan_for(&prep, &covers, c, false) {
-            return Ok(t);
-        }
-    }
-    let largest = Configuration::Filters14_18;
-    if !options.superset {
-        return plan_for(&prep, &covers, largest, false);
-    }
-    let mut best: Option<FilterTable> = None;
-    for c in Configuration::ALL {
-        if let Ok(t) = plan_for(&prep, &covers, c, true) {
-            if best
-                .as_ref()
-                .is_none_or(|b| t.superset_extra() < b.superset_extra())
-            {
-                best = Some(t);
-            }
-        }
-    }
-    best.map_or_else(|| plan_for(&prep, &covers, largest, false), Ok)
+}
+
+/// The sizes a `const` table of `filters` needs ([`crate::filters::SizedTable`]).
+pub const fn plan_sizes(filters: &[Filter], options: PlanOptions) -> TableSizes {
+    plan_or_panic(filters, options).sizes()
+}
+
+/// Plans a `const` filter list at compile time: `const_plan!(FILTERS, options)` gives a
+/// `&'static` [`SizedTable`](crate::filters::SizedTable) of exactly the table elements
+/// of its configuration and the lookup keys it needs, computed by the same `const fn`
+/// as the run-time planner ([`planner::plan_in`](crate::planner::plan_in)). `FILTERS`
+/// is a constant expression of type `[Filter; N]` or `&[Filter]`, `options` a constant
+/// [`PlanOptions`](crate::planner::PlanOptions) (`PlanOptions::choose()` or
+/// `PlanOptions::new(configuration)`). The split driver installs it as a
+/// [`FilterTable`](crate::FilterTable) ([`FilterTable::from_sized`](crate::FilterTable::from_sized)).
+///
+/// A list that does not fit is a compile-time error naming the counts.
+///
+/// ```
+/// use twocan_core::{Filter, Frame};
+/// use twocan_flexcan::planner::PlanOptions;
+/// use twocan_flexcan::{const_plan, Configuration};
+///
+/// const FILTERS: [Filter; 3] = [
+///     Filter::standard(0x100),
+///     Filter::standard(0x101),
+///     Filter::extended(0x18FE_F100),
+/// ];
+/// let table = const_plan!(FILTERS, PlanOptions::choose());
+/// assert_eq!(table.configuration(), Configuration::Filters8_0);
+/// let (_, user) = table.evaluate(&Frame::standard(0x101, &[]).unwrap()).unwrap();
+/// assert_eq!(user, Some(1));
+/// // 0x100 and 0x101 share one element (a cube of two users): their keys are looked up.
+/// assert_eq!(table.lookup_keys().0.len(), 2);
+/// ```
+///
+/// A list that needs more primary elements than the configuration has does not
+/// compile:
+///
+/// ```compile_fail
+/// use twocan_core::{Filter, Format, FrameKind};
+/// use twocan_flexcan::planner::PlanOptions;
+/// use twocan_flexcan::{const_plan, Configuration};
+///
+/// const MASKS: [Filter; 9] = {
+///     let mut f = [Filter::pass_all(); 9];
+///     let mut i = 0;
+///     while i < 9 {
+///         f[i] = Filter::masked(FrameKind::Data, Format::Standard, 0x7F0, (i as u32) << 4);
+///         i += 1;
+///     }
+///     f
+/// };
+/// // error: evaluation panicked: twocan_flexcan::const_plan!: the filters need 9
+/// // primary filter elements, the configuration has 8 (and 0 secondary, all used)
+/// let table = const_plan!(MASKS, PlanOptions::new(Configuration::Filters8_0));
+/// ```
+#[macro_export]
+macro_rules! const_plan {
+    ($filters:expr, $options:expr $(,)?) => {{
+        #[allow(long_running_const_eval)]
+        const FULL: $crate::FilterTable<{ $crate::filters::MAX_LOOKUP_KEYS }> =
+            $crate::planner::plan_or_panic(&$filters, $options);
+        const SIZES: $crate::filters::TableSizes = FULL.sizes();
+        const TABLE: $crate::filters::SizedTable<
+            { SIZES.elements },
+            { SIZES.primary },
+            { SIZES.keys },
+        > = FULL.sized();
+        &TABLE
+    }};
 }
 
 #[cfg(test)]
@@ -616,6 +1095,14 @@ mod tests {
         out
     }
 
+    fn list_of(cubes: &[Cube]) -> Box<CubeList> {
+        let mut l = Box::new(CubeList::new());
+        for &c in cubes {
+            l.push(c).unwrap();
+        }
+        l
+    }
+
     #[test]
     fn primary_need_matches_exhaustive_search_on_small_sets() {
         let mut s = 0x2545_F491_u64;
@@ -625,6 +1112,7 @@ mod tests {
             s ^= s << 17;
             s
         };
+        let mut scratch: Box<Scratch> = Box::default();
         for _ in 0..200 {
             let n = 3 + next() % 9;
             let f: Vec<Filter> = (0..n)
@@ -636,25 +1124,16 @@ mod tests {
                     }
                 })
                 .collect();
-            let prep = Prepared::new(&f).unwrap();
-            let blocks = all_blocks(&prep.keys);
+            // The planner's covers, as `plan_in` makes them (before any configuration is
+            // tried: whether 8/0 fits does not matter).
+            let _ = plan_in(
+                &f,
+                PlanOptions::new(Configuration::Filters8_0),
+                &mut scratch,
+            );
+            let sc = &mut *scratch;
+            let blocks = all_blocks(&sc.prep.keys);
             assert!(blocks.len() <= 16);
-            let mut covers = [
-                CubeList::new(),
-                CubeList::new(),
-                CubeList::new(),
-                CubeList::new(),
-            ];
-            for &k in prep.keys.keys() {
-                covers[0].push(Cube::single(k)).unwrap();
-            }
-            exact_cover(&prep.keys, 2, &mut covers[1]).unwrap();
-            exact_cover(&prep.keys, 3, &mut covers[2]).unwrap();
-            let (head, tail) = covers.split_at_mut(3);
-            min_cover(&prep.keys, 1, 1, &head[1], COVER_BUDGET, &mut tail[0]);
-            if covers[3].is_empty() {
-                covers[3] = covers[1].clone();
-            }
             for c in [Configuration::Filters8_0, Configuration::Filters10_6] {
                 let cap = c.secondary_filter_capacity();
                 let mut best = usize::MAX;
@@ -663,15 +1142,23 @@ mod tests {
                         .filter(|b| set & (1 << b) != 0)
                         .map(|b| blocks[b])
                         .collect();
-                    for &k in prep.keys.keys() {
+                    for &k in sc.prep.keys.keys() {
                         if !cubes.iter().any(|x| x.contains(k)) {
                             cubes.push(Cube::single(k));
                         }
                     }
-                    best = best.min(need(&prep, &cubes, cap).primary);
+                    best = best.min(need(&sc.prep, &list_of(&cubes), cap));
                 }
-                let (_, got) = best_cover(&prep, &covers, c);
-                assert_eq!(got.primary, best, "{c:?} {f:?}");
+                let got = best_cover(
+                    &sc.prep,
+                    &sc.covers,
+                    sc.n_covers,
+                    cap,
+                    None,
+                    &mut sc.best,
+                    &mut sc.cand,
+                );
+                assert_eq!(got, best, "{c:?} {f:?}");
             }
         }
     }
@@ -699,5 +1186,91 @@ mod tests {
             }
         }
         assert_eq!(dropped, t.superset_extra());
+    }
+}
+
+/// The run-time planner's stack: every value [`plan_in`] and the functions it calls
+/// hold by value is small (the tables are in the [`Scratch`]).
+#[cfg(test)]
+mod stack {
+    use super::*;
+    use core::mem::size_of;
+
+    #[test]
+    fn by_value_types_on_the_run_time_path_are_small() {
+        let sizes: [(&str, usize); 12] = [
+            ("&[Filter]", size_of::<&[Filter]>()),
+            ("PlanOptions", size_of::<PlanOptions>()),
+            ("PlanError", size_of::<PlanError>()),
+            (
+                "Result<&FilterTable, PlanError>",
+                size_of::<Result<&FilterTable, PlanError>>(),
+            ),
+            ("Filter", size_of::<Filter>()),
+            ("Cube", size_of::<Cube>()),
+            ("Primary", size_of::<Primary>()),
+            ("PlannedPrimary", size_of::<PlannedPrimary>()),
+            ("(u32, Hit)", size_of::<(u32, Hit)>()),
+            (
+                "Option<(usize, usize)> (tune pick)",
+                size_of::<Option<(usize, usize)>>(),
+            ),
+            ("Configuration", size_of::<Configuration>()),
+            ("Result<(), PlanError>", size_of::<Result<(), PlanError>>()),
+        ];
+        for (name, size) in sizes {
+            println!("{name}: {size} B");
+            assert!(size <= 128, "{name}: {size} B");
+        }
+        println!("Scratch<64>: {} B", size_of::<Scratch>());
+        println!("FilterTable<64>: {} B", size_of::<FilterTable>());
+        assert!(size_of::<FilterTable>() < 1024);
+        use crate::filters::SizedTable;
+        println!(
+            "SizedTable<8, 8, 0>: {} B",
+            size_of::<SizedTable<8, 8, 0>>()
+        );
+        println!(
+            "SizedTable<16, 10, 4>: {} B",
+            size_of::<SizedTable<16, 10, 4>>()
+        );
+        println!(
+            "SizedTable<32, 14, 64>: {} B",
+            size_of::<SizedTable<32, 14, 64>>()
+        );
+    }
+
+    fn filters_367() -> Vec<Filter> {
+        (0..367u32)
+            .map(|i| Filter::extended(0x0C00_0000 + i * 0x1_0203))
+            .collect()
+    }
+
+    /// The largest list of the DBC corpus's size (367 identifiers, 365 extended) in
+    /// superset mode, the scratch boxed, on a thread with a 64 KiB stack (debug builds'
+    /// frames included).
+    #[test]
+    fn plan_in_runs_on_a_small_stack() {
+        let list = filters_367();
+        // Room for every key: the superset table looks all of them up.
+        let mut scratch: Box<Scratch<MAX_LOOKUP_KEYS>> = Box::default();
+        let t = std::thread::Builder::new()
+            .stack_size(64 * 1024)
+            .spawn(move || {
+                plan_in(&list, PlanOptions::choose().superset(true), &mut scratch)
+                    .map(|t| (t.configuration(), t.superset_extra() > 0))
+            })
+            .unwrap();
+        assert_eq!(t.join().unwrap(), Ok((Configuration::Filters14_18, true)));
+        // With the default capacity the same list is refused, naming the keys.
+        let mut small: Box<Scratch> = Box::default();
+        assert!(matches!(
+            plan_in(
+                &filters_367(),
+                PlanOptions::choose().superset(true),
+                &mut small
+            ),
+            Err(PlanError::TooManyLookupKeys { max: 64, .. })
+        ));
     }
 }

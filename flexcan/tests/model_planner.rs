@@ -11,8 +11,17 @@ mod support;
 
 use support::*;
 use twocan_core::{Filter, Format, Frame, FrameKind};
-use twocan_flexcan::planner::{plan, PlanOptions};
-use twocan_flexcan::{Configuration, FilterTable};
+use twocan_flexcan::filters::{LOOKUP_KEYS, MAX_LOOKUP_KEYS};
+use twocan_flexcan::planner::{plan_for, PlanError, PlanOptions};
+use twocan_flexcan::Configuration;
+
+/// Tables with room for every lookup key: the planner unconstrained by a driver's
+/// capacity (the default capacity is checked at the end of each test).
+type FilterTable = twocan_flexcan::FilterTable<MAX_LOOKUP_KEYS>;
+
+fn plan(filters: &[Filter], options: PlanOptions) -> Result<FilterTable, PlanError> {
+    plan_for::<MAX_LOOKUP_KEYS>(filters, options)
+}
 
 fn frames(filters: &[Filter]) -> Vec<Frame> {
     let mut out = Vec::new();
@@ -103,6 +112,15 @@ fn merged_tables_deliver_exactly_through_the_model() {
     assert_eq!(t.configuration(), Configuration::Filters8_0);
     for c in Configuration::ALL {
         check(&f, PlanOptions::new(c));
+    }
+    // The 64-identifier block alone needs 64 lookup keys: with the default capacity
+    // the planner splits blocks and takes a larger configuration, still exact.
+    assert!(t.key_table().len() > LOOKUP_KEYS);
+    let small = twocan_flexcan::planner::plan(&f, PlanOptions::default()).unwrap();
+    assert!(small.key_table().len() <= LOOKUP_KEYS);
+    for frame in frames(&f) {
+        let want = f.iter().position(|x| x.matches(&frame)).map(|i| i as u16);
+        assert_eq!(small.evaluate(&frame).and_then(|(_, i)| i), want);
     }
 }
 

@@ -6,8 +6,16 @@
 
 use proptest::prelude::*;
 use twocan_core::{Filter, Format, Frame, FrameKind};
-use twocan_flexcan::planner::{plan, PlanError, PlanOptions};
-use twocan_flexcan::{Configuration, FilterTable};
+use twocan_flexcan::filters::{LOOKUP_KEYS, MAX_LOOKUP_KEYS};
+use twocan_flexcan::planner::{plan_for, PlanError, PlanOptions};
+use twocan_flexcan::Configuration;
+
+/// Tables with room for every lookup key: the planner unconstrained by a driver.
+type FilterTable = twocan_flexcan::FilterTable<MAX_LOOKUP_KEYS>;
+
+fn plan(filters: &[Filter], options: PlanOptions) -> Result<FilterTable, PlanError> {
+    plan_for::<MAX_LOOKUP_KEYS>(filters, options)
+}
 
 fn list() -> impl Strategy<Value = Vec<Filter>> {
     let block = (0u32..0x7C0, 1u32..40).prop_map(|(start, len)| {
@@ -54,7 +62,11 @@ fn probes(filters: &[Filter]) -> Vec<Frame> {
     out
 }
 
-fn check(filters: &[Filter], t: &FilterTable, frames: &[Frame]) -> Result<(), TestCaseError> {
+fn check<const K: usize>(
+    filters: &[Filter],
+    t: &twocan_flexcan::FilterTable<K>,
+    frames: &[Frame],
+) -> Result<(), TestCaseError> {
     for f in frames {
         let want = filters.iter().position(|x| x.matches(f)).map(|i| i as u16);
         match (want, t.evaluate(f)) {
@@ -94,6 +106,29 @@ proptest! {
                     }
                     Err(e) => prop_assert!(false, "{:?}", e),
                 }
+            }
+        }
+    }
+
+    /// With the default lookup capacity: exact, within the capacity, and a table
+    /// whenever one element per identifier fits (that table needs no lookup key).
+    #[test]
+    fn default_capacity_tables_are_exact(filters in list()) {
+        let frames = probes(&filters);
+        for configuration in Configuration::ALL.map(Some).into_iter().chain([None]) {
+            let options = PlanOptions { configuration, merge: true, superset: false };
+            let single = plan(&filters, options.merge(false));
+            match twocan_flexcan::planner::plan(&filters, options) {
+                Ok(t) => {
+                    prop_assert!(t.key_table().len() <= LOOKUP_KEYS);
+                    check(&filters, &t, &frames)?;
+                }
+                Err(PlanError::TooManyLookupKeys { needed, max }) => {
+                    prop_assert!(single.is_err());
+                    prop_assert!(needed as usize > LOOKUP_KEYS);
+                    prop_assert_eq!(max as usize, LOOKUP_KEYS);
+                }
+                Err(e) => prop_assert!(single.is_err(), "{:?}", e),
             }
         }
     }
