@@ -947,6 +947,60 @@ fn filter_list_semantics<B: Backend>() {
     assert_eq!(got, expected_cases(&cases), "{}: new list", B::NAME);
 }
 
+// --- issue 22: what is reported is what is accepted --------------------------------------
+
+/// Item 9: the receive ring figures are those of the rings frames arrive in. The peer
+/// sends more frames than the reported size while the node's interrupts are serviced
+/// and nothing is taken: exactly `size` frames are held, the rest are counted as
+/// overflows, and `size` frames come out.
+fn rx_ring_figures_are_what_arrives<B: Backend>() {
+    let (mut h, mut dut, peer) = setup::<B>(&NodeOptions::pass_all());
+    let size = dut.driver_ref().rx_stats().size;
+    let sent = size + 10;
+    for i in 0..sent {
+        peer.borrow_mut()
+            .send(std_frame(0x100 + (i % 0x400) as u16, &[i as u8]));
+    }
+    settle(&mut h, &mut dut, &[&peer], 400_000);
+    assert_eq!(peer.borrow().pending(), 0);
+    let s = dut.driver_ref().rx_stats();
+    assert_eq!(
+        (s.count, s.overflows as usize),
+        (size, sent - size),
+        "{}: {s:?}",
+        B::NAME
+    );
+    assert_eq!(drain(&mut dut).len(), size, "{}", B::NAME);
+    assert_eq!(dut.hw_lost(), 0, "{}", B::NAME);
+}
+
+/// Item 10: one DLC rule. A remote frame with each code 0..=15, built by `Frame::remote`
+/// (the constructor that refused 9..=15 before), leaves with that code; the same code
+/// sent by the peer comes out of the driver equal to what `Frame::remote` and
+/// `set_dlc` build.
+fn remote_dlc_codes_are_one_rule_both_ways<B: Backend>() {
+    let (mut h, mut dut, peer) = setup::<B>(&NodeOptions::pass_all());
+    let built: Vec<Frame> = (0..=15u8)
+        .map(|code| Frame::remote(0x240 + code as u32, code % 2 == 1, code).unwrap())
+        .collect();
+    for f in &built {
+        let mut by_set = remote_frame(f.raw_id(), f.is_extended(), 0);
+        by_set.set_dlc(f.dlc()).unwrap();
+        assert_eq!(by_set, *f);
+    }
+    for f in &built {
+        dut.driver().try_send(f).unwrap();
+        settle(&mut h, &mut dut, &[&peer], 20_000);
+    }
+    assert_eq!(peer.borrow().received_frames(), built, "{}", B::NAME);
+    for f in &built {
+        peer.borrow_mut().send(*f);
+    }
+    settle(&mut h, &mut dut, &[&peer], 50_000);
+    let got: Vec<Frame> = drain(&mut dut).iter().map(|r| r.frame).collect();
+    assert_eq!(got, built, "{}", B::NAME);
+}
+
 // ---------------------------------------------------------------------------------------
 
 #[test]
@@ -964,8 +1018,8 @@ fn frames_that_break_the_format_are_typed_errors() {
         Err(FrameError::TooMuchData(9))
     );
     assert_eq!(
-        Frame::remote(0x10, false, 9),
-        Err(FrameError::DlcTooLarge(9))
+        Frame::remote(0x10, false, 16),
+        Err(FrameError::DlcTooLarge(16))
     );
     let mut r = remote_frame(0x10, false, 4);
     assert_eq!(r.set_data(&[1]), Err(FrameError::DataOnRemoteFrame));
@@ -1275,6 +1329,14 @@ macro_rules! suite {
             #[test]
             fn filter_list_semantics() {
                 super::filter_list_semantics::<$backend>();
+            }
+            #[test]
+            fn remote_dlc_codes_are_one_rule_both_ways() {
+                super::remote_dlc_codes_are_one_rule_both_ways::<$backend>();
+            }
+            #[test]
+            fn rx_ring_figures_are_what_arrives() {
+                super::rx_ring_figures_are_what_arrives::<$backend>();
             }
         }
     };
