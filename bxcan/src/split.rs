@@ -687,7 +687,8 @@ unsafe impl<R: Registers, F: Registers, const K: usize> Hardware for BxCan<R, F,
         mode::request(&self.regs, Mode::Normal, bound)
     }
 
-    /// The APB1 clock of the [`Config`] ([`Config::get_clock_hz`]), [`Limits::BXCAN`];
+    /// The bit-timing rule every bxCAN entry point applies ([`crate::config::timing_rule`]
+    /// of the [`Config`]'s APB1 clock, [`Config::get_clock_hz`]: [`Limits::BXCAN`]);
     /// the banks this instance owns now (`CAN2SB`, RM0410 §40.7.4): four 16-bit list
     /// identifiers (standard) or two 32-bit ones (extended) per bank; three transmit
     /// mailboxes, two receive FIFOs of three (§40.7.3, §40.7.5); no triple sampling;
@@ -714,6 +715,7 @@ unsafe impl<R: Registers, F: Registers, const K: usize> Hardware for BxCan<R, F,
             RX_FIFO_DEPTH as u8,
             self.config.get_timestamps().then_some(16),
         )
+        .with_timing_rule(crate::config::timing_rule(self.config.get_clock_hz()))
         .with_wakeup_events(self.config.get_interrupts() & crate::regs::ier::WKUIE != 0)
     }
 

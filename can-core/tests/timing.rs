@@ -508,9 +508,10 @@ fn any_limits() -> impl Strategy<Value = Limits> {
             b(),
             b(),
             any::<bool>(),
-            proptest::option::of(any::<u8>())
+            proptest::option::of(any::<u8>()),
+            b()
         )
-            .prop_map(|(p, prop, ps1, ps2, sjw, le, triple)| Limits {
+            .prop_map(|(p, prop, ps1, ps2, sjw, le, triple, quanta)| Limits {
                 controller: Controller::FlexCan,
                 prescaler: Bounds::new(p.min, p.max % 2000),
                 prop_seg: prop,
@@ -519,6 +520,7 @@ fn any_limits() -> impl Strategy<Value = Limits> {
                 sjw,
                 triple_sampling_min_phase_seg1: triple,
                 sjw_le_phase_seg1: le,
+                quanta,
             }),
     ]
 }

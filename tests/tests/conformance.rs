@@ -10,8 +10,7 @@
 
 use twocan_core::sim::{Fault, NodeId, Receivers, SimNode};
 use twocan_core::timestamp::{bit_times_to_micros, COUNTER_PERIOD};
-use twocan_core::timing::Limits;
-use twocan_core::timing::TimingError;
+use twocan_core::timing::{cia_sample_point, Limits, Timing, TimingError};
 use twocan_core::{
     BusMode, BusOffRecovery, Error, ErrorCounters, ErrorState, Filter, FilterError, Format, Frame,
     FrameError, FrameKind, Hardware, LastErrorCode, Mode, Timestamp,
@@ -321,53 +320,36 @@ fn filter_capacity<B: Backend>() {
 }
 
 fn bit_rate_limits<B: Backend>() {
-    let l: Limits = B::LIMITS;
-    // Fastest the registers express: prescaler 1 and the fewest quanta (1 + tseg1 min
-    // + tseg2 min). Accepted unless the manual forbids it (FlexCAN's 5 quanta: fewer
-    // than 8, Kinetis RM "Arbitration and matching timing"); then the fastest accepted
-    // rate is the backend's documented one.
-    let fastest = B::CLOCK_HZ / l.min_quanta();
-    if B::FASTEST_BITRATE == fastest {
-        assert_eq!(B::check_timing(fastest, 750), Ok(fastest), "{}", B::NAME);
-    } else {
-        assert!(B::FASTEST_BITRATE < fastest);
+    // The fastest and the slowest rates the backend accepts (hardware facts, the
+    // backend's constants) are accepted as a wished rate; one bit per second beyond, and
+    // twice or half of them, are refused with the same error on both backends (FlexCAN:
+    // the fastest is the Kinetis manual's, 16 bus clocks per bit; 2 Mbit/s, 8 quanta,
+    // is beyond it from the default 16 MHz bus clock; ACAN's 3.2 Mbit/s, 5 quanta,
+    // further still).
+    let fastest = B::FASTEST_BITRATE;
+    assert_eq!(B::check_timing(fastest, 750), Ok(fastest), "{}", B::NAME);
+    let five_quanta = B::CLOCK_HZ / 5; // ACAN's fastest on FlexCAN; in range on bxCAN
+    for beyond in [fastest + 1, 2 * fastest, five_quanta]
+        .into_iter()
+        .filter(|&r| r > fastest)
+    {
         assert_eq!(
-            B::check_timing(fastest, 750),
-            Err(TimingRefused::ForbiddenByManual),
-            "{}",
-            B::NAME
-        );
-        let top = B::FASTEST_BITRATE;
-        assert_eq!(B::check_timing(top, 750), Ok(top), "{}", B::NAME);
-        // Twice the fastest accepted: exact from the clock, still forbidden.
-        assert_eq!(
-            B::check_timing(2 * top, 750),
-            Err(TimingRefused::ForbiddenByManual),
-            "{}",
+            B::check_timing(beyond, 750),
+            Err(TimingRefused::TooHigh),
+            "{} {beyond}",
             B::NAME
         );
     }
-    assert_eq!(
-        B::check_timing(fastest + 1, 750),
-        Err(TimingRefused::TooHigh),
-        "{}",
-        B::NAME
-    );
-    // Slowest: the largest prescaler and the most quanta; below it is out of reach, and
-    // refused with the same error on both backends (not only by the tolerance check).
-    let slowest = l.min_bitrate(B::CLOCK_HZ);
-    assert_eq!(
-        B::check_timing(slowest / 2, 750),
-        Err(TimingRefused::TooLow),
-        "{}",
-        B::NAME
-    );
-    assert_eq!(
-        B::check_timing(slowest - 1, 750),
-        Err(TimingRefused::TooLow),
-        "{}",
-        B::NAME
-    );
+    let slowest = B::SLOWEST_BITRATE;
+    assert_eq!(B::check_timing(slowest, 875), Ok(slowest), "{}", B::NAME);
+    for below in [slowest - 1, slowest / 2] {
+        assert_eq!(
+            B::check_timing(below, 875),
+            Err(TimingRefused::TooLow),
+            "{} {below}",
+            B::NAME
+        );
+    }
     assert_eq!(B::check_timing(0, 750), Err(TimingRefused::Zero));
     // The sample point must lie strictly between 50 % and 100 % of the bit.
     for sp in [0, 500, 1000, 1200] {
@@ -549,14 +531,27 @@ fn capabilities_are_the_hardware_facts<B: Backend>() {
     let caps = dut.driver_ref().capabilities();
     assert_eq!(caps.clock_hz, B::CLOCK_HZ, "{}", B::NAME);
     assert_eq!(caps.timing_limits, B::LIMITS, "{}", B::NAME);
-    // Slowest: largest prescaler × most quanta (25 for both); fastest: bxCAN prescaler 1
-    // and the fewest quanta (1 + 1 + 1); FlexCAN the Kinetis manual's rule with the
-    // default bus clock of 16 MHz ("Arbitration and matching timing": at least 8 quanta,
-    // 16 MHz / 8 = 2 Mbit/s, and 16 bus clocks per bit, 16 MHz / 16 = 1 Mbit/s), below
-    // the register ranges' 3.2 Mbit/s (5 quanta, ACAN §16.1).
+    assert_eq!(caps.peripheral_clock, B::PERIPHERAL_CLOCK, "{}", B::NAME);
+    // FlexCAN: at least 8 quanta per bit (Kinetis RM), not the CTRL1 fields' 5.
+    let fewest_quanta = match B::CLOCK_HZ {
+        16_000_000 => 8,
+        _ => 3,
+    };
+    assert_eq!(
+        caps.timing_limits.min_quanta(),
+        fewest_quanta,
+        "{}",
+        B::NAME
+    );
+    // Slowest: largest prescaler × most quanta (25 for both), rounded down (bxCAN:
+    // 2,109.375 bit/s); fastest: bxCAN prescaler 1 and the fewest quanta (1 + 1 + 1);
+    // FlexCAN the Kinetis manual's rule with the default bus clock of 16 MHz
+    // ("Arbitration and matching timing": at least 8 quanta, 16 MHz / 8 = 2 Mbit/s, and
+    // 16 bus clocks per bit, 16 MHz / 16 = 1 Mbit/s), below the register ranges'
+    // 3.2 Mbit/s (5 quanta, ACAN §16.1).
     let (slowest, fastest) = match B::CLOCK_HZ {
-        16_000_000 => (16_000_000u32.div_ceil(256 * 25), 1_000_000),
-        54_000_000 => (54_000_000u32.div_ceil(1024 * 25), 18_000_000),
+        16_000_000 => (16_000_000 / (256 * 25), 1_000_000),
+        54_000_000 => (54_000_000 / (1024 * 25), 18_000_000),
         c => panic!("unexpected clock {c}"),
     };
     assert_eq!(
@@ -949,6 +944,165 @@ fn filter_list_semantics<B: Backend>() {
 
 // --- issue 22: what is reported is what is accepted --------------------------------------
 
+/// A consistent timing of `clocks_per_bit` clocks with `quanta` quanta within the
+/// register fields of `limits` (whatever the manual's quanta rule says), wished at its
+/// own rate; `None` when the fields cannot hold it.
+fn register_timing(
+    clock_hz: u32,
+    limits: &Limits,
+    clocks_per_bit: u32,
+    quanta: u32,
+) -> Option<Timing> {
+    if quanta < 3 || clocks_per_bit % quanta != 0 {
+        return None;
+    }
+    let p = clocks_per_bit / quanta;
+    if !limits.prescaler.contains(p as u16) {
+        return None;
+    }
+    let rate = clock_hz / clocks_per_bit;
+    (1..quanta - 1)
+        .map(|t2| {
+            let t1 = quanta - 1 - t2;
+            Timing::from_tsegs(clock_hz, rate, limits, p as u16, t1 as u8, t2 as u8)
+        })
+        .find(|t| t.consistency().is_ok())
+}
+
+/// Items 5, 6, 7: the fastest and the slowest timings the capabilities report are
+/// accepted by every entry point — as counts (configuration: FlexCAN `begin`, bxCAN
+/// `Config::from_timing`; `set_timing`; `Capabilities::check_timing`) and as a wished
+/// rate (configuration: FlexCAN `Settings` + `begin`, bxCAN `Config::from_bitrate_with`;
+/// `Capabilities::timing_for`; `set_bitrate`); one bit per second beyond is refused by
+/// every one, as is a timing one clock per bit faster, or one quantum shorter, than
+/// what the capabilities name, where the registers hold one.
+fn reported_timings_are_accepted_by_every_entry_point<B: Backend>() {
+    let (_h, mut dut, _peer) = setup::<B>(&NodeOptions::pass_all());
+    let caps = dut.driver_ref().capabilities();
+    let fastest = caps.fastest_timing().expect("a fastest timing");
+    let slowest = caps.slowest_timing().expect("a slowest timing");
+    assert_eq!(
+        (caps.min_bitrate, caps.max_bitrate),
+        (B::SLOWEST_BITRATE, B::FASTEST_BITRATE),
+        "{}",
+        B::NAME
+    );
+    assert_eq!(fastest.actual_bitrate(), caps.max_bitrate);
+    assert_eq!(slowest.actual_bitrate(), caps.min_bitrate);
+    let l = caps.timing_limits;
+    for t in [fastest, slowest] {
+        assert!(
+            l.min_quanta() <= t.quanta() && t.quanta() <= l.max_quanta(),
+            "{}: {t:?}",
+            B::NAME
+        );
+    }
+    dut.driver().set_mode(Mode::Stopped).unwrap();
+    let cases = [
+        (fastest, caps.max_bitrate + 1, TimingError::BitrateTooHigh),
+        (slowest, caps.min_bitrate - 1, TimingError::BitrateTooLow),
+    ];
+    for (t, beyond, error) in cases {
+        let rate = t.actual_bitrate();
+        let refused = match error {
+            TimingError::BitrateTooHigh => TimingRefused::TooHigh,
+            _ => TimingRefused::TooLow,
+        };
+        // As counts.
+        assert_eq!(caps.check_timing(&t), Ok(()), "{} {rate}", B::NAME);
+        assert_eq!(B::check_given_timing(&t), Ok(rate), "{} {rate}", B::NAME);
+        assert_eq!(dut.driver().set_timing(&t), Ok(()), "{} {rate}", B::NAME);
+        assert_eq!(dut.bitrate_in_registers(), rate, "{}", B::NAME);
+        // As a wished rate.
+        let sp = cia_sample_point(rate);
+        assert!(caps.bitrate_in_range(rate));
+        assert_eq!(B::check_timing(rate, sp), Ok(rate), "{} {rate}", B::NAME);
+        assert_eq!(
+            caps.timing_for(rate, sp).map(|t| t.actual_bitrate()),
+            Ok(rate)
+        );
+        dut.driver().set_bitrate(RATE, 875).unwrap();
+        assert_eq!(
+            dut.driver()
+                .set_bitrate(rate, sp)
+                .map(|t| t.actual_bitrate()),
+            Ok(rate),
+            "{} {rate}",
+            B::NAME
+        );
+        assert_eq!(dut.bitrate_in_registers(), rate, "{}", B::NAME);
+        // One bit per second beyond, as a wished rate (the solver would find the
+        // extreme timing within the tolerance: still refused), and as the wished rate
+        // of the extreme timing's counts.
+        assert!(!caps.bitrate_in_range(beyond));
+        assert_eq!(
+            B::check_timing(beyond, sp),
+            Err(refused),
+            "{} {beyond}",
+            B::NAME
+        );
+        assert_eq!(caps.timing_for(beyond, sp), Err(error), "{}", B::NAME);
+        assert_eq!(
+            dut.driver().set_bitrate(beyond, sp),
+            Err(Error::Timing(error)),
+            "{} {beyond}",
+            B::NAME
+        );
+        assert_eq!(
+            dut.bitrate_in_registers(),
+            rate,
+            "{}: nothing written",
+            B::NAME
+        );
+        let wished_beyond = Timing {
+            bitrate: beyond,
+            ..t
+        };
+        assert_eq!(
+            B::check_given_timing(&wished_beyond),
+            Err(refused),
+            "{}",
+            B::NAME
+        );
+    }
+    // Timings beyond the reported ones that the registers still hold: one clock per bit
+    // faster than the fastest (FlexCAN: 15 clocks, below 16 bus clocks per bit; bxCAN's
+    // registers hold nothing faster than 3 clocks), and one quantum fewer than the
+    // reported minimum at a rate in range (FlexCAN: 7 quanta; bxCAN: none below 3).
+    let n = fastest.clocks_per_bit() as u32 - 1;
+    let faster = (l.min_quanta().saturating_sub(3)..=l.max_quanta())
+        .rev()
+        .find_map(|q| register_timing(B::CLOCK_HZ, &l, n, q));
+    let short_q = l.min_quanta() - 1;
+    let short = (1..=l.prescaler.max as u32)
+        .map(|p| p * short_q)
+        .filter(|&n| n >= fastest.clocks_per_bit() as u32)
+        .find_map(|n| register_timing(B::CLOCK_HZ, &l, n, short_q));
+    let beyond: Vec<Timing> = faster.into_iter().chain(short).collect();
+    let expected = match B::CLOCK_HZ {
+        16_000_000 => 2,
+        _ => 0,
+    };
+    assert_eq!(beyond.len(), expected, "{}: {beyond:?}", B::NAME);
+    for t in beyond {
+        assert_eq!(
+            caps.check_timing(&t),
+            Err(TimingError::ForbiddenByManual),
+            "{}: {t:?}",
+            B::NAME
+        );
+        assert_eq!(
+            dut.driver().set_timing(&t),
+            Err(Error::Timing(TimingError::ForbiddenByManual)),
+            "{}: {t:?}",
+            B::NAME
+        );
+        assert!(B::check_given_timing(&t).is_err(), "{}: {t:?}", B::NAME);
+    }
+    dut.driver().set_bitrate(RATE, 875).unwrap();
+    dut.driver().set_mode(Mode::Normal).unwrap();
+}
+
 /// Item 9: the receive ring figures are those of the rings frames arrive in. The peer
 /// sends more frames than the reported size while the node's interrupts are serviced
 /// and nothing is taken: exactly `size` frames are held, the rest are counted as
@@ -1329,6 +1483,10 @@ macro_rules! suite {
             #[test]
             fn filter_list_semantics() {
                 super::filter_list_semantics::<$backend>();
+            }
+            #[test]
+            fn reported_timings_are_accepted_by_every_entry_point() {
+                super::reported_timings_are_accepted_by_every_entry_point::<$backend>();
             }
             #[test]
             fn remote_dlc_codes_are_one_rule_both_ways() {
