@@ -256,6 +256,14 @@ pub unsafe trait Hardware {
         0
     }
 
+    /// Any context: which receive queues the installed filters can feed, bit `q` for
+    /// queue `q` (bxCAN: the FIFOs the active banks are assigned to, `CAN_FFA1R`). The
+    /// driver reports the rings of these queues as the receive buffer
+    /// ([`crate::State::rx_stats`]). The default is every queue the controller has.
+    fn fed_rx_queues(&self) -> u8 {
+        ((1u16 << Self::RX_QUEUES) - 1) as u8
+    }
+
     /// The map of the filters installed now (read at split time).
     fn filter_map(&self) -> Self::FilterMap;
 

@@ -1106,10 +1106,14 @@ fn reported_timings_are_accepted_by_every_entry_point<B: Backend>() {
 /// Item 9: the receive ring figures are those of the rings frames arrive in. The peer
 /// sends more frames than the reported size while the node's interrupts are serviced
 /// and nothing is taken: exactly `size` frames are held, the rest are counted as
-/// overflows, and `size` frames come out.
+/// overflows, and `size` frames come out. Each ring reports what it holds: the one the
+/// filters feed (bxCAN FIFO 0 with the backend's plan; FlexCAN's one FIFO) is full, a
+/// ring they do not feed holds nothing.
 fn rx_ring_figures_are_what_arrives<B: Backend>() {
     let (mut h, mut dut, peer) = setup::<B>(&NodeOptions::pass_all());
     let size = dut.driver_ref().rx_stats().size;
+    let ring0 = dut.driver_ref().rx_ring_stats(0).unwrap();
+    assert_eq!(size, ring0.size, "{}: the fed ring only", B::NAME);
     let sent = size + 10;
     for i in 0..sent {
         peer.borrow_mut()
@@ -1122,6 +1126,21 @@ fn rx_ring_figures_are_what_arrives<B: Backend>() {
         (s.count, s.overflows as usize),
         (size, sent - size),
         "{}: {s:?}",
+        B::NAME
+    );
+    let per_ring: Vec<(usize, u32)> = (0..B::RX_QUEUES as usize)
+        .map(|q| {
+            let r = dut.driver_ref().rx_ring_stats(q).unwrap();
+            (r.count, r.overflows)
+        })
+        .collect();
+    let mut want = vec![(size, (sent - size) as u32)];
+    want.resize(B::RX_QUEUES as usize, (0, 0));
+    assert_eq!(per_ring, want, "{}", B::NAME);
+    assert_eq!(
+        dut.driver_ref().rx_ring_stats(B::RX_QUEUES as usize),
+        None,
+        "{}",
         B::NAME
     );
     assert_eq!(drain(&mut dut).len(), size, "{}", B::NAME);
@@ -1153,6 +1172,48 @@ fn remote_dlc_codes_are_one_rule_both_ways<B: Backend>() {
     settle(&mut h, &mut dut, &[&peer], 50_000);
     let got: Vec<Frame> = drain(&mut dut).iter().map(|r| r.frame).collect();
     assert_eq!(got, built, "{}", B::NAME);
+}
+
+/// Item 9, bxCAN with both FIFOs fed (`FifoPolicy::Balanced`: the standard filter's bank
+/// to one FIFO, the extended filters' bank to the other): the reported size is both
+/// rings, and that many frames arrive, each ring holding its own.
+#[test]
+fn bxcan_ring_figures_with_both_fifos_fed() {
+    let mut h = Harness::new(RATE).unwrap();
+    let config = twocan_tests::backend::bxcan_config(RATE, Recovery::Automatic).unwrap();
+    let filters = [
+        Filter::standard(0x123),
+        Filter::extended(0x0123_4567),
+        Filter::extended(0x0ABC_DEF0),
+    ];
+    let mut bx = twocan_host::BxNode::with_config(
+        &mut h,
+        &config,
+        &filters,
+        twocan_bxcan::FifoPolicy::Balanced,
+    )
+    .unwrap();
+    let (peer, _) = attach_peer(&h, "peer");
+    run(&mut h, &mut bx, 20);
+    let d = bx.driver_ref();
+    let (r0, r1) = (d.rx_ring_stats(0).unwrap(), d.rx_ring_stats(1).unwrap());
+    assert_eq!(d.rx_stats().size, r0.size + r1.size);
+    let extra = 5;
+    for i in 0..r0.size + r1.size + 2 * extra {
+        let f = if i % 2 == 0 {
+            std_frame(0x123, &[i as u8])
+        } else {
+            ext_frame(0x0123_4567, &[i as u8])
+        };
+        peer.borrow_mut().send(f);
+    }
+    settle(&mut h, &mut bx, &[&peer], 400_000);
+    let d = bx.driver_ref();
+    let s = d.rx_stats();
+    assert_eq!(s.count, s.size, "{s:?}");
+    let (r0, r1) = (d.rx_ring_stats(0).unwrap(), d.rx_ring_stats(1).unwrap());
+    assert_eq!((r0.count, r1.count), (r0.size, r1.size));
+    assert_eq!((r0.overflows, r1.overflows), (extra as u32, extra as u32));
 }
 
 // ---------------------------------------------------------------------------------------
