@@ -33,3 +33,30 @@ fn slowest_register_timing_is_accepted_by_every_entry_point() {
     assert_eq!(d.hardware().set_timing(&t), Ok(()));
     assert_eq!(d.hardware().set_timing(&slowest(2_110)), Ok(()));
 }
+
+/// The reset-value table of `docs/differences.md`: `CAN_IER` resets to 0 and the driver
+/// writes `DEFAULT_INTERRUPTS`, the 11 sources the table names (0x0001_8F5B: FIFO full
+/// and sleep acknowledge off); `CAN_FMR.FINIT` (1 at reset) is 0 once the filters are
+/// programmed, and the controller has left sleep mode (`SLEEP` 1 at reset).
+#[test]
+fn registers_the_reset_value_table_names() {
+    use twocan_bxcan::config::DEFAULT_INTERRUPTS;
+    use twocan_bxcan::model::BxCanModel;
+    use twocan_bxcan::regs::{self, fmr, ier, mcr};
+    use twocan_core::Registers;
+    let fresh = BxCanModel::can1();
+    assert_eq!(fresh.read32(regs::IER), 0);
+    assert_eq!(fresh.read32(regs::FMR) & fmr::FINIT, fmr::FINIT);
+    assert_eq!(fresh.read32(regs::MCR) & mcr::SLEEP, mcr::SLEEP);
+    assert_eq!(DEFAULT_INTERRUPTS, 0x0001_8F5B);
+    assert_eq!(DEFAULT_INTERRUPTS.count_ones(), 11);
+    assert_eq!(
+        DEFAULT_INTERRUPTS & (ier::FFIE0 | ier::FFIE1 | ier::SLKIE),
+        0
+    );
+    let (_can, clocked, _bus) = can1_with(&config(), &pass_all());
+    let m = &clocked.model;
+    assert_eq!(m.read32(regs::IER), DEFAULT_INTERRUPTS);
+    assert_eq!(m.read32(regs::FMR) & fmr::FINIT, 0);
+    assert_eq!(m.read32(regs::MCR) & (mcr::SLEEP | mcr::INRQ), 0);
+}

@@ -603,7 +603,13 @@ impl embedded_can::Frame for Frame {
     }
 }
 
-/// A frame taken from a controller, with where and when it was accepted.
+// The sizes `docs/differences.md` states (ACAN's `CANMessage` is 16 bytes), checked on
+// every target the crate builds for.
+const _: () = assert!(core::mem::size_of::<Frame>() == 16);
+const _: () = assert!(core::mem::size_of::<RxFrame>() == 32);
+
+/// A frame taken from a controller, with where and when it was accepted (32 bytes: the
+/// 16-byte [`Frame`], two 16-bit indices and an 8-byte optional time stamp).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct RxFrame {
@@ -787,6 +793,16 @@ mod tests {
         assert!(r.data().is_empty());
         assert_eq!(r.set_dlc(16), Err(FrameError::DlcTooLarge(16)));
         assert_eq!(core::mem::size_of::<Frame>(), 16);
+    }
+
+    /// The sizes `docs/differences.md` states: `Frame` 16 bytes (ACAN's `CANMessage` is
+    /// 16 bytes too, with `idx`), `RxFrame` 32 bytes (the frame, the user's filter index,
+    /// the hardware match index and an 8-byte optional time stamp, 8-byte aligned).
+    #[test]
+    fn frame_sizes_are_the_documented_ones() {
+        assert_eq!(core::mem::size_of::<Frame>(), 16);
+        assert_eq!(core::mem::size_of::<RxFrame>(), 32);
+        assert_eq!(core::mem::align_of::<RxFrame>(), 8);
     }
 
     /// Issue 22, item 10: one DLC rule, whatever builds or changes the frame. Every
