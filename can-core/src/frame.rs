@@ -253,9 +253,7 @@ impl Frame {
     /// A remote frame with the DLC code `dlc` (`0..=15`, [`Frame::check_dlc`]): it asks
     /// for `min(dlc, 8)` bytes.
     pub fn new_remote(id: Id, dlc: u8) -> Result<Self, FrameError> {
-        if let Err(e) = Self::check_dlc(true, dlc, 0) {
-            return Err(e);
-        }
+        Self::check_dlc(true, dlc, 0)?;
         Ok(Frame {
             word: Self::id_word(id_raw(&id), id_is_extended(&id), true),
             dlc,
@@ -810,7 +808,6 @@ mod tests {
     /// every code; so do `with_dlc` and `set_dlc` for data frames of every length.
     #[test]
     fn one_dlc_rule_for_every_constructor() {
-        use embedded_can::Frame as _;
         let id = standard_id(0x123).unwrap();
         for dlc in 0..=16u8 {
             let by_remote = Frame::remote(0x123, false, dlc);

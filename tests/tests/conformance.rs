@@ -953,7 +953,7 @@ fn register_timing(
     clocks_per_bit: u32,
     quanta: u32,
 ) -> Option<Timing> {
-    if quanta < 3 || clocks_per_bit % quanta != 0 {
+    if quanta < 3 || !clocks_per_bit.is_multiple_of(quanta) {
         return None;
     }
     let p = clocks_per_bit / quanta;

@@ -246,7 +246,7 @@ impl TimingRule {
         }
         let mut q = self.limits.max_quanta();
         while q >= self.limits.min_quanta() && q > 0 {
-            if n % q as u64 == 0 {
+            if n.is_multiple_of(q as u64) {
                 let p = n / q as u64;
                 if p >= self.limits.prescaler.min as u64 && p <= self.limits.prescaler.max as u64 {
                     return Some((p as u16, q));
