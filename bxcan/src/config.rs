@@ -3,9 +3,19 @@
 //! Everything here is written while the controller is in initialization mode (RM0410
 //! §40.4.1 "Initialization mode": `CAN_BTR` can only be written there; the notes'
 //! `CAN_MCR` bit list for TTCM, ABOM, AWUM, NART, RFLM, TXFP, DBF).
+//!
+//! **One bit-timing rule.** [`timing_rule`] is what this driver accepts from an APB1
+//! clock: the `CAN_BTR` field ranges ([`Limits::BXCAN`], RM0410 §40.7.7), nothing more.
+//! [`Config::from_bitrate`], [`Config::from_bitrate_with`] and [`Config::from_timing`]
+//! judge by it ([`TimingRule::timing_for`], [`TimingRule::accept`]), the running
+//! controller reports it in its capabilities and applies it to `set_timing` and
+//! `set_bitrate`: the slowest and fastest timings the capabilities name are accepted by
+//! all of them, one bit per second beyond is refused by all of them.
 
 use twocan_core::timing::frame_time::{frame_in_flight_wait, MAX_FRAME_IN_FLIGHT_BITS};
-use twocan_core::timing::{solve, solve_cia, Limits, Timing, TimingError, DEFAULT_TOLERANCE_PPM};
+use twocan_core::timing::{
+    cia_sample_point, Limits, Timing, TimingError, TimingRule, DEFAULT_TOLERANCE_PPM,
+};
 use twocan_core::TxPolicy;
 
 use crate::regs::{btr, ier, mcr, FILTER_BANKS};
@@ -37,6 +47,13 @@ impl From<TimingError> for ConfigError {
 /// (the reset value, and this crate's default): `ABOM = 0`, software starts it by
 /// entering and leaving initialization mode ([`twocan_core::Hardware::recover`]).
 pub use twocan_core::BusOffRecovery as Recovery;
+
+/// The bit timing rule of every bxCAN entry point (module docs): the APB1 clock
+/// `apb1_hz` and the `CAN_BTR` field ranges, [`Limits::BXCAN`] (RM0410 §40.7.7 "Bit
+/// timing"; the reference manual adds no rule beyond them).
+pub const fn timing_rule(apb1_hz: u32) -> TimingRule {
+    TimingRule::new(apb1_hz, Limits::BXCAN)
+}
 
 /// The `CAN_BTR` timing fields (BRP, TS1, TS2, SJW).
 const BTR_TIMING: u32 = btr::BRP.mask() | btr::TS1.mask() | btr::TS2.mask() | btr::SJW.mask();
@@ -142,10 +159,17 @@ impl Config {
     }
 
     /// A configuration with a raw `CAN_BTR` timing value (RM0410 §40.9.2 "CAN bit timing
-    /// register": `BRP[9:0]`, `TS1[19:16]`, `TS2[22:20]`, `SJW[25:24]`).
+    /// register": `BRP[9:0]`, `TS1[19:16]`, `TS2[22:20]`, `SJW[25:24]`). The clock is
+    /// unknown, so only the clock-free part of [`timing_rule`] applies: the counts must
+    /// be consistent ([`Timing::consistency`]: SJW ≤ TS2), else
+    /// [`ConfigError::Timing`]`(`[`TimingError::Inconsistent`]`)`.
     pub const fn from_btr(btr_value: u32) -> Result<Config, ConfigError> {
         if btr_value & !BTR_TIMING != 0 {
             return Err(ConfigError::BtrReservedBits);
+        }
+        let c = Timing::from_bxcan_btr(0, 0, btr_value).consistency();
+        if !c.is_ok() {
+            return Err(ConfigError::Timing(TimingError::Inconsistent(c)));
         }
         Ok(Config {
             wait_iterations: btr_wait_iterations(btr_value),
@@ -153,14 +177,19 @@ impl Config {
         })
     }
 
-    /// A configuration from a [`Timing`] (for example adjusted by hand), accepted when
-    /// consistent with [`Limits::BXCAN`] and within `tolerance_ppm` of its wished bit
-    /// rate ([`Timing::validate`]).
+    /// A configuration from a [`Timing`] (for example adjusted by hand) on its own clock,
+    /// accepted by [`timing_rule`] ([`TimingRule::accept`]): a bxCAN timing consistent
+    /// with the `CAN_BTR` ranges, its wished bit rate in the rule's range, within
+    /// `tolerance_ppm` of it.
     pub const fn from_timing(timing: Timing, tolerance_ppm: u32) -> Result<Config, ConfigError> {
-        let t = match timing.validate(tolerance_ppm) {
-            Ok(t) => t,
-            Err(e) => return Err(ConfigError::Timing(e)),
-        };
+        if let Err(e) = timing_rule(timing.clock_hz).accept(&timing, tolerance_ppm) {
+            return Err(ConfigError::Timing(e));
+        }
+        Self::from_accepted(timing)
+    }
+
+    /// The configuration of a timing [`timing_rule`] accepted.
+    const fn from_accepted(t: Timing) -> Result<Config, ConfigError> {
         let clock_hz = t.clock_hz;
         // Each poll reads an APB1 register, at least one APB1 cycle: twice the longest
         // frame in flight at this rate, in APB1 cycles, bounds the waits that a frame on
@@ -189,30 +218,28 @@ impl Config {
     /// clock, RM0410 §40.7.7 "Bit timing": tq = (BRP + 1) × tPCLK), CiA sample point,
     /// refused beyond [`DEFAULT_TOLERANCE_PPM`] (0.1 %) from the wished rate.
     ///
-    /// A rate outside what the clock reaches is refused first, with the same typed error
-    /// on every backend ([`Limits::check_bitrate`]: `BitrateTooHigh`, `BitrateTooLow`).
+    /// A rate outside [`timing_rule`]'s range is refused first, with the same typed
+    /// error on every backend ([`TimingRule::check_bitrate`]: `BitrateTooHigh`,
+    /// `BitrateTooLow`).
     pub const fn from_bitrate(apb1_hz: u32, bitrate: u32) -> Result<Config, ConfigError> {
-        if let Err(e) = Limits::BXCAN.check_bitrate(apb1_hz, bitrate) {
-            return Err(ConfigError::Timing(e));
-        }
-        match solve_cia(apb1_hz, bitrate, &Limits::BXCAN) {
-            Ok(t) => Self::from_timing(t, DEFAULT_TOLERANCE_PPM),
-            Err(e) => Err(ConfigError::Timing(e)),
-        }
+        Self::from_bitrate_with(
+            apb1_hz,
+            bitrate,
+            cia_sample_point(bitrate),
+            DEFAULT_TOLERANCE_PPM,
+        )
     }
 
-    /// Like [`Config::from_bitrate`] with a sample point (per mille) and a tolerance.
+    /// Like [`Config::from_bitrate`] with a sample point (per mille) and a tolerance
+    /// ([`TimingRule::timing_for`] of [`timing_rule`]).
     pub const fn from_bitrate_with(
         apb1_hz: u32,
         bitrate: u32,
         sample_point_permille: u16,
         tolerance_ppm: u32,
     ) -> Result<Config, ConfigError> {
-        if let Err(e) = Limits::BXCAN.check_bitrate(apb1_hz, bitrate) {
-            return Err(ConfigError::Timing(e));
-        }
-        match solve(apb1_hz, bitrate, &Limits::BXCAN, sample_point_permille) {
-            Ok(t) => Self::from_timing(t, tolerance_ppm),
+        match timing_rule(apb1_hz).timing_for(bitrate, sample_point_permille, tolerance_ppm) {
+            Ok(t) => Self::from_accepted(t),
             Err(e) => Err(ConfigError::Timing(e)),
         }
     }
@@ -424,6 +451,44 @@ impl Config {
 mod tests {
     use super::*;
 
+    /// Issue 22, item 6: the slowest and the fastest timings of the rule are accepted by
+    /// every builder, and one bit per second beyond by none.
+    #[test]
+    fn the_rule_s_extremes_are_accepted_by_every_builder() {
+        let rule = timing_rule(54_000_000);
+        for t in [rule.slowest().unwrap(), rule.fastest().unwrap()] {
+            let rate = t.actual_bitrate();
+            let by_timing = Config::from_timing(t, DEFAULT_TOLERANCE_PPM).unwrap();
+            let by_rate = Config::from_bitrate(54_000_000, rate).unwrap();
+            assert_eq!(by_rate.btr_value(), by_timing.btr_value(), "{rate}");
+            assert_eq!(by_rate.btr_value(), t.bxcan_btr().unwrap());
+            assert!(Config::from_btr(t.bxcan_btr().unwrap()).is_ok());
+        }
+        let (min, max) = (rule.min_bitrate(), rule.max_bitrate());
+        assert_eq!((min, max), (2_109, 18_000_000));
+        assert_eq!(
+            Config::from_bitrate(54_000_000, min - 1),
+            Err(ConfigError::Timing(TimingError::BitrateTooLow))
+        );
+        assert_eq!(
+            Config::from_bitrate(54_000_000, max + 1),
+            Err(ConfigError::Timing(TimingError::BitrateTooHigh))
+        );
+        // A hand-made timing wished one bit per second below the slowest rate.
+        let mut below = rule.slowest().unwrap();
+        below.bitrate = min - 1;
+        assert_eq!(
+            Config::from_timing(below, DEFAULT_TOLERANCE_PPM),
+            Err(ConfigError::Timing(TimingError::BitrateTooLow))
+        );
+        // A raw BTR with SJW above TS2 breaks the rule's consistency.
+        let sjw4_ts2_1 = btr::SJW.val(3) | btr::TS2.val(0) | btr::TS1.val(5);
+        assert!(matches!(
+            Config::from_btr(sjw4_ts2_1),
+            Err(ConfigError::Timing(TimingError::Inconsistent(_)))
+        ));
+    }
+
     #[test]
     fn raw_btr_is_checked() {
         assert_eq!(
@@ -512,7 +577,7 @@ mod tests {
             Config::from_bitrate(54_000_000, 1),
             Err(ConfigError::Timing(TimingError::BitrateTooLow))
         );
-        let fastest = Limits::BXCAN.max_bitrate(54_000_000);
+        let fastest = timing_rule(54_000_000).max_bitrate();
         assert!(Config::from_bitrate(54_000_000, fastest).is_ok());
         assert_eq!(
             Config::from_bitrate(54_000_000, fastest + 1),

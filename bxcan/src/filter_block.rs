@@ -34,6 +34,16 @@ pub(crate) fn banks_of<F: Registers>(regs: &F, instance: Instance) -> (usize, us
     bank_range(instance, can2sb(regs))
 }
 
+/// The FIFOs `instance`'s active banks feed in the block behind `regs`: bit 0 FIFO 0,
+/// bit 1 FIFO 1 (`CAN_FA1R.FACTx` and `CAN_FFA1R.FFAx` of its banks, RM0410 §40.9.4).
+pub(crate) fn fed_fifos<F: Registers>(regs: &F, instance: Instance) -> u8 {
+    let (start, end) = banks_of(regs, instance);
+    let ours = ((1u32 << (end - start)) - 1) << start;
+    let active = regs.read32(FA1R) & ours;
+    let to_fifo1 = regs.read32(FFA1R) & active;
+    u8::from(active & !to_fifo1 != 0) | (u8::from(to_fifo1 != 0) << 1)
+}
+
 /// A `CAN2SB` change refused: bank `bank` is active and the change would give it to
 /// the other instance, or renumber it (a CAN2 bank's filter match index counts from
 /// `CAN2SB`, see `docs/models.md`), behind the back of the driver that installed it.

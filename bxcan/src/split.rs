@@ -105,6 +105,9 @@ pub struct BxCan<R: Registers, F: Registers = R, const K: usize = LOOKUP_KEYS> {
     generation: AtomicU32,
     /// FIFO frames released by `install_filters` and not yet taken (receive half only).
     discarded: AtomicU32,
+    /// The FIFOs the installed filters feed (`fed_rx_queues`), read from the filter
+    /// block when the filters are installed.
+    fed: AtomicU8,
 }
 
 // SAFETY: the atomics are shared; `displaced` is touched by the transmit interrupt's
@@ -117,6 +120,10 @@ impl<R: Registers, F: Registers, const K: usize> Can<R, F, K> {
     /// installed filters come along.
     pub fn into_split(self) -> BxCan<R, F, K> {
         let listen_only = self.regs.read32(BTR) & (btr::SILM | btr::LBKM) == btr::SILM;
+        let fed = match &self.filter_regs {
+            Some(f) => filter_block::fed_fifos(f, self.instance),
+            None => filter_block::fed_fifos(&self.regs, self.instance),
+        };
         BxCan {
             regs: self.regs,
             filter_regs: self.filter_regs,
@@ -134,6 +141,7 @@ impl<R: Registers, F: Registers, const K: usize> Can<R, F, K> {
             listen_only: AtomicBool::new(listen_only),
             generation: AtomicU32::new(0),
             discarded: AtomicU32::new(0),
+            fed: AtomicU8::new(fed),
         }
     }
 }
@@ -759,12 +767,24 @@ unsafe impl<R: Registers, F: Registers, const K: usize> Hardware for BxCan<R, F,
             None => filter_block::program_then(&self.regs, self.instance, filters, drain),
         };
         r.map_err(|_| Error::InvalidArgument)?;
+        let fed = match &self.filter_regs {
+            Some(f) => filter_block::fed_fifos(f, self.instance),
+            None => filter_block::fed_fifos(&self.regs, self.instance),
+        };
+        self.fed.store(fed, Ordering::Relaxed);
         // SAFETY: the receive half's context, the only one touching the map.
         unsafe { *self.fmi.get() = fmi };
         Ok(())
     }
 
     fn filter_map(&self) {}
+
+    /// The FIFOs the active banks of the installed filters are assigned to
+    /// (`CAN_FA1R`, `CAN_FFA1R`, read when they were installed): a `FifoPolicy::Fifo0`
+    /// plan feeds FIFO 0 only.
+    fn fed_rx_queues(&self) -> u8 {
+        self.fed.load(Ordering::Relaxed)
+    }
 
     /// The FIFO frames `install_filters` released under `FINIT` (`RFOMx`).
     fn take_filter_switch_discards(&self) -> u32 {
@@ -824,7 +844,8 @@ unsafe impl<R: Registers, F: Registers, const K: usize> Hardware for BxCan<R, F,
         mode::request(&self.regs, Mode::Normal, bound)
     }
 
-    /// The APB1 clock of the [`Config`] ([`Config::get_clock_hz`]), [`Limits::BXCAN`];
+    /// The bit-timing rule every bxCAN entry point applies ([`crate::config::timing_rule`]
+    /// of the [`Config`]'s APB1 clock, [`Config::get_clock_hz`]: [`Limits::BXCAN`]);
     /// the banks this instance owns now (`CAN2SB`, RM0410 §40.7.4): four 16-bit list
     /// identifiers (standard) or two 32-bit ones (extended) per bank; three transmit
     /// mailboxes, two receive FIFOs of three (§40.7.3, §40.7.5); no triple sampling;
@@ -851,6 +872,7 @@ unsafe impl<R: Registers, F: Registers, const K: usize> Hardware for BxCan<R, F,
             RX_FIFO_DEPTH as u8,
             self.config.get_timestamps().then_some(16),
         )
+        .with_timing_rule(crate::config::timing_rule(self.config.get_clock_hz()))
         .with_wakeup_events(self.config.get_interrupts() & crate::regs::ier::WKUIE != 0)
     }
 

@@ -7,6 +7,14 @@
 //! is computed from, the filter capacity of its current message-buffer or filter-bank
 //! partition, its receive FIFO depth, whether it records time stamps.
 //!
+//! The bit-timing figures are exactly what the controller accepts: they come from its
+//! [`TimingRule`] ([`Capabilities::timing_rule`]), the one rule
+//! [`crate::Hardware::set_timing`], [`crate::Driver::set_bitrate`] and the backends'
+//! configuration entry points apply. [`Capabilities::fastest_timing`] and
+//! [`Capabilities::slowest_timing`] are accepted by all of them, and
+//! [`Capabilities::min_bitrate`] ..= [`Capabilities::max_bitrate`] are their bit rates
+//! (rounded down); a wished rate one bit per second beyond is refused.
+//!
 //! ```
 //! use twocan_core::mock::MockHardware;
 //! use twocan_core::{BusMode, Driver, Hardware};
@@ -16,9 +24,14 @@
 //! assert_eq!(caps.tx_mailboxes, 3);
 //! assert!(caps.modes.supports(BusMode::LoopBack));
 //! assert!(caps.min_bitrate <= 125_000 && 1_000_000 <= caps.max_bitrate);
+//! let fastest = caps.fastest_timing().unwrap();
+//! assert_eq!(fastest.actual_bitrate(), caps.max_bitrate);
+//! assert_eq!(caps.check_timing(&fastest), Ok(()));
 //! ```
 
-use crate::timing::{solve, Limits, Timing, TimingError, DEFAULT_TOLERANCE_PPM};
+use crate::timing::{
+    Limits, PeripheralClockRule, Timing, TimingError, TimingRule, DEFAULT_TOLERANCE_PPM,
+};
 
 /// The bus modes of a running controller, chosen while it is stopped
 /// ([`crate::Hardware::set_bus_mode`]).
@@ -88,15 +101,21 @@ pub struct Capabilities {
     /// The CAN clock the bit timing is computed from, Hz (FlexCAN on a Teensy 3.x: the
     /// 16 MHz oscillator; bxCAN: the APB1 clock it was configured with).
     pub clock_hz: u32,
-    /// The register ranges of the bit timing.
+    /// The register ranges of the bit timing and the quanta per bit the controller
+    /// accepts (FlexCAN: [`Limits::FLEXCAN_KINETIS`], 8..=25 quanta, the Kinetis
+    /// manual's rule; bxCAN: [`Limits::BXCAN`]).
     pub timing_limits: Limits,
-    /// Slowest bit rate reachable from [`Capabilities::clock_hz`]
-    /// ([`Limits::min_bitrate`]).
+    /// The manual's minimum ratio between a peripheral clock and the bit rate, where
+    /// the controller has one (FlexCAN: 16 bus clocks per bit, with the bus clock
+    /// `begin` was given, [`crate::timing::flexcan_rules::rule`]); part of
+    /// [`Capabilities::timing_rule`].
+    pub peripheral_clock: Option<PeripheralClockRule>,
+    /// The bit rate of the slowest accepted timing, rounded down
+    /// ([`TimingRule::min_bitrate`]): the slowest wished rate accepted.
     pub min_bitrate: u32,
-    /// Fastest bit rate the controller accepts: reachable from
-    /// [`Capabilities::clock_hz`] ([`Limits::max_bitrate`]) and, where the controller's
-    /// manual has a stricter rule, allowed by it ([`Capabilities::with_max_bitrate`];
-    /// FlexCAN: [`crate::timing::flexcan_rules::max_bitrate`] with the bus clock in use).
+    /// The bit rate of the fastest accepted timing, rounded down
+    /// ([`TimingRule::max_bitrate`]): the fastest wished rate accepted (FlexCAN: with
+    /// the Kinetis manual's rules and the bus clock in use).
     pub max_bitrate: u32,
     /// The optional modes offered.
     pub modes: ModeSupport,
@@ -128,8 +147,9 @@ pub struct Capabilities {
 }
 
 impl Capabilities {
-    /// Capabilities with the bit-rate range computed from `clock_hz` and `limits`; the
-    /// other fields as given.
+    /// Capabilities with the bit-timing rule of `clock_hz` and `timing_limits` (no rule
+    /// beyond the limits: [`Capabilities::with_timing_rule`] adds one) and the bit-rate
+    /// range it accepts; the other fields as given.
     #[allow(clippy::too_many_arguments)]
     pub const fn new(
         clock_hz: u32,
@@ -142,11 +162,13 @@ impl Capabilities {
         rx_fifo_depth: u8,
         timestamp_bits: Option<u8>,
     ) -> Self {
+        let rule = TimingRule::new(clock_hz, timing_limits);
         Capabilities {
             clock_hz,
             timing_limits,
-            min_bitrate: timing_limits.min_bitrate(clock_hz),
-            max_bitrate: timing_limits.max_bitrate(clock_hz),
+            peripheral_clock: None,
+            min_bitrate: rule.min_bitrate(),
+            max_bitrate: rule.max_bitrate(),
             modes,
             max_standard_filters,
             max_extended_filters,
@@ -164,47 +186,64 @@ impl Capabilities {
         self
     }
 
-    /// The same capabilities with [`Capabilities::max_bitrate`] lowered to `max` (a rule
-    /// of the controller's manual beyond the register ranges); a higher `max` changes
-    /// nothing.
-    pub const fn with_max_bitrate(mut self, max: u32) -> Self {
-        if max < self.max_bitrate {
-            self.max_bitrate = max;
-        }
+    /// The same capabilities with the bit-timing figures of `rule`: its clock, limits
+    /// and peripheral-clock ratio, and the bit-rate range it accepts. A backend passes
+    /// the one rule its entry points apply.
+    pub const fn with_timing_rule(mut self, rule: TimingRule) -> Self {
+        self.clock_hz = rule.clock_hz;
+        self.timing_limits = rule.limits;
+        self.peripheral_clock = rule.peripheral_clock;
+        self.min_bitrate = rule.min_bitrate();
+        self.max_bitrate = rule.max_bitrate();
         self
     }
 
-    /// Whether `bitrate` lies in [`Capabilities::min_bitrate`] ..=
-    /// [`Capabilities::max_bitrate`].
-    pub const fn bitrate_in_range(&self, bitrate: u32) -> bool {
-        bitrate >= self.min_bitrate && bitrate <= self.max_bitrate
+    /// The controller's bit-timing rule: [`Capabilities::clock_hz`],
+    /// [`Capabilities::timing_limits`], [`Capabilities::peripheral_clock`].
+    pub const fn timing_rule(&self) -> TimingRule {
+        TimingRule {
+            clock_hz: self.clock_hz,
+            limits: self.timing_limits,
+            peripheral_clock: self.peripheral_clock,
+        }
     }
 
-    /// A bit timing for `bitrate` from this controller's clock and limits, aiming at
-    /// `sample_point_permille`: [`Limits::check_bitrate`]'s errors,
-    /// [`TimingError::BitrateTooHigh`] above [`Capabilities::max_bitrate`], the
-    /// solver's, and [`TimingError::TooFarFromWishedBitrate`] beyond
-    /// [`DEFAULT_TOLERANCE_PPM`].
+    /// The fastest timing the controller accepts ([`TimingRule::fastest`]; its bit rate
+    /// is [`Capabilities::max_bitrate`]). `None` when nothing is accepted.
+    pub const fn fastest_timing(&self) -> Option<Timing> {
+        self.timing_rule().fastest()
+    }
+
+    /// The slowest timing the controller accepts ([`TimingRule::slowest`]; its bit rate
+    /// is [`Capabilities::min_bitrate`]). `None` when nothing is accepted.
+    pub const fn slowest_timing(&self) -> Option<Timing> {
+        self.timing_rule().slowest()
+    }
+
+    /// Whether a wished `bitrate` is in range ([`TimingRule::check_bitrate`]):
+    /// [`Capabilities::min_bitrate`] ..= [`Capabilities::max_bitrate`].
+    pub const fn bitrate_in_range(&self, bitrate: u32) -> bool {
+        self.timing_rule().check_bitrate(bitrate).is_ok()
+    }
+
+    /// Whether the controller accepts `timing` ([`TimingRule::check_timing`]): what
+    /// [`crate::Hardware::set_timing`] checks besides the mode.
+    pub const fn check_timing(&self, timing: &Timing) -> Result<(), TimingError> {
+        self.timing_rule().check_timing(timing)
+    }
+
+    /// A bit timing for `bitrate` from this controller's rule, aiming at
+    /// `sample_point_permille`, within [`DEFAULT_TOLERANCE_PPM`]
+    /// ([`TimingRule::timing_for`]): [`TimingError::BitrateTooHigh`] above
+    /// [`Capabilities::max_bitrate`], [`TimingError::BitrateTooLow`] below
+    /// [`Capabilities::min_bitrate`], the solver's errors, and
+    /// [`TimingError::TooFarFromWishedBitrate`].
     pub const fn timing_for(
         &self,
         bitrate: u32,
         sample_point_permille: u16,
     ) -> Result<Timing, TimingError> {
-        if let Err(e) = self.timing_limits.check_bitrate(self.clock_hz, bitrate) {
-            return Err(e);
-        }
-        if bitrate > self.max_bitrate {
-            return Err(TimingError::BitrateTooHigh);
-        }
-        match solve(
-            self.clock_hz,
-            bitrate,
-            &self.timing_limits,
-            sample_point_permille,
-        ) {
-            Ok(t) if t.within_tolerance(DEFAULT_TOLERANCE_PPM) => Ok(t),
-            Ok(_) => Err(TimingError::TooFarFromWishedBitrate),
-            Err(e) => Err(e),
-        }
+        self.timing_rule()
+            .timing_for(bitrate, sample_point_permille, DEFAULT_TOLERANCE_PPM)
     }
 }

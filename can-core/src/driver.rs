@@ -242,9 +242,15 @@ impl<H: Hardware, const RX: usize, const TX: usize, const RX1: usize> Driver<H, 
         self.state.traffic()
     }
 
-    /// Receive ring figures (ACAN `receiveBufferSize/Count/PeakCount`).
+    /// Receive ring figures (ACAN `receiveBufferSize/Count/PeakCount`): the rings the
+    /// installed filters feed ([`State::rx_stats`]).
     pub fn rx_stats(&self) -> BufferStats {
         self.state.rx_stats()
+    }
+
+    /// The figures of receive ring `queue` ([`State::rx_ring_stats`]).
+    pub fn rx_ring_stats(&self, queue: usize) -> Option<BufferStats> {
+        self.state.rx_ring_stats(queue)
     }
 
     /// Transmit queue figures (ACAN `transmitBufferSize/Count/PeakCount`).

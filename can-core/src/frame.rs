@@ -7,6 +7,16 @@
 //!
 //! A remote frame carries a DLC (the length of the answer it asks for) but no data bytes.
 //!
+//! **One DLC rule** ([`Frame::check_dlc`]), applied by every constructor and setter
+//! that takes a code ([`Frame::remote`], [`Frame::new_remote`], the
+//! `embedded_can::Frame::new_remote` of this type, [`Frame::with_dlc`],
+//! [`Frame::set_dlc`], [`Frame::from_registers`]): the code fits the four-bit field
+//! (`0..=15`, else [`FrameError::DlcTooLarge`]); a data frame's code agrees with its data
+//! (`0..=8` equal to the number of bytes, `9..=15` with 8 bytes, else
+//! [`FrameError::DlcMismatch`]); a remote frame takes any code (the length asked for is
+//! `min(code, 8)`). [`Frame::from_words`], the backends' decoding fast path, masks
+//! instead of checking and so lands on the same set of frames.
+//!
 //! The DLC is kept as written: ISO 11898-1 (classical CAN) gives the DLC field four
 //! bits and says codes 9..=15 mean eight data bytes. A frame built with
 //! [`Frame::with_dlc`] (or read from a mailbox holding such a code) keeps the code,
@@ -33,8 +43,7 @@ pub enum FrameError {
     StandardIdOutOfRange(u32),
     /// An extended identifier above `0x1FFF_FFFF`.
     ExtendedIdOutOfRange(u32),
-    /// A data length code out of range: above 15 (the field has four bits), or above 8
-    /// where only a length is accepted ([`Frame::new_remote`], [`Frame::remote`]).
+    /// A data length code above 15 (the field has four bits; [`Frame::check_dlc`]).
     DlcTooLarge(u8),
     /// A DLC code that does not agree with the data: a code `0..=8` other than the
     /// number of data bytes, or a code `9..=15` with fewer than 8 data bytes.
@@ -142,15 +151,17 @@ const ID_BITS: u32 = 0x1FFF_FFFF;
 ///     Err(FrameError::ExtendedIdOutOfRange(0x2000_0000))
 /// );
 /// assert_eq!(Frame::standard(0x100, &[0; 9]), Err(FrameError::TooMuchData(9)));
-/// assert_eq!(Frame::remote(0x100, false, 9), Err(FrameError::DlcTooLarge(9)));
+/// assert_eq!(Frame::remote(0x100, false, 16), Err(FrameError::DlcTooLarge(16)));
 /// let id = twocan_core::frame::standard_id(0x100)?;
 /// assert_eq!(
 ///     Frame::with_dlc(id, &[1, 2], 3),
 ///     Err(FrameError::DlcMismatch { dlc: 3, len: 2 })
 /// );
-/// // DLC codes 9..=15 are kept as written, with 8 data bytes (ISO 11898-1).
+/// // DLC codes 9..=15 are kept as written, with 8 data bytes (ISO 11898-1); a remote
+/// // frame with such a code asks for 8 bytes.
 /// let long = Frame::with_dlc(id, &[0; 8], 15)?;
 /// assert_eq!((long.dlc(), long.data().len()), (15, 8));
+/// assert_eq!(Frame::remote(0x100, false, 9)?.len_from_dlc(), 8);
 /// # Ok::<(), FrameError>(())
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
@@ -185,6 +196,38 @@ impl defmt::Format for Frame {
 }
 
 impl Frame {
+    /// The one DLC rule (module docs): whether a frame of this kind (`remote`) with
+    /// `data_len` data bytes may carry the DLC code `dlc`. ISO 11898-1 (classical CAN):
+    /// the DLC field has four bits; codes `0..=8` are the data length, `9..=15` mean
+    /// eight bytes; a remote frame carries no data and any code (it asks for
+    /// `min(code, 8)` bytes).
+    ///
+    /// ```
+    /// use twocan_core::{Frame, FrameError};
+    /// assert_eq!(Frame::check_dlc(true, 13, 0), Ok(()));
+    /// assert_eq!(Frame::check_dlc(false, 13, 8), Ok(()));
+    /// assert_eq!(Frame::check_dlc(false, 13, 7), Err(FrameError::DlcMismatch { dlc: 13, len: 7 }));
+    /// assert_eq!(Frame::check_dlc(true, 16, 0), Err(FrameError::DlcTooLarge(16)));
+    /// ```
+    pub const fn check_dlc(remote: bool, dlc: u8, data_len: usize) -> Result<(), FrameError> {
+        if dlc > MAX_DLC_CODE {
+            return Err(FrameError::DlcTooLarge(dlc));
+        }
+        if remote {
+            return Ok(());
+        }
+        let agrees = if dlc > MAX_DLC {
+            data_len == MAX_DLC as usize
+        } else {
+            dlc as usize == data_len
+        };
+        if agrees {
+            Ok(())
+        } else {
+            Err(FrameError::DlcMismatch { dlc, len: data_len })
+        }
+    }
+
     /// A data frame; `data.len()` becomes the DLC.
     pub fn new_data(id: Id, data: &[u8]) -> Result<Self, FrameError> {
         Self::data_frame(id, id_raw(&id), data)
@@ -207,11 +250,10 @@ impl Frame {
         })
     }
 
-    /// A remote frame asking for `dlc` bytes.
+    /// A remote frame with the DLC code `dlc` (`0..=15`, [`Frame::check_dlc`]): it asks
+    /// for `min(dlc, 8)` bytes.
     pub fn new_remote(id: Id, dlc: u8) -> Result<Self, FrameError> {
-        if dlc > MAX_DLC {
-            return Err(FrameError::DlcTooLarge(dlc));
-        }
+        Self::check_dlc(true, dlc, 0)?;
         Ok(Frame {
             word: Self::id_word(id_raw(&id), id_is_extended(&id), true),
             dlc,
@@ -219,13 +261,14 @@ impl Frame {
         })
     }
 
-    /// A remote frame with a raw identifier (`extended` selects 29 bits).
+    /// A remote frame with a raw identifier (`extended` selects 29 bits) and the DLC
+    /// code `dlc` (`0..=15`, [`Frame::check_dlc`]).
     pub const fn remote(raw_id: u32, extended: bool, dlc: u8) -> Result<Self, FrameError> {
         if let Err(e) = raw_to_id(raw_id, extended) {
             return Err(e);
         }
-        if dlc > MAX_DLC {
-            return Err(FrameError::DlcTooLarge(dlc));
+        if let Err(e) = Self::check_dlc(true, dlc, 0) {
+            return Err(e);
         }
         Ok(Frame {
             word: Self::id_word(raw_id, extended, true),
@@ -276,12 +319,15 @@ impl Frame {
         if let Err(e) = raw_to_id(raw_id, extended) {
             return Err(e);
         }
-        if dlc > MAX_DLC_CODE {
-            return Err(FrameError::DlcTooLarge(dlc));
+        // The register always holds 8 bytes: the data length is the one the code gives,
+        // so only the field width can be wrong.
+        let len = if dlc > MAX_DLC { MAX_DLC } else { dlc };
+        let data_len = if remote { 0 } else { len as usize };
+        if let Err(e) = Self::check_dlc(remote, dlc, data_len) {
+            return Err(e);
         }
         let mut bytes = [0u8; 8];
         if !remote {
-            let len = if dlc > MAX_DLC { MAX_DLC } else { dlc };
             let mut i = 0;
             while i < len as usize {
                 bytes[i] = data[i];
@@ -414,26 +460,13 @@ impl Frame {
         Ok(f)
     }
 
-    /// Sets the DLC code, keeping the data. A data frame accepts its own data length
-    /// (`0..=8`) or, with 8 data bytes, any code `9..=15`; a remote frame accepts any
-    /// code `0..=15` (the length asked for is `min(code, 8)`). Above 15 is
-    /// [`FrameError::DlcTooLarge`]; a code that disagrees with the data is
+    /// Sets the DLC code, keeping the data, by [`Frame::check_dlc`]: a data frame
+    /// accepts its own data length (`0..=8`) or, with 8 data bytes, any code `9..=15`; a
+    /// remote frame accepts any code `0..=15` (the length asked for is `min(code, 8)`).
+    /// Above 15 is [`FrameError::DlcTooLarge`]; a code that disagrees with the data is
     /// [`FrameError::DlcMismatch`]. The frame is unchanged on error.
     pub fn set_dlc(&mut self, dlc: u8) -> Result<(), FrameError> {
-        if dlc > MAX_DLC_CODE {
-            return Err(FrameError::DlcTooLarge(dlc));
-        }
-        if !self.is_remote() {
-            let len = self.data_len();
-            let fits = if dlc > MAX_DLC {
-                len == MAX_DLC as usize
-            } else {
-                dlc as usize == len
-            };
-            if !fits {
-                return Err(FrameError::DlcMismatch { dlc, len });
-            }
-        }
+        Self::check_dlc(self.is_remote(), dlc, self.data_len())?;
         self.dlc = dlc;
         Ok(())
     }
@@ -568,7 +601,13 @@ impl embedded_can::Frame for Frame {
     }
 }
 
-/// A frame taken from a controller, with where and when it was accepted.
+// The sizes `docs/differences.md` states (ACAN's `CANMessage` is 16 bytes), checked on
+// every target the crate builds for.
+const _: () = assert!(core::mem::size_of::<Frame>() == 16);
+const _: () = assert!(core::mem::size_of::<RxFrame>() == 32);
+
+/// A frame taken from a controller, with where and when it was accepted (32 bytes: the
+/// 16-byte [`Frame`], two 16-bit indices and an 8-byte optional time stamp).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct RxFrame {
@@ -607,7 +646,8 @@ mod tests {
             Err(FrameError::TooMuchData(9))
         );
         let id = standard_id(1).unwrap();
-        assert_eq!(Frame::new_remote(id, 9), Err(FrameError::DlcTooLarge(9)));
+        assert_eq!(Frame::new_remote(id, 16), Err(FrameError::DlcTooLarge(16)));
+        assert_eq!(Frame::new_remote(id, 9).map(|f| f.len_from_dlc()), Ok(8));
         assert!(Frame::new_remote(id, 8).is_ok());
     }
 
@@ -650,7 +690,10 @@ mod tests {
         use embedded_can::Frame as _;
         let id = StandardId::new(0x10).unwrap();
         assert!(<Frame as embedded_can::Frame>::new(id, &[0; 9]).is_none());
-        assert!(<Frame as embedded_can::Frame>::new_remote(id, 9).is_none());
+        assert!(<Frame as embedded_can::Frame>::new_remote(id, 16).is_none());
+        // A code of 9..=15 is a valid remote request for 8 bytes; the trait reads 8.
+        let r = <Frame as embedded_can::Frame>::new_remote(id, 9).unwrap();
+        assert_eq!((r.dlc(), embedded_can::Frame::dlc(&r)), (9, 8));
         assert!(<Frame as embedded_can::Frame>::new_remote(id, usize::MAX).is_none());
         let f = <Frame as embedded_can::Frame>::new(id, &[1, 2]).unwrap();
         assert_eq!(embedded_can::Frame::dlc(&f), 2);
@@ -748,6 +791,58 @@ mod tests {
         assert!(r.data().is_empty());
         assert_eq!(r.set_dlc(16), Err(FrameError::DlcTooLarge(16)));
         assert_eq!(core::mem::size_of::<Frame>(), 16);
+    }
+
+    /// The sizes `docs/differences.md` states: `Frame` 16 bytes (ACAN's `CANMessage` is
+    /// 16 bytes too, with `idx`), `RxFrame` 32 bytes (the frame, the user's filter index,
+    /// the hardware match index and an 8-byte optional time stamp, 8-byte aligned).
+    #[test]
+    fn frame_sizes_are_the_documented_ones() {
+        assert_eq!(core::mem::size_of::<Frame>(), 16);
+        assert_eq!(core::mem::size_of::<RxFrame>(), 32);
+        assert_eq!(core::mem::align_of::<RxFrame>(), 8);
+    }
+
+    /// Issue 22, item 10: one DLC rule, whatever builds or changes the frame. Every
+    /// remote-frame constructor, `from_registers` and `set_dlc` give the same answer for
+    /// every code; so do `with_dlc` and `set_dlc` for data frames of every length.
+    #[test]
+    fn one_dlc_rule_for_every_constructor() {
+        let id = standard_id(0x123).unwrap();
+        for dlc in 0..=16u8 {
+            let by_remote = Frame::remote(0x123, false, dlc);
+            let by_new_remote = Frame::new_remote(id, dlc);
+            let by_trait = <Frame as embedded_can::Frame>::new_remote(id, dlc as usize);
+            let by_registers = Frame::from_registers(0x123, false, true, dlc, [0; 8]);
+            let by_set_dlc = Frame::remote(0x123, false, 0).and_then(|mut f| {
+                f.set_dlc(dlc)?;
+                Ok(f)
+            });
+            assert_eq!(by_remote, by_set_dlc, "remote, DLC {dlc}");
+            assert_eq!(by_new_remote, by_set_dlc, "remote, DLC {dlc}");
+            assert_eq!(by_registers, by_set_dlc, "remote, DLC {dlc}");
+            assert_eq!(by_trait, by_set_dlc.ok(), "remote, DLC {dlc}");
+            assert_eq!(by_set_dlc.is_ok(), dlc <= MAX_DLC_CODE, "remote, DLC {dlc}");
+            for len in 0..=8usize {
+                let data = &[0x5Au8; 8][..len];
+                let by_with_dlc = Frame::with_dlc(id, data, dlc);
+                let by_set_dlc = Frame::new_data(id, data).and_then(|mut f| {
+                    f.set_dlc(dlc)?;
+                    Ok(f)
+                });
+                assert_eq!(by_with_dlc, by_set_dlc, "data, DLC {dlc}, {len} bytes");
+                let agrees = if dlc > MAX_DLC {
+                    len == 8
+                } else {
+                    dlc as usize == len
+                };
+                assert_eq!(
+                    by_set_dlc.is_ok(),
+                    dlc <= MAX_DLC_CODE && agrees,
+                    "data, DLC {dlc}, {len} bytes"
+                );
+            }
+        }
     }
 
     #[test]

@@ -276,6 +276,14 @@ pub unsafe trait Hardware {
         0
     }
 
+    /// Any context: which receive queues the installed filters can feed, bit `q` for
+    /// queue `q` (bxCAN: the FIFOs the active banks are assigned to, `CAN_FFA1R`). The
+    /// driver reports the rings of these queues as the receive buffer
+    /// ([`crate::State::rx_stats`]). The default is every queue the controller has.
+    fn fed_rx_queues(&self) -> u8 {
+        ((1u16 << Self::RX_QUEUES) - 1) as u8
+    }
+
     /// The map of the filters installed now (read at split time).
     fn filter_map(&self) -> Self::FilterMap;
 
@@ -315,10 +323,10 @@ pub unsafe trait Hardware {
 
     /// Stopped controller only: writes a new bit timing (computed for
     /// [`Capabilities::clock_hz`] within [`Capabilities::timing_limits`]); the filters
-    /// stay. [`Error::WrongMode`] while on the bus; [`Error::Timing`] for a timing made
-    /// for another clock or other limits, faster than [`Capabilities::max_bitrate`],
-    /// inconsistent, or forbidden by the controller's manual
-    /// ([`crate::timing::TimingError::ForbiddenByManual`]).
+    /// stay. [`Error::WrongMode`] while on the bus; [`Error::Timing`] for a timing the
+    /// controller's rule refuses ([`Capabilities::check_timing`]: made for another clock
+    /// or register layout, inconsistent, or forbidden by the controller's manual,
+    /// [`crate::timing::TimingError::ForbiddenByManual`]).
     fn set_timing(&self, timing: &Timing) -> Result<(), Error>;
 
     /// Stopped controller only: selects the bus mode used from the next start; the
@@ -328,29 +336,15 @@ pub unsafe trait Hardware {
 }
 
 /// The checks [`Hardware::set_timing`] applies before any register is written: the
-/// controller is stopped (`stopped`), the timing was made for `caps`' clock and limits,
-/// its bit rate is at most [`Capabilities::max_bitrate`], and it is consistent.
+/// controller is stopped (`stopped`), and it accepts the timing
+/// ([`Capabilities::check_timing`], the controller's one rule: made for its clock and
+/// register layout, consistent, allowed by its manual). The wished rate the timing
+/// carries is not judged: the counts are written as given.
 pub fn check_timing_for(caps: &Capabilities, timing: &Timing, stopped: bool) -> Result<(), Error> {
-    use crate::timing::TimingError;
     if !stopped {
         return Err(Error::WrongMode);
     }
-    if timing.clock_hz != caps.clock_hz {
-        return Err(Error::Timing(TimingError::WrongClock));
-    }
-    if timing.limits != caps.timing_limits {
-        return Err(Error::Timing(TimingError::WrongController));
-    }
-    caps.timing_limits
-        .check_bitrate(caps.clock_hz, timing.actual_bitrate())
-        .map_err(Error::Timing)?;
-    if timing.actual_bitrate() > caps.max_bitrate {
-        return Err(Error::Timing(TimingError::BitrateTooHigh));
-    }
-    let consistency = timing.consistency();
-    if !consistency.is_ok() {
-        return Err(Error::Timing(TimingError::Inconsistent(consistency)));
-    }
+    caps.check_timing(timing).map_err(Error::Timing)?;
     if timing.triple_sampling && !caps.modes.triple_sampling {
         return Err(Error::Unsupported);
     }

@@ -450,18 +450,38 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
         })
     }
 
-    /// Receive ring figures (queue 0, and queue 1 added when it has room).
+    /// The receive rings as one buffer: `size` and `peak` are those of the rings the
+    /// installed filters feed ([`Hardware::fed_rx_queues`]: bxCAN FIFO 0, FIFO 1 or
+    /// both, as the plan assigns the banks; FlexCAN its one FIFO), added where both are
+    /// fed, so that `size` frames arrive before an overflow; `count` and `overflows` are
+    /// over every ring (a frame still waiting in a ring no longer fed is counted, and
+    /// taken by `receive`). Each ring: [`State::rx_ring_stats`].
     pub fn rx_stats(&self) -> BufferStats {
-        let a = self.rx0.stats();
-        if H::RX_QUEUES < 2 {
-            return a;
+        let all = ((1u16 << H::RX_QUEUES) - 1) as u8;
+        let fed = self.hardware().map_or(all, |h| h.fed_rx_queues()) & all;
+        let rings = [self.rx_ring_stats(0), self.rx_ring_stats(1)];
+        let mut total = BufferStats::default();
+        for (q, ring) in rings.into_iter().enumerate() {
+            let Some(r) = ring else { continue };
+            total.count += r.count;
+            total.overflows += r.overflows;
+            // A ring of no room (`RX1` = 0) holds nothing: its frames are overflows.
+            if fed & (1 << q) != 0 && r.size > 0 {
+                total.size += r.size;
+                total.peak += r.peak;
+            }
         }
-        let b = self.rx1.stats();
-        BufferStats {
-            size: a.size + b.size,
-            count: a.count + b.count,
-            peak: if RX1 == 0 { a.peak } else { a.peak + b.peak },
-            overflows: a.overflows + b.overflows,
+        total
+    }
+
+    /// The figures of receive ring `queue` (0: the `RX` ring, bxCAN FIFO 0 or the
+    /// FlexCAN Rx FIFO; 1: the `RX1` ring, bxCAN FIFO 1), whether the installed filters
+    /// feed it or not; `None` for a queue the controller does not have.
+    pub fn rx_ring_stats(&self, queue: usize) -> Option<BufferStats> {
+        match queue {
+            _ if queue >= H::RX_QUEUES => None,
+            0 => Some(self.rx0.stats()),
+            _ => Some(self.rx1.stats()),
         }
     }
 
@@ -1001,9 +1021,14 @@ impl<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE:
         Ok(())
     }
 
-    /// Receive ring figures.
+    /// Receive ring figures ([`State::rx_stats`]).
     pub fn stats(&self) -> BufferStats {
         self.s.rx_stats()
+    }
+
+    /// The figures of one receive ring ([`State::rx_ring_stats`]).
+    pub fn ring_stats(&self, queue: usize) -> Option<BufferStats> {
+        self.s.rx_ring_stats(queue)
     }
 
     /// The shared state (statistics, the controller).

@@ -2,8 +2,8 @@
 
 use proptest::prelude::*;
 use twocan_core::timing::{
-    cia_sample_point, solve, solve_cia, Bounds, Consistency, Controller, Limits, Solutions, Timing,
-    TimingError, DEFAULT_TOLERANCE_PPM,
+    cia_sample_point, flexcan_rules, solve, solve_cia, Bounds, Consistency, Controller, Limits,
+    Solutions, Timing, TimingError, TimingRule, DEFAULT_TOLERANCE_PPM,
 };
 
 const MHZ: u32 = 1_000_000;
@@ -508,9 +508,10 @@ fn any_limits() -> impl Strategy<Value = Limits> {
             b(),
             b(),
             any::<bool>(),
-            proptest::option::of(any::<u8>())
+            proptest::option::of(any::<u8>()),
+            b()
         )
-            .prop_map(|(p, prop, ps1, ps2, sjw, le, triple)| Limits {
+            .prop_map(|(p, prop, ps1, ps2, sjw, le, triple, quanta)| Limits {
                 controller: Controller::FlexCan,
                 prescaler: Bounds::new(p.min, p.max % 2000),
                 prop_seg: prop,
@@ -519,6 +520,7 @@ fn any_limits() -> impl Strategy<Value = Limits> {
                 sjw,
                 triple_sampling_min_phase_seg1: triple,
                 sjw_le_phase_seg1: le,
+                quanta,
             }),
     ]
 }
@@ -603,6 +605,69 @@ proptest! {
             prop_assert_eq!(v, ctrl1 & twocan_core::timing::FLEXCAN_CTRL1_TIMING_MASK);
         } else {
             prop_assert!(!f.consistency().is_ok());
+        }
+    }
+}
+
+/// A driver's rule: one of the three built-in limits from a clock, FlexCAN's with a
+/// peripheral clock (below the CAN clock now and then: nothing accepted then).
+fn any_rule() -> impl Strategy<Value = TimingRule> {
+    (
+        1_000_000u32..100_000_000,
+        0u8..3,
+        proptest::option::of(8_000_000u32..120_000_000),
+    )
+        .prop_map(|(clock, which, bus)| match (which, bus) {
+            (0, _) => TimingRule::new(clock, Limits::BXCAN),
+            (1, _) | (_, None) => TimingRule::new(clock, Limits::FLEXCAN_KINETIS),
+            (_, Some(bus)) => flexcan_rules::rule(clock, bus, 16, true),
+        })
+}
+
+proptest! {
+    /// Issue 22, items 5–7: what a rule reports is what it accepts. Its fastest and
+    /// slowest timings pass `check_timing` and `accept`; their rates bound the wished
+    /// rates `check_bitrate` takes, one beyond is refused; every timing `timing_for`
+    /// gives passes `check_timing` and lies in the reported range and limits.
+    #[test]
+    fn a_rule_accepts_what_it_reports(rule in any_rule(), rate in 1u32..20_000_000) {
+        match (rule.fastest(), rule.slowest()) {
+            (Some(fast), Some(slow)) => {
+                for t in [fast, slow] {
+                    prop_assert_eq!(rule.check_timing(&t), Ok(()));
+                    prop_assert_eq!(rule.accept(&t, DEFAULT_TOLERANCE_PPM), Ok(()));
+                }
+                let (min, max) = (rule.min_bitrate(), rule.max_bitrate());
+                prop_assert_eq!((slow.actual_bitrate(), fast.actual_bitrate()), (min, max));
+                prop_assert!(min <= max);
+                prop_assert_eq!(rule.check_bitrate(max), Ok(()));
+                prop_assert_eq!(rule.check_bitrate(max + 1), Err(TimingError::BitrateTooHigh));
+                if min > 1 {
+                    prop_assert_eq!(rule.check_bitrate(min), Ok(()));
+                    prop_assert_eq!(rule.check_bitrate(min - 1), Err(TimingError::BitrateTooLow));
+                }
+                match rule.timing_for(rate, cia_sample_point(rate), DEFAULT_TOLERANCE_PPM) {
+                    Ok(t) => {
+                        prop_assert_eq!(rule.check_timing(&t), Ok(()));
+                        prop_assert!(rule.limits.min_quanta() <= t.quanta());
+                        prop_assert!(t.quanta() <= rule.limits.max_quanta());
+                        prop_assert!(min <= t.actual_bitrate() && t.actual_bitrate() <= max);
+                        prop_assert!(t.within_tolerance(DEFAULT_TOLERANCE_PPM));
+                    }
+                    Err(e) => {
+                        let in_range = rule.check_bitrate(rate).is_ok();
+                        prop_assert_eq!(
+                            e == TimingError::TooFarFromWishedBitrate,
+                            in_range,
+                            "{:?} for {} in {}..={}", e, rate, min, max
+                        );
+                    }
+                }
+            }
+            (None, None) => {
+                prop_assert_eq!(rule.check_bitrate(rate), Err(TimingError::ForbiddenByManual));
+            }
+            other => prop_assert!(false, "one extreme without the other: {:?}", other),
         }
     }
 }

@@ -6,6 +6,15 @@
 //! hardware, in the order of the Kinetis reference manuals' "FlexCAN initialization
 //! sequence":
 //!
+//! The bit timing is judged by the driver's one rule ([`Settings::timing_rule`],
+//! [`TimingRule::accept`]), the rule the running controller applies to `set_timing` and
+//! `set_bitrate` and reports in its capabilities: a wished rate outside its range is
+//! [`BeginError::Timing`] (`check`: [`ConfigErrors::BIT_RATE_OUT_OF_RANGE`]), a timing
+//! it refuses [`ConfigErrors::BIT_TIMING_INCONSISTENT`] or
+//! [`ConfigErrors::BIT_TIMING_FORBIDDEN`], a timing too far from the wished rate
+//! [`ConfigErrors::BIT_RATE_TOO_FAR`].
+//!
+//!
 //! 1. SIM clock gates of the ports and the module, pin mux of Tx and Rx (ALT2, open
 //!    drain, pull-up; ACAN §7, §16.7.5–6);
 //! 2. module disabled (`MDIS`, wait `LPMACK`), engine clock = oscillator
@@ -23,6 +32,7 @@
 //! Every wait is bounded by [`Settings::handshake_bound`]; a missing acknowledge is
 //! [`BeginError::Hardware`]`(`[`Error::Timeout`]`)`.
 
+use twocan_core::timing::{TimingError, TimingRule};
 use twocan_core::{BusMode, BusOffRecovery, Error, Filter, Registers};
 
 use crate::begin_error::{BeginError, ConfigErrors};
@@ -52,40 +62,10 @@ fn plan(
     primary: &[Filter],
     secondary: &[Filter],
 ) -> Result<Plan, ConfigErrors> {
-    let mut errors = ConfigErrors::NONE;
-
-    // The range every backend applies (`begin` refuses it first, with
-    // `BeginError::Timing`; `check` reports it as a flag).
-    if twocan_core::timing::Limits::FLEXCAN
-        .check_bitrate(CAN_CLOCK_HZ, settings.wished_bit_rate())
-        .is_err()
-    {
-        errors |= ConfigErrors::BIT_RATE_OUT_OF_RANGE;
-    }
-    if !settings.bit_rate_close_to_wished() {
-        errors |= ConfigErrors::BIT_RATE_TOO_FAR;
-    }
-    // The table-6 rules, the register widths, and the clock the counts were made for.
+    let mut errors = timing_errors(&settings.timing_rule(), settings);
     let timing_bits = settings.timing.flexcan_ctrl1();
-    if !settings.consistency().is_ok()
-        || timing_bits.is_err()
-        || settings.timing.clock_hz != CAN_CLOCK_HZ
-    {
+    if timing_bits.is_err() {
         errors |= ConfigErrors::BIT_TIMING_INCONSISTENT;
-    }
-
-    // The Kinetis manual's rules beyond the field ranges ("Arbitration and matching
-    // timing"): 8 quanta per bit, 16 bus clocks per CAN bit (16 MBs, Rx FIFO on), a
-    // bus clock not below the oscillator (CAN) clock.
-    let bus = settings.bus_clock_hz.unwrap_or(CAN_CLOCK_HZ);
-    let rules = twocan_core::timing::flexcan_rules::check(
-        &settings.timing,
-        bus,
-        crate::configuration::MESSAGE_BUFFERS,
-        true,
-    );
-    if rules.is_err() {
-        errors |= ConfigErrors::BIT_TIMING_FORBIDDEN;
     }
 
     let table = FilterTable::compile(settings.configuration, primary, secondary);
@@ -161,6 +141,46 @@ fn plan(
     }
 }
 
+/// The table-5 flags of the bit timing, by the driver's rule ([`TimingRule::accept`]'s
+/// three questions, each asked on its own so that every flag that applies is set): the
+/// wished rate out of the rule's range ([`ConfigErrors::BIT_RATE_OUT_OF_RANGE`]; no
+/// timing at all accepted, a bus clock below the CAN clock:
+/// [`ConfigErrors::BIT_TIMING_FORBIDDEN`]); the timing refused
+/// ([`ConfigErrors::BIT_TIMING_INCONSISTENT`] for another clock, layout or inconsistent
+/// counts, ACAN §15.2.2; [`ConfigErrors::BIT_TIMING_FORBIDDEN`] for the Kinetis
+/// manual's rules); the timing too far from the wished rate
+/// ([`ConfigErrors::BIT_RATE_TOO_FAR`], ACAN §15.2.1).
+fn timing_errors(rule: &TimingRule, settings: &Settings) -> ConfigErrors {
+    let mut errors = ConfigErrors::NONE;
+    match rule.check_bitrate(settings.wished_bit_rate()) {
+        Ok(()) => {}
+        Err(TimingError::ForbiddenByManual) => errors |= ConfigErrors::BIT_TIMING_FORBIDDEN,
+        Err(_) => errors |= ConfigErrors::BIT_RATE_OUT_OF_RANGE,
+    }
+    if !settings.bit_rate_close_to_wished() {
+        errors |= ConfigErrors::BIT_RATE_TOO_FAR;
+    }
+    match rule.check_timing(&settings.timing) {
+        Ok(()) => {}
+        Err(TimingError::ForbiddenByManual) => errors |= ConfigErrors::BIT_TIMING_FORBIDDEN,
+        Err(_) => errors |= ConfigErrors::BIT_TIMING_INCONSISTENT,
+    }
+    errors
+}
+
+/// The error `begin` gives before any other check: the wished rate outside the range of
+/// the driver's rule ([`TimingRule::check_bitrate`]; a rule that accepts nothing is left
+/// to the flags, [`ConfigErrors::BIT_TIMING_FORBIDDEN`]).
+fn bitrate_error(settings: &Settings) -> Option<TimingError> {
+    match settings
+        .timing_rule()
+        .check_bitrate(settings.wished_bit_rate())
+    {
+        Ok(()) | Err(TimingError::ForbiddenByManual) => None,
+        Err(e) => Some(e),
+    }
+}
+
 /// Writes the plan (steps 2–5 of the module docs).
 fn configure<R: Registers>(regs: &mut R, plan: &Plan, polls: u32) -> Result<(), Error> {
     handshake::disable(regs, polls)?;
@@ -198,7 +218,8 @@ fn configure<R: Registers>(regs: &mut R, plan: &Plan, polls: u32) -> Result<(), 
 /// Every error `begin` would report for these arguments (ACAN table 5), found
 /// without touching any register. [`ConfigErrors::NONE`] when `begin` would proceed.
 ///
-/// A wished bit rate outside the controller's range, which `begin` refuses with
+/// A wished bit rate outside the range of the driver's rule ([`Settings::timing_rule`]:
+/// 2,500 bit/s to 1 Mbit/s with the default bus clock), which `begin` refuses with
 /// [`BeginError::Timing`] before any other check, is reported here as
 /// [`ConfigErrors::BIT_RATE_OUT_OF_RANGE`], with every other flag that applies.
 ///
@@ -209,6 +230,10 @@ fn configure<R: Registers>(regs: &mut R, plan: &Plan, polls: u32) -> Result<(), 
 /// assert_eq!(check(t36, &Settings::new(125_000), &[], &[]), ConfigErrors::NONE);
 /// let slow = check(t36, &Settings::new(2_499), &[], &[]);
 /// assert!(slow.contains(ConfigErrors::BIT_RATE_OUT_OF_RANGE));
+/// // One bit per second above the fastest rate, though 1 ppm from a timing: refused,
+/// // as `set_bitrate` refuses it.
+/// let fast = check(t36, &Settings::new(1_000_001), &[], &[]);
+/// assert_eq!(fast, ConfigErrors::BIT_RATE_OUT_OF_RANGE);
 /// ```
 pub fn check(
     target: Target,
@@ -243,9 +268,9 @@ impl<R: Registers> FlexCan<R> {
         primary: &[Filter],
         secondary: &[Filter],
     ) -> Result<Self, BeginError> {
-        twocan_core::timing::Limits::FLEXCAN
-            .check_bitrate(crate::settings::CAN_CLOCK_HZ, settings.wished_bit_rate())
-            .map_err(BeginError::Timing)?;
+        if let Some(e) = bitrate_error(settings) {
+            return Err(BeginError::Timing(e));
+        }
         let plan = plan(target, settings, primary, secondary).map_err(BeginError::Config)?;
         plan.system.apply(sys);
         let polls = settings.handshake_bound();

@@ -54,12 +54,14 @@ bitflags::bitflags! {
         /// oscillator clock ([`twocan_core::timing::flexcan_rules`],
         /// [`crate::Settings::bus_clock_hz`]). ACAN checks only the field ranges.
         const BIT_TIMING_FORBIDDEN = 1 << 9;
-        /// Bit 10 (not in ACAN): the wished bit rate is outside what the 16 MHz CAN
-        /// clock reaches within the CTRL1 field ranges (Kinetis RM, CTRL1 field
-        /// descriptions: PRESDIV up to 256, at most 25 quanta per bit; ACAN §16.1:
-        /// 2,500 bit/s to 3.2 Mbit/s; [`twocan_core::timing::Limits::check_bitrate`]).
-        /// [`crate::check`] reports it; `begin` refuses such a rate before any other
-        /// check, with [`BeginError::Timing`].
+        /// Bit 10 (not in ACAN): the wished bit rate is outside the range of the driver's
+        /// bit-timing rule ([`crate::Settings::timing_rule`],
+        /// [`twocan_core::timing::TimingRule::check_bitrate`]): from 2,500 bit/s (PRESDIV
+        /// 256, 25 quanta, ACAN §16.1) to the fastest timing the Kinetis manual allows
+        /// with the bus clock (1 Mbit/s from 16 MHz, 2 Mbit/s from 32 MHz and above) —
+        /// the range the capabilities report and `set_bitrate` applies. [`crate::check`]
+        /// reports it; `begin` refuses such a rate before any other check, with
+        /// [`BeginError::Timing`].
         const BIT_RATE_OUT_OF_RANGE = 1 << 10;
     }
 }
@@ -116,10 +118,11 @@ impl defmt::Format for ConfigErrors {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum BeginError {
-    /// The wished bit rate is outside what the 16 MHz CAN clock reaches (the rule every
-    /// backend applies first: [`twocan_core::timing::Limits::check_bitrate`]); no
-    /// register was written. ACAN's tolerance check ([`ConfigErrors::BIT_RATE_TOO_FAR`])
-    /// applies in addition.
+    /// The wished bit rate is outside the range of the driver's bit-timing rule (the
+    /// question every entry point of every backend asks first:
+    /// [`twocan_core::timing::TimingRule::check_bitrate`] of
+    /// [`crate::Settings::timing_rule`]); no register was written. ACAN's tolerance
+    /// check ([`ConfigErrors::BIT_RATE_TOO_FAR`]) applies in addition.
     Timing(twocan_core::timing::TimingError),
     /// The settings, filters or pins are invalid (ACAN table 5); no register was
     /// written.

@@ -6,19 +6,43 @@
 //! what you need, then hand the settings to `begin`, which checks them all before it
 //! touches the hardware.
 //!
+//! **One bit-timing rule.** [`timing_rule`] is what this driver accepts: the CTRL1 field
+//! ranges with at least 8 quanta per bit and 16 bus clocks per CAN bit
+//! ([`twocan_core::timing::flexcan_rules::rule`], Kinetis RM "Arbitration and matching
+//! timing"). [`Settings::new`] solves within its limits, `begin` and [`crate::check`]
+//! judge the settings by it ([`Settings::timing_rule`], with the settings' bus clock),
+//! and the running controller reports it in its capabilities and applies it to
+//! `set_timing` and `set_bitrate`: a rate or a timing one entry point takes, they all
+//! take.
+//!
 //! Two table-7 properties are not fields: the receive and transmit buffer sizes
 //! (`mReceiveBufferSize` 32, `mTransmitBufferSize` 16) are the `RX` and `TX` const
 //! generics of [`twocan_core::Driver`] ([`RECEIVE_BUFFER_SIZE`] and
 //! [`TRANSMIT_BUFFER_SIZE`] are ACAN's defaults, [`crate::AcanDriver`] uses them).
 
-use twocan_core::timing::{solve, Consistency, Limits, Timing, DEFAULT_TOLERANCE_PPM};
+use twocan_core::timing::{
+    flexcan_rules, solve, Consistency, Timing, TimingRule, DEFAULT_TOLERANCE_PPM,
+};
 use twocan_core::BusOffRecovery;
 
-use crate::configuration::Configuration;
+use crate::configuration::{Configuration, MESSAGE_BUFFERS};
 
 /// The FlexCAN engine clock ACAN uses: the 16 MHz crystal oscillator of every
 /// Teensy 3.x, selected by `CTRL1.CLKSRC = 0` (ACAN §16.1 bit-rate formula).
 pub const CAN_CLOCK_HZ: u32 = 16_000_000;
+
+/// The bit timing rule of every FlexCAN entry point (module docs): the 16 MHz CAN clock,
+/// [`twocan_core::timing::Limits::FLEXCAN_KINETIS`], and at least 16 bus clocks per CAN bit with the 16
+/// message buffers and the Rx FIFO this driver configures, from the bus clock
+/// `bus_clock_hz` (`None`: the least the manual allows, the 16 MHz oscillator clock; see
+/// [`Settings::bus_clock_hz`]).
+pub const fn timing_rule(bus_clock_hz: Option<u32>) -> TimingRule {
+    let bus = match bus_clock_hz {
+        Some(hz) => hz,
+        None => CAN_CLOCK_HZ,
+    };
+    flexcan_rules::rule(CAN_CLOCK_HZ, bus, MESSAGE_BUFFERS, true)
+}
 
 /// The bit rate of the default settings (ACAN table 7: `mWhishedBitRate` 250,000).
 pub const DEFAULT_BIT_RATE: u32 = 250_000;
@@ -95,9 +119,11 @@ pub struct Settings {
     /// Use the alternate Rx pin (ACAN §7, table 3). Default `false`.
     pub use_alternate_rx_pin: bool,
     /// Priority of the message interrupt, 0 highest, 255 lowest (ACAN §16.7.4,
-    /// default 64). The driver only stores it: the firmware writes it to the NVIC
-    /// for [`crate::Irqs::message`] (Kinetis implements the 4 upper bits, so 64 is
-    /// level 4).
+    /// default 64). With the `rt` feature, `IrqState::start` writes it to the NVIC for
+    /// every line of the instance — message, bus-off, error and the two warnings of
+    /// [`crate::Irqs`] — before it unmasks them; without it the firmware sets the
+    /// priorities itself ([`crate::FlexCan::message_irq_priority`] gives the value). The
+    /// Kinetis NVIC implements the 4 upper bits of the byte, so 64 is level 4.
     pub message_irq_priority: u8,
     /// The Tx pin is open-drain: recessive leaves it Hi-Z (`PORTx_PCRn.ODE`, ACAN
     /// §16.7.5). Default `false`.
@@ -146,9 +172,13 @@ impl Settings {
     /// Settings for `bit_rate` with the default tolerance of 1,000 ppm (ACAN §16.1,
     /// `ACANSettings (bitRate)`). Usable in `const` items.
     ///
-    /// The computation never fails: a wished rate the 16 MHz clock cannot reach (1
-    /// bit/s, 0, above 3.2 Mbit/s) gives the closest consistent timing, and
-    /// [`Settings::bit_rate_close_to_wished`] is then `false` — `begin` reports it.
+    /// The timing is solved within the limits the driver accepts
+    /// ([`twocan_core::timing::Limits::FLEXCAN_KINETIS`]: at least 8 quanta per bit, where ACAN's field
+    /// ranges allow 5). The computation never fails: a wished rate the 16 MHz clock
+    /// cannot reach within them (1 bit/s, 0, above 2 Mbit/s) gives the closest
+    /// consistent timing, and [`Settings::bit_rate_close_to_wished`] is then `false` —
+    /// `begin` reports it (and refuses a rate outside [`Settings::timing_rule`]'s range
+    /// first).
     pub const fn new(bit_rate: u32) -> Self {
         Self::with_tolerance(bit_rate, DEFAULT_TOLERANCE_PPM)
     }
@@ -207,6 +237,12 @@ impl Settings {
         }
     }
 
+    /// The bit timing rule `begin` applies to these settings: [`timing_rule`] with
+    /// [`Settings::bus_clock_hz`].
+    pub const fn timing_rule(&self) -> TimingRule {
+        timing_rule(self.bus_clock_hz)
+    }
+
     /// Whether the actual bit rate is exactly the wished one (ACAN §16.4).
     pub const fn exact_bit_rate(&self) -> bool {
         self.timing.is_exact()
@@ -232,12 +268,12 @@ impl Settings {
     }
 }
 
-/// The timing ACAN §16.1 describes for `bit_rate`: the closest rate from the 16 MHz
-/// clock, always consistent. Rates the solver refuses (0, above 3.2 Mbit/s) get the
-/// slowest or fastest timing, still carrying the wished rate so that the distance
-/// shows.
+/// The timing ACAN §16.1 describes for `bit_rate`, within the limits the driver accepts
+/// ([`timing_rule`]'s): the closest rate from the 16 MHz clock, always consistent. Rates
+/// the solver refuses (0, above 2 Mbit/s) get the slowest or fastest timing, still
+/// carrying the wished rate so that the distance shows.
 const fn timing_for(bit_rate: u32) -> Timing {
-    let limits = Limits::FLEXCAN;
+    let limits = timing_rule(None).limits;
     let solvable = if bit_rate == 0 {
         1
     } else if bit_rate as u64 * limits.min_quanta() as u64 > CAN_CLOCK_HZ as u64 {
@@ -321,12 +357,31 @@ mod tests {
 
     #[test]
     fn out_of_range_rates_do_not_panic() {
-        for rate in [0, 1, 3_300_000, 10_000_000, u32::MAX] {
+        for rate in [0, 1, 2_100_000, 3_200_000, 10_000_000, u32::MAX] {
             let s = Settings::new(rate);
             assert!(s.consistency().is_ok(), "{rate}");
             assert!(!s.bit_rate_close_to_wished(), "{rate}");
         }
-        assert!(Settings::new(3_200_000).exact_bit_rate());
+        // The fastest exact rate within 8 quanta per bit, and the slowest.
+        assert!(Settings::new(2_000_000).exact_bit_rate());
         assert!(Settings::new(2_500).exact_bit_rate());
+    }
+
+    #[test]
+    fn settings_solve_within_the_rule_the_driver_applies() {
+        use twocan_core::timing::Limits;
+        // Every timing `new` computes has at least 8 quanta (ACAN's ranges would take 5
+        // for 3.2 Mbit/s and for 15,166 bit/s, 1,055 = 211 × 5 clocks).
+        for rate in [
+            15_166, 125_000, 440_000, 842_000, 1_000_000, 1_600_000, 2_000_000,
+        ] {
+            let s = Settings::new(rate);
+            assert!(s.timing.quanta() >= 8, "{rate}: {:?}", s.timing);
+            assert_eq!(s.timing.limits, Limits::FLEXCAN_KINETIS);
+        }
+        // With a 60 MHz bus clock every one of them is accepted.
+        let mut s = Settings::new(15_166);
+        s.bus_clock_hz = Some(60_000_000);
+        assert_eq!(s.timing_rule().accept(&s.timing, s.tolerance_ppm), Ok(()));
     }
 }

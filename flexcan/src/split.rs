@@ -866,11 +866,11 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
         Ok(())
     }
 
-    /// The 16 MHz oscillator, [`Limits::FLEXCAN`], the fastest bit rate the Kinetis
-    /// manual allows with the bus clock `begin` was given (FlexCAN chapter,
-    /// "Arbitration and matching timing": 8 quanta, 16 bus clocks per CAN bit,
-    /// [`twocan_core::timing::flexcan_rules::max_bitrate`]; 1 Mbit/s from a 16 MHz bus
-    /// clock, 2 Mbit/s from 32 MHz and above); one ID table element per exact
+    /// The driver's one bit-timing rule ([`crate::settings::timing_rule`] with the bus
+    /// clock `begin` was given): the 16 MHz oscillator, [`Limits::FLEXCAN_KINETIS`]
+    /// (8..=25 quanta per bit) and 16 bus clocks per CAN bit (Kinetis RM, FlexCAN
+    /// chapter, "Arbitration and matching timing"; 1 Mbit/s from a 16 MHz bus clock,
+    /// 2 Mbit/s from 32 MHz and above); one ID table element per exact
     /// filter of either format (format A), as many as the configuration's primary and
     /// secondary elements (ACAN §11, table 4); MB15 and the remote-frame mailboxes;
     /// the 6-frame Rx FIFO; the 16-bit free-running timer (Kinetis RM, TIMER).
@@ -882,7 +882,7 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
         let filters = (c.primary_filter_capacity() + c.secondary_filter_capacity()) as u16;
         Capabilities::new(
             crate::settings::CAN_CLOCK_HZ,
-            Limits::FLEXCAN,
+            Limits::FLEXCAN_KINETIS,
             ModeSupport {
                 loop_back: true,
                 listen_only: true,
@@ -898,12 +898,7 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
             RX_FIFO_DEPTH as u8,
             Some(16),
         )
-        .with_max_bitrate(twocan_core::timing::flexcan_rules::max_bitrate(
-            crate::settings::CAN_CLOCK_HZ,
-            self.bus_clock_hz,
-            crate::configuration::MESSAGE_BUFFERS,
-            true,
-        ))
+        .with_timing_rule(crate::settings::timing_rule(Some(self.bus_clock_hz)))
     }
 
     fn bus_mode(&self) -> BusMode {
@@ -922,22 +917,15 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
     /// PSEG1, PSEG2, SMP, PROPSEG: writable in Freeze mode only, Kinetis RM CTRL1);
     /// the acknowledge bound grows for a slower rate.
     ///
-    /// Besides the portable checks ([`twocan_core::hardware::check_timing_for`]), the
-    /// Kinetis manual's rule `begin` applies ("Arbitration and matching timing": 8 quanta
-    /// per bit, 16 bus clocks per CAN bit with the bus clock `begin` was given,
-    /// [`twocan_core::timing::flexcan_rules::check`]):
+    /// The timing is judged by the rule `begin` applies and the capabilities report
+    /// ([`twocan_core::hardware::check_timing_for`] with [`Hardware::capabilities`]: the
+    /// register ranges, 8 quanta per bit and 16 bus clocks per CAN bit with the bus clock
+    /// `begin` was given):
     /// [`TimingError::ForbiddenByManual`](twocan_core::timing::TimingError::ForbiddenByManual)
-    /// when it is broken, nothing written.
+    /// when the manual's rule is broken, nothing written.
     fn set_timing(&self, timing: &Timing) -> Result<(), Error> {
         let stopped = self.mode() == MODE_STOPPED;
         twocan_core::hardware::check_timing_for(&self.capabilities(), timing, stopped)?;
-        twocan_core::timing::flexcan_rules::check(
-            timing,
-            self.bus_clock_hz,
-            crate::configuration::MESSAGE_BUFFERS,
-            true,
-        )
-        .map_err(|_| Error::Timing(twocan_core::timing::TimingError::ForbiddenByManual))?;
         let bits = timing.flexcan_ctrl1().map_err(Error::Timing)?;
         self.regs
             .modify32(regs::CTRL1, |v| (v & !FLEXCAN_CTRL1_TIMING_MASK) | bits);

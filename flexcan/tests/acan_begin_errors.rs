@@ -5,6 +5,7 @@
 mod common;
 
 use common::*;
+use twocan_core::timing::{Limits, Timing, TimingError};
 use twocan_core::{Error, Filter, Format, FrameKind};
 use twocan_flexcan::model::{FlexCanModel, ModelMode};
 use twocan_flexcan::regs::{self, mcr};
@@ -61,11 +62,35 @@ fn no_error() {
     assert_eq!(flags.bits(), 0);
 }
 
+/// Runs `begin` with a wished rate outside the driver's rule: refused with
+/// `BeginError::Timing` before anything is written; `check` reports the rate as a flag
+/// among the others. Gives (the error, `check`'s flags).
+fn rate_error(target: Target, settings: &Settings) -> (TimingError, ConfigErrors) {
+    let model = model_for(target.board);
+    let mut sys = HostSystem::new();
+    let flags = twocan_flexcan::check(target, settings, &[], &[]);
+    let r = FlexCan::begin(model.clone(), &mut sys, target, settings, &[], &[]);
+    let e = match r {
+        Err(BeginError::Timing(e)) => e,
+        other => panic!("{:?}", other.err()),
+    };
+    assert!(sys.written().is_empty());
+    assert_eq!(model.mode(), ModelMode::Disabled);
+    assert!(
+        flags.contains(ConfigErrors::BIT_RATE_OUT_OF_RANGE),
+        "{flags:?}"
+    );
+    (e, flags)
+}
+
 /// Issue 14: the Kinetis reference manual ("Arbitration and matching timing") asks for
 /// at least 8 time quanta per bit and, with 16 message buffers and the Rx FIFO, at
 /// least 16 peripheral (bus) clocks per CAN bit, with a bus clock not below the 16 MHz
 /// oscillator clock. `begin` refuses what it forbids, writing nothing; the edges of
-/// each rule are accepted.
+/// each rule are accepted. Issue 22: the wished rate is judged by the same rule, so a
+/// rate above the fastest the rule allows is `BeginError::Timing(BitrateTooHigh)`, as
+/// `set_bitrate` refuses it; a hand-made timing the rule forbids at a rate in range is
+/// `BIT_TIMING_FORBIDDEN`, as `set_timing` refuses it.
 #[test]
 fn bit_timing_the_manual_forbids_is_refused() {
     let accepted = |s: &Settings| {
@@ -83,47 +108,67 @@ fn bit_timing_the_manual_forbids_is_refused() {
         s.bus_clock_hz = bus;
         s
     };
+    // A timing the solver with ACAN's field ranges (5..=25 quanta) would give.
+    let hand_made = |rate: u32, prescaler: u16, tseg1: u8, tseg2: u8, bus: Option<u32>| {
+        let mut s = with_bus(rate, bus);
+        s.timing = Timing::from_tsegs(16_000_000, rate, &Limits::FLEXCAN, prescaler, tseg1, tseg2);
+        s
+    };
     // 1 Mbit/s from the least bus clock the manual allows (16 MHz, the default
     // assumption): 16 clocks and 16 quanta per bit, the edge of the clock rule.
     let one = with_bus(1_000_000, None);
     assert_eq!(one.timing.quanta(), 16);
     accepted(&one);
-    // 2 Mbit/s: 8 quanta (the edge of the quanta rule), 8 clocks per bit from a
-    // 16 MHz bus: refused; from a 32 MHz bus, 16 clocks: accepted; 31 MHz: refused.
-    let two = with_bus(2_000_000, None);
-    assert_eq!(two.timing.quanta(), 8);
-    assert_eq!(
-        begin_error(T32_CAN0, &two, &[], &[]),
-        ConfigErrors::BIT_TIMING_FORBIDDEN
-    );
+    // 2 Mbit/s: 8 quanta (the edge of the quanta rule); from a 32 MHz bus, 16 clocks:
+    // accepted. From a 16 MHz bus (8 clocks per bit) and a 31 MHz one (15.5), above the
+    // fastest rate the rule allows (1 Mbit/s; 16 MHz / 9 = 1,777,777 bit/s): the rate is
+    // refused, and `check` flags the timing too.
     accepted(&with_bus(2_000_000, Some(32_000_000)));
     accepted(&with_bus(2_000_000, Some(60_000_000)));
-    assert_eq!(
-        begin_error(T32_CAN0, &with_bus(2_000_000, Some(31_000_000)), &[], &[]),
-        ConfigErrors::BIT_TIMING_FORBIDDEN
-    );
-    // 7 quanta (16 MHz / 7 ≈ 2.29 Mbit/s) and ACAN's 5-quanta 3.2 Mbit/s: refused
-    // whatever the bus clock.
-    let seven = with_bus(2_285_714, Some(60_000_000));
+    for bus in [None, Some(31_000_000)] {
+        let two = with_bus(2_000_000, bus);
+        assert_eq!(two.timing.quanta(), 8);
+        assert_eq!(
+            rate_error(T32_CAN0, &two),
+            (
+                TimingError::BitrateTooHigh,
+                ConfigErrors::BIT_RATE_OUT_OF_RANGE | ConfigErrors::BIT_TIMING_FORBIDDEN
+            ),
+            "{bus:?}"
+        );
+    }
+    // 7 quanta (prescaler 2, 1,142,857 bit/s) and 5 quanta (prescaler 4, 800 kbit/s):
+    // rates in range with a 60 MHz bus, timings the quanta rule forbids.
+    let seven = hand_made(1_142_857, 2, 4, 2, Some(60_000_000));
     assert_eq!(seven.timing.quanta(), 7);
     assert_eq!(
         begin_error(T32_CAN0, &seven, &[], &[]),
         ConfigErrors::BIT_TIMING_FORBIDDEN
     );
-    let acan_fastest = with_bus(3_200_000, Some(60_000_000));
-    assert_eq!(acan_fastest.timing.quanta(), 5);
+    let five = hand_made(800_000, 4, 2, 2, Some(60_000_000));
+    assert_eq!(five.timing.quanta(), 5);
     assert_eq!(
-        begin_error(T32_CAN0, &acan_fastest, &[], &[]),
+        begin_error(T32_CAN0, &five, &[], &[]),
         ConfigErrors::BIT_TIMING_FORBIDDEN
     );
-    // A bus clock below the oscillator clock is refused even at a slow rate.
+    // ACAN's 3.2 Mbit/s (5 quanta, prescaler 1): above the range whatever the bus clock.
+    let acan_fastest = hand_made(3_200_000, 1, 2, 2, Some(60_000_000));
+    assert_eq!(
+        rate_error(T32_CAN0, &acan_fastest),
+        (
+            TimingError::BitrateTooHigh,
+            ConfigErrors::BIT_RATE_OUT_OF_RANGE | ConfigErrors::BIT_TIMING_FORBIDDEN
+        )
+    );
+    // A bus clock below the oscillator clock is refused even at a slow rate: no timing
+    // at all is allowed (a flag, not a rate error).
     assert_eq!(
         begin_error(T32_CAN0, &with_bus(125_000, Some(15_999_999)), &[], &[]),
         ConfigErrors::BIT_TIMING_FORBIDDEN
     );
     accepted(&with_bus(125_000, Some(16_000_000)));
     // Reported together with ACAN's own flags.
-    let mut both = with_bus(3_200_000, None);
+    let mut both = hand_made(800_000, 4, 2, 2, None);
     both.use_alternate_rx_pin = true;
     assert_eq!(
         begin_error(T36_CAN1, &both, &[], &[]),
@@ -144,16 +189,17 @@ fn bit_rate_too_far_15_2_1() {
     assert_eq!(f.bits() & 0xFF, 1 << 0);
 }
 
-/// A wished rate outside what the 16 MHz clock reaches is refused by `begin` with the
-/// portable error every backend gives (before ACAN's tolerance check, which alone lets
-/// 3,200,001 bit/s through at 0.3 ppm), and nothing is written.
+/// A wished rate outside the driver's rule (2,500 bit/s to 1 Mbit/s from the default
+/// 16 MHz bus clock) is refused by `begin` with the portable error every backend gives
+/// (before ACAN's tolerance check, which alone lets 1,000,001 bit/s through at 1 ppm),
+/// and nothing is written.
 #[test]
 fn bit_rates_out_of_range_are_refused_as_on_every_backend() {
-    use twocan_core::timing::TimingError;
     for (rate, want) in [
         (1, TimingError::BitrateTooLow),
         (2_499, TimingError::BitrateTooLow),
-        (3_200_001, TimingError::BitrateTooHigh),
+        (1_000_001, TimingError::BitrateTooHigh),
+        (3_200_000, TimingError::BitrateTooHigh),
         (0, TimingError::BitrateZero),
     ] {
         let model = model_for(T32_CAN0.board);
@@ -179,24 +225,11 @@ fn bit_rates_out_of_range_are_refused_as_on_every_backend() {
             "{rate}: {flags:?}"
         );
     }
-    // In range: no such flag (the slowest and the fastest of the register ranges).
-    for rate in [2_500, 3_200_000, 125_000] {
+    // In range: no flag at all (the slowest and the fastest of the rule, and between).
+    for rate in [2_500, 1_000_000, 125_000] {
         let flags = twocan_flexcan::check(T32_CAN0, &Settings::new(rate), &[], &[]);
-        assert!(
-            !flags.contains(ConfigErrors::BIT_RATE_OUT_OF_RANGE),
-            "{rate}: {flags:?}"
-        );
+        assert_eq!(flags, ConfigErrors::NONE, "{rate}");
     }
-    assert_eq!(
-        twocan_flexcan::check(T32_CAN0, &Settings::new(125_000), &[], &[]),
-        ConfigErrors::NONE
-    );
-    // In range for the clock: 3.2 Mbit/s (5 quanta) goes on to the manual's rules
-    // (`bit_timing_the_manual_forbids_is_refused`).
-    assert_eq!(
-        begin_error(T32_CAN0, &Settings::new(3_200_000), &[], &[]),
-        ConfigErrors::BIT_TIMING_FORBIDDEN
-    );
     // The slowest, 2,500 bit/s, and the fastest the manual allows from the least bus
     // clock, 1 Mbit/s.
     for rate in [2_500, 1_000_000] {

@@ -6,7 +6,7 @@
 mod common;
 
 use common::*;
-use twocan_core::timing::{Consistency, Timing};
+use twocan_core::timing::{solve, Consistency, Limits, Timing, TimingError};
 use twocan_flexcan::regs::{self, ctrl1, mcr};
 use twocan_flexcan::settings::{DEFAULT_IRQ_PRIORITY, SAMPLE_POINT_PERMILLE};
 use twocan_flexcan::{
@@ -64,9 +64,23 @@ fn bit_rate_500_kbit_exact_16_1() {
 
 #[test]
 fn fastest_and_slowest_exact_rates_16_1() {
-    let fast = Settings::with_tolerance(3_200_000, 0);
+    // ACAN's fastest exact rate, 3.2 Mbit/s, is 5 quanta per bit: the solver reproduces
+    // it with ACAN's field ranges (`Limits::FLEXCAN`). `Settings` solve within what the
+    // driver accepts (at least 8 quanta, Kinetis RM "Arbitration and matching timing";
+    // issue 22: one rule), where the fastest exact rate is 2 Mbit/s.
+    let acan = solve(
+        CAN_CLOCK_HZ,
+        3_200_000,
+        &Limits::FLEXCAN,
+        SAMPLE_POINT_PERMILLE,
+    )
+    .unwrap();
+    assert!(acan.is_exact());
+    assert_eq!((acan.prescaler, acan.quanta()), (1, 5));
+    let fast = Settings::with_tolerance(2_000_000, 0);
     assert!(fast.bit_rate_close_to_wished() && fast.exact_bit_rate());
-    assert_eq!((fast.timing.prescaler, fast.timing.quanta()), (1, 5));
+    assert_eq!((fast.timing.prescaler, fast.timing.quanta()), (1, 8));
+    assert!(!Settings::with_tolerance(3_200_000, 0).bit_rate_close_to_wished());
     let slow = Settings::with_tolerance(2_500, 0);
     assert!(slow.bit_rate_close_to_wished() && slow.exact_bit_rate());
     assert_eq!((slow.timing.prescaler, slow.timing.quanta()), (256, 25));
@@ -79,12 +93,30 @@ fn fastest_rate_is_refused_even_in_loop_back_16_1() {
     // ACAN: "It works when the FlexCAN module is configured in both loop back mode and
     // self reception mode." Its 5 quanta per bit are below the Kinetis manual's 8
     // ("Arbitration and matching timing"), which makes no exception for loop-back:
-    // `begin` refuses it (docs/differences.md).
+    // `begin` refuses the rate (above the fastest the rule allows) and ACAN's timing for
+    // it (docs/differences.md).
     let r = begin::<32, 16>(&loop_back(3_200_000), &[], &[]);
     assert!(
-        matches!(r, Err(twocan_flexcan::BeginError::Config(f)) if f == twocan_flexcan::ConfigErrors::BIT_TIMING_FORBIDDEN),
+        matches!(
+            r,
+            Err(twocan_flexcan::BeginError::Timing(
+                TimingError::BitrateTooHigh
+            ))
+        ),
         "{:?}",
         r.err()
+    );
+    let mut acan = loop_back(3_200_000);
+    acan.timing = solve(
+        CAN_CLOCK_HZ,
+        3_200_000,
+        &Limits::FLEXCAN,
+        SAMPLE_POINT_PERMILLE,
+    )
+    .unwrap();
+    assert_eq!(
+        twocan_flexcan::check(t32(), &acan, &[], &[]),
+        ConfigErrors::BIT_RATE_OUT_OF_RANGE | ConfigErrors::BIT_TIMING_FORBIDDEN
     );
     // The fastest rate the manual allows from the 16 MHz CAN clock, 2 Mbit/s (8
     // quanta), runs in loop-back with a bus clock of 32 MHz or more.
@@ -147,8 +179,12 @@ fn user_changed_segments_16_1() {
     assert_eq!(ctrl1::PSEG1.get(c), 5);
     assert_eq!(ctrl1::PSEG2.get(c), 3);
     assert_eq!(ctrl1::RJW.get(c), 3);
+    // The register holds the counts; the settings' timing carries the driver's limits.
     assert_eq!(
-        Timing::from_flexcan_ctrl1(CAN_CLOCK_HZ, 500_000, c),
+        Timing {
+            limits: Limits::FLEXCAN_KINETIS,
+            ..Timing::from_flexcan_ctrl1(CAN_CLOCK_HZ, 500_000, c)
+        },
         s.timing
     );
     assert_eq!(

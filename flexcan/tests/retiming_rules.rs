@@ -83,3 +83,72 @@ fn a_faster_bus_clock_allows_two_megabits() {
         ConfigErrors::NONE
     );
 }
+
+/// Issue 22, item 5: one bit-rate rule. 1,000,001 bit/s is one above the fastest rate the
+/// capabilities report from the default bus clock (the solver would round it to
+/// 1 Mbit/s, 1 ppm away): `check`, `begin` and `set_bitrate` all refuse it as too high;
+/// 1,000,000 bit/s is accepted by all three.
+#[test]
+fn one_above_the_fastest_rate_is_refused_by_every_entry_point() {
+    use twocan_flexcan::{BeginError, FlexCan, HostSystem};
+    let (_model, mut can) =
+        begin_on::<8, 4>(teensy36(), &settings(500_000, None), &[], &[]).expect("500 kbit/s");
+    let max = can.capabilities().max_bitrate;
+    assert_eq!(max, 1_000_000);
+    can.set_mode(Mode::Stopped).unwrap();
+    for (rate, ok) in [(max, true), (max + 1, false)] {
+        let s = settings(rate, None);
+        let flags = twocan_flexcan::check(teensy36(), &s, &[], &[]);
+        let begun = FlexCan::begin(
+            Ticking::new(model_for(Board::Teensy36)),
+            &mut HostSystem::new(),
+            teensy36(),
+            &s,
+            &[],
+            &[],
+        );
+        let retimed = can.set_bitrate(rate, 750);
+        if ok {
+            assert_eq!(flags, ConfigErrors::NONE, "{rate}");
+            assert!(begun.is_ok(), "{rate}: {:?}", begun.err());
+            assert_eq!(retimed.map(|t| t.actual_bitrate()), Ok(rate));
+        } else {
+            assert_eq!(flags, ConfigErrors::BIT_RATE_OUT_OF_RANGE, "{rate}");
+            assert!(
+                matches!(begun, Err(BeginError::Timing(TimingError::BitrateTooHigh))),
+                "{rate}: {:?}",
+                begun.err()
+            );
+            assert_eq!(
+                retimed,
+                Err(Error::Timing(TimingError::BitrateTooHigh)),
+                "{rate}"
+            );
+        }
+    }
+}
+
+/// Issue 22, item 7: the timing limits the capabilities report are the ones the driver
+/// accepts. Their fewest quanta per bit is the Kinetis manual's 8, not the CTRL1 fields'
+/// 5; a consistent timing with that many quanta (at a rate the clock rule allows) is
+/// accepted by `set_timing`, one quantum fewer is refused.
+#[test]
+fn reported_timing_limits_are_what_set_timing_accepts() {
+    let s = settings(500_000, Some(60_000_000));
+    let (_model, mut can) = begin_on::<8, 4>(teensy36(), &s, &[], &[]).expect("500 kbit/s");
+    let caps = can.capabilities();
+    let l = caps.timing_limits;
+    assert_eq!((l.min_quanta(), l.max_quanta()), (8, 25));
+    can.set_mode(Mode::Stopped).unwrap();
+    // Prescaler 2: 8 quanta → 1 Mbit/s, 7 quanta → 1.14 Mbit/s (both within 60 MHz / 16).
+    let q = l.min_quanta() as u8;
+    let fewest = Timing::from_tsegs(16_000_000, 1_000_000, &l, 2, q - 3, 2);
+    assert_eq!(fewest.quanta(), 8);
+    assert_eq!(can.hardware().set_timing(&fewest), Ok(()));
+    let fewer = Timing::from_tsegs(16_000_000, 1_142_857, &l, 2, q - 4, 2);
+    assert_eq!(fewer.quanta(), 7);
+    assert_eq!(
+        can.hardware().set_timing(&fewer),
+        Err(Error::Timing(TimingError::ForbiddenByManual))
+    );
+}

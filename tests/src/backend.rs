@@ -12,7 +12,10 @@
 
 use twocan_bxcan::model::BxCanModel;
 use twocan_bxcan::{Config as BxConfig, ConfigError, FifoPolicy, PlanError};
-use twocan_core::timing::{solve, Limits, TimingError, DEFAULT_TOLERANCE_PPM};
+use twocan_core::timing::{
+    cia_sample_point, solve, Limits, PeripheralClockRule, Timing, TimingError,
+    DEFAULT_TOLERANCE_PPM,
+};
 use twocan_core::{
     BusOffRecovery, Driver, Filter, Hardware, Mode, ModeSupport, Registers, TxPolicy,
 };
@@ -201,12 +204,23 @@ pub trait Backend {
     /// The CAN clock the bit timing is made from (FlexCAN: 16 MHz oscillator; bxCAN:
     /// APB1 of the STM32F767 at 216 MHz, 54 MHz).
     const CLOCK_HZ: u32;
-    /// The bit-timing register ranges.
+    /// The bit-timing register ranges and the quanta per bit the manual allows (FlexCAN:
+    /// the CTRL1 fields with at least 8 quanta, Kinetis RM "Arbitration and matching
+    /// timing"; bxCAN: the `CAN_BTR` fields, RM0410 §40.7.7).
     const LIMITS: Limits;
+    /// The manual's minimum ratio between the peripheral clock and the bit rate, with
+    /// the peripheral clock of the node [`Backend::attach`] brings up (FlexCAN: 16 bus
+    /// clocks per bit with 16 message buffers and the Rx FIFO, from the least bus clock
+    /// the manual allows, 16 MHz; bxCAN: none).
+    const PERIPHERAL_CLOCK: Option<PeripheralClockRule>;
     /// The fastest bit rate the backend accepts: `CLOCK_HZ / LIMITS.min_quanta()`
     /// unless a rule beyond the register ranges forbids it (FlexCAN: 1 Mbit/s, 16 bus
     /// clocks per bit from the least bus clock the manual allows, 16 MHz).
     const FASTEST_BITRATE: u32;
+    /// The slowest bit rate the backend accepts, rounded down: the largest prescaler and
+    /// the most quanta (FlexCAN 16 MHz / (256 × 25) = 2,500 bit/s; bxCAN 54 MHz /
+    /// (1024 × 25) = 2,109.375 bit/s).
+    const SLOWEST_BITRATE: u32;
     /// Whether the node [`Backend::attach`] brings up reports wake-up events
     /// (FlexCAN: no, `MCR.WAKMSK`/`SLFWAK` never set, Kinetis RM MCR; bxCAN: yes,
     /// `CAN_IER.WKUIE` among the interrupts, RM0410 §40.8).
@@ -231,6 +245,11 @@ pub trait Backend {
     /// with a sample point in per mille. Gives the actual bit rate.
     fn check_timing(bitrate: u32, sample_point_permille: u16) -> Result<u32, TimingRefused>;
 
+    /// Checks a timing given as counts (with its wished rate) the way an application
+    /// would configure it, with the default tolerance (FlexCAN: `Settings::timing` given
+    /// to `begin`; bxCAN: `Config::from_timing`). Gives the actual bit rate.
+    fn check_given_timing(timing: &Timing) -> Result<u32, TimingRefused>;
+
     /// Replaces the node's filter list through the receive half (`Driver::set_filters`),
     /// compiled for the partition the node was brought up with.
     fn set_filters(node: &mut Self::Node, filters: &[Filter]) -> Result<(), Refused>;
@@ -251,6 +270,7 @@ fn timing_refused(e: TimingError) -> TimingRefused {
         TimingError::BitrateTooLow => TimingRefused::TooLow,
         TimingError::TooFarFromWishedBitrate => TimingRefused::TooFar,
         TimingError::SamplePointOutOfRange => TimingRefused::SamplePoint,
+        TimingError::ForbiddenByManual => TimingRefused::ForbiddenByManual,
         _ => TimingRefused::Other,
     }
 }
@@ -260,6 +280,9 @@ fn timing_refused(e: TimingError) -> TimingRefused {
 
 /// FlexCAN can0 of a Teensy 3.6 through ACAN's `begin`.
 pub struct FlexCanBackend;
+
+/// The limits the FlexCAN driver accepts (the fields and 8 quanta per bit).
+const LIMITS_FLEX: Limits = Limits::FLEXCAN_KINETIS;
 
 /// The Teensy 3.6 can0 target.
 pub fn teensy36_can0() -> Target {
@@ -366,8 +389,13 @@ impl Backend for FlexCanBackend {
     const RX_QUEUES: u8 = 1;
     const TIMESTAMP_BITS: Option<u8> = Some(16);
     const CLOCK_HZ: u32 = 16_000_000;
-    const LIMITS: Limits = Limits::FLEXCAN;
+    const LIMITS: Limits = Limits::FLEXCAN_KINETIS;
+    const PERIPHERAL_CLOCK: Option<PeripheralClockRule> = Some(PeripheralClockRule {
+        peripheral_hz: 16_000_000,
+        min_clocks_per_bit: 16,
+    });
     const FASTEST_BITRATE: u32 = 1_000_000;
+    const SLOWEST_BITRATE: u32 = 2_500;
     const WAKEUP_EVENTS: bool = false;
     const TIMESTAMP_COUNTER_READABLE: bool = true;
 
@@ -384,28 +412,46 @@ impl Backend for FlexCanBackend {
     }
 
     fn check_timing(bitrate: u32, sample_point_permille: u16) -> Result<u32, TimingRefused> {
-        // The rule `begin` applies first, as every backend does.
-        Limits::FLEXCAN
-            .check_bitrate(CAN_CLOCK_HZ, bitrate)
+        // An application's settings for that rate and sample point (the solver within
+        // the limits the driver accepts), given to `begin`.
+        let t = solve(CAN_CLOCK_HZ, bitrate, &LIMITS_FLEX, sample_point_permille)
             .map_err(timing_refused)?;
-        let t = solve(
-            CAN_CLOCK_HZ,
-            bitrate,
-            &Limits::FLEXCAN,
-            sample_point_permille,
-        )
-        .map_err(timing_refused)?;
-        let mut s = Settings::new(bitrate);
-        s.timing = t;
-        let flags = twocan_flexcan::check(teensy36_can0(), &s, &[], &[]);
-        if flags.contains(ConfigErrors::BIT_RATE_TOO_FAR) {
-            Err(TimingRefused::TooFar)
-        } else if flags == ConfigErrors::BIT_TIMING_FORBIDDEN {
-            Err(TimingRefused::ForbiddenByManual)
-        } else if !flags.is_empty() {
-            Err(TimingRefused::Other)
-        } else {
-            Ok(s.actual_bit_rate())
+        Self::check_given_timing(&t)
+    }
+
+    fn check_given_timing(timing: &Timing) -> Result<u32, TimingRefused> {
+        let mut s = Settings::new(timing.bitrate);
+        s.timing = *timing;
+        let model = twocan_flexcan::model::FlexCanModel::mk66fx1m0();
+        let r = twocan_flexcan::FlexCan::begin(
+            twocan_flexcan::IdleClocked::new(model),
+            &mut twocan_flexcan::HostSystem::new(),
+            teensy36_can0(),
+            &s,
+            &[Filter::pass_all()],
+            &[],
+        );
+        let flags = twocan_flexcan::check(teensy36_can0(), &s, &[Filter::pass_all()], &[]);
+        match r {
+            Ok(_) => {
+                assert_eq!(flags, ConfigErrors::NONE, "check() and begin() agree");
+                Ok(s.actual_bit_rate())
+            }
+            Err(BeginError::Timing(e)) => {
+                assert!(flags.contains(ConfigErrors::BIT_RATE_OUT_OF_RANGE));
+                Err(timing_refused(e))
+            }
+            Err(BeginError::Config(f)) => {
+                assert_eq!(f, flags, "check() and begin() agree");
+                if f.contains(ConfigErrors::BIT_RATE_TOO_FAR) {
+                    Err(TimingRefused::TooFar)
+                } else if f == ConfigErrors::BIT_TIMING_FORBIDDEN {
+                    Err(TimingRefused::ForbiddenByManual)
+                } else {
+                    Err(TimingRefused::Other)
+                }
+            }
+            Err(BeginError::Hardware(e)) => panic!("begin: {e:?}"),
         }
     }
 
@@ -515,7 +561,9 @@ impl Backend for BxCanBackend {
     const TIMESTAMP_BITS: Option<u8> = None;
     const CLOCK_HZ: u32 = 54_000_000;
     const LIMITS: Limits = Limits::BXCAN;
-    const FASTEST_BITRATE: u32 = STM32F767_APB1_HZ / Limits::BXCAN.min_quanta();
+    const PERIPHERAL_CLOCK: Option<PeripheralClockRule> = None;
+    const FASTEST_BITRATE: u32 = STM32F767_APB1_HZ / 3;
+    const SLOWEST_BITRATE: u32 = STM32F767_APB1_HZ / (1024 * 25);
     const WAKEUP_EVENTS: bool = true;
     const TIMESTAMP_COUNTER_READABLE: bool = false;
 
@@ -540,6 +588,14 @@ impl Backend for BxCanBackend {
             DEFAULT_TOLERANCE_PPM,
         )
         .map_err(|e| match e {
+            ConfigError::Timing(t) => timing_refused(t),
+            _ => TimingRefused::Other,
+        })?;
+        Ok(bxcan_btr_bitrate(c.btr_value(), STM32F767_APB1_HZ))
+    }
+
+    fn check_given_timing(timing: &Timing) -> Result<u32, TimingRefused> {
+        let c = BxConfig::from_timing(*timing, DEFAULT_TOLERANCE_PPM).map_err(|e| match e {
             ConfigError::Timing(t) => timing_refused(t),
             _ => TimingRefused::Other,
         })?;
@@ -595,7 +651,7 @@ fn portable_bitrate_change<H: Hardware>(
     driver
         .set_mode(Mode::Stopped)
         .map_err(|e| Refused::Other(format!("stop: {e:?}")))?;
-    let sp = twocan_core::timing::cia_sample_point(rate);
+    let sp = cia_sample_point(rate);
     driver
         .set_bitrate(rate, sp)
         .map_err(|e| Refused::Other(format!("set_bitrate: {e:?}")))?;

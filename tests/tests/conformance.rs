@@ -9,8 +9,7 @@
 //! table cross-checked with the reference filter semantics — never from the drivers.
 
 use twocan_core::timestamp::{bit_times_to_micros, COUNTER_PERIOD};
-use twocan_core::timing::Limits;
-use twocan_core::timing::TimingError;
+use twocan_core::timing::{cia_sample_point, Limits, Timing, TimingError};
 use twocan_core::{
     BusMode, BusOffRecovery, Error, ErrorCounters, ErrorState, Filter, FilterError, Format, Frame,
     FrameError, FrameKind, Hardware, LastErrorCode, Mode, Timestamp,
@@ -321,53 +320,36 @@ fn filter_capacity<B: Backend>() {
 }
 
 fn bit_rate_limits<B: Backend>() {
-    let l: Limits = B::LIMITS;
-    // Fastest the registers express: prescaler 1 and the fewest quanta (1 + tseg1 min
-    // + tseg2 min). Accepted unless the manual forbids it (FlexCAN's 5 quanta: fewer
-    // than 8, Kinetis RM "Arbitration and matching timing"); then the fastest accepted
-    // rate is the backend's documented one.
-    let fastest = B::CLOCK_HZ / l.min_quanta();
-    if B::FASTEST_BITRATE == fastest {
-        assert_eq!(B::check_timing(fastest, 750), Ok(fastest), "{}", B::NAME);
-    } else {
-        assert!(B::FASTEST_BITRATE < fastest);
+    // The fastest and the slowest rates the backend accepts (hardware facts, the
+    // backend's constants) are accepted as a wished rate; one bit per second beyond, and
+    // twice or half of them, are refused with the same error on both backends (FlexCAN:
+    // the fastest is the Kinetis manual's, 16 bus clocks per bit; 2 Mbit/s, 8 quanta,
+    // is beyond it from the default 16 MHz bus clock; ACAN's 3.2 Mbit/s, 5 quanta,
+    // further still).
+    let fastest = B::FASTEST_BITRATE;
+    assert_eq!(B::check_timing(fastest, 750), Ok(fastest), "{}", B::NAME);
+    let five_quanta = B::CLOCK_HZ / 5; // ACAN's fastest on FlexCAN; in range on bxCAN
+    for beyond in [fastest + 1, 2 * fastest, five_quanta]
+        .into_iter()
+        .filter(|&r| r > fastest)
+    {
         assert_eq!(
-            B::check_timing(fastest, 750),
-            Err(TimingRefused::ForbiddenByManual),
-            "{}",
-            B::NAME
-        );
-        let top = B::FASTEST_BITRATE;
-        assert_eq!(B::check_timing(top, 750), Ok(top), "{}", B::NAME);
-        // Twice the fastest accepted: exact from the clock, still forbidden.
-        assert_eq!(
-            B::check_timing(2 * top, 750),
-            Err(TimingRefused::ForbiddenByManual),
-            "{}",
+            B::check_timing(beyond, 750),
+            Err(TimingRefused::TooHigh),
+            "{} {beyond}",
             B::NAME
         );
     }
-    assert_eq!(
-        B::check_timing(fastest + 1, 750),
-        Err(TimingRefused::TooHigh),
-        "{}",
-        B::NAME
-    );
-    // Slowest: the largest prescaler and the most quanta; below it is out of reach, and
-    // refused with the same error on both backends (not only by the tolerance check).
-    let slowest = l.min_bitrate(B::CLOCK_HZ);
-    assert_eq!(
-        B::check_timing(slowest / 2, 750),
-        Err(TimingRefused::TooLow),
-        "{}",
-        B::NAME
-    );
-    assert_eq!(
-        B::check_timing(slowest - 1, 750),
-        Err(TimingRefused::TooLow),
-        "{}",
-        B::NAME
-    );
+    let slowest = B::SLOWEST_BITRATE;
+    assert_eq!(B::check_timing(slowest, 875), Ok(slowest), "{}", B::NAME);
+    for below in [slowest - 1, slowest / 2] {
+        assert_eq!(
+            B::check_timing(below, 875),
+            Err(TimingRefused::TooLow),
+            "{} {below}",
+            B::NAME
+        );
+    }
     assert_eq!(B::check_timing(0, 750), Err(TimingRefused::Zero));
     // The sample point must lie strictly between 50 % and 100 % of the bit.
     for sp in [0, 500, 1000, 1200] {
@@ -549,14 +531,27 @@ fn capabilities_are_the_hardware_facts<B: Backend>() {
     let caps = dut.driver_ref().capabilities();
     assert_eq!(caps.clock_hz, B::CLOCK_HZ, "{}", B::NAME);
     assert_eq!(caps.timing_limits, B::LIMITS, "{}", B::NAME);
-    // Slowest: largest prescaler × most quanta (25 for both); fastest: bxCAN prescaler 1
-    // and the fewest quanta (1 + 1 + 1); FlexCAN the Kinetis manual's rule with the
-    // default bus clock of 16 MHz ("Arbitration and matching timing": at least 8 quanta,
-    // 16 MHz / 8 = 2 Mbit/s, and 16 bus clocks per bit, 16 MHz / 16 = 1 Mbit/s), below
-    // the register ranges' 3.2 Mbit/s (5 quanta, ACAN §16.1).
+    assert_eq!(caps.peripheral_clock, B::PERIPHERAL_CLOCK, "{}", B::NAME);
+    // FlexCAN: at least 8 quanta per bit (Kinetis RM), not the CTRL1 fields' 5.
+    let fewest_quanta = match B::CLOCK_HZ {
+        16_000_000 => 8,
+        _ => 3,
+    };
+    assert_eq!(
+        caps.timing_limits.min_quanta(),
+        fewest_quanta,
+        "{}",
+        B::NAME
+    );
+    // Slowest: largest prescaler × most quanta (25 for both), rounded down (bxCAN:
+    // 2,109.375 bit/s); fastest: bxCAN prescaler 1 and the fewest quanta (1 + 1 + 1);
+    // FlexCAN the Kinetis manual's rule with the default bus clock of 16 MHz
+    // ("Arbitration and matching timing": at least 8 quanta, 16 MHz / 8 = 2 Mbit/s, and
+    // 16 bus clocks per bit, 16 MHz / 16 = 1 Mbit/s), below the register ranges'
+    // 3.2 Mbit/s (5 quanta, ACAN §16.1).
     let (slowest, fastest) = match B::CLOCK_HZ {
-        16_000_000 => (16_000_000u32.div_ceil(256 * 25), 1_000_000),
-        54_000_000 => (54_000_000u32.div_ceil(1024 * 25), 18_000_000),
+        16_000_000 => (16_000_000 / (256 * 25), 1_000_000),
+        54_000_000 => (54_000_000 / (1024 * 25), 18_000_000),
         c => panic!("unexpected clock {c}"),
     };
     assert_eq!(
@@ -947,6 +942,280 @@ fn filter_list_semantics<B: Backend>() {
     assert_eq!(got, expected_cases(&cases), "{}: new list", B::NAME);
 }
 
+// --- issue 22: what is reported is what is accepted --------------------------------------
+
+/// A consistent timing of `clocks_per_bit` clocks with `quanta` quanta within the
+/// register fields of `limits` (whatever the manual's quanta rule says), wished at its
+/// own rate; `None` when the fields cannot hold it.
+fn register_timing(
+    clock_hz: u32,
+    limits: &Limits,
+    clocks_per_bit: u32,
+    quanta: u32,
+) -> Option<Timing> {
+    if quanta < 3 || !clocks_per_bit.is_multiple_of(quanta) {
+        return None;
+    }
+    let p = clocks_per_bit / quanta;
+    if !limits.prescaler.contains(p as u16) {
+        return None;
+    }
+    let rate = clock_hz / clocks_per_bit;
+    (1..quanta - 1)
+        .map(|t2| {
+            let t1 = quanta - 1 - t2;
+            Timing::from_tsegs(clock_hz, rate, limits, p as u16, t1 as u8, t2 as u8)
+        })
+        .find(|t| t.consistency().is_ok())
+}
+
+/// Items 5, 6, 7: the fastest and the slowest timings the capabilities report are
+/// accepted by every entry point — as counts (configuration: FlexCAN `begin`, bxCAN
+/// `Config::from_timing`; `set_timing`; `Capabilities::check_timing`) and as a wished
+/// rate (configuration: FlexCAN `Settings` + `begin`, bxCAN `Config::from_bitrate_with`;
+/// `Capabilities::timing_for`; `set_bitrate`); one bit per second beyond is refused by
+/// every one, as is a timing one clock per bit faster, or one quantum shorter, than
+/// what the capabilities name, where the registers hold one.
+fn reported_timings_are_accepted_by_every_entry_point<B: Backend>() {
+    let (_h, mut dut, _peer) = setup::<B>(&NodeOptions::pass_all());
+    let caps = dut.driver_ref().capabilities();
+    let fastest = caps.fastest_timing().expect("a fastest timing");
+    let slowest = caps.slowest_timing().expect("a slowest timing");
+    assert_eq!(
+        (caps.min_bitrate, caps.max_bitrate),
+        (B::SLOWEST_BITRATE, B::FASTEST_BITRATE),
+        "{}",
+        B::NAME
+    );
+    assert_eq!(fastest.actual_bitrate(), caps.max_bitrate);
+    assert_eq!(slowest.actual_bitrate(), caps.min_bitrate);
+    let l = caps.timing_limits;
+    for t in [fastest, slowest] {
+        assert!(
+            l.min_quanta() <= t.quanta() && t.quanta() <= l.max_quanta(),
+            "{}: {t:?}",
+            B::NAME
+        );
+    }
+    dut.driver().set_mode(Mode::Stopped).unwrap();
+    let cases = [
+        (fastest, caps.max_bitrate + 1, TimingError::BitrateTooHigh),
+        (slowest, caps.min_bitrate - 1, TimingError::BitrateTooLow),
+    ];
+    for (t, beyond, error) in cases {
+        let rate = t.actual_bitrate();
+        let refused = match error {
+            TimingError::BitrateTooHigh => TimingRefused::TooHigh,
+            _ => TimingRefused::TooLow,
+        };
+        // As counts.
+        assert_eq!(caps.check_timing(&t), Ok(()), "{} {rate}", B::NAME);
+        assert_eq!(B::check_given_timing(&t), Ok(rate), "{} {rate}", B::NAME);
+        assert_eq!(dut.driver().set_timing(&t), Ok(()), "{} {rate}", B::NAME);
+        assert_eq!(dut.bitrate_in_registers(), rate, "{}", B::NAME);
+        // As a wished rate.
+        let sp = cia_sample_point(rate);
+        assert!(caps.bitrate_in_range(rate));
+        assert_eq!(B::check_timing(rate, sp), Ok(rate), "{} {rate}", B::NAME);
+        assert_eq!(
+            caps.timing_for(rate, sp).map(|t| t.actual_bitrate()),
+            Ok(rate)
+        );
+        dut.driver().set_bitrate(RATE, 875).unwrap();
+        assert_eq!(
+            dut.driver()
+                .set_bitrate(rate, sp)
+                .map(|t| t.actual_bitrate()),
+            Ok(rate),
+            "{} {rate}",
+            B::NAME
+        );
+        assert_eq!(dut.bitrate_in_registers(), rate, "{}", B::NAME);
+        // One bit per second beyond, as a wished rate (the solver would find the
+        // extreme timing within the tolerance: still refused), and as the wished rate
+        // of the extreme timing's counts.
+        assert!(!caps.bitrate_in_range(beyond));
+        assert_eq!(
+            B::check_timing(beyond, sp),
+            Err(refused),
+            "{} {beyond}",
+            B::NAME
+        );
+        assert_eq!(caps.timing_for(beyond, sp), Err(error), "{}", B::NAME);
+        assert_eq!(
+            dut.driver().set_bitrate(beyond, sp),
+            Err(Error::Timing(error)),
+            "{} {beyond}",
+            B::NAME
+        );
+        assert_eq!(
+            dut.bitrate_in_registers(),
+            rate,
+            "{}: nothing written",
+            B::NAME
+        );
+        let wished_beyond = Timing {
+            bitrate: beyond,
+            ..t
+        };
+        assert_eq!(
+            B::check_given_timing(&wished_beyond),
+            Err(refused),
+            "{}",
+            B::NAME
+        );
+    }
+    // Timings beyond the reported ones that the registers still hold: one clock per bit
+    // faster than the fastest (FlexCAN: 15 clocks, below 16 bus clocks per bit; bxCAN's
+    // registers hold nothing faster than 3 clocks), and one quantum fewer than the
+    // reported minimum at a rate in range (FlexCAN: 7 quanta; bxCAN: none below 3).
+    let n = fastest.clocks_per_bit() as u32 - 1;
+    let faster = (l.min_quanta().saturating_sub(3)..=l.max_quanta())
+        .rev()
+        .find_map(|q| register_timing(B::CLOCK_HZ, &l, n, q));
+    let short_q = l.min_quanta() - 1;
+    let short = (1..=l.prescaler.max as u32)
+        .map(|p| p * short_q)
+        .filter(|&n| n >= fastest.clocks_per_bit() as u32)
+        .find_map(|n| register_timing(B::CLOCK_HZ, &l, n, short_q));
+    let beyond: Vec<Timing> = faster.into_iter().chain(short).collect();
+    let expected = match B::CLOCK_HZ {
+        16_000_000 => 2,
+        _ => 0,
+    };
+    assert_eq!(beyond.len(), expected, "{}: {beyond:?}", B::NAME);
+    for t in beyond {
+        assert_eq!(
+            caps.check_timing(&t),
+            Err(TimingError::ForbiddenByManual),
+            "{}: {t:?}",
+            B::NAME
+        );
+        assert_eq!(
+            dut.driver().set_timing(&t),
+            Err(Error::Timing(TimingError::ForbiddenByManual)),
+            "{}: {t:?}",
+            B::NAME
+        );
+        assert!(B::check_given_timing(&t).is_err(), "{}: {t:?}", B::NAME);
+    }
+    dut.driver().set_bitrate(RATE, 875).unwrap();
+    dut.driver().set_mode(Mode::Normal).unwrap();
+}
+
+/// Item 9: the receive ring figures are those of the rings frames arrive in. The peer
+/// sends more frames than the reported size while the node's interrupts are serviced
+/// and nothing is taken: exactly `size` frames are held, the rest are counted as
+/// overflows, and `size` frames come out. Each ring reports what it holds: the one the
+/// filters feed (bxCAN FIFO 0 with the backend's plan; FlexCAN's one FIFO) is full, a
+/// ring they do not feed holds nothing.
+fn rx_ring_figures_are_what_arrives<B: Backend>() {
+    let (mut h, mut dut, peer) = setup::<B>(&NodeOptions::pass_all());
+    let size = dut.driver_ref().rx_stats().size;
+    let ring0 = dut.driver_ref().rx_ring_stats(0).unwrap();
+    assert_eq!(size, ring0.size, "{}: the fed ring only", B::NAME);
+    let sent = size + 10;
+    for i in 0..sent {
+        peer.borrow_mut()
+            .send(std_frame(0x100 + (i % 0x400) as u16, &[i as u8]));
+    }
+    settle(&mut h, &mut dut, &[&peer], 400_000);
+    assert_eq!(peer.borrow().pending(), 0);
+    let s = dut.driver_ref().rx_stats();
+    assert_eq!(
+        (s.count, s.overflows as usize),
+        (size, sent - size),
+        "{}: {s:?}",
+        B::NAME
+    );
+    let per_ring: Vec<(usize, u32)> = (0..B::RX_QUEUES as usize)
+        .map(|q| {
+            let r = dut.driver_ref().rx_ring_stats(q).unwrap();
+            (r.count, r.overflows)
+        })
+        .collect();
+    let mut want = vec![(size, (sent - size) as u32)];
+    want.resize(B::RX_QUEUES as usize, (0, 0));
+    assert_eq!(per_ring, want, "{}", B::NAME);
+    assert_eq!(
+        dut.driver_ref().rx_ring_stats(B::RX_QUEUES as usize),
+        None,
+        "{}",
+        B::NAME
+    );
+    assert_eq!(drain(&mut dut).len(), size, "{}", B::NAME);
+    assert_eq!(dut.hw_lost(), 0, "{}", B::NAME);
+}
+
+/// Item 10: one DLC rule. A remote frame with each code 0..=15, built by `Frame::remote`
+/// (the constructor that refused 9..=15 before), leaves with that code; the same code
+/// sent by the peer comes out of the driver equal to what `Frame::remote` and
+/// `set_dlc` build.
+fn remote_dlc_codes_are_one_rule_both_ways<B: Backend>() {
+    let (mut h, mut dut, peer) = setup::<B>(&NodeOptions::pass_all());
+    let built: Vec<Frame> = (0..=15u8)
+        .map(|code| Frame::remote(0x240 + code as u32, code % 2 == 1, code).unwrap())
+        .collect();
+    for f in &built {
+        let mut by_set = remote_frame(f.raw_id(), f.is_extended(), 0);
+        by_set.set_dlc(f.dlc()).unwrap();
+        assert_eq!(by_set, *f);
+    }
+    for f in &built {
+        dut.driver().try_send(f).unwrap();
+        settle(&mut h, &mut dut, &[&peer], 20_000);
+    }
+    assert_eq!(peer.borrow().received_frames(), built, "{}", B::NAME);
+    for f in &built {
+        peer.borrow_mut().send(*f);
+    }
+    settle(&mut h, &mut dut, &[&peer], 50_000);
+    let got: Vec<Frame> = drain(&mut dut).iter().map(|r| r.frame).collect();
+    assert_eq!(got, built, "{}", B::NAME);
+}
+
+/// Item 9, bxCAN with both FIFOs fed (`FifoPolicy::Balanced`: the standard filter's bank
+/// to one FIFO, the extended filters' bank to the other): the reported size is both
+/// rings, and that many frames arrive, each ring holding its own.
+#[test]
+fn bxcan_ring_figures_with_both_fifos_fed() {
+    let mut h = Harness::new(RATE).unwrap();
+    let config = twocan_tests::backend::bxcan_config(RATE, Recovery::Automatic).unwrap();
+    let filters = [
+        Filter::standard(0x123),
+        Filter::extended(0x0123_4567),
+        Filter::extended(0x0ABC_DEF0),
+    ];
+    let mut bx = twocan_host::BxNode::with_config(
+        &mut h,
+        &config,
+        &filters,
+        twocan_bxcan::FifoPolicy::Balanced,
+    )
+    .unwrap();
+    let (peer, _) = attach_peer(&h, "peer");
+    run(&mut h, &mut bx, 20);
+    let d = bx.driver_ref();
+    let (r0, r1) = (d.rx_ring_stats(0).unwrap(), d.rx_ring_stats(1).unwrap());
+    assert_eq!(d.rx_stats().size, r0.size + r1.size);
+    let extra = 5;
+    for i in 0..r0.size + r1.size + 2 * extra {
+        let f = if i % 2 == 0 {
+            std_frame(0x123, &[i as u8])
+        } else {
+            ext_frame(0x0123_4567, &[i as u8])
+        };
+        peer.borrow_mut().send(f);
+    }
+    settle(&mut h, &mut bx, &[&peer], 400_000);
+    let d = bx.driver_ref();
+    let s = d.rx_stats();
+    assert_eq!(s.count, s.size, "{s:?}");
+    let (r0, r1) = (d.rx_ring_stats(0).unwrap(), d.rx_ring_stats(1).unwrap());
+    assert_eq!((r0.count, r1.count), (r0.size, r1.size));
+    assert_eq!((r0.overflows, r1.overflows), (extra as u32, extra as u32));
+}
+
 // ---------------------------------------------------------------------------------------
 
 #[test]
@@ -964,8 +1233,8 @@ fn frames_that_break_the_format_are_typed_errors() {
         Err(FrameError::TooMuchData(9))
     );
     assert_eq!(
-        Frame::remote(0x10, false, 9),
-        Err(FrameError::DlcTooLarge(9))
+        Frame::remote(0x10, false, 16),
+        Err(FrameError::DlcTooLarge(16))
     );
     let mut r = remote_frame(0x10, false, 4);
     assert_eq!(r.set_data(&[1]), Err(FrameError::DataOnRemoteFrame));
@@ -1275,6 +1544,18 @@ macro_rules! suite {
             #[test]
             fn filter_list_semantics() {
                 super::filter_list_semantics::<$backend>();
+            }
+            #[test]
+            fn reported_timings_are_accepted_by_every_entry_point() {
+                super::reported_timings_are_accepted_by_every_entry_point::<$backend>();
+            }
+            #[test]
+            fn remote_dlc_codes_are_one_rule_both_ways() {
+                super::remote_dlc_codes_are_one_rule_both_ways::<$backend>();
+            }
+            #[test]
+            fn rx_ring_figures_are_what_arrives() {
+                super::rx_ring_figures_are_what_arrives::<$backend>();
             }
         }
     };

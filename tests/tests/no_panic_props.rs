@@ -29,7 +29,8 @@ proptest! {
             Err(e) => prop_assert!(false, "unexpected {:?}", e),
         }
         let r = Frame::remote(raw, ext, dlc);
-        prop_assert_eq!(r.is_ok(), raw <= limit && dlc <= 8);
+        // One DLC rule (issue 22 item 10): a remote frame takes any code of the field.
+        prop_assert_eq!(r.is_ok(), raw <= limit && dlc <= 15);
         let mut bytes = [0u8; 8];
         for (b, d) in bytes.iter_mut().zip(&data) { *b = *d; }
         let reg = Frame::from_registers(raw, ext, remote, dlc, bytes);
@@ -55,7 +56,7 @@ proptest! {
             let e = <Frame as embedded_can::Frame>::new(id, &data);
             prop_assert_eq!(e.is_some(), data.len() <= 8);
             let e = <Frame as embedded_can::Frame>::new_remote(id, dlc as usize);
-            prop_assert_eq!(e.is_some(), dlc <= 8);
+            prop_assert_eq!(e.is_some(), dlc <= 15);
         }
     }
 

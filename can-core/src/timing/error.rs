@@ -12,11 +12,13 @@ pub enum TimingError {
     ClockZero,
     /// The wished bit rate is 0 bit/s.
     BitrateZero,
-    /// The wished bit rate is above clock / minimum quanta per bit (prescaler 1,
-    /// shortest bit): no timing can be that fast (16 MHz FlexCAN: 3.2 Mbit/s,
-    /// ACAN §16.1).
+    /// The wished bit rate is above the bit rate of the fastest timing the controller
+    /// accepts ([`TimingRule::max_bitrate`](super::TimingRule::max_bitrate): smallest
+    /// prescaler, fewest quanta, and the manual's rules; 16 MHz FlexCAN with a 16 MHz
+    /// bus clock: 1 Mbit/s), or, for the solver, above clock / fewest quanta per bit.
     BitrateTooHigh,
-    /// The wished bit rate is below the slowest the controller reaches (largest
+    /// The wished bit rate is below the bit rate of the slowest timing the controller
+    /// accepts ([`TimingRule::min_bitrate`](super::TimingRule::min_bitrate): largest
     /// prescaler, most quanta per bit: 16 MHz FlexCAN: 2.5 kbit/s, ACAN §16.1).
     BitrateTooLow,
     /// The sample point target is not strictly between 50 % and 100 %
@@ -51,10 +53,10 @@ impl fmt::Display for TimingError {
             TimingError::ClockZero => f.write_str("CAN clock is 0 Hz"),
             TimingError::BitrateZero => f.write_str("bit rate is 0 bit/s"),
             TimingError::BitrateTooHigh => {
-                f.write_str("bit rate above clock / minimum quanta per bit")
+                f.write_str("bit rate above the fastest timing the controller accepts")
             }
             TimingError::BitrateTooLow => {
-                f.write_str("bit rate below clock / (largest prescaler × most quanta per bit)")
+                f.write_str("bit rate below the slowest timing the controller accepts")
             }
             TimingError::SamplePointOutOfRange => {
                 f.write_str("sample point must be above 50 % and below 100 %")

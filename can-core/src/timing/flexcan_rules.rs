@@ -15,15 +15,20 @@
 //!
 //! ACAN (§16.1) checks only the field ranges, so it accepts 5 quanta per bit (its "fastest
 //! exact bit rate" of 3.2 Mbit/s from the 16 MHz clock is 5 quanta, which it reports
-//! working in loop-back and self-reception mode only). [`Limits::FLEXCAN`](super::Limits::FLEXCAN)
-//! keeps ACAN's ranges so that the solver reproduces ACAN's figures; [`check`] is the
-//! reference manual's stricter rule, which the FlexCAN backend's `begin` enforces
-//! (`ConfigErrors::BIT_TIMING_FORBIDDEN`; `docs/bit-timing.md`).
+//! working in loop-back and self-reception mode only). [`Limits::FLEXCAN`] keeps ACAN's
+//! ranges so that the solver reproduces ACAN's figures; [`rule`] is the reference
+//! manual's stricter rule as a [`TimingRule`] ([`Limits::FLEXCAN_KINETIS`] and the
+//! peripheral-clock ratio), which every FlexCAN entry point applies (`Settings`,
+//! `begin`/`check`, `set_timing`, `set_bitrate`, the capabilities, the `can-timing`
+//! tool; `docs/bit-timing.md`).
 
+use super::limits::Limits;
+use super::rule::{ManualViolation, PeripheralClockRule, TimingRule};
 use super::Timing;
 
-/// The least number of time quanta per bit the manual allows.
-pub const MIN_QUANTA_PER_BIT: u32 = 8;
+/// The least number of time quanta per bit the manual allows
+/// ([`Limits::FLEXCAN_KINETIS`]).
+pub const MIN_QUANTA_PER_BIT: u32 = Limits::FLEXCAN_KINETIS.quanta.min as u32;
 
 /// The least number of peripheral clocks per CAN bit for `mailboxes` message buffers
 /// (16, 32 or 64; other counts are rounded up to the next of these) with the Rx FIFO on
@@ -38,117 +43,52 @@ pub const fn min_peripheral_clocks_per_bit(mailboxes: u8, rx_fifo: bool) -> u32 
     }
 }
 
+/// What a FlexCAN module with `mailboxes` message buffers, the Rx FIFO on or off, and a
+/// peripheral (bus) clock of `peripheral_hz` accepts from the CAN clock `can_clock_hz`:
+/// [`Limits::FLEXCAN_KINETIS`] (the CTRL1 fields, at least 8 quanta per bit) and at least
+/// [`min_peripheral_clocks_per_bit`] peripheral clocks per CAN bit, the peripheral clock
+/// not below the CAN clock.
+pub const fn rule(
+    can_clock_hz: u32,
+    peripheral_hz: u32,
+    mailboxes: u8,
+    rx_fifo: bool,
+) -> TimingRule {
+    TimingRule::new(can_clock_hz, Limits::FLEXCAN_KINETIS).with_peripheral_clock(
+        PeripheralClockRule {
+            peripheral_hz,
+            min_clocks_per_bit: min_peripheral_clocks_per_bit(mailboxes, rx_fifo),
+        },
+    )
+}
+
 /// The fastest bit rate the manual's rules allow from the CAN clock `can_clock_hz` and
-/// the peripheral clock `peripheral_hz`: at least [`MIN_QUANTA_PER_BIT`] quanta of at
-/// least one CAN clock each, and at least [`min_peripheral_clocks_per_bit`] peripheral
-/// clocks per bit (`peripheral_hz / rate` rounded down is at least the minimum exactly
-/// when `rate <= peripheral_hz / minimum` rounded down). 0 when no rate is allowed (a
-/// peripheral clock below the CAN clock, or a clock of 0).
+/// the peripheral clock `peripheral_hz`: the bit rate of [`rule`]'s fastest timing
+/// ([`TimingRule::max_bitrate`]), a rate the CAN clock reaches. 0 when no rate is
+/// allowed (a peripheral clock below the CAN clock, or a clock of 0).
 pub const fn max_bitrate(
     can_clock_hz: u32,
     peripheral_hz: u32,
     mailboxes: u8,
     rx_fifo: bool,
 ) -> u32 {
-    if peripheral_hz < can_clock_hz || can_clock_hz == 0 {
-        return 0;
-    }
-    let by_quanta = can_clock_hz / MIN_QUANTA_PER_BIT;
-    let by_clocks = peripheral_hz / min_peripheral_clocks_per_bit(mailboxes, rx_fifo);
-    if by_quanta < by_clocks {
-        by_quanta
-    } else {
-        by_clocks
-    }
+    rule(can_clock_hz, peripheral_hz, mailboxes, rx_fifo).max_bitrate()
 }
 
-/// A timing the FlexCAN reference manual forbids.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub enum FlexcanTimingViolation {
-    /// Fewer than [`MIN_QUANTA_PER_BIT`] time quanta per bit.
-    TooFewQuanta {
-        /// The timing's quanta per bit.
-        quanta: u32,
-    },
-    /// Fewer peripheral clocks per CAN bit than the table requires.
-    TooFewPeripheralClocks {
-        /// Peripheral clocks per bit (rounded down).
-        clocks_per_bit: u64,
-        /// The table's minimum.
-        min: u32,
-    },
-    /// A peripheral clock slower than the timing's CAN (oscillator) clock.
-    PeripheralClockBelowCanClock {
-        /// The peripheral clock, Hz.
-        peripheral_hz: u32,
-        /// The CAN clock the timing is made from, Hz.
-        can_clock_hz: u32,
-    },
-    /// A peripheral clock of 0 Hz, or a timing with a bit rate of 0.
-    Zero,
-}
-
-impl core::fmt::Display for FlexcanTimingViolation {
-    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        match self {
-            FlexcanTimingViolation::TooFewQuanta { quanta } => write!(
-                f,
-                "{quanta} time quanta per bit, fewer than the {MIN_QUANTA_PER_BIT} the FlexCAN manual requires"
-            ),
-            FlexcanTimingViolation::TooFewPeripheralClocks {
-                clocks_per_bit,
-                min,
-            } => write!(
-                f,
-                "{clocks_per_bit} peripheral clocks per CAN bit, fewer than the {min} the FlexCAN manual requires"
-            ),
-            FlexcanTimingViolation::PeripheralClockBelowCanClock {
-                peripheral_hz,
-                can_clock_hz,
-            } => write!(
-                f,
-                "peripheral clock {peripheral_hz} Hz below the CAN clock {can_clock_hz} Hz"
-            ),
-            FlexcanTimingViolation::Zero => f.write_str("a clock or bit rate of 0"),
-        }
-    }
-}
-
-impl core::error::Error for FlexcanTimingViolation {}
-
-/// Checks `timing` against the FlexCAN manual's rules, for a module with `mailboxes`
-/// message buffers, the Rx FIFO on or off, and a peripheral (bus) clock of
-/// `peripheral_hz`.
+/// The manual's rules beyond the register ranges that `timing` breaks, for a module with
+/// `mailboxes` message buffers, the Rx FIFO on or off, and a peripheral (bus) clock of
+/// `peripheral_hz` ([`rule`] with the timing's own clock,
+/// [`TimingRule::manual_violation`]).
 pub const fn check(
     timing: &Timing,
     peripheral_hz: u32,
     mailboxes: u8,
     rx_fifo: bool,
-) -> Result<(), FlexcanTimingViolation> {
-    let quanta = timing.quanta();
-    if quanta < MIN_QUANTA_PER_BIT {
-        return Err(FlexcanTimingViolation::TooFewQuanta { quanta });
+) -> Result<(), ManualViolation> {
+    match rule(timing.clock_hz, peripheral_hz, mailboxes, rx_fifo).manual_violation(timing) {
+        None => Ok(()),
+        Some(v) => Err(v),
     }
-    let bitrate = timing.actual_bitrate();
-    if peripheral_hz == 0 || bitrate == 0 {
-        return Err(FlexcanTimingViolation::Zero);
-    }
-    if peripheral_hz < timing.clock_hz {
-        return Err(FlexcanTimingViolation::PeripheralClockBelowCanClock {
-            peripheral_hz,
-            can_clock_hz: timing.clock_hz,
-        });
-    }
-    let clocks_per_bit = peripheral_hz as u64 / bitrate as u64;
-    let min = min_peripheral_clocks_per_bit(mailboxes, rx_fifo);
-    if clocks_per_bit < min as u64 {
-        return Err(FlexcanTimingViolation::TooFewPeripheralClocks {
-            clocks_per_bit,
-            min,
-        });
-    }
-    Ok(())
 }
 
 #[cfg(test)]
@@ -172,7 +112,7 @@ mod tests {
         assert_eq!(t.quanta(), 5);
         assert_eq!(
             check(&t, 60_000_000, 16, true),
-            Err(FlexcanTimingViolation::TooFewQuanta { quanta: 5 })
+            Err(ManualViolation::TooFewQuanta { quanta: 5, min: 8 })
         );
     }
 
@@ -189,7 +129,7 @@ mod tests {
         assert_eq!(two.quanta(), 8);
         assert_eq!(
             check(&two, 16_000_000, 16, true),
-            Err(FlexcanTimingViolation::TooFewPeripheralClocks {
+            Err(ManualViolation::TooFewPeripheralClocks {
                 clocks_per_bit: 8,
                 min: 16
             })
@@ -198,7 +138,7 @@ mod tests {
         // A peripheral clock below the oscillator clock is refused first.
         assert_eq!(
             check(&t, 15_000_000, 16, true),
-            Err(FlexcanTimingViolation::PeripheralClockBelowCanClock {
+            Err(ManualViolation::PeripheralClockBelowCanClock {
                 peripheral_hz: 15_000_000,
                 can_clock_hz: 16_000_000
             })
@@ -209,7 +149,7 @@ mod tests {
             .unwrap_err()
             .to_string()
             .contains("8 peripheral clocks per CAN bit"));
-        assert_eq!(check(&t, 0, 16, true), Err(FlexcanTimingViolation::Zero));
+        assert_eq!(check(&t, 0, 16, true), Err(ManualViolation::Zero));
     }
 
     #[test]
@@ -228,8 +168,10 @@ mod tests {
         assert_eq!(max_bitrate(16_000_000, 16_000_000, 16, true), 1_000_000);
         // 60 MHz bus: 3.75 Mbit/s by clocks, 2 Mbit/s by quanta.
         assert_eq!(max_bitrate(16_000_000, 60_000_000, 16, true), 2_000_000);
-        // 24 MHz bus: 1.5 Mbit/s; 64 MBs with the FIFO: 30 clocks → 800 kbit/s.
-        assert_eq!(max_bitrate(16_000_000, 24_000_000, 16, true), 1_500_000);
+        // 24 MHz bus: 16 clocks allow 1.5 Mbit/s, which 16 MHz does not reach: the
+        // fastest reachable is 11 CAN clocks per bit (11 × 24 ≥ 16 × 16), 1,454,545 bit/s;
+        // 64 MBs with the FIFO: 30 clocks → 20 CAN clocks, 800 kbit/s.
+        assert_eq!(max_bitrate(16_000_000, 24_000_000, 16, true), 1_454_545);
         assert_eq!(max_bitrate(16_000_000, 24_000_000, 64, true), 800_000);
         // A bus clock below the CAN clock allows nothing.
         assert_eq!(max_bitrate(16_000_000, 8_000_000, 16, true), 0);

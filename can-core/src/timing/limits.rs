@@ -18,6 +18,10 @@
 //! FlexCAN values are ACAN §16.1 (the constraint list after the 500 kbit/s example)
 //! and agree with the K20/K64/K66 reference manuals (CTRL1 fields hold the count
 //! minus one; PSEG2 "valid programmable values are 1–7", i.e. 2..=8 quanta).
+//! [`Limits::FLEXCAN_KINETIS`] is the same with the Kinetis manual's 8..=25 quanta per
+//! bit ("Arbitration and matching timing"): the limits the FlexCAN driver accepts and
+//! reports; [`Limits::FLEXCAN`] keeps the field ranges alone, as ACAN computes with
+//! them ([`super::flexcan_rules`]).
 //! bxCAN values are RM0410 §40.7.7 (CAN_BTR: BRP\[9:0\], TS1\[3:0\], TS2\[2:0\],
 //! SJW\[1:0\], each holding the count minus one).
 //!
@@ -31,6 +35,7 @@
 //!   `prop_seg` the range 0..=0 and `phase_seg1` holds the whole TS1.
 
 use super::error::TimingError;
+use super::rule::TimingRule;
 
 /// An inclusive range of counts (quanta, or prescaler steps).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -116,12 +121,24 @@ pub struct Limits {
     /// SJW ≤ min(PS1, PS2); bxCAN: TS1 includes the propagation segment, so only
     /// SJW ≤ TS2 is checked).
     pub sjw_le_phase_seg1: bool,
+    /// Quanta per bit (1 + tseg1 + tseg2) a rule beyond the field ranges allows: the
+    /// counts the fields can express that the controller's manual still forbids
+    /// ([`Limits::FLEXCAN_KINETIS`]: at least 8). [`Limits::min_quanta`] and
+    /// [`Limits::max_quanta`] are the fields' range narrowed by this one; the solver and
+    /// [`crate::timing::Solutions`] search only inside it, and [`Timing::consistency`]
+    /// (ACAN table 6) does not look at it: a timing outside it is
+    /// [`TimingError::ForbiddenByManual`] ([`crate::timing::TimingRule::check_timing`]).
+    ///
+    /// [`Timing::consistency`]: crate::timing::Timing::consistency
+    pub quanta: Bounds,
 }
 
 impl Limits {
-    /// FlexCAN limits, ACAN §16.1: `1 ≤ PRESDIV ≤ 256`, `1 ≤ RJW ≤ 4`,
+    /// FlexCAN CTRL1 field ranges, ACAN §16.1: `1 ≤ PRESDIV ≤ 256`, `1 ≤ RJW ≤ 4`,
     /// `1 ≤ PROPSEG ≤ 8`, `1 ≤ PSEG1 ≤ 8` (2 with triple sampling), `2 ≤ PSEG2 ≤ 8`,
-    /// `RJW ≤ PSEG2`; plus `RJW ≤ PSEG1`.
+    /// `RJW ≤ PSEG2`; plus `RJW ≤ PSEG1`; 5..=25 quanta per bit. These reproduce ACAN's
+    /// computations (its 3.2 Mbit/s "fastest exact" rate is 5 quanta); the driver
+    /// accepts [`Limits::FLEXCAN_KINETIS`].
     pub const FLEXCAN: Limits = Limits {
         controller: Controller::FlexCan,
         prescaler: Bounds::new(1, 256),
@@ -131,6 +148,16 @@ impl Limits {
         sjw: Bounds::new(1, 4),
         triple_sampling_min_phase_seg1: Some(2),
         sjw_le_phase_seg1: true,
+        quanta: Bounds::new(5, 25),
+    };
+
+    /// What the FlexCAN driver accepts and reports: [`Limits::FLEXCAN`]'s field ranges
+    /// with at least 8 quanta per bit (Kinetis K20/K64/K66 reference manuals, FlexCAN
+    /// chapter, "Arbitration and matching timing": "the minimum number of time quanta per
+    /// CAN bit must be 8").
+    pub const FLEXCAN_KINETIS: Limits = Limits {
+        quanta: Bounds::new(8, 25),
+        ..Limits::FLEXCAN
     };
 
     /// bxCAN limits, RM0410 §40.7.7 (CAN_BTR): `1 ≤ BRP ≤ 1024`, `1 ≤ TS1 ≤ 16`,
@@ -144,6 +171,7 @@ impl Limits {
         sjw: Bounds::new(1, 4),
         triple_sampling_min_phase_seg1: None,
         sjw_le_phase_seg1: false,
+        quanta: Bounds::new(3, 25),
     };
 
     /// Range of the generic tseg1 = propagation segment + phase segment 1.
@@ -159,31 +187,44 @@ impl Limits {
         self.phase_seg2
     }
 
-    /// Fewest quanta in a bit: 1 + min tseg1 + min tseg2 (FlexCAN 5, bxCAN 3).
+    /// Fewest quanta in a bit: 1 + min tseg1 + min tseg2, or [`Limits::quanta`]'s
+    /// minimum when larger (FlexCAN fields 5, [`Limits::FLEXCAN_KINETIS`] 8, bxCAN 3).
     pub const fn min_quanta(&self) -> u32 {
-        1 + self.tseg1().min as u32 + self.phase_seg2.min as u32
+        let fields = 1 + self.tseg1().min as u32 + self.phase_seg2.min as u32;
+        if (self.quanta.min as u32) > fields {
+            self.quanta.min as u32
+        } else {
+            fields
+        }
     }
 
-    /// Most quanta in a bit: 1 + max tseg1 + max tseg2 (25 for both).
+    /// Most quanta in a bit: 1 + max tseg1 + max tseg2, or [`Limits::quanta`]'s maximum
+    /// when smaller (25 for all three).
     pub const fn max_quanta(&self) -> u32 {
-        1 + self.tseg1().max as u32 + self.phase_seg2.max as u32
+        let fields = 1 + self.tseg1().max as u32 + self.phase_seg2.max as u32;
+        if (self.quanta.max as u32) < fields {
+            self.quanta.max as u32
+        } else {
+            fields
+        }
     }
 
-    /// The fastest bit rate these limits reach from `clock_hz`: prescaler 1 (the
-    /// smallest), fewest quanta per bit.
+    /// The fastest bit rate these limits reach from `clock_hz` (smallest prescaler,
+    /// fewest quanta per bit), rounded down like every bit rate here
+    /// ([`Timing::actual_bitrate`](crate::timing::Timing::actual_bitrate), ACAN §16.3):
+    /// [`TimingRule::max_bitrate`] without a rule beyond these limits.
     pub const fn max_bitrate(&self, clock_hz: u32) -> u32 {
-        clock_hz / (self.prescaler.min as u32 * self.min_quanta())
+        TimingRule::new(clock_hz, *self).max_bitrate()
     }
 
     /// The slowest bit rate these limits reach from `clock_hz` (largest prescaler, most
-    /// quanta per bit), rounded up: a wished rate below it cannot be met.
+    /// quanta per bit), rounded down ([`TimingRule::min_bitrate`]).
     pub const fn min_bitrate(&self, clock_hz: u32) -> u32 {
-        let slowest = self.prescaler.max as u64 * self.max_quanta() as u64;
-        clock_hz.div_ceil(slowest as u32)
+        TimingRule::new(clock_hz, *self).min_bitrate()
     }
 
-    /// The one rule every backend applies to a wished bit rate before any tolerance
-    /// check: [`TimingError::ClockZero`], [`TimingError::BitrateZero`],
+    /// [`TimingRule::check_bitrate`] for these limits alone (no rule beyond them):
+    /// [`TimingError::ClockZero`], [`TimingError::BitrateZero`],
     /// [`TimingError::BitrateTooHigh`] above [`Limits::max_bitrate`],
     /// [`TimingError::BitrateTooLow`] below [`Limits::min_bitrate`].
     ///
@@ -192,7 +233,10 @@ impl Limits {
     /// const OK: Result<(), TimingError> = Limits::FLEXCAN.check_bitrate(16_000_000, 500_000);
     /// assert_eq!(OK, Ok(()));
     /// assert_eq!(Limits::FLEXCAN.max_bitrate(16_000_000), 3_200_000); // ACAN §16.1
+    /// assert_eq!(Limits::FLEXCAN_KINETIS.max_bitrate(16_000_000), 2_000_000); // 8 quanta
     /// assert_eq!(Limits::FLEXCAN.min_bitrate(16_000_000), 2_500);
+    /// // 54 MHz / (1024 × 25) = 2,109.375 bit/s, rounded down.
+    /// assert_eq!(Limits::BXCAN.min_bitrate(54_000_000), 2_109);
     /// assert_eq!(
     ///     Limits::FLEXCAN.check_bitrate(16_000_000, 3_200_001),
     ///     Err(TimingError::BitrateTooHigh)
@@ -203,20 +247,11 @@ impl Limits {
     /// );
     /// ```
     pub const fn check_bitrate(&self, clock_hz: u32, bitrate: u32) -> Result<(), TimingError> {
-        if clock_hz == 0 {
-            Err(TimingError::ClockZero)
-        } else if bitrate == 0 {
-            Err(TimingError::BitrateZero)
-        } else if bitrate > self.max_bitrate(clock_hz) {
-            Err(TimingError::BitrateTooHigh)
-        } else if bitrate < self.min_bitrate(clock_hz) {
-            Err(TimingError::BitrateTooLow)
-        } else {
-            Ok(())
-        }
+        TimingRule::new(clock_hz, *self).check_bitrate(bitrate)
     }
 
-    /// Whether these limits can be used by the solver: every range non-empty,
+    /// Whether these limits can be used by the solver: every range non-empty (the
+    /// quanta per bit too, [`Limits::min_quanta`] ≤ [`Limits::max_quanta`]),
     /// prescaler and phase segments ≥ 1, tseg1, tseg2 and SJW maxima ≤ 255 (they
     /// are `u8` in [`Timing`](crate::timing::Timing)), and the smallest SJW always
     /// possible (SJW min ≤ phase segment minima).
@@ -225,7 +260,8 @@ impl Limits {
             && self.prop_seg.min <= self.prop_seg.max
             && self.phase_seg1.min <= self.phase_seg1.max
             && self.phase_seg2.min <= self.phase_seg2.max
-            && self.sjw.min <= self.sjw.max;
+            && self.sjw.min <= self.sjw.max
+            && self.min_quanta() <= self.max_quanta();
         let mins_ok = self.prescaler.min >= 1
             && self.phase_seg1.min >= 1
             && self.phase_seg2.min >= 1

@@ -31,7 +31,11 @@
 //! * [`encode`]: bxCAN `CAN_BTR` and FlexCAN `CTRL1` values.
 //! * [`iter`]: [`Solutions`], every timing within a tolerance.
 //! * [`frame_time`]: worst-case frame durations and wait bounds at a bit rate.
-//! * [`flexcan_rules`]: the FlexCAN manual's 8-quanta and clocks-per-bit rules.
+//! * [`rule`]: [`TimingRule`], what one controller accepts — the one rule every entry
+//!   point that takes a bit rate or a timing applies, and the fastest and slowest
+//!   accepted timings the capabilities report.
+//! * [`flexcan_rules`]: the FlexCAN manual's 8-quanta and clocks-per-bit rules, as a
+//!   [`TimingRule`].
 //!
 //! All arithmetic is integer (u64/u128 where products would overflow); see
 //! `docs/bit-timing.md` for worked examples.
@@ -43,6 +47,7 @@ pub mod flexcan_rules;
 pub mod frame_time;
 pub mod iter;
 pub mod limits;
+pub mod rule;
 pub mod segments;
 pub mod solver;
 
@@ -54,5 +59,6 @@ pub use encode::{
 pub use error::TimingError;
 pub use iter::Solutions;
 pub use limits::{Bounds, Controller, Limits};
+pub use rule::{ManualViolation, PeripheralClockRule, TimingRule};
 pub use segments::Timing;
 pub use solver::{cia_sample_point, solve, solve_cia, DEFAULT_TOLERANCE_PPM};

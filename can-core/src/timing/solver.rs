@@ -76,7 +76,7 @@ const fn better(a: &Candidate, b: &Candidate, clock: u64, bitrate: u64, target: 
 
 /// For a bit of `quanta` quanta, the (tseg1, tseg2) whose sample point is closest
 /// to `target` per mille; on a tie the smaller tseg1. `None` if no split fits.
-const fn best_split(quanta: u64, limits: &Limits, target: u64) -> Option<(u64, u64)> {
+pub(crate) const fn best_split(quanta: u64, limits: &Limits, target: u64) -> Option<(u64, u64)> {
     let t1 = limits.tseg1();
     let t2 = limits.tseg2();
     let segs = quanta - 1;

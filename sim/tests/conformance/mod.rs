@@ -834,6 +834,32 @@ pub fn bus_off_and_recovery<D: Dut>() {
     assert_eq!(p.borrow().received_frames(), vec![f]);
 }
 
+/// Issue 22, item 10 (one DLC rule): a remote frame carries its DLC code as written, 8
+/// to 15 (ISO 11898-1: four DLC bits; 9..=15 ask for eight bytes), built by
+/// `Frame::remote` like any other code; the node under test sends each with that code in
+/// the DLC field (the wire layout is the one that code gives, with no data field) and a
+/// plain receiver gets the same frame.
+pub fn remote_dlc_codes_on_the_wire<D: Dut>() {
+    let mut bus = Bus::new(500_000).unwrap();
+    let (mut dut, id) = D::join(&mut bus);
+    let p = peer();
+    bus.attach("p", p.clone());
+    let built: Vec<Frame> = (8..=15u8)
+        .map(|code| Frame::remote(0x2A0 + u32::from(code), false, code).unwrap())
+        .collect();
+    for f in &built {
+        dut.send(f);
+        let r = next_frame(&mut bus);
+        assert!(r.is_error_free(), "{f:?}");
+        assert_eq!(r.transmitters, vec![id]);
+        assert_eq!(r.frame, *f);
+        assert_eq!(r.frame.dlc(), f.dlc());
+        assert_eq!(r.bits, frame_bits(f), "{f:?}");
+    }
+    assert_eq!(p.borrow().received_frames(), built);
+    assert_eq!(dut.counters(), ErrorCounters { tec: 0, rec: 0 });
+}
+
 /// One `#[test]` per case of the table for the node kind `$dut`.
 #[macro_export]
 macro_rules! conformance_tests {
@@ -929,6 +955,10 @@ macro_rules! conformance_tests {
         #[test]
         fn bus_off_and_recovery() {
             conformance::bus_off_and_recovery::<$dut>();
+        }
+        #[test]
+        fn remote_dlc_codes_on_the_wire() {
+            conformance::remote_dlc_codes_on_the_wire::<$dut>();
         }
     };
 }

@@ -5,10 +5,18 @@
 //!            [--sample-point PCT] [--tolerance PPM] [--json] [--all]
 //! ```
 //!
-//! Exit status: 0 timing found within tolerance, 1 timing printed but outside the
-//! tolerance (ACAN "too far from wished bit rate") or, for FlexCAN, forbidden by the
-//! Kinetis manual's rules (8 quanta and 16 bus clocks per bit, bus clock not below
-//! the CAN clock: `twocan_core::timing::flexcan_rules`), 2 bad options or input.
+//! The timing is computed and judged by the rule the driver applies
+//! (`twocan_core::timing::TimingRule`; FlexCAN: `flexcan_rules::rule` with the bus clock,
+//! 8 quanta and 16 bus clocks per bit, as the FlexCAN backend's `begin`, `set_timing`,
+//! `set_bitrate` and capabilities; bxCAN: the `CAN_BTR` ranges, as `Config::from_bitrate`
+//! and the capabilities): what it accepts, the driver accepts.
+//!
+//! Exit status: 0 timing accepted (in the rule's range, allowed, within tolerance), 1
+//! timing printed but refused: outside the tolerance (ACAN "too far from wished bit
+//! rate"), a wished rate outside the rule's range (one bit per second beyond the
+//! fastest or slowest accepted timing), or, for FlexCAN, forbidden by the Kinetis
+//! manual's rules (bus clock not below the CAN clock, 16 bus clocks per bit); 2 bad
+//! options or input, or no timing at all (a rate above clock / fewest quanta).
 
 use std::process::ExitCode;
 
@@ -17,8 +25,8 @@ use clap::{CommandFactory, Parser, ValueEnum};
 use serde::ser::{SerializeMap, Serializer};
 use serde::Serialize;
 use twocan_core::timing::{
-    cia_sample_point, flexcan_rules, solve, Controller, Limits, Solutions, Timing,
-    DEFAULT_TOLERANCE_PPM, FLEXCAN_CTRL1_TIMING_MASK,
+    cia_sample_point, flexcan_rules, solve, Controller, Limits, Solutions, Timing, TimingError,
+    TimingRule, DEFAULT_TOLERANCE_PPM, FLEXCAN_CTRL1_TIMING_MASK,
 };
 
 /// The controller whose bit timing register is computed.
@@ -154,16 +162,22 @@ fn permille(v: u16) -> String {
     format!("{}.{}", v / 10, v % 10)
 }
 
-/// Why the controller's manual forbids `t` beyond the register ranges, if it does
-/// (FlexCAN: Kinetis RM "Arbitration and matching timing", 16 message buffers with the
-/// Rx FIFO as the driver configures them; bxCAN: none).
-fn manual_violation(t: &Timing, bus_clock: u32) -> Option<String> {
-    match t.limits.controller {
-        Controller::FlexCan => flexcan_rules::check(t, bus_clock, 16, true)
-            .err()
-            .map(|e| e.to_string()),
-        Controller::BxCan => None,
+impl Options {
+    /// The rule the driver applies (FlexCAN: Kinetis RM "Arbitration and matching
+    /// timing", 16 message buffers with the Rx FIFO as the driver configures them, the
+    /// bus clock given; bxCAN: the `CAN_BTR` ranges).
+    fn rule(&self) -> TimingRule {
+        match self.controller {
+            Controller::FlexCan => flexcan_rules::rule(self.clock, self.bus_clock, 16, true),
+            Controller::BxCan => TimingRule::new(self.clock, Limits::BXCAN),
+        }
     }
+}
+
+/// Why the controller's manual forbids `t` beyond the register ranges, if it does
+/// ([`TimingRule::manual_violation`]; bxCAN: never).
+fn manual_violation(rule: &TimingRule, t: &Timing) -> Option<String> {
+    rule.manual_violation(t).map(|e| e.to_string())
 }
 
 /// Register values of a timing: (name, value) pairs, the whole register first.
@@ -246,8 +260,8 @@ struct TimingJson {
 }
 
 impl TimingJson {
-    fn new(t: &Timing, tolerance: u32, bus_clock: u32) -> Self {
-        let manual_rule = manual_violation(t, bus_clock);
+    fn new(t: &Timing, tolerance: u32, rule: &TimingRule) -> Self {
+        let manual_rule = manual_violation(rule, t);
         TimingJson {
             manual_ok: manual_rule.is_none(),
             manual_rule,
@@ -274,8 +288,8 @@ impl TimingJson {
     }
 }
 
-/// The whole `--json` answer: the request, the chosen timing, and with `--all` every
-/// timing within the tolerance.
+/// The whole `--json` answer: the request, the rule's range, the verdict, the chosen
+/// timing, and with `--all` every timing within the tolerance.
 #[derive(Serialize)]
 struct Answer {
     controller: &'static str,
@@ -283,23 +297,78 @@ struct Answer {
     bitrate: u32,
     tolerance_ppm: u32,
     sample_point_target_permille: u16,
+    /// The slowest and fastest wished rates the driver accepts (the bit rates of the
+    /// rule's slowest and fastest timings, rounded down).
+    min_bitrate: u32,
+    max_bitrate: u32,
+    /// Whether the driver accepts this timing for this wished rate and tolerance.
+    accepted: bool,
+    /// Why not (the driver's error), when it does not.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    refusal: Option<String>,
     #[serde(flatten)]
     chosen: TimingJson,
     #[serde(skip_serializing_if = "Option::is_none")]
     solutions: Option<Vec<TimingJson>>,
 }
 
-fn json(o: &Options, target: u16, t: &Timing, all: &[Timing]) -> String {
+/// The computed answer: the target sample point, the chosen timing, the rule's verdict
+/// on it ([`TimingRule::accept`]), every timing within the tolerance (with `--all`).
+struct Outcome {
+    rule: TimingRule,
+    target: u16,
+    timing: Timing,
+    verdict: Result<(), TimingError>,
+    all: Vec<Timing>,
+}
+
+/// Solves within the rule's limits and judges the result by the rule; `Err` (exit 2)
+/// when there is no timing at all.
+fn compute(o: &Options) -> Result<Outcome, String> {
+    let rule = o.rule();
+    let target = o.sample_point.unwrap_or(cia_sample_point(o.bitrate));
+    let timing = solve(o.clock, o.bitrate, &rule.limits, target).map_err(|e| {
+        format!(
+            "{e} (controller {}, clock {} Hz, bit rate {} bit/s, sample point {} %)",
+            o.controller.name(),
+            o.clock,
+            o.bitrate,
+            permille(target)
+        )
+    })?;
+    let all = if o.all {
+        match Solutions::new(o.clock, o.bitrate, &rule.limits, o.tolerance) {
+            Ok(s) => s.collect(),
+            Err(_) => Vec::new(),
+        }
+    } else {
+        Vec::new()
+    };
+    Ok(Outcome {
+        verdict: rule.accept(&timing, o.tolerance),
+        rule,
+        target,
+        timing,
+        all,
+    })
+}
+
+fn json(o: &Options, out: &Outcome) -> String {
     let answer = Answer {
         controller: o.controller.name(),
         clock: o.clock,
         bitrate: o.bitrate,
         tolerance_ppm: o.tolerance,
-        sample_point_target_permille: target,
-        chosen: TimingJson::new(t, o.tolerance, o.bus_clock),
+        sample_point_target_permille: out.target,
+        min_bitrate: out.rule.min_bitrate(),
+        max_bitrate: out.rule.max_bitrate(),
+        accepted: out.verdict.is_ok(),
+        refusal: out.verdict.err().map(|e| e.to_string()),
+        chosen: TimingJson::new(&out.timing, o.tolerance, &out.rule),
         solutions: o.all.then(|| {
-            all.iter()
-                .map(|s| TimingJson::new(s, o.tolerance, o.bus_clock))
+            out.all
+                .iter()
+                .map(|s| TimingJson::new(s, o.tolerance, &out.rule))
                 .collect()
         }),
     };
@@ -307,7 +376,8 @@ fn json(o: &Options, target: u16, t: &Timing, all: &[Timing]) -> String {
     serde_json::to_string(&answer).unwrap_or_default()
 }
 
-fn print_text(o: &Options, target: u16, t: &Timing, all: &[Timing]) {
+fn print_text(o: &Options, out: &Outcome) {
+    let (target, t, all) = (out.target, &out.timing, &out.all);
     let ok = t.within_tolerance(o.tolerance);
     println!("controller      {}", o.controller.name());
     println!("clock           {} Hz", o.clock);
@@ -351,7 +421,7 @@ fn print_text(o: &Options, target: u16, t: &Timing, all: &[Timing]) {
     );
     println!("sjw             {}", t.sjw);
     if o.controller == Controller::FlexCan {
-        match manual_violation(t, o.bus_clock) {
+        match manual_violation(&out.rule, t) {
             None => println!(
                 "Kinetis RM      ok (8+ quanta, 16+ bus clocks per bit at bus {} Hz)",
                 o.bus_clock
@@ -360,6 +430,15 @@ fn print_text(o: &Options, target: u16, t: &Timing, all: &[Timing]) {
         }
     }
     println!("osc. tolerance  {} ppm", t.oscillator_tolerance_ppm());
+    println!(
+        "accepted range  {} ..= {} bit/s",
+        out.rule.min_bitrate(),
+        out.rule.max_bitrate()
+    );
+    match out.verdict {
+        Ok(()) => println!("driver          accepts"),
+        Err(e) => println!("driver          REFUSES: {e}"),
+    }
     let regs = registers(t);
     if let Some(((name, value), fields)) = regs.split_first() {
         match o.controller {
@@ -405,35 +484,19 @@ fn main() -> ExitCode {
         Ok(o) => o,
         Err(e) => e.exit(),
     };
-    let limits: Limits = o.controller.limits();
-    let target = o.sample_point.unwrap_or(cia_sample_point(o.bitrate));
-    let t = match solve(o.clock, o.bitrate, &limits, target) {
-        Ok(t) => t,
+    let out = match compute(&o) {
+        Ok(out) => out,
         Err(e) => {
-            eprintln!(
-                "can-timing: error: {e} (controller {}, clock {} Hz, bit rate {} bit/s, sample point {} %)",
-                o.controller.name(),
-                o.clock,
-                o.bitrate,
-                permille(target)
-            );
+            eprintln!("can-timing: error: {e}");
             return ExitCode::from(2);
         }
     };
-    let all: Vec<Timing> = if o.all {
-        match Solutions::new(o.clock, o.bitrate, &limits, o.tolerance) {
-            Ok(s) => s.collect(),
-            Err(_) => Vec::new(),
-        }
-    } else {
-        Vec::new()
-    };
     if o.json {
-        println!("{}", json(&o, target, &t, &all));
+        println!("{}", json(&o, &out));
     } else {
-        print_text(&o, target, &t, &all);
+        print_text(&o, &out);
     }
-    if t.validate(o.tolerance).is_ok() && manual_violation(&t, o.bus_clock).is_none() {
+    if out.verdict.is_ok() {
         ExitCode::SUCCESS
     } else {
         ExitCode::from(1)
@@ -451,13 +514,7 @@ mod tests {
 
     fn run_json(line: &str) -> String {
         let o = parse_args(line).unwrap();
-        let limits = o.controller.limits();
-        let target = o.sample_point.unwrap_or(cia_sample_point(o.bitrate));
-        let t = solve(o.clock, o.bitrate, &limits, target).unwrap();
-        let all: Vec<Timing> = Solutions::new(o.clock, o.bitrate, &limits, o.tolerance)
-            .unwrap()
-            .collect();
-        json(&o, target, &t, &all)
+        json(&o, &compute(&o).unwrap())
     }
 
     #[test]
@@ -504,9 +561,10 @@ mod tests {
         assert!(j.contains("8 peripheral clocks per CAN bit"), "{j}");
         let j = run_json("--controller flexcan --bitrate 2000000 --bus-clock 32000000 --json");
         assert!(j.contains("\"manual_ok\":true,"), "{j}");
-        // ACAN's 3.2 Mbit/s: 5 quanta, whatever the bus clock.
-        let j = run_json("--controller flexcan --bitrate 3200000 --bus-clock 60000000 --json");
-        assert!(j.contains("5 time quanta per bit"), "{j}");
+        // ACAN's 3.2 Mbit/s is 5 quanta: no timing of 8 or more, whatever the bus
+        // clock (exit status 2, as the driver has none either).
+        let o = parse_args("--controller flexcan --bitrate 3200000 --bus-clock 60000000").unwrap();
+        assert!(compute(&o).err().unwrap().contains("above"));
         // A bus clock below the CAN clock.
         let j = run_json("--controller flexcan --bitrate 125000 --bus-clock 8000000 --json");
         assert!(j.contains("below the CAN clock"), "{j}");
@@ -515,6 +573,55 @@ mod tests {
         assert!(j.contains("\"manual_ok\":true,"), "{j}");
         let o = parse_args("--controller flexcan --bitrate 1000000").unwrap();
         assert_eq!(o.bus_clock, 16_000_000);
+    }
+
+    /// Issue 22: the tool judges by the driver's rule, one bit per second beyond the
+    /// fastest and the slowest accepted rates is refused, the rates themselves accepted.
+    #[test]
+    fn the_driver_s_rule_decides() {
+        let verdict = |line: &str| compute(&parse_args(line).unwrap()).unwrap().verdict;
+        assert_eq!(verdict("--controller flexcan --bitrate 1000000"), Ok(()));
+        assert_eq!(
+            verdict("--controller flexcan --bitrate 1000001"),
+            Err(TimingError::BitrateTooHigh)
+        );
+        assert_eq!(verdict("--controller flexcan --bitrate 2500"), Ok(()));
+        assert_eq!(
+            verdict("--controller flexcan --bitrate 2499"),
+            Err(TimingError::BitrateTooLow)
+        );
+        assert_eq!(
+            verdict("--controller flexcan --bitrate 2000000 --bus-clock 16000000"),
+            Err(TimingError::BitrateTooHigh)
+        );
+        assert_eq!(
+            verdict("--controller bxcan --clock 54000000 --bitrate 2109"),
+            Ok(())
+        );
+        assert_eq!(
+            verdict("--controller bxcan --clock 54000000 --bitrate 2108"),
+            Err(TimingError::BitrateTooLow)
+        );
+        assert_eq!(
+            verdict("--controller bxcan --clock 54000000 --bitrate 18000000"),
+            Ok(())
+        );
+        // Above 54 MHz / 3 quanta there is no timing at all (exit status 2).
+        let o = parse_args("--controller bxcan --clock 54000000 --bitrate 18000001").unwrap();
+        assert!(compute(&o).is_err());
+        let j = run_json("--controller bxcan --clock 54000000 --bitrate 2108 --json");
+        let v: serde_json::Value = serde_json::from_str(&j).unwrap();
+        assert_eq!(v["accepted"], false);
+        assert_eq!(
+            (v["min_bitrate"].as_u64(), v["max_bitrate"].as_u64()),
+            (Some(2_109), Some(18_000_000))
+        );
+        assert!(v["refusal"].as_str().unwrap().contains("below"), "{j}");
+        // The timings it accepts are the driver's: 8 quanta at least on FlexCAN.
+        let o = parse_args("--controller flexcan --bitrate 15166 --all").unwrap();
+        let out = compute(&o).unwrap();
+        assert_eq!(out.verdict, Ok(()));
+        assert!(out.timing.quanta() >= 8 && out.all.iter().all(|t| t.quanta() >= 8));
     }
 
     #[test]
