@@ -40,7 +40,7 @@
 
 use core::cell::{Cell, UnsafeCell};
 use core::mem::MaybeUninit;
-use core::sync::atomic::{AtomicBool, AtomicU32, AtomicU8, Ordering};
+use core::sync::atomic::{AtomicU32, AtomicU8, Ordering};
 
 use crate::controller::{ErrorStatus, Mode};
 use crate::dispatch::Dispatcher;
@@ -110,6 +110,15 @@ pub(crate) struct Stamped<R> {
 
 /// No state recorded yet (0, so that a `static State` is all zeros and lives in `.bss`).
 const STATE_UNKNOWN: u8 = 0;
+
+/// `State::stage`: no controller (0: all zeros).
+const EMPTY: u8 = 0;
+/// `State::stage`: one `split` claimed the state and is writing the controller; nothing
+/// may read it yet.
+const CLAIMED: u8 = 1;
+/// `State::stage`: the controller is written (release store after the write); readers
+/// that load `READY` with acquire ordering see it whole.
+const READY: u8 = 2;
 
 fn state_code(s: ErrorState) -> u8 {
     match s {
@@ -181,7 +190,8 @@ pub struct State<
     const RX1: usize = 0,
     const DONE: usize = 8,
 > {
-    taken: AtomicBool,
+    /// [`EMPTY`], [`CLAIMED`] or [`READY`]: who may touch `hw` (see `split`).
+    stage: AtomicU8,
     hw: UnsafeCell<MaybeUninit<H>>,
     rx0: SpscRing<Stamped<H::Raw>, RX>,
     rx1: SpscRing<Stamped<H::Raw>, RX1>,
@@ -264,7 +274,7 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
     /// Empty, with no controller yet: all zeros.
     pub const fn new() -> Self {
         State {
-            taken: AtomicBool::new(false),
+            stage: AtomicU8::new(EMPTY),
             hw: UnsafeCell::new(MaybeUninit::uninit()),
             rx0: SpscRing::new(),
             rx1: SpscRing::new(),
@@ -293,9 +303,20 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
     /// Stores `hardware` and hands out the handles; once only. A second call gives
     /// `hardware` back. The controller's transmit order must be `Q`'s
     /// ([`Error::InvalidArgument`] otherwise, with the controller given back).
+    ///
+    /// Any context may call it, and several may race: the first to claim the state
+    /// (one compare-and-swap) is the only one that touches the queue and writes the
+    /// controller; the controller becomes visible to [`State::hardware`] (and to every
+    /// reader in other contexts) only once it is written, through a release store that
+    /// those readers load with acquire ordering.
     #[allow(clippy::type_complexity)]
     pub fn split(&self, hardware: H) -> Result<Parts<'_, H, RX, Q, RX1, DONE>, (Error, H)> {
-        if self.taken.load(Ordering::Acquire) {
+        // Claim first: a losing `split` must not touch the winner's queue.
+        if self
+            .stage
+            .compare_exchange(EMPTY, CLAIMED, Ordering::Acquire, Ordering::Relaxed)
+            .is_err()
+        {
             return Err((Error::WrongMode, hardware));
         }
         let adopted = critical_section::with(|cs| {
@@ -303,21 +324,23 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
             unsafe { &mut *self.queue.borrow(cs).get() }.adopt(hardware.tx_policy())
         });
         if !adopted {
+            // Nothing was written: the state is free again.
+            self.stage.store(EMPTY, Ordering::Release);
             return Err((Error::InvalidArgument, hardware));
         }
-        if self.taken.swap(true, Ordering::AcqRel) {
-            return Err((Error::WrongMode, hardware));
-        }
-        // SAFETY: `taken` was false: no handle exists, so nothing reads `hw` yet, and
-        // the swap above makes this the only writer ever.
+        // SAFETY: this call moved `stage` from EMPTY to CLAIMED, so it is the only
+        // writer of `hw`, and no reader touches `hw` before `stage` is READY (stored
+        // below, after the write).
         unsafe { (*self.hw.get()).write(hardware) };
-        // SAFETY: written just above.
+        // SAFETY: written just above, by this thread.
         let hw = unsafe { (*self.hw.get()).assume_init_ref() };
         let map = hw.filter_map();
         let status = hw.error_status();
-        self.refresh_timestamps();
         self.state
-            .store(state_code(status.state), Ordering::Release);
+            .store(state_code(status.state), Ordering::Relaxed);
+        // Publish: the controller (and the state code) are written before this store.
+        self.stage.store(READY, Ordering::Release);
+        self.refresh_timestamps();
         Ok(Parts {
             tx: Tx { s: self, next: 0 },
             rx: Rx { s: self, map },
@@ -334,10 +357,12 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
     /// Stores `hardware` in a state owned exclusively (the one-struct
     /// [`crate::Driver`]); returns the filter map and status for its handles.
     pub(crate) fn install(&mut self, hardware: H) -> (H::FilterMap, ErrorStatus) {
+        debug_assert_eq!(*self.stage.get_mut(), EMPTY, "installed once");
         let policy = hardware.tx_policy();
         self.queue.get_mut().get_mut().adopt(policy);
         self.hw.get_mut().write(hardware);
-        *self.taken.get_mut() = true;
+        // `&mut self`: no other context can look; READY for the readers to come.
+        *self.stage.get_mut() = READY;
         let hw = self.hw();
         let status = hw.error_status();
         self.refresh_timestamps();
@@ -348,18 +373,21 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
 
     /// Takes the controller back out of a state owned exclusively.
     pub(crate) fn uninstall(&mut self) -> Option<H> {
-        if !core::mem::replace(self.taken.get_mut(), false) {
+        if core::mem::replace(self.stage.get_mut(), EMPTY) != READY {
             return None;
         }
-        // SAFETY: `taken` was set: `hw` holds a controller, moved out exactly once
-        // (the flag is cleared first).
+        // SAFETY: the stage was READY: `hw` holds a controller, moved out exactly once
+        // (the stage is EMPTY from now on, and `&mut self` excludes every reader).
         Some(unsafe { self.hw.get_mut().assume_init_read() })
     }
 
-    /// The controller, once [`State::split`] stored it.
+    /// The controller, once [`State::split`] stored it (any context).
     pub fn hardware(&self) -> Option<&H> {
-        if self.taken.load(Ordering::Acquire) {
-            // SAFETY: `taken` is set only after `hw` was written (release/acquire).
+        if self.stage.load(Ordering::Acquire) == READY {
+            // SAFETY: READY is stored (release) only after `hw` was written, and this
+            // load is acquire: the write happens before this read. Nothing writes `hw`
+            // again while a shared reference to the state exists (`uninstall` takes
+            // `&mut self`).
             Some(unsafe { (*self.hw.get()).assume_init_ref() })
         } else {
             None
@@ -368,8 +396,11 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
 
     #[inline(always)]
     fn hw(&self) -> &H {
-        // SAFETY: only handles call this, and handles exist only after `split` wrote
-        // `hw`.
+        debug_assert_eq!(self.stage.load(Ordering::Relaxed), READY);
+        // SAFETY: only the handles (and `install`, after its write) call this. A handle
+        // is made by `split` after it wrote `hw`, in the same thread, and reaches
+        // another context only through something that synchronises (a thread spawn, an
+        // `IrqCell`'s release/acquire, a channel): the write happens before this read.
         unsafe { (*self.hw.get()).assume_init_ref() }
     }
 
