@@ -101,10 +101,23 @@ pub struct BxCan<R: Registers, F: Registers = R, const K: usize = LOOKUP_KEYS> {
     discarded: AtomicU32,
 }
 
-// SAFETY: the atomics are shared; `displaced` is touched by the transmit interrupt's
-// methods only (one context at a time, the `Hardware` contract); the register handles
-// are shared as `Hardware` documents (disjoint registers or write-1-to-clear bits).
-unsafe impl<R: Registers + Sync, F: Registers + Sync, const K: usize> Sync for BxCan<R, F, K> {}
+// SAFETY: what each field needs to be shared between contexts:
+// - `regs`, `filter_regs`: every context reads and writes registers through `&R`/`&F`
+//   (`R: Sync`, `F: Sync`), each its own registers or write-1-to-clear bits (module
+//   docs, the `Hardware` contract);
+// - `fmi`: touched only by `decode` and `install_filters`, both `unsafe` and called
+//   from the receive half's one context (the `Hardware` contract, upheld by
+//   `twocan_core::split::Rx`); that context may move between threads with the receive
+//   half, so the map must be `Send` (the `where` clause);
+// - `displaced`: touched only by `displace` and `settle`, both `unsafe` and called from
+//   the transmit interrupt's context inside the driver's critical section; `Frame` is
+//   plain data;
+// - `instance`, `config`: read only; everything else is atomic.
+// `BxCan` itself is `Send` (moved into the driver's state) exactly when `R` and `F` are.
+unsafe impl<R: Registers + Sync, F: Registers + Sync, const K: usize> Sync for BxCan<R, F, K> where
+    FmiMap<K>: Send
+{
+}
 
 impl<R: Registers, F: Registers, const K: usize> Can<R, F, K> {
     /// The controller for the split driver (`twocan_core::split::State::split`); the

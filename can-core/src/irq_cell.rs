@@ -38,9 +38,24 @@ pub struct IrqCell<T> {
     value: UnsafeCell<MaybeUninit<T>>,
 }
 
-// SAFETY: the value is reached only through `run`, which gives `&mut T` to one context
-// at a time (the busy flag); `T: Send` lets it move to that context.
+// SAFETY: the value is written once by the context whose `put` moved the state from
+// EMPTY to WRITING, and reached afterwards only through `run`, which gives `&mut T` to
+// one context at a time (the BUSY state, taken by compare-and-swap; release/acquire
+// orders each context's accesses after the previous one's). Like `Mutex<T>`, sharing
+// the cell hands the value itself (not `&T`) from context to context: `T: Send`, and no
+// `T: Sync` is needed because no two contexts hold a reference at once.
 unsafe impl<T: Send> Sync for IrqCell<T> {}
+
+impl<T> Drop for IrqCell<T> {
+    fn drop(&mut self) {
+        if matches!(*self.state.get_mut(), READY | BUSY) {
+            // SAFETY: READY (or BUSY, left by a `run` that panicked) is stored only
+            // after the value was written; `&mut self` excludes every other access,
+            // and the value is dropped once, here.
+            unsafe { self.value.get_mut().assume_init_drop() };
+        }
+    }
+}
 
 impl<T> Default for IrqCell<T> {
     fn default() -> Self {

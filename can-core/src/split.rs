@@ -219,12 +219,22 @@ pub struct State<
     _q: core::marker::PhantomData<Q>,
 }
 
-// SAFETY: the controller is written once by `split` before `taken` is published and
-// only read afterwards (`H: Sync` makes sharing it sound); the rings follow the SPSC
-// contract through the unique handles; the queue is only touched inside a critical
-// section.
+// SAFETY: what each field needs to be shared between contexts:
+// - `hw`: written once, by the one `split` that claimed the state, before `stage` is
+//   published READY (release; readers acquire), then only read through `&H` from every
+//   context: `H: Sync`. A controller moved in through `&State` by one thread is dropped
+//   (or taken back by `uninstall`) by whichever thread owns the state later: `H: Send`,
+//   as `OnceLock<T>: Sync` needs `T: Send + Sync`.
+// - the rings: one producer handle and one consumer handle each (`SpscRing`'s
+//   contract, upheld by the handles `split` makes once); their entries move between
+//   contexts: `H::Raw: Send` (raw frames), and completions and state changes are plain
+//   data.
+// - `queue`: only touched inside a critical section (`critical_section::Mutex`), and its
+//   entries move between contexts: `Q: Send`.
+// - `clock`: inside a `critical_section::Mutex`; the counters, `stage` and `state` are
+//   atomics; the wakers are `AtomicWaker`s (`Sync`).
 unsafe impl<
-        H: Hardware + Sync,
+        H: Hardware + Send + Sync,
         const RX: usize,
         Q: TxQueue + Send,
         const RX1: usize,
@@ -234,6 +244,7 @@ where
     H::Raw: Send,
 {
 }
+
 
 impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize> Default
     for State<H, RX, Q, RX1, DONE>

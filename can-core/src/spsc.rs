@@ -83,8 +83,11 @@ pub struct SpscRing<T: Copy, const N: usize> {
 }
 
 // SAFETY: the slots are accessed by one producer and one consumer at a time (the
-// contract of `push` and `pop`), with the acquire/release protocol of the module docs
-// ordering each slot's write before its read; `T: Send` moves values between contexts.
+// contract of `push` and `pop`, upheld by their callers: the split driver's unique
+// handles), with the acquire/release protocol of the module docs ordering each slot's
+// write before its read; `T: Send` because values move from the producer's context to
+// the consumer's (`T: Copy`, so no slot is ever dropped). The indices and figures are
+// atomics. (`Send` is automatic: `T: Send` makes the slots `Send`.)
 unsafe impl<T: Copy + Send, const N: usize> Sync for SpscRing<T, N> {}
 
 impl<T: Copy, const N: usize> Default for SpscRing<T, N> {

@@ -3,11 +3,17 @@
 //! this file under it, with several scheduler seeds), which reports a data race where a
 //! native run may only see wrong values.
 
+use std::marker::PhantomData;
+use std::sync::atomic::{AtomicU32, Ordering};
 use std::sync::Barrier;
 
-use twocan_core::mock::MockHardware;
+use twocan_core::mock::{MockFilterList, MockHardware};
 use twocan_core::split::State;
-use twocan_core::{AnyQueue, FifoQueue, Frame, Hardware, TxPolicy};
+use twocan_core::timing::Timing;
+use twocan_core::{
+    AnyQueue, BusMode, BusOffRecovery, Capabilities, Error, ErrorStatus, FifoQueue, Frame,
+    Hardware, MailboxId, MailboxState, Mode, RxFrame, Settled, StatusEvents, Token, TxPolicy,
+};
 
 /// Rounds of each race: many natively, a few under Miri (each is slow there).
 const ROUNDS: usize = if cfg!(miri) { 4 } else { 300 };
@@ -83,4 +89,143 @@ fn a_losing_split_leaves_the_winners_queue_order_alone() {
             TxPolicy::Priority => assert!(c < b, "identifier order lost: {sent:x?}"),
         }
     }
+}
+
+/// A controller for these tests: the mock, with two receive queues that hand out
+/// `feed[q]` frames each (from whichever context drains them), and a marker `M` that
+/// decides the controller's `Send`/`Sync`.
+struct Fed<M = ()> {
+    mock: MockHardware,
+    feed: [AtomicU32; 2],
+    _marker: PhantomData<M>,
+}
+
+impl<M> Fed<M> {
+    fn new(frames: [u32; 2]) -> Self {
+        Fed {
+            mock: MockHardware::new(3),
+            feed: frames.map(AtomicU32::new),
+            _marker: PhantomData,
+        }
+    }
+}
+
+// SAFETY: the mock keeps every `Hardware` promise (one critical section around its
+// state); `feed` is atomic, each queue's counter decremented by its one `read_rx`
+// context.
+unsafe impl<M> Hardware for Fed<M> {
+    type Raw = Frame;
+    type FilterMap = MockFilterList;
+    type Filters = MockFilterList;
+    const RX_QUEUES: usize = 2;
+
+    fn tx_policy(&self) -> TxPolicy {
+        self.mock.tx_policy()
+    }
+    fn free_mailbox(&self, frame: &Frame) -> Result<Option<u8>, Error> {
+        self.mock.free_mailbox(frame)
+    }
+    unsafe fn load(&self, mailbox: u8, frame: &Frame, token: Token) {
+        // SAFETY: the caller's contract, passed on.
+        unsafe { self.mock.load(mailbox, frame, token) }
+    }
+    unsafe fn settle<F: FnMut(Settled)>(&self, f: F) {
+        // SAFETY: the caller's contract, passed on.
+        unsafe { self.mock.settle(f) }
+    }
+    fn mailbox_count(&self) -> u8 {
+        self.mock.mailbox_count()
+    }
+    fn mailbox_state(&self, mailbox: MailboxId) -> MailboxState {
+        self.mock.mailbox_state(mailbox)
+    }
+    unsafe fn request_abort(&self, token: Token) -> bool {
+        // SAFETY: the caller's contract, passed on.
+        unsafe { self.mock.request_abort(token) }
+    }
+    unsafe fn abort_all_mailboxes(&self) {
+        // SAFETY: the caller's contract, passed on.
+        unsafe { self.mock.abort_all_mailboxes() }
+    }
+    unsafe fn read_rx(&self, queue: usize, overrun: &mut bool) -> Option<Frame> {
+        let left = &self.feed[queue];
+        let n = left.load(Ordering::Relaxed);
+        if n > 0 {
+            left.store(n - 1, Ordering::Relaxed);
+            *overrun = true;
+            return Some(Frame::standard(queue as u16, &[]).unwrap());
+        }
+        // SAFETY: the caller's contract, passed on.
+        (queue == 0).then(|| unsafe { self.mock.read_rx(0, overrun) })?
+    }
+    unsafe fn decode(&self, raw: &Frame, map: &MockFilterList) -> Option<RxFrame> {
+        // SAFETY: the caller's contract, passed on.
+        unsafe { self.mock.decode(raw, map) }
+    }
+    unsafe fn install_filters(&self, filters: &MockFilterList) -> Result<MockFilterList, Error> {
+        // SAFETY: the caller's contract, passed on.
+        unsafe { self.mock.install_filters(filters) }
+    }
+    fn filter_map(&self) -> MockFilterList {
+        self.mock.filter_map()
+    }
+    unsafe fn take_status(&self) -> StatusEvents {
+        // SAFETY: the caller's contract, passed on.
+        unsafe { self.mock.take_status() }
+    }
+    fn error_status(&self) -> ErrorStatus {
+        self.mock.error_status()
+    }
+    fn on_bus(&self) -> bool {
+        self.mock.on_bus()
+    }
+    fn set_mode(&self, mode: Mode) -> Result<(), Error> {
+        self.mock.set_mode(mode)
+    }
+    fn recover(&self) -> Result<(), Error> {
+        self.mock.recover()
+    }
+    fn capabilities(&self) -> Capabilities {
+        self.mock.capabilities()
+    }
+    fn bus_mode(&self) -> BusMode {
+        self.mock.bus_mode()
+    }
+    fn bus_off_recovery(&self) -> BusOffRecovery {
+        self.mock.bus_off_recovery()
+    }
+    fn set_timing(&self, timing: &Timing) -> Result<(), Error> {
+        self.mock.set_timing(timing)
+    }
+    fn set_bus_mode(&self, mode: BusMode) -> Result<(), Error> {
+        self.mock.set_bus_mode(mode)
+    }
+}
+
+/// Whether `T: Sync`, decided at compile time (an inherent constant whose bound fails
+/// gives way to the trait's).
+struct Probe<T: ?Sized>(PhantomData<T>);
+trait NotSync {
+    const SYNC: bool = false;
+}
+impl<T: ?Sized> NotSync for Probe<T> {}
+impl<T: ?Sized + Sync> Probe<T> {
+    const SYNC: bool = true;
+}
+
+/// `Sync` but not `Send` (a guard must be released on the thread that took it).
+type SyncNotSend = std::sync::MutexGuard<'static, ()>;
+
+/// Item 2: sharing a `State` lets any thread move a controller in (`split` through
+/// `&State`) that the owner drops later on its own thread, so the state may be shared
+/// only when the controller may move between threads (`H: Send`), as for `OnceLock`.
+#[test]
+fn a_state_is_shared_only_over_a_controller_that_may_move() {
+    assert!(Probe::<Fed<SyncNotSend>>::SYNC, "the probe sees a Sync controller");
+    assert!(
+        !Probe::<State<Fed<SyncNotSend>, 4, FifoQueue<2>>>::SYNC,
+        "a State over a controller that is not Send must not be Sync"
+    );
+    assert!(Probe::<State<Fed, 4, FifoQueue<2>>>::SYNC);
+    assert!(Probe::<State<MockHardware, 4, FifoQueue<2>>>::SYNC);
 }

@@ -338,11 +338,18 @@ impl<R: Registers> FlexCanHw<R> {
     }
 }
 
-// SAFETY: the shared fields are atomics; the filter table is touched only from the
-// receive half's context (the `Hardware` contract of `decode` and `install_filters`);
-// the register accesses of each context are those listed in the module docs (disjoint
-// registers, write-1-to-clear bits).
-unsafe impl<R: Registers + Sync> Sync for FlexCanHw<R> {}
+// SAFETY: what each field needs to be shared between contexts:
+// - `regs`: every context reads and writes registers through `&R` (`R: Sync`), each
+//   its own registers or write-1-to-clear bits (module docs, the `Hardware` contract);
+// - `table`: touched only by `decode` and `install_filters` (both `unsafe`, called from
+//   the receive half's one context: the `Hardware` contract, upheld by
+//   `twocan_core::split::Rx`) and by `filters`, which takes the receive half's proof of
+//   context ([`ReceiveContext`]); the context may move between threads with the
+//   receive half, so the table must be `Send` (the `where` clause);
+// - `target`, `configuration`, `srxdis`, `recovery`, `irq_priority`, `system`,
+//   `bus_clock_hz`: read only; everything else is atomic.
+// `FlexCanHw` itself is `Send` (moved into the driver's state) exactly when `R` is.
+unsafe impl<R: Registers + Sync> Sync for FlexCanHw<R> where FilterTable: Send {}
 
 // SAFETY: as for `Sync`: each method stays within its context's registers.
 unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
