@@ -24,7 +24,7 @@ use crate::error::{Error, ErrorCounters, ErrorState, ErrorStatistics, LastErrorC
 use crate::frame::{Frame, RxFrame};
 use crate::hardware::{Completion, Hardware, Token};
 use crate::mailbox::TxPolicy;
-use crate::split::{AbortRequest, RxIrq, State, StateChange, StatusIrq, Tx, TxIrq};
+use crate::split::{AbortRequest, Rx0Irq, Rx1Irq, State, StateChange, StatusIrq, Tx, TxIrq};
 use crate::spsc::BufferStats;
 use crate::timing::Timing;
 use crate::txqueue::AnyQueue;
@@ -157,9 +157,9 @@ impl<H: Hardware, const RX: usize, const TX: usize, const RX1: usize> Driver<H, 
     pub fn on_interrupt(&mut self) {
         let s = &self.state;
         TxIrq { s }.on_interrupt();
-        RxIrq { s, queue: 0 }.on_interrupt();
+        Rx0Irq { s }.on_interrupt();
         if RX1 > 0 && H::RX_QUEUES > 1 {
-            RxIrq { s, queue: 1 }.on_interrupt();
+            Rx1Irq { s }.on_interrupt();
         }
         let mut status = StatusIrq { s, last: self.last };
         status.on_interrupt();
@@ -172,13 +172,15 @@ impl<H: Hardware, const RX: usize, const TX: usize, const RX1: usize> Driver<H, 
         TxIrq { s: &self.state }.on_interrupt();
     }
 
-    /// The receive handler of hardware queue `queue` ([`RxIrq::on_interrupt`]).
+    /// The receive handler of hardware queue `queue` ([`crate::split::RxIrq::on_interrupt`]; a
+    /// queue the controller does not have: nothing).
     pub fn on_rx(&mut self, queue: u8) {
-        RxIrq {
-            s: &self.state,
-            queue,
+        let s = &self.state;
+        match queue {
+            0 => Rx0Irq { s }.on_interrupt(),
+            1 => Rx1Irq { s }.on_interrupt(),
+            _ => {}
         }
-        .on_interrupt();
     }
 
     /// The status line's handler ([`StatusIrq::on_interrupt`]), then a read of the

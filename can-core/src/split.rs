@@ -139,8 +139,27 @@ struct ErrorCounts {
     bit: Counter,
     crc: Counter,
     bus_off: Counter,
-    overruns: Counter,
     wakeups: Counter,
+}
+
+/// The counters of one hardware receive queue, written by its receive handler only.
+///
+/// One writer per counter, rather than a read-modify-write shared by both handlers:
+/// an atomic `fetch_add` would need LDREX/STREX (ARMv7-M has them, ARMv6-M does not)
+/// and costs a retry loop on the per-frame path; a plain load and store per queue
+/// works on every core and the readers add the two.
+struct QueueCounts {
+    received: Counter,
+    overruns: Counter,
+}
+
+impl QueueCounts {
+    const fn new() -> Self {
+        QueueCounts {
+            received: Counter::new(),
+            overruns: Counter::new(),
+        }
+    }
 }
 
 impl ErrorCounts {
@@ -152,7 +171,6 @@ impl ErrorCounts {
             bit: Counter::new(),
             crc: Counter::new(),
             bus_off: Counter::new(),
-            overruns: Counter::new(),
             wakeups: Counter::new(),
         }
     }
@@ -210,7 +228,9 @@ pub struct State<
     sent: Counter,
     failed: Counter,
     aborted: Counter,
-    received: Counter,
+    /// Per hardware receive queue: each queue's handler is the one writer of its
+    /// counters (bxCAN's RX0 and RX1 handlers may preempt each other); read as sums.
+    per_queue: [QueueCounts; 2],
     dropped: Counter,
     state_changes: Counter,
     errors: ErrorCounts,
@@ -272,9 +292,10 @@ pub struct Parts<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize,
     /// Transmit interrupt handler (bxCAN TX line; FlexCAN message-buffer line).
     pub tx_irq: TxIrq<'a, H, RX, Q, RX1, DONE>,
     /// Receive interrupt handler of queue 0 (bxCAN RX0; FlexCAN message-buffer line).
-    pub rx0_irq: RxIrq<'a, H, RX, Q, RX1, DONE>,
-    /// Receive interrupt handler of queue 1 (bxCAN RX1; unused on FlexCAN).
-    pub rx1_irq: RxIrq<'a, H, RX, Q, RX1, DONE>,
+    pub rx0_irq: Rx0Irq<'a, H, RX, Q, RX1, DONE>,
+    /// Receive interrupt handler of queue 1 (bxCAN RX1; unused on FlexCAN). A type of
+    /// its own: it cannot be put where queue 0's handler belongs.
+    pub rx1_irq: Rx1Irq<'a, H, RX, Q, RX1, DONE>,
     /// Status interrupt handler (bxCAN SCE; FlexCAN bus-off, error, warning, wake-up).
     pub status_irq: StatusIrq<'a, H, RX, Q, RX1, DONE>,
 }
@@ -301,7 +322,7 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
             sent: Counter::new(),
             failed: Counter::new(),
             aborted: Counter::new(),
-            received: Counter::new(),
+            per_queue: [QueueCounts::new(), QueueCounts::new()],
             dropped: Counter::new(),
             state_changes: Counter::new(),
             errors: ErrorCounts::new(),
@@ -356,8 +377,8 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
             tx: Tx { s: self, next: 0 },
             rx: Rx { s: self, map },
             tx_irq: TxIrq { s: self },
-            rx0_irq: RxIrq { s: self, queue: 0 },
-            rx1_irq: RxIrq { s: self, queue: 1 },
+            rx0_irq: RxIrq { s: self },
+            rx1_irq: RxIrq { s: self },
             status_irq: StatusIrq {
                 s: self,
                 last: status.state,
@@ -422,7 +443,10 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
             sent: self.sent.get(),
             failed: self.failed.get(),
             aborted: self.aborted.get(),
-            received: self.received.get(),
+            received: self.per_queue[0]
+                .received
+                .get()
+                .saturating_add(self.per_queue[1].received.get()),
             rx_ring_overflows: self.rx0.stats().overflows + self.rx1.stats().overflows,
             rx_dropped: self.dropped.get(),
             completion_overflows: self.done.stats().overflows,
@@ -441,7 +465,10 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
             bit: e.bit.get(),
             crc: e.crc.get(),
             bus_off: e.bus_off.get(),
-            hardware_overruns: e.overruns.get(),
+            hardware_overruns: self.per_queue[0]
+                .overruns
+                .get()
+                .saturating_add(self.per_queue[1].overruns.get()),
         }
     }
 
@@ -1130,25 +1157,60 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
 /// assert_eq!(CAN.rx_stats().overflows, 1);
 /// # Ok::<(), twocan_core::Error>(())
 /// ```
-pub struct RxIrq<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize>
-{
+pub struct RxIrq<
+    'a,
+    H: Hardware,
+    const RX: usize,
+    Q: TxQueue,
+    const RX1: usize,
+    const DONE: usize,
+    const QUEUE: usize,
+> {
     pub(crate) s: &'a State<H, RX, Q, RX1, DONE>,
-    pub(crate) queue: u8,
 }
 
-impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize>
-    RxIrq<'_, H, RX, Q, RX1, DONE>
+/// The receive interrupt handler of hardware queue 0 (bxCAN RX0 / FIFO 0, FlexCAN's Rx
+/// FIFO on the ORed message-buffer line).
+pub type Rx0Irq<'a, H, const RX: usize, Q, const RX1: usize, const DONE: usize> =
+    RxIrq<'a, H, RX, Q, RX1, DONE, 0>;
+
+/// The receive interrupt handler of hardware queue 1 (bxCAN RX1 / FIFO 1; a FlexCAN
+/// controller has no second queue: its handler finds nothing).
+///
+/// Each queue's handler has a type of its own, so that one cannot be put where the
+/// other belongs (run from the other line's vector, it would leave that line's level
+/// triggered cause set for ever):
+///
+/// ```compile_fail,E0308
+/// use twocan_core::irq_cell::IrqCell;
+/// use twocan_core::mock::MockHardware;
+/// use twocan_core::split::Rx0Irq;
+/// use twocan_core::{FifoQueue, State};
+///
+/// type Q = FifoQueue<4>;
+/// static CAN: State<MockHardware, 8, Q, 8> = State::new();
+/// static RX0: IrqCell<Rx0Irq<'static, MockHardware, 8, Q, 8, 8>> = IrqCell::new();
+/// let p = CAN.split(MockHardware::new(3)).ok().unwrap();
+/// let _ = RX0.put(p.rx1_irq); // queue 1's handler where queue 0's belongs: refused
+/// ```
+pub type Rx1Irq<'a, H, const RX: usize, Q, const RX1: usize, const DONE: usize> =
+    RxIrq<'a, H, RX, Q, RX1, DONE, 1>;
+
+impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize, const QUEUE: usize>
+    RxIrq<'_, H, RX, Q, RX1, DONE, QUEUE>
 {
     /// Moves every frame of the hardware queue into its ring as raw words and releases
     /// the hardware; a full ring counts the frame as an overflow. No decoding here.
     #[inline]
     pub fn on_interrupt(&mut self) {
+        const { assert!(QUEUE < 2, "a controller has at most two receive queues") };
         let s = self.s;
-        // The queue number as a constant in each branch, so that the backend's register
-        // offsets fold into the loop.
-        // SAFETY (both): this handle is the only caller of `read_rx` for its queue and
-        // the only producer of its ring.
-        if self.queue == 0 {
+        // The queue number is a constant, so that the backend's register offsets fold
+        // into the loop.
+        // SAFETY (both): this handle (one per queue, made once by `split`, its type
+        // naming its queue) is the only caller of `read_rx` for its queue and the only
+        // producer of its ring.
+        if QUEUE == 0 {
             unsafe { drain(s, 0, &s.rx0) }
         } else {
             unsafe { drain(s, 1, &s.rx1) }
@@ -1156,8 +1218,8 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
     }
 
     /// Which hardware queue this handler drains.
-    pub fn queue(&self) -> usize {
-        self.queue as usize
+    pub const fn queue(&self) -> usize {
+        QUEUE
     }
 }
 
@@ -1165,7 +1227,7 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
 ///
 /// # Safety
 /// Called from queue `q`'s receive interrupt handle only (the one caller of `read_rx`
-/// for `q` and the one producer of `ring`).
+/// for `q`, the one producer of `ring` and the one writer of queue `q`'s counters).
 #[inline(always)]
 unsafe fn drain<
     H: Hardware,
@@ -1180,13 +1242,14 @@ unsafe fn drain<
     ring: &SpscRing<Stamped<H::Raw>, N>,
 ) {
     let hw = s.hw();
+    let counts = &s.per_queue[q];
     let mut overrun = false;
     let mut any = false;
     // SAFETY: the caller's contract.
     unsafe {
         while let Some(raw) = hw.read_rx(q, &mut overrun) {
             any = true;
-            s.received.inc();
+            counts.received.inc();
             // Widened here, on the interrupt side: the counter's wraps are only known
             // while the frame is fresh.
             let wraps = match hw.raw_timestamp(&raw) {
@@ -1197,25 +1260,13 @@ unsafe fn drain<
         }
     }
     if overrun {
-        overrun_counter(s).inc();
+        counts.overruns.inc();
     }
     #[cfg(feature = "async")]
     if any {
         s.wakers.rx.wake();
     }
     let _ = any;
-}
-
-fn overrun_counter<
-    H: Hardware,
-    const RX: usize,
-    Q: TxQueue,
-    const RX1: usize,
-    const DONE: usize,
->(
-    s: &State<H, RX, Q, RX1, DONE>,
-) -> &Counter {
-    &s.errors.overruns
 }
 
 /// The status (error, bus-off, wake-up) interrupt handler.

@@ -229,3 +229,31 @@ fn a_state_is_shared_only_over_a_controller_that_may_move() {
     assert!(Probe::<State<Fed, 4, FifoQueue<2>>>::SYNC);
     assert!(Probe::<State<MockHardware, 4, FifoQueue<2>>>::SYNC);
 }
+
+/// Item 8: bxCAN's RX0 and RX1 handlers preempt each other when their priorities
+/// differ; neither may lose the other's counts (received frames, hardware overruns).
+#[test]
+fn two_receive_handlers_lose_no_counts() {
+    const CALLS: u32 = if cfg!(miri) { 40 } else { 200_000 };
+    let state: State<Fed, 4, FifoQueue<2>, 4> = State::new();
+    let p = state.split(Fed::new([0, 0])).ok().unwrap();
+    let hw = state.hardware().unwrap();
+    let (mut rx0, mut rx1) = (p.rx0_irq, p.rx1_irq);
+    std::thread::scope(|s| {
+        s.spawn(|| {
+            for _ in 0..CALLS {
+                // One frame with an overrun per interrupt (the feed is this queue's).
+                hw.feed[0].store(1, Ordering::Relaxed);
+                rx0.on_interrupt();
+            }
+        });
+        s.spawn(|| {
+            for _ in 0..CALLS {
+                hw.feed[1].store(1, Ordering::Relaxed);
+                rx1.on_interrupt();
+            }
+        });
+    });
+    assert_eq!(state.traffic().received, 2 * CALLS);
+    assert_eq!(state.error_stats().hardware_overruns, 2 * CALLS);
+}

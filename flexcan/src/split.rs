@@ -5,7 +5,7 @@
 //! Interrupt lines (Kinetis RM, FlexCAN "Interrupts"): the ORed message-buffer vector
 //! runs both the transmit handler ([`twocan_core::split::TxIrq`]: settle MB15 and the
 //! remote-frame mailboxes, refill) and the receive handler
-//! ([`twocan_core::split::RxIrq`] of queue 0: the Rx FIFO); the bus-off, error,
+//! ([`twocan_core::split::Rx0Irq`]: the Rx FIFO); the bus-off, error,
 //! Tx/Rx-warning and wake-up vectors run the status handler
 //! ([`twocan_core::split::StatusIrq`]). Who touches which register:
 //! - transmit half and transmit handler: `IFLAG1` read, the words of one transmit

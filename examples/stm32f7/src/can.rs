@@ -6,7 +6,7 @@
 use twocan_bxcan::regs::CanRegs;
 use twocan_bxcan::BxCan;
 use twocan_core::irq_cell::IrqCell;
-use twocan_core::split::{Rx, RxIrq, State, StatusIrq, Tx, TxIrq};
+use twocan_core::split::{Rx, Rx0Irq, Rx1Irq, State, StatusIrq, Tx, TxIrq};
 use twocan_core::{FifoQueue, Registers};
 
 /// Receive ring per FIFO, transmit queue and completion ring sizes of the examples.
@@ -30,8 +30,8 @@ pub type CanRxHalf<R = CanRegs, F = CanRegs> = Rx<'static, BxCan<R, F>, RX, Queu
 /// The interrupt handles of one bxCAN instance.
 pub struct Vectors<R: Registers + 'static = CanRegs, F: Registers + 'static = CanRegs> {
     tx: IrqCell<TxIrq<'static, BxCan<R, F>, RX, Queue, RX, COMPLETIONS>>,
-    rx0: IrqCell<RxIrq<'static, BxCan<R, F>, RX, Queue, RX, COMPLETIONS>>,
-    rx1: IrqCell<RxIrq<'static, BxCan<R, F>, RX, Queue, RX, COMPLETIONS>>,
+    rx0: IrqCell<Rx0Irq<'static, BxCan<R, F>, RX, Queue, RX, COMPLETIONS>>,
+    rx1: IrqCell<Rx1Irq<'static, BxCan<R, F>, RX, Queue, RX, COMPLETIONS>>,
     sce: IrqCell<StatusIrq<'static, BxCan<R, F>, RX, Queue, RX, COMPLETIONS>>,
 }
 

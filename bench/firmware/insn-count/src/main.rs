@@ -32,7 +32,7 @@ use cortex_m_rt::entry;
 use heapless::spsc::{Consumer, Producer, Queue};
 use twocan_bxcan::RawFrame;
 use twocan_bxcan::{BxCan, Config, FilterPlan};
-use twocan_core::split::{Rx, RxIrq, State, StateChange, Tx, TxIrq, STATE_CHANGES};
+use twocan_core::split::{Rx, Rx0Irq, State, StateChange, Tx, TxIrq, STATE_CHANGES};
 use twocan_core::timing::{solve_cia, Limits};
 use twocan_core::txqueue::Queued;
 use twocan_core::Completion;
@@ -114,7 +114,7 @@ type OurState = State<Hw, RX, Q, 0, DONE>;
 type OurTx = Tx<'static, Hw, RX, Q, 0, DONE>;
 type OurRx = Rx<'static, Hw, RX, Q, 0, DONE>;
 type OurTxIrq = TxIrq<'static, Hw, RX, Q, 0, DONE>;
-type OurRxIrq = RxIrq<'static, Hw, RX, Q, 0, DONE>;
+type OurRxIrq = Rx0Irq<'static, Hw, RX, Q, 0, DONE>;
 
 /// The driver's shared state: all zeros, in `.bss`. The same type as `loopback-twocan`'s.
 static CAN: OurState = State::new();
