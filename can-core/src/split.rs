@@ -40,6 +40,8 @@
 
 use core::cell::{Cell, UnsafeCell};
 use core::mem::MaybeUninit;
+#[cfg(feature = "async")]
+use core::sync::atomic::AtomicBool;
 use core::sync::atomic::{AtomicU32, AtomicU8, Ordering};
 
 use crate::controller::{ErrorStatus, Mode};
@@ -236,6 +238,11 @@ pub struct State<
     errors: ErrorCounts,
     #[cfg(feature = "async")]
     pub(crate) wakers: crate::asynch::Wakers,
+    /// A completion was recorded since the transmit handler last looked: the event that
+    /// wakes the transmit half's waits. Written and cleared only inside the critical
+    /// section (plain load and store, no read-modify-write).
+    #[cfg(feature = "async")]
+    tx_event: AtomicBool,
     _q: core::marker::PhantomData<Q>,
 }
 
@@ -328,6 +335,8 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
             errors: ErrorCounts::new(),
             #[cfg(feature = "async")]
             wakers: crate::asynch::Wakers::new(),
+            #[cfg(feature = "async")]
+            tx_event: AtomicBool::new(false),
             _q: core::marker::PhantomData,
         }
     }
@@ -565,6 +574,10 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
         // SAFETY: completions are produced only inside the critical section (transmit
         // interrupt, transmit half's slow path), so producers never overlap.
         let _ = unsafe { self.done.push(done) };
+        // The event the transmit handler wakes on (inside the critical section, as
+        // every `record`).
+        #[cfg(feature = "async")]
+        self.tx_event.store(true, Ordering::Relaxed);
     }
 
     /// The transmit interrupt's work, inside the critical section `cs`: settle ended
@@ -1122,14 +1135,22 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
     /// free mailboxes from the queue, in one critical section.
     pub fn on_interrupt(&mut self) {
         let s = self.s;
-        #[cfg(feature = "async")]
-        let before = s.sent.get() + s.failed.get() + s.aborted.get();
-        critical_section::with(|cs| {
+        let _completed = critical_section::with(|cs| {
             // SAFETY: the queue is only touched inside a critical section.
-            s.service_tx(unsafe { &mut *s.queue.borrow(cs).get() })
+            s.service_tx(unsafe { &mut *s.queue.borrow(cs).get() });
+            // Taken inside the section, where `record` sets it: load and store suffice.
+            #[cfg(feature = "async")]
+            {
+                let event = s.tx_event.load(Ordering::Relaxed);
+                s.tx_event.store(false, Ordering::Relaxed);
+                event
+            }
         });
+        // Woken on the event (a completion recorded here, or since the last interrupt by
+        // the transmit half's own slow path), never on a difference of the saturating
+        // counters: those stop moving after 2^32 frames.
         #[cfg(feature = "async")]
-        if s.sent.get() + s.failed.get() + s.aborted.get() != before {
+        if _completed {
             // Completions came, so mailboxes (and queue room) were freed.
             s.wakers.tx_done.wake();
             s.wakers.tx_room.wake();
@@ -1411,5 +1432,51 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
     /// Stopped controller only: the bus mode used from the next start, the filters kept.
     pub fn set_bus_mode(&self, mode: crate::capabilities::BusMode) -> Result<(), Error> {
         self.hardware().ok_or(Error::WrongMode)?.set_bus_mode(mode)
+    }
+}
+
+#[cfg(all(test, feature = "mock", feature = "async"))]
+mod tests {
+    use core::future::Future;
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    use std::sync::Arc;
+    use std::task::{Context, Poll, Wake, Waker};
+
+    use super::State;
+    use crate::mock::MockHardware;
+    use crate::{FifoQueue, Frame, TxOutcome};
+
+    /// Counts its wake-ups.
+    struct Count(AtomicUsize);
+    impl Wake for Count {
+        fn wake(self: Arc<Self>) {
+            self.0.fetch_add(1, Ordering::Relaxed);
+        }
+    }
+
+    /// Item 7 of issue 26: the transmit handler woke the waiting task only when
+    /// `sent + failed + aborted` changed, so after the saturating counters reached
+    /// `u32::MAX` (about 2^32 frames) nothing was woken any more (and the sum itself
+    /// overflowed). It wakes on the event: a completion recorded.
+    #[test]
+    fn a_saturated_sent_counter_still_wakes_the_waiting_task() {
+        let state: State<MockHardware, 8, FifoQueue<4>> = State::new();
+        let mut p = state.split(MockHardware::new(1)).ok().unwrap();
+        state.sent.add(u32::MAX);
+        let count = Arc::new(Count(AtomicUsize::new(0)));
+        let waker = Waker::from(count.clone());
+        let mut cx = Context::from_waker(&waker);
+
+        let token = p.tx.try_send(&Frame::standard(0x10, &[]).unwrap()).unwrap();
+        let mut done = core::pin::pin!(p.tx.completion());
+        assert!(done.as_mut().poll(&mut cx).is_pending());
+        state.hardware().unwrap().complete_all();
+        p.tx_irq.on_interrupt();
+        assert_eq!(count.0.load(Ordering::Relaxed), 1, "the waiting task was not woken");
+        match done.as_mut().poll(&mut cx) {
+            Poll::Ready(c) => assert_eq!((c.token, c.outcome), (token, TxOutcome::Sent)),
+            Poll::Pending => panic!("woken without a completion"),
+        }
+        assert_eq!(state.traffic().sent, u32::MAX);
     }
 }
