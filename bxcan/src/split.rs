@@ -600,6 +600,12 @@ unsafe impl<R: Registers, F: Registers, const K: usize> Hardware for BxCan<R, F,
         })
     }
 
+    /// `CAN_RFxR.FMPx` ≠ 0 (RM0410 §40.9.2: the number of messages pending in FIFO x;
+    /// reading `CAN_RFxR` has no side effect, its write bits act only when written).
+    fn rx_pending(&self, queue: usize) -> bool {
+        rfxr::FMP.get(self.regs.read32(rfxr(queue & 1))) != 0
+    }
+
     fn raw_timestamp(&self, raw: &RawFrame) -> Option<u16> {
         self.config
             .get_timestamps()

@@ -83,6 +83,44 @@ fn time_stamps_keep_arrival_order_across_fifos() {
     assert!(stamps.windows(2).all(|w| w[0] < w[1]), "{stamps:?}");
 }
 
+/// Issue 26, item 9: a FIFO 1 frame stamped 32,768 bit times or more after the latest
+/// stamp (a quiet bus; bxCAN's counter cannot be read) was placed one period early and
+/// delivered before the older FIFO 0 frame still in the ring. Frames keep their bus
+/// order, however long the bus was quiet; the stamps may be off by whole periods only.
+#[test]
+fn a_fifo1_frame_after_a_quiet_bus_comes_after_the_older_fifo0_frame() {
+    for quiet in [32_768, 40_000, 65_000, 70_000, 100_000, 200_000] {
+        let cfg = loopback_config(TxPolicy::Fifo).timestamps(true);
+        let (can, _regs, bus) = can1_with(&cfg, &odd_fifo1_even_fifo0());
+        let mut d = driver(can);
+        // Frame 2 into FIFO 0, read by its handler: it waits in the ring.
+        d.try_send(&std(2)).unwrap();
+        settle(&bus);
+        d.on_rx(0);
+        d.on_tx();
+        run(&bus, quiet);
+        // Frame 1 into FIFO 1, read after the quiet bus.
+        d.try_send(&std(1)).unwrap();
+        settle(&bus);
+        d.on_rx(1);
+        d.on_tx();
+        let got = drain(&mut d);
+        let ids: Vec<u32> = got.iter().map(|r| r.frame.raw_id()).collect();
+        assert_eq!(ids, [2, 1], "bus order after {quiet} quiet bit times");
+        let (a, b) = (got[0].timestamp.unwrap(), got[1].timestamp.unwrap());
+        let apart = b
+            .bit_times_since(a)
+            .expect("the later frame's stamp is later");
+        if quiet < 65_000 {
+            // Less than one period apart: the stamps are exact.
+            assert!(
+                apart > quiet && apart < quiet + 200,
+                "{apart} after {quiet}"
+            );
+        }
+    }
+}
+
 #[test]
 fn without_time_stamps_fifo0_goes_first() {
     // Documented: no time stamps, no order across FIFOs (FIFO 0 first).

@@ -232,6 +232,19 @@ pub unsafe trait Hardware {
         None
     }
 
+    /// Whether hardware receive queue `queue` holds a frame its receive handler has not
+    /// read yet, read now. Any context (a read without side effects: the driver reads it
+    /// from the other queue's receive interrupt and the transmit interrupt, inside its
+    /// critical section, when it widens a time stamp without a readable counter, so
+    /// that frames of several queues keep their bus order after a quiet bus; see
+    /// [`crate::timestamp::Extender::extend_received`]). The default, `true`, means
+    /// "unknown"; a controller whose counter software can read
+    /// ([`Hardware::timer_now`]) never needs it.
+    fn rx_pending(&self, queue: usize) -> bool {
+        let _ = queue;
+        true
+    }
+
     /// The free-running time stamp counter read now, where software can read it
     /// (FlexCAN `TIMER`; `None` on bxCAN, whose TTCM counter is internal, and whenever
     /// the counter cannot be read). The driver reads it inside its critical section,

@@ -272,7 +272,6 @@ where
 {
 }
 
-
 impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize> Default
     for State<H, RX, Q, RX1, DONE>
 {
@@ -507,21 +506,40 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
         });
     }
 
-    /// Widens a 16-bit stamp read from the hardware before this call (interrupt side).
+    /// Widens the 16-bit stamp of a completion read from the hardware before this call
+    /// (transmit interrupt side).
     #[inline]
     fn widen(&self, stamp: u16) -> Timestamp {
+        self.widen_from(None, stamp)
+    }
+
+    /// Widens the 16-bit stamp of a frame just read from receive queue `queue` (its
+    /// receive interrupt).
+    #[inline]
+    fn widen_received(&self, queue: usize, stamp: u16) -> Timestamp {
+        self.widen_from(Some(queue), stamp)
+    }
+
+    #[inline]
+    fn widen_from(&self, queue: Option<usize>, stamp: u16) -> Timestamp {
         let hw = self.hw();
+        let pending = |q: usize| q < H::RX_QUEUES && hw.rx_pending(q);
         critical_section::with(|cs| {
             let c = self.clock.borrow(cs);
             let mut e = c.get();
             // The counter is read after the stamp, inside the section: every stamp
-            // widened is at or before the reading, whichever context read it.
+            // widened is at or before the reading, whichever context read it. Without a
+            // readable counter, the queues' "frame pending" flags are read inside the
+            // section too, so that they are current for the reference it leaves.
             let t = match hw.timer_now() {
                 Some(now) => {
                     e.observe(now);
                     e.extend_before(stamp)
                 }
-                None => e.extend_near(stamp),
+                None => match queue {
+                    Some(q) => e.extend_received(q, stamp, pending),
+                    None => e.extend_sent(stamp, pending),
+                },
             };
             c.set(e);
             t
@@ -1217,8 +1235,14 @@ pub type Rx0Irq<'a, H, const RX: usize, Q, const RX1: usize, const DONE: usize> 
 pub type Rx1Irq<'a, H, const RX: usize, Q, const RX1: usize, const DONE: usize> =
     RxIrq<'a, H, RX, Q, RX1, DONE, 1>;
 
-impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize, const QUEUE: usize>
-    RxIrq<'_, H, RX, Q, RX1, DONE, QUEUE>
+impl<
+        H: Hardware,
+        const RX: usize,
+        Q: TxQueue,
+        const RX1: usize,
+        const DONE: usize,
+        const QUEUE: usize,
+    > RxIrq<'_, H, RX, Q, RX1, DONE, QUEUE>
 {
     /// Moves every frame of the hardware queue into its ring as raw words and releases
     /// the hardware; a full ring counts the frame as an overflow. No decoding here.
@@ -1274,7 +1298,7 @@ unsafe fn drain<
             // Widened here, on the interrupt side: the counter's wraps are only known
             // while the frame is fresh.
             let wraps = match hw.raw_timestamp(&raw) {
-                Some(t) => s.widen(t).wraps(),
+                Some(t) => s.widen_received(q, t).wraps(),
                 None => 0,
             };
             let _ = ring.push(Stamped { raw, wraps });
@@ -1472,7 +1496,11 @@ mod tests {
         assert!(done.as_mut().poll(&mut cx).is_pending());
         state.hardware().unwrap().complete_all();
         p.tx_irq.on_interrupt();
-        assert_eq!(count.0.load(Ordering::Relaxed), 1, "the waiting task was not woken");
+        assert_eq!(
+            count.0.load(Ordering::Relaxed),
+            1,
+            "the waiting task was not woken"
+        );
         match done.as_mut().poll(&mut cx) {
             Poll::Ready(c) => assert_eq!((c.token, c.outcome), (token, TxOutcome::Sent)),
             Poll::Pending => panic!("woken without a completion"),

@@ -39,7 +39,11 @@ fn hardware_is_never_seen_before_it_is_written() {
                 }
             });
             let parts = state.split(MockHardware::new(3)).ok().unwrap();
-            assert_eq!(reader.join().unwrap(), 3, "a controller read before it was written");
+            assert_eq!(
+                reader.join().unwrap(),
+                3,
+                "a controller read before it was written"
+            );
             timer.join().unwrap();
             drop(parts);
         });
@@ -221,7 +225,10 @@ type SyncNotSend = std::sync::MutexGuard<'static, ()>;
 /// only when the controller may move between threads (`H: Send`), as for `OnceLock`.
 #[test]
 fn a_state_is_shared_only_over_a_controller_that_may_move() {
-    assert!(Probe::<Fed<SyncNotSend>>::SYNC, "the probe sees a Sync controller");
+    assert!(
+        Probe::<Fed<SyncNotSend>>::SYNC,
+        "the probe sees a Sync controller"
+    );
     assert!(
         !Probe::<State<Fed<SyncNotSend>, 4, FifoQueue<2>>>::SYNC,
         "a State over a controller that is not Send must not be Sync"
