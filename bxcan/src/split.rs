@@ -646,10 +646,10 @@ unsafe impl<R: Registers, F: Registers, const K: usize> Hardware for BxCan<R, F,
         Ok(())
     }
 
-    fn filter_map(&self) {}
+    unsafe fn filter_map(&self) {}
 
     /// The FIFO frames `install_filters` released under `FINIT` (`RFOMx`).
-    fn take_filter_switch_discards(&self) -> u32 {
+    unsafe fn take_filter_switch_discards(&self) -> u32 {
         self.discarded.swap(0, Ordering::Relaxed)
     }
 
@@ -687,14 +687,14 @@ unsafe impl<R: Registers, F: Registers, const K: usize> Hardware for BxCan<R, F,
         self.regs.read32(MSR) & (msr::INAK | msr::SLAK) == 0
     }
 
-    fn set_mode(&self, mode: Mode) -> Result<(), Error> {
+    unsafe fn set_mode(&self, mode: Mode) -> Result<(), Error> {
         mode::request(&self.regs, mode, self.wait.load(Ordering::Relaxed))
     }
 
     /// Manual recovery (`ABOM` = 0): when bus-off, enter and leave initialization mode;
     /// the hardware then waits for 128 × 11 recessive bits. Refused with
     /// [`Error::WrongMode`] when recovery is automatic (nothing to start).
-    fn recover(&self) -> Result<(), Error> {
+    unsafe fn recover(&self) -> Result<(), Error> {
         if self.config.get_recovery() == Recovery::Automatic {
             return Err(Error::WrongMode);
         }
@@ -755,7 +755,7 @@ unsafe impl<R: Registers, F: Registers, const K: usize> Hardware for BxCan<R, F,
     /// In initialization mode only (`CAN_BTR` is writable only then, RM0410 §40.9.2):
     /// BRP, TS1, TS2, SJW; the mode bits stay. The acknowledge bound grows for a slower
     /// rate.
-    fn set_timing(&self, timing: &Timing) -> Result<(), Error> {
+    unsafe fn set_timing(&self, timing: &Timing) -> Result<(), Error> {
         let stopped = mode::current(&self.regs) == Mode::Stopped;
         twocan_core::hardware::check_timing_for(&self.capabilities(), timing, stopped)?;
         let bits = timing.bxcan_btr().map_err(Error::Timing)?;
@@ -771,7 +771,7 @@ unsafe impl<R: Registers, F: Registers, const K: usize> Hardware for BxCan<R, F,
     }
 
     /// In initialization mode only: `CAN_BTR.SILM` (listen-only), `LBKM` (loop-back).
-    fn set_bus_mode(&self, mode: BusMode) -> Result<(), Error> {
+    unsafe fn set_bus_mode(&self, mode: BusMode) -> Result<(), Error> {
         if mode::current(&self.regs) != Mode::Stopped {
             return Err(Error::WrongMode);
         }

@@ -274,14 +274,17 @@ impl<H: Hardware, const RX: usize, const TX: usize, const RX1: usize> Driver<H, 
 
     /// Changes the operating mode.
     pub fn set_mode(&mut self, mode: Mode) -> Result<(), Error> {
-        let r = self.hardware().set_mode(mode);
+        // SAFETY: the driver plays every role; `&mut self` makes this the control
+        // context, with no filter switch or other control call running.
+        let r = unsafe { self.hardware().set_mode(mode) };
         self.state();
         r
     }
 
     /// Starts bus-off recovery by software (refused where recovery is automatic).
     pub fn recover(&mut self) -> Result<(), Error> {
-        let r = self.hardware().recover();
+        // SAFETY: the control context, as in `set_mode`.
+        let r = unsafe { self.hardware().recover() };
         self.state();
         r
     }
@@ -299,7 +302,8 @@ impl<H: Hardware, const RX: usize, const TX: usize, const RX1: usize> Driver<H, 
     /// Stopped controller only: a new bit timing; the filters stay
     /// ([`Hardware::set_timing`]).
     pub fn set_timing(&mut self, timing: &Timing) -> Result<(), Error> {
-        self.hardware().set_timing(timing)
+        // SAFETY: the control context, as in `set_mode`.
+        unsafe { self.hardware().set_timing(timing) }
     }
 
     /// Stopped controller only: the bit timing for `bitrate` from the controller's clock,
@@ -314,24 +318,37 @@ impl<H: Hardware, const RX: usize, const TX: usize, const RX1: usize> Driver<H, 
             .capabilities()
             .timing_for(bitrate, sample_point_permille)
             .map_err(Error::Timing)?;
-        self.hardware().set_timing(&t)?;
+        // SAFETY: the control context, as in `set_mode`.
+        unsafe { self.hardware().set_timing(&t)? };
         Ok(t)
     }
 
     /// Stopped controller only: the bus mode used from the next start; the filters stay
     /// ([`Hardware::set_bus_mode`]).
     pub fn set_bus_mode(&mut self, mode: BusMode) -> Result<(), Error> {
-        self.hardware().set_bus_mode(mode)
+        // SAFETY: the control context, as in `set_mode`.
+        unsafe { self.hardware().set_bus_mode(mode) }
     }
 
     /// Installs a new compiled filter list, atomically: once it returns, no frame is
     /// reported with an index of the old list (see [`crate::hardware`]); the old list's
     /// frames discarded on the way are counted in [`TrafficStats::rx_dropped`].
     pub fn set_filters(&mut self, filters: &H::Filters) -> Result<(), Error> {
-        // SAFETY: the driver plays the receive half, the context of `install_filters`.
+        // SAFETY: the driver plays the receive half, the context of `install_filters`
+        // (`&mut self`: nothing else runs meanwhile).
         self.map = unsafe { self.hardware().install_filters(filters)? };
-        self.state.count_filter_switch_discards();
+        // SAFETY: as above.
+        unsafe { self.state.count_filter_switch_discards() };
         Ok(())
+    }
+
+    /// The controller seen from the receive half's context, for a backend's
+    /// receive-side methods (FlexCAN's installed filter table); see
+    /// [`crate::hardware::ReceiveContext`].
+    pub fn receive_context(&mut self) -> crate::hardware::ReceiveContext<'_, H> {
+        // SAFETY: the driver plays the receive half; `&mut self` is held for the
+        // context's lifetime, so no filter switch runs meanwhile.
+        unsafe { crate::hardware::ReceiveContext::new(self.hardware()) }
     }
 
     /// Reads the controller's time stamp counter where software can, so that time

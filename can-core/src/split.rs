@@ -374,7 +374,8 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
         unsafe { (*self.hw.get()).write(hardware) };
         // SAFETY: written just above, by this thread.
         let hw = unsafe { (*self.hw.get()).assume_init_ref() };
-        let map = hw.filter_map();
+        // SAFETY: the controller is not shared yet (READY is stored below).
+        let map = unsafe { hw.filter_map() };
         let status = hw.error_status();
         self.state
             .store(state_code(status.state), Ordering::Relaxed);
@@ -408,7 +409,8 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
         self.refresh_timestamps();
         self.state
             .store(state_code(status.state), Ordering::Relaxed);
-        (hw.filter_map(), status)
+        // SAFETY: `&mut self`: the controller is not shared.
+        (unsafe { hw.filter_map() }, status)
     }
 
     /// Takes the controller back out of a state owned exclusively.
@@ -718,9 +720,14 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
 
     /// Adds the frames the last filter switch discarded from the hardware FIFO to
     /// [`TrafficStats::rx_dropped`] (the receive half's context, the counter's writer).
-    pub(crate) fn count_filter_switch_discards(&self) {
+    ///
+    /// # Safety
+    /// Called from the receive half's context.
+    pub(crate) unsafe fn count_filter_switch_discards(&self) {
         if let Some(hw) = self.hardware() {
-            self.dropped.add(hw.take_filter_switch_discards());
+            // SAFETY: the caller's contract.
+            self.dropped
+                .add(unsafe { hw.take_filter_switch_discards() });
         }
     }
 
@@ -1074,10 +1081,48 @@ impl<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE:
     /// discarded from the hardware FIFO or dropped from the ring, and counted in
     /// [`TrafficStats::rx_dropped`] either way; see [`crate::hardware`]).
     pub fn set_filters(&mut self, filters: &H::Filters) -> Result<(), Error> {
-        // SAFETY: the receive half is the context of `install_filters`.
+        // SAFETY: the receive half is the context of `install_filters` (and of the
+        // control methods, so no mode change runs meanwhile); `&mut self` keeps this
+        // half's other calls (`decode`, a `ReceiveContext`) out while it runs.
         self.map = unsafe { self.s.hw().install_filters(filters)? };
-        self.s.count_filter_switch_discards();
+        // SAFETY: as above, the receive half's context.
+        unsafe { self.s.count_filter_switch_discards() };
         Ok(())
+    }
+
+    /// The controller seen from this half's context, for a backend's receive-side
+    /// methods (FlexCAN's installed filter table): no filter switch runs while it is
+    /// borrowed.
+    pub fn receive_context(&mut self) -> crate::hardware::ReceiveContext<'_, H> {
+        // SAFETY: the receive half, borrowed exclusively for the context's lifetime.
+        unsafe { crate::hardware::ReceiveContext::new(self.s.hw()) }
+    }
+
+    /// Changes the operating mode. The receive half is the controller's control
+    /// context: mode, timing, bus mode and recovery changes never race a filter switch
+    /// or each other (see [`crate::hardware`]).
+    pub fn set_mode(&mut self, mode: Mode) -> Result<(), Error> {
+        // SAFETY: the control context (this half, `&mut self`).
+        unsafe { self.s.hw().set_mode(mode) }
+    }
+
+    /// Starts bus-off recovery by software (refused with [`Error::WrongMode`] where
+    /// recovery is automatic).
+    pub fn recover(&mut self) -> Result<(), Error> {
+        // SAFETY: the control context (this half, `&mut self`).
+        unsafe { self.s.hw().recover() }
+    }
+
+    /// Stopped controller only: a new bit timing, the filters kept.
+    pub fn set_timing(&mut self, timing: &crate::timing::Timing) -> Result<(), Error> {
+        // SAFETY: the control context (this half, `&mut self`).
+        unsafe { self.s.hw().set_timing(timing) }
+    }
+
+    /// Stopped controller only: the bus mode used from the next start, the filters kept.
+    pub fn set_bus_mode(&mut self, mode: crate::capabilities::BusMode) -> Result<(), Error> {
+        // SAFETY: the control context (this half, `&mut self`).
+        unsafe { self.s.hw().set_bus_mode(mode) }
     }
 
     /// Receive ring figures.
@@ -1424,7 +1469,7 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
 // The handles need no `unsafe impl Send`: each is a shared reference to the state
 // (`Send` exactly when the state is `Sync`, see above) plus data owned by its context.
 
-/// Errors of the control operations shared by both halves.
+/// Reads any context may make.
 impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize>
     State<H, RX, Q, RX1, DONE>
 {
@@ -1433,29 +1478,9 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
         self.hardware().map(|h| h.error_status())
     }
 
-    /// Changes the operating mode.
-    pub fn set_mode(&self, mode: Mode) -> Result<(), Error> {
-        self.hardware().ok_or(Error::WrongMode)?.set_mode(mode)
-    }
-
-    /// Starts bus-off recovery by software.
-    pub fn recover(&self) -> Result<(), Error> {
-        self.hardware().ok_or(Error::WrongMode)?.recover()
-    }
-
     /// What the controller can do, as configured now.
     pub fn capabilities(&self) -> Option<crate::capabilities::Capabilities> {
         self.hardware().map(|h| h.capabilities())
-    }
-
-    /// Stopped controller only: a new bit timing, the filters kept.
-    pub fn set_timing(&self, timing: &crate::timing::Timing) -> Result<(), Error> {
-        self.hardware().ok_or(Error::WrongMode)?.set_timing(timing)
-    }
-
-    /// Stopped controller only: the bus mode used from the next start, the filters kept.
-    pub fn set_bus_mode(&self, mode: crate::capabilities::BusMode) -> Result<(), Error> {
-        self.hardware().ok_or(Error::WrongMode)?.set_bus_mode(mode)
     }
 }
 

@@ -399,7 +399,7 @@ mod tests {
         let t = e
             .extend_received(1, (41_000 + 65_535 + 70_000) as u16, empty)
             .ticks();
-        assert!(t > r && (P + 41_000 + 65_535 + 70_000 - t) % P == 0);
+        assert!(t > r && (P + 41_000 + 65_535 + 70_000 - t).is_multiple_of(P));
     }
 
     #[test]

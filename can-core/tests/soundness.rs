@@ -170,8 +170,9 @@ unsafe impl<M> Hardware for Fed<M> {
         // SAFETY: the caller's contract, passed on.
         unsafe { self.mock.install_filters(filters) }
     }
-    fn filter_map(&self) -> MockFilterList {
-        self.mock.filter_map()
+    unsafe fn filter_map(&self) -> MockFilterList {
+        // SAFETY: the caller's contract, passed on.
+        unsafe { self.mock.filter_map() }
     }
     unsafe fn take_status(&self) -> StatusEvents {
         // SAFETY: the caller's contract, passed on.
@@ -183,11 +184,13 @@ unsafe impl<M> Hardware for Fed<M> {
     fn on_bus(&self) -> bool {
         self.mock.on_bus()
     }
-    fn set_mode(&self, mode: Mode) -> Result<(), Error> {
-        self.mock.set_mode(mode)
+    unsafe fn set_mode(&self, mode: Mode) -> Result<(), Error> {
+        // SAFETY: the caller's contract, passed on.
+        unsafe { self.mock.set_mode(mode) }
     }
-    fn recover(&self) -> Result<(), Error> {
-        self.mock.recover()
+    unsafe fn recover(&self) -> Result<(), Error> {
+        // SAFETY: the caller's contract, passed on.
+        unsafe { self.mock.recover() }
     }
     fn capabilities(&self) -> Capabilities {
         self.mock.capabilities()
@@ -198,11 +201,13 @@ unsafe impl<M> Hardware for Fed<M> {
     fn bus_off_recovery(&self) -> BusOffRecovery {
         self.mock.bus_off_recovery()
     }
-    fn set_timing(&self, timing: &Timing) -> Result<(), Error> {
-        self.mock.set_timing(timing)
+    unsafe fn set_timing(&self, timing: &Timing) -> Result<(), Error> {
+        // SAFETY: the caller's contract, passed on.
+        unsafe { self.mock.set_timing(timing) }
     }
-    fn set_bus_mode(&self, mode: BusMode) -> Result<(), Error> {
-        self.mock.set_bus_mode(mode)
+    unsafe fn set_bus_mode(&self, mode: BusMode) -> Result<(), Error> {
+        // SAFETY: the caller's contract, passed on.
+        unsafe { self.mock.set_bus_mode(mode) }
     }
 }
 
@@ -225,16 +230,15 @@ type SyncNotSend = std::sync::MutexGuard<'static, ()>;
 /// only when the controller may move between threads (`H: Send`), as for `OnceLock`.
 #[test]
 fn a_state_is_shared_only_over_a_controller_that_may_move() {
-    assert!(
+    let sync = [
+        // The probe sees a `Sync` controller.
         Probe::<Fed<SyncNotSend>>::SYNC,
-        "the probe sees a Sync controller"
-    );
-    assert!(
-        !Probe::<State<Fed<SyncNotSend>, 4, FifoQueue<2>>>::SYNC,
-        "a State over a controller that is not Send must not be Sync"
-    );
-    assert!(Probe::<State<Fed, 4, FifoQueue<2>>>::SYNC);
-    assert!(Probe::<State<MockHardware, 4, FifoQueue<2>>>::SYNC);
+        // A state over it must not be `Sync`: the controller is not `Send`.
+        Probe::<State<Fed<SyncNotSend>, 4, FifoQueue<2>>>::SYNC,
+        Probe::<State<Fed, 4, FifoQueue<2>>>::SYNC,
+        Probe::<State<MockHardware, 4, FifoQueue<2>>>::SYNC,
+    ];
+    assert_eq!(sync, [true, false, true, true]);
 }
 
 /// Item 8: bxCAN's RX0 and RX1 handlers preempt each other when their priorities

@@ -53,7 +53,7 @@ fn default_bus_clock_refuses_what_begin_refuses() {
     assert!(five.consistency().is_ok(), "{:?}", five.consistency());
     let before = can.hardware().capabilities();
     assert_eq!(
-        can.hardware().set_timing(&five),
+        can.set_timing(&five),
         Err(Error::Timing(TimingError::ForbiddenByManual))
     );
     assert_eq!(can.hardware().capabilities(), before);
