@@ -6,7 +6,7 @@ mod common;
 
 use common::*;
 use twocan_bxcan::{Bank, Fifo, FilterPlan};
-use twocan_core::{Filter, TxPolicy};
+use twocan_core::{Driver, Filter, Registers, TxPolicy};
 
 #[test]
 fn fifo0_first_and_order_within_each_fifo() {
@@ -119,6 +119,29 @@ fn a_fifo1_frame_after_a_quiet_bus_comes_after_the_older_fifo0_frame() {
             );
         }
     }
+}
+
+/// Issue 26 (found by reading): the one-struct driver without a FIFO 1 ring (`RX1 = 0`)
+/// never read FIFO 1, so a frame a filter put there stayed in the hardware (its RX1
+/// line asserted, the FIFO overrunning). It is drained and counted as a ring overflow,
+/// as the split state does with `RX1 = 0`: no frame is lost silently.
+#[test]
+fn without_a_fifo1_ring_fifo1_is_still_drained_and_counted() {
+    let (can, regs, bus) = can1_with(&loopback_config(TxPolicy::Fifo), &odd_fifo1_even_fifo0());
+    let mut d: twocan_core::Driver<_, 8, 4> = Driver::new(can.into_split());
+    for id in [1, 2, 3] {
+        d.try_send(&std(id)).unwrap();
+        settle(&bus);
+        d.on_interrupt();
+    }
+    let fmp1 = twocan_bxcan::regs::rfxr::FMP.get(regs.read32(twocan_bxcan::regs::rfxr(1)));
+    assert_eq!(fmp1, 0, "FIFO 1 released");
+    let got: Vec<u32> = std::iter::from_fn(|| d.receive().ok())
+        .map(|r| r.frame.raw_id())
+        .collect();
+    assert_eq!(got, [2]);
+    let t = d.traffic();
+    assert_eq!((t.received, t.rx_ring_overflows), (3, 2));
 }
 
 #[test]

@@ -37,6 +37,11 @@ pub const DRIVER_COMPLETIONS: usize = 32;
 /// The portable CAN driver over controller `H` with a receive ring of `RX` frames (and
 /// `RX1` for a second hardware receive queue), a transmit queue of `TX` frames in the
 /// controller's order, and a completion ring of [`DRIVER_COMPLETIONS`].
+///
+/// With `RX1 = 0` on a controller with two receive queues (bxCAN), frames that the
+/// filters put in the second queue are still taken from the hardware (its FIFO never
+/// stays full) and counted in [`TrafficStats::rx_ring_overflows`]: give `RX1` room
+/// when a filter plan uses FIFO 1.
 pub struct Driver<H: Hardware, const RX: usize, const TX: usize, const RX1: usize = 0> {
     state: State<H, RX, AnyQueue<TX>, RX1, DRIVER_COMPLETIONS>,
     next: u32,
@@ -158,7 +163,9 @@ impl<H: Hardware, const RX: usize, const TX: usize, const RX1: usize> Driver<H, 
         let s = &self.state;
         TxIrq { s }.on_interrupt();
         Rx0Irq { s }.on_interrupt();
-        if RX1 > 0 && H::RX_QUEUES > 1 {
+        if H::RX_QUEUES > 1 {
+            // Also without a ring for it (`RX1 = 0`): the hardware queue is released and
+            // its frames are counted as ring overflows, never left in the hardware.
             Rx1Irq { s }.on_interrupt();
         }
         let mut status = StatusIrq { s, last: self.last };

@@ -794,7 +794,11 @@ pub enum AbortRequest {
     /// The frame is in a mailbox: its abort was requested; the completion (aborted, or
     /// sent if the abort came too late) follows.
     Requested,
-    /// No frame with this token is queued or in a mailbox (it completed already).
+    /// Nothing was aborted: no frame with this token is queued or waiting in a mailbox
+    /// now. That does not mean its completion was delivered: a frame whose mailbox
+    /// ended (sent, or failed) but was not settled yet still gets its one completion
+    /// when the transmit interrupt settles it, possibly after this call returns. A
+    /// token never handed out is not found either.
     NotFound,
 }
 
