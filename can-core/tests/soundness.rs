@@ -268,3 +268,20 @@ fn two_receive_handlers_lose_no_counts() {
     assert_eq!(state.traffic().received, 2 * CALLS);
     assert_eq!(state.error_stats().hardware_overruns, 2 * CALLS);
 }
+
+/// Found by reading (issue 26): `AbortRequest::NotFound` said "completed already", but
+/// a frame whose mailbox ended and was not settled yet is not found, and its completion
+/// comes afterwards. The documentation now says so; this is the case it describes.
+#[test]
+fn not_found_may_still_have_its_completion_to_come() {
+    use twocan_core::{AbortRequest, TxOutcome};
+    let state: State<MockHardware, 4, FifoQueue<2>> = State::new();
+    let mut p = state.split(MockHardware::new(1)).ok().unwrap();
+    let token = p.tx.try_send(&Frame::standard(0x10, &[]).unwrap()).unwrap();
+    state.hardware().unwrap().complete(); // sent; the transmit interrupt has not run
+    assert_eq!(p.tx.abort(token), AbortRequest::NotFound);
+    assert_eq!(p.tx.take_completion(), None, "not delivered yet");
+    p.tx_irq.on_interrupt();
+    let done = p.tx.take_completion().unwrap();
+    assert_eq!((done.token, done.outcome), (token, TxOutcome::Sent));
+}
