@@ -42,9 +42,10 @@
 //! it unmasks any; `twocan-flexcan`'s `rt` entry points do the same. Lines of different
 //! cells may have different priorities.
 
-use core::cell::UnsafeCell;
 use core::mem::MaybeUninit;
-use core::sync::atomic::{AtomicU8, Ordering};
+use core::sync::atomic::Ordering;
+
+use crate::sync::{const_fn, AtomicU8, UnsafeCell};
 
 const EMPTY: u8 = 0;
 const WRITING: u8 = 1;
@@ -67,11 +68,11 @@ unsafe impl<T: Send> Sync for IrqCell<T> {}
 
 impl<T> Drop for IrqCell<T> {
     fn drop(&mut self) {
-        if matches!(*self.state.get_mut(), READY | BUSY) {
+        if matches!(self.state.load(Ordering::Relaxed), READY | BUSY) {
             // SAFETY: READY (or BUSY, left by a `run` that panicked) is stored only
             // after the value was written; `&mut self` excludes every other access,
             // and the value is dropped once, here.
-            unsafe { self.value.get_mut().assume_init_drop() };
+            self.value.with_mut(|p| unsafe { (*p).assume_init_drop() });
         }
     }
 }
@@ -83,11 +84,13 @@ impl<T> Default for IrqCell<T> {
 }
 
 impl<T> IrqCell<T> {
-    /// Empty (all zeros, `.bss`).
-    pub const fn new() -> Self {
-        IrqCell {
-            state: AtomicU8::new(EMPTY),
-            value: UnsafeCell::new(MaybeUninit::uninit()),
+    const_fn! {
+        /// Empty (all zeros, `.bss`).
+        pub fn new() -> Self {
+            IrqCell {
+                state: AtomicU8::new(EMPTY),
+                value: UnsafeCell::new(MaybeUninit::uninit()),
+            }
         }
     }
 
@@ -106,7 +109,7 @@ impl<T> IrqCell<T> {
         // SAFETY: this call moved the state from EMPTY to WRITING: no other `put` writes
         // and no `run` reads the value until READY is stored below (release; `run`
         // acquires it).
-        unsafe { (*self.value.get()).write(value) };
+        self.value.with_mut(|p| unsafe { (*p).write(value) });
         self.state.store(READY, Ordering::Release);
         Ok(Installed { cell: self })
     }
@@ -124,7 +127,8 @@ impl<T> IrqCell<T> {
         }
         // SAFETY: the BUSY state makes this the only reference to the value, which
         // READY guarantees is initialised.
-        f(unsafe { (*self.value.get()).assume_init_mut() });
+        self.value
+            .with_mut(|p| f(unsafe { (*p).assume_init_mut() }));
         self.state.store(READY, Ordering::Release);
         true
     }

@@ -44,12 +44,16 @@ pub mod irq_cell;
 pub mod mailbox;
 #[cfg(any(test, feature = "mock"))]
 pub mod mock;
+#[cfg(all(test, twocan_loom))]
+mod loom_tests;
+mod once;
 pub mod priority;
 pub mod registers;
 #[cfg(feature = "sim")]
 pub mod sim;
 pub mod split;
 pub mod spsc;
+mod sync;
 pub mod timestamp;
 pub mod timing;
 pub mod txqueue;

@@ -39,7 +39,6 @@
 //! ```
 
 use core::cell::{Cell, UnsafeCell};
-use core::mem::MaybeUninit;
 #[cfg(feature = "async")]
 use core::sync::atomic::AtomicBool;
 use core::sync::atomic::{AtomicU32, AtomicU8, Ordering};
@@ -50,6 +49,7 @@ use crate::error::{Error, ErrorCounters, ErrorState, ErrorStatistics, LastErrorC
 use crate::frame::{Frame, RxFrame};
 use crate::hardware::{Completion, Hardware, Settled, Token};
 use crate::mailbox::{TxOutcome, TxPolicy};
+use crate::once::OnceSlot;
 use crate::spsc::{BufferStats, Counter, SpscRing};
 use crate::timestamp::{Extender, Timestamp};
 use crate::txqueue::{FifoQueue, Queued, TxQueue};
@@ -112,15 +112,6 @@ pub(crate) struct Stamped<R> {
 
 /// No state recorded yet (0, so that a `static State` is all zeros and lives in `.bss`).
 const STATE_UNKNOWN: u8 = 0;
-
-/// `State::stage`: no controller (0: all zeros).
-const EMPTY: u8 = 0;
-/// `State::stage`: one `split` claimed the state and is writing the controller; nothing
-/// may read it yet.
-const CLAIMED: u8 = 1;
-/// `State::stage`: the controller is written (release store after the write); readers
-/// that load `READY` with acquire ordering see it whole.
-const READY: u8 = 2;
 
 fn state_code(s: ErrorState) -> u8 {
     match s {
@@ -210,9 +201,8 @@ pub struct State<
     const RX1: usize = 0,
     const DONE: usize = 8,
 > {
-    /// [`EMPTY`], [`CLAIMED`] or [`READY`]: who may touch `hw` (see `split`).
-    stage: AtomicU8,
-    hw: UnsafeCell<MaybeUninit<H>>,
+    /// The controller, published once by `split` (see [`OnceSlot`]).
+    hw: OnceSlot<H>,
     rx0: SpscRing<Stamped<H::Raw>, RX>,
     rx1: SpscRing<Stamped<H::Raw>, RX1>,
     /// The time stamp extender shared by the receive and transmit interrupt sides (and
@@ -247,11 +237,11 @@ pub struct State<
 }
 
 // SAFETY: what each field needs to be shared between contexts:
-// - `hw`: written once, by the one `split` that claimed the state, before `stage` is
-//   published READY (release; readers acquire), then only read through `&H` from every
-//   context: `H: Sync`. A controller moved in through `&State` by one thread is dropped
-//   (or taken back by `uninstall`) by whichever thread owns the state later: `H: Send`,
-//   as `OnceLock<T>: Sync` needs `T: Send + Sync`.
+// - `hw`: a `OnceSlot<H>`, `Sync` when `H: Send + Sync` (as `OnceLock<T>`): written
+//   once by the one `split` that claimed it and published (release; readers acquire),
+//   then only read through `&H` from every context (`H: Sync`); a controller moved in
+//   through `&State` by one thread is dropped (or taken back by `uninstall`) by
+//   whichever thread owns the state later (`H: Send`).
 // - the rings: one producer handle and one consumer handle each (`SpscRing`'s
 //   contract, upheld by the handles `split` makes once); their entries move between
 //   contexts: `H::Raw: Send` (raw frames), and completions and state changes are plain
@@ -280,14 +270,6 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
     }
 }
 
-impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize> Drop
-    for State<H, RX, Q, RX1, DONE>
-{
-    fn drop(&mut self) {
-        drop(self.uninstall());
-    }
-}
-
 /// The handles [`State::split`] hands out, each for one context.
 pub struct Parts<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize>
 {
@@ -309,11 +291,11 @@ pub struct Parts<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize,
 impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize>
     State<H, RX, Q, RX1, DONE>
 {
+    crate::sync::const_fn! {
     /// Empty, with no controller yet: all zeros.
-    pub const fn new() -> Self {
+    pub fn new() -> Self {
         State {
-            stage: AtomicU8::new(EMPTY),
-            hw: UnsafeCell::new(MaybeUninit::uninit()),
+            hw: OnceSlot::new(),
             rx0: SpscRing::new(),
             rx1: SpscRing::new(),
             clock: critical_section::Mutex::new(Cell::new(Extender::new())),
@@ -339,6 +321,7 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
             _q: core::marker::PhantomData,
         }
     }
+    }
 
     /// Stores `hardware` and hands out the handles; once only. A second call gives
     /// `hardware` back. The controller's transmit order must be `Q`'s
@@ -352,35 +335,28 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
     #[allow(clippy::type_complexity)]
     pub fn split(&self, hardware: H) -> Result<Parts<'_, H, RX, Q, RX1, DONE>, (Error, H)> {
         // Claim first: a losing `split` must not touch the winner's queue.
-        if self
-            .stage
-            .compare_exchange(EMPTY, CLAIMED, Ordering::Acquire, Ordering::Relaxed)
-            .is_err()
-        {
+        let Some(claim) = self.hw.claim() else {
             return Err((Error::WrongMode, hardware));
-        }
+        };
         let adopted = critical_section::with(|cs| {
             // SAFETY: the queue is only touched inside a critical section.
             unsafe { &mut *self.queue.borrow(cs).get() }.adopt(hardware.tx_policy())
         });
         if !adopted {
-            // Nothing was written: the state is free again.
-            self.stage.store(EMPTY, Ordering::Release);
+            // Nothing was written: dropping the claim frees the state again.
+            drop(claim);
             return Err((Error::InvalidArgument, hardware));
         }
-        // SAFETY: this call moved `stage` from EMPTY to CLAIMED, so it is the only
-        // writer of `hw`, and no reader touches `hw` before `stage` is READY (stored
-        // below, after the write).
-        unsafe { (*self.hw.get()).write(hardware) };
-        // SAFETY: written just above, by this thread.
-        let hw = unsafe { (*self.hw.get()).assume_init_ref() };
-        // SAFETY: the controller is not shared yet (READY is stored below).
-        let map = unsafe { hw.filter_map() };
-        let status = hw.error_status();
-        self.state
-            .store(state_code(status.state), Ordering::Relaxed);
-        // Publish: the controller (and the state code) are written before this store.
-        self.stage.store(READY, Ordering::Release);
+        // Written, read while only this context can see it, then published (release):
+        // every reader (`hardware()`, acquire) sees the controller whole.
+        let (_, (map, status)) = claim.publish(hardware, |hw| {
+            // SAFETY: not published yet: this is the only context that sees it.
+            let map = unsafe { hw.filter_map() };
+            let status = hw.error_status();
+            self.state
+                .store(state_code(status.state), Ordering::Relaxed);
+            (map, status)
+        });
         self.refresh_timestamps();
         Ok(Parts {
             tx: Tx { s: self, next: 0 },
@@ -398,52 +374,36 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
     /// Stores `hardware` in a state owned exclusively (the one-struct
     /// [`crate::Driver`]); returns the filter map and status for its handles.
     pub(crate) fn install(&mut self, hardware: H) -> (H::FilterMap, ErrorStatus) {
-        debug_assert_eq!(*self.stage.get_mut(), EMPTY, "installed once");
         let policy = hardware.tx_policy();
         self.queue.get_mut().get_mut().adopt(policy);
-        self.hw.get_mut().write(hardware);
-        // `&mut self`: no other context can look; READY for the readers to come.
-        *self.stage.get_mut() = READY;
-        let hw = self.hw();
+        // `&mut self`: no other context can look.
+        let hw = self.hw.set(hardware);
         let status = hw.error_status();
-        self.refresh_timestamps();
+        // SAFETY: `&mut self`: the controller is not shared.
+        let map = unsafe { hw.filter_map() };
         self.state
             .store(state_code(status.state), Ordering::Relaxed);
-        // SAFETY: `&mut self`: the controller is not shared.
-        (unsafe { hw.filter_map() }, status)
+        self.refresh_timestamps();
+        (map, status)
     }
 
     /// Takes the controller back out of a state owned exclusively.
     pub(crate) fn uninstall(&mut self) -> Option<H> {
-        if core::mem::replace(self.stage.get_mut(), EMPTY) != READY {
-            return None;
-        }
-        // SAFETY: the stage was READY: `hw` holds a controller, moved out exactly once
-        // (the stage is EMPTY from now on, and `&mut self` excludes every reader).
-        Some(unsafe { self.hw.get_mut().assume_init_read() })
+        self.hw.take()
     }
 
     /// The controller, once [`State::split`] stored it (any context).
     pub fn hardware(&self) -> Option<&H> {
-        if self.stage.load(Ordering::Acquire) == READY {
-            // SAFETY: READY is stored (release) only after `hw` was written, and this
-            // load is acquire: the write happens before this read. Nothing writes `hw`
-            // again while a shared reference to the state exists (`uninstall` takes
-            // `&mut self`).
-            Some(unsafe { (*self.hw.get()).assume_init_ref() })
-        } else {
-            None
-        }
+        self.hw.get()
     }
 
     #[inline(always)]
     fn hw(&self) -> &H {
-        debug_assert_eq!(self.stage.load(Ordering::Relaxed), READY);
-        // SAFETY: only the handles (and `install`, after its write) call this. A handle
-        // is made by `split` after it wrote `hw`, in the same thread, and reaches
-        // another context only through something that synchronises (a thread spawn, an
-        // `IrqCell`'s release/acquire, a channel): the write happens before this read.
-        unsafe { (*self.hw.get()).assume_init_ref() }
+        // SAFETY: only the handles call this. A handle is made by `split` after it
+        // published the controller, in the same thread, and reaches another context
+        // only through something that synchronises (a thread spawn, an `IrqCell`'s
+        // release/acquire, a channel): the publication happens before this read.
+        unsafe { self.hw.get_unchecked() }
     }
 
     /// Traffic counters.
