@@ -12,7 +12,10 @@
 //!   `CAN_ESR.LEC` (set to 0b111 after reading);
 //! - receive half: the filter registers (under `CAN_FMR.FINIT`), and `RFOMx` under it to
 //!   discard the old list's frames;
-//! - control (initialization mode): `CAN_BTR` (timing fields, `SILM`, `LBKM`).
+//! - any context, inside the driver's critical section: `CAN_RFxR` read (`FMPx`, no side
+//!   effect) when a time stamp is widened ([`Hardware::rx_pending`]);
+//! - control (the receive half's context; initialization mode): `CAN_BTR` (timing fields,
+//!   `SILM`, `LBKM`), `CAN_MCR` mode requests.
 //!
 //! A raw received frame is the four output-mailbox words (`CAN_RIxR`, `CAN_RDTxR`,
 //! `CAN_RDLxR`, `CAN_RDHxR`) with the FIFO number in the reserved bits 7:4 of the

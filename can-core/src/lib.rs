@@ -41,11 +41,11 @@ pub mod frame;
 pub mod hardware;
 pub mod io;
 pub mod irq_cell;
+#[cfg(all(test, twocan_loom))]
+mod loom_tests;
 pub mod mailbox;
 #[cfg(any(test, feature = "mock"))]
 pub mod mock;
-#[cfg(all(test, twocan_loom))]
-mod loom_tests;
 mod once;
 pub mod priority;
 pub mod registers;

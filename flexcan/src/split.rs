@@ -21,8 +21,8 @@
 //!   for reception.
 //! - receive half (`install_filters`, in Freeze mode): the ID table, `RXIMR`,
 //!   `RXFGMASK`, `MCR.IDAM`, and `IFLAG1.BUF5I` to discard the old list's frames;
-//! - control (stopped): `CTRL1` timing fields, `LOM`, `LPB`, `MCR.SRXDIS`; `CTRL1.BOFFREC`
-//!   (`recover`, any mode).
+//! - control (the receive half's context; stopped): `CTRL1` timing fields, `LOM`, `LPB`,
+//!   `MCR.SRXDIS`; `CTRL1.BOFFREC` (`recover`, any mode); `MCR` mode requests.
 //!
 //! A raw received frame is the Rx FIFO output's four words (control/status,
 //! identifier, data) and `RXFIR.IDHIT`; the thread side decodes it and maps the hit
