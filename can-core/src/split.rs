@@ -560,6 +560,21 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
         self.tx_event.store(true, Ordering::Relaxed);
     }
 
+    /// Whether a completion was recorded since the last call (cleared). Called inside
+    /// the critical section, where `record` sets the flag: a load and a store suffice.
+    /// Always `false` without the `async` feature (nothing waits).
+    #[inline(always)]
+    fn take_tx_event(&self) -> bool {
+        #[cfg(feature = "async")]
+        {
+            let event = self.tx_event.load(Ordering::Relaxed);
+            self.tx_event.store(false, Ordering::Relaxed);
+            event
+        }
+        #[cfg(not(feature = "async"))]
+        false
+    }
+
     /// The transmit interrupt's work, inside the critical section `cs`: settle ended
     /// mailboxes, put displaced frames back, refill free mailboxes from the queue.
     fn service_tx(&self, q: &mut Q) {
@@ -1162,26 +1177,22 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
     /// free mailboxes from the queue, in one critical section.
     pub fn on_interrupt(&mut self) {
         let s = self.s;
-        let _completed = critical_section::with(|cs| {
+        let completed = critical_section::with(|cs| {
             // SAFETY: the queue is only touched inside a critical section.
             s.service_tx(unsafe { &mut *s.queue.borrow(cs).get() });
-            // Taken inside the section, where `record` sets it: load and store suffice.
-            #[cfg(feature = "async")]
-            {
-                let event = s.tx_event.load(Ordering::Relaxed);
-                s.tx_event.store(false, Ordering::Relaxed);
-                event
-            }
+            s.take_tx_event()
         });
         // Woken on the event (a completion recorded here, or since the last interrupt by
         // the transmit half's own slow path), never on a difference of the saturating
         // counters: those stop moving after 2^32 frames.
         #[cfg(feature = "async")]
-        if _completed {
+        if completed {
             // Completions came, so mailboxes (and queue room) were freed.
             s.wakers.tx_done.wake();
             s.wakers.tx_room.wake();
         }
+        #[cfg(not(feature = "async"))]
+        let _ = completed;
     }
 }
 
