@@ -292,35 +292,35 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
     State<H, RX, Q, RX1, DONE>
 {
     crate::sync::const_fn! {
-    /// Empty, with no controller yet: all zeros.
-    pub fn new() -> Self {
-        State {
-            hw: OnceSlot::new(),
-            rx0: SpscRing::new(),
-            rx1: SpscRing::new(),
-            clock: critical_section::Mutex::new(Cell::new(Extender::new())),
-            queue: critical_section::Mutex::new(UnsafeCell::new(Q::EMPTY)),
-            queue_len: AtomicU32::new(0),
-            queue_peak: AtomicU32::new(0),
-            queue_overflows: Counter::new(),
-            done: SpscRing::new(),
-            changes: SpscRing::new(),
-            state: AtomicU8::new(STATE_UNKNOWN),
-            queued: Counter::new(),
-            sent: Counter::new(),
-            failed: Counter::new(),
-            aborted: Counter::new(),
-            per_queue: [QueueCounts::new(), QueueCounts::new()],
-            dropped: Counter::new(),
-            state_changes: Counter::new(),
-            errors: ErrorCounts::new(),
-            #[cfg(feature = "async")]
-            wakers: crate::asynch::Wakers::new(),
-            #[cfg(feature = "async")]
-            tx_event: AtomicBool::new(false),
-            _q: core::marker::PhantomData,
+        /// Empty, with no controller yet: all zeros.
+        pub fn new() -> Self {
+            State {
+                hw: OnceSlot::new(),
+                rx0: SpscRing::new(),
+                rx1: SpscRing::new(),
+                clock: critical_section::Mutex::new(Cell::new(Extender::new())),
+                queue: critical_section::Mutex::new(UnsafeCell::new(Q::EMPTY)),
+                queue_len: AtomicU32::new(0),
+                queue_peak: AtomicU32::new(0),
+                queue_overflows: Counter::new(),
+                done: SpscRing::new(),
+                changes: SpscRing::new(),
+                state: AtomicU8::new(STATE_UNKNOWN),
+                queued: Counter::new(),
+                sent: Counter::new(),
+                failed: Counter::new(),
+                aborted: Counter::new(),
+                per_queue: [QueueCounts::new(), QueueCounts::new()],
+                dropped: Counter::new(),
+                state_changes: Counter::new(),
+                errors: ErrorCounts::new(),
+                #[cfg(feature = "async")]
+                wakers: crate::asynch::Wakers::new(),
+                #[cfg(feature = "async")]
+                tx_event: AtomicBool::new(false),
+                _q: core::marker::PhantomData,
+            }
         }
-    }
     }
 
     /// Stores `hardware` and hands out the handles; once only. A second call gives
