@@ -12,7 +12,10 @@
 //!   `CAN_ESR.LEC` (set to 0b111 after reading);
 //! - receive half: the filter registers (under `CAN_FMR.FINIT`), and `RFOMx` under it to
 //!   discard the old list's frames;
-//! - control (initialization mode): `CAN_BTR` (timing fields, `SILM`, `LBKM`).
+//! - any context, inside the driver's critical section: `CAN_RFxR` read (`FMPx`, no side
+//!   effect) when a time stamp is widened ([`Hardware::rx_pending`]);
+//! - control (the receive half's context; initialization mode): `CAN_BTR` (timing fields,
+//!   `SILM`, `LBKM`), `CAN_MCR` mode requests.
 //!
 //! A raw received frame is the four output-mailbox words (`CAN_RIxR`, `CAN_RDTxR`,
 //! `CAN_RDLxR`, `CAN_RDHxR`) with the FIFO number in the reserved bits 7:4 of the
@@ -110,10 +113,23 @@ pub struct BxCan<R: Registers, F: Registers = R, const K: usize = LOOKUP_KEYS> {
     fed: AtomicU8,
 }
 
-// SAFETY: the atomics are shared; `displaced` is touched by the transmit interrupt's
-// methods only (one context at a time, the `Hardware` contract); the register handles
-// are shared as `Hardware` documents (disjoint registers or write-1-to-clear bits).
-unsafe impl<R: Registers + Sync, F: Registers + Sync, const K: usize> Sync for BxCan<R, F, K> {}
+// SAFETY: what each field needs to be shared between contexts:
+// - `regs`, `filter_regs`: every context reads and writes registers through `&R`/`&F`
+//   (`R: Sync`, `F: Sync`), each its own registers or write-1-to-clear bits (module
+//   docs, the `Hardware` contract);
+// - `fmi`: touched only by `decode` and `install_filters`, both `unsafe` and called
+//   from the receive half's one context (the `Hardware` contract, upheld by
+//   `twocan_core::split::Rx`); that context may move between threads with the receive
+//   half, so the map must be `Send` (the `where` clause);
+// - `displaced`: touched only by `displace` and `settle`, both `unsafe` and called from
+//   the transmit interrupt's context inside the driver's critical section; `Frame` is
+//   plain data;
+// - `instance`, `config`: read only; everything else is atomic.
+// `BxCan` itself is `Send` (moved into the driver's state) exactly when `R` and `F` are.
+unsafe impl<R: Registers + Sync, F: Registers + Sync, const K: usize> Sync for BxCan<R, F, K> where
+    FmiMap<K>: Send
+{
+}
 
 impl<R: Registers, F: Registers, const K: usize> Can<R, F, K> {
     /// The controller for the split driver (`twocan_core::split::State::split`); the
@@ -726,6 +742,12 @@ unsafe impl<R: Registers, F: Registers, const K: usize> Hardware for BxCan<R, F,
         })
     }
 
+    /// `CAN_RFxR.FMPx` ≠ 0 (RM0410 §40.9.2: the number of messages pending in FIFO x;
+    /// reading `CAN_RFxR` has no side effect, its write bits act only when written).
+    fn rx_pending(&self, queue: usize) -> bool {
+        rfxr::FMP.get(self.regs.read32(rfxr(queue & 1))) != 0
+    }
+
     fn raw_timestamp(&self, raw: &RawFrame) -> Option<u16> {
         self.config
             .get_timestamps()
@@ -777,7 +799,7 @@ unsafe impl<R: Registers, F: Registers, const K: usize> Hardware for BxCan<R, F,
         Ok(())
     }
 
-    fn filter_map(&self) {}
+    unsafe fn filter_map(&self) {}
 
     /// The FIFOs the active banks of the installed filters are assigned to
     /// (`CAN_FA1R`, `CAN_FFA1R`, read when they were installed): a `FifoPolicy::Fifo0`
@@ -787,7 +809,7 @@ unsafe impl<R: Registers, F: Registers, const K: usize> Hardware for BxCan<R, F,
     }
 
     /// The FIFO frames `install_filters` released under `FINIT` (`RFOMx`).
-    fn take_filter_switch_discards(&self) -> u32 {
+    unsafe fn take_filter_switch_discards(&self) -> u32 {
         self.discarded.swap(0, Ordering::Relaxed)
     }
 
@@ -825,14 +847,14 @@ unsafe impl<R: Registers, F: Registers, const K: usize> Hardware for BxCan<R, F,
         self.regs.read32(MSR) & (msr::INAK | msr::SLAK) == 0
     }
 
-    fn set_mode(&self, mode: Mode) -> Result<(), Error> {
+    unsafe fn set_mode(&self, mode: Mode) -> Result<(), Error> {
         mode::request(&self.regs, mode, self.wait.load(Ordering::Relaxed))
     }
 
     /// Manual recovery (`ABOM` = 0): when bus-off, enter and leave initialization mode;
     /// the hardware then waits for 128 × 11 recessive bits. Refused with
     /// [`Error::WrongMode`] when recovery is automatic (nothing to start).
-    fn recover(&self) -> Result<(), Error> {
+    unsafe fn recover(&self) -> Result<(), Error> {
         if self.config.get_recovery() == Recovery::Automatic {
             return Err(Error::WrongMode);
         }
@@ -895,7 +917,7 @@ unsafe impl<R: Registers, F: Registers, const K: usize> Hardware for BxCan<R, F,
     /// In initialization mode only (`CAN_BTR` is writable only then, RM0410 §40.9.2):
     /// BRP, TS1, TS2, SJW; the mode bits stay. The acknowledge bound grows for a slower
     /// rate.
-    fn set_timing(&self, timing: &Timing) -> Result<(), Error> {
+    unsafe fn set_timing(&self, timing: &Timing) -> Result<(), Error> {
         let stopped = mode::current(&self.regs) == Mode::Stopped;
         twocan_core::hardware::check_timing_for(&self.capabilities(), timing, stopped)?;
         let bits = timing.bxcan_btr().map_err(Error::Timing)?;
@@ -911,7 +933,7 @@ unsafe impl<R: Registers, F: Registers, const K: usize> Hardware for BxCan<R, F,
     }
 
     /// In initialization mode only: `CAN_BTR.SILM` (listen-only), `LBKM` (loop-back).
-    fn set_bus_mode(&self, mode: BusMode) -> Result<(), Error> {
+    unsafe fn set_bus_mode(&self, mode: BusMode) -> Result<(), Error> {
         if mode::current(&self.regs) != Mode::Stopped {
             return Err(Error::WrongMode);
         }

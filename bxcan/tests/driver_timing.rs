@@ -30,8 +30,8 @@ fn slowest_register_timing_is_accepted_by_every_entry_point() {
     let caps = d.capabilities();
     assert!(caps.min_bitrate <= t.actual_bitrate(), "{caps:?}");
     d.set_mode(Mode::Stopped).unwrap();
-    assert_eq!(d.hardware().set_timing(&t), Ok(()));
-    assert_eq!(d.hardware().set_timing(&slowest(2_110)), Ok(()));
+    assert_eq!(d.set_timing(&t), Ok(()));
+    assert_eq!(d.set_timing(&slowest(2_110)), Ok(()));
 }
 
 /// The reset-value table of `docs/differences.md`: `CAN_IER` resets to 0 and the driver

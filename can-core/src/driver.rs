@@ -24,7 +24,7 @@ use crate::error::{Error, ErrorCounters, ErrorState, ErrorStatistics, LastErrorC
 use crate::frame::{Frame, RxFrame};
 use crate::hardware::{Completion, Hardware, Token};
 use crate::mailbox::TxPolicy;
-use crate::split::{AbortRequest, RxIrq, State, StateChange, StatusIrq, Tx, TxIrq};
+use crate::split::{AbortRequest, Rx0Irq, Rx1Irq, State, StateChange, StatusIrq, Tx, TxIrq};
 use crate::spsc::BufferStats;
 use crate::timing::Timing;
 use crate::txqueue::AnyQueue;
@@ -37,6 +37,11 @@ pub const DRIVER_COMPLETIONS: usize = 32;
 /// The portable CAN driver over controller `H` with a receive ring of `RX` frames (and
 /// `RX1` for a second hardware receive queue), a transmit queue of `TX` frames in the
 /// controller's order, and a completion ring of [`DRIVER_COMPLETIONS`].
+///
+/// With `RX1 = 0` on a controller with two receive queues (bxCAN), frames that the
+/// filters put in the second queue are still taken from the hardware (its FIFO never
+/// stays full) and counted in [`TrafficStats::rx_ring_overflows`]: give `RX1` room
+/// when a filter plan uses FIFO 1.
 pub struct Driver<H: Hardware, const RX: usize, const TX: usize, const RX1: usize = 0> {
     state: State<H, RX, AnyQueue<TX>, RX1, DRIVER_COMPLETIONS>,
     next: u32,
@@ -157,9 +162,11 @@ impl<H: Hardware, const RX: usize, const TX: usize, const RX1: usize> Driver<H, 
     pub fn on_interrupt(&mut self) {
         let s = &self.state;
         TxIrq { s }.on_interrupt();
-        RxIrq { s, queue: 0 }.on_interrupt();
-        if RX1 > 0 && H::RX_QUEUES > 1 {
-            RxIrq { s, queue: 1 }.on_interrupt();
+        Rx0Irq { s }.on_interrupt();
+        if H::RX_QUEUES > 1 {
+            // Also without a ring for it (`RX1 = 0`): the hardware queue is released and
+            // its frames are counted as ring overflows, never left in the hardware.
+            Rx1Irq { s }.on_interrupt();
         }
         let mut status = StatusIrq { s, last: self.last };
         status.on_interrupt();
@@ -172,13 +179,15 @@ impl<H: Hardware, const RX: usize, const TX: usize, const RX1: usize> Driver<H, 
         TxIrq { s: &self.state }.on_interrupt();
     }
 
-    /// The receive handler of hardware queue `queue` ([`RxIrq::on_interrupt`]).
+    /// The receive handler of hardware queue `queue` ([`crate::split::RxIrq::on_interrupt`]; a
+    /// queue the controller does not have: nothing).
     pub fn on_rx(&mut self, queue: u8) {
-        RxIrq {
-            s: &self.state,
-            queue,
+        let s = &self.state;
+        match queue {
+            0 => Rx0Irq { s }.on_interrupt(),
+            1 => Rx1Irq { s }.on_interrupt(),
+            _ => {}
         }
-        .on_interrupt();
     }
 
     /// The status line's handler ([`StatusIrq::on_interrupt`]), then a read of the
@@ -278,14 +287,17 @@ impl<H: Hardware, const RX: usize, const TX: usize, const RX1: usize> Driver<H, 
 
     /// Changes the operating mode.
     pub fn set_mode(&mut self, mode: Mode) -> Result<(), Error> {
-        let r = self.hardware().set_mode(mode);
+        // SAFETY: the driver plays every role; `&mut self` makes this the control
+        // context, with no filter switch or other control call running.
+        let r = unsafe { self.hardware().set_mode(mode) };
         self.state();
         r
     }
 
     /// Starts bus-off recovery by software (refused where recovery is automatic).
     pub fn recover(&mut self) -> Result<(), Error> {
-        let r = self.hardware().recover();
+        // SAFETY: the control context, as in `set_mode`.
+        let r = unsafe { self.hardware().recover() };
         self.state();
         r
     }
@@ -303,7 +315,8 @@ impl<H: Hardware, const RX: usize, const TX: usize, const RX1: usize> Driver<H, 
     /// Stopped controller only: a new bit timing; the filters stay
     /// ([`Hardware::set_timing`]).
     pub fn set_timing(&mut self, timing: &Timing) -> Result<(), Error> {
-        self.hardware().set_timing(timing)
+        // SAFETY: the control context, as in `set_mode`.
+        unsafe { self.hardware().set_timing(timing) }
     }
 
     /// Stopped controller only: the bit timing for `bitrate` from the controller's clock,
@@ -318,24 +331,37 @@ impl<H: Hardware, const RX: usize, const TX: usize, const RX1: usize> Driver<H, 
             .capabilities()
             .timing_for(bitrate, sample_point_permille)
             .map_err(Error::Timing)?;
-        self.hardware().set_timing(&t)?;
+        // SAFETY: the control context, as in `set_mode`.
+        unsafe { self.hardware().set_timing(&t)? };
         Ok(t)
     }
 
     /// Stopped controller only: the bus mode used from the next start; the filters stay
     /// ([`Hardware::set_bus_mode`]).
     pub fn set_bus_mode(&mut self, mode: BusMode) -> Result<(), Error> {
-        self.hardware().set_bus_mode(mode)
+        // SAFETY: the control context, as in `set_mode`.
+        unsafe { self.hardware().set_bus_mode(mode) }
     }
 
     /// Installs a new compiled filter list, atomically: once it returns, no frame is
     /// reported with an index of the old list (see [`crate::hardware`]); the old list's
     /// frames discarded on the way are counted in [`TrafficStats::rx_dropped`].
     pub fn set_filters(&mut self, filters: &H::Filters) -> Result<(), Error> {
-        // SAFETY: the driver plays the receive half, the context of `install_filters`.
+        // SAFETY: the driver plays the receive half, the context of `install_filters`
+        // (`&mut self`: nothing else runs meanwhile).
         self.map = unsafe { self.hardware().install_filters(filters)? };
-        self.state.count_filter_switch_discards();
+        // SAFETY: as above.
+        unsafe { self.state.count_filter_switch_discards() };
         Ok(())
+    }
+
+    /// The controller seen from the receive half's context, for a backend's
+    /// receive-side methods (FlexCAN's installed filter table); see
+    /// [`crate::hardware::ReceiveContext`].
+    pub fn receive_context(&mut self) -> crate::hardware::ReceiveContext<'_, H> {
+        // SAFETY: the driver plays the receive half; `&mut self` is held for the
+        // context's lifetime, so no filter switch runs meanwhile.
+        unsafe { crate::hardware::ReceiveContext::new(self.hardware()) }
     }
 
     /// Reads the controller's time stamp counter where software can, so that time

@@ -4,18 +4,38 @@
 //! A backend implements [`Hardware`] on one value that every half of the driver shares
 //! by reference (it is `Sync`). Each method says which context calls it; the backend
 //! guarantees that calls from different contexts touch disjoint registers, or only
-//! write-1-to-clear bits of a shared status register, so they never need a lock:
+//! write-1-to-clear bits of a shared status register, so they never need a lock.
 //!
-//! | context | methods |
-//! |---|---|
-//! | transmit half (thread/task) | [`Hardware::free_mailbox`], [`Hardware::load`] (queue empty), [`Hardware::request_abort`] |
-//! | transmit interrupt (inside the driver's one critical section) | [`Hardware::settle`], [`Hardware::free_mailbox`], [`Hardware::load`], [`Hardware::displace`] |
-//! | receive interrupt of queue `q` | [`Hardware::read_rx`] |
-//! | receive half (thread/task) | [`Hardware::decode`], [`Hardware::install_filters`] |
-//! | status interrupt | [`Hardware::take_status`] |
-//! | any (reads only) | [`Hardware::error_status`], [`Hardware::tx_policy`], [`Hardware::on_bus`] |
-//! | any (reads only) | [`Hardware::capabilities`], [`Hardware::bus_mode`], [`Hardware::bus_off_recovery`] |
-//! | control (thread, with the halves idle or tolerant) | [`Hardware::set_mode`], [`Hardware::recover`], [`Hardware::set_timing`], [`Hardware::set_bus_mode`] |
+//! **The types say who may call what.** Every method that belongs to one context is
+//! `unsafe`: only the driver's handle for that context calls it, and the handle exists
+//! once. Every *safe* method — of this trait and of a backend's own type — may be called
+//! from any context at any time, and [`crate::State::hardware`], `Tx::hardware` and
+//! `Rx::hardware` hand out `&H` for those only. A backend method that needs the receive
+//! half's context (FlexCAN's copy of the installed filter table) takes a
+//! [`ReceiveContext`], which only the receive half (and the one-struct driver, with
+//! `&mut self`) can make.
+//!
+//! So a context that holds only `&H` cannot change the mode under a filter switch:
+//!
+//! ```compile_fail,E0133
+//! use twocan_core::mock::MockHardware;
+//! use twocan_core::{FifoQueue, Hardware, Mode, State};
+//!
+//! static CAN: State<MockHardware, 8, FifoQueue<4>> = State::new();
+//! let _p = CAN.split(MockHardware::new(3)).ok().unwrap();
+//! // e.g. a timer interrupt: the control methods are the receive half's.
+//! let _ = CAN.hardware().unwrap().set_mode(Mode::Stopped);
+//! ```
+//!
+//! | context | who runs it | methods |
+//! |---|---|---|
+//! | transmit half | `Tx` (thread/task) | [`Hardware::load`] (queue empty), [`Hardware::request_abort`], [`Hardware::abort_all_mailboxes`] (the last two inside the critical section) |
+//! | transmit interrupt | `TxIrq`, and `Tx`'s slow path, inside the driver's one critical section | [`Hardware::settle`], [`Hardware::load`], [`Hardware::displace`] |
+//! | receive interrupt of queue `q` | `RxIrq<.., q>` | [`Hardware::read_rx`] |
+//! | receive half | `Rx` (thread/task) | [`Hardware::decode`], [`Hardware::install_filters`], [`Hardware::take_filter_switch_discards`], [`Hardware::filter_map`]; a backend's [`ReceiveContext`] methods |
+//! | control | `Rx` too (the receive half is the controller's one control context, so that configuration never races a filter switch), or the one-struct driver | [`Hardware::set_mode`], [`Hardware::recover`], [`Hardware::set_timing`], [`Hardware::set_bus_mode`] |
+//! | status interrupt | `StatusIrq` | [`Hardware::take_status`] |
+//! | any (safe, reads or self-contained) | every handle, [`crate::State`], `&H` | [`Hardware::free_mailbox`], [`Hardware::tx_policy`], [`Hardware::mailbox_count`], [`Hardware::mailbox_state`], [`Hardware::error_status`], [`Hardware::on_bus`], [`Hardware::raw_timestamp`], [`Hardware::timer_now`], [`Hardware::rx_pending`], [`Hardware::capabilities`], [`Hardware::bus_mode`], [`Hardware::bus_off_recovery`] |
 //!
 //! # Portable semantics every backend keeps
 //!
@@ -116,6 +136,35 @@ pub fn sort_by_token<T>(ended: &mut [(u32, T)]) {
             ended.swap(j, j - 1);
             j -= 1;
         }
+    }
+}
+
+/// The controller as the receive half's context sees it: made only by
+/// `twocan_core::split::Rx::receive_context` and `Driver::receive_context`, each from an
+/// exclusive borrow (`&mut`) of the one receive half, so holding one proves that no
+/// filter switch ([`Hardware::install_filters`]) runs meanwhile. A backend offers its
+/// receive-side methods (those that read what a filter switch writes) on it.
+///
+/// ```compile_fail
+/// // Not made outside the driver.
+/// let cx = twocan_core::hardware::ReceiveContext { hw: &() };
+/// ```
+#[derive(Debug)]
+pub struct ReceiveContext<'a, H> {
+    hw: &'a H,
+}
+
+impl<'a, H> ReceiveContext<'a, H> {
+    /// # Safety
+    /// The caller is the receive half's context and stays so while the result lives
+    /// (it holds the one receive half borrowed exclusively).
+    pub(crate) unsafe fn new(hw: &'a H) -> Self {
+        ReceiveContext { hw }
+    }
+
+    /// The controller (its any-context methods).
+    pub fn hardware(&self) -> &'a H {
+        self.hw
     }
 }
 
@@ -252,6 +301,19 @@ pub unsafe trait Hardware {
         None
     }
 
+    /// Whether hardware receive queue `queue` holds a frame its receive handler has not
+    /// read yet, read now. Any context (a read without side effects: the driver reads it
+    /// from the other queue's receive interrupt and the transmit interrupt, inside its
+    /// critical section, when it widens a time stamp without a readable counter, so
+    /// that frames of several queues keep their bus order after a quiet bus; see
+    /// [`crate::timestamp::Extender::extend_received`]). The default, `true`, means
+    /// "unknown"; a controller whose counter software can read
+    /// ([`Hardware::timer_now`]) never needs it.
+    fn rx_pending(&self, queue: usize) -> bool {
+        let _ = queue;
+        true
+    }
+
     /// The free-running time stamp counter read now, where software can read it
     /// (FlexCAN `TIMER`; `None` on bxCAN, whose TTCM counter is internal, and whenever
     /// the counter cannot be read). The driver reads it inside its critical section,
@@ -272,7 +334,11 @@ pub unsafe trait Hardware {
     /// since the previous call; the call resets the count. The driver adds them to
     /// [`crate::TrafficStats::rx_dropped`], so that a filter switch loses no frame
     /// silently. The default, 0, is for a controller whose switch discards nothing.
-    fn take_filter_switch_discards(&self) -> u32 {
+    ///
+    /// # Safety
+    /// Called from the receive half's context only (another context would take the
+    /// count from it).
+    unsafe fn take_filter_switch_discards(&self) -> u32 {
         0
     }
 
@@ -284,8 +350,12 @@ pub unsafe trait Hardware {
         ((1u16 << Self::RX_QUEUES) - 1) as u8
     }
 
-    /// The map of the filters installed now (read at split time).
-    fn filter_map(&self) -> Self::FilterMap;
+    /// The map of the filters installed now.
+    ///
+    /// # Safety
+    /// Called from the receive half's context, or before the controller is shared
+    /// (`split` and the one-struct driver read it before any other context can call in).
+    unsafe fn filter_map(&self) -> Self::FilterMap;
 
     /// Status interrupt: reads and acknowledges error and wake-up causes.
     ///
@@ -305,11 +375,18 @@ pub unsafe trait Hardware {
     fn on_bus(&self) -> bool;
 
     /// Changes the operating mode (bounded wait on the acknowledge bit).
-    fn set_mode(&self, mode: Mode) -> Result<(), Error>;
+    ///
+    /// # Safety
+    /// Called from the control context only (see the [module docs](self)): never at the
+    /// same time as another control method or [`Hardware::install_filters`].
+    unsafe fn set_mode(&self, mode: Mode) -> Result<(), Error>;
 
     /// Starts bus-off recovery by software ([`BusOffRecovery::Manual`]); refused with
     /// [`Error::WrongMode`] when the controller recovers by itself.
-    fn recover(&self) -> Result<(), Error>;
+    ///
+    /// # Safety
+    /// As for [`Hardware::set_mode`].
+    unsafe fn recover(&self) -> Result<(), Error>;
 
     /// What this instance can do, as configured now (clock, bit-rate range, modes,
     /// filter capacity of the current partition, mailboxes, FIFO depth, time stamps).
@@ -327,12 +404,18 @@ pub unsafe trait Hardware {
     /// controller's rule refuses ([`Capabilities::check_timing`]: made for another clock
     /// or register layout, inconsistent, or forbidden by the controller's manual,
     /// [`crate::timing::TimingError::ForbiddenByManual`]).
-    fn set_timing(&self, timing: &Timing) -> Result<(), Error>;
+    ///
+    /// # Safety
+    /// As for [`Hardware::set_mode`].
+    unsafe fn set_timing(&self, timing: &Timing) -> Result<(), Error>;
 
     /// Stopped controller only: selects the bus mode used from the next start; the
     /// filters stay. [`Error::WrongMode`] while on the bus, [`Error::Unsupported`] for a
     /// mode [`Capabilities::modes`] does not offer.
-    fn set_bus_mode(&self, mode: BusMode) -> Result<(), Error>;
+    ///
+    /// # Safety
+    /// As for [`Hardware::set_mode`].
+    unsafe fn set_bus_mode(&self, mode: BusMode) -> Result<(), Error>;
 }
 
 /// The checks [`Hardware::set_timing`] applies before any register is written: the

@@ -38,13 +38,17 @@ pub mod frame;
 pub mod hardware;
 pub mod io;
 pub mod irq_cell;
+#[cfg(all(test, twocan_loom))]
+mod loom_tests;
 pub mod mailbox;
 #[cfg(any(test, feature = "mock"))]
 pub mod mock;
+mod once;
 pub mod priority;
 pub mod registers;
 pub mod split;
 pub mod spsc;
+mod sync;
 pub mod timestamp;
 pub mod timing;
 pub mod txqueue;

@@ -382,7 +382,7 @@ unsafe impl Hardware for MockHardware {
         Ok(filters.clone())
     }
 
-    fn filter_map(&self) -> MockFilterList {
+    unsafe fn filter_map(&self) -> MockFilterList {
         self.with(|m| m.filters.clone())
     }
 
@@ -402,12 +402,12 @@ unsafe impl Hardware for MockHardware {
         self.with(|m| m.mode == Mode::Normal)
     }
 
-    fn set_mode(&self, mode: Mode) -> Result<(), Error> {
+    unsafe fn set_mode(&self, mode: Mode) -> Result<(), Error> {
         self.with(|m| m.mode = mode);
         Ok(())
     }
 
-    fn recover(&self) -> Result<(), Error> {
+    unsafe fn recover(&self) -> Result<(), Error> {
         Ok(())
     }
 
@@ -446,14 +446,14 @@ unsafe impl Hardware for MockHardware {
         BusOffRecovery::Manual
     }
 
-    fn set_timing(&self, timing: &crate::timing::Timing) -> Result<(), Error> {
+    unsafe fn set_timing(&self, timing: &crate::timing::Timing) -> Result<(), Error> {
         let stopped = self.with(|m| m.mode == Mode::Stopped);
         crate::hardware::check_timing_for(&self.capabilities(), timing, stopped)?;
         self.with(|m| m.bitrate = timing.actual_bitrate());
         Ok(())
     }
 
-    fn set_bus_mode(&self, mode: BusMode) -> Result<(), Error> {
+    unsafe fn set_bus_mode(&self, mode: BusMode) -> Result<(), Error> {
         if !self.capabilities().modes.supports(mode) {
             return Err(Error::Unsupported);
         }

@@ -39,8 +39,9 @@
 //! ```
 
 use core::cell::{Cell, UnsafeCell};
-use core::mem::MaybeUninit;
-use core::sync::atomic::{AtomicBool, AtomicU32, AtomicU8, Ordering};
+#[cfg(feature = "async")]
+use core::sync::atomic::AtomicBool;
+use core::sync::atomic::{AtomicU32, AtomicU8, Ordering};
 
 use crate::controller::{ErrorStatus, Mode};
 use crate::dispatch::Dispatcher;
@@ -48,6 +49,7 @@ use crate::error::{Error, ErrorCounters, ErrorState, ErrorStatistics, LastErrorC
 use crate::frame::{Frame, RxFrame};
 use crate::hardware::{Completion, Hardware, Settled, Token};
 use crate::mailbox::{TxOutcome, TxPolicy};
+use crate::once::OnceSlot;
 use crate::spsc::{BufferStats, Counter, SpscRing};
 use crate::timestamp::{Extender, Timestamp};
 use crate::txqueue::{FifoQueue, Queued, TxQueue};
@@ -130,8 +132,27 @@ struct ErrorCounts {
     bit: Counter,
     crc: Counter,
     bus_off: Counter,
-    overruns: Counter,
     wakeups: Counter,
+}
+
+/// The counters of one hardware receive queue, written by its receive handler only.
+///
+/// One writer per counter, rather than a read-modify-write shared by both handlers:
+/// an atomic `fetch_add` would need LDREX/STREX (ARMv7-M has them, ARMv6-M does not)
+/// and costs a retry loop on the per-frame path; a plain load and store per queue
+/// works on every core and the readers add the two.
+struct QueueCounts {
+    received: Counter,
+    overruns: Counter,
+}
+
+impl QueueCounts {
+    const fn new() -> Self {
+        QueueCounts {
+            received: Counter::new(),
+            overruns: Counter::new(),
+        }
+    }
 }
 
 impl ErrorCounts {
@@ -143,7 +164,6 @@ impl ErrorCounts {
             bit: Counter::new(),
             crc: Counter::new(),
             bus_off: Counter::new(),
-            overruns: Counter::new(),
             wakeups: Counter::new(),
         }
     }
@@ -181,8 +201,8 @@ pub struct State<
     const RX1: usize = 0,
     const DONE: usize = 8,
 > {
-    taken: AtomicBool,
-    hw: UnsafeCell<MaybeUninit<H>>,
+    /// The controller, published once by `split` (see [`OnceSlot`]).
+    hw: OnceSlot<H>,
     rx0: SpscRing<Stamped<H::Raw>, RX>,
     rx1: SpscRing<Stamped<H::Raw>, RX1>,
     /// The time stamp extender shared by the receive and transmit interrupt sides (and
@@ -200,21 +220,38 @@ pub struct State<
     sent: Counter,
     failed: Counter,
     aborted: Counter,
-    received: Counter,
+    /// Per hardware receive queue: each queue's handler is the one writer of its
+    /// counters (bxCAN's RX0 and RX1 handlers may preempt each other); read as sums.
+    per_queue: [QueueCounts; 2],
     dropped: Counter,
     state_changes: Counter,
     errors: ErrorCounts,
     #[cfg(feature = "async")]
     pub(crate) wakers: crate::wakers::Wakers,
+    /// A completion was recorded since the transmit handler last looked: the event that
+    /// wakes the transmit half's waits. Written and cleared only inside the critical
+    /// section (plain load and store, no read-modify-write).
+    #[cfg(feature = "async")]
+    tx_event: AtomicBool,
     _q: core::marker::PhantomData<Q>,
 }
 
-// SAFETY: the controller is written once by `split` before `taken` is published and
-// only read afterwards (`H: Sync` makes sharing it sound); the rings follow the SPSC
-// contract through the unique handles; the queue is only touched inside a critical
-// section.
+// SAFETY: what each field needs to be shared between contexts:
+// - `hw`: a `OnceSlot<H>`, `Sync` when `H: Send + Sync` (as `OnceLock<T>`): written
+//   once by the one `split` that claimed it and published (release; readers acquire),
+//   then only read through `&H` from every context (`H: Sync`); a controller moved in
+//   through `&State` by one thread is dropped (or taken back by `uninstall`) by
+//   whichever thread owns the state later (`H: Send`).
+// - the rings: one producer handle and one consumer handle each (`SpscRing`'s
+//   contract, upheld by the handles `split` makes once); their entries move between
+//   contexts: `H::Raw: Send` (raw frames), and completions and state changes are plain
+//   data.
+// - `queue`: only touched inside a critical section (`critical_section::Mutex`), and its
+//   entries move between contexts: `Q: Send`.
+// - `clock`: inside a `critical_section::Mutex`; the counters, `stage` and `state` are
+//   atomics; the wakers are `AtomicWaker`s (`Sync`).
 unsafe impl<
-        H: Hardware + Sync,
+        H: Hardware + Send + Sync,
         const RX: usize,
         Q: TxQueue + Send,
         const RX1: usize,
@@ -233,14 +270,6 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
     }
 }
 
-impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize> Drop
-    for State<H, RX, Q, RX1, DONE>
-{
-    fn drop(&mut self) {
-        drop(self.uninstall());
-    }
-}
-
 /// The handles [`State::split`] hands out, each for one context.
 pub struct Parts<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize>
 {
@@ -251,9 +280,10 @@ pub struct Parts<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize,
     /// Transmit interrupt handler (bxCAN TX line; FlexCAN message-buffer line).
     pub tx_irq: TxIrq<'a, H, RX, Q, RX1, DONE>,
     /// Receive interrupt handler of queue 0 (bxCAN RX0; FlexCAN message-buffer line).
-    pub rx0_irq: RxIrq<'a, H, RX, Q, RX1, DONE>,
-    /// Receive interrupt handler of queue 1 (bxCAN RX1; unused on FlexCAN).
-    pub rx1_irq: RxIrq<'a, H, RX, Q, RX1, DONE>,
+    pub rx0_irq: Rx0Irq<'a, H, RX, Q, RX1, DONE>,
+    /// Receive interrupt handler of queue 1 (bxCAN RX1; unused on FlexCAN). A type of
+    /// its own: it cannot be put where queue 0's handler belongs.
+    pub rx1_irq: Rx1Irq<'a, H, RX, Q, RX1, DONE>,
     /// Status interrupt handler (bxCAN SCE; FlexCAN bus-off, error, warning, wake-up).
     pub status_irq: StatusIrq<'a, H, RX, Q, RX1, DONE>,
 }
@@ -261,69 +291,79 @@ pub struct Parts<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize,
 impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize>
     State<H, RX, Q, RX1, DONE>
 {
-    /// Empty, with no controller yet: all zeros.
-    pub const fn new() -> Self {
-        State {
-            taken: AtomicBool::new(false),
-            hw: UnsafeCell::new(MaybeUninit::uninit()),
-            rx0: SpscRing::new(),
-            rx1: SpscRing::new(),
-            clock: critical_section::Mutex::new(Cell::new(Extender::new())),
-            queue: critical_section::Mutex::new(UnsafeCell::new(Q::EMPTY)),
-            queue_len: AtomicU32::new(0),
-            queue_peak: AtomicU32::new(0),
-            queue_overflows: Counter::new(),
-            done: SpscRing::new(),
-            changes: SpscRing::new(),
-            state: AtomicU8::new(STATE_UNKNOWN),
-            queued: Counter::new(),
-            sent: Counter::new(),
-            failed: Counter::new(),
-            aborted: Counter::new(),
-            received: Counter::new(),
-            dropped: Counter::new(),
-            state_changes: Counter::new(),
-            errors: ErrorCounts::new(),
-            #[cfg(feature = "async")]
-            wakers: crate::wakers::Wakers::new(),
-            _q: core::marker::PhantomData,
+    crate::sync::const_fn! {
+        /// Empty, with no controller yet: all zeros.
+        pub fn new() -> Self {
+            State {
+                hw: OnceSlot::new(),
+                rx0: SpscRing::new(),
+                rx1: SpscRing::new(),
+                clock: critical_section::Mutex::new(Cell::new(Extender::new())),
+                queue: critical_section::Mutex::new(UnsafeCell::new(Q::EMPTY)),
+                queue_len: AtomicU32::new(0),
+                queue_peak: AtomicU32::new(0),
+                queue_overflows: Counter::new(),
+                done: SpscRing::new(),
+                changes: SpscRing::new(),
+                state: AtomicU8::new(STATE_UNKNOWN),
+                queued: Counter::new(),
+                sent: Counter::new(),
+                failed: Counter::new(),
+                aborted: Counter::new(),
+                per_queue: [QueueCounts::new(), QueueCounts::new()],
+                dropped: Counter::new(),
+                state_changes: Counter::new(),
+                errors: ErrorCounts::new(),
+                #[cfg(feature = "async")]
+                wakers: crate::wakers::Wakers::new(),
+                #[cfg(feature = "async")]
+                tx_event: AtomicBool::new(false),
+                _q: core::marker::PhantomData,
+            }
         }
     }
 
     /// Stores `hardware` and hands out the handles; once only. A second call gives
     /// `hardware` back. The controller's transmit order must be `Q`'s
     /// ([`Error::InvalidArgument`] otherwise, with the controller given back).
+    ///
+    /// Any context may call it, and several may race: the first to claim the state
+    /// (one compare-and-swap) is the only one that touches the queue and writes the
+    /// controller; the controller becomes visible to [`State::hardware`] (and to every
+    /// reader in other contexts) only once it is written, through a release store that
+    /// those readers load with acquire ordering.
     #[allow(clippy::type_complexity)]
     pub fn split(&self, hardware: H) -> Result<Parts<'_, H, RX, Q, RX1, DONE>, (Error, H)> {
-        if self.taken.load(Ordering::Acquire) {
+        // Claim first: a losing `split` must not touch the winner's queue.
+        let Some(claim) = self.hw.claim() else {
             return Err((Error::WrongMode, hardware));
-        }
+        };
         let adopted = critical_section::with(|cs| {
             // SAFETY: the queue is only touched inside a critical section.
             unsafe { &mut *self.queue.borrow(cs).get() }.adopt(hardware.tx_policy())
         });
         if !adopted {
+            // Nothing was written: dropping the claim frees the state again.
+            drop(claim);
             return Err((Error::InvalidArgument, hardware));
         }
-        if self.taken.swap(true, Ordering::AcqRel) {
-            return Err((Error::WrongMode, hardware));
-        }
-        // SAFETY: `taken` was false: no handle exists, so nothing reads `hw` yet, and
-        // the swap above makes this the only writer ever.
-        unsafe { (*self.hw.get()).write(hardware) };
-        // SAFETY: written just above.
-        let hw = unsafe { (*self.hw.get()).assume_init_ref() };
-        let map = hw.filter_map();
-        let status = hw.error_status();
+        // Written, read while only this context can see it, then published (release):
+        // every reader (`hardware()`, acquire) sees the controller whole.
+        let (_, (map, status)) = claim.publish(hardware, |hw| {
+            // SAFETY: not published yet: this is the only context that sees it.
+            let map = unsafe { hw.filter_map() };
+            let status = hw.error_status();
+            self.state
+                .store(state_code(status.state), Ordering::Relaxed);
+            (map, status)
+        });
         self.refresh_timestamps();
-        self.state
-            .store(state_code(status.state), Ordering::Release);
         Ok(Parts {
             tx: Tx { s: self, next: 0 },
             rx: Rx { s: self, map },
             tx_irq: TxIrq { s: self },
-            rx0_irq: RxIrq { s: self, queue: 0 },
-            rx1_irq: RxIrq { s: self, queue: 1 },
+            rx0_irq: RxIrq { s: self },
+            rx1_irq: RxIrq { s: self },
             status_irq: StatusIrq {
                 s: self,
                 last: status.state,
@@ -336,41 +376,34 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
     pub(crate) fn install(&mut self, hardware: H) -> (H::FilterMap, ErrorStatus) {
         let policy = hardware.tx_policy();
         self.queue.get_mut().get_mut().adopt(policy);
-        self.hw.get_mut().write(hardware);
-        *self.taken.get_mut() = true;
-        let hw = self.hw();
+        // `&mut self`: no other context can look.
+        let hw = self.hw.set(hardware);
         let status = hw.error_status();
-        self.refresh_timestamps();
+        // SAFETY: `&mut self`: the controller is not shared.
+        let map = unsafe { hw.filter_map() };
         self.state
             .store(state_code(status.state), Ordering::Relaxed);
-        (hw.filter_map(), status)
+        self.refresh_timestamps();
+        (map, status)
     }
 
     /// Takes the controller back out of a state owned exclusively.
     pub(crate) fn uninstall(&mut self) -> Option<H> {
-        if !core::mem::replace(self.taken.get_mut(), false) {
-            return None;
-        }
-        // SAFETY: `taken` was set: `hw` holds a controller, moved out exactly once
-        // (the flag is cleared first).
-        Some(unsafe { self.hw.get_mut().assume_init_read() })
+        self.hw.take()
     }
 
-    /// The controller, once [`State::split`] stored it.
+    /// The controller, once [`State::split`] stored it (any context).
     pub fn hardware(&self) -> Option<&H> {
-        if self.taken.load(Ordering::Acquire) {
-            // SAFETY: `taken` is set only after `hw` was written (release/acquire).
-            Some(unsafe { (*self.hw.get()).assume_init_ref() })
-        } else {
-            None
-        }
+        self.hw.get()
     }
 
     #[inline(always)]
     fn hw(&self) -> &H {
-        // SAFETY: only handles call this, and handles exist only after `split` wrote
-        // `hw`.
-        unsafe { (*self.hw.get()).assume_init_ref() }
+        // SAFETY: only the handles call this. A handle is made by `split` after it
+        // published the controller, in the same thread, and reaches another context
+        // only through something that synchronises (a thread spawn, an `IrqCell`'s
+        // release/acquire, a channel): the publication happens before this read.
+        unsafe { self.hw.get_unchecked() }
     }
 
     /// Traffic counters.
@@ -380,7 +413,10 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
             sent: self.sent.get(),
             failed: self.failed.get(),
             aborted: self.aborted.get(),
-            received: self.received.get(),
+            received: self.per_queue[0]
+                .received
+                .get()
+                .saturating_add(self.per_queue[1].received.get()),
             rx_ring_overflows: self.rx0.stats().overflows + self.rx1.stats().overflows,
             rx_dropped: self.dropped.get(),
             completion_overflows: self.done.stats().overflows,
@@ -399,7 +435,10 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
             bit: e.bit.get(),
             crc: e.crc.get(),
             bus_off: e.bus_off.get(),
-            hardware_overruns: e.overruns.get(),
+            hardware_overruns: self.per_queue[0]
+                .overruns
+                .get()
+                .saturating_add(self.per_queue[1].overruns.get()),
         }
     }
 
@@ -429,21 +468,40 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
         });
     }
 
-    /// Widens a 16-bit stamp read from the hardware before this call (interrupt side).
+    /// Widens the 16-bit stamp of a completion read from the hardware before this call
+    /// (transmit interrupt side).
     #[inline]
     fn widen(&self, stamp: u16) -> Timestamp {
+        self.widen_from(None, stamp)
+    }
+
+    /// Widens the 16-bit stamp of a frame just read from receive queue `queue` (its
+    /// receive interrupt).
+    #[inline]
+    fn widen_received(&self, queue: usize, stamp: u16) -> Timestamp {
+        self.widen_from(Some(queue), stamp)
+    }
+
+    #[inline]
+    fn widen_from(&self, queue: Option<usize>, stamp: u16) -> Timestamp {
         let hw = self.hw();
+        let pending = |q: usize| q < H::RX_QUEUES && hw.rx_pending(q);
         critical_section::with(|cs| {
             let c = self.clock.borrow(cs);
             let mut e = c.get();
             // The counter is read after the stamp, inside the section: every stamp
-            // widened is at or before the reading, whichever context read it.
+            // widened is at or before the reading, whichever context read it. Without a
+            // readable counter, the queues' "frame pending" flags are read inside the
+            // section too, so that they are current for the reference it leaves.
             let t = match hw.timer_now() {
                 Some(now) => {
                     e.observe(now);
                     e.extend_before(stamp)
                 }
-                None => e.extend_near(stamp),
+                None => match queue {
+                    Some(q) => e.extend_received(q, stamp, pending),
+                    None => e.extend_sent(stamp, pending),
+                },
             };
             c.set(e);
             t
@@ -516,6 +574,25 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
         // SAFETY: completions are produced only inside the critical section (transmit
         // interrupt, transmit half's slow path), so producers never overlap.
         let _ = unsafe { self.done.push(done) };
+        // The event the transmit handler wakes on (inside the critical section, as
+        // every `record`).
+        #[cfg(feature = "async")]
+        self.tx_event.store(true, Ordering::Relaxed);
+    }
+
+    /// Whether a completion was recorded since the last call (cleared). Called inside
+    /// the critical section, where `record` sets the flag: a load and a store suffice.
+    /// Always `false` without the `async` feature (nothing waits).
+    #[inline(always)]
+    fn take_tx_event(&self) -> bool {
+        #[cfg(feature = "async")]
+        {
+            let event = self.tx_event.load(Ordering::Relaxed);
+            self.tx_event.store(false, Ordering::Relaxed);
+            event
+        }
+        #[cfg(not(feature = "async"))]
+        false
     }
 
     /// The transmit interrupt's work, inside the critical section `cs`: settle ended
@@ -653,9 +730,14 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
 
     /// Adds the frames the last filter switch discarded from the hardware FIFO to
     /// [`TrafficStats::rx_dropped`] (the receive half's context, the counter's writer).
-    pub(crate) fn count_filter_switch_discards(&self) {
+    ///
+    /// # Safety
+    /// Called from the receive half's context.
+    pub(crate) unsafe fn count_filter_switch_discards(&self) {
         if let Some(hw) = self.hardware() {
-            self.dropped.add(hw.take_filter_switch_discards());
+            // SAFETY: the caller's contract.
+            self.dropped
+                .add(unsafe { hw.take_filter_switch_discards() });
         }
     }
 
@@ -722,7 +804,11 @@ pub enum AbortRequest {
     /// The frame is in a mailbox: its abort was requested; the completion (aborted, or
     /// sent if the abort came too late) follows.
     Requested,
-    /// No frame with this token is queued or in a mailbox (it completed already).
+    /// Nothing was aborted: no frame with this token is queued or waiting in a mailbox
+    /// now. That does not mean its completion was delivered: a frame whose mailbox
+    /// ended (sent, or failed) but was not settled yet still gets its one completion
+    /// when the transmit interrupt settles it, possibly after this call returns. A
+    /// token never handed out is not found either.
     NotFound,
 }
 
@@ -1015,10 +1101,48 @@ impl<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE:
     /// discarded from the hardware FIFO or dropped from the ring, and counted in
     /// [`TrafficStats::rx_dropped`] either way; see [`crate::hardware`]).
     pub fn set_filters(&mut self, filters: &H::Filters) -> Result<(), Error> {
-        // SAFETY: the receive half is the context of `install_filters`.
+        // SAFETY: the receive half is the context of `install_filters` (and of the
+        // control methods, so no mode change runs meanwhile); `&mut self` keeps this
+        // half's other calls (`decode`, a `ReceiveContext`) out while it runs.
         self.map = unsafe { self.s.hw().install_filters(filters)? };
-        self.s.count_filter_switch_discards();
+        // SAFETY: as above, the receive half's context.
+        unsafe { self.s.count_filter_switch_discards() };
         Ok(())
+    }
+
+    /// The controller seen from this half's context, for a backend's receive-side
+    /// methods (FlexCAN's installed filter table): no filter switch runs while it is
+    /// borrowed.
+    pub fn receive_context(&mut self) -> crate::hardware::ReceiveContext<'_, H> {
+        // SAFETY: the receive half, borrowed exclusively for the context's lifetime.
+        unsafe { crate::hardware::ReceiveContext::new(self.s.hw()) }
+    }
+
+    /// Changes the operating mode. The receive half is the controller's control
+    /// context: mode, timing, bus mode and recovery changes never race a filter switch
+    /// or each other (see [`crate::hardware`]).
+    pub fn set_mode(&mut self, mode: Mode) -> Result<(), Error> {
+        // SAFETY: the control context (this half, `&mut self`).
+        unsafe { self.s.hw().set_mode(mode) }
+    }
+
+    /// Starts bus-off recovery by software (refused with [`Error::WrongMode`] where
+    /// recovery is automatic).
+    pub fn recover(&mut self) -> Result<(), Error> {
+        // SAFETY: the control context (this half, `&mut self`).
+        unsafe { self.s.hw().recover() }
+    }
+
+    /// Stopped controller only: a new bit timing, the filters kept.
+    pub fn set_timing(&mut self, timing: &crate::timing::Timing) -> Result<(), Error> {
+        // SAFETY: the control context (this half, `&mut self`).
+        unsafe { self.s.hw().set_timing(timing) }
+    }
+
+    /// Stopped controller only: the bus mode used from the next start, the filters kept.
+    pub fn set_bus_mode(&mut self, mode: crate::capabilities::BusMode) -> Result<(), Error> {
+        // SAFETY: the control context (this half, `&mut self`).
+        unsafe { self.s.hw().set_bus_mode(mode) }
     }
 
     /// Receive ring figures ([`State::rx_stats`]).
@@ -1099,18 +1223,22 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
     /// free mailboxes from the queue, in one critical section.
     pub fn on_interrupt(&mut self) {
         let s = self.s;
-        #[cfg(feature = "async")]
-        let before = s.sent.get() + s.failed.get() + s.aborted.get();
-        critical_section::with(|cs| {
+        let completed = critical_section::with(|cs| {
             // SAFETY: the queue is only touched inside a critical section.
-            s.service_tx(unsafe { &mut *s.queue.borrow(cs).get() })
+            s.service_tx(unsafe { &mut *s.queue.borrow(cs).get() });
+            s.take_tx_event()
         });
+        // Woken on the event (a completion recorded here, or since the last interrupt by
+        // the transmit half's own slow path), never on a difference of the saturating
+        // counters: those stop moving after 2^32 frames.
         #[cfg(feature = "async")]
-        if s.sent.get() + s.failed.get() + s.aborted.get() != before {
+        if completed {
             // Completions came, so mailboxes (and queue room) were freed.
             s.wakers.tx_done.wake();
             s.wakers.tx_room.wake();
         }
+        #[cfg(not(feature = "async"))]
+        let _ = completed;
     }
 }
 
@@ -1134,25 +1262,66 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
 /// assert_eq!(CAN.rx_stats().overflows, 1);
 /// # Ok::<(), twocan_core::Error>(())
 /// ```
-pub struct RxIrq<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize>
-{
+pub struct RxIrq<
+    'a,
+    H: Hardware,
+    const RX: usize,
+    Q: TxQueue,
+    const RX1: usize,
+    const DONE: usize,
+    const QUEUE: usize,
+> {
     pub(crate) s: &'a State<H, RX, Q, RX1, DONE>,
-    pub(crate) queue: u8,
 }
 
-impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize>
-    RxIrq<'_, H, RX, Q, RX1, DONE>
+/// The receive interrupt handler of hardware queue 0 (bxCAN RX0 / FIFO 0, FlexCAN's Rx
+/// FIFO on the ORed message-buffer line).
+pub type Rx0Irq<'a, H, const RX: usize, Q, const RX1: usize, const DONE: usize> =
+    RxIrq<'a, H, RX, Q, RX1, DONE, 0>;
+
+/// The receive interrupt handler of hardware queue 1 (bxCAN RX1 / FIFO 1; a FlexCAN
+/// controller has no second queue: its handler finds nothing).
+///
+/// Each queue's handler has a type of its own, so that one cannot be put where the
+/// other belongs (run from the other line's vector, it would leave that line's level
+/// triggered cause set for ever):
+///
+/// ```compile_fail,E0308
+/// use twocan_core::irq_cell::IrqCell;
+/// use twocan_core::mock::MockHardware;
+/// use twocan_core::split::Rx0Irq;
+/// use twocan_core::{FifoQueue, State};
+///
+/// type Q = FifoQueue<4>;
+/// static CAN: State<MockHardware, 8, Q, 8> = State::new();
+/// static RX0: IrqCell<Rx0Irq<'static, MockHardware, 8, Q, 8, 8>> = IrqCell::new();
+/// let p = CAN.split(MockHardware::new(3)).ok().unwrap();
+/// let _ = RX0.put(p.rx1_irq); // queue 1's handler where queue 0's belongs: refused
+/// ```
+pub type Rx1Irq<'a, H, const RX: usize, Q, const RX1: usize, const DONE: usize> =
+    RxIrq<'a, H, RX, Q, RX1, DONE, 1>;
+
+impl<
+        H: Hardware,
+        const RX: usize,
+        Q: TxQueue,
+        const RX1: usize,
+        const DONE: usize,
+        const QUEUE: usize,
+    > RxIrq<'_, H, RX, Q, RX1, DONE, QUEUE>
 {
     /// Moves every frame of the hardware queue into its ring as raw words and releases
     /// the hardware; a full ring counts the frame as an overflow. No decoding here.
     #[inline]
     pub fn on_interrupt(&mut self) {
+        const { assert!(QUEUE < 2, "a controller has at most two receive queues") };
         let s = self.s;
-        // The queue number as a constant in each branch, so that the backend's register
-        // offsets fold into the loop.
-        // SAFETY (both): this handle is the only caller of `read_rx` for its queue and
-        // the only producer of its ring.
-        if self.queue == 0 {
+        // The queue number is a constant, so that the backend's register offsets fold
+        // into the loop.
+        // SAFETY (both): this handle (one per queue, made once by `split`, its type
+        // naming its queue) is the only caller of `read_rx` for its queue and the only
+        // producer of its ring.
+        if QUEUE == 0 {
             unsafe { drain(s, 0, &s.rx0) }
         } else {
             unsafe { drain(s, 1, &s.rx1) }
@@ -1160,8 +1329,8 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
     }
 
     /// Which hardware queue this handler drains.
-    pub fn queue(&self) -> usize {
-        self.queue as usize
+    pub const fn queue(&self) -> usize {
+        QUEUE
     }
 }
 
@@ -1169,7 +1338,7 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
 ///
 /// # Safety
 /// Called from queue `q`'s receive interrupt handle only (the one caller of `read_rx`
-/// for `q` and the one producer of `ring`).
+/// for `q`, the one producer of `ring` and the one writer of queue `q`'s counters).
 #[inline(always)]
 unsafe fn drain<
     H: Hardware,
@@ -1184,42 +1353,31 @@ unsafe fn drain<
     ring: &SpscRing<Stamped<H::Raw>, N>,
 ) {
     let hw = s.hw();
+    let counts = &s.per_queue[q];
     let mut overrun = false;
     let mut any = false;
     // SAFETY: the caller's contract.
     unsafe {
         while let Some(raw) = hw.read_rx(q, &mut overrun) {
             any = true;
-            s.received.inc();
+            counts.received.inc();
             // Widened here, on the interrupt side: the counter's wraps are only known
             // while the frame is fresh.
             let wraps = match hw.raw_timestamp(&raw) {
-                Some(t) => s.widen(t).wraps(),
+                Some(t) => s.widen_received(q, t).wraps(),
                 None => 0,
             };
             let _ = ring.push(Stamped { raw, wraps });
         }
     }
     if overrun {
-        overrun_counter(s).inc();
+        counts.overruns.inc();
     }
     #[cfg(feature = "async")]
     if any {
         s.wakers.rx.wake();
     }
     let _ = any;
-}
-
-fn overrun_counter<
-    H: Hardware,
-    const RX: usize,
-    Q: TxQueue,
-    const RX1: usize,
-    const DONE: usize,
->(
-    s: &State<H, RX, Q, RX1, DONE>,
-) -> &Counter {
-    &s.errors.overruns
 }
 
 /// The status (error, bus-off, wake-up) interrupt handler.
@@ -1332,7 +1490,7 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
 // The handles need no `unsafe impl Send`: each is a shared reference to the state
 // (`Send` exactly when the state is `Sync`, see above) plus data owned by its context.
 
-/// Errors of the control operations shared by both halves.
+/// Reads any context may make.
 impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize>
     State<H, RX, Q, RX1, DONE>
 {
@@ -1341,28 +1499,58 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
         self.hardware().map(|h| h.error_status())
     }
 
-    /// Changes the operating mode.
-    pub fn set_mode(&self, mode: Mode) -> Result<(), Error> {
-        self.hardware().ok_or(Error::WrongMode)?.set_mode(mode)
-    }
-
-    /// Starts bus-off recovery by software.
-    pub fn recover(&self) -> Result<(), Error> {
-        self.hardware().ok_or(Error::WrongMode)?.recover()
-    }
-
     /// What the controller can do, as configured now.
     pub fn capabilities(&self) -> Option<crate::capabilities::Capabilities> {
         self.hardware().map(|h| h.capabilities())
     }
+}
 
-    /// Stopped controller only: a new bit timing, the filters kept.
-    pub fn set_timing(&self, timing: &crate::timing::Timing) -> Result<(), Error> {
-        self.hardware().ok_or(Error::WrongMode)?.set_timing(timing)
+#[cfg(all(test, feature = "mock", feature = "async"))]
+mod tests {
+    use core::future::Future;
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    use std::sync::Arc;
+    use std::task::{Context, Poll, Wake, Waker};
+
+    use super::State;
+    use crate::mock::MockHardware;
+    use crate::{FifoQueue, Frame, TxOutcome};
+
+    /// Counts its wake-ups.
+    struct Count(AtomicUsize);
+    impl Wake for Count {
+        fn wake(self: Arc<Self>) {
+            self.0.fetch_add(1, Ordering::Relaxed);
+        }
     }
 
-    /// Stopped controller only: the bus mode used from the next start, the filters kept.
-    pub fn set_bus_mode(&self, mode: crate::capabilities::BusMode) -> Result<(), Error> {
-        self.hardware().ok_or(Error::WrongMode)?.set_bus_mode(mode)
+    /// Item 7 of issue 26: the transmit handler woke the waiting task only when
+    /// `sent + failed + aborted` changed, so after the saturating counters reached
+    /// `u32::MAX` (about 2^32 frames) nothing was woken any more (and the sum itself
+    /// overflowed). It wakes on the event: a completion recorded.
+    #[test]
+    fn a_saturated_sent_counter_still_wakes_the_waiting_task() {
+        let state: State<MockHardware, 8, FifoQueue<4>> = State::new();
+        let mut p = state.split(MockHardware::new(1)).ok().unwrap();
+        state.sent.add(u32::MAX);
+        let count = Arc::new(Count(AtomicUsize::new(0)));
+        let waker = Waker::from(count.clone());
+        let mut cx = Context::from_waker(&waker);
+
+        let token = p.tx.try_send(&Frame::standard(0x10, &[]).unwrap()).unwrap();
+        let mut done = core::pin::pin!(p.tx.completion());
+        assert!(done.as_mut().poll(&mut cx).is_pending());
+        state.hardware().unwrap().complete_all();
+        p.tx_irq.on_interrupt();
+        assert_eq!(
+            count.0.load(Ordering::Relaxed),
+            1,
+            "the waiting task was not woken"
+        );
+        match done.as_mut().poll(&mut cx) {
+            Poll::Ready(c) => assert_eq!((c.token, c.outcome), (token, TxOutcome::Sent)),
+            Poll::Pending => panic!("woken without a completion"),
+        }
+        assert_eq!(state.traffic().sent, u32::MAX);
     }
 }

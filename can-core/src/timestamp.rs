@@ -137,6 +137,9 @@ pub const fn bit_times_to_micros(bits: u64, bit_rate: u32) -> Result<u64, Error>
     }
 }
 
+/// Receive queues whose order the extender keeps (bxCAN's two FIFOs).
+pub const RX_QUEUES: usize = 2;
+
 /// Widens 16-bit counter values to [`Timestamp`]s relative to a reference it keeps (the
 /// latest extended value it saw). All zeros is a valid start (`const`), so that a
 /// `static` driver state holds one in `.bss`.
@@ -148,9 +151,17 @@ pub const fn bit_times_to_micros(bits: u64, bit_rate: u32) -> Result<u64, Error>
 ///   the latest reading is placed less than one period before it. Exact when readings
 ///   are less than 65,536 bit times apart and each stamp is widened less than 65,536 bit
 ///   times after it was taken;
-/// - it cannot ([`Extender::extend_near`]): each stamp is placed within ±32,767 bit times
-///   of the reference, which moves forward to the stamp when it is later. Exact when
-///   every stamp is within 32,767 bit times of the latest stamp widened before it.
+/// - it cannot ([`Extender::extend_received`], [`Extender::extend_sent`]): a stamp is
+///   placed after the reference (less than one period after it, moving the reference)
+///   unless it may be older than the reference, and then within ±32,767 bit times of
+///   it. A received frame may be older than the reference only when its receive queue
+///   held a frame (not read yet) at the last time the reference moved and has not been
+///   found empty since: the extender keeps that per queue, from the hardware's "frame
+///   pending" flags read when it widens a stamp (`pending`). So a frame read after a
+///   quiet bus of any length is placed after every frame read before it — never before
+///   a frame it followed on the bus — and its stamp is off by whole periods only. A
+///   transmit stamp is placed within ±32,767 bit times of the reference (the hardware
+///   does not tell whether an older completion is pending).
 ///
 /// The first reading (or, without readings, the first stamp) lands one period above the
 /// origin, at one period plus its counter value, so that a stamp from up to one period
@@ -164,6 +175,10 @@ pub struct Extender {
     /// A stamp or reading set the reference ([`Extender::extend_near`] places its first
     /// stamp at its counter value, one period above the origin).
     primed: bool,
+    /// Bit `q`: receive queue `q` held a frame not read yet when the reference last
+    /// moved, and was not found empty since, so its next frames may be older than the
+    /// reference.
+    maybe_older: u8,
 }
 
 impl Extender {
@@ -172,6 +187,7 @@ impl Extender {
         Extender {
             reference: 0,
             primed: false,
+            maybe_older: 0,
         }
     }
 
@@ -198,20 +214,90 @@ impl Extender {
     }
 
     /// A stamp within ±32,767 bit times of the reference (no counter reading): placed
-    /// there, and the reference moves forward to it when it is later.
+    /// there, and the reference moves forward to it when it is later. Without what the
+    /// hardware holds, every receive queue may then hold older frames (see
+    /// [`Extender::extend_received`]).
     pub fn extend_near(&mut self, stamp: u16) -> Timestamp {
+        self.extend_sent(stamp, |_| true)
+    }
+
+    /// The stamp of a completed transmission (no counter reading): placed within
+    /// ±32,767 bit times of the reference, which moves forward to it when it is later.
+    /// `pending(q)`: whether receive queue `q` holds a frame not read yet, read now
+    /// (`true` when unknown).
+    pub fn extend_sent(&mut self, stamp: u16, pending: impl Fn(usize) -> bool) -> Timestamp {
+        let (at, moved) = self.place(stamp, true);
+        self.note_queues(None, moved, pending);
+        at
+    }
+
+    /// The stamp of a frame just read from receive queue `queue` (`< RX_QUEUES`; no
+    /// counter reading). `pending(q)`: whether receive queue `q` holds a frame not read
+    /// yet, read now, after the frame was taken (`true` when unknown).
+    ///
+    /// Placed after the reference (less than one period after it, the reference moving
+    /// forward to it), unless `queue` may hold frames older than the reference: then
+    /// within ±32,767 bit times of it, as [`Extender::extend_near`]. Queue `q` may hold
+    /// older frames when `pending(q)` was true as the reference last moved and has not
+    /// been false since (its frames read after it was found empty arrived after the
+    /// reference's frame was read, so after the reference).
+    pub fn extend_received(
+        &mut self,
+        queue: usize,
+        stamp: u16,
+        pending: impl Fn(usize) -> bool,
+    ) -> Timestamp {
+        let near = queue < RX_QUEUES && self.maybe_older & (1 << queue) != 0;
+        let (at, moved) = self.place(stamp, near);
+        self.note_queues(Some(queue), moved, pending);
+        at
+    }
+
+    /// Places `stamp` after the reference, or (`near`) within ±32,767 bit times of it;
+    /// moves the reference forward to it when it is later. Whether it moved.
+    fn place(&mut self, stamp: u16, near: bool) -> (Timestamp, bool) {
         if !self.primed {
             self.primed = true;
             self.reference = u64::from(stamp);
-            return self.reference();
+            return (self.reference(), true);
         }
-        let d = stamp.wrapping_sub(self.reference as u16) as i16;
-        // The reference is one period above the origin: never below it.
-        let at = (self.reference + COUNTER_PERIOD).wrapping_add_signed(i64::from(d));
-        if d > 0 {
-            self.reference = (at - COUNTER_PERIOD) & Timestamp::MAX_TICKS;
+        let ahead = stamp.wrapping_sub(self.reference as u16);
+        if near && (ahead as i16) < 0 {
+            // Behind the reference, which stays: never below the origin (the
+            // reference is one period above it).
+            let back = u64::from(ahead.wrapping_neg());
+            return (
+                Timestamp::from_masked(self.reference + COUNTER_PERIOD - back),
+                false,
+            );
         }
-        Timestamp::from_masked(at)
+        self.reference = (self.reference + u64::from(ahead)) & Timestamp::MAX_TICKS;
+        (self.reference(), ahead != 0)
+    }
+
+    /// After a stamp from `source` (a receive queue, or `None` for a transmission) was
+    /// placed: which queues may hold frames older than the reference now.
+    fn note_queues(&mut self, source: Option<usize>, moved: bool, pending: impl Fn(usize) -> bool) {
+        for q in 0..RX_QUEUES {
+            let bit = 1u8 << q;
+            let older = if moved && source == Some(q) {
+                // The frame that moved the reference came from this queue: the queue's
+                // later frames follow it.
+                false
+            } else if moved {
+                // Frames of this queue not read yet may be older than the new reference.
+                pending(q)
+            } else {
+                // A queue found empty now: its later frames arrive after this moment,
+                // so after the reference.
+                self.maybe_older & bit != 0 && pending(q)
+            };
+            if older {
+                self.maybe_older |= bit;
+            } else {
+                self.maybe_older &= !bit;
+            }
+        }
     }
 }
 
@@ -295,6 +381,49 @@ mod tests {
         e.observe(0);
         // 70,000 bit times without a reading: one period is lost, never a fraction.
         assert_eq!(e.observe(70_000u64 as u16).ticks(), P + 70_000 - P);
+    }
+
+    #[test]
+    fn received_stamps_after_a_quiet_bus_are_placed_after_the_reference() {
+        let empty = |_: usize| false;
+        let mut e = Extender::new();
+        assert_eq!(e.extend_received(0, 1_000, empty).ticks(), P + 1_000);
+        // A quiet bus of 40,000 bit times, then a frame of the other FIFO, which was
+        // empty when the reference moved: after it (the old rule put it 25,536 before).
+        assert_eq!(e.extend_received(1, 41_000, empty).ticks(), P + 41_000);
+        // 65,535 after, either FIFO: still exact.
+        let t = 41_000 + 65_535;
+        assert_eq!(e.extend_received(0, t as u16, empty).ticks(), P + t);
+        // Longer: off by whole periods, never placed before the reference.
+        let r = e.reference().ticks();
+        let t = e
+            .extend_received(1, (41_000 + 65_535 + 70_000) as u16, empty)
+            .ticks();
+        assert!(t > r && (P + 41_000 + 65_535 + 70_000 - t).is_multiple_of(P));
+    }
+
+    #[test]
+    fn an_older_frame_of_a_pending_fifo_is_placed_before_the_reference() {
+        // FIFO 1 holds a frame while FIFO 0's newer frame is read first.
+        let fifo1_pending = |q: usize| q == 1;
+        let mut e = Extender::new();
+        assert_eq!(
+            e.extend_received(0, 10_000, fifo1_pending).ticks(),
+            P + 10_000
+        );
+        // FIFO 1's frame, stamped 300 bit times earlier and read now (FIFO 1 empty
+        // after it): before the reference, which stays.
+        assert_eq!(e.extend_received(1, 9_700, |_| false).ticks(), P + 9_700);
+        assert_eq!(e.reference().ticks(), P + 10_000);
+        // FIFO 1 was found empty: its next frame, 50,000 later, is placed after.
+        assert_eq!(e.extend_received(1, 60_000, |_| false).ticks(), P + 60_000);
+        // A transmit stamp moves the reference while FIFO 0 holds a frame: FIFO 0's
+        // older frame is placed before it.
+        assert_eq!(e.extend_sent(60_500, |q| q == 0).ticks(), P + 60_500);
+        assert_eq!(e.extend_received(0, 60_400, |_| false).ticks(), P + 60_400);
+        // Without what the hardware holds (`extend_near`), every queue may be older.
+        assert_eq!(e.extend_near(61_000).ticks(), P + 61_000);
+        assert_eq!(e.extend_received(1, 60_900, |_| true).ticks(), P + 60_900);
     }
 
     #[test]

@@ -126,7 +126,7 @@ pub use instance::Can0;
 pub use instance::Can1;
 pub use instance::{Instance, Irqs, Target};
 pub use settings::{Settings, CAN_CLOCK_HZ, RECEIVE_BUFFER_SIZE, TRANSMIT_BUFFER_SIZE};
-pub use split::FlexCanHw;
+pub use split::{FlexCanHw, InstalledFilters};
 pub use system::HostSystem;
 
 /// The driver with ACAN's default buffer sizes: a receive ring of 32 frames and a

@@ -16,7 +16,7 @@
 //!
 //! Which handler each line runs (Kinetis RM, FlexCAN "Interrupts"): the ORed
 //! message-buffer line the transmit handler then the Rx FIFO handler
-//! ([`twocan_core::split::TxIrq`], [`twocan_core::split::RxIrq`]); the bus-off, error
+//! ([`twocan_core::split::TxIrq`], [`twocan_core::split::Rx0Irq`]); the bus-off, error
 //! and warning lines the status handler ([`twocan_core::split::StatusIrq`]).
 //!
 //! # Order
@@ -51,7 +51,7 @@ use core::mem::MaybeUninit;
 use core::sync::atomic::{AtomicU8, Ordering};
 
 use twocan_core::irq_cell::IrqCell;
-use twocan_core::split::{Rx, RxIrq, State, StatusIrq, Tx, TxIrq};
+use twocan_core::split::{Rx, Rx0Irq, State, StatusIrq, Tx, TxIrq};
 use twocan_core::txqueue::TxQueue;
 use twocan_core::{Error, FifoQueue, Registers};
 
@@ -206,7 +206,7 @@ pub fn is_wired(instance: Instance) -> bool {
 
 type Message<R, const RX: usize, Q, const DONE: usize> = (
     TxIrq<'static, FlexCanHw<R>, RX, Q, 0, DONE>,
-    RxIrq<'static, FlexCanHw<R>, RX, Q, 0, DONE>,
+    Rx0Irq<'static, FlexCanHw<R>, RX, Q, 0, DONE>,
 );
 type Status<R, const RX: usize, Q, const DONE: usize> =
     StatusIrq<'static, FlexCanHw<R>, RX, Q, 0, DONE>;

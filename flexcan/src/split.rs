@@ -5,7 +5,7 @@
 //! Interrupt lines (Kinetis RM, FlexCAN "Interrupts"): the ORed message-buffer vector
 //! runs both the transmit handler ([`twocan_core::split::TxIrq`]: settle MB15 and the
 //! remote-frame mailboxes, refill) and the receive handler
-//! ([`twocan_core::split::RxIrq`] of queue 0: the Rx FIFO); the bus-off, error,
+//! ([`twocan_core::split::Rx0Irq`]: the Rx FIFO); the bus-off, error,
 //! Tx/Rx-warning and wake-up vectors run the status handler
 //! ([`twocan_core::split::StatusIrq`]). Who touches which register:
 //! - transmit half and transmit handler: `IFLAG1` read, the words of one transmit
@@ -25,8 +25,8 @@
 //!   for reception.
 //! - receive half (`install_filters`, in Freeze mode): the ID table, `RXIMR`,
 //!   `RXFGMASK`, `MCR.IDAM`, and `IFLAG1.BUF5I` to discard the old list's frames;
-//! - control (stopped): `CTRL1` timing fields, `LOM`, `LPB`, `MCR.SRXDIS`; `CTRL1.BOFFREC`
-//!   (`recover`, any mode).
+//! - control (the receive half's context; stopped): `CTRL1` timing fields, `LOM`, `LPB`,
+//!   `MCR.SRXDIS`; `CTRL1.BOFFREC` (`recover`, any mode); `MCR` mode requests.
 //!
 //! A raw received frame is the Rx FIFO output's four words (control/status,
 //! identifier, data) and `RXFIR.IDHIT`; the thread side decodes it and maps the hit
@@ -34,7 +34,9 @@
 
 use core::sync::atomic::{AtomicU32, AtomicU8, Ordering};
 
-use twocan_core::hardware::{sort_by_token, Completion, Settled, StatusEvents, Token};
+use twocan_core::hardware::{
+    sort_by_token, Completion, ReceiveContext, Settled, StatusEvents, Token,
+};
 use twocan_core::timing::{Limits, Timing, FLEXCAN_CTRL1_TIMING_MASK};
 use twocan_core::{
     AtomicLastError, BusMode, BusOffRecovery, Capabilities, Error, ErrorCounters, ErrorState,
@@ -173,6 +175,43 @@ impl<R: Registers> FlexCan<R> {
     }
 }
 
+/// FlexCAN's receive-side method, on the receive half's context
+/// ([`ReceiveContext`]: `Rx::receive_context`, `Driver::receive_context`), where no
+/// filter switch can rewrite the table while it is read.
+///
+/// ```
+/// use twocan_core::{Driver, Registers};
+/// use twocan_flexcan::{FlexCanHw, InstalledFilters};
+///
+/// fn show<R: Registers>(driver: &mut Driver<FlexCanHw<R>, 8, 4>) -> usize {
+///     driver.receive_context().filters().elements().len()
+/// }
+/// ```
+///
+/// Any other context has only `&FlexCanHw` (`State::hardware`, `Tx::hardware`), which
+/// does not offer the table, so a copy is never torn by a concurrent `set_filters`:
+///
+/// ```compile_fail,E0599
+/// # fn show<R: twocan_core::Registers + Sync + Send>(
+/// #     state: &twocan_core::State<twocan_flexcan::FlexCanHw<R>, 8>,
+/// # ) {
+/// let table = state.hardware().unwrap().filters();
+/// # }
+/// ```
+pub trait InstalledFilters {
+    /// A copy of the filter table in force.
+    fn filters(&self) -> FilterTable;
+}
+
+impl<R: Registers> InstalledFilters for ReceiveContext<'_, FlexCanHw<R>> {
+    fn filters(&self) -> FilterTable {
+        // SAFETY: the table is written only by `install_filters`, which the receive
+        // half calls with `&mut self`; a `ReceiveContext` borrows that half (or the
+        // one-struct driver) exclusively for its lifetime, so no write overlaps.
+        unsafe { (*self.hardware().table.get()).clone() }
+    }
+}
+
 impl<R: Registers> FlexCanHw<R> {
     /// Which instance of which chip.
     pub const fn target(&self) -> Target {
@@ -203,14 +242,6 @@ impl<R: Registers> FlexCanHw<R> {
     /// The free-running timer (`TIMER`, one tick per bit time).
     pub fn timer(&self) -> u16 {
         regs::timer::TIMER.get(self.regs.read32(regs::TIMER)) as u16
-    }
-
-    /// A copy of the filter table in force (read it from the receive half's context,
-    /// or while no other context runs).
-    pub fn filters(&self) -> FilterTable {
-        // SAFETY: a read; the table is written only by `install_filters`, from the
-        // receive half's context, which this caller is or does not overlap with.
-        unsafe { (*self.table.get()).clone() }
     }
 
     /// Frames whose `RXFIR.IDHIT` mapped to no filter (reported with
@@ -422,6 +453,40 @@ impl<R: Registers> FlexCanHw<R> {
         }
     }
 
+    /// Puts the module in Freeze mode for a filter switch from `mode` (the mode
+    /// recorded, which stays as it is: see `install_filters`). On a timeout the freeze
+    /// request is withdrawn and the module left as it was.
+    fn freeze_for_switch(&self, mode: u8) -> Result<(), Error> {
+        let polls = self.polls.load(Ordering::Relaxed);
+        if mode == MODE_STOPPED {
+            return Ok(());
+        }
+        if mode == MODE_SLEEP {
+            handshake::enable(&self.regs, polls)?;
+        }
+        if let Err(e) = handshake::freeze(&self.regs, polls) {
+            let _ = self.resume_after_switch(mode);
+            return Err(e);
+        }
+        Ok(())
+    }
+
+    /// Back to `mode` after a filter switch: leaves Freeze mode and waits until the
+    /// module is synchronised to the bus (normal), or disables it again (sleep).
+    fn resume_after_switch(&self, mode: u8) -> Result<(), Error> {
+        let polls = self.polls.load(Ordering::Relaxed);
+        match mode {
+            MODE_NORMAL => {
+                handshake::leave_freeze(&self.regs, polls)?;
+                handshake::wait_synch(&self.regs, polls, |esr| {
+                    self.latch(esr);
+                })
+            }
+            MODE_SLEEP => handshake::disable(&self.regs, polls),
+            _ => Ok(()),
+        }
+    }
+
     fn mode_change(&self, mode: Mode) -> Result<(), Error> {
         let polls = self.polls.load(Ordering::Relaxed);
         // From the hardware, not from the last request: a timed-out change may have
@@ -446,11 +511,18 @@ impl<R: Registers> FlexCanHw<R> {
     }
 }
 
-// SAFETY: the shared fields are atomics; the filter table is touched only from the
-// receive half's context (the `Hardware` contract of `decode` and `install_filters`);
-// the register accesses of each context are those listed in the module docs (disjoint
-// registers, write-1-to-clear bits).
-unsafe impl<R: Registers + Sync> Sync for FlexCanHw<R> {}
+// SAFETY: what each field needs to be shared between contexts:
+// - `regs`: every context reads and writes registers through `&R` (`R: Sync`), each
+//   its own registers or write-1-to-clear bits (module docs, the `Hardware` contract);
+// - `table`: touched only by `decode` and `install_filters` (both `unsafe`, called from
+//   the receive half's one context: the `Hardware` contract, upheld by
+//   `twocan_core::split::Rx`) and by `filters`, which takes the receive half's proof of
+//   context ([`ReceiveContext`]); the context may move between threads with the
+//   receive half, so the table must be `Send` (the `where` clause);
+// - `target`, `configuration`, `srxdis`, `recovery`, `irq_priority`, `system`,
+//   `bus_clock_hz`: read only; everything else is atomic.
+// `FlexCanHw` itself is `Send` (moved into the driver's state) exactly when `R` is.
+unsafe impl<R: Registers + Sync> Sync for FlexCanHw<R> where FilterTable: Send {}
 
 // SAFETY: as for `Sync`: each method stays within its context's registers.
 unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
@@ -749,21 +821,24 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
         (self.mode() != MODE_SLEEP).then(|| self.timer())
     }
 
-    /// Freeze (no frame enters the Rx FIFO), write the table, pop and discard what the
-    /// old table accepted into the FIFO, then switch the thread-side table and the
-    /// generation together, and come back to the mode it was in (the table must be
-    /// compiled for the configuration `begin` chose). Frames of the old list still in
-    /// the driver's ring carry the old generation: `decode` drops them.
+    /// Freeze (no frame enters the Rx FIFO; the ID table is writable only in Freeze
+    /// mode, Kinetis RM "Rx FIFO"), write the table, pop and discard what the old table
+    /// accepted into the FIFO, then switch the thread-side table and the generation
+    /// together, and come back to the mode it was in (the table must be compiled for the
+    /// configuration `begin` chose). Frames of the old list still in the driver's ring
+    /// carry the old generation: `decode` drops them.
+    ///
+    /// The switch is not a mode change for the other contexts: the mode they read
+    /// (`on_bus`, the state `error_status` reports, what `free_mailbox` allows) stays the
+    /// one the application set, so a transmit half waiting for room keeps waiting and
+    /// the status handler records no `Stopped` change. A mailbox loaded meanwhile is
+    /// sent once the module leaves Freeze mode.
     unsafe fn install_filters(&self, filters: &FilterTable) -> Result<(), Error> {
         if filters.configuration() != self.configuration() {
             return Err(Error::InvalidArgument);
         }
-        let previous = match self.mode() {
-            MODE_NORMAL => Mode::Normal,
-            MODE_STOPPED => Mode::Stopped,
-            _ => Mode::Sleep,
-        };
-        self.mode_change(Mode::Stopped)?;
+        let mode = self.mode();
+        self.freeze_for_switch(mode)?;
         FlexCan::write_filters(&self.regs, filters);
         // The FIFO holds at most its depth; the receive interrupt may pop some too.
         // Each frame popped here is counted (`take_filter_switch_discards`).
@@ -776,17 +851,18 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
             popped += 1;
         }
         self.discarded.fetch_add(popped, Ordering::Relaxed);
-        // SAFETY: the receive half's context, the only one touching the table.
+        // SAFETY: the receive half's context, the only one touching the table
+        // (`ReceiveContext` borrows that half, so no copy is being read).
         unsafe { *self.table.get() = filters.clone() };
         let next = (self.generation.load(Ordering::Relaxed) + 1) & 0xFFFF;
         self.generation.store(next, Ordering::Release);
-        self.mode_change(previous)
+        self.resume_after_switch(mode)
     }
 
-    fn filter_map(&self) {}
+    unsafe fn filter_map(&self) {}
 
     /// The Rx FIFO frames `install_filters` popped in Freeze mode (writing `BUF5I`).
-    fn take_filter_switch_discards(&self) -> u32 {
+    unsafe fn take_filter_switch_discards(&self) -> u32 {
         self.discarded.swap(0, Ordering::Relaxed)
     }
 
@@ -837,7 +913,7 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
         self.mode() == MODE_NORMAL
     }
 
-    fn set_mode(&self, mode: Mode) -> Result<(), Error> {
+    unsafe fn set_mode(&self, mode: Mode) -> Result<(), Error> {
         self.mode_change(mode)
     }
 
@@ -849,7 +925,7 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
     /// and joins the bus) — and asserts it again at once, which "will be effective only
     /// the next time the module enters Bus Off". `CTRL1.BOFFREC` is writable in any
     /// mode. Not bus-off: nothing to do, `Ok`.
-    fn recover(&self) -> Result<(), Error> {
+    unsafe fn recover(&self) -> Result<(), Error> {
         if self.recovery == BusOffRecovery::Automatic {
             return Err(Error::WrongMode);
         }
@@ -923,7 +999,7 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
     /// `begin` was given):
     /// [`TimingError::ForbiddenByManual`](twocan_core::timing::TimingError::ForbiddenByManual)
     /// when the manual's rule is broken, nothing written.
-    fn set_timing(&self, timing: &Timing) -> Result<(), Error> {
+    unsafe fn set_timing(&self, timing: &Timing) -> Result<(), Error> {
         let stopped = self.mode() == MODE_STOPPED;
         twocan_core::hardware::check_timing_for(&self.capabilities(), timing, stopped)?;
         let bits = timing.flexcan_ctrl1().map_err(Error::Timing)?;
@@ -937,7 +1013,7 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
     /// In Freeze mode ([`Mode::Stopped`]): `CTRL1.LOM` and `CTRL1.LPB` (Freeze mode
     /// only); loop-back also clears `MCR.SRXDIS` ("In this mode, MCR\[SRXDIS\] cannot
     /// be asserted"), the other modes restore it.
-    fn set_bus_mode(&self, mode: BusMode) -> Result<(), Error> {
+    unsafe fn set_bus_mode(&self, mode: BusMode) -> Result<(), Error> {
         if self.mode() != MODE_STOPPED {
             return Err(Error::WrongMode);
         }

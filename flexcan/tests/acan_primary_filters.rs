@@ -7,7 +7,7 @@ mod common;
 use common::*;
 use twocan_core::{Filter, Format, Frame, FrameKind};
 use twocan_flexcan::model::FlexCanModel;
-use twocan_flexcan::Configuration;
+use twocan_flexcan::{Configuration, InstalledFilters};
 
 fn filters_0_1_2() -> [Filter; 3] {
     [
@@ -234,8 +234,8 @@ fn unused_elements_accept_nothing_extra() {
 
 #[test]
 fn table_and_masks_written_as_compiled() {
-    let (model, can) = begin::<32, 16>(&loop_back(125_000), &filters_0_1_2(), &[]).unwrap();
-    let table = can.hardware().filters();
+    let (model, mut can) = begin::<32, 16>(&loop_back(125_000), &filters_0_1_2(), &[]).unwrap();
+    let table = can.receive_context().filters();
     for (i, e) in table.elements().iter().enumerate() {
         assert_eq!(
             model.peek32(twocan_flexcan::regs::rx_fifo_filter(i)),

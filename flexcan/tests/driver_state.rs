@@ -272,3 +272,81 @@ fn pins_and_clock_gates_7_16_7_5_16_7_6() {
 }
 
 use twocan_core::Registers as _;
+
+/// A probe to run once, shared with the register access that runs it.
+type Probe = std::rc::Rc<std::cell::RefCell<Option<Box<dyn FnOnce()>>>>;
+
+/// Register access that runs a probe once, at the write of `RXFGMASK` (the last table
+/// write of a filter switch, in Freeze mode).
+struct Probed {
+    inner: Ticking,
+    probe: Probe,
+}
+
+impl twocan_core::Registers for Probed {
+    fn read32(&self, offset: usize) -> u32 {
+        self.inner.read32(offset)
+    }
+    fn write32(&self, offset: usize, value: u32) {
+        self.inner.write32(offset, value);
+        if offset == twocan_flexcan::regs::RXFGMASK {
+            let probe = self.probe.borrow_mut().take();
+            if let Some(probe) = probe {
+                probe();
+            }
+        }
+    }
+}
+
+/// Issue 26 (found by reading): `set_filters` froze the module through the mode
+/// machinery, so meanwhile `on_bus()` read false — a concurrent async `send` with a
+/// full queue failed with `WrongMode` — and the status handler could record `Stopped`
+/// changes that the application never asked for. The switch is invisible to the other
+/// contexts now: on the bus, error-active, no state change.
+#[test]
+fn a_filter_switch_is_not_a_mode_change() {
+    use std::cell::RefCell;
+    use std::rc::Rc;
+    use twocan_core::split::State;
+    use twocan_core::{Filter, Hardware};
+    use twocan_flexcan::{FilterTable, FlexCanHw};
+
+    let settings = loop_back(500_000);
+    let model = model_for(Board::Teensy32);
+    let probe: Probe = Rc::new(RefCell::new(None));
+    let regs = Probed {
+        inner: Ticking::new(model.clone()),
+        probe: probe.clone(),
+    };
+    let target = Target::new(Board::Teensy32, Instance::Can0);
+    let can = FlexCan::begin(
+        regs,
+        &mut HostSystem::new(),
+        target,
+        &settings,
+        &[Filter::standard(0x10)],
+        &[],
+    )
+    .unwrap();
+    let state: &'static State<FlexCanHw<Probed>, 8> = Box::leak(Box::new(State::new()));
+    let mut p = state.split(can.into_split()).ok().unwrap();
+    let seen = Rc::new(RefCell::new(None));
+    let seen_in_probe = seen.clone();
+    let mut status = p.status_irq;
+    *probe.borrow_mut() = Some(Box::new(move || {
+        // Another context, while the table is written in Freeze mode.
+        let hw = state.hardware().unwrap();
+        status.poll_state();
+        *seen_in_probe.borrow_mut() = Some((hw.on_bus(), hw.error_status().state));
+    }) as Box<dyn FnOnce()>);
+    let table =
+        FilterTable::compile(settings.configuration, &[Filter::standard(0x20)], &[]).unwrap();
+    p.rx.set_filters(&table).unwrap();
+    assert_eq!(
+        *seen.borrow(),
+        Some((true, ErrorState::Active)),
+        "seen during the switch"
+    );
+    assert_eq!(p.rx.take_state_change(), None, "no state change recorded");
+    assert_eq!(model.mode(), ModelMode::Normal);
+}

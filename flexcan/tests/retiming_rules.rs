@@ -53,7 +53,7 @@ fn default_bus_clock_refuses_what_begin_refuses() {
     assert!(five.consistency().is_ok(), "{:?}", five.consistency());
     let before = can.hardware().capabilities();
     assert_eq!(
-        can.hardware().set_timing(&five),
+        can.set_timing(&five),
         Err(Error::Timing(TimingError::ForbiddenByManual))
     );
     assert_eq!(can.hardware().capabilities(), before);
@@ -144,11 +144,11 @@ fn reported_timing_limits_are_what_set_timing_accepts() {
     let q = l.min_quanta() as u8;
     let fewest = Timing::from_tsegs(16_000_000, 1_000_000, &l, 2, q - 3, 2);
     assert_eq!(fewest.quanta(), 8);
-    assert_eq!(can.hardware().set_timing(&fewest), Ok(()));
+    assert_eq!(can.set_timing(&fewest), Ok(()));
     let fewer = Timing::from_tsegs(16_000_000, 1_142_857, &l, 2, q - 4, 2);
     assert_eq!(fewer.quanta(), 7);
     assert_eq!(
-        can.hardware().set_timing(&fewer),
+        can.set_timing(&fewer),
         Err(Error::Timing(TimingError::ForbiddenByManual))
     );
 }

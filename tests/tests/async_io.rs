@@ -102,14 +102,14 @@ struct Sim<'a> {
 
 struct FlexIrqs<'a> {
     tx: twocan_core::split::TxIrq<'a, FlexHw, RX_RING, Queue, 0, DONE>,
-    rx: twocan_core::split::RxIrq<'a, FlexHw, RX_RING, Queue, 0, DONE>,
+    rx: twocan_core::split::Rx0Irq<'a, FlexHw, RX_RING, Queue, 0, DONE>,
     status: twocan_core::split::StatusIrq<'a, FlexHw, RX_RING, Queue, 0, DONE>,
 }
 
 struct BxIrqs<'a> {
     tx: twocan_core::split::TxIrq<'a, BxHw, RX_RING, Queue, RX_RING, DONE>,
-    rx0: twocan_core::split::RxIrq<'a, BxHw, RX_RING, Queue, RX_RING, DONE>,
-    rx1: twocan_core::split::RxIrq<'a, BxHw, RX_RING, Queue, RX_RING, DONE>,
+    rx0: twocan_core::split::Rx0Irq<'a, BxHw, RX_RING, Queue, RX_RING, DONE>,
+    rx1: twocan_core::split::Rx1Irq<'a, BxHw, RX_RING, Queue, RX_RING, DONE>,
     status: twocan_core::split::StatusIrq<'a, BxHw, RX_RING, Queue, RX_RING, DONE>,
 }
 

@@ -23,7 +23,7 @@ compile_error!("features `lean` and `full` are exclusive");
 compile_error!("enable feature `lean` or `full`");
 
 use twocan_bxcan::{BxCan, Config, Init};
-use twocan_core::split::{Parts, Rx, RxIrq, State, Tx, TxIrq};
+use twocan_core::split::{Parts, Rx, Rx0Irq, State, Tx, TxIrq};
 use twocan_core::{Error, FifoQueue, Filter, Mmio, TxPolicy};
 
 pub const APB1_HZ: u32 = 54_000_000;
@@ -128,7 +128,7 @@ pub type OurParts = Parts<'static, Hw, RX, Q, 0, DONE>;
 pub type OurTx = Tx<'static, Hw, RX, Q, 0, DONE>;
 pub type OurRx = Rx<'static, Hw, RX, Q, 0, DONE>;
 pub type OurTxIrq = TxIrq<'static, Hw, RX, Q, 0, DONE>;
-pub type OurRxIrq = RxIrq<'static, Hw, RX, Q, 0, DONE>;
+pub type OurRxIrq = Rx0Irq<'static, Hw, RX, Q, 0, DONE>;
 
 /// Configures CAN1 at `regs` ([`CONFIG`], the variant's filters) and starts it, ready
 /// for `State::split`. `RETRIES` more attempts after a mode request that timed out (the

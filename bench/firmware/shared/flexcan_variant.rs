@@ -25,7 +25,7 @@ compile_error!("features `lean` and `full` are exclusive");
 #[cfg(not(any(feature = "lean", feature = "full")))]
 compile_error!("enable feature `lean` or `full`");
 
-use twocan_core::split::{Parts, Rx, RxIrq, State, Tx, TxIrq};
+use twocan_core::split::{Parts, Rx, Rx0Irq, State, Tx, TxIrq};
 use twocan_core::{Error, FifoQueue, Filter, Registers};
 use twocan_flexcan::{
     BeginError, Board, Configuration, FlexCan, FlexCanHw, Instance, Settings, Target,
@@ -82,7 +82,7 @@ pub type OurParts<R> = Parts<'static, Hw<R>, RX, Q, 0, DONE>;
 pub type OurTx<R> = Tx<'static, Hw<R>, RX, Q, 0, DONE>;
 pub type OurRx<R> = Rx<'static, Hw<R>, RX, Q, 0, DONE>;
 pub type OurTxIrq<R> = TxIrq<'static, Hw<R>, RX, Q, 0, DONE>;
-pub type OurRxIrq<R> = RxIrq<'static, Hw<R>, RX, Q, 0, DONE>;
+pub type OurRxIrq<R> = Rx0Irq<'static, Hw<R>, RX, Q, 0, DONE>;
 
 /// `begin` with [`SETTINGS`] and [`FILTERS`] on the registers `regs()` gives and the
 /// SIM/PORT registers `sys`, then the controller for the split driver. `RETRIES` more

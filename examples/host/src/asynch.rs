@@ -33,7 +33,7 @@ use std::task::{Context, Wake, Waker};
 
 use twocan_bxcan::model::BxCanModel;
 use twocan_bxcan::BxCan;
-use twocan_core::split::{Rx, RxIrq, State, StatusIrq, Tx, TxIrq};
+use twocan_core::split::{Rx, Rx0Irq, Rx1Irq, State, StatusIrq, Tx, TxIrq};
 use twocan_core::{Error, ErrorState, FifoQueue};
 use twocan_flexcan::model::FlexCanModel;
 use twocan_flexcan::FlexCanHw;
@@ -68,7 +68,7 @@ pub struct FlexIrqs<'a> {
     /// The peripheral model (its interrupt request, its counters).
     pub model: FlexCanModel,
     tx: TxIrq<'a, FlexHw, RX_RING, Queue, 0, COMPLETIONS>,
-    rx: RxIrq<'a, FlexHw, RX_RING, Queue, 0, COMPLETIONS>,
+    rx: Rx0Irq<'a, FlexHw, RX_RING, Queue, 0, COMPLETIONS>,
     status: StatusIrq<'a, FlexHw, RX_RING, Queue, 0, COMPLETIONS>,
 }
 
@@ -98,8 +98,8 @@ pub struct BxIrqs<'a> {
     /// The peripheral model (its interrupt lines, its counters).
     pub model: BxCanModel,
     tx: TxIrq<'a, BxHw, RX_RING, Queue, RX_RING, COMPLETIONS>,
-    rx0: RxIrq<'a, BxHw, RX_RING, Queue, RX_RING, COMPLETIONS>,
-    rx1: RxIrq<'a, BxHw, RX_RING, Queue, RX_RING, COMPLETIONS>,
+    rx0: Rx0Irq<'a, BxHw, RX_RING, Queue, RX_RING, COMPLETIONS>,
+    rx1: Rx1Irq<'a, BxHw, RX_RING, Queue, RX_RING, COMPLETIONS>,
     status: StatusIrq<'a, BxHw, RX_RING, Queue, RX_RING, COMPLETIONS>,
 }
 

@@ -6,7 +6,7 @@
 use twocan_bxcan::regs::CanRegs;
 use twocan_bxcan::BxCan;
 use twocan_core::irq_cell::IrqCell;
-use twocan_core::split::{Rx, RxIrq, State, StatusIrq, Tx, TxIrq};
+use twocan_core::split::{Rx, Rx0Irq, Rx1Irq, State, StatusIrq, Tx, TxIrq};
 use twocan_core::{FifoQueue, Registers};
 
 /// Receive ring per FIFO, transmit queue and completion ring sizes of the examples.
@@ -30,8 +30,8 @@ pub type CanRxHalf<R = CanRegs, F = CanRegs> = Rx<'static, BxCan<R, F>, RX, Queu
 /// The interrupt handles of one bxCAN instance.
 pub struct Vectors<R: Registers + 'static = CanRegs, F: Registers + 'static = CanRegs> {
     tx: IrqCell<TxIrq<'static, BxCan<R, F>, RX, Queue, RX, COMPLETIONS>>,
-    rx0: IrqCell<RxIrq<'static, BxCan<R, F>, RX, Queue, RX, COMPLETIONS>>,
-    rx1: IrqCell<RxIrq<'static, BxCan<R, F>, RX, Queue, RX, COMPLETIONS>>,
+    rx0: IrqCell<Rx0Irq<'static, BxCan<R, F>, RX, Queue, RX, COMPLETIONS>>,
+    rx1: IrqCell<Rx1Irq<'static, BxCan<R, F>, RX, Queue, RX, COMPLETIONS>>,
     sce: IrqCell<StatusIrq<'static, BxCan<R, F>, RX, Queue, RX, COMPLETIONS>>,
 }
 
@@ -74,23 +74,40 @@ impl<R: Registers + 'static, F: Registers + 'static> Vectors<R, F> {
 }
 
 /// Splits `state` over `hw`, puts the interrupt handles in `vectors`, then unmasks
-/// `irqs` (TX, RX0, RX1, SCE). Returns the thread-side halves; `None` when `state` was
-/// split already.
+/// `irqs` (TX, RX0, RX1, SCE): each line only once the handle its vector runs is in
+/// place (`IrqCell::put` gives the token that unmasks it). Returns the thread-side
+/// halves; `None` when `state` was split already.
 #[cfg(target_os = "none")]
-pub fn start<R: Registers + Sync + 'static, F: Registers + Sync + 'static>(
+pub fn start<R: Registers + Send + Sync + 'static, F: Registers + Send + Sync + 'static>(
     state: &'static CanState<R, F>,
     vectors: &'static Vectors<R, F>,
     hw: BxCan<R, F>,
     irqs: [stm32f7xx_hal::pac::Interrupt; 4],
+    nvic: &mut cortex_m::peripheral::NVIC,
 ) -> Option<(CanTxHalf<R, F>, CanRxHalf<R, F>)> {
     let parts = state.split(hw).ok()?;
-    let put = vectors.tx.put(parts.tx_irq).is_ok()
-        && vectors.rx0.put(parts.rx0_irq).is_ok()
-        && vectors.rx1.put(parts.rx1_irq).is_ok()
-        && vectors.sce.put(parts.status_irq).is_ok();
-    if !put {
-        return None;
-    }
-    crate::rt::unmask(irqs);
+    let [tx, rx0, rx1, sce] = irqs;
+    let lines = &mut crate::rt::Lines(nvic);
+    let priority = crate::rt::CAN_PRIORITY;
+    vectors
+        .tx
+        .put(parts.tx_irq)
+        .ok()?
+        .enable(lines, &[tx], priority);
+    vectors
+        .rx0
+        .put(parts.rx0_irq)
+        .ok()?
+        .enable(lines, &[rx0], priority);
+    vectors
+        .rx1
+        .put(parts.rx1_irq)
+        .ok()?
+        .enable(lines, &[rx1], priority);
+    vectors
+        .sce
+        .put(parts.status_irq)
+        .ok()?
+        .enable(lines, &[sce], priority);
     Some((parts.tx, parts.rx))
 }

@@ -158,13 +158,29 @@ pub fn boot() -> Boot {
     }
 }
 
-/// Unmasks the four bxCAN interrupts of an instance (TX, RX0, RX1, SCE), after the
-/// handles their vectors run are in place ([`crate::can::start`]).
-pub fn unmask(interrupts: [pac::Interrupt; 4]) {
-    for irq in interrupts {
+/// Priority of the CAN interrupt lines: one for all (0, the highest, as after reset).
+/// Each line runs its own handler cell; a cell run from several lines would need them
+/// at one priority (`twocan_core::irq_cell`, "One priority per cell"), which
+/// `Installed::enable` gives.
+pub const CAN_PRIORITY: u8 = 0;
+
+/// The NVIC as `twocan_core::irq_cell::Installed::enable` uses it: only a cell that
+/// holds its handler unmasks the lines that run it ([`crate::can::start`]).
+pub struct Lines<'a>(pub &'a mut cortex_m::peripheral::NVIC);
+
+impl twocan_core::irq_cell::Nvic<pac::Interrupt> for Lines<'_> {
+    fn set_priority(&mut self, line: pac::Interrupt, priority: u8) {
         // SAFETY: this crate's critical sections mask every interrupt
-        // (`critical-section-single-core`); the vectors run handles put in place before.
-        unsafe { cortex_m::peripheral::NVIC::unmask(irq) };
+        // (`critical-section-single-core`), none is built from priorities; the line is
+        // still masked.
+        unsafe { self.0.set_priority(line, priority) };
+    }
+
+    fn unmask(&mut self, line: pac::Interrupt) {
+        // SAFETY: this crate's critical sections mask every interrupt (none is built
+        // from NVIC masks); `Installed::enable` calls this after the handle the line's
+        // vector runs is in place.
+        unsafe { cortex_m::peripheral::NVIC::unmask(line) };
     }
 }
 

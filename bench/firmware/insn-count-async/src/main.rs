@@ -26,7 +26,7 @@ use core::task::{Context, Poll};
 
 use cortex_m_rt::entry;
 use twocan_bxcan::{BxCan, Config};
-use twocan_core::split::{Rx, RxIrq, State};
+use twocan_core::split::{Rx, Rx0Irq, State};
 use twocan_core::{Error, FifoQueue, Frame, Mmio, RxFrame, TxPolicy};
 
 #[path = "../../shared/flag_waker.rs"]
@@ -65,7 +65,7 @@ const RECEIVE: usize = 4;
 type Hw = BxCan<Mmio>;
 type Q = FifoQueue<TXQ>;
 type OurRx = Rx<'static, Hw, RX, Q, 0, 8>;
-type OurRxIrq = RxIrq<'static, Hw, RX, Q, 0, 8>;
+type OurRxIrq = Rx0Irq<'static, Hw, RX, Q, 0, 8>;
 
 /// The driver's shared state (with the waker cells of the `async` feature).
 static CAN: State<Hw, RX, Q> = State::new();

@@ -89,8 +89,14 @@ mod firmware {
             rt::halt(CAN_BLINKS);
         }
         let can = init.enable().unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        let (mut tx, mut rx) = can::start(&CAN1, &CAN1_VECTORS, can.into_split(), rt::CAN1_IRQS)
-            .unwrap_or_else(|| rt::halt(CAN_BLINKS));
+        let (mut tx, mut rx) = can::start(
+            &CAN1,
+            &CAN1_VECTORS,
+            can.into_split(),
+            rt::CAN1_IRQS,
+            &mut boot.core.NVIC,
+        )
+        .unwrap_or_else(|| rt::halt(CAN_BLINKS));
         twocan_stm32f7::info!(
             "CAN1 on the bus with the application's {=usize} filters",
             app.filters().len()

@@ -92,8 +92,14 @@ mod firmware {
             rt::halt(CAN_BLINKS);
         }
         let can = init.enable().unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        let (tx, rx) = can::start(&CAN1, &CAN1_VECTORS, can.into_split(), rt::CAN1_IRQS)
-            .unwrap_or_else(|| rt::halt(CAN_BLINKS));
+        let (tx, rx) = can::start(
+            &CAN1,
+            &CAN1_VECTORS,
+            can.into_split(),
+            rt::CAN1_IRQS,
+            &mut boot.core.NVIC,
+        )
+        .unwrap_or_else(|| rt::halt(CAN_BLINKS));
         let led = boot.led;
         EXECUTOR.init(Executor::new()).run(|spawner| {
             spawner.spawn(echo_task(tx, rx, led).unwrap_or_else(|_| rt::halt(CAN_BLINKS)));

@@ -116,10 +116,22 @@ mod firmware {
         }
         let can1 = init1.enable().unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         let can2 = init2.enable().unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        let (mut tx1, mut rx1) = can::start(&CAN1, &CAN1_VECTORS, can1.into_split(), rt::CAN1_IRQS)
-            .unwrap_or_else(|| rt::halt(CAN_BLINKS));
-        let (mut tx2, mut rx2) = can::start(&CAN2, &CAN2_VECTORS, can2.into_split(), rt::CAN2_IRQS)
-            .unwrap_or_else(|| rt::halt(CAN_BLINKS));
+        let (mut tx1, mut rx1) = can::start(
+            &CAN1,
+            &CAN1_VECTORS,
+            can1.into_split(),
+            rt::CAN1_IRQS,
+            &mut boot.core.NVIC,
+        )
+        .unwrap_or_else(|| rt::halt(CAN_BLINKS));
+        let (mut tx2, mut rx2) = can::start(
+            &CAN2,
+            &CAN2_VECTORS,
+            can2.into_split(),
+            rt::CAN2_IRQS,
+            &mut boot.core.NVIC,
+        )
+        .unwrap_or_else(|| rt::halt(CAN_BLINKS));
 
         let mut period = Every::new(time::millis(), 10);
         let mut shown = 0;

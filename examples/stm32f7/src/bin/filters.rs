@@ -119,8 +119,14 @@ mod firmware {
             rt::halt(CAN_BLINKS);
         }
         let can = init.enable().unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        let (mut tx, mut rx) = can::start(&CAN1, &CAN1_VECTORS, can.into_split(), rt::CAN1_IRQS)
-            .unwrap_or_else(|| rt::halt(CAN_BLINKS));
+        let (mut tx, mut rx) = can::start(
+            &CAN1,
+            &CAN1_VECTORS,
+            can.into_split(),
+            rt::CAN1_IRQS,
+            &mut boot.core.NVIC,
+        )
+        .unwrap_or_else(|| rt::halt(CAN_BLINKS));
 
         let mut dispatcher: Dispatcher<(), FILTERS> = Dispatcher::new();
         for i in 0..FILTERS {

@@ -66,8 +66,14 @@ mod firmware {
             rt::halt(CAN_BLINKS);
         }
         let can = init.enable().unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        let (mut tx, mut rx) = can::start(&CAN1, &CAN1_VECTORS, can.into_split(), rt::CAN1_IRQS)
-            .unwrap_or_else(|| rt::halt(CAN_BLINKS));
+        let (mut tx, mut rx) = can::start(
+            &CAN1,
+            &CAN1_VECTORS,
+            can.into_split(),
+            rt::CAN1_IRQS,
+            &mut boot.core.NVIC,
+        )
+        .unwrap_or_else(|| rt::halt(CAN_BLINKS));
 
         let message = Frame::standard(0x542, &[]).unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         let mut send = Every::new(time::millis(), 1000);

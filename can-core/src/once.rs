@@ -1,0 +1,138 @@
+//! [`OnceSlot`]: a value written once by whichever context claims the slot first, and
+//! read by every context only after it is written — how [`crate::State`] holds its
+//! controller.
+//!
+//! Three stages in one atomic byte (all zeros is empty, so a `static` of it is `.bss`):
+//! EMPTY → CLAIMED (one compare-and-swap: the claimer is the only writer, nobody
+//! reads) → READY (a release store after the write; readers load it with acquire
+//! ordering, so the write happens before their reads). A claim dropped without
+//! publishing goes back to EMPTY. The loom model (`src/loom_tests.rs`) checks this.
+
+use core::mem::MaybeUninit;
+use core::sync::atomic::Ordering;
+
+use crate::sync::{const_fn, AtomicU8, UnsafeCell};
+
+/// No value (0: all zeros).
+const EMPTY: u8 = 0;
+/// One context claimed the slot and is writing the value; nobody may read it yet.
+const CLAIMED: u8 = 1;
+/// The value is written (release store after the write).
+const READY: u8 = 2;
+
+/// A value published once (see the [module docs](self)).
+pub(crate) struct OnceSlot<T> {
+    stage: AtomicU8,
+    value: UnsafeCell<MaybeUninit<T>>,
+}
+
+// SAFETY: the value is written only by the one context whose `claim` moved the stage
+// from EMPTY to CLAIMED, before the release store of READY, and from then on only read
+// through `&T` by every context (`T: Sync`) until `take` (or the drop) moves it out
+// with `&mut self`, possibly on another thread than the one that wrote it (`T: Send`):
+// as `OnceLock<T>`.
+unsafe impl<T: Send + Sync> Sync for OnceSlot<T> {}
+
+impl<T> OnceSlot<T> {
+    const_fn! {
+        /// Empty.
+        pub(crate) fn new() -> Self {
+            OnceSlot {
+                stage: AtomicU8::new(EMPTY),
+                value: UnsafeCell::new(MaybeUninit::uninit()),
+            }
+        }
+    }
+
+    /// Claims the empty slot for this context: `None` when another context claimed it
+    /// (or it holds a value).
+    pub(crate) fn claim(&self) -> Option<Claim<'_, T>> {
+        self.stage
+            .compare_exchange(EMPTY, CLAIMED, Ordering::Acquire, Ordering::Relaxed)
+            .ok()
+            .map(|_| Claim { slot: self })
+    }
+
+    /// The value, once published (any context).
+    #[inline]
+    pub(crate) fn get(&self) -> Option<&T> {
+        if self.stage.load(Ordering::Acquire) == READY {
+            // SAFETY: READY was stored (release) after the value was written, and this
+            // load is acquire; nothing writes the value while `&self` lives.
+            Some(unsafe { self.get_unchecked() })
+        } else {
+            None
+        }
+    }
+
+    /// The value, without looking at the stage.
+    ///
+    /// # Safety
+    /// The value was published, and the publication happens before this call (the
+    /// caller was made after it in the publishing thread, and reached its context
+    /// through something that synchronises, or loaded READY with acquire ordering).
+    #[inline(always)]
+    pub(crate) unsafe fn get_unchecked(&self) -> &T {
+        // SAFETY: the caller's contract: the value is initialised and not written
+        // again while `&self` lives.
+        self.value.with(|p| unsafe { &*(*p).as_ptr() })
+    }
+
+    /// Puts `value` in a slot owned exclusively (`&mut self`: no other context can
+    /// look); a value there before is dropped.
+    pub(crate) fn set(&mut self, value: T) -> &T {
+        drop(self.take());
+        // SAFETY: `&mut self`: no other access; the stage is EMPTY (after `take`).
+        self.value.with_mut(|p| unsafe { (*p).write(value) });
+        self.stage.store(READY, Ordering::Relaxed);
+        // SAFETY: written just above.
+        unsafe { self.get_unchecked() }
+    }
+
+    /// Moves the value out of a slot owned exclusively; the slot is empty again.
+    pub(crate) fn take(&mut self) -> Option<T> {
+        if self.stage.load(Ordering::Relaxed) != READY {
+            return None;
+        }
+        self.stage.store(EMPTY, Ordering::Relaxed);
+        // SAFETY: the stage was READY: the value is initialised; it is moved out once
+        // (the stage is EMPTY now) and `&mut self` excludes every other access.
+        Some(self.value.with(|p| unsafe { (*p).assume_init_read() }))
+    }
+}
+
+impl<T> Drop for OnceSlot<T> {
+    fn drop(&mut self) {
+        drop(self.take());
+    }
+}
+
+/// The right to write the value of a claimed [`OnceSlot`]; dropped unpublished, it
+/// gives the slot back (EMPTY).
+pub(crate) struct Claim<'a, T> {
+    slot: &'a OnceSlot<T>,
+}
+
+impl<'a, T> Claim<'a, T> {
+    /// Writes `value`, runs `before` on it while no other context can see it yet, then
+    /// publishes it (release). Returns the published value and `before`'s result.
+    pub(crate) fn publish<R>(self, value: T, before: impl FnOnce(&T) -> R) -> (&'a T, R) {
+        let slot = self.slot;
+        core::mem::forget(self);
+        // SAFETY: this claim moved the stage from EMPTY to CLAIMED: this is the only
+        // writer, and nobody reads before READY.
+        slot.value.with_mut(|p| unsafe { (*p).write(value) });
+        // SAFETY: written just above, by this context.
+        let value = unsafe { slot.get_unchecked() };
+        let r = before(value);
+        slot.stage.store(READY, Ordering::Release);
+        (value, r)
+    }
+}
+
+impl<T> Drop for Claim<'_, T> {
+    fn drop(&mut self) {
+        // Nothing was written.
+        self.slot.stage.store(EMPTY, Ordering::Release);
+    }
+}
