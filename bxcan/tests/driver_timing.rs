@@ -10,7 +10,7 @@ mod common;
 use common::*;
 use twocan_bxcan::Config;
 use twocan_core::timing::{Limits, Timing, DEFAULT_TOLERANCE_PPM};
-use twocan_core::{Hardware, Mode};
+use twocan_core::Mode;
 
 /// The slowest timing the `CAN_BTR` fields hold, wished at `wished` bit/s.
 fn slowest(wished: u32) -> Timing {
