@@ -51,7 +51,7 @@
 //! # Ok::<(), twocan_core::Error>(())
 //! ```
 
-use core::future::{poll_fn, Future};
+use core::future::poll_fn;
 use core::task::Poll;
 
 use atomic_waker::AtomicWaker;
@@ -250,22 +250,6 @@ impl<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE:
             Poll::Pending
         })
         .await
-    }
-}
-
-impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize>
-    crate::io::AsyncCanTx for Tx<'_, H, RX, Q, RX1, DONE>
-{
-    fn send(&mut self, frame: &Frame) -> impl Future<Output = Result<Token, Error>> {
-        Tx::send(self, frame)
-    }
-}
-
-impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize>
-    crate::io::AsyncCanRx for Rx<'_, H, RX, Q, RX1, DONE>
-{
-    fn recv(&mut self) -> impl Future<Output = Result<RxFrame, Error>> {
-        Rx::recv(self)
     }
 }
 

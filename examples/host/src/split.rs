@@ -1,14 +1,15 @@
-//! The async API on the simulated boards (feature `async` of twocan-core): the
-//! controllers of [`FlexNode`] and [`BxNode`] split over a [`State`] of the caller, their
-//! interrupt handlers as [`Serviced`] nodes (run when the model raises a line, as the
-//! chips' vectors would), and [`drive`], a small single-threaded executor that
-//! interleaves servicing the interrupts, polling the woken futures and stepping the bus
-//! (the models are `Rc`-based: one thread).
+//! Moving a simulated board between the one-struct [`twocan_core::Driver`] and the split
+//! driver: [`split_flex`] and [`split_bx`] take the controller out of a [`FlexNode`] /
+//! [`BxNode`] and split a [`State`] of the caller over it — the transmit and receive
+//! halves for the application, the interrupt handlers as [`Serviced`] nodes that run
+//! when the model raises a line, as the chips' vectors would. [`unsplit_flex`] and
+//! [`unsplit_bx`] go back: the halves and handlers are given up, the state hands the
+//! controller back, and it becomes a one-struct driver again. The type aliases name the
+//! host nodes' configuration of each backend's split driver.
 //!
 //! ```
-//! use std::pin::pin;
 //! use twocan_core::{Filter, Frame};
-//! use twocan_host::asynch::{drive, split_bx, split_flex, BxState, FlexState};
+//! use twocan_host::split::{split_bx, split_flex, BxState, FlexState};
 //! use twocan_host::{BxNode, FlexNode, Harness};
 //!
 //! let mut h = Harness::new(500_000).unwrap();
@@ -18,27 +19,21 @@
 //! let (mut fi, mut ftx, _frx) = split_flex(&fs, teensy).unwrap();
 //! let (mut bi, _btx, mut brx) = split_bx(&bs, stm32).unwrap();
 //! let frame = Frame::standard(0x123, &[1, 2, 3]).unwrap();
-//! let mut send = pin!(async { ftx.send(&frame).await.map(|_| ()) });
-//! let mut recv = pin!(async { brx.recv().await.map(|f| assert_eq!(f.frame, frame)) });
-//! let until = h.now() + 1_000;
-//! let done = drive(&mut h, &mut [&mut fi, &mut bi], &mut [send.as_mut(), recv.as_mut()], until);
-//! assert!(done.iter().all(|r| matches!(r, Some(Ok(())))));
+//! ftx.try_send(&frame).unwrap();
+//! h.run_for(1_000, &mut [&mut fi, &mut bi]);
+//! assert_eq!(brx.receive().unwrap().frame, frame);
 //! ```
-
-use std::future::Future;
-use std::pin::Pin;
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::Arc;
-use std::task::{Context, Wake, Waker};
 
 use twocan_bxcan::model::BxCanModel;
 use twocan_bxcan::BxCan;
 use twocan_core::split::{Rx, Rx0Irq, Rx1Irq, State, StatusIrq, Tx, TxIrq};
-use twocan_core::{Error, ErrorState, FifoQueue};
+use twocan_core::{Driver, ErrorState, FifoQueue};
 use twocan_flexcan::model::FlexCanModel;
 use twocan_flexcan::FlexCanHw;
 
-use crate::{BxNode, Clocked, FlexNode, Harness, Serviced, SetupError, RX_RING, TX_RING};
+use twocan_sim::NodeId;
+
+use crate::{BxNode, Clocked, FlexNode, Serviced, SetupError, RX_RING, TX_RING};
 
 /// Completion ring of the split nodes.
 pub const COMPLETIONS: usize = 8;
@@ -67,6 +62,8 @@ pub type BxRx<'a> = Rx<'a, BxHw, RX_RING, Queue, RX_RING, COMPLETIONS>;
 pub struct FlexIrqs<'a> {
     /// The peripheral model (its interrupt request, its counters).
     pub model: FlexCanModel,
+    /// The node's place on the bus.
+    pub id: NodeId,
     tx: TxIrq<'a, FlexHw, RX_RING, Queue, 0, COMPLETIONS>,
     rx: Rx0Irq<'a, FlexHw, RX_RING, Queue, 0, COMPLETIONS>,
     status: StatusIrq<'a, FlexHw, RX_RING, Queue, 0, COMPLETIONS>,
@@ -97,6 +94,8 @@ impl Serviced for FlexIrqs<'_> {
 pub struct BxIrqs<'a> {
     /// The peripheral model (its interrupt lines, its counters).
     pub model: BxCanModel,
+    /// The node's place on the bus.
+    pub id: NodeId,
     tx: TxIrq<'a, BxHw, RX_RING, Queue, RX_RING, COMPLETIONS>,
     rx0: Rx0Irq<'a, BxHw, RX_RING, Queue, RX_RING, COMPLETIONS>,
     rx1: Rx1Irq<'a, BxHw, RX_RING, Queue, RX_RING, COMPLETIONS>,
@@ -136,12 +135,13 @@ pub fn split_flex(
     state: &FlexState,
     node: FlexNode,
 ) -> Result<(FlexIrqs<'_>, FlexTx<'_>, FlexRx<'_>), SetupError> {
-    let FlexNode { model, driver, .. } = node;
+    let FlexNode { model, driver, id } = node;
     let p = state
         .split(driver.release())
         .map_err(|(e, _)| SetupError::Driver(e))?;
     let irqs = FlexIrqs {
         model,
+        id,
         tx: p.tx_irq,
         rx: p.rx0_irq,
         status: p.status_irq,
@@ -155,12 +155,13 @@ pub fn split_bx(
     state: &BxState,
     node: BxNode,
 ) -> Result<(BxIrqs<'_>, BxTx<'_>, BxRx<'_>), SetupError> {
-    let BxNode { model, driver, .. } = node;
+    let BxNode { model, driver, id } = node;
     let p = state
         .split(driver.release())
         .map_err(|(e, _)| SetupError::Driver(e))?;
     let irqs = BxIrqs {
         model,
+        id,
         tx: p.tx_irq,
         rx0: p.rx0_irq,
         rx1: p.rx1_irq,
@@ -169,60 +170,25 @@ pub fn split_bx(
     Ok((irqs, p.tx, p.rx))
 }
 
-/// A waker that marks its future to be polled again.
-#[derive(Default)]
-struct Flag(AtomicBool);
-
-impl Wake for Flag {
-    fn wake(self: Arc<Self>) {
-        self.0.store(true, Ordering::Release);
-    }
-    fn wake_by_ref(self: &Arc<Self>) {
-        self.0.store(true, Ordering::Release);
-    }
+/// The way back from [`split_flex`]: once the halves and handlers are dropped, takes the
+/// controller out of `state` and makes it a one-struct driver again, with the `model`
+/// and `id` the handlers held ([`FlexIrqs::model`], [`FlexIrqs::id`]). `None` when the
+/// state was never split.
+pub fn unsplit_flex(state: FlexState, model: FlexCanModel, id: NodeId) -> Option<FlexNode> {
+    let hw = state.into_hardware()?;
+    Some(FlexNode {
+        model,
+        driver: Driver::new(hw),
+        id,
+    })
 }
 
-/// A future of [`drive`].
-pub type Task<'f> = Pin<&'f mut dyn Future<Output = Result<(), Error>>>;
-
-/// Runs `futures` with the bus: services `nodes`, polls each future that was woken
-/// (each once at the start), steps the bus by one event when no future is woken, until
-/// every future is ready or the bus time reaches `until`. Returns each future's
-/// output, `None` for one still pending at `until` (the caller drops it: the async API
-/// is cancel-safe).
-pub fn drive(
-    h: &mut Harness,
-    nodes: &mut [&mut dyn Serviced],
-    futures: &mut [Task<'_>],
-    until: u64,
-) -> Vec<Option<Result<(), Error>>> {
-    let flags: Vec<Arc<Flag>> = futures
-        .iter()
-        .map(|_| Arc::new(Flag(AtomicBool::new(true))))
-        .collect();
-    let wakers: Vec<Waker> = flags.iter().map(|f| Waker::from(f.clone())).collect();
-    let mut out: Vec<Option<Result<(), Error>>> = futures.iter().map(|_| None).collect();
-    let mut at_end = false;
-    loop {
-        for n in nodes.iter_mut() {
-            n.service();
-        }
-        for (i, fut) in futures.iter_mut().enumerate() {
-            if out[i].is_none() && flags[i].0.swap(false, Ordering::AcqRel) {
-                if let std::task::Poll::Ready(v) =
-                    fut.as_mut().poll(&mut Context::from_waker(&wakers[i]))
-                {
-                    out[i] = Some(v);
-                }
-            }
-        }
-        let woken =
-            (0..futures.len()).any(|i| out[i].is_none() && flags[i].0.load(Ordering::Acquire));
-        if at_end && !woken || out.iter().all(Option::is_some) {
-            return out;
-        }
-        if !woken && h.bus().borrow_mut().step_until(until).is_none() {
-            at_end = true;
-        }
-    }
+/// The way back from [`split_bx`] (see [`unsplit_flex`]).
+pub fn unsplit_bx(state: BxState, model: BxCanModel, id: NodeId) -> Option<BxNode> {
+    let hw = state.into_hardware()?;
+    Some(BxNode {
+        model,
+        driver: Driver::new(hw),
+        id,
+    })
 }
