@@ -5,7 +5,8 @@
 //! when the model raises a line, as the chips' vectors would. [`unsplit_flex`] and
 //! [`unsplit_bx`] go back: the halves and handlers are given up, the state hands the
 //! controller back, and it becomes a one-struct driver again. The type aliases name the
-//! host nodes' configuration of each backend's split driver.
+//! host nodes' configuration of each backend's split driver
+//! (`twocan_flexcan::types`, `twocan_bxcan::types` with the host's sizes).
 //!
 //! ```
 //! use twocan_core::{Filter, Frame};
@@ -25,10 +26,11 @@
 //! ```
 
 use twocan_bxcan::model::BxCanModel;
+use twocan_bxcan::types as bx;
 use twocan_bxcan::BxCan;
-use twocan_core::split::{Rx, Rx0Irq, Rx1Irq, State, StatusIrq, Tx, TxIrq};
 use twocan_core::{Driver, ErrorState, FifoQueue};
 use twocan_flexcan::model::FlexCanModel;
+use twocan_flexcan::types as flex;
 use twocan_flexcan::FlexCanHw;
 
 use twocan_sim::NodeId;
@@ -39,23 +41,27 @@ use crate::{BxNode, Clocked, FlexNode, Serviced, SetupError, RX_RING, TX_RING};
 pub const COMPLETIONS: usize = 8;
 
 /// The FlexCAN controller over its model.
-pub type FlexHw = FlexCanHw<Clocked<FlexCanModel>>;
+pub type FlexHw = FlexCanHw<FlexRegs>;
+/// The FlexCAN model's registers, bus time passing while the driver polls.
+pub type FlexRegs = Clocked<FlexCanModel>;
 /// The bxCAN controller over its model.
-pub type BxHw = BxCan<Clocked<BxCanModel>>;
+pub type BxHw = BxCan<BxRegs>;
+/// The bxCAN model's registers, bus time passing while the driver polls.
+pub type BxRegs = Clocked<BxCanModel>;
 /// The transmit queue of both (request order).
 pub type Queue = FifoQueue<TX_RING>;
 /// The shared state of a split FlexCAN node.
-pub type FlexState = State<FlexHw, RX_RING, Queue, 0, COMPLETIONS>;
+pub type FlexState = flex::FlexState<FlexRegs, RX_RING, Queue, COMPLETIONS>;
 /// The shared state of a split bxCAN node (a receive ring per FIFO).
-pub type BxState = State<BxHw, RX_RING, Queue, RX_RING, COMPLETIONS>;
+pub type BxState = bx::BxState<BxRegs, BxRegs, RX_RING, Queue, COMPLETIONS>;
 /// FlexCAN transmit half.
-pub type FlexTx<'a> = Tx<'a, FlexHw, RX_RING, Queue, 0, COMPLETIONS>;
+pub type FlexTx<'a> = flex::FlexTx<'a, FlexRegs, RX_RING, Queue, COMPLETIONS>;
 /// FlexCAN receive half.
-pub type FlexRx<'a> = Rx<'a, FlexHw, RX_RING, Queue, 0, COMPLETIONS>;
+pub type FlexRx<'a> = flex::FlexRx<'a, FlexRegs, RX_RING, Queue, COMPLETIONS>;
 /// bxCAN transmit half.
-pub type BxTx<'a> = Tx<'a, BxHw, RX_RING, Queue, RX_RING, COMPLETIONS>;
+pub type BxTx<'a> = bx::BxTx<'a, BxRegs, BxRegs, RX_RING, Queue, COMPLETIONS>;
 /// bxCAN receive half.
-pub type BxRx<'a> = Rx<'a, BxHw, RX_RING, Queue, RX_RING, COMPLETIONS>;
+pub type BxRx<'a> = bx::BxRx<'a, BxRegs, BxRegs, RX_RING, Queue, COMPLETIONS>;
 
 /// The interrupt handlers of a split FlexCAN node: the ORed message-buffer vector
 /// (transmit, then receive) and the status vectors.
@@ -64,9 +70,9 @@ pub struct FlexIrqs<'a> {
     pub model: FlexCanModel,
     /// The node's place on the bus.
     pub id: NodeId,
-    tx: TxIrq<'a, FlexHw, RX_RING, Queue, 0, COMPLETIONS>,
-    rx: Rx0Irq<'a, FlexHw, RX_RING, Queue, 0, COMPLETIONS>,
-    status: StatusIrq<'a, FlexHw, RX_RING, Queue, 0, COMPLETIONS>,
+    tx: flex::FlexTxIrq<'a, FlexRegs, RX_RING, Queue, COMPLETIONS>,
+    rx: flex::FlexRxIrq<'a, FlexRegs, RX_RING, Queue, COMPLETIONS>,
+    status: flex::FlexStatusIrq<'a, FlexRegs, RX_RING, Queue, COMPLETIONS>,
 }
 
 impl FlexIrqs<'_> {
@@ -96,10 +102,10 @@ pub struct BxIrqs<'a> {
     pub model: BxCanModel,
     /// The node's place on the bus.
     pub id: NodeId,
-    tx: TxIrq<'a, BxHw, RX_RING, Queue, RX_RING, COMPLETIONS>,
-    rx0: Rx0Irq<'a, BxHw, RX_RING, Queue, RX_RING, COMPLETIONS>,
-    rx1: Rx1Irq<'a, BxHw, RX_RING, Queue, RX_RING, COMPLETIONS>,
-    status: StatusIrq<'a, BxHw, RX_RING, Queue, RX_RING, COMPLETIONS>,
+    tx: bx::BxTxIrq<'a, BxRegs, BxRegs, RX_RING, Queue, COMPLETIONS>,
+    rx0: bx::BxRx0Irq<'a, BxRegs, BxRegs, RX_RING, Queue, COMPLETIONS>,
+    rx1: bx::BxRx1Irq<'a, BxRegs, BxRegs, RX_RING, Queue, COMPLETIONS>,
+    status: bx::BxStatusIrq<'a, BxRegs, BxRegs, RX_RING, Queue, COMPLETIONS>,
 }
 
 impl BxIrqs<'_> {
