@@ -5,7 +5,6 @@
 
 use twocan_bxcan::regs::CanRegs;
 use twocan_bxcan::types::{BxRx, BxRx0Irq, BxRx1Irq, BxState, BxStatusIrq, BxTx, BxTxIrq};
-use twocan_bxcan::BxCan;
 use twocan_core::irq_cell::IrqCell;
 use twocan_core::Registers;
 
@@ -81,7 +80,7 @@ impl<R: Registers + 'static, F: Registers + 'static> Vectors<R, F> {
 pub fn start<R: Registers + Send + Sync + 'static, F: Registers + Send + Sync + 'static>(
     state: &'static CanState<R, F>,
     vectors: &'static Vectors<R, F>,
-    hw: BxCan<R, F>,
+    hw: twocan_bxcan::BxCan<R, F>,
     irqs: [stm32f7xx_hal::pac::Interrupt; 4],
     nvic: &mut cortex_m::peripheral::NVIC,
 ) -> Option<(CanTxHalf<R, F>, CanRxHalf<R, F>)> {
