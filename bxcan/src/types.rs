@@ -49,62 +49,42 @@ pub type BxState<
     const DONE: usize = COMPLETIONS,
 > = State<BxCan<R, F>, RX, Q, RX, DONE>;
 
-/// The transmit half (implements [`twocan_core::CanTx`]).
-pub type BxTx<
-    'a,
-    R = CanRegs,
-    F = R,
-    const RX: usize = RX_RING,
-    Q = Queue,
-    const DONE: usize = COMPLETIONS,
-> = Tx<'a, BxCan<R, F>, RX, Q, RX, DONE>;
+/// A handle type of the split driver over this backend, its defaults filled in.
+macro_rules! alias {
+    ($(#[$doc:meta])* $name:ident = $target:ident) => {
+        $(#[$doc])*
+        pub type $name<
+            'a,
+            R = CanRegs,
+            F = R,
+            const RX: usize = RX_RING,
+            Q = Queue,
+            const DONE: usize = COMPLETIONS,
+        > = $target<'a, BxCan<R, F>, RX, Q, RX, DONE>;
+    };
+}
 
-/// The receive half (implements [`twocan_core::CanRx`]).
-pub type BxRx<
-    'a,
-    R = CanRegs,
-    F = R,
-    const RX: usize = RX_RING,
-    Q = Queue,
-    const DONE: usize = COMPLETIONS,
-> = Rx<'a, BxCan<R, F>, RX, Q, RX, DONE>;
-
-/// The transmit handler (`CANx_TX` line).
-pub type BxTxIrq<
-    'a,
-    R = CanRegs,
-    F = R,
-    const RX: usize = RX_RING,
-    Q = Queue,
-    const DONE: usize = COMPLETIONS,
-> = TxIrq<'a, BxCan<R, F>, RX, Q, RX, DONE>;
-
-/// FIFO 0's receive handler (`CANx_RX0` line).
-pub type BxRx0Irq<
-    'a,
-    R = CanRegs,
-    F = R,
-    const RX: usize = RX_RING,
-    Q = Queue,
-    const DONE: usize = COMPLETIONS,
-> = Rx0Irq<'a, BxCan<R, F>, RX, Q, RX, DONE>;
-
-/// FIFO 1's receive handler (`CANx_RX1` line).
-pub type BxRx1Irq<
-    'a,
-    R = CanRegs,
-    F = R,
-    const RX: usize = RX_RING,
-    Q = Queue,
-    const DONE: usize = COMPLETIONS,
-> = Rx1Irq<'a, BxCan<R, F>, RX, Q, RX, DONE>;
-
-/// The status handler (`CANx_SCE` line).
-pub type BxStatusIrq<
-    'a,
-    R = CanRegs,
-    F = R,
-    const RX: usize = RX_RING,
-    Q = Queue,
-    const DONE: usize = COMPLETIONS,
-> = StatusIrq<'a, BxCan<R, F>, RX, Q, RX, DONE>;
+alias! {
+    /// The transmit half (implements [`twocan_core::CanTx`]).
+    BxTx = Tx
+}
+alias! {
+    /// The receive half (implements [`twocan_core::CanRx`]).
+    BxRx = Rx
+}
+alias! {
+    /// The transmit handler (`CANx_TX` line).
+    BxTxIrq = TxIrq
+}
+alias! {
+    /// FIFO 0's receive handler (`CANx_RX0` line).
+    BxRx0Irq = Rx0Irq
+}
+alias! {
+    /// FIFO 1's receive handler (`CANx_RX1` line).
+    BxRx1Irq = Rx1Irq
+}
+alias! {
+    /// The status handler (`CANx_SCE` line).
+    BxStatusIrq = StatusIrq
+}

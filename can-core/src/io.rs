@@ -129,22 +129,30 @@ pub trait AsyncCanRx: CanRx {
     fn event(&mut self) -> impl core::future::Future<Output = Result<crate::RxEvent, Error>>;
 }
 
-impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize> CanStatus
-    for Tx<'_, H, RX, Q, RX1, DONE>
-{
-    fn traffic(&self) -> TrafficStats {
-        self.state().traffic()
-    }
-    fn error_stats(&self) -> ErrorStatistics {
-        self.state().error_stats()
-    }
-    fn error_status(&self) -> ErrorStatus {
-        self.hardware().error_status()
-    }
-    fn capabilities(&self) -> Capabilities {
-        self.hardware().capabilities()
-    }
+/// `CanStatus` of a half: the shared state's statistics, the controller's status.
+macro_rules! status_of_a_half {
+    ($half:ident) => {
+        impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize>
+            CanStatus for $half<'_, H, RX, Q, RX1, DONE>
+        {
+            fn traffic(&self) -> TrafficStats {
+                self.state().traffic()
+            }
+            fn error_stats(&self) -> ErrorStatistics {
+                self.state().error_stats()
+            }
+            fn error_status(&self) -> ErrorStatus {
+                self.hardware().error_status()
+            }
+            fn capabilities(&self) -> Capabilities {
+                self.hardware().capabilities()
+            }
+        }
+    };
 }
+
+status_of_a_half!(Tx);
+status_of_a_half!(Rx);
 
 impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize> CanTx
     for Tx<'_, H, RX, Q, RX1, DONE>
@@ -163,23 +171,6 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
     }
     fn tx_stats(&self) -> BufferStats {
         Tx::stats(self)
-    }
-}
-
-impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize> CanStatus
-    for Rx<'_, H, RX, Q, RX1, DONE>
-{
-    fn traffic(&self) -> TrafficStats {
-        self.state().traffic()
-    }
-    fn error_stats(&self) -> ErrorStatistics {
-        self.state().error_stats()
-    }
-    fn error_status(&self) -> ErrorStatus {
-        self.hardware().error_status()
-    }
-    fn capabilities(&self) -> Capabilities {
-        self.hardware().capabilities()
     }
 }
 

@@ -40,47 +40,37 @@ pub type FlexState<
     const DONE: usize = COMPLETIONS,
 > = State<FlexCanHw<R>, RX, Q, 0, DONE>;
 
-/// The transmit half (implements [`twocan_core::CanTx`]).
-pub type FlexTx<
-    'a,
-    R = FlexCanRegs,
-    const RX: usize = RECEIVE_BUFFER_SIZE,
-    Q = Queue,
-    const DONE: usize = COMPLETIONS,
-> = Tx<'a, FlexCanHw<R>, RX, Q, 0, DONE>;
+/// A handle type of the split driver over this backend, its defaults filled in.
+macro_rules! alias {
+    ($(#[$doc:meta])* $name:ident = $target:ident) => {
+        $(#[$doc])*
+        pub type $name<
+            'a,
+            R = FlexCanRegs,
+            const RX: usize = RECEIVE_BUFFER_SIZE,
+            Q = Queue,
+            const DONE: usize = COMPLETIONS,
+        > = $target<'a, FlexCanHw<R>, RX, Q, 0, DONE>;
+    };
+}
 
-/// The receive half (implements [`twocan_core::CanRx`]).
-pub type FlexRx<
-    'a,
-    R = FlexCanRegs,
-    const RX: usize = RECEIVE_BUFFER_SIZE,
-    Q = Queue,
-    const DONE: usize = COMPLETIONS,
-> = Rx<'a, FlexCanHw<R>, RX, Q, 0, DONE>;
-
-/// The transmit handler (the ORed message-buffer line).
-pub type FlexTxIrq<
-    'a,
-    R = FlexCanRegs,
-    const RX: usize = RECEIVE_BUFFER_SIZE,
-    Q = Queue,
-    const DONE: usize = COMPLETIONS,
-> = TxIrq<'a, FlexCanHw<R>, RX, Q, 0, DONE>;
-
-/// The Rx FIFO's receive handler (the ORed message-buffer line).
-pub type FlexRxIrq<
-    'a,
-    R = FlexCanRegs,
-    const RX: usize = RECEIVE_BUFFER_SIZE,
-    Q = Queue,
-    const DONE: usize = COMPLETIONS,
-> = Rx0Irq<'a, FlexCanHw<R>, RX, Q, 0, DONE>;
-
-/// The status handler (bus-off, error, Tx/Rx warning lines).
-pub type FlexStatusIrq<
-    'a,
-    R = FlexCanRegs,
-    const RX: usize = RECEIVE_BUFFER_SIZE,
-    Q = Queue,
-    const DONE: usize = COMPLETIONS,
-> = StatusIrq<'a, FlexCanHw<R>, RX, Q, 0, DONE>;
+alias! {
+    /// The transmit half (implements [`twocan_core::CanTx`]).
+    FlexTx = Tx
+}
+alias! {
+    /// The receive half (implements [`twocan_core::CanRx`]).
+    FlexRx = Rx
+}
+alias! {
+    /// The transmit handler (the ORed message-buffer line).
+    FlexTxIrq = TxIrq
+}
+alias! {
+    /// The Rx FIFO's receive handler (the ORed message-buffer line).
+    FlexRxIrq = Rx0Irq
+}
+alias! {
+    /// The status handler (bus-off, error, Tx/Rx warning lines).
+    FlexStatusIrq = StatusIrq
+}
