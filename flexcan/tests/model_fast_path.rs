@@ -10,7 +10,7 @@
 #[path = "model_support.rs"]
 mod support;
 
-use support::Rig;
+use support::{accept_all_into_fifo, Rig};
 use twocan_core::registers::Registers;
 use twocan_core::Frame;
 use twocan_flexcan::model::FlexCanModel;
@@ -31,16 +31,7 @@ impl Model for Module {
 
     fn start(bus: &mut Bus, _rng: &mut Lcg) -> Self {
         let m = FlexCanModel::mk20dx256();
-        m.modify32(regs::MCR, |v| v & !mcr::MDIS);
-        m.modify32(regs::MCR, |v| v | mcr::RFEN | mcr::IRMQ | mcr::SRXDIS);
-        for n in 0..8 {
-            m.write32(regs::rx_fifo_filter(n), 0);
-            m.write32(regs::rximr(n), 0);
-        }
-        for n in 8..16 {
-            m.write32(regs::mb_cs(n), 0);
-            m.write32(regs::rximr(n), u32::MAX);
-        }
+        accept_all_into_fifo(&m, mcr::SRXDIS);
         bus.attach("fc", m.clone());
         m.modify32(regs::MCR, |v| v & !mcr::HALT);
         bus.run_for(11);
