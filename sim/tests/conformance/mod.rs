@@ -70,6 +70,18 @@ impl<D: Dut, const N: usize> Case<D, N> {
     }
 }
 
+/// The most common start: the dut and one plain peer `p` ([`Case`]).
+fn with_peer<D: Dut>() -> (Bus, D, NodeId, Rc<RefCell<SimNode>>) {
+    let Case {
+        bus,
+        dut,
+        id,
+        peers: [p],
+        ..
+    } = Case::<D, 1>::new([("p", SimNode::new())]);
+    (bus, dut, id, p)
+}
+
 fn frame(id: u16) -> Frame {
     Frame::standard(id, &[0x5A, id as u8]).unwrap()
 }
@@ -156,13 +168,7 @@ pub fn rule_2_dominant_after_own_flag<D: Dut>() {
 /// then 7. An error-active transmitter is not suspended: the retransmission starts right
 /// after the intermission of the error frame.
 pub fn rule_3_and_7_transmitter<D: Dut>() {
-    let Case {
-        mut bus,
-        mut dut,
-        id,
-        peers: [p],
-        ..
-    } = Case::<D, 1>::new([("p", SimNode::new())]);
+    let (mut bus, mut dut, id, p) = with_peer::<D>();
     let f = frame(0x0F0);
     bus.inject_from(id, 1, Fault::Bit { at: None });
     dut.send(&f);
@@ -204,13 +210,7 @@ fn make_passive<D: Dut>(bus: &mut Bus, dut: &mut D, id: NodeId, f: &Frame) -> Bo
 /// starts 8 bits after the intermission. After the ACK-error attempt (delimiter
 /// ce+8..=ce+15, end ce+16, intermission to ce+19), the retry starts at ce+19+8.
 pub fn rule_3_exception_1_ack_error_when_passive<D: Dut>() {
-    let Case {
-        mut bus,
-        mut dut,
-        id,
-        peers: [p],
-        ..
-    } = Case::<D, 1>::new([("p", SimNode::new())]);
+    let (mut bus, mut dut, id, p) = with_peer::<D>();
     let f = frame(0x0F1);
     let last = make_passive(&mut bus, &mut dut, id, &f);
     bus.inject_next(Fault::Ack);
@@ -299,13 +299,7 @@ pub fn rule_8_reception_above_127<D: Dut>() {
 /// and the dut receives its frame; the dut's frame follows right after (no new suspension:
 /// it was a receiver).
 pub fn suspend_transmission_other_node_starts_first<D: Dut>() {
-    let Case {
-        mut bus,
-        mut dut,
-        id,
-        peers: [p],
-        ..
-    } = Case::<D, 1>::new([("p", SimNode::new())]);
+    let (mut bus, mut dut, id, p) = with_peer::<D>();
     let f = frame(0x0F3);
     let last = make_passive(&mut bus, &mut dut, id, &f);
     let g = frame(0x7FF);
@@ -325,13 +319,7 @@ pub fn suspend_transmission_other_node_starts_first<D: Dut>() {
 /// SOF and the first four identifier bits are dominant, so wire bit 5 is a recessive stuff
 /// bit inside the arbitration field. The retry succeeds; TEC stays 0 throughout.
 pub fn rule_3_exception_2_stuff_error_in_arbitration<D: Dut>() {
-    let Case {
-        mut bus,
-        mut dut,
-        id,
-        peers: [_],
-        ..
-    } = Case::<D, 1>::new([("p", SimNode::new())]);
+    let (mut bus, mut dut, id, _) = with_peer::<D>();
     let f = Frame::standard(0x000, &[1]).unwrap();
     assert!(frame_bits(&f).arbitration_end > 5);
     bus.try_inject_from(id, 1, Fault::Bit { at: Some(5) })
@@ -351,13 +339,7 @@ pub fn rule_3_exception_2_stuff_error_in_arbitration<D: Dut>() {
 /// 8 (and starts a new flag). One bit error (rule 3: +8) whose error flag is hit at its
 /// third bit (rule 4: +8): TEC 16; the retry succeeds: 15.
 pub fn rule_4_bit_error_in_own_active_flag_transmitter<D: Dut>() {
-    let Case {
-        mut bus,
-        mut dut,
-        id,
-        peers: [_],
-        ..
-    } = Case::<D, 1>::new([("p", SimNode::new())]);
+    let (mut bus, mut dut, id, _) = with_peer::<D>();
     let f = frame(0x0F5);
     bus.inject_from(id, 1, Fault::Bit { at: None });
     bus.try_inject_next(Fault::FlagBit { who: id, bit: 2 })
@@ -430,13 +412,7 @@ pub fn rule_6_dominant_bits_after_active_flag<D: Dut>() {
 /// 1 applies: its passive flag ce+2..=ce+7 is all recessive), then the bus is held dominant
 /// from ce+8 for 8 bits: TEC 128 + 8 = 136.
 pub fn rule_6_dominant_bits_after_passive_flag<D: Dut>() {
-    let Case {
-        mut bus,
-        mut dut,
-        id,
-        peers: [_],
-        ..
-    } = Case::<D, 1>::new([("p", SimNode::new())]);
+    let (mut bus, mut dut, id, _) = with_peer::<D>();
     let f = frame(0x0F7);
     let ce = frame_bits(&f).crc_end;
     make_passive(&mut bus, &mut dut, id, &f);
@@ -455,13 +431,7 @@ pub fn rule_6_dominant_bits_after_passive_flag<D: Dut>() {
 /// the counters move only by the success (rule 7): a TEC of 8 becomes 7. The attempt lasts
 /// ce + 25 bits and the intermission.
 pub fn overload_frame_leaves_the_counters<D: Dut>() {
-    let Case {
-        mut bus,
-        mut dut,
-        id,
-        peers: [p],
-        ..
-    } = Case::<D, 1>::new([("p", SimNode::new())]);
+    let (mut bus, mut dut, id, p) = with_peer::<D>();
     let f = frame(0x0F8);
     let ce = frame_bits(&f).crc_end;
     bus.inject_from(id, 1, Fault::Bit { at: None });
@@ -489,12 +459,7 @@ pub fn overload_frame_leaves_the_counters<D: Dut>() {
 /// Played twice: dut transmitter (TEC 0 → 8, the peer's REC 8), dut receiver (REC 8).
 pub fn overload_rule_6_after_overload_flag<D: Dut>() {
     for dut_sends in [true, false] {
-        let Case {
-            mut bus,
-            mut dut,
-            peers: [p],
-            ..
-        } = Case::<D, 1>::new([("p", SimNode::new())]);
+        let (mut bus, mut dut, _, p) = with_peer::<D>();
         let f = frame(0x0F9);
         let ce = frame_bits(&f).crc_end;
         bus.try_inject_next(Fault::StuckDominant {
@@ -724,12 +689,7 @@ pub fn dominant_last_error_delimiter_bit_is_overload<D: Dut>() {
 pub fn faults_in_an_overload_delimiter<D: Dut>() {
     for (bit, tec, rec, len) in [(7u8, 0u16, 0u16, 42u64), (2, 8, 1, 37)] {
         for dut_sends in [true, false] {
-            let Case {
-                mut bus,
-                mut dut,
-                peers: [p],
-                ..
-            } = Case::<D, 1>::new([("p", SimNode::new())]);
+            let (mut bus, mut dut, _, p) = with_peer::<D>();
             let f = frame(0x0FC);
             bus.try_inject_next(Fault::IntermissionBit {
                 who: Sees::Bus,
@@ -774,13 +734,7 @@ pub fn faults_in_an_overload_delimiter<D: Dut>() {
 /// delimiter ce+18..=ce+25, end ce+26, +3: ce+29 (the peer received the frame at ce+9,
 /// REC - 1 by rule 8, and drives nothing after it).
 pub fn delimiter_form_error_after_passive_ack_error<D: Dut>() {
-    let Case {
-        mut bus,
-        mut dut,
-        id,
-        peers: [p],
-        ..
-    } = Case::<D, 1>::new([("p", SimNode::new())]);
+    let (mut bus, mut dut, id, p) = with_peer::<D>();
     let f = frame(0x0FD);
     make_passive(&mut bus, &mut dut, id, &f);
     let rec_before = p.borrow().counters().rec;
@@ -804,13 +758,7 @@ pub fn delimiter_form_error_after_passive_ack_error<D: Dut>() {
 /// delimiter bit in an attempt without error or overload frame (the frame is then sent
 /// as if no fault had been injected: 0 errors, TEC 0, length ce+10+3).
 pub fn delimiter_and_intermission_refusals<D: Dut>() {
-    let Case {
-        mut bus,
-        mut dut,
-        id,
-        peers: [p],
-        ..
-    } = Case::<D, 1>::new([("p", SimNode::new())]);
+    let (mut bus, mut dut, id, p) = with_peer::<D>();
     for (fault, error) in [
         (
             Fault::DelimiterBit {
@@ -863,13 +811,7 @@ pub fn delimiter_and_intermission_refusals<D: Dut>() {
 /// of the last error frame (8 + 3 recessive bits) are the first sequence, so the retry
 /// starts 127 × 11 bits after that error frame ends.
 pub fn bus_off_and_recovery<D: Dut>() {
-    let Case {
-        mut bus,
-        mut dut,
-        id,
-        peers: [p],
-        ..
-    } = Case::<D, 1>::new([("p", SimNode::new())]);
+    let (mut bus, mut dut, id, p) = with_peer::<D>();
     let f = frame(0x0F4);
     bus.inject_from(id, 32, Fault::Bit { at: None });
     dut.send(&f);
@@ -896,13 +838,7 @@ pub fn bus_off_and_recovery<D: Dut>() {
 /// the DLC field (the wire layout is the one that code gives, with no data field) and a
 /// plain receiver gets the same frame.
 pub fn remote_dlc_codes_on_the_wire<D: Dut>() {
-    let Case {
-        mut bus,
-        mut dut,
-        id,
-        peers: [p],
-        ..
-    } = Case::<D, 1>::new([("p", SimNode::new())]);
+    let (mut bus, mut dut, id, p) = with_peer::<D>();
     let built: Vec<Frame> = (8..=15u8)
         .map(|code| Frame::remote(0x2A0 + u32::from(code), false, code).unwrap())
         .collect();
