@@ -49,6 +49,9 @@
 //! - [`instance`]: CAN1/CAN2/CAN3 and what the firmware must do (RCC, AF9);
 //! - `hal` (feature `hal-stm32f7`): the hand-over from `stm32f7xx-hal` (singletons,
 //!   clocks, typed pins; CAN2 only with CAN1's filter-block handle);
+//! - `rt` (feature `rt`): the interrupt entry points `CAN1_TX` ... in the library, the
+//!   handlers installed before the lines are unmasked, priorities applied, and the way
+//!   back (`IrqState::start`, `IrqState::stop`);
 //! - [`regs`]: the register map.
 //!
 //! # Critical sections
@@ -83,6 +86,12 @@ pub mod instance;
 mod mailbox;
 mod mode;
 pub mod planner;
+// The library's interrupt entry points and their handler slots (feature `rt`): the
+// `unsafe` of a slot written once and of the NVIC calls.
+#[cfg(feature = "rt")]
+#[cfg_attr(docsrs, doc(cfg(feature = "rt")))]
+#[allow(unsafe_code)]
+pub mod rt;
 // Interrupt-shared state: the `Hardware` contract and the per-mailbox frame cell.
 #[allow(unsafe_code)]
 pub mod split;
