@@ -566,7 +566,7 @@ macro_rules! entry_points {
 /// The STM32F7 (`stm32f7xx-hal`'s PAC: RM0410 table 40 "STM32F76xxx and STM32F77xxx
 /// vector table"): lines per instance, the entry points, and `start`/`stop` with them.
 #[cfg(feature = "hal-stm32f7")]
-mod stm32f7 {
+mod f7 {
     use super::*;
     use stm32f7xx_hal::pac::Interrupt;
 
@@ -667,4 +667,4 @@ mod stm32f7 {
 }
 
 #[cfg(feature = "hal-stm32f7")]
-pub use stm32f7::{lines, vectors};
+pub use f7::{lines, vectors};
