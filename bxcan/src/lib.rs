@@ -22,7 +22,9 @@
 //! handle ([`regs::CanRegs`], a [`twocan_core::Mmio`] window over the instance's block:
 //! safe code reaches no other address) with no `unsafe` in the program; the state is a
 //! `static`, and the handlers go to the TX, RX0, RX1 and SCE vectors before those are
-//! unmasked (see `examples/stm32f7/src/can.rs`). Compiled by the same test:
+//! unmasked: with feature `rt` the library defines those vectors and does it
+//! (`rt::IrqState::start`, and `stop` for the way back; see
+//! `examples/stm32f7/src/can.rs`). Compiled by the same test:
 //!
 #![cfg_attr(
     feature = "hal-stm32f7",
