@@ -97,6 +97,7 @@ pub mod rt;
 // Interrupt-shared state: the `Hardware` contract and the per-mailbox frame cell.
 #[allow(unsafe_code)]
 pub mod split;
+pub mod types;
 
 pub use config::{Config, ConfigError, Recovery};
 pub use controller::{Can, Failed, Init};

@@ -392,9 +392,18 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
         self.hw.take()
     }
 
+    /// Gives the controller back once no handle borrows the state any more (it takes
+    /// the state by value, so the handles are gone; a `static` state gives it back
+    /// with [`State::unsplit`]). Frames and completions still in the rings and the
+    /// queue go with the state; the controller keeps its configuration and its
+    /// mailboxes. `None` when the state was never split.
+    pub fn into_hardware(mut self) -> Option<H> {
+        self.uninstall()
+    }
+
     /// The controller, once [`State::split`] stored it (any context). The reference is
     /// a [`Lease`]: while it lives, [`State::unsplit`] refuses to take the controller
-    /// out ([`Error::Busy`]); drop it before ending the controller.
+    /// out ([`UnsplitError::Leased`]); drop it before ending the controller.
     pub fn hardware(&self) -> Option<Lease<'_, H>> {
         self.hw.lease()
     }
@@ -1176,22 +1185,6 @@ impl<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE:
     /// The map from hardware match index to user filter index in force.
     pub fn filter_map(&self) -> &H::FilterMap {
         &self.map
-    }
-}
-
-impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize> crate::io::CanTx
-    for Tx<'_, H, RX, Q, RX1, DONE>
-{
-    fn try_send(&mut self, frame: &Frame) -> nb::Result<Token, Error> {
-        Tx::try_send(self, frame)
-    }
-}
-
-impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize> crate::io::CanRx
-    for Rx<'_, H, RX, Q, RX1, DONE>
-{
-    fn receive(&mut self) -> nb::Result<RxFrame, Error> {
-        Rx::receive(self)
     }
 }
 

@@ -2,32 +2,30 @@
 //! its four interrupt handlers in one `static` ([`CanState`], the library's
 //! `twocan_bxcan::rt::IrqState`), run by the library's own entry points `CAN1_TX`,
 //! `CAN1_RX0`, `CAN1_RX1`, `CAN1_SCE` (and `CAN2_…`; one handler per line, RM0410
-//! §40.8): the examples define no CAN vector. [`start`] puts the handlers in place
+//! §40.8): the examples define no CAN vector. `start` puts the handlers in place
 //! **before** it unmasks the lines.
 
 use twocan_bxcan::regs::CanRegs;
 use twocan_bxcan::rt::IrqState;
-use twocan_bxcan::BxCan;
-use twocan_core::split::{Rx, Tx};
-use twocan_core::FifoQueue;
+use twocan_bxcan::types::{BxRx, BxTx};
 
 /// Receive ring per FIFO, transmit queue and completion ring sizes of the examples.
-pub const RX: usize = 32;
+pub const RX: usize = twocan_bxcan::types::RX_RING;
 /// See [`RX`].
-pub const TX: usize = 16;
+pub const TX: usize = twocan_bxcan::types::TX_QUEUE;
 /// See [`RX`].
-pub const COMPLETIONS: usize = 8;
+pub const COMPLETIONS: usize = twocan_bxcan::types::COMPLETIONS;
 
 /// A transmit queue in request order (`TXFP = 1`, the driver's default).
-pub type Queue = FifoQueue<TX>;
+pub type Queue = twocan_bxcan::types::Queue;
 /// The shared state and interrupt handlers of an instance with registers `R` and filter
 /// registers `F` (a whole block by default; `ControlRegs` and
 /// `twocan_bxcan::hal::Can1Filters` for CAN1 and CAN2 sharing CAN1's filters).
 pub type CanState<R = CanRegs, F = CanRegs> = IrqState<R, F, RX, Queue, RX, COMPLETIONS>;
 /// The transmit half.
-pub type CanTxHalf<R = CanRegs, F = CanRegs> = Tx<'static, BxCan<R, F>, RX, Queue, RX, COMPLETIONS>;
+pub type CanTxHalf<R = CanRegs, F = CanRegs> = BxTx<'static, R, F>;
 /// The receive half.
-pub type CanRxHalf<R = CanRegs, F = CanRegs> = Rx<'static, BxCan<R, F>, RX, Queue, RX, COMPLETIONS>;
+pub type CanRxHalf<R = CanRegs, F = CanRegs> = BxRx<'static, R, F>;
 
 /// Starts `state` over `hw` (`IrqState::start`: the four handlers installed, then each
 /// line of the instance given [`crate::rt::CAN_PRIORITY`] and unmasked). Returns the
@@ -35,7 +33,7 @@ pub type CanRxHalf<R = CanRegs, F = CanRegs> = Rx<'static, BxCan<R, F>, RX, Queu
 #[cfg(target_os = "none")]
 pub fn start<R, F>(
     state: &'static CanState<R, F>,
-    hw: BxCan<R, F>,
+    hw: twocan_bxcan::BxCan<R, F>,
     nvic: &mut cortex_m::peripheral::NVIC,
 ) -> Option<(CanTxHalf<R, F>, CanRxHalf<R, F>)>
 where
