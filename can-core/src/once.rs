@@ -169,8 +169,9 @@ impl<T> Drop for OnceSlot<T> {
     }
 }
 
-/// A reference to the value of a [`OnceSlot`], counted so that
-/// [`OnceSlot::take_shared`] waits for it (see the module docs).
+/// A reference to the controller a split state holds ([`crate::State::hardware`]),
+/// counted: while one lives, [`crate::State::unsplit`] refuses to take the controller
+/// out.
 pub struct Lease<'a, T> {
     slot: &'a OnceSlot<T>,
     value: &'a T,

@@ -23,6 +23,7 @@
 
 #[cfg(feature = "async")]
 pub mod asynch;
+pub mod firmware;
 
 use twocan_core::{CanRx, CanTx, Dispatcher, Filter, Format, Frame, FrameKind, RxFrame};
 
