@@ -169,9 +169,9 @@ impl<T> Drop for OnceSlot<T> {
     }
 }
 
-/// A reference to the controller a split state holds ([`crate::State::hardware`]),
-/// counted: while one lives, [`crate::State::unsplit`] refuses to take the controller
-/// out.
+/// A reference to the controller of a `State` (`State::hardware`), counted while it
+/// lives: `State::unsplit` does not take the controller out meanwhile (it refuses with
+/// `UnsplitError::Leased`). Dereferences to the controller.
 pub struct Lease<'a, T> {
     slot: &'a OnceSlot<T>,
     value: &'a T,
