@@ -93,6 +93,7 @@ pub mod filters;
 mod handshake;
 pub mod instance;
 mod message_buffer;
+pub mod options;
 #[cfg(any(feature = "teensy32", feature = "teensy35", feature = "teensy36"))]
 pub mod pin;
 pub mod planner;

@@ -11,11 +11,10 @@
 //! - **full**: transmit completions (a completion ring of [`DONE`] = 8), receive and
 //!   transmit time stamps, traffic statistics, the filter list compiled by `begin`'s
 //!   runtime planner;
-//! - **lean**: the closest the current driver API comes to issue 21's lean driver: no
-//!   completion ring ([`DONE`] = 0). The FlexCAN driver has no switch yet for its time
-//!   stamps (always widened), its statistics, or a filter plan made at compile time
-//!   (`begin` always compiles the list): **pending** — when the lean driver lands, the
-//!   lean block below is the one place to switch to its types.
+//! - **lean**: no completion ring ([`DONE`] = 0) and the controller's lean choices
+//!   (`twocan_flexcan::options::Lean`: no time stamps, no filter switch while running).
+//!   Statistics stay on (twocan-core's counters), and `begin` still compiles the list
+//!   at run time.
 
 // Each firmware that includes this module uses a part of it.
 #![allow(dead_code)]
@@ -27,6 +26,7 @@ compile_error!("enable feature `lean` or `full`");
 
 use twocan_core::split::{Parts, Rx, Rx0Irq, State, Tx, TxIrq};
 use twocan_core::{Error, FifoQueue, Filter, Registers};
+use twocan_flexcan::options::{Full, Lean};
 use twocan_flexcan::{
     BeginError, Board, Configuration, FlexCan, FlexCanHw, Instance, Settings, Target,
 };
@@ -62,6 +62,9 @@ pub const VARIANT: &str = "lean";
 /// Completion ring capacity (0: completions off).
 #[cfg(feature = "lean")]
 pub const DONE: usize = 0;
+/// The controller's compile-time choices: no time stamps, no filter switch.
+#[cfg(feature = "lean")]
+pub type Opts = Lean;
 
 // ------------------------------------------------------------------ full
 
@@ -69,11 +72,14 @@ pub const DONE: usize = 0;
 pub const VARIANT: &str = "full";
 #[cfg(feature = "full")]
 pub const DONE: usize = 8;
+/// The controller's compile-time choices: time stamps, filter switches.
+#[cfg(feature = "full")]
+pub type Opts = Full;
 
 // ------------------------------------------------------------------ both
 
 /// The controller the split driver holds.
-pub type Hw<R> = FlexCanHw<R>;
+pub type Hw<R> = FlexCanHw<R, Opts>;
 /// The transmit queue.
 pub type Q = FifoQueue<TXQ>;
 /// The shared state a `static` holds.
@@ -102,5 +108,5 @@ pub fn configure<const RETRIES: u32, R: Registers, S: Registers>(
             _ => break,
         }
     }
-    Ok(attempt?.into_split())
+    Ok(attempt?.into_split_with::<Opts>())
 }

@@ -1,0 +1,56 @@
+//! Compile-time choices of the split driver's FlexCAN controller ([`crate::FlexCanHw`]'s
+//! second type parameter): what each frame pays for is chosen when the firmware is
+//! built, not tested while it runs.
+//!
+//! | choice | [`Full`] (the default) | [`Lean`] |
+//! |---|---|---|
+//! | receive and transmit time stamps ([`Options::STAMPS`]) | the 16-bit `TIME STAMP` of the message buffer, widened by the driver | none: no `TIMER` read, no critical section in the receive handler |
+//! | filter lists replaced while running ([`Options::FILTER_SWITCH`]) | `set_filters`; each raw frame carries the filter generation, and frames of a replaced list are dropped | `set_filters` refused with [`twocan_core::Error::Unsupported`]: no generation word per frame |
+//!
+//! ```
+//! use twocan_flexcan::options::{Full, Lean, Options};
+//! assert!(Full::STAMPS && Full::FILTER_SWITCH);
+//! assert!(!Lean::STAMPS && !Lean::FILTER_SWITCH);
+//! ```
+//!
+//! A lean controller comes from [`crate::FlexCan::into_split_with`]:
+//!
+//! ```
+//! # fn f<R: twocan_core::Registers>(c: twocan_flexcan::FlexCan<R>) {
+//! use twocan_flexcan::options::Lean;
+//! let hw = c.into_split_with::<Lean>(); // FlexCanHw<R, Lean>
+//! # let _ = hw;
+//! # }
+//! ```
+
+/// The compile-time choices (implemented by [`Full`] and [`Lean`]; a firmware may
+/// implement it for a mix of its own).
+pub trait Options: 'static {
+    /// Received frames and transmit completions carry the message buffer's `TIME STAMP`
+    /// (Kinetis RM, "Message buffer structure"), widened by the driver
+    /// ([`twocan_core::Hardware::raw_timestamp`]); capabilities report `timestamps`.
+    const STAMPS: bool;
+    /// The filter list may be replaced while the controller runs
+    /// ([`twocan_core::split::Rx::set_filters`]): every raw frame carries the list's
+    /// generation so that frames the old list accepted are dropped.
+    const FILTER_SWITCH: bool;
+}
+
+/// Every feature: time stamps and filter switches (the default).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Full {}
+
+impl Options for Full {
+    const STAMPS: bool = true;
+    const FILTER_SWITCH: bool = true;
+}
+
+/// Neither time stamps nor filter switches while running: the filter list `begin`
+/// installed stays.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Lean {}
+
+impl Options for Lean {
+    const STAMPS: bool = false;
+    const FILTER_SWITCH: bool = false;
+}

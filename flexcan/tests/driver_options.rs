@@ -1,0 +1,161 @@
+//! The controller's compile-time choices (`twocan_flexcan::options`): the lean
+//! controller delivers the same frames and completions without time stamps and refuses
+//! a filter switch; the transmit interrupt settles one or several mailboxes alike.
+#![cfg(feature = "model")]
+
+mod common;
+
+use common::*;
+use twocan_core::{Driver, Error, Filter, Hardware, TxOutcome};
+use twocan_flexcan::options::{Full, Lean};
+use twocan_flexcan::{Board, FilterTable, FlexCan, FlexCanHw, HostSystem, Instance, Target};
+
+type LeanCan = Driver<FlexCanHw<Ticking, Lean>, 32, 16>;
+
+fn lean_begin(filters: &[Filter]) -> (twocan_flexcan::model::FlexCanModel, LeanCan) {
+    let model = model_for(Board::Teensy36);
+    let controller = FlexCan::begin(
+        Ticking::new(model.clone()),
+        &mut HostSystem::new(),
+        Target::new(Board::Teensy36, Instance::Can0),
+        &loop_back(500_000),
+        filters,
+        &[],
+    )
+    .unwrap();
+    (model, Driver::new(controller.into_split_with::<Lean>()))
+}
+
+/// Runs the bus, servicing the lean driver's interrupt after each event.
+fn run_lean(bus: &mut twocan_sim::Bus, can: &mut LeanCan, bits: u64) {
+    let until = bus.now() + bits;
+    loop {
+        if can.hardware().registers().irq_pending() {
+            can.on_interrupt();
+        }
+        if bus.step_until(until).is_none() {
+            break;
+        }
+    }
+    if can.hardware().registers().irq_pending() {
+        can.on_interrupt();
+    }
+}
+
+#[test]
+fn lean_controller_delivers_without_time_stamps() {
+    let (model, mut can) = lean_begin(&[Filter::standard(0x10), Filter::standard(0x20)]);
+    assert!(!can.hardware().capabilities().modes.timestamps);
+    let mut tokens = Vec::new();
+    for id in [0x20, 0x10, 0x30] {
+        tokens.push(can.try_send(&std_data(id, &[id as u8])).unwrap());
+    }
+    let mut bus = bus_with(500_000, &[&model]);
+    run_lean(&mut bus, &mut can, 2_000);
+    let got: Vec<_> = core::iter::from_fn(|| can.receive().ok()).collect();
+    let seen: Vec<(u32, u16, Option<_>)> = got
+        .iter()
+        .map(|rx| (rx.frame.raw_id(), rx.filter, rx.timestamp))
+        .collect();
+    // 0x30 passes no filter; the others come back with their filter and no stamp.
+    assert_eq!(seen, vec![(0x20, 1, None), (0x10, 0, None)]);
+    let done: Vec<_> = core::iter::from_fn(|| can.take_completion()).collect();
+    assert_eq!(done.len(), 3);
+    for (c, t) in done.iter().zip(&tokens) {
+        assert_eq!(
+            (c.token, c.outcome, c.timestamp),
+            (*t, TxOutcome::Sent, None)
+        );
+    }
+}
+
+#[test]
+fn lean_controller_refuses_a_filter_switch() {
+    let (model, mut can) = lean_begin(&[Filter::standard(0x10)]);
+    let table = FilterTable::compile(
+        twocan_flexcan::Configuration::default(),
+        &[Filter::standard(0x20)],
+        &[],
+    )
+    .unwrap();
+    assert_eq!(can.set_filters(&table), Err(Error::Unsupported));
+    // The list `begin` installed stays in force.
+    can.try_send(&std_data(0x10, &[])).unwrap();
+    let mut bus = bus_with(500_000, &[&model]);
+    run_lean(&mut bus, &mut can, 1_000);
+    let rx = can.receive().unwrap();
+    assert_eq!((rx.frame.raw_id(), rx.filter), (0x10, 0));
+}
+
+#[test]
+fn full_controller_stamps_what_the_lean_one_does_not() {
+    let (model, mut can) = begin::<32, 16>(&loop_back(500_000), &[], &[]).unwrap();
+    assert!(can.hardware().capabilities().modes.timestamps);
+    let _: &FlexCanHw<Ticking, Full> = can.hardware();
+    can.try_send(&std_data(0x10, &[])).unwrap();
+    let mut bus = bus_with(500_000, &[&model]);
+    run1(&mut bus, &mut can, 1_000);
+    assert!(can.receive().unwrap().timestamp.is_some());
+    assert!(can.take_completion().unwrap().timestamp.is_some());
+}
+
+/// Several transmit mailboxes ended before the interrupt is serviced: one interrupt
+/// settles them all, each once, in the order they were requested (token order, not
+/// mailbox order), and leaves every mailbox empty.
+#[test]
+fn several_mailboxes_settled_by_one_interrupt_in_request_order() {
+    use twocan_core::{AbortRequest, Mode};
+    use twocan_flexcan::regs::{self, IFLAG1};
+    let (model, mut can) = begin::<32, 16>(&loop_back(500_000), &[], &[]).unwrap();
+    let c = can.hardware().configuration();
+    let r = c.remote_mailbox_count() as usize;
+    assert!(r >= 3);
+    let first = c.first_remote_mailbox() as usize;
+    let mask = 0b111 << first;
+    // Frozen: the mailboxes are loaded (MB first, first + 1, first + 2, in request
+    // order) and wait.
+    can.set_mode(Mode::Stopped).unwrap();
+    let mut tokens = [
+        can.try_send_now(&remote(0x300, false)).unwrap(),
+        can.try_send_now(&remote(0x100, false)).unwrap(),
+        can.try_send_now(&remote(0x200, false)).unwrap(),
+    ];
+    // The first one aborted and settled: its mailbox takes a later request, so that
+    // mailbox order is no longer request order.
+    assert_eq!(can.abort(tokens[0]), AbortRequest::Requested);
+    can.on_interrupt();
+    let aborted = can.take_completion().unwrap();
+    assert_eq!(
+        (aborted.token, aborted.outcome),
+        (tokens[0], TxOutcome::Aborted)
+    );
+    tokens[0] = can.try_send_now(&remote(0x050, false)).unwrap();
+    assert_eq!(cs_code(&model, first), regs::code::TX_DATA);
+    can.set_mode(Mode::Normal).unwrap();
+    let mut bus = bus_with(500_000, &[&model]);
+    bus.run_for(2_000); // no interrupt serviced meanwhile
+    assert_eq!(model.peek32(IFLAG1) & mask, mask, "all three ended");
+    can.on_interrupt();
+    let done: Vec<_> = core::iter::from_fn(|| can.take_completion()).collect();
+    let got: Vec<_> = done.iter().map(|c| (c.token, c.outcome)).collect();
+    let mut want: Vec<_> = tokens.iter().map(|t| (*t, TxOutcome::Sent)).collect();
+    want.sort_by_key(|(t, _)| t.0);
+    assert_ne!(
+        want.iter().map(|w| w.0).collect::<Vec<_>>(),
+        tokens,
+        "a real reordering"
+    );
+    assert_eq!(got, want);
+    assert_eq!(can.traffic().sent, 3);
+    for mb in 0..=r {
+        assert_eq!(
+            can.mailbox_state(twocan_core::MailboxId(mb as u8)),
+            twocan_core::MailboxState::Empty
+        );
+    }
+}
+
+fn cs_code(model: &twocan_flexcan::model::FlexCanModel, mb: usize) -> u32 {
+    use twocan_flexcan::regs::{self, cs};
+    cs::CODE.get(model.peek32(regs::mb_cs(mb)))
+}
