@@ -26,7 +26,6 @@ compile_error!("enable feature `lean` or `full`");
 
 use twocan_core::split::{Parts, Rx, Rx0Irq, State, Tx, TxIrq};
 use twocan_core::{Error, FifoQueue, Filter, Registers};
-use twocan_flexcan::options::{Full, Lean};
 use twocan_flexcan::{
     BeginError, Board, Configuration, FlexCan, FlexCanHw, Instance, Settings, Target,
 };
@@ -64,7 +63,7 @@ pub const VARIANT: &str = "lean";
 pub const DONE: usize = 0;
 /// The controller's compile-time choices: no time stamps, no filter switch.
 #[cfg(feature = "lean")]
-pub type Opts = Lean;
+pub type Opts = twocan_flexcan::options::Lean;
 
 // ------------------------------------------------------------------ full
 
@@ -74,7 +73,7 @@ pub const VARIANT: &str = "full";
 pub const DONE: usize = 8;
 /// The controller's compile-time choices: time stamps, filter switches.
 #[cfg(feature = "full")]
-pub type Opts = Full;
+pub type Opts = twocan_flexcan::options::Full;
 
 // ------------------------------------------------------------------ both
 
