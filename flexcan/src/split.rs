@@ -33,7 +33,7 @@
 //! to the user's filter ([`FilterTable::filter_index`]).
 
 use core::marker::PhantomData;
-use core::sync::atomic::{AtomicU32, AtomicU8, Ordering};
+use core::sync::atomic::{AtomicBool, AtomicU32, AtomicU8, Ordering};
 
 use twocan_core::hardware::{
     sort_by_token, Completion, ReceiveContext, Settled, StatusEvents, Token,
@@ -79,6 +79,12 @@ const fn bus_mode_code(m: BusMode) -> u8 {
     }
 }
 
+/// Whether the transmit half is refused in bus mode `bus_mode` and mode `mode` (codes):
+/// listen-only, or sleep.
+const fn tx_refused(bus_mode: u8, mode: u8) -> bool {
+    bus_mode == bus_mode_code(BusMode::ListenOnly) || mode == MODE_SLEEP
+}
+
 /// Position of the filter generation in a raw frame's last word (`IDHIT` below it).
 const GENERATION_SHIFT: u32 = 16;
 
@@ -116,6 +122,10 @@ pub struct FlexCanHw<R: Registers, O: Options = Full> {
     polls: AtomicU32,
     irq_priority: u8,
     mode: AtomicU8,
+    /// Whether the transmit half is refused ([`Error::WrongMode`]): listen-only or
+    /// sleep, from `bus_mode` and `mode` (one load on the transmit path). Written
+    /// after each of them, by the control context only.
+    tx_refused: AtomicBool,
     /// Filter list generation (low 16 bits), stamped on each raw frame by `read_rx`
     /// and compared by `decode`: frames read before the last `install_filters` are
     /// dropped. Written by `install_filters` only.
@@ -180,6 +190,7 @@ impl<R: Registers> FlexCan<R> {
             generation: AtomicU32::new(0),
             irq_priority: self.irq_priority,
             mode: AtomicU8::new(mode_code(mode)),
+            tx_refused: AtomicBool::new(tx_refused(bus_mode_code(self.bus_mode), mode_code(mode))),
             tokens: [const { AtomicU32::new(0) }; MAX_TX],
             last_error: AtomicLastError::new(self.last_error.get()),
             unresolved: AtomicU32::new(0),
@@ -321,12 +332,20 @@ impl<R: Registers, O: Options> FlexCanHw<R, O> {
     /// Refused with [`Error::WrongMode`] in listen-only mode and while disabled (sleep).
     #[inline(always)]
     fn check_can_send(&self) -> Result<(), Error> {
-        if self.bus_mode.load(Ordering::Relaxed) == bus_mode_code(BusMode::ListenOnly)
-            || self.mode() == MODE_SLEEP
-        {
+        if self.tx_refused.load(Ordering::Relaxed) {
             return Err(Error::WrongMode);
         }
         Ok(())
+    }
+
+    /// `tx_refused` from `bus_mode` and `mode` (after a store to either; the control
+    /// context, their one writer).
+    fn note_tx_refused(&self) {
+        let refused = tx_refused(
+            self.bus_mode.load(Ordering::Relaxed),
+            self.mode.load(Ordering::Relaxed),
+        );
+        self.tx_refused.store(refused, Ordering::Relaxed);
     }
 
     /// MB15 for a data frame, the first free remote-frame mailbox for a remote frame.
@@ -605,6 +624,7 @@ impl<R: Registers, O: Options> FlexCanHw<R, O> {
             Mode::Normal => {
                 handshake::leave_freeze(&self.regs, polls)?;
                 self.mode.store(MODE_NORMAL, Ordering::Relaxed);
+                self.note_tx_refused();
                 return handshake::wait_synch(&self.regs, polls, |esr| {
                     self.latch(esr);
                 });
@@ -613,6 +633,7 @@ impl<R: Registers, O: Options> FlexCanHw<R, O> {
             Mode::Sleep => handshake::disable(&self.regs, polls)?,
         }
         self.mode.store(mode_code(mode), Ordering::Relaxed);
+        self.note_tx_refused();
         Ok(())
     }
 }
@@ -1094,6 +1115,7 @@ unsafe impl<R: Registers, O: Options> Hardware for FlexCanHw<R, O> {
         self.regs
             .modify32(regs::MCR, |v| (v & !regs::mcr::SRXDIS) | srxdis);
         self.bus_mode.store(bus_mode_code(mode), Ordering::Relaxed);
+        self.note_tx_refused();
         Ok(())
     }
 }
