@@ -45,14 +45,15 @@ use crate::regs::{self, code, cs, ctrl1, ctrl2, iflag1, mcr, CTRL1, CTRL2, IFLAG
 use crate::settings::{Settings, CAN_CLOCK_HZ};
 use crate::system::{choose_pins, SystemPlan};
 
-/// Everything `begin` will write, computed before anything is written.
+/// Everything `begin` will write but the filter table, computed before anything is
+/// written (the lists are checked; the table is built once, inside the controller
+/// `begin` returns, so that no table-sized value moves through the configuration).
 #[derive(Debug, Clone)]
 struct Plan {
     system: SystemPlan,
     mcr: u32,
     ctrl1: u32,
     configuration: Configuration,
-    table: FilterTable,
 }
 
 /// The checks of ACAN table 5, all of them, then the register values.
@@ -68,10 +69,7 @@ fn plan(
         errors |= ConfigErrors::BIT_TIMING_INCONSISTENT;
     }
 
-    let table = FilterTable::compile(settings.configuration, primary, secondary);
-    if let Err(e) = &table {
-        errors |= *e;
-    }
+    errors |= FilterTable::check(settings.configuration, primary, secondary);
 
     let pins = match target.board.pins(target.instance) {
         None => {
@@ -96,8 +94,8 @@ fn plan(
         },
     };
 
-    match (errors.is_empty(), timing_bits, table, pins) {
-        (true, Ok(timing_bits), Ok(table), Some((tx, rx))) => {
+    match (errors.is_empty(), timing_bits, pins) {
+        (true, Ok(timing_bits), Some((tx, rx))) => {
             let system = SystemPlan::new(
                 target.instance.clock_gate(),
                 tx,
@@ -134,7 +132,6 @@ fn plan(
                 mcr,
                 ctrl1,
                 configuration: settings.configuration,
-                table,
             })
         }
         _ => Err(errors),
@@ -181,8 +178,13 @@ fn bitrate_error(settings: &Settings) -> Option<TimingError> {
     }
 }
 
-/// Writes the plan (steps 2–5 of the module docs).
-fn configure<R: Registers>(regs: &mut R, plan: &Plan, polls: u32) -> Result<(), Error> {
+/// Writes the plan and `table` (steps 2–5 of the module docs).
+fn configure<R: Registers>(
+    regs: &mut R,
+    plan: &Plan,
+    table: &FilterTable,
+    polls: u32,
+) -> Result<(), Error> {
     handshake::disable(regs, polls)?;
     regs.modify32(CTRL1, |v| v & !ctrl1::CLKSRC);
     handshake::enable(regs, polls)?;
@@ -196,7 +198,7 @@ fn configure<R: Registers>(regs: &mut R, plan: &Plan, polls: u32) -> Result<(), 
         let kept = v & ctrl2::TASD.mask();
         kept | ctrl2::RFFN.val(plan.configuration.rffn() as u32) | ctrl2::RRS
     });
-    FlexCan::<R>::write_filters(regs, &plan.table);
+    FlexCan::<R>::write_filters(regs, table);
     // Masks of the transmit mailboxes: a remote-frame mailbox briefly receives after
     // its transmission; exact matching keeps it to its own identifier.
     for n in plan.configuration.primary_filter_capacity()..MESSAGE_BUFFERS as usize {
@@ -261,7 +263,7 @@ impl<R: Registers> FlexCan<R> {
     /// [`crate::regs::SystemRegs`], as `Can0::begin` uses; host: [`crate::HostSystem`]).
     /// `regs` may be `&mut M` to keep the registers (a model) after an error.
     pub fn begin<S: Registers>(
-        mut regs: R,
+        regs: R,
         sys: &mut S,
         target: Target,
         settings: &Settings,
@@ -274,7 +276,6 @@ impl<R: Registers> FlexCan<R> {
         let plan = plan(target, settings, primary, secondary).map_err(BeginError::Config)?;
         plan.system.apply(sys);
         let polls = settings.handshake_bound();
-        configure(&mut regs, &plan, polls)?;
         let bus_mode = if settings.listen_only {
             BusMode::ListenOnly
         } else if settings.loop_back {
@@ -282,17 +283,20 @@ impl<R: Registers> FlexCan<R> {
         } else {
             BusMode::Normal
         };
-        Ok(FlexCan::configured(
+        // The table is built once, in the controller, and written from there.
+        let mut controller = FlexCan::configured(
             regs,
             target,
-            plan.table,
+            FilterTable::build(plan.configuration, primary, secondary),
             bus_mode,
             settings.bus_off_recovery,
             polls,
             settings.message_irq_priority,
             plan.system,
             settings.bus_clock_hz.unwrap_or(CAN_CLOCK_HZ),
-        ))
+        );
+        configure(&mut controller.regs, &plan, &controller.table, polls)?;
+        Ok(controller)
     }
 }
 

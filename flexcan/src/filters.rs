@@ -171,6 +171,20 @@ impl FilterTable {
         primary: &[Filter],
         secondary: &[Filter],
     ) -> Result<Self, ConfigErrors> {
+        let errors = Self::check(configuration, primary, secondary);
+        if !errors.is_empty() {
+            return Err(errors);
+        }
+        Ok(Self::build(configuration, primary, secondary))
+    }
+
+    /// The errors [`FilterTable::compile`] reports for these lists (none: it compiles),
+    /// without building the table.
+    pub(crate) fn check(
+        configuration: Configuration,
+        primary: &[Filter],
+        secondary: &[Filter],
+    ) -> ConfigErrors {
         let mut errors = ConfigErrors::NONE;
         if primary.len() > configuration.primary_filter_capacity() {
             errors |= ConfigErrors::TOO_MANY_PRIMARY_FILTERS;
@@ -184,14 +198,15 @@ impl FilterTable {
         if !secondary.iter().all(secondary_conforms) {
             errors |= ConfigErrors::SECONDARY_FILTER_NOT_CONFORM;
         }
-        if !errors.is_empty() {
-            return Err(errors);
-        }
-        Ok(Self::build(configuration, primary, secondary))
+        errors
     }
 
-    /// Builds a table from lists already checked.
-    fn build(configuration: Configuration, primary: &[Filter], secondary: &[Filter]) -> Self {
+    /// Builds a table from lists already checked ([`FilterTable::check`]).
+    pub(crate) fn build(
+        configuration: Configuration,
+        primary: &[Filter],
+        secondary: &[Filter],
+    ) -> Self {
         let p = primary.len();
         let s = secondary.len();
         let capacity_p = configuration.primary_filter_capacity();

@@ -98,14 +98,12 @@ pub fn configure<const RETRIES: u32, R: Registers, S: Registers>(
     regs: impl Fn() -> R,
     sys: &mut S,
 ) -> Result<Hw<R>, BeginError> {
-    let mut attempt = FlexCan::begin(regs(), sys, TARGET, &SETTINGS, &FILTERS, &[]);
-    for _ in 0..RETRIES {
-        match attempt {
-            Err(BeginError::Hardware(Error::Timeout)) => {
-                attempt = FlexCan::begin(regs(), sys, TARGET, &SETTINGS, &FILTERS, &[])
-            }
-            _ => break,
+    // One call site of `begin`: its result goes straight into the split controller.
+    let mut retries = 0;
+    loop {
+        match FlexCan::begin(regs(), sys, TARGET, &SETTINGS, &FILTERS, &[]) {
+            Err(BeginError::Hardware(Error::Timeout)) if retries < RETRIES => retries += 1,
+            attempt => return Ok(attempt?.into_split_with::<Opts>()),
         }
     }
-    Ok(attempt?.into_split_with::<Opts>())
 }
