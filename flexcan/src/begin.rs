@@ -33,16 +33,19 @@
 //! [`BeginError::Hardware`]`(`[`Error::Timeout`]`)`.
 
 use twocan_core::timing::{TimingError, TimingRule};
-use twocan_core::{BusMode, BusOffRecovery, Error, Filter, Registers};
+use twocan_core::{BusMode, BusOffRecovery, Error, Filter, LastErrorCode, Mode, Registers};
 
 use crate::begin_error::{BeginError, ConfigErrors};
 use crate::configuration::{Configuration, DATA_MAILBOX, MESSAGE_BUFFERS};
 use crate::controller::FlexCan;
 use crate::filters::FilterTable;
 use crate::handshake;
+use crate::installed::PlannedTable;
 use crate::instance::Target;
+use crate::options::Options;
 use crate::regs::{self, code, cs, ctrl1, ctrl2, iflag1, mcr, CTRL1, CTRL2, IFLAG1, IMASK1, MCR};
 use crate::settings::{Settings, CAN_CLOCK_HZ};
+use crate::split::{FlexCanHw, Parts};
 use crate::system::{choose_pins, SystemPlan};
 
 /// Everything `begin` will write but the filter table, computed before anything is
@@ -60,8 +63,8 @@ struct Plan {
 fn plan(
     target: Target,
     settings: &Settings,
-    primary: &[Filter],
-    secondary: &[Filter],
+    configuration: Configuration,
+    filter_errors: ConfigErrors,
 ) -> Result<Plan, ConfigErrors> {
     let mut errors = timing_errors(&settings.timing_rule(), settings);
     let timing_bits = settings.timing.flexcan_ctrl1();
@@ -69,7 +72,7 @@ fn plan(
         errors |= ConfigErrors::BIT_TIMING_INCONSISTENT;
     }
 
-    errors |= FilterTable::check(settings.configuration, primary, secondary);
+    errors |= filter_errors;
 
     let pins = match target.board.pins(target.instance) {
         None => {
@@ -131,7 +134,7 @@ fn plan(
                 system,
                 mcr,
                 ctrl1,
-                configuration: settings.configuration,
+                configuration,
             })
         }
         _ => Err(errors),
@@ -178,11 +181,12 @@ fn bitrate_error(settings: &Settings) -> Option<TimingError> {
     }
 }
 
-/// Writes the plan and `table` (steps 2–5 of the module docs).
+/// Writes the plan, and the filter table with `write_table` (steps 2–5 of the module
+/// docs).
 fn configure<R: Registers>(
     regs: &mut R,
     plan: &Plan,
-    table: &FilterTable,
+    write_table: impl FnOnce(&R),
     polls: u32,
 ) -> Result<(), Error> {
     handshake::disable(regs, polls)?;
@@ -198,7 +202,7 @@ fn configure<R: Registers>(
         let kept = v & ctrl2::TASD.mask();
         kept | ctrl2::RFFN.val(plan.configuration.rffn() as u32) | ctrl2::RRS
     });
-    FlexCan::<R>::write_filters(regs, table);
+    write_table(regs);
     // Masks of the transmit mailboxes: a remote-frame mailbox briefly receives after
     // its transmission; exact matching keeps it to its own identifier.
     for n in plan.configuration.primary_filter_capacity()..MESSAGE_BUFFERS as usize {
@@ -243,7 +247,8 @@ pub fn check(
     primary: &[Filter],
     secondary: &[Filter],
 ) -> ConfigErrors {
-    match plan(target, settings, primary, secondary) {
+    let filters = FilterTable::check(settings.configuration, primary, secondary);
+    match plan(target, settings, settings.configuration, filters) {
         Ok(_) => ConfigErrors::NONE,
         Err(e) => e,
     }
@@ -273,16 +278,12 @@ impl<R: Registers> FlexCan<R> {
         if let Some(e) = bitrate_error(settings) {
             return Err(BeginError::Timing(e));
         }
-        let plan = plan(target, settings, primary, secondary).map_err(BeginError::Config)?;
+        let filters = FilterTable::check(settings.configuration, primary, secondary);
+        let plan =
+            plan(target, settings, settings.configuration, filters).map_err(BeginError::Config)?;
         plan.system.apply(sys);
         let polls = settings.handshake_bound();
-        let bus_mode = if settings.listen_only {
-            BusMode::ListenOnly
-        } else if settings.loop_back {
-            BusMode::LoopBack
-        } else {
-            BusMode::Normal
-        };
+        let bus_mode = bus_mode_of(settings);
         // The table is built once, in the controller, and written from there.
         let mut controller = FlexCan::configured(
             regs,
@@ -295,8 +296,100 @@ impl<R: Registers> FlexCan<R> {
             plan.system,
             settings.bus_clock_hz.unwrap_or(CAN_CLOCK_HZ),
         );
-        configure(&mut controller.regs, &plan, &controller.table, polls)?;
+        let table = &controller.table;
+        configure(
+            &mut controller.regs,
+            &plan,
+            |r| FlexCan::write_filters(r, table),
+            polls,
+        )?;
         Ok(controller)
+    }
+
+    /// `begin` with a filter table planned at compile time ([`crate::const_plan!`],
+    /// [`crate::filters::SizedTable::planned`]), straight to the split controller with
+    /// the options `O` ([`crate::options::Lean`], or a firmware's own whose table is a
+    /// [`PlannedTable`]): no filter list is checked or compiled at run time and no
+    /// table-sized value is built — the controller keeps a few words pointing into the
+    /// plan, whose elements and masks are written as [`FlexCan::begin`] writes a
+    /// compiled list's. The plan's configuration replaces `settings.configuration`.
+    /// The same checks of the settings as `begin` (ACAN table 5, the filter flags
+    /// aside: the plan fits by construction), the same initialization sequence.
+    ///
+    /// ```
+    /// use twocan_core::Filter;
+    /// use twocan_flexcan::options::Lean;
+    /// use twocan_flexcan::planner::PlanOptions;
+    /// use twocan_flexcan::{const_plan, Board, FlexCan, FlexCanHw, HostSystem, Instance};
+    /// use twocan_flexcan::{model::FlexCanModel, IdleClocked, Settings, Target};
+    ///
+    /// const FILTERS: [Filter; 2] = [Filter::standard(0x100), Filter::extended(0x1234)];
+    /// let plan = const_plan!(FILTERS, PlanOptions::choose()).planned();
+    /// // The model, its clock running while the driver waits for an acknowledge.
+    /// let model = IdleClocked::new(FlexCanModel::mk66fx1m0());
+    /// let target = Target::new(Board::Teensy36, Instance::Can0);
+    /// let mut settings = Settings::new(500_000);
+    /// settings.loop_back = true;
+    /// let hw: FlexCanHw<_, Lean> =
+    ///     FlexCan::begin_planned(model, &mut HostSystem::new(), target, &settings, plan)
+    ///         .map_err(|e| format!("{e:?}"))?;
+    /// assert_eq!(hw.configuration(), plan.configuration());
+    /// # Ok::<(), String>(())
+    /// ```
+    pub fn begin_planned<S: Registers, O: Options<Table = PlannedTable>>(
+        mut regs: R,
+        sys: &mut S,
+        target: Target,
+        settings: &Settings,
+        table: PlannedTable,
+    ) -> Result<FlexCanHw<R, O>, BeginError> {
+        if let Some(e) = bitrate_error(settings) {
+            return Err(BeginError::Timing(e));
+        }
+        let plan = plan(target, settings, table.configuration(), ConfigErrors::NONE)
+            .map_err(BeginError::Config)?;
+        plan.system.apply(sys);
+        let polls = settings.handshake_bound();
+        configure(
+            &mut regs,
+            &plan,
+            |r| {
+                FlexCan::write_table(
+                    r,
+                    table.rejects_all(),
+                    table.elements(),
+                    table.individual_masks(),
+                    table.global_mask(),
+                )
+            },
+            polls,
+        )?;
+        Ok(FlexCanHw::from_parts(
+            regs,
+            target,
+            table,
+            Parts {
+                bus_mode: bus_mode_of(settings),
+                recovery: settings.bus_off_recovery,
+                polls,
+                irq_priority: settings.message_irq_priority,
+                mode: Mode::Normal,
+                last_error: LastErrorCode::None,
+                system: plan.system,
+                bus_clock_hz: settings.bus_clock_hz.unwrap_or(CAN_CLOCK_HZ),
+            },
+        ))
+    }
+}
+
+/// The bus mode the settings ask for (ACAN §4: listen-only, loop-back).
+fn bus_mode_of(settings: &Settings) -> BusMode {
+    if settings.listen_only {
+        BusMode::ListenOnly
+    } else if settings.loop_back {
+        BusMode::LoopBack
+    } else {
+        BusMode::Normal
     }
 }
 

@@ -91,6 +91,7 @@ pub mod controller;
 pub mod end;
 pub mod filters;
 mod handshake;
+pub mod installed;
 pub mod instance;
 mod message_buffer;
 pub mod options;

@@ -50,6 +50,7 @@ use crate::configuration::{Configuration, DATA_MAILBOX};
 use crate::controller::FlexCan;
 use crate::filters::{FilterTable, UNKNOWN_FILTER};
 use crate::handshake;
+use crate::installed::{InstalledTable, Unresolved};
 use crate::instance::Target;
 use crate::message_buffer::MbWords;
 use crate::options::{Full, Options};
@@ -110,7 +111,7 @@ pub struct FlexCanHw<R: Registers, O: Options = Full> {
     /// The installed filter table (ID table, masks, map from `IDHIT` to the user's
     /// index): touched only from the receive half's context (`decode`,
     /// `install_filters`), so one copy.
-    table: core::cell::UnsafeCell<FilterTable>,
+    table: core::cell::UnsafeCell<O::Table>,
     /// The table's message-buffer configuration (read from every context).
     configuration: Configuration,
     /// The [`BusMode`] (`CTRL1.LOM`/`LPB`) as its code (read by the transmit half).
@@ -172,32 +173,67 @@ impl<R: Registers> FlexCan<R> {
 
     /// The controller for the split driver with the compile-time choices `O`
     /// ([`crate::options`]: [`Full`], [`crate::options::Lean`]).
-    pub fn into_split_with<O: Options>(self) -> FlexCanHw<R, O> {
-        let mode = self.mode;
-        let first = self.table.configuration().first_remote_mailbox() as u32;
-        let srxdis = self.bus_mode != BusMode::LoopBack
-            && self.regs.read32(regs::MCR) & regs::mcr::SRXDIS != 0;
+    pub fn into_split_with<O: Options<Table = FilterTable>>(self) -> FlexCanHw<R, O> {
+        let last_error = self.last_error.get();
+        FlexCanHw::from_parts(
+            self.regs,
+            self.target,
+            self.table,
+            Parts {
+                bus_mode: self.bus_mode,
+                recovery: self.recovery,
+                polls: self.polls,
+                irq_priority: self.irq_priority,
+                mode: self.mode,
+                last_error,
+                system: self.system,
+                bus_clock_hz: self.bus_clock_hz,
+            },
+        )
+    }
+}
+
+/// The small values a split controller starts from (a started [`FlexCan`]'s, or
+/// `begin_planned`'s).
+pub(crate) struct Parts {
+    pub(crate) bus_mode: BusMode,
+    pub(crate) recovery: BusOffRecovery,
+    pub(crate) polls: u32,
+    pub(crate) irq_priority: u8,
+    pub(crate) mode: Mode,
+    pub(crate) last_error: LastErrorCode,
+    pub(crate) system: SystemPlan,
+    pub(crate) bus_clock_hz: u32,
+}
+
+impl<R: Registers, O: Options> FlexCanHw<R, O> {
+    /// The split controller over `regs` with `table` installed.
+    pub(crate) fn from_parts(regs: R, target: Target, table: O::Table, p: Parts) -> Self {
+        let configuration = table.configuration();
+        let first = configuration.first_remote_mailbox() as u32;
+        let srxdis =
+            p.bus_mode != BusMode::LoopBack && regs.read32(regs::MCR) & regs::mcr::SRXDIS != 0;
         FlexCanHw {
-            regs: self.regs,
-            target: self.target,
+            regs,
+            target,
             tx_mask: (0xFFFF_u32 >> first << first) & 0xFFFF,
-            configuration: self.table.configuration(),
-            table: core::cell::UnsafeCell::new(self.table),
-            bus_mode: AtomicU8::new(bus_mode_code(self.bus_mode)),
+            configuration,
+            table: core::cell::UnsafeCell::new(table),
+            bus_mode: AtomicU8::new(bus_mode_code(p.bus_mode)),
             srxdis,
-            recovery: self.recovery,
-            polls: AtomicU32::new(self.polls),
+            recovery: p.recovery,
+            polls: AtomicU32::new(p.polls),
             generation: AtomicU32::new(0),
-            irq_priority: self.irq_priority,
-            mode: AtomicU8::new(mode_code(mode)),
-            tx_refused: AtomicBool::new(tx_refused(bus_mode_code(self.bus_mode), mode_code(mode))),
+            irq_priority: p.irq_priority,
+            mode: AtomicU8::new(mode_code(p.mode)),
+            tx_refused: AtomicBool::new(tx_refused(bus_mode_code(p.bus_mode), mode_code(p.mode))),
             tokens: [const { AtomicU32::new(0) }; MAX_TX],
-            last_error: AtomicLastError::new(self.last_error.get()),
+            last_error: AtomicLastError::new(p.last_error),
             unresolved: AtomicU32::new(0),
             loaded: AtomicU32::new(0),
             abort_wanted: AtomicU32::new(0),
-            system: self.system,
-            bus_clock_hz: self.bus_clock_hz,
+            system: p.system,
+            bus_clock_hz: p.bus_clock_hz,
             discarded: AtomicU32::new(0),
             caught: AtomicU32::new(0),
             unreported: AtomicU32::new(0),
@@ -234,7 +270,9 @@ pub trait InstalledFilters {
     fn filters(&self) -> FilterTable;
 }
 
-impl<R: Registers, O: Options> InstalledFilters for ReceiveContext<'_, FlexCanHw<R, O>> {
+impl<R: Registers, O: Options<Table = FilterTable>> InstalledFilters
+    for ReceiveContext<'_, FlexCanHw<R, O>>
+{
     fn filters(&self) -> FilterTable {
         // SAFETY: the table is written only by `install_filters`, which the receive
         // half calls with `&mut self`; a `ReceiveContext` borrows that half (or the
@@ -297,7 +335,9 @@ impl<R: Registers, O: Options> FlexCanHw<R, O> {
     pub fn into_registers(self) -> R {
         self.regs
     }
+}
 
+impl<R: Registers, O: Options<Table = FilterTable>> FlexCanHw<R, O> {
     /// The controller back, as `begin` gave it (the reverse of
     /// [`FlexCan::into_split`]): for [`FlexCan::end`] after
     /// [`twocan_core::Driver::release`].
@@ -324,7 +364,9 @@ impl<R: Registers, O: Options> FlexCanHw<R, O> {
         controller.last_error.set(last_error);
         controller
     }
+}
 
+impl<R: Registers, O: Options> FlexCanHw<R, O> {
     fn mode(&self) -> u8 {
         self.mode.load(Ordering::Relaxed)
     }
@@ -649,7 +691,7 @@ impl<R: Registers, O: Options> FlexCanHw<R, O> {
 // - `target`, `configuration`, `srxdis`, `recovery`, `irq_priority`, `system`,
 //   `bus_clock_hz`: read only; everything else is atomic.
 // `FlexCanHw` itself is `Send` (moved into the driver's state) exactly when `R` is.
-unsafe impl<R: Registers + Sync, O: Options> Sync for FlexCanHw<R, O> where FilterTable: Send {}
+unsafe impl<R: Registers + Sync, O: Options> Sync for FlexCanHw<R, O> {}
 
 // SAFETY: as for `Sync`: each method stays within its context's registers.
 unsafe impl<R: Registers, O: Options> Hardware for FlexCanHw<R, O> {
@@ -845,7 +887,7 @@ unsafe impl<R: Registers, O: Options> Hardware for FlexCanHw<R, O> {
     #[inline]
     unsafe fn decode(&self, raw: &RawFrame, _map: &()) -> Option<RxFrame> {
         // SAFETY: the receive half's context, the only one touching the table.
-        let map = unsafe { &*self.table.get() };
+        let table = unsafe { &*self.table.get() };
         let [control, id, word0, word1, tagged] = *raw;
         if O::FILTER_SWITCH
             && tagged >> GENERATION_SHIFT != self.generation.load(Ordering::Relaxed) & 0xFFFF
@@ -861,12 +903,12 @@ unsafe impl<R: Registers, O: Options> Hardware for FlexCanHw<R, O> {
             word1,
         }
         .frame();
-        let filter = match map.filter_index(hit as usize, &frame) {
-            Some(i) => i,
+        let filter = match table.resolve(hit as usize, &frame) {
+            Ok(i) => i,
             // A superset element's extra identifier: dropped and counted by the driver.
-            None if map.hit(hit as usize) == Some(crate::filters::Hit::Lookup) => return None,
+            Err(Unresolved::Superset) => return None,
             // An IDHIT the table does not produce (stale, corrupted): kept, flagged.
-            None => {
+            Err(Unresolved::Unknown) => {
                 let n = self.unresolved.load(Ordering::Relaxed);
                 self.unresolved
                     .store(n.saturating_add(1), Ordering::Relaxed);
@@ -913,7 +955,7 @@ unsafe impl<R: Registers, O: Options> Hardware for FlexCanHw<R, O> {
     /// Refused with [`Error::Unsupported`] without [`Options::FILTER_SWITCH`]
     /// ([`crate::options::Lean`]).
     unsafe fn install_filters(&self, filters: &FilterTable) -> Result<(), Error> {
-        if !O::FILTER_SWITCH {
+        if !O::FILTER_SWITCH || !<O::Table as InstalledTable>::REPLACEABLE {
             return Err(Error::Unsupported);
         }
         if filters.configuration() != self.configuration() {
@@ -944,7 +986,7 @@ unsafe impl<R: Registers, O: Options> Hardware for FlexCanHw<R, O> {
         self.discarded.fetch_add(popped, Ordering::Relaxed);
         // SAFETY: the receive half's context, the only one touching the table
         // (`ReceiveContext` borrows that half, so no copy is being read).
-        unsafe { *self.table.get() = filters.clone() };
+        unsafe { (*self.table.get()).replace(filters)? };
         let next = (self.generation.load(Ordering::Relaxed) + 1) & 0xFFFF;
         self.generation.store(next, Ordering::Release);
         self.resume_after_switch(mode)

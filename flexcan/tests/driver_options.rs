@@ -7,23 +7,28 @@ mod common;
 
 use common::*;
 use twocan_core::{Driver, Error, Filter, Hardware, TxOutcome};
+use twocan_flexcan::installed::PlannedTable;
 use twocan_flexcan::options::{Full, Lean};
-use twocan_flexcan::{Board, FilterTable, FlexCan, FlexCanHw, HostSystem, Instance, Target};
+use twocan_flexcan::planner::PlanOptions;
+use twocan_flexcan::{
+    const_plan, Board, FilterTable, FlexCan, FlexCanHw, HostSystem, Instance, Target,
+};
 
 type LeanCan = Driver<FlexCanHw<Ticking, Lean>, 32, 16>;
 
-fn lean_begin(filters: &[Filter]) -> (twocan_flexcan::model::FlexCanModel, LeanCan) {
+const FILTERS: [Filter; 2] = [Filter::standard(0x10), Filter::standard(0x20)];
+
+fn lean_begin(plan: PlannedTable) -> (twocan_flexcan::model::FlexCanModel, LeanCan) {
     let model = model_for(Board::Teensy36);
-    let controller = FlexCan::begin(
+    let hw = FlexCan::begin_planned(
         Ticking::new(model.clone()),
         &mut HostSystem::new(),
         Target::new(Board::Teensy36, Instance::Can0),
         &loop_back(500_000),
-        filters,
-        &[],
+        plan,
     )
     .unwrap();
-    (model, Driver::new(controller.into_split_with::<Lean>()))
+    (model, Driver::new(hw))
 }
 
 /// Runs the bus, servicing the lean driver's interrupt after each event.
@@ -44,7 +49,7 @@ fn run_lean(bus: &mut twocan_sim::Bus, can: &mut LeanCan, bits: u64) {
 
 #[test]
 fn lean_controller_delivers_without_time_stamps() {
-    let (model, mut can) = lean_begin(&[Filter::standard(0x10), Filter::standard(0x20)]);
+    let (model, mut can) = lean_begin(const_plan!(FILTERS, PlanOptions::choose()).planned());
     assert!(!can.hardware().capabilities().modes.timestamps);
     let mut tokens = Vec::new();
     for id in [0x20, 0x10, 0x30] {
@@ -71,13 +76,9 @@ fn lean_controller_delivers_without_time_stamps() {
 
 #[test]
 fn lean_controller_refuses_a_filter_switch() {
-    let (model, mut can) = lean_begin(&[Filter::standard(0x10)]);
-    let table = FilterTable::compile(
-        twocan_flexcan::Configuration::default(),
-        &[Filter::standard(0x20)],
-        &[],
-    )
-    .unwrap();
+    let (model, mut can) = lean_begin(const_plan!(FILTERS, PlanOptions::choose()).planned());
+    let c = can.hardware().configuration();
+    let table = FilterTable::compile(c, &[Filter::standard(0x20)], &[]).unwrap();
     assert_eq!(can.set_filters(&table), Err(Error::Unsupported));
     // The list `begin` installed stays in force.
     can.try_send(&std_data(0x10, &[])).unwrap();
@@ -158,4 +159,63 @@ fn several_mailboxes_settled_by_one_interrupt_in_request_order() {
 fn cs_code(model: &twocan_flexcan::model::FlexCanModel, mb: usize) -> u32 {
     use twocan_flexcan::regs::{self, cs};
     cs::CODE.get(model.peek32(regs::mb_cs(mb)))
+}
+
+/// A `const` plan written by `begin_planned` and the run-time planner's table for the
+/// same list (installed with `set_filters`) leave the same register contents: the ID
+/// table, the individual masks, `RXFGMASK` and `MCR.IDAM`; and resolve frames alike.
+#[test]
+fn const_plan_and_runtime_planner_write_the_same_registers() {
+    use twocan_flexcan::planner;
+    use twocan_flexcan::regs::{self, MCR, RXFGMASK};
+    const LIST: [Filter; 4] = [
+        Filter::standard(0x100),
+        Filter::standard(0x101),
+        Filter::extended(0x18FE_F100),
+        Filter::standard(0x7F0),
+    ];
+    const OPTIONS: PlanOptions = PlanOptions::choose();
+    let planned = const_plan!(LIST, OPTIONS).planned();
+    let (a, mut lean) = lean_begin(planned);
+    let runtime = planner::plan(&LIST, OPTIONS).unwrap();
+    assert_eq!(runtime.configuration(), planned.configuration());
+    let mut settings = loop_back(500_000);
+    settings.configuration = runtime.configuration();
+    let (b, mut full) = begin::<32, 16>(&settings, &[Filter::pass_all()], &[]).unwrap();
+    full.set_filters(&runtime).unwrap();
+    let c = planned.configuration();
+    let words = |m: &twocan_flexcan::model::FlexCanModel| {
+        let mut w: Vec<u32> = (0..c.table_elements())
+            .map(|i| m.peek32(regs::rx_fifo_filter(i)))
+            .collect();
+        w.extend((0..c.primary_filter_capacity()).map(|i| m.peek32(regs::rximr(i))));
+        w.push(m.peek32(RXFGMASK));
+        w.push(regs::mcr::IDAM.get(m.peek32(MCR)));
+        w
+    };
+    assert_eq!(words(&a), words(&b));
+    // The same frames come back with the same filter index.
+    let frames = [0x100u16, 0x101, 0x102, 0x7F0];
+    let mut bus_a = bus_with(500_000, &[&a]);
+    let mut bus_b = bus_with(500_000, &[&b]);
+    for id in frames {
+        lean.try_send(&std_data(id, &[])).unwrap();
+        full.try_send(&std_data(id, &[])).unwrap();
+    }
+    full.try_send(&ext_data(0x18FE_F100, &[1])).unwrap();
+    lean.try_send(&ext_data(0x18FE_F100, &[1])).unwrap();
+    run_lean(&mut bus_a, &mut lean, 3_000);
+    run1(&mut bus_b, &mut full, 3_000);
+    let got_a: Vec<_> = core::iter::from_fn(|| lean.receive().ok())
+        .map(|rx| (rx.frame.raw_id(), rx.filter))
+        .collect();
+    let got_b: Vec<_> = drain(&mut full)
+        .iter()
+        .map(|rx| (rx.frame.raw_id(), rx.filter))
+        .collect();
+    assert_eq!(got_a, got_b);
+    assert_eq!(
+        got_a,
+        vec![(0x100, 0), (0x101, 1), (0x7F0, 3), (0x18FE_F100, 2)]
+    );
 }

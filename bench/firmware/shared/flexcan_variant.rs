@@ -12,9 +12,10 @@
 //!   transmit time stamps, traffic statistics, the filter list compiled by `begin`'s
 //!   runtime planner;
 //! - **lean**: no completion ring ([`DONE`] = 0) and the controller's lean choices
-//!   (`twocan_flexcan::options::Lean`: no time stamps, no filter switch while running).
-//!   Statistics stay on (twocan-core's counters), and `begin` still compiles the list
-//!   at run time.
+//!   (`twocan_flexcan::options::Lean`: no time stamps, no filter switch while running,
+//!   the filter table planned at compile time by `const_plan!` and written by
+//!   `FlexCan::begin_planned`, which keeps a few words pointing into the plan).
+//!   Statistics stay on (twocan-core's counters).
 
 // Each firmware that includes this module uses a part of it.
 #![allow(dead_code)]
@@ -101,9 +102,26 @@ pub fn configure<const RETRIES: u32, R: Registers, S: Registers>(
     // One call site of `begin`: its result goes straight into the split controller.
     let mut retries = 0;
     loop {
-        match FlexCan::begin(regs(), sys, TARGET, &SETTINGS, &FILTERS, &[]) {
+        match begin(regs(), sys) {
             Err(BeginError::Hardware(Error::Timeout)) if retries < RETRIES => retries += 1,
-            attempt => return Ok(attempt?.into_split_with::<Opts>()),
+            attempt => return attempt,
         }
     }
+}
+
+/// Lean: the filter table planned at compile time, written by `begin_planned`.
+#[cfg(feature = "lean")]
+#[inline(always)]
+fn begin<R: Registers, S: Registers>(regs: R, sys: &mut S) -> Result<Hw<R>, BeginError> {
+    use twocan_flexcan::const_plan;
+    use twocan_flexcan::planner::PlanOptions;
+    let plan = const_plan!(FILTERS, PlanOptions::new(Configuration::Filters8_0)).planned();
+    FlexCan::begin_planned(regs, sys, TARGET, &SETTINGS, plan)
+}
+
+/// Full: `begin` compiles the list at run time; the controller keeps the table.
+#[cfg(feature = "full")]
+#[inline(always)]
+fn begin<R: Registers, S: Registers>(regs: R, sys: &mut S) -> Result<Hw<R>, BeginError> {
+    Ok(FlexCan::begin(regs, sys, TARGET, &SETTINGS, &FILTERS, &[])?.into_split_with::<Opts>())
 }
