@@ -60,7 +60,7 @@ struct Plan {
 }
 
 /// The checks of ACAN table 5, all of them, then the register values.
-fn plan(
+const fn plan(
     target: Target,
     settings: &Settings,
     configuration: Configuration,
@@ -69,14 +69,14 @@ fn plan(
     let mut errors = timing_errors(&settings.timing_rule(), settings);
     let timing_bits = settings.timing.flexcan_ctrl1();
     if timing_bits.is_err() {
-        errors |= ConfigErrors::BIT_TIMING_INCONSISTENT;
+        errors = errors.union(ConfigErrors::BIT_TIMING_INCONSISTENT);
     }
 
-    errors |= filter_errors;
+    errors = errors.union(filter_errors);
 
     let pins = match target.board.pins(target.instance) {
         None => {
-            errors |= ConfigErrors::NO_SUCH_INSTANCE;
+            errors = errors.union(ConfigErrors::NO_SUCH_INSTANCE);
             None
         }
         Some(pins) => match choose_pins(
@@ -87,10 +87,10 @@ fn plan(
             Ok(chosen) => Some(chosen),
             Err((no_tx, no_rx)) => {
                 if no_tx {
-                    errors |= ConfigErrors::NO_ALTERNATE_TX_PIN;
+                    errors = errors.union(ConfigErrors::NO_ALTERNATE_TX_PIN);
                 }
                 if no_rx {
-                    errors |= ConfigErrors::NO_ALTERNATE_RX_PIN;
+                    errors = errors.union(ConfigErrors::NO_ALTERNATE_RX_PIN);
                 }
                 None
             }
@@ -123,7 +123,7 @@ fn plan(
             if settings.loop_back {
                 ctrl1 |= ctrl1::LPB;
             }
-            if settings.bus_off_recovery == BusOffRecovery::Manual {
+            if matches!(settings.bus_off_recovery, BusOffRecovery::Manual) {
                 ctrl1 |= ctrl1::BOFFREC;
             }
             if settings.error_interrupts {
@@ -150,20 +150,24 @@ fn plan(
 /// counts, ACAN §15.2.2; [`ConfigErrors::BIT_TIMING_FORBIDDEN`] for the Kinetis
 /// manual's rules); the timing too far from the wished rate
 /// ([`ConfigErrors::BIT_RATE_TOO_FAR`], ACAN §15.2.1).
-fn timing_errors(rule: &TimingRule, settings: &Settings) -> ConfigErrors {
+const fn timing_errors(rule: &TimingRule, settings: &Settings) -> ConfigErrors {
     let mut errors = ConfigErrors::NONE;
     match rule.check_bitrate(settings.wished_bit_rate()) {
         Ok(()) => {}
-        Err(TimingError::ForbiddenByManual) => errors |= ConfigErrors::BIT_TIMING_FORBIDDEN,
-        Err(_) => errors |= ConfigErrors::BIT_RATE_OUT_OF_RANGE,
+        Err(TimingError::ForbiddenByManual) => {
+            errors = errors.union(ConfigErrors::BIT_TIMING_FORBIDDEN)
+        }
+        Err(_) => errors = errors.union(ConfigErrors::BIT_RATE_OUT_OF_RANGE),
     }
     if !settings.bit_rate_close_to_wished() {
-        errors |= ConfigErrors::BIT_RATE_TOO_FAR;
+        errors = errors.union(ConfigErrors::BIT_RATE_TOO_FAR);
     }
     match rule.check_timing(&settings.timing) {
         Ok(()) => {}
-        Err(TimingError::ForbiddenByManual) => errors |= ConfigErrors::BIT_TIMING_FORBIDDEN,
-        Err(_) => errors |= ConfigErrors::BIT_TIMING_INCONSISTENT,
+        Err(TimingError::ForbiddenByManual) => {
+            errors = errors.union(ConfigErrors::BIT_TIMING_FORBIDDEN)
+        }
+        Err(_) => errors = errors.union(ConfigErrors::BIT_TIMING_INCONSISTENT),
     }
     errors
 }
@@ -171,7 +175,7 @@ fn timing_errors(rule: &TimingRule, settings: &Settings) -> ConfigErrors {
 /// The error `begin` gives before any other check: the wished rate outside the range of
 /// the driver's rule ([`TimingRule::check_bitrate`]; a rule that accepts nothing is left
 /// to the flags, [`ConfigErrors::BIT_TIMING_FORBIDDEN`]).
-fn bitrate_error(settings: &Settings) -> Option<TimingError> {
+const fn bitrate_error(settings: &Settings) -> Option<TimingError> {
     match settings
         .timing_rule()
         .check_bitrate(settings.wished_bit_rate())
@@ -337,22 +341,35 @@ impl<R: Registers> FlexCan<R> {
     /// # Ok::<(), String>(())
     /// ```
     pub fn begin_planned<S: Registers, O: Options<Table = PlannedTable>>(
-        mut regs: R,
+        regs: R,
         sys: &mut S,
         target: Target,
         settings: &Settings,
         table: PlannedTable,
     ) -> Result<FlexCanHw<R, O>, BeginError> {
-        if let Some(e) = bitrate_error(settings) {
-            return Err(BeginError::Timing(e));
+        let checked = BeginPlan::new(target, settings, table.configuration())?;
+        Self::begin_checked(regs, sys, &checked, table)
+    }
+
+    /// [`FlexCan::begin_planned`] with the settings checked beforehand ([`BeginPlan`]):
+    /// with a `const` plan of `const` settings, no check of the settings links into the
+    /// firmware — `begin` is the initialization sequence alone. `table` must be planned
+    /// for the configuration `checked` was made for ([`Error::InvalidArgument`]
+    /// otherwise, nothing written).
+    pub fn begin_checked<S: Registers, O: Options<Table = PlannedTable>>(
+        mut regs: R,
+        sys: &mut S,
+        checked: &BeginPlan,
+        table: PlannedTable,
+    ) -> Result<FlexCanHw<R, O>, BeginError> {
+        let plan = &checked.plan;
+        if table.configuration() != plan.configuration {
+            return Err(BeginError::Hardware(Error::InvalidArgument));
         }
-        let plan = plan(target, settings, table.configuration(), ConfigErrors::NONE)
-            .map_err(BeginError::Config)?;
         plan.system.apply(sys);
-        let polls = settings.handshake_bound();
         configure(
             &mut regs,
-            &plan,
+            plan,
             |r| {
                 FlexCan::write_table(
                     r,
@@ -362,28 +379,105 @@ impl<R: Registers> FlexCan<R> {
                     table.global_mask(),
                 )
             },
-            polls,
+            checked.polls,
         )?;
         Ok(FlexCanHw::from_parts(
             regs,
-            target,
+            checked.target,
             table,
             Parts {
-                bus_mode: bus_mode_of(settings),
-                recovery: settings.bus_off_recovery,
-                polls,
-                irq_priority: settings.message_irq_priority,
+                bus_mode: checked.bus_mode,
+                recovery: checked.recovery,
+                polls: checked.polls,
+                irq_priority: checked.irq_priority,
                 mode: Mode::Normal,
                 last_error: LastErrorCode::None,
                 system: plan.system,
-                bus_clock_hz: settings.bus_clock_hz.unwrap_or(CAN_CLOCK_HZ),
+                bus_clock_hz: checked.bus_clock_hz,
             },
         ))
     }
 }
 
+/// What `begin` writes for `settings` on `target` with a table planned for a
+/// configuration, every check of ACAN table 5 done (the filter flags aside): made once,
+/// by a `const fn`, so that `const` settings are checked at compile time
+/// ([`BeginPlan::new_or_panic`]) and [`FlexCan::begin_checked`] links no check.
+///
+/// ```
+/// use twocan_flexcan::begin::BeginPlan;
+/// use twocan_flexcan::{Board, Configuration, Instance, Settings, Target};
+///
+/// const T36: Target = Target::new(Board::Teensy36, Instance::Can0);
+/// const CHECKED: BeginPlan =
+///     BeginPlan::new_or_panic(T36, &Settings::new(500_000), Configuration::Filters8_0);
+/// assert!(BeginPlan::new(T36, &Settings::new(2_000_000), Configuration::Filters8_0).is_err());
+/// # let _ = CHECKED;
+/// ```
+#[derive(Debug, Clone)]
+pub struct BeginPlan {
+    target: Target,
+    plan: Plan,
+    polls: u32,
+    bus_mode: BusMode,
+    recovery: BusOffRecovery,
+    irq_priority: u8,
+    bus_clock_hz: u32,
+}
+
+impl BeginPlan {
+    /// The checks `begin` makes of `settings` on `target` (ACAN table 5 and the bit-rate
+    /// range first, as [`FlexCan::begin`]), and the register values, for a table of
+    /// `configuration` (which replaces `settings.configuration`).
+    pub const fn new(
+        target: Target,
+        settings: &Settings,
+        configuration: Configuration,
+    ) -> Result<Self, BeginError> {
+        if let Some(e) = bitrate_error(settings) {
+            return Err(BeginError::Timing(e));
+        }
+        match plan(target, settings, configuration, ConfigErrors::NONE) {
+            Ok(plan) => Ok(BeginPlan {
+                target,
+                plan,
+                polls: settings.handshake_bound(),
+                bus_mode: bus_mode_of(settings),
+                recovery: settings.bus_off_recovery,
+                irq_priority: settings.message_irq_priority,
+                bus_clock_hz: match settings.bus_clock_hz {
+                    Some(hz) => hz,
+                    None => CAN_CLOCK_HZ,
+                },
+            }),
+            Err(e) => Err(BeginError::Config(e)),
+        }
+    }
+
+    /// [`BeginPlan::new`], panicking on an error: in a `const` item, settings that
+    /// `begin` would refuse are a compile-time error.
+    pub const fn new_or_panic(
+        target: Target,
+        settings: &Settings,
+        configuration: Configuration,
+    ) -> Self {
+        match Self::new(target, settings, configuration) {
+            Ok(p) => p,
+            Err(BeginError::Timing(_)) => {
+                panic!("twocan_flexcan::BeginPlan: bit rate outside the driver's range")
+            }
+            Err(_) => panic!("twocan_flexcan::BeginPlan: settings refused (ACAN table 5)"),
+        }
+    }
+
+    /// The configuration the plan is made for.
+    pub const fn configuration(&self) -> Configuration {
+        self.plan.configuration
+    }
+}
+
 /// The bus mode the settings ask for (ACAN §4: listen-only, loop-back).
-fn bus_mode_of(settings: &Settings) -> BusMode {
+const fn bus_mode_of(settings: &Settings) -> BusMode {
     if settings.listen_only {
         BusMode::ListenOnly
     } else if settings.loop_back {

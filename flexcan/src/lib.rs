@@ -116,7 +116,7 @@ mod idle_clock;
 #[cfg(feature = "model")]
 pub use idle_clock::IdleClocked;
 
-pub use begin::check;
+pub use begin::{check, BeginPlan};
 pub use begin_error::{BeginError, ConfigErrors};
 pub use board::{Board, Chip, InstancePins};
 pub use configuration::Configuration;

@@ -219,3 +219,59 @@ fn const_plan_and_runtime_planner_write_the_same_registers() {
         vec![(0x100, 0), (0x101, 1), (0x7F0, 3), (0x18FE_F100, 2)]
     );
 }
+
+/// Settings checked in `const` evaluation ([`twocan_flexcan::BeginPlan`]) give the same
+/// controller as `begin_planned`; the checks refuse what `begin` refuses; a table of
+/// another configuration than the checked one is refused before any register is written.
+#[test]
+fn settings_checked_at_compile_time() {
+    use twocan_flexcan::{check, BeginError, BeginPlan, ConfigErrors, Configuration};
+    const T: Target = Target::new(Board::Teensy36, Instance::Can0);
+    const SETTINGS: twocan_flexcan::Settings = {
+        let mut s = twocan_flexcan::Settings::new(500_000);
+        s.loop_back = true;
+        s.self_reception = true;
+        s
+    };
+    const PLAN: PlannedTable = const_plan!(FILTERS, PlanOptions::choose()).planned();
+    const CHECKED: BeginPlan = BeginPlan::new_or_panic(T, &SETTINGS, PLAN.configuration());
+    let model = model_for(Board::Teensy36);
+    let hw: FlexCanHw<Ticking, Lean> = FlexCan::begin_checked(
+        Ticking::new(model.clone()),
+        &mut HostSystem::new(),
+        &CHECKED,
+        PLAN,
+    )
+    .unwrap();
+    let mut can: LeanCan = Driver::new(hw);
+    can.try_send(&std_data(0x20, &[])).unwrap();
+    let mut bus = bus_with(500_000, &[&model]);
+    run_lean(&mut bus, &mut can, 1_000);
+    assert_eq!(can.receive().map(|rx| rx.filter), Ok(1));
+
+    // Refused as `begin` refuses them, with the same flags.
+    let bad = SETTINGS;
+    let t35_can1 = Target::new(Board::Teensy35, Instance::Can1); // no such module
+    let want = check(t35_can1, &bad, &[], &[]);
+    assert_eq!(want, ConfigErrors::NO_SUCH_INSTANCE);
+    assert_eq!(
+        BeginPlan::new(t35_can1, &bad, Configuration::Filters8_0).err(),
+        Some(BeginError::Config(want))
+    );
+    // A table of another configuration: nothing written.
+    let other = BeginPlan::new(T, &SETTINGS, Configuration::Filters14_18).unwrap();
+    assert_ne!(other.configuration(), PLAN.configuration());
+    let model = model_for(Board::Teensy36);
+    let before = model.peek32(twocan_flexcan::regs::MCR);
+    let r: Result<FlexCanHw<Ticking, Lean>, _> = FlexCan::begin_checked(
+        Ticking::new(model.clone()),
+        &mut HostSystem::new(),
+        &other,
+        PLAN,
+    );
+    assert_eq!(
+        r.err(),
+        Some(BeginError::Hardware(twocan_core::Error::InvalidArgument))
+    );
+    assert_eq!(model.peek32(twocan_flexcan::regs::MCR), before);
+}

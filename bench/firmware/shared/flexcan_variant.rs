@@ -13,8 +13,9 @@
 //!   runtime planner;
 //! - **lean**: no completion ring ([`DONE`] = 0) and the controller's lean choices
 //!   (`twocan_flexcan::options::Lean`: no time stamps, no filter switch while running,
-//!   the filter table planned at compile time by `const_plan!` and written by
-//!   `FlexCan::begin_planned`, which keeps a few words pointing into the plan).
+//!   the filter table planned at compile time by `const_plan!` and the settings checked
+//!   at compile time (`BeginPlan`), written by `FlexCan::begin_checked`, which keeps a
+//!   few words pointing into the plan).
 //!   Statistics stay on (twocan-core's counters).
 
 // Each firmware that includes this module uses a part of it.
@@ -109,14 +110,17 @@ pub fn configure<const RETRIES: u32, R: Registers, S: Registers>(
     }
 }
 
-/// Lean: the filter table planned at compile time, written by `begin_planned`.
+/// Lean: the filter table planned and the settings checked at compile time, written by
+/// `begin_checked` (no check links into the firmware).
 #[cfg(feature = "lean")]
 #[inline(always)]
 fn begin<R: Registers, S: Registers>(regs: R, sys: &mut S) -> Result<Hw<R>, BeginError> {
-    use twocan_flexcan::const_plan;
     use twocan_flexcan::planner::PlanOptions;
+    use twocan_flexcan::{const_plan, BeginPlan};
+    const CHECKED: BeginPlan =
+        BeginPlan::new_or_panic(TARGET, &SETTINGS, Configuration::Filters8_0);
     let plan = const_plan!(FILTERS, PlanOptions::new(Configuration::Filters8_0)).planned();
-    FlexCan::begin_planned(regs, sys, TARGET, &SETTINGS, plan)
+    FlexCan::begin_checked(regs, sys, &CHECKED, plan)
 }
 
 /// Full: `begin` compiles the list at run time; the controller keeps the table.
