@@ -310,6 +310,83 @@ impl<R: Registers> FlexCan<R> {
         Ok(controller)
     }
 
+    /// [`FlexCan::begin`] compiling the lists straight into `slot`, a table in a
+    /// `static` ([`crate::filters::TableSlot`]), and giving the split controller with
+    /// the options `O` ([`crate::options::FullInSlot`]) that keeps the reference: every
+    /// feature of [`FlexCan::begin`] + [`FlexCan::into_split`] (filter switches, time
+    /// stamps), without a table-sized value on the configuration's stack or in the
+    /// driver state. On an error the slot comes back with it (to try again).
+    ///
+    /// ```
+    /// use twocan_core::Filter;
+    /// use twocan_flexcan::filters::TableSlot;
+    /// use twocan_flexcan::options::FullInSlot;
+    /// use twocan_flexcan::{Board, FlexCan, FlexCanHw, HostSystem, Instance, Settings, Target};
+    /// use twocan_flexcan::{model::FlexCanModel, IdleClocked};
+    ///
+    /// static TABLE: TableSlot = TableSlot::new();
+    /// let model = IdleClocked::new(FlexCanModel::mk66fx1m0());
+    /// let target = Target::new(Board::Teensy36, Instance::Can0);
+    /// let hw: FlexCanHw<_, FullInSlot> = FlexCan::begin_in(
+    ///     model,
+    ///     &mut HostSystem::new(),
+    ///     target,
+    ///     &Settings::new(500_000),
+    ///     &[Filter::standard(0x100)],
+    ///     &[],
+    ///     TABLE.take().unwrap(),
+    /// )
+    /// .map_err(|(e, _)| format!("{e:?}"))?;
+    /// # let _ = hw;
+    /// # Ok::<(), String>(())
+    /// ```
+    #[allow(clippy::type_complexity)]
+    pub fn begin_in<S: Registers, O: Options<Table = &'static mut FilterTable>>(
+        mut regs: R,
+        sys: &mut S,
+        target: Target,
+        settings: &Settings,
+        primary: &[Filter],
+        secondary: &[Filter],
+        slot: &'static mut FilterTable,
+    ) -> Result<FlexCanHw<R, O>, (BeginError, &'static mut FilterTable)> {
+        if let Some(e) = bitrate_error(settings) {
+            return Err((BeginError::Timing(e), slot));
+        }
+        let filters = FilterTable::check(settings.configuration, primary, secondary);
+        let plan = match plan(target, settings, settings.configuration, filters) {
+            Ok(p) => p,
+            Err(e) => return Err((BeginError::Config(e), slot)),
+        };
+        plan.system.apply(sys);
+        let polls = settings.handshake_bound();
+        slot.fill(plan.configuration, primary, secondary);
+        let table: &FilterTable = slot;
+        if let Err(e) = configure(
+            &mut regs,
+            &plan,
+            |r| FlexCan::write_filters(r, table),
+            polls,
+        ) {
+            return Err((BeginError::Hardware(e), slot));
+        }
+        Ok(FlexCanHw::from_parts(
+            regs,
+            target,
+            slot,
+            Parts {
+                bus_mode: bus_mode_of(settings),
+                recovery: settings.bus_off_recovery,
+                polls,
+                irq_priority: settings.message_irq_priority,
+                mode: Mode::Normal,
+                last_error: LastErrorCode::None,
+                system: plan.system,
+                bus_clock_hz: settings.bus_clock_hz.unwrap_or(CAN_CLOCK_HZ),
+            },
+        ))
+    }
+
     /// `begin` with a filter table planned at compile time ([`crate::const_plan!`],
     /// [`crate::filters::SizedTable::planned`]), straight to the split controller with
     /// the options `O` ([`crate::options::Lean`], or a firmware's own whose table is a

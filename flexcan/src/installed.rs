@@ -64,6 +64,24 @@ impl InstalledTable for FilterTable {
     }
 }
 
+impl InstalledTable for &'static mut FilterTable {
+    const REPLACEABLE: bool = true;
+
+    fn configuration(&self) -> Configuration {
+        FilterTable::configuration(self)
+    }
+
+    #[inline]
+    fn resolve(&self, hit: usize, frame: &Frame) -> Result<u16, Unresolved> {
+        <FilterTable as InstalledTable>::resolve(self, hit, frame)
+    }
+
+    fn replace(&mut self, table: &FilterTable) -> Result<(), Error> {
+        self.clone_from(table);
+        Ok(())
+    }
+}
+
 /// A filter table planned at compile time, read in place from its `static`
 /// ([`SizedTable::planned`]): the ID table elements, the individual masks, the global
 /// mask, what a hit on each element means and the lookup keys, as slices of the plan —

@@ -49,6 +49,18 @@ impl Options for Full {
     const FILTER_SWITCH: bool = true;
 }
 
+/// As [`Full`], the table in a `static` [`crate::filters::TableSlot`] that `begin`
+/// compiles into ([`crate::FlexCan::begin_in`]): no table-sized value moves through
+/// the configuration, and the driver state holds a reference instead of the table.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FullInSlot {}
+
+impl Options for FullInSlot {
+    type Table = &'static mut FilterTable;
+    const STAMPS: bool = true;
+    const FILTER_SWITCH: bool = true;
+}
+
 /// Neither time stamps nor filter switches while running; the filter table planned at
 /// compile time, read from its `static` ([`crate::FlexCan::begin_planned`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

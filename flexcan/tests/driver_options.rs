@@ -275,3 +275,70 @@ fn settings_checked_at_compile_time() {
     );
     assert_eq!(model.peek32(twocan_flexcan::regs::MCR), before);
 }
+
+/// `begin_in` compiles into a `static` slot; the controller keeps the reference, takes
+/// filter switches and stamps as the owned-table controller does; an error gives the
+/// slot back.
+#[test]
+fn table_in_a_static_slot() {
+    use twocan_flexcan::filters::TableSlot;
+    use twocan_flexcan::options::FullInSlot;
+    static TABLE: TableSlot = TableSlot::new();
+    let model = model_for(Board::Teensy36);
+    let target = Target::new(Board::Teensy36, Instance::Can0);
+    let slot = TABLE.take().unwrap();
+    assert!(TABLE.take().is_none());
+    // Refused first (no such module on a Teensy 3.5): the slot comes back.
+    let bad = Target::new(Board::Teensy35, Instance::Can1);
+    let r: Result<FlexCanHw<Ticking, FullInSlot>, _> = FlexCan::begin_in(
+        Ticking::new(model.clone()),
+        &mut HostSystem::new(),
+        bad,
+        &loop_back(500_000),
+        &[Filter::standard(0x10)],
+        &[],
+        slot,
+    );
+    let Err((twocan_flexcan::BeginError::Config(_), slot)) = r else {
+        panic!("refused with the slot back");
+    };
+    let hw: FlexCanHw<Ticking, FullInSlot> = FlexCan::begin_in(
+        Ticking::new(model.clone()),
+        &mut HostSystem::new(),
+        target,
+        &loop_back(500_000),
+        &[Filter::standard(0x10)],
+        &[],
+        slot,
+    )
+    .map_err(|(e, _)| e)
+    .unwrap();
+    let mut can: Driver<FlexCanHw<Ticking, FullInSlot>, 32, 16> = Driver::new(hw);
+    let mut bus = bus_with(500_000, &[&model]);
+    let table = FilterTable::compile(
+        can.hardware().configuration(),
+        &[Filter::standard(0x20)],
+        &[Filter::standard(0x10)],
+    )
+    .unwrap();
+    can.set_filters(&table).unwrap();
+    for id in [0x10, 0x20, 0x30] {
+        can.try_send(&std_data(id, &[])).unwrap();
+    }
+    let until = bus.now() + 1_000;
+    loop {
+        if can.hardware().registers().irq_pending() {
+            can.on_interrupt();
+        }
+        if bus.step_until(until).is_none() {
+            break;
+        }
+    }
+    if can.hardware().registers().irq_pending() {
+        can.on_interrupt();
+    }
+    let got: Vec<_> = core::iter::from_fn(|| can.receive().ok())
+        .map(|rx| (rx.frame.raw_id(), rx.filter, rx.timestamp.is_some()))
+        .collect();
+    assert_eq!(got, vec![(0x10, 1, true), (0x20, 0, true)]);
+}

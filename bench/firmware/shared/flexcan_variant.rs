@@ -2,15 +2,17 @@
 //! selected by the firmware crate's cargo feature (`lean` or `full`, exactly one).
 //! Included with `#[path]` by `insn-count-flexcan` (QEMU, RAM stand-in) and
 //! `loopback-flexcan` (Teensy 3.6), generic over the register handle `R` (the stand-in
-//! or FlexCAN0's `FlexCanRegs`).
+//! or FlexCAN0's `Can0At`).
 //!
 //! Both: FlexCAN0 of a Teensy 3.6 at 500 kbit/s from the 16 MHz oscillator clock,
 //! loop-back with self reception, the 8-filter Rx FIFO partition (`Filters8_0`), one
-//! pass-all filter, request-order transmit through MB15.
+//! pass-all filter, request-order transmit through MB15. The register handle is
+//! `FlexCanAt` (the module's address known at compile time).
 //!
 //! - **full**: transmit completions (a completion ring of [`DONE`] = 8), receive and
-//!   transmit time stamps, traffic statistics, the filter list compiled by `begin`'s
-//!   runtime planner;
+//!   transmit time stamps, traffic statistics, the filter list compiled at run time by
+//!   `FlexCan::begin_in` straight into a `static` `TableSlot`
+//!   (`twocan_flexcan::options::FullInSlot`: filter switches too);
 //! - **lean**: no completion ring ([`DONE`] = 0) and the controller's lean choices
 //!   (`twocan_flexcan::options::Lean`: no time stamps, no filter switch while running,
 //!   the filter table planned at compile time by `const_plan!` and the settings checked
@@ -73,9 +75,10 @@ pub type Opts = twocan_flexcan::options::Lean;
 pub const VARIANT: &str = "full";
 #[cfg(feature = "full")]
 pub const DONE: usize = 8;
-/// The controller's compile-time choices: time stamps, filter switches.
+/// The controller's compile-time choices: time stamps, filter switches, the table in a
+/// `static` slot that `begin_in` compiles into.
 #[cfg(feature = "full")]
-pub type Opts = twocan_flexcan::options::Full;
+pub type Opts = twocan_flexcan::options::FullInSlot;
 
 // ------------------------------------------------------------------ both
 
@@ -100,32 +103,43 @@ pub fn configure<const RETRIES: u32, R: Registers, S: Registers>(
     regs: impl Fn() -> R,
     sys: &mut S,
 ) -> Result<Hw<R>, BeginError> {
-    // One call site of `begin`: its result goes straight into the split controller.
-    let mut retries = 0;
-    loop {
-        match begin(regs(), sys) {
-            Err(BeginError::Hardware(Error::Timeout)) if retries < RETRIES => retries += 1,
-            attempt => return attempt,
+    #[cfg(feature = "lean")]
+    {
+        // The filter table planned and the settings checked at compile time, written
+        // by `begin_checked` (no check links into the firmware).
+        use twocan_flexcan::planner::PlanOptions;
+        use twocan_flexcan::{const_plan, BeginPlan};
+        const CHECKED: BeginPlan =
+            BeginPlan::new_or_panic(TARGET, &SETTINGS, Configuration::Filters8_0);
+        let plan = const_plan!(FILTERS, PlanOptions::new(Configuration::Filters8_0)).planned();
+        let mut retries = 0;
+        loop {
+            match FlexCan::begin_checked(regs(), sys, &CHECKED, plan) {
+                Err(BeginError::Hardware(Error::Timeout)) if retries < RETRIES => retries += 1,
+                attempt => return attempt,
+            }
+        }
+    }
+    #[cfg(feature = "full")]
+    {
+        // `begin` compiles the list at run time straight into the table's `static`.
+        let Some(mut slot) = TABLE.take() else {
+            return Err(BeginError::Hardware(Error::InvalidArgument));
+        };
+        let mut retries = 0;
+        loop {
+            match FlexCan::begin_in(regs(), sys, TARGET, &SETTINGS, &FILTERS, &[], slot) {
+                Err((BeginError::Hardware(Error::Timeout), back)) if retries < RETRIES => {
+                    retries += 1;
+                    slot = back;
+                }
+                Err((e, _)) => return Err(e),
+                Ok(hw) => return Ok(hw),
+            }
         }
     }
 }
 
-/// Lean: the filter table planned and the settings checked at compile time, written by
-/// `begin_checked` (no check links into the firmware).
-#[cfg(feature = "lean")]
-#[inline(always)]
-fn begin<R: Registers, S: Registers>(regs: R, sys: &mut S) -> Result<Hw<R>, BeginError> {
-    use twocan_flexcan::planner::PlanOptions;
-    use twocan_flexcan::{const_plan, BeginPlan};
-    const CHECKED: BeginPlan =
-        BeginPlan::new_or_panic(TARGET, &SETTINGS, Configuration::Filters8_0);
-    let plan = const_plan!(FILTERS, PlanOptions::new(Configuration::Filters8_0)).planned();
-    FlexCan::begin_checked(regs, sys, &CHECKED, plan)
-}
-
-/// Full: `begin` compiles the list at run time; the controller keeps the table.
+/// The full variant's filter table (`begin_in` compiles into it).
 #[cfg(feature = "full")]
-#[inline(always)]
-fn begin<R: Registers, S: Registers>(regs: R, sys: &mut S) -> Result<Hw<R>, BeginError> {
-    Ok(FlexCan::begin(regs, sys, TARGET, &SETTINGS, &FILTERS, &[])?.into_split_with::<Opts>())
-}
+static TABLE: twocan_flexcan::filters::TableSlot = twocan_flexcan::filters::TableSlot::new();
