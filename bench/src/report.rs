@@ -1185,8 +1185,12 @@ fn render_targets(s: &mut String, f: &Figures) {
              step by step and the per-region and stack tables of section 2 show where the \
              instructions and the bytes go; the configuration stack and most of the flash \
              come from the configuration path (filter plan, filter map and controller \
-             values moved by value; in the full variant the runtime planner); and the lean \
-             lines measure today's driver, whose lean mode (issue 21) is pending.\n",
+             values moved by value; in the full variant the runtime planner); and the bxCAN \
+             lean lines measure today's driver, whose lean mode (issue 21) is pending. \
+             FlexCAN's lean and full controllers (`twocan_flexcan::options`) configure \
+             within the bound; what they still miss per frame is twocan-core's shared \
+             work (the transmit handler and its completion record, ring peaks, \
+             saturating counters, frame decoding), and in flash its transmit machinery.\n",
             missed.len()
         );
     }
