@@ -485,6 +485,11 @@ impl<R: Registers, O: Options> FlexCanHw<R, O> {
     /// became a receive mailbox for the answer; an aborted one shows `ABORT`).
     #[inline(always)]
     fn settle_one(&self, mb: usize) -> Option<Completion> {
+        // Every configuration's transmit mailboxes fit the token slots (`15 - mb` < 8).
+        const {
+            let first = Configuration::Filters8_0.first_remote_mailbox();
+            assert!(((DATA_MAILBOX - first) as usize) < MAX_TX)
+        };
         let control = self.regs.read32(regs::mb_cs(mb));
         let c = cs::CODE.get(control);
         let bit = 1 << mb;
