@@ -46,6 +46,8 @@
 //!   implementation: who touches which register from which context;
 //! - [`filters`]: banks ([`Bank`]), direct configuration, match-index numbering, the
 //!   compiled [`FilterPlan`]; [`planner`]: portable filters → fewest banks, exactly;
+//! - [`chip`]: the STM32 parts as data ([`Chip`]: instances, bank counts, APB1 limits,
+//!   interrupt numbers, pins), chosen with [`Config::chip`];
 //! - [`instance`]: CAN1/CAN2/CAN3 and what the firmware must do (RCC, AF9);
 //! - `hal` (feature `hal-stm32f7`): the hand-over from `stm32f7xx-hal` (singletons,
 //!   clocks, typed pins; CAN2 only with CAN1's filter-block handle);
@@ -64,6 +66,8 @@
 #![deny(unsafe_code)]
 
 pub mod regs;
+
+pub mod chip;
 
 #[cfg(feature = "model")]
 pub mod model;
@@ -87,6 +91,7 @@ pub mod planner;
 #[allow(unsafe_code)]
 pub mod split;
 
+pub use chip::Chip;
 pub use config::{Config, ConfigError, Recovery};
 pub use controller::{Can, Failed, Init};
 pub use filters::{Bank, BankError, BankKind, Fifo, FilterPlan, PlanError, PlanRef, SizedPlan};
