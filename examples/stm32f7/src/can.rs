@@ -82,7 +82,7 @@ pub fn start<R: Registers + Send + Sync + 'static, F: Registers + Send + Sync + 
     state: &'static CanState<R, F>,
     vectors: &'static Vectors<R, F>,
     hw: BxCan<R, F>,
-    irqs: [stm32f7xx_hal::pac::Interrupt; 4],
+    irqs: [crate::rt::Interrupt; 4],
     nvic: &mut cortex_m::peripheral::NVIC,
 ) -> Option<(CanTxHalf<R, F>, CanRxHalf<R, F>)> {
     let parts = state.split(hw).ok()?;

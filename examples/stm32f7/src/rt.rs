@@ -184,6 +184,9 @@ impl twocan_core::irq_cell::Nvic<pac::Interrupt> for Lines<'_> {
     }
 }
 
+/// The device interrupt numbers (`crate::can::start` takes the instance's four).
+pub use pac::Interrupt;
+
 /// CAN1's interrupts.
 pub const CAN1_IRQS: [pac::Interrupt; 4] = [
     pac::Interrupt::CAN1_TX,
