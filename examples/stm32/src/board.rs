@@ -33,6 +33,11 @@ pub struct Board {
     pub led: Pin,
     /// The LED lights when its pin is low (the Blue Pill's PC13 drives its cathode).
     pub led_active_low: bool,
+    /// The `app` example's node number and its peer's (`twocan_app::App::new`): the
+    /// three-board bus of `docs/firmware.md` has the Teensy `app` as node 1, the
+    /// NUCLEO-F446RE as node 2 (peer 1) and the Blue Pill as node 3 (peer 2), so that no
+    /// two boards send the same identifiers.
+    pub app: (u8, u8),
 }
 
 /// The pin pair of `instance` on `chip` that a board uses, by index into the part's
@@ -66,6 +71,7 @@ impl Board {
             number: 13,
         },
         led_active_low: true,
+        app: (3, 2),
     };
 
     /// NUCLEO-F446RE (MB1136): HSE = the ST-LINK's 8 MHz MCO output, in bypass (UM1724
@@ -92,6 +98,7 @@ impl Board {
             number: 5,
         },
         led_active_low: false,
+        app: (2, 1),
     };
 
     /// Every board.

@@ -1,6 +1,7 @@
 //! The portable application (`twocan_app::App`, the same module as the host demo) on
-//! CAN1 at 500 kbit/s, as node 2 talking with node 1 — the Teensy `app` example is
-//! node 1 — over a bus with transceivers (Blue Pill: CAN on PB8 = RX, PB9 = TX;
+//! CAN1 at 500 kbit/s: the NUCLEO-F446RE as node 2 talking with node 1 — the Teensy
+//! `app` example is node 1 — and the Blue Pill as node 3 talking with node 2 (the three
+//! on one bus, `Board::app`), over a bus with transceivers (Blue Pill: CAN on PB8 = RX, PB9 = TX;
 //! NUCLEO-F446RE: CAN1 on PA11 = RX, PA12 = TX; 120 Ω at each end).
 //!
 //! The application's portable filters are compiled by the bxCAN planner into FIFO 0
@@ -27,9 +28,9 @@ mod firmware {
     use twocan_stm32::time::{self, Every};
     use twocan_stm32::BOARD;
 
-    /// This node and its peer.
-    const NODE: u8 = 2;
-    const PEER: u8 = 1;
+    /// This node and its peer (per board: `Board::app`).
+    const NODE: u8 = BOARD.app.0;
+    const PEER: u8 = BOARD.app.1;
 
     static CAN1: CanState = CanState::new();
     static CAN1_VECTORS: Vectors = Vectors::new();
