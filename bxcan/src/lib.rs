@@ -49,7 +49,8 @@
 //! - [`chip`]: the STM32 parts as data ([`Chip`]: instances, bank counts, APB1 limits,
 //!   interrupt numbers, pins), chosen with [`Config::chip`];
 //! - [`instance`]: CAN1/CAN2/CAN3 and what the firmware must do (RCC, AF9);
-//! - `hal` (feature `hal-stm32f7`): the hand-over from `stm32f7xx-hal` (singletons,
+//! - `hal` (features `hal-stm32f7`, `hal-stm32f4`): the hand-over from `stm32f7xx-hal`
+//!   or `stm32f4xx-hal` (singletons,
 //!   clocks, typed pins; CAN2 only with CAN1's filter-block handle);
 //! - [`regs`]: the register map.
 //!
@@ -78,9 +79,9 @@ mod error;
 pub mod filter_block;
 pub mod filters;
 pub mod fmi;
-// The hand-over from `stm32f7xx-hal`: the one `unsafe` turning a consumed PAC singleton
+// The hand-over from an STM32 HAL: the one `unsafe` turning a consumed PAC singleton
 // into a register window.
-#[cfg(feature = "hal-stm32f7")]
+#[cfg(any(feature = "hal-stm32f7", feature = "hal-stm32f4"))]
 #[allow(unsafe_code)]
 pub mod hal;
 pub mod instance;

@@ -126,6 +126,14 @@ pub const BOARD: Board = Board::BLUEPILL;
 #[cfg(feature = "nucleo-f446re")]
 pub const BOARD: Board = Board::NUCLEO_F446RE;
 
+/// Planner options for CAN1's banks as the examples find them: 14 on both parts — the
+/// F103's whole block, and the F446's banks below `CAN2SB` at its reset value 14 (RM0390
+/// §30.9.4; `can1-can2` keeps that split). The examples plan at build time
+/// (`twocan_bxcan::const_plan!`): the run-time planner's working memory (about 90 KB)
+/// does not fit the F103C8's 20 KiB of RAM.
+pub const CAN1_BANKS: twocan_bxcan::PlanOptions =
+    twocan_bxcan::PlanOptions::new(twocan_bxcan::chip::SINGLE_BLOCK_BANKS as u8);
+
 /// Bit rate of the examples that talk over a bus (as the other families' `app`).
 #[cfg(not(feature = "bus-250k"))]
 pub const BIT_RATE: u32 = 500_000;

@@ -20,9 +20,10 @@ mod firmware {
 
     use critical_section::Mutex;
     use twocan_app::{App, AppStats};
-    use twocan_bxcan::{Can, FifoPolicy, Recovery};
+    use twocan_bxcan::{const_plan, Can, FifoPolicy, Recovery};
     use twocan_core::ErrorState;
     use twocan_stm32::board::BIT_RATE;
+    use twocan_stm32::board::CAN1_BANKS;
     use twocan_stm32::can::{self, CanState, Vectors};
     use twocan_stm32::rt::{self, CAN_BLINKS};
     use twocan_stm32::time::{self, Every};
@@ -62,11 +63,13 @@ mod firmware {
             .recovery(Recovery::Automatic);
         let mut init =
             Can::can1(boot.can1.whole(), &config).unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        let plan = init
-            .can()
-            .plan(&app.filters(), FifoPolicy::Fifo0)
-            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        if init.set_filters(&plan).is_err() {
+        // The application's filters (`twocan_app::filters_for`, the list `app.filters()`
+        // returns) planned at build time (`const_plan!`, see `stm32-loopback`).
+        let plan = const_plan!(
+            twocan_app::filters_for(NODE, PEER),
+            CAN1_BANKS.fifo(FifoPolicy::Fifo0)
+        );
+        if init.set_filters(plan).is_err() {
             rt::halt(CAN_BLINKS);
         }
         let can = init.enable().unwrap_or_else(|_| rt::halt(CAN_BLINKS));

@@ -23,9 +23,10 @@ mod firmware {
     use embassy_executor::Executor;
     use static_cell::StaticCell;
     use twocan_app::asynch::{echo, EchoStats};
-    use twocan_bxcan::{Can, FifoPolicy, Recovery};
+    use twocan_bxcan::{const_plan, Can, FifoPolicy, Recovery};
     use twocan_core::Filter;
     use twocan_stm32::board::BIT_RATE;
+    use twocan_stm32::board::CAN1_BANKS;
     use twocan_stm32::can::{self, CanRxHalf, CanState, CanTxHalf, Vectors};
     use twocan_stm32::rt::{self, Led, CAN_BLINKS};
     use twocan_stm32::BOARD;
@@ -64,11 +65,9 @@ mod firmware {
         let mut init =
             Can::can1(boot.can1.whole(), &config).unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         // One FIFO keeps the frames in arrival order.
-        let plan = init
-            .can()
-            .plan(&[Filter::pass_all()], FifoPolicy::Fifo0)
-            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        if init.set_filters(&plan).is_err() {
+        // Planned at build time (`const_plan!`, see `stm32-loopback`).
+        let plan = const_plan!([Filter::pass_all()], CAN1_BANKS.fifo(FifoPolicy::Fifo0));
+        if init.set_filters(plan).is_err() {
             rt::halt(CAN_BLINKS);
         }
         let can = init.enable().unwrap_or_else(|_| rt::halt(CAN_BLINKS));

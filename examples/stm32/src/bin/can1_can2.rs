@@ -22,8 +22,9 @@ mod firmware {
     use critical_section::Mutex;
     use twocan_app::{App, AppStats};
     use twocan_bxcan::regs::{ControlRegs, FilterRegs};
-    use twocan_bxcan::{Can, FifoPolicy, Recovery};
+    use twocan_bxcan::{const_plan, Can, FifoPolicy, Recovery};
     use twocan_stm32::board::BIT_RATE;
+    use twocan_stm32::board::CAN1_BANKS;
     use twocan_stm32::can::{self, CanState, Vectors};
     use twocan_stm32::rt::{self, CAN_BLINKS};
     use twocan_stm32::time::{self, Every};
@@ -62,19 +63,21 @@ mod firmware {
 
         let mut init1 =
             Can::can1_dual(can1, filters, &config1).unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        let plan1 = init1
-            .can()
-            .plan(&node1.filters(), FifoPolicy::Fifo0)
-            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        if init1.set_filters(&plan1).is_err() {
+        // Each node's filters (`twocan_app::filters_for`) planned at build time for its 14
+        // banks (`const_plan!`).
+        let plan1 = const_plan!(
+            twocan_app::filters_for(1, 2),
+            CAN1_BANKS.fifo(FifoPolicy::Fifo0)
+        );
+        if init1.set_filters(plan1).is_err() {
             rt::halt(CAN_BLINKS);
         }
         let mut init2 = Can::can2(can2, filters, &base).unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        let plan2 = init2
-            .can()
-            .plan(&node2.filters(), FifoPolicy::Fifo1)
-            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        if init2.set_filters(&plan2).is_err() {
+        let plan2 = const_plan!(
+            twocan_app::filters_for(2, 1),
+            CAN1_BANKS.fifo(FifoPolicy::Fifo1)
+        );
+        if init2.set_filters(plan2).is_err() {
             rt::halt(CAN_BLINKS);
         }
         let can1 = init1.enable().unwrap_or_else(|_| rt::halt(CAN_BLINKS));

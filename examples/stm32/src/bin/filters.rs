@@ -23,8 +23,9 @@
 mod firmware {
     use core::sync::atomic::{AtomicU32, Ordering};
 
-    use twocan_bxcan::{Can, FifoPolicy};
+    use twocan_bxcan::{const_plan, Can, FifoPolicy};
     use twocan_core::{Dispatcher, Filter, Format, Frame, FrameKind, RxFrame};
+    use twocan_stm32::board::CAN1_BANKS;
     use twocan_stm32::can::{self, CanState, Vectors};
     use twocan_stm32::rt::{self, CAN_BLINKS};
     use twocan_stm32::time::{self, Every};
@@ -43,16 +44,14 @@ mod firmware {
     /// Filter banks of the plan assigned to FIFO 0 and FIFO 1.
     pub static BANKS: [AtomicU32; 2] = [const { AtomicU32::new(0) }; 2];
 
-    fn filters() -> [Filter; FILTERS] {
-        [
-            Filter::exact(FrameKind::Data, Format::Standard, 0x100),
-            Filter::exact(FrameKind::Data, Format::Standard, 0x101),
-            Filter::exact(FrameKind::Remote, Format::Standard, 0x542),
-            Filter::masked(FrameKind::Data, Format::Standard, 0x7F0, 0x300),
-            Filter::exact(FrameKind::Data, Format::Extended, 0x12_3456),
-            Filter::masked(FrameKind::Data, Format::Extended, 0x1FFF_00FF, 0x18FF_0000),
-        ]
-    }
+    const LIST: [Filter; FILTERS] = [
+        Filter::exact(FrameKind::Data, Format::Standard, 0x100),
+        Filter::exact(FrameKind::Data, Format::Standard, 0x101),
+        Filter::exact(FrameKind::Remote, Format::Standard, 0x542),
+        Filter::masked(FrameKind::Data, Format::Standard, 0x7F0, 0x300),
+        Filter::exact(FrameKind::Data, Format::Extended, 0x12_3456),
+        Filter::masked(FrameKind::Data, Format::Extended, 0x1FFF_00FF, 0x18FF_0000),
+    ];
 
     /// The frames sent, in order (the first six hit filters #0..#5, the last none).
     fn frames() -> [Result<Frame, twocan_core::FrameError>; 7] {
@@ -88,14 +87,12 @@ mod firmware {
             .loopback(true);
         let mut init =
             Can::can1(boot.can1.whole(), &config).unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        let plan = init
-            .can()
-            .plan(&filters(), FifoPolicy::Balanced)
-            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
+        // Planned at build time (`const_plan!`, see `stm32-loopback`).
+        let plan = const_plan!(LIST, CAN1_BANKS.fifo(FifoPolicy::Balanced));
         for bank in plan.banks() {
             BANKS[bank.fifo.index()].fetch_add(1, Ordering::Relaxed);
         }
-        if init.set_filters(&plan).is_err() {
+        if init.set_filters(plan).is_err() {
             rt::halt(CAN_BLINKS);
         }
         let can = init.enable().unwrap_or_else(|_| rt::halt(CAN_BLINKS));

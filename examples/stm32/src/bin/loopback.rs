@@ -11,8 +11,9 @@
 mod firmware {
     use core::sync::atomic::{AtomicU32, Ordering};
 
-    use twocan_bxcan::{Can, FifoPolicy};
+    use twocan_bxcan::{const_plan, Can, FifoPolicy};
     use twocan_core::{Filter, Frame};
+    use twocan_stm32::board::CAN1_BANKS;
     use twocan_stm32::can::{self, CanState, Vectors};
     use twocan_stm32::rt::{self, CAN_BLINKS};
     use twocan_stm32::time::{self, Every};
@@ -38,11 +39,10 @@ mod firmware {
             .loopback(true);
         let mut init =
             Can::can1(boot.can1.whole(), &config).unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        let plan = init
-            .can()
-            .plan(&[Filter::pass_all()], FifoPolicy::Fifo0)
-            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        if init.set_filters(&plan).is_err() {
+        // Planned at build time (`const_plan!`): the run-time planner's working memory
+        // (about 90 KB) does not fit the F103C8's 20 KiB of RAM.
+        let plan = const_plan!([Filter::pass_all()], CAN1_BANKS.fifo(FifoPolicy::Fifo0));
+        if init.set_filters(plan).is_err() {
             rt::halt(CAN_BLINKS);
         }
         let can = init.enable().unwrap_or_else(|_| rt::halt(CAN_BLINKS));
