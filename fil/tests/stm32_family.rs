@@ -549,14 +549,16 @@ fn three_boards_count_what_the_host_demo_counts() {
     };
     for (b, s) in steps.iter().enumerate() {
         assert!(s.len() >= 145, "board {b}: {} steps", s.len());
-        // The firmware's 10 ms period, give or take the harness step its SysTick falls in.
-        for (k, t) in s.iter().enumerate() {
-            let due = s[0] + k as u64 * PERIOD_US;
-            assert!(
-                t.abs_diff(due) <= QUANTUM_US,
-                "board {b}: step {k} at {t} us, due at {due} us"
-            );
-        }
+        // The firmware's 10 ms period: a step ends (its `STATS` written) within a few
+        // harness steps of its due time (receiving and answering take the firmware
+        // tens of microseconds).
+        let late: Vec<_> = s
+            .iter()
+            .enumerate()
+            .map(|(k, t)| t.abs_diff(s[0] + k as u64 * PERIOD_US))
+            .collect();
+        eprintln!("board {b}: step lateness (us) max {:?}", late.iter().max());
+        assert!(late.iter().all(|l| *l <= 10 * QUANTUM_US), "board {b}: {late:?}");
     }
     let Some((fil, w)) = run_firmware(steps[0][0]) else {
         return;
@@ -566,12 +568,16 @@ fn three_boards_count_what_the_host_demo_counts() {
     }
     eprintln!("first steps (us): {:?}", steps.each_ref().map(|s| s[0]));
     eprintln!("firmware: {fil:#?}");
-    // Not vacuous: each node counted its peer's heartbeats, requests were answered.
+    // Not vacuous: each node counted its peer's heartbeats and got answers to its
+    // requests; node 1 is asked by node 2, node 2 by nodes 1 and 3, node 3 by nobody.
     for (b, a) in fil.apps.iter().enumerate() {
         assert!(a.heartbeats >= 140, "board {b}: {a:?}");
-        assert!(a.requests >= 10 && a.answers >= 10, "board {b}: {a:?}");
+        assert!(a.answers >= 10, "board {b}: {a:?}");
         assert_eq!(a.heartbeat_gaps + a.heartbeat_duplicates, 0, "board {b}: {a:?}");
     }
+    assert!(fil.apps[0].requests >= 10, "{fil:?}");
+    assert!(fil.apps[1].requests >= 2 * 10, "{fil:?}");
+    assert_eq!(fil.apps[2].requests, 0, "{fil:?}");
     assert!(fil.wire[3].sent >= 290, "{fil:?}");
     let host = run_host(&steps);
     assert_eq!(fil, host, "the firmware and the host count differently");
