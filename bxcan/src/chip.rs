@@ -2,7 +2,7 @@
 //! from a [`Chip`] by the driver ([`crate::Config::chip`]: which instances exist, the
 //! banks each owns, the APB1 limit), by the planner ([`Chip::plan_options`]), the
 //! capabilities report, the HAL hand-over, the behavioural model
-//! ([`crate::model::BxCanModel::of_part`]) and the firmware-in-the-loop board profiles.
+//! (`model::BxCanModel::of_part`, feature `model`) and the firmware-in-the-loop board profiles.
 //! A new part of a supported family is a new `Chip` value, not new code.
 //!
 //! The bxCAN cell is the same on every part below: the same register offsets, bit

@@ -47,7 +47,12 @@ fn loopback_frames_come_back() {
         );
         assert!(rx0_taken(&w) >= 3, "{board}: {:?}", m.board().taken);
         // The part's line names, from the chip table the profile reads.
-        let names: Vec<_> = m.board().cans[0].instance.irqs.iter().map(|i| i.0).collect();
+        let names: Vec<_> = m.board().cans[0]
+            .instance
+            .irqs
+            .iter()
+            .map(|i| i.0)
+            .collect();
         let want = if board == "bluepill" {
             "USB_LP_CAN_RX0"
         } else {
@@ -165,9 +170,19 @@ fn can1_and_can2_of_the_f446_exchange_frames() {
     assert!(hb(0x101) >= 100 && hb(0x102) >= 100);
     for (a, b, peer_hb) in [(0, 1, hb(0x102)), (1, 0, hb(0x101))] {
         let (a, b) = (stats[a], stats[b]);
-        assert_eq!(a.heartbeat_gaps + a.heartbeat_duplicates + a.unhandled, 0, "{a:?}");
-        assert!(a.heartbeats + 1 >= peer_hb && a.heartbeats <= peer_hb, "{a:?}");
-        assert!(a.requests >= 1 && a.answers >= 1 && a.measurements >= 1, "{a:?}");
+        assert_eq!(
+            a.heartbeat_gaps + a.heartbeat_duplicates + a.unhandled,
+            0,
+            "{a:?}"
+        );
+        assert!(
+            a.heartbeats + 1 >= peer_hb && a.heartbeats <= peer_hb,
+            "{a:?}"
+        );
+        assert!(
+            a.requests >= 1 && a.answers >= 1 && a.measurements >= 1,
+            "{a:?}"
+        );
         assert!(b.sent > 0);
     }
     // Both controllers on the wire, CAN2's lines (63..=66) taken.
@@ -389,8 +404,7 @@ fn run_firmware(first: u64) -> Option<(Outcome, World<'static>)> {
     };
     let ports = [port(0), port(1), port(2)];
     let stats = |node| w.bus.node_stats(node).unwrap();
-    let hw = |a: &twocan_fil::world::Attached| match &w.machines[a.board].board().cans[a.port]
-        .model
+    let hw = |a: &twocan_fil::world::Attached| match &w.machines[a.board].board().cans[a.port].model
     {
         Model::FlexCan(m) => (m.frames_discarded(), m.frames_lost()),
         Model::BxCan(m) => {
@@ -477,11 +491,7 @@ fn run_host(steps: &[Vec<u64>; 3]) -> Outcome {
         if now != Some(t) {
             h.run_until(
                 bits(t),
-                &mut [
-                    &mut teensy as &mut dyn Serviced,
-                    &mut nucleo,
-                    &mut bluepill,
-                ],
+                &mut [&mut teensy as &mut dyn Serviced, &mut nucleo, &mut bluepill],
             );
             now = Some(t);
         }
@@ -503,11 +513,7 @@ fn run_host(steps: &[Vec<u64>; 3]) -> Outcome {
     }
     h.run_until(
         bits(RUN_US),
-        &mut [
-            &mut teensy as &mut dyn Serviced,
-            &mut nucleo,
-            &mut bluepill,
-        ],
+        &mut [&mut teensy as &mut dyn Serviced, &mut nucleo, &mut bluepill],
     );
     let bus = h.bus().borrow();
     let bx = |n: &BxNode| {
@@ -515,11 +521,7 @@ fn run_host(steps: &[Vec<u64>; 3]) -> Outcome {
         s.overruns[0] + s.overruns[1]
     };
     let outcome = Outcome {
-        apps: [
-            stats_of(&apps[0]),
-            stats_of(&apps[1]),
-            stats_of(&apps[2]),
-        ],
+        apps: [stats_of(&apps[0]), stats_of(&apps[1]), stats_of(&apps[2])],
         wire: [
             bus.node_stats(teensy.id).unwrap(),
             bus.node_stats(nucleo.id).unwrap(),
@@ -558,7 +560,10 @@ fn three_boards_count_what_the_host_demo_counts() {
             .map(|(k, t)| t.abs_diff(s[0] + k as u64 * PERIOD_US))
             .collect();
         eprintln!("board {b}: step lateness (us) max {:?}", late.iter().max());
-        assert!(late.iter().all(|l| *l <= 10 * QUANTUM_US), "board {b}: {late:?}");
+        assert!(
+            late.iter().all(|l| *l <= 10 * QUANTUM_US),
+            "board {b}: {late:?}"
+        );
     }
     let Some((fil, w)) = run_firmware(steps[0][0]) else {
         return;
@@ -573,7 +578,11 @@ fn three_boards_count_what_the_host_demo_counts() {
     for (b, a) in fil.apps.iter().enumerate() {
         assert!(a.heartbeats >= 140, "board {b}: {a:?}");
         assert!(a.answers >= 10, "board {b}: {a:?}");
-        assert_eq!(a.heartbeat_gaps + a.heartbeat_duplicates, 0, "board {b}: {a:?}");
+        assert_eq!(
+            a.heartbeat_gaps + a.heartbeat_duplicates,
+            0,
+            "board {b}: {a:?}"
+        );
     }
     assert!(fil.apps[0].requests >= 10, "{fil:?}");
     assert!(fil.apps[1].requests >= 2 * 10, "{fil:?}");

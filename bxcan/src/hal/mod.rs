@@ -12,7 +12,7 @@
 //! `pac::Peripherals::take()`. Giving it **by value** to a family's `can1`, `can1_dual`,
 //! `can2` or `can3` is the proof that nothing else reaches that instance's registers; the
 //! constructor turns it into the bounded register window of [`crate::regs`] (the one
-//! `unsafe` of the hand-over is here, in this crate: [`whole`] and [`control`]). It also:
+//! `unsafe` of the hand-over is here, in this crate: `whole`, `control` and `dual`). It also:
 //!
 //! - enables and resets the instance's clock in RCC (`RCC_APB1ENR.CANxEN`,
 //!   `RCC_APB1RSTR`) through the HAL;

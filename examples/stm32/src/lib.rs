@@ -36,7 +36,7 @@ compile_error!("choose one board feature only");
 use defmt_rtt as _;
 
 pub mod board;
-/// The split driver's state and vectors: the very file of `twocan-stm32f7`.
+// The split driver's state and vectors: the very file of `twocan-stm32f7`.
 #[path = "../../stm32f7/src/can.rs"]
 pub mod can;
 /// The examples' log (`info!`, `warn!`, `error!`): the very file of `twocan-teensy`.
@@ -44,7 +44,7 @@ pub mod can;
 pub mod log;
 #[cfg(target_os = "none")]
 pub mod rt;
-/// The SysTick time base: the very file of `twocan-teensy`.
+// The SysTick time base: the very file of `twocan-teensy`.
 #[path = "../../teensy/src/time.rs"]
 pub mod time;
 

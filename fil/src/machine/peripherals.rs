@@ -164,8 +164,14 @@ mod tests {
     #[test]
     fn bit_band_aliases_map_to_their_bit() {
         // RCC_APB1ENR (0x4002_101C) bit 25 on the F1; RCC_CR (0x4002_3800) bit 16 on the F4.
-        assert_eq!(bit_band_target(0x4200_0000 + 0x2_101C * 32 + 25 * 4), (0x4002_101C, 25));
-        assert_eq!(bit_band_target(0x4200_0000 + 0x2_3800 * 32 + 16 * 4), (0x4002_3800, 16));
+        assert_eq!(
+            bit_band_target(0x4200_0000 + 0x2_101C * 32 + 25 * 4),
+            (0x4002_101C, 25)
+        );
+        assert_eq!(
+            bit_band_target(0x4200_0000 + 0x2_3800 * 32 + 16 * 4),
+            (0x4002_3800, 16)
+        );
         assert_eq!(bit_band_target(0x4242_0000), (0x4002_1000, 0));
     }
 }
