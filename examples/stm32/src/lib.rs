@@ -13,12 +13,12 @@
 //!   interface: clocks with the board's HAL after a bounded probe of the external
 //!   oscillator, the CAN singletons consumed into their register windows, pins, SysTick,
 //!   LED, halt; the CAN interrupt lines of the part;
-//! - [`can`]: the split driver's state and its interrupt vectors' handles — the very
-//!   file of `twocan-stm32f7`;
+//! - [`can`]: the split driver's state and interrupt handlers (the library's
+//!   `twocan_bxcan::rt::IrqState`, as in `twocan-stm32f7`), started on the part's lines;
 //! - [`time`], `log`: the very files of `twocan-teensy`;
 //! - the `can1_vectors!` / `can2_vectors!` macros: the four CAN vectors of the part
-//!   (their names differ: `USB_HP_CAN_TX` on the F103, `CAN1_TX` on the F446) running
-//!   one [`can::Vectors`].
+//!   (their names differ: `USB_HP_CAN_TX` on the F103, `CAN1_TX` on the F446), each one
+//!   call of `twocan_bxcan::rt::dispatch` with its instance and line.
 #![cfg_attr(not(test), no_std)]
 #![deny(missing_docs)]
 
@@ -36,8 +36,6 @@ compile_error!("choose one board feature only");
 use defmt_rtt as _;
 
 pub mod board;
-// The split driver's state and vectors: the very file of `twocan-stm32f7`.
-#[path = "../../stm32f7/src/can.rs"]
 pub mod can;
 /// The examples' log (`info!`, `warn!`, `error!`): the very file of `twocan-teensy`.
 #[path = "../../teensy/src/log.rs"]
@@ -49,6 +47,14 @@ pub mod rt;
 pub mod time;
 
 pub use board::Board;
+
+/// What the vector macros name through `$crate` (not an API).
+#[doc(hidden)]
+#[cfg(target_os = "none")]
+pub mod __private {
+    pub use twocan_bxcan::regs::Instance;
+    pub use twocan_bxcan::rt::{dispatch, Line};
+}
 #[cfg(any(feature = "bluepill", feature = "nucleo-f446re"))]
 pub use board::BOARD;
 

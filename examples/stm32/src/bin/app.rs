@@ -24,7 +24,7 @@ mod firmware {
     use twocan_core::ErrorState;
     use twocan_stm32::board::BIT_RATE;
     use twocan_stm32::board::CAN1_BANKS;
-    use twocan_stm32::can::{self, CanState, Vectors};
+    use twocan_stm32::can::{self, CanState};
     use twocan_stm32::rt::{self, CAN_BLINKS};
     use twocan_stm32::time::{self, Every};
     use twocan_stm32::BOARD;
@@ -34,8 +34,7 @@ mod firmware {
     const PEER: u8 = BOARD.app.1;
 
     static CAN1: CanState = CanState::new();
-    static CAN1_VECTORS: Vectors = Vectors::new();
-    twocan_stm32::can1_vectors!(CAN1_VECTORS);
+    twocan_stm32::can1_vectors!();
 
     /// The application's counters, copied after each step (`None` before the first).
     pub static STATS: Mutex<RefCell<Option<AppStats>>> = Mutex::new(RefCell::new(None));
@@ -73,14 +72,9 @@ mod firmware {
             rt::halt(CAN_BLINKS);
         }
         let can = init.enable().unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        let (mut tx, mut rx) = can::start(
-            &CAN1,
-            &CAN1_VECTORS,
-            can.into_split(),
-            rt::CAN1_IRQS,
-            &mut boot.core.NVIC,
-        )
-        .unwrap_or_else(|| rt::halt(CAN_BLINKS));
+        let (mut tx, mut rx) =
+            can::start(&CAN1, can.into_split(), rt::CAN1_IRQS, &mut boot.core.NVIC)
+                .unwrap_or_else(|| rt::halt(CAN_BLINKS));
         twocan_stm32::info!(
             "CAN1 on the bus with the application's {=usize} filters",
             app.filters().len()

@@ -27,13 +27,12 @@ mod firmware {
     use twocan_core::Filter;
     use twocan_stm32::board::BIT_RATE;
     use twocan_stm32::board::CAN1_BANKS;
-    use twocan_stm32::can::{self, CanRxHalf, CanState, CanTxHalf, Vectors};
+    use twocan_stm32::can::{self, CanRxHalf, CanState, CanTxHalf};
     use twocan_stm32::rt::{self, Led, CAN_BLINKS};
     use twocan_stm32::BOARD;
 
     static CAN1: CanState = CanState::new();
-    static CAN1_VECTORS: Vectors = Vectors::new();
-    twocan_stm32::can1_vectors!(CAN1_VECTORS);
+    twocan_stm32::can1_vectors!();
     static EXECUTOR: StaticCell<Executor> = StaticCell::new();
 
     /// Echoes sent so far (for a debugger).
@@ -71,14 +70,8 @@ mod firmware {
             rt::halt(CAN_BLINKS);
         }
         let can = init.enable().unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        let (tx, rx) = can::start(
-            &CAN1,
-            &CAN1_VECTORS,
-            can.into_split(),
-            rt::CAN1_IRQS,
-            &mut boot.core.NVIC,
-        )
-        .unwrap_or_else(|| rt::halt(CAN_BLINKS));
+        let (tx, rx) = can::start(&CAN1, can.into_split(), rt::CAN1_IRQS, &mut boot.core.NVIC)
+            .unwrap_or_else(|| rt::halt(CAN_BLINKS));
         let led = boot.led;
         EXECUTOR.init(Executor::new()).run(|spawner| {
             spawner.spawn(echo_task(tx, rx, led).unwrap_or_else(|_| rt::halt(CAN_BLINKS)));

@@ -25,7 +25,7 @@ mod firmware {
     use twocan_bxcan::{const_plan, Can, FifoPolicy, Recovery};
     use twocan_stm32::board::BIT_RATE;
     use twocan_stm32::board::CAN1_BANKS;
-    use twocan_stm32::can::{self, CanState, Vectors};
+    use twocan_stm32::can::{self, CanState};
     use twocan_stm32::rt::{self, CAN_BLINKS};
     use twocan_stm32::time::{self, Every};
     use twocan_stm32::BOARD;
@@ -33,13 +33,10 @@ mod firmware {
     // Each controller owns its control registers and shares CAN1's filter block (RM0390
     // §30.9.4) through the `&'static FilterRegs` that `Can1::dual` lends.
     type Shared = CanState<ControlRegs, &'static FilterRegs>;
-    type SharedVectors = Vectors<ControlRegs, &'static FilterRegs>;
     static CAN1: Shared = Shared::new();
-    static CAN1_VECTORS: SharedVectors = SharedVectors::new();
     static CAN2: Shared = Shared::new();
-    static CAN2_VECTORS: SharedVectors = SharedVectors::new();
-    twocan_stm32::can1_vectors!(CAN1_VECTORS);
-    twocan_stm32::can2_vectors!(CAN2_VECTORS);
+    twocan_stm32::can1_vectors!();
+    twocan_stm32::can2_vectors!();
 
     /// The counters of node 1 (CAN1) and node 2 (CAN2), copied after each step
     /// (`None` before the first).
@@ -82,22 +79,12 @@ mod firmware {
         }
         let can1 = init1.enable().unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         let can2 = init2.enable().unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        let (mut tx1, mut rx1) = can::start(
-            &CAN1,
-            &CAN1_VECTORS,
-            can1.into_split(),
-            rt::CAN1_IRQS,
-            &mut boot.core.NVIC,
-        )
-        .unwrap_or_else(|| rt::halt(CAN_BLINKS));
-        let (mut tx2, mut rx2) = can::start(
-            &CAN2,
-            &CAN2_VECTORS,
-            can2.into_split(),
-            rt::CAN2_IRQS,
-            &mut boot.core.NVIC,
-        )
-        .unwrap_or_else(|| rt::halt(CAN_BLINKS));
+        let (mut tx1, mut rx1) =
+            can::start(&CAN1, can1.into_split(), rt::CAN1_IRQS, &mut boot.core.NVIC)
+                .unwrap_or_else(|| rt::halt(CAN_BLINKS));
+        let (mut tx2, mut rx2) =
+            can::start(&CAN2, can2.into_split(), rt::CAN2_IRQS, &mut boot.core.NVIC)
+                .unwrap_or_else(|| rt::halt(CAN_BLINKS));
 
         let mut period = Every::new(time::millis(), 10);
         let mut shown = 0;

@@ -26,7 +26,7 @@ mod firmware {
     use twocan_bxcan::{const_plan, Can, FifoPolicy};
     use twocan_core::{Dispatcher, Filter, Format, Frame, FrameKind, RxFrame};
     use twocan_stm32::board::CAN1_BANKS;
-    use twocan_stm32::can::{self, CanState, Vectors};
+    use twocan_stm32::can::{self, CanState};
     use twocan_stm32::rt::{self, CAN_BLINKS};
     use twocan_stm32::time::{self, Every};
     use twocan_stm32::BOARD;
@@ -34,8 +34,7 @@ mod firmware {
     const FILTERS: usize = 6;
 
     static CAN1: CanState = CanState::new();
-    static CAN1_VECTORS: Vectors = Vectors::new();
-    twocan_stm32::can1_vectors!(CAN1_VECTORS);
+    twocan_stm32::can1_vectors!();
 
     /// Frames per filter index.
     pub static HITS: [AtomicU32; FILTERS] = [const { AtomicU32::new(0) }; FILTERS];
@@ -96,14 +95,9 @@ mod firmware {
             rt::halt(CAN_BLINKS);
         }
         let can = init.enable().unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        let (mut tx, mut rx) = can::start(
-            &CAN1,
-            &CAN1_VECTORS,
-            can.into_split(),
-            rt::CAN1_IRQS,
-            &mut boot.core.NVIC,
-        )
-        .unwrap_or_else(|| rt::halt(CAN_BLINKS));
+        let (mut tx, mut rx) =
+            can::start(&CAN1, can.into_split(), rt::CAN1_IRQS, &mut boot.core.NVIC)
+                .unwrap_or_else(|| rt::halt(CAN_BLINKS));
 
         let mut dispatcher: Dispatcher<(), FILTERS> = Dispatcher::new();
         for i in 0..FILTERS {

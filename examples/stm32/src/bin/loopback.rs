@@ -14,14 +14,13 @@ mod firmware {
     use twocan_bxcan::{const_plan, Can, FifoPolicy};
     use twocan_core::{Filter, Frame};
     use twocan_stm32::board::CAN1_BANKS;
-    use twocan_stm32::can::{self, CanState, Vectors};
+    use twocan_stm32::can::{self, CanState};
     use twocan_stm32::rt::{self, CAN_BLINKS};
     use twocan_stm32::time::{self, Every};
     use twocan_stm32::BOARD;
 
     static CAN1: CanState = CanState::new();
-    static CAN1_VECTORS: Vectors = Vectors::new();
-    twocan_stm32::can1_vectors!(CAN1_VECTORS);
+    twocan_stm32::can1_vectors!();
 
     /// Frames handed to the driver.
     pub static SENT: AtomicU32 = AtomicU32::new(0);
@@ -46,14 +45,9 @@ mod firmware {
             rt::halt(CAN_BLINKS);
         }
         let can = init.enable().unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        let (mut tx, mut rx) = can::start(
-            &CAN1,
-            &CAN1_VECTORS,
-            can.into_split(),
-            rt::CAN1_IRQS,
-            &mut boot.core.NVIC,
-        )
-        .unwrap_or_else(|| rt::halt(CAN_BLINKS));
+        let (mut tx, mut rx) =
+            can::start(&CAN1, can.into_split(), rt::CAN1_IRQS, &mut boot.core.NVIC)
+                .unwrap_or_else(|| rt::halt(CAN_BLINKS));
 
         let message = Frame::standard(0x542, &[]).unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         let mut send = Every::new(time::millis(), 1000);

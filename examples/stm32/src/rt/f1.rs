@@ -135,29 +135,11 @@ pub(super) fn led_raw(on: bool) {
 }
 
 /// The four CAN vectors of the F103 (`USB_HP_CAN_TX`, `USB_LP_CAN_RX0`, `CAN_RX1`,
-/// `CAN_SCE`; RM0008 §10.1.2) running the [`crate::can::Vectors`] named `$vectors` (a
-/// `static` of the calling module).
+/// `CAN_SCE`; RM0008 §10.1.2), each running its line of CAN's `crate::can::CanState`
+/// (`twocan_bxcan::rt::dispatch`). Invoke once in the firmware.
 #[macro_export]
 macro_rules! can1_vectors {
-    ($vectors:ident) => {
-        mod can1_lines {
-            use $crate::rt::pac::interrupt;
-            #[interrupt]
-            fn USB_HP_CAN_TX() {
-                super::$vectors.on_tx();
-            }
-            #[interrupt]
-            fn USB_LP_CAN_RX0() {
-                super::$vectors.on_rx0();
-            }
-            #[interrupt]
-            fn CAN_RX1() {
-                super::$vectors.on_rx1();
-            }
-            #[interrupt]
-            fn CAN_SCE() {
-                super::$vectors.on_sce();
-            }
-        }
+    () => {
+        $crate::__can_vectors!(can1_lines, Can1: USB_HP_CAN_TX, USB_LP_CAN_RX0, CAN_RX1, CAN_SCE);
     };
 }

@@ -180,55 +180,19 @@ pub(super) fn led_raw(on: bool) {
 }
 
 /// The four CAN1 vectors of the F446 (`CAN1_TX`, `CAN1_RX0`, `CAN1_RX1`, `CAN1_SCE`;
-/// RM0390 §10.2) running the [`crate::can::Vectors`] named `$vectors` (a `static` of the
-/// calling module).
+/// RM0390 §10.2), each running its line of CAN1's `crate::can::CanState`
+/// (`twocan_bxcan::rt::dispatch`). Invoke once in the firmware.
 #[macro_export]
 macro_rules! can1_vectors {
-    ($vectors:ident) => {
-        mod can1_lines {
-            use $crate::rt::pac::interrupt;
-            #[interrupt]
-            fn CAN1_TX() {
-                super::$vectors.on_tx();
-            }
-            #[interrupt]
-            fn CAN1_RX0() {
-                super::$vectors.on_rx0();
-            }
-            #[interrupt]
-            fn CAN1_RX1() {
-                super::$vectors.on_rx1();
-            }
-            #[interrupt]
-            fn CAN1_SCE() {
-                super::$vectors.on_sce();
-            }
-        }
+    () => {
+        $crate::__can_vectors!(can1_lines, Can1: CAN1_TX, CAN1_RX0, CAN1_RX1, CAN1_SCE);
     };
 }
 
 /// The four CAN2 vectors of the F446 (`CAN2_TX` … `CAN2_SCE`, lines 63..=66).
 #[macro_export]
 macro_rules! can2_vectors {
-    ($vectors:ident) => {
-        mod can2_lines {
-            use $crate::rt::pac::interrupt;
-            #[interrupt]
-            fn CAN2_TX() {
-                super::$vectors.on_tx();
-            }
-            #[interrupt]
-            fn CAN2_RX0() {
-                super::$vectors.on_rx0();
-            }
-            #[interrupt]
-            fn CAN2_RX1() {
-                super::$vectors.on_rx1();
-            }
-            #[interrupt]
-            fn CAN2_SCE() {
-                super::$vectors.on_sce();
-            }
-        }
+    () => {
+        $crate::__can_vectors!(can2_lines, Can2: CAN2_TX, CAN2_RX0, CAN2_RX1, CAN2_SCE);
     };
 }

@@ -61,26 +61,6 @@ impl Can1 {
     }
 }
 
-/// The NVIC as `twocan_core::irq_cell::Installed::enable` uses it: only a cell that
-/// holds its handler unmasks the lines that run it (`crate::can::start`).
-pub struct Lines<'a>(pub &'a mut cortex_m::peripheral::NVIC);
-
-impl twocan_core::irq_cell::Nvic<Interrupt> for Lines<'_> {
-    fn set_priority(&mut self, line: Interrupt, priority: u8) {
-        // SAFETY: this crate's critical sections mask every interrupt
-        // (`critical-section-single-core`), none is built from priorities; the line is
-        // still masked.
-        unsafe { self.0.set_priority(line, priority) };
-    }
-
-    fn unmask(&mut self, line: Interrupt) {
-        // SAFETY: this crate's critical sections mask every interrupt (none is built
-        // from NVIC masks); `Installed::enable` calls this after the handle the line's
-        // vector runs is in place.
-        unsafe { cortex_m::peripheral::NVIC::unmask(line) };
-    }
-}
-
 #[cortex_m_rt::exception]
 fn SysTick() {
     crate::time::tick();
@@ -107,4 +87,34 @@ pub fn halt(code: u8) -> ! {
 #[panic_handler]
 fn panic(_info: &core::panic::PanicInfo) -> ! {
     halt(PANIC_BLINKS)
+}
+
+/// The `#[interrupt]` handlers of one instance under the part's vector names, each one
+/// call of `twocan_bxcan::rt::dispatch` (used by the family's `can1_vectors!` and
+/// `can2_vectors!`).
+#[doc(hidden)]
+#[macro_export]
+macro_rules! __can_vectors {
+    ($module:ident, $instance:ident: $tx:ident, $rx0:ident, $rx1:ident, $sce:ident) => {
+        mod $module {
+            use $crate::__private::{dispatch, Instance, Line};
+            use $crate::rt::pac::interrupt;
+            #[interrupt]
+            fn $tx() {
+                let _ = dispatch(Instance::$instance, Line::Tx);
+            }
+            #[interrupt]
+            fn $rx0() {
+                let _ = dispatch(Instance::$instance, Line::Rx0);
+            }
+            #[interrupt]
+            fn $rx1() {
+                let _ = dispatch(Instance::$instance, Line::Rx1);
+            }
+            #[interrupt]
+            fn $sce() {
+                let _ = dispatch(Instance::$instance, Line::Sce);
+            }
+        }
+    };
 }
