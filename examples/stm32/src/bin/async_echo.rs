@@ -36,6 +36,9 @@ mod firmware {
     static EXECUTOR: StaticCell<Executor> = StaticCell::new();
 
     /// Echoes sent so far (for a debugger).
+    // `#[used]`: only stored to here, it must stay in the image for a debugger (and
+    // can-fil) to read.
+    #[used]
     pub static ECHOED: AtomicU32 = AtomicU32::new(0);
 
     /// Receives and echoes, forever; drains the completions it does not wait for.
