@@ -51,8 +51,8 @@
 //! - [`chip`]: the STM32 parts as data ([`Chip`]: instances, bank counts, APB1 limits,
 //!   interrupt numbers, pins), chosen with [`Config::chip`];
 //! - [`instance`]: CAN1/CAN2/CAN3 and what the firmware must do (RCC, AF9);
-//! - `hal` (features `hal-stm32f7`, `hal-stm32f4`): the hand-over from `stm32f7xx-hal`
-//!   or `stm32f4xx-hal` (singletons,
+//! - `hal` (features `hal-stm32f7`, `hal-stm32f4`, `hal-stm32f1`): the hand-over from
+//!   `stm32f7xx-hal`, `stm32f4xx-hal` or `stm32f1xx-hal` (singletons,
 //!   clocks, typed pins; CAN2 only with CAN1's filter-block handle);
 //! - `rt` (feature `rt`): the interrupt entry points `CAN1_TX` ... in the library, the
 //!   handlers installed before the lines are unmasked, priorities applied, and the way
@@ -86,7 +86,11 @@ pub mod filters;
 pub mod fmi;
 // The hand-over from an STM32 HAL: the one `unsafe` turning a consumed PAC singleton
 // into a register window.
-#[cfg(any(feature = "hal-stm32f7", feature = "hal-stm32f4"))]
+#[cfg(any(
+    feature = "hal-stm32f7",
+    feature = "hal-stm32f4",
+    feature = "hal-stm32f1"
+))]
 #[allow(unsafe_code)]
 pub mod hal;
 pub mod instance;

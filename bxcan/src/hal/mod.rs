@@ -1,7 +1,8 @@
 //! Hand-over from an STM32 HAL: the bxCAN instances built from the HAL's PAC singletons,
 //! its clocks and CAN pins, with no `unsafe` in the program. One module per HAL
-//! ([`f7`]: `stm32f7xx-hal` 0.8, feature `hal-stm32f7`, its items also re-exported here;
-//! [`f4`]: `stm32f4xx-hal` 0.23, feature `hal-stm32f4`), over one generic piece (this
+//! (`f7`: `stm32f7xx-hal` 0.8, feature `hal-stm32f7`, its items also re-exported here;
+//! `f4`: `stm32f4xx-hal` 0.23, feature `hal-stm32f4`; `f1`: `stm32f1xx-hal` 0.11, feature
+//! `hal-stm32f1`, the STM32F103's CAN), over one generic piece (this
 //! module): the handle [`HandedOver`], the shared filter block [`Can1Filters`], giving
 //! the parts back ([`HandedOver::free`], [`HandedOver::park`], [`Parked::free`]), and
 //! `configure`. A family module adds only what its HAL spells differently: the pins
@@ -62,6 +63,8 @@ use crate::controller::{Can, Failed, Init};
 use crate::instance::Instance;
 use crate::regs::{CanRegs, ControlRegs, FilterRegs};
 
+#[cfg(feature = "hal-stm32f1")]
+pub mod f1;
 #[cfg(feature = "hal-stm32f4")]
 pub mod f4;
 #[cfg(feature = "hal-stm32f7")]
@@ -84,6 +87,10 @@ pub trait RxPin<CAN>: sealed::Sealed {}
 
 /// `Sealed` and `$role<$can>` for each pin `Pin<$port, $n, Alternate<$af>>` of the calling
 /// family module (its HAL's `Pin` and `Alternate` in scope).
+#[cfg_attr(
+    not(any(feature = "hal-stm32f7", feature = "hal-stm32f4")),
+    allow(unused_macros)
+)]
 macro_rules! can_pins {
     ($can:ty, $af:literal, $role:ident: $(($port:literal, $n:literal)),+ $(,)?) => {
         $(
@@ -92,10 +99,18 @@ macro_rules! can_pins {
         )+
     };
 }
+#[cfg_attr(
+    not(any(feature = "hal-stm32f7", feature = "hal-stm32f4")),
+    allow(unused_imports)
+)]
 pub(crate) use can_pins;
 
 /// CAN1's filter registers (`CAN_FMR` .. `CAN_F27R2`, CAN1's block + `0x200..0x320`),
 /// reached only through the [`Can1Filters`] handles that a family's `can1_dual` gives out.
+#[cfg_attr(
+    not(any(feature = "hal-stm32f7", feature = "hal-stm32f4")),
+    allow(dead_code)
+)]
 // SAFETY: offsets 0x200..0x320 from CAN1's base (RM0410 §2.2.2, §40.9.5) are CAN1's
 // filter registers, 32-bit accessible. A reference to this value is created only by
 // `can1_dual`, which consumes the `pac::CAN1` singleton (handed out once per program by
@@ -103,8 +118,8 @@ pub(crate) use can_pins;
 static CAN1_FILTERS: FilterRegs = unsafe { FilterRegs::new(crate::regs::CAN1_BASE) };
 
 /// A handle to CAN1's filter block, shared by CAN1 and CAN2 in dual mode: from
-/// [`can1_dual`] only (the proof that CAN1's singleton was handed over and its block
-/// split), and required by [`can2`]. Copying it shares the one block; the drivers program
+/// `can1_dual` only (the proof that CAN1's singleton was handed over and its block
+/// split), and required by `can2`. Copying it shares the one block; the drivers program
 /// it in critical sections.
 #[derive(Debug, Clone, Copy)]
 pub struct Can1Filters {
@@ -125,11 +140,11 @@ impl Registers for Can1Filters {
 
 /// A bxCAN instance handed over by the HAL, clocked, not yet configured: its register
 /// handles, the APB1 frequency and (`P`) the PAC singleton and pins it was built from
-/// ([`HalParts`], or `()` when they were parked or, for [`can1_dual`], not kept).
+/// ([`HalParts`], or `()` when they were parked or, for `can1_dual`, not kept).
 /// [`HandedOver::configure`] puts it in initialization mode ([`Init`]).
 ///
-/// - [`Can1`] (from [`can1`]) and `Can3` (from `can3`) own a whole register block;
-/// - [`DualCan`] (from [`can1_dual`]) and [`Can2`] (from [`can2`]) own a control block
+/// - `Can1` (from `can1`) and `Can3` (from `can3`) own a whole register block;
+/// - [`DualCan`] (from `can1_dual`) and `Can2` (from `can2`) own a control block
 ///   and share CAN1's filter block.
 #[derive(Debug)]
 pub struct HandedOver<R: Registers, F: Registers = R, P = ()> {
@@ -189,6 +204,10 @@ impl Window for ControlRegs {
 }
 
 /// `Sealed` and [`PacCan`] for a PAC singleton type (`pac::CAN1`, …) and its window.
+#[cfg_attr(
+    not(any(feature = "hal-stm32f7", feature = "hal-stm32f4")),
+    allow(unused_macros)
+)]
 macro_rules! pac_can {
     ($($can:ty => $window:ty),+ $(,)?) => {
         $(
@@ -202,6 +221,10 @@ macro_rules! pac_can {
         )+
     };
 }
+#[cfg_attr(
+    not(any(feature = "hal-stm32f7", feature = "hal-stm32f4")),
+    allow(unused_imports)
+)]
 pub(crate) use pac_can;
 
 impl<CAN: PacCan, TX, RX> Parked<CAN, TX, RX> {
@@ -259,6 +282,11 @@ pub(crate) unsafe fn whole<CAN: PacCan<Window = CanRegs>, TX, RX>(
 /// # Safety
 ///
 /// As [`whole`], for CAN2's singleton (CAN2 has no filter registers of its own).
+// Dual-CAN pieces: unused with the F103-only `hal-stm32f1` alone.
+#[cfg_attr(
+    not(any(feature = "hal-stm32f7", feature = "hal-stm32f4")),
+    allow(dead_code)
+)]
 pub(crate) unsafe fn control<CAN: PacCan<Window = ControlRegs>, TX, RX>(
     can: CAN,
     tx: TX,
@@ -286,6 +314,11 @@ pub(crate) unsafe fn control<CAN: PacCan<Window = ControlRegs>, TX, RX>(
 ///
 /// `can1` is CAN1's PAC singleton, at `CAN::base()` = CAN1's block (the `CAN1_FILTERS`
 /// window's base), and its clock is enabled.
+// Dual-CAN pieces: unused with the F103-only `hal-stm32f1` alone.
+#[cfg_attr(
+    not(any(feature = "hal-stm32f7", feature = "hal-stm32f4")),
+    allow(dead_code)
+)]
 pub(crate) unsafe fn dual<CAN: PacCan, TX, RX>(
     can1: CAN,
     tx: TX,
