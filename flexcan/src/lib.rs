@@ -86,14 +86,22 @@
 pub mod begin;
 pub mod begin_error;
 pub mod board;
+pub mod can_clock;
 pub mod configuration;
 pub mod controller;
 pub mod end;
 pub mod filters;
 mod handshake;
+pub mod imxrt;
 pub mod instance;
 mod message_buffer;
-#[cfg(any(feature = "teensy32", feature = "teensy35", feature = "teensy36"))]
+#[cfg(all(
+    any(feature = "teensy32", feature = "teensy35", feature = "teensy36"),
+    not(any(feature = "teensy40", feature = "teensy41"))
+))]
+pub mod pin;
+#[cfg(any(feature = "teensy40", feature = "teensy41"))]
+#[path = "imxrt/pin.rs"]
 pub mod pin;
 pub mod planner;
 pub mod settings;
@@ -106,6 +114,13 @@ pub mod regs;
 #[cfg_attr(docsrs, doc(cfg(feature = "rt")))]
 pub mod rt;
 
+#[cfg(all(feature = "rt", any(feature = "teensy40", feature = "teensy41")))]
+#[cfg_attr(
+    docsrs,
+    doc(cfg(all(feature = "rt", any(feature = "teensy40", feature = "teensy41"))))
+)]
+pub mod rt_imxrt;
+
 #[cfg(feature = "model")]
 pub mod model;
 
@@ -117,17 +132,24 @@ pub use idle_clock::IdleClocked;
 pub use begin::check;
 pub use begin_error::{BeginError, ConfigErrors};
 pub use board::{Board, Chip, InstancePins};
+pub use can_clock::CanClock;
 pub use configuration::Configuration;
 pub use controller::FlexCan;
 pub use filters::{FilterTable, SizedTable, UNKNOWN_FILTER};
-#[cfg(any(feature = "teensy32", feature = "teensy35", feature = "teensy36"))]
+#[cfg(all(
+    any(feature = "teensy32", feature = "teensy35", feature = "teensy36"),
+    not(any(feature = "teensy40", feature = "teensy41"))
+))]
 pub use instance::Can0;
-#[cfg(feature = "teensy36")]
+#[cfg(any(feature = "teensy36", feature = "teensy40", feature = "teensy41"))]
 pub use instance::Can1;
+#[cfg(any(feature = "teensy40", feature = "teensy41"))]
+pub use instance::{Can2, Can3};
 pub use instance::{Instance, Irqs, Target};
 pub use settings::{Settings, CAN_CLOCK_HZ, RECEIVE_BUFFER_SIZE, TRANSMIT_BUFFER_SIZE};
 pub use split::{FlexCanHw, InstalledFilters};
 pub use system::HostSystem;
+pub use system::{PortPlan, SystemPlan};
 
 /// The driver with ACAN's default buffer sizes: a receive ring of 32 frames and a
 /// transmit ring of 16 (ACAN table 7, §8.2, §10.1). Choose other sizes with

@@ -177,12 +177,14 @@ impl Slot {
     }
 }
 
-static SLOTS: [Slot; 2] = [Slot::new(), Slot::new()];
+static SLOTS: [Slot; 4] = [Slot::new(), Slot::new(), Slot::new(), Slot::new()];
 
 const fn slot(instance: Instance) -> &'static Slot {
     match instance {
         Instance::Can0 => &SLOTS[0],
         Instance::Can1 => &SLOTS[1],
+        Instance::Can2 => &SLOTS[2],
+        Instance::Can3 => &SLOTS[3],
     }
 }
 
@@ -360,15 +362,20 @@ where
     }
 }
 
-/// Priority, then unmask, for each line `start` uses.
+/// Priority, then unmask, for each line `start` uses, once per distinct line (the
+/// i.MX RT1062 has one line per module: [`Irqs::is_single_line`]).
 fn enable(nvic: &mut impl Nvic, irqs: Irqs, priority: u8) {
-    for irq in [
+    let lines = [
         irqs.message,
         irqs.bus_off,
         irqs.error,
         irqs.tx_warning,
         irqs.rx_warning,
-    ] {
+    ];
+    for (i, &irq) in lines.iter().enumerate() {
+        if lines[..i].contains(&irq) {
+            continue;
+        }
         nvic.set_priority(IrqNumber(irq), priority);
         nvic.unmask(IrqNumber(irq));
     }
