@@ -59,7 +59,13 @@ cargo build --quiet --release --target "$m3" --manifest-path fil/firmware/Cargo.
 for bin in bluepill-can bluepill-gate bluepill-stuck; do
     cp "fil/firmware/target/$m3/release/$bin" "$out/bluepill/"
 done
-# Teensy 4.1 (i.MX RT1062): the examples' ELFs go to $out/teensy41/ once examples/teensy
-# builds them (issue 24); the teensy41 profile's own test firmwares are the imxrt-* above.
-mkdir -p "$out/teensy41"
+# Teensy 4.0 / 4.1 (i.MX RT1062, examples/teensy4, issue 24): the teensy41 profile runs
+# both (one chip); the profile's own test firmwares are the imxrt-* above.
+for board in teensy41 teensy40; do
+    cargo build --quiet --release --target "$target" -p twocan-teensy4 --features "$board" --bins
+    mkdir -p "$out/$board"
+    for bin in loopback filters app async-echo can1-can2; do
+        cp "$rel/teensy4-$bin" "$out/$board/"
+    done
+done
 echo "firmware for the harness in $out"
