@@ -26,8 +26,13 @@ pub const FILTERS: Settings = LOOPBACK;
 /// The loop-back example receives everything.
 pub const LOOPBACK_FILTERS: [Filter; 1] = [Filter::pass_all()];
 
-/// `app`: node 1 talking with node 2 (as the Teensy 3 `app`).
-pub const APP_NODES: (u8, u8) = (1, 2);
+/// `app`: node 1 talking with node 2 (as the Teensy 3 `app`); with the feature
+/// `app-node3`, node 3 listening to node 1 (a third node next to a node-1/node-2 pair).
+pub const APP_NODES: (u8, u8) = if cfg!(feature = "app-node3") {
+    (3, 1)
+} else {
+    (1, 2)
+};
 
 /// `can1-can2`: CAN1 is node 1, CAN2 node 2.
 pub const CAN1_CAN2_NODES: [(u8, u8); 2] = [(1, 2), (2, 1)];
