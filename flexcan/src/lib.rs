@@ -45,9 +45,16 @@
 //!
 //! | features enabled | `Board::DEFAULT` | `Can1` |
 //! |---|---|---|
-//! | `teensy36` (with or without the others) | `Teensy36` | yes |
+//! | `teensy41` (with or without the others) | `Teensy41` | yes (and `Can2`, `Can3`; no `Can0`) |
+//! | `teensy40`, not `teensy41` | `Teensy40` | yes (and `Can2`, `Can3`; no `Can0`) |
+//! | `teensy36`, no Teensy 4 feature | `Teensy36` | yes |
 //! | `teensy35`, maybe `teensy32`, not `teensy36` | `Teensy35` | no |
 //! | `teensy32` alone | `Teensy32` | no |
+//!
+//! On a Teensy 4.x (i.MX RT1062, [`imxrt`]) the tokens are `Can1`, `Can2`, `Can3` (CAN1 on
+//! pins 22/23, CAN2 on 1/0, CAN3 on 31/30), the settings name the CCM clock root
+//! (`Settings::with_clock(rate, CanClock::IMXRT_24MHZ)`), and with `rt` the entry points
+//! are `CAN1`, `CAN2`, `CAN3` (`rt_imxrt`), one line per module.
 //!
 //! So `teensy32` + `teensy36` builds for a Teensy 3.6: firmware for a Teensy 3.2 linked
 //! that way would drive the wrong pins. Check `Board::DEFAULT` (or `cargo tree -e
