@@ -86,7 +86,7 @@ impl<H: Hardware, const RX: usize, const TX: usize, const RX1: usize> Driver<H, 
 
     /// The controller (for backend-specific operations).
     pub fn hardware(&self) -> &H {
-        self.shared().hardware().expect("installed by new")
+        self.shared().owned_hardware().expect("installed by new")
     }
 
     fn shared(&self) -> &St<H, RX, TX, RX1> {
@@ -375,22 +375,6 @@ impl<H: Hardware, const RX: usize, const TX: usize, const RX1: usize> Driver<H, 
     /// The shared state (statistics).
     pub fn shared_state(&self) -> &State<H, RX, AnyQueue<TX>, RX1, DRIVER_COMPLETIONS> {
         &self.state
-    }
-}
-
-impl<H: Hardware, const RX: usize, const TX: usize, const RX1: usize> crate::io::CanTx
-    for Driver<H, RX, TX, RX1>
-{
-    fn try_send(&mut self, frame: &Frame) -> nb::Result<Token, Error> {
-        Driver::try_send(self, frame)
-    }
-}
-
-impl<H: Hardware, const RX: usize, const TX: usize, const RX1: usize> crate::io::CanRx
-    for Driver<H, RX, TX, RX1>
-{
-    fn receive(&mut self) -> nb::Result<RxFrame, Error> {
-        Driver::receive(self)
     }
 }
 

@@ -57,6 +57,10 @@ impl Nvic for Recorder {
     fn unmask(&mut self, irq: IrqNumber) {
         self.calls.push(("unmask", irq.number(), 0));
     }
+
+    fn mask(&mut self, irq: IrqNumber) {
+        self.calls.push(("mask", irq.number(), 0));
+    }
 }
 
 #[test]
