@@ -30,7 +30,8 @@ mod firmware {
         loop {
             let _ = echo(&mut tx, &mut rx, &mut stats).await;
             while tx.take_completion().is_some() {}
-            ECHOED.store(stats.echoed, Ordering::Relaxed);
+            // A read-modify-write: a plain store to a static nothing reads may be dropped.
+            ECHOED.fetch_max(stats.echoed, Ordering::Relaxed);
         }
     }
 
