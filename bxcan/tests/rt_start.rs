@@ -234,6 +234,41 @@ fn start_installs_then_unmasks_stop_masks_then_takes_and_the_controller_begins_a
     peer.borrow_mut().send(std(0x200));
     settle(&bus);
     assert!(model.irq_lines().rx0);
+    // A reference from `hardware()` alive: refused, the handlers put back and the
+    // lines unmasked again (each after its handler is in place; the priorities stay).
+    let lease = state.state().hardware().unwrap();
+    nvic.calls.clear();
+    let Err((e, (tx, mut rx))) = state.stop_on(tx, rx, CAN1_LINES, &mut nvic) else {
+        panic!("stopped while a reference to the controller was alive");
+    };
+    assert_eq!(e, rt::StopError::Leased);
+    drop(lease);
+    let calls: Vec<Call> = nvic.calls.iter().map(|(c, _)| c.clone()).collect();
+    assert_eq!(
+        calls,
+        [
+            Call::Mask(19),
+            Call::Mask(20),
+            Call::Mask(21),
+            Call::Mask(22),
+            Call::Unmask(19),
+            Call::Unmask(20),
+            Call::Unmask(21),
+            Call::Unmask(22),
+        ]
+    );
+    assert!(nvic.calls[4..]
+        .iter()
+        .all(|(_, installed)| *installed == [true; 4]));
+    // The frame waiting in FIFO 0 was taken when RX0 was unmasked again: one more.
+    let waiting: Vec<u32> = std::iter::from_fn(|| rx.receive().ok())
+        .map(|f| f.frame.raw_id())
+        .collect();
+    assert_eq!(waiting, [0x200]);
+    peer.borrow_mut().send(std(0x201));
+    settle(&bus);
+    assert!(model.irq_lines().rx0);
+
     nvic.calls.clear();
     let (hw, left) = state
         .stop_on(tx, rx, CAN1_LINES, &mut nvic)

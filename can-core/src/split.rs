@@ -393,17 +393,17 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
     }
 
     /// Gives the controller back once no handle borrows the state any more (it takes
-    /// the state by value, so the handles are gone; a `static` state keeps its
-    /// controller for ever). Frames and completions still in the rings and the queue go
-    /// with the state; the controller keeps its configuration and its mailboxes.
-    /// `None` when the state was never split.
+    /// the state by value, so the handles are gone; a `static` state gives it back
+    /// with [`State::unsplit`]). Frames and completions still in the rings and the
+    /// queue go with the state; the controller keeps its configuration and its
+    /// mailboxes. `None` when the state was never split.
     pub fn into_hardware(mut self) -> Option<H> {
         self.uninstall()
     }
 
     /// The controller, once [`State::split`] stored it (any context). The reference is
     /// a [`Lease`]: while it lives, [`State::unsplit`] refuses to take the controller
-    /// out ([`Error::Busy`]); drop it before ending the controller.
+    /// out ([`UnsplitError::Leased`]); drop it before ending the controller.
     pub fn hardware(&self) -> Option<Lease<'_, H>> {
         self.hw.lease()
     }

@@ -2,7 +2,7 @@
 //! its four interrupt handlers in one `static` ([`CanState`], the library's
 //! `twocan_bxcan::rt::IrqState`), run by the library's own entry points `CAN1_TX`,
 //! `CAN1_RX0`, `CAN1_RX1`, `CAN1_SCE` (and `CAN2_…`; one handler per line, RM0410
-//! §40.8): the examples define no CAN vector. [`start`] puts the handlers in place
+//! §40.8): the examples define no CAN vector. `start` puts the handlers in place
 //! **before** it unmasks the lines.
 
 use twocan_bxcan::regs::CanRegs;
