@@ -11,7 +11,10 @@ use twocan_flexcan::{
 use twocan_teensy4::configs::{self, APP_NODES, CAN1_CAN2_NODES};
 use twocan_teensy4::filters_example;
 
-fn examples() -> Vec<(&'static str, Instance, Settings, Vec<Filter>, Vec<Filter>)> {
+/// An example: name, module, settings, primary and secondary filters.
+type Example = (&'static str, Instance, Settings, Vec<Filter>, Vec<Filter>);
+
+fn examples() -> Vec<Example> {
     let app = |(n, p): (u8, u8)| App::new(n, p).filters().to_vec();
     vec![
         (
