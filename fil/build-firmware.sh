@@ -76,7 +76,19 @@ cargo build --quiet --release --target "$m3" --manifest-path fil/firmware/Cargo.
 for bin in bluepill-can bluepill-gate bluepill-stuck; do
     cp "fil/firmware/target/$m3/release/$bin" "$out/bluepill/"
 done
-# Teensy 4.1 (i.MX RT1062): the examples' ELFs go to $out/teensy41/ once examples/teensy
-# builds them (issue 24); the teensy41 profile's own test firmwares are the imxrt-* above.
-mkdir -p "$out/teensy41"
+# Teensy 4.1 (i.MX RT1062, examples/teensy4, issue 24) for the teensy41 profile; its own
+# test firmwares are the imxrt-* above. (The Teensy 4.0 build differs in the flash size
+# of its boot header only; CI cross-builds it.)
+for board in teensy41; do
+    cargo build --quiet --release --target "$target" -p twocan-teensy4 --features "$board" --bins
+    mkdir -p "$out/$board"
+    for bin in loopback filters app async-echo can1-can2; do
+        cp "$rel/teensy4-$bin" "$out/$board/"
+    done
+done
+# The Teensy 4.1 `app` as node 3 (feature app-node3): the third board of the three-board
+# run (tests/teensy41_examples.rs).
+cargo build --quiet --release --target "$target" -p twocan-teensy4 --features teensy41,app-node3 \
+    --bin teensy4-app
+cp "$rel/teensy4-app" "$out/teensy41/teensy4-app-node3"
 echo "firmware for the harness in $out"

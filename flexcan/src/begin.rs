@@ -36,17 +36,21 @@ use twocan_core::timing::{TimingError, TimingRule};
 use twocan_core::{BusMode, BusOffRecovery, Error, Filter, LastErrorCode, Mode, Registers};
 
 use crate::begin_error::{BeginError, ConfigErrors};
+use crate::can_clock::CanClock;
 use crate::configuration::{Configuration, DATA_MAILBOX, MESSAGE_BUFFERS};
 use crate::controller::FlexCan;
 use crate::filters::FilterTable;
 use crate::handshake;
+use crate::imxrt::ImxrtPlan;
 use crate::installed::PlannedTable;
 use crate::instance::Target;
 use crate::options::Options;
-use crate::regs::{self, code, cs, ctrl1, ctrl2, iflag1, mcr, CTRL1, CTRL2, IFLAG1, IMASK1, MCR};
-use crate::settings::{Settings, CAN_CLOCK_HZ};
+use crate::regs::{
+    self, code, cs, ctrl1, ctrl2, iflag1, mcr, CTRL1, CTRL2, IFLAG1, IFLAG2, IMASK1, IMASK2, MCR,
+};
+use crate::settings::Settings;
 use crate::split::{FlexCanHw, Parts};
-use crate::system::{choose_pins, SystemPlan};
+use crate::system::{choose_pins, PortPlan, SystemPlan};
 
 /// Everything `begin` will write but the filter table, computed before anything is
 /// written (the lists are checked; the table is built once, inside the controller
@@ -57,6 +61,8 @@ struct Plan {
     mcr: u32,
     ctrl1: u32,
     configuration: Configuration,
+    /// The module's message buffers (16 or 64, [`crate::Chip::message_buffers`]).
+    message_buffers: usize,
 }
 
 /// The checks of ACAN table 5, all of them, then the register values.
@@ -74,38 +80,21 @@ const fn plan(
 
     errors = errors.union(filter_errors);
 
-    let pins = match target.board.pins(target.instance) {
-        None => {
+    let chip = target.board.chip();
+    if !settings.can_clock.fits(chip) {
+        errors = errors.union(ConfigErrors::CLOCK_NOT_ON_CHIP);
+    }
+    let system = match (chip.is_imxrt(), target.clock_gate()) {
+        (_, None) => {
             errors = errors.union(ConfigErrors::NO_SUCH_INSTANCE);
             None
         }
-        Some(pins) => match choose_pins(
-            pins,
-            settings.use_alternate_tx_pin,
-            settings.use_alternate_rx_pin,
-        ) {
-            Ok(chosen) => Some(chosen),
-            Err((no_tx, no_rx)) => {
-                if no_tx {
-                    errors = errors.union(ConfigErrors::NO_ALTERNATE_TX_PIN);
-                }
-                if no_rx {
-                    errors = errors.union(ConfigErrors::NO_ALTERNATE_RX_PIN);
-                }
-                None
-            }
-        },
+        (true, Some(gate)) => imxrt_system(target, gate, settings, &mut errors),
+        (false, Some(gate)) => kinetis_system(target, gate, settings, &mut errors),
     };
 
-    match (errors.is_empty(), timing_bits, pins) {
-        (true, Ok(timing_bits), Some((tx, rx))) => {
-            let system = SystemPlan::new(
-                target.instance.clock_gate(),
-                tx,
-                rx,
-                settings.tx_pin_open_collector,
-                settings.rx_pin_pull_up,
-            );
+    match (errors.is_empty(), timing_bits, system) {
+        (true, Ok(timing_bits), Some(system)) => {
             let mut mcr = mcr::FRZ
                 | mcr::HALT
                 | mcr::RFEN
@@ -135,9 +124,75 @@ const fn plan(
                 mcr,
                 ctrl1,
                 configuration,
+                message_buffers: chip.message_buffers(),
             })
         }
         _ => Err(errors),
+    }
+}
+
+/// The Kinetis SIM/PORT plan: the pins of ACAN §7 (alternates on request).
+const fn kinetis_system(
+    target: Target,
+    gate: (usize, u32),
+    settings: &Settings,
+    errors: &mut ConfigErrors,
+) -> Option<SystemPlan> {
+    let Some(pins) = target.board.pins(target.instance) else {
+        return None;
+    };
+    match choose_pins(
+        pins,
+        settings.use_alternate_tx_pin,
+        settings.use_alternate_rx_pin,
+    ) {
+        Ok((tx, rx)) => Some(SystemPlan::Kinetis(PortPlan::new(
+            gate,
+            tx,
+            rx,
+            settings.tx_pin_open_collector,
+            settings.rx_pin_pull_up,
+        ))),
+        Err((no_tx, no_rx)) => {
+            if no_tx {
+                *errors = errors.union(ConfigErrors::NO_ALTERNATE_TX_PIN);
+            }
+            if no_rx {
+                *errors = errors.union(ConfigErrors::NO_ALTERNATE_RX_PIN);
+            }
+            None
+        }
+    }
+}
+
+/// The RT1062 CCM/IOMUXC plan: the board's one pin pair (no alternates on the Teensy
+/// 4.x, so asking for one is [`ConfigErrors::NO_ALTERNATE_TX_PIN`] /
+/// [`ConfigErrors::NO_ALTERNATE_RX_PIN`]), the clock root of the settings.
+const fn imxrt_system(
+    target: Target,
+    gate: (usize, u32),
+    settings: &Settings,
+    errors: &mut ConfigErrors,
+) -> Option<SystemPlan> {
+    let Some(pins) = target.board.imx_pins(target.instance) else {
+        return None;
+    };
+    if settings.use_alternate_tx_pin {
+        *errors = errors.union(ConfigErrors::NO_ALTERNATE_TX_PIN);
+    }
+    if settings.use_alternate_rx_pin {
+        *errors = errors.union(ConfigErrors::NO_ALTERNATE_RX_PIN);
+    }
+    match settings.can_clock {
+        CanClock::Imxrt(root) if errors.is_empty() => Some(SystemPlan::Imxrt(ImxrtPlan::new(
+            gate,
+            root,
+            pins.tx,
+            pins.rx,
+            settings.tx_pin_open_collector,
+            settings.rx_pin_pull_up,
+        ))),
+        _ => None,
     }
 }
 
@@ -222,6 +277,11 @@ fn configure<R: Registers>(
     }
     regs.write32(IFLAG1, u32::MAX);
     regs.write32(IMASK1, iflag1::BUF5I | iflag1::BUF7I | tx_flags);
+    if plan.message_buffers > 32 {
+        // MB32 and above lie beyond `MAXMB` (15): never flagged, masked anyway.
+        regs.write32(IFLAG2, u32::MAX);
+        regs.write32(IMASK2, 0);
+    }
     handshake::unfreeze(regs, polls)
 }
 
@@ -298,7 +358,7 @@ impl<R: Registers> FlexCan<R> {
             polls,
             settings.message_irq_priority,
             plan.system,
-            settings.bus_clock_hz.unwrap_or(CAN_CLOCK_HZ),
+            settings.bus_clock_hz.unwrap_or(settings.can_clock.hz()),
         );
         let table = &controller.table;
         configure(
@@ -382,7 +442,7 @@ impl<R: Registers> FlexCan<R> {
                 mode: Mode::Normal,
                 last_error: LastErrorCode::None,
                 system: plan.system,
-                bus_clock_hz: settings.bus_clock_hz.unwrap_or(CAN_CLOCK_HZ),
+                bus_clock_hz: settings.bus_clock_hz.unwrap_or(settings.can_clock.hz()),
             },
         ))
     }
@@ -524,7 +584,7 @@ impl BeginPlan {
                 irq_priority: settings.message_irq_priority,
                 bus_clock_hz: match settings.bus_clock_hz {
                     Some(hz) => hz,
-                    None => CAN_CLOCK_HZ,
+                    None => settings.can_clock.hz(),
                 },
             }),
             Err(e) => Err(BeginError::Config(e)),
@@ -566,7 +626,8 @@ const fn bus_mode_of(settings: &Settings) -> BusMode {
 
 #[cfg(all(
     target_os = "none",
-    any(feature = "teensy32", feature = "teensy35", feature = "teensy36")
+    any(feature = "teensy32", feature = "teensy35", feature = "teensy36"),
+    not(any(feature = "teensy40", feature = "teensy41"))
 ))]
 mod firmware {
     use twocan_core::Filter;
@@ -597,7 +658,7 @@ mod firmware {
             let target = self.target();
             // SAFETY: the token is unique (taken once) and consumed here, so this is
             // the only access to FlexCAN0, at its reference-manual base address.
-            let regs = unsafe { FlexCanRegs::new(target.instance.base()) };
+            let regs = unsafe { FlexCanRegs::new(regs::CAN0_BASE) };
             FlexCan::begin(regs, &mut system(), target, settings, primary, secondary)
                 .map_err(|e| (self, e))
         }
@@ -614,7 +675,7 @@ mod firmware {
         ) -> Result<FlexCan<FlexCanRegs>, (Self, BeginError)> {
             let target = self.target();
             // SAFETY: as for `Can0::begin`, for FlexCAN1.
-            let regs = unsafe { FlexCanRegs::new(target.instance.base()) };
+            let regs = unsafe { FlexCanRegs::new(regs::CAN1_BASE) };
             FlexCan::begin(regs, &mut system(), target, settings, primary, secondary)
                 .map_err(|e| (self, e))
         }

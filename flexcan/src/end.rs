@@ -83,7 +83,8 @@ impl<R: Registers> FlexCan<R> {
 
 #[cfg(all(
     target_os = "none",
-    any(feature = "teensy32", feature = "teensy35", feature = "teensy36")
+    any(feature = "teensy32", feature = "teensy35", feature = "teensy36"),
+    not(any(feature = "teensy40", feature = "teensy41"))
 ))]
 mod firmware {
     use super::*;

@@ -66,9 +66,16 @@
 //!
 //! | features enabled | `Board::DEFAULT` | `Can1` |
 //! |---|---|---|
-//! | `teensy36` (with or without the others) | `Teensy36` | yes |
+//! | `teensy41` (with or without the others) | `Teensy41` | yes (and `Can2`, `Can3`; no `Can0`) |
+//! | `teensy40`, not `teensy41` | `Teensy40` | yes (and `Can2`, `Can3`; no `Can0`) |
+//! | `teensy36`, no Teensy 4 feature | `Teensy36` | yes |
 //! | `teensy35`, maybe `teensy32`, not `teensy36` | `Teensy35` | no |
 //! | `teensy32` alone | `Teensy32` | no |
+//!
+//! On a Teensy 4.x (i.MX RT1062, [`imxrt`]) the tokens are `Can1`, `Can2`, `Can3` (CAN1 on
+//! pins 22/23, CAN2 on 1/0, CAN3 on 31/30), the settings name the CCM clock root
+//! (`Settings::with_clock(rate, CanClock::IMXRT_24MHZ)`), and with `rt` the entry points
+//! are `CAN1`, `CAN2`, `CAN3` (`rt_imxrt`), one line per module.
 //!
 //! So `teensy32` + `teensy36` builds for a Teensy 3.6: firmware for a Teensy 3.2 linked
 //! that way would drive the wrong pins. Check `Board::DEFAULT` (or `cargo tree -e
@@ -106,25 +113,35 @@
 #![deny(missing_docs)]
 
 // The one call per module (ACAN's `begin`/`end`): take, begin, state, interrupts.
+// Teensy 3.x only for now (its `Can0`); a Teensy 4 board feature turns it off.
 #[cfg(all(
     feature = "rt",
-    any(feature = "teensy32", feature = "teensy35", feature = "teensy36")
+    any(feature = "teensy32", feature = "teensy35", feature = "teensy36"),
+    not(any(feature = "teensy40", feature = "teensy41"))
 ))]
 #[cfg_attr(docsrs, doc(cfg(feature = "rt")))]
 pub mod acan;
 pub mod begin;
 pub mod begin_error;
 pub mod board;
+pub mod can_clock;
 pub mod configuration;
 pub mod controller;
 pub mod end;
 pub mod filters;
 mod handshake;
+pub mod imxrt;
 pub mod installed;
 pub mod instance;
 mod message_buffer;
 pub mod options;
-#[cfg(any(feature = "teensy32", feature = "teensy35", feature = "teensy36"))]
+#[cfg(all(
+    any(feature = "teensy32", feature = "teensy35", feature = "teensy36"),
+    not(any(feature = "teensy40", feature = "teensy41"))
+))]
+pub mod pin;
+#[cfg(any(feature = "teensy40", feature = "teensy41"))]
+#[path = "imxrt/pin.rs"]
 pub mod pin;
 pub mod planner;
 pub mod settings;
@@ -138,6 +155,13 @@ pub mod regs;
 #[cfg_attr(docsrs, doc(cfg(feature = "rt")))]
 pub mod rt;
 
+#[cfg(all(feature = "rt", any(feature = "teensy40", feature = "teensy41")))]
+#[cfg_attr(
+    docsrs,
+    doc(cfg(all(feature = "rt", any(feature = "teensy40", feature = "teensy41"))))
+)]
+pub mod rt_imxrt;
+
 #[cfg(feature = "model")]
 pub mod model;
 
@@ -149,17 +173,24 @@ pub use idle_clock::IdleClocked;
 pub use begin::{check, BeginPlan};
 pub use begin_error::{BeginError, ConfigErrors};
 pub use board::{Board, Chip, InstancePins};
+pub use can_clock::CanClock;
 pub use configuration::Configuration;
 pub use controller::FlexCan;
 pub use filters::{FilterTable, SizedTable, UNKNOWN_FILTER};
-#[cfg(any(feature = "teensy32", feature = "teensy35", feature = "teensy36"))]
+#[cfg(all(
+    any(feature = "teensy32", feature = "teensy35", feature = "teensy36"),
+    not(any(feature = "teensy40", feature = "teensy41"))
+))]
 pub use instance::Can0;
-#[cfg(feature = "teensy36")]
+#[cfg(any(feature = "teensy36", feature = "teensy40", feature = "teensy41"))]
 pub use instance::Can1;
+#[cfg(any(feature = "teensy40", feature = "teensy41"))]
+pub use instance::{Can2, Can3};
 pub use instance::{Instance, Irqs, Target};
 pub use settings::{Settings, CAN_CLOCK_HZ, RECEIVE_BUFFER_SIZE, TRANSMIT_BUFFER_SIZE};
 pub use split::{FlexCanHw, InstalledFilters};
 pub use system::HostSystem;
+pub use system::{PortPlan, SystemPlan};
 
 /// The driver with ACAN's default buffer sizes: a receive ring of 32 frames and a
 /// transmit ring of 16 (ACAN table 7, §8.2, §10.1). Choose other sizes with

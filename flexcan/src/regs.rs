@@ -172,8 +172,13 @@ pub const RX15MASK: usize = 0x18;
 pub const ECR: usize = 0x1C;
 /// Error and Status 1 register.
 pub const ESR1: usize = 0x20;
+/// Interrupt Masks 2 register (MB32–MB63; modules of more than 32 message buffers, the
+/// i.MX RT1062's: IMXRT1060RM, FlexCAN memory map).
+pub const IMASK2: usize = 0x24;
 /// Interrupt Masks 1 register.
 pub const IMASK1: usize = 0x28;
+/// Interrupt Flags 2 register (MB32–MB63; i.MX RT1062).
+pub const IFLAG2: usize = 0x2C;
 /// Interrupt Flags 1 register.
 pub const IFLAG1: usize = 0x30;
 /// Control 2 register.

@@ -203,12 +203,14 @@ impl Slot {
     }
 }
 
-static SLOTS: [Slot; 2] = [Slot::new(), Slot::new()];
+static SLOTS: [Slot; 4] = [Slot::new(), Slot::new(), Slot::new(), Slot::new()];
 
 const fn slot(instance: Instance) -> &'static Slot {
     match instance {
         Instance::Can0 => &SLOTS[0],
         Instance::Can1 => &SLOTS[1],
+        Instance::Can2 => &SLOTS[2],
+        Instance::Can3 => &SLOTS[3],
     }
 }
 
@@ -508,12 +510,21 @@ fn lines(irqs: Irqs) -> [u16; 5] {
 }
 
 /// The one priority on every line (they run two cells; the four status lines one),
-/// then each line unmasked: after the handlers are in place.
+/// then each line unmasked: after the handlers are in place. A line shared by several
+/// sources (the i.MX RT1062 has one per module: [`Irqs::is_single_line`]) is set once.
 fn enable(nvic: &mut impl Nvic, irqs: Irqs, priority: u8) {
-    for irq in lines(irqs) {
+    let lines = lines(irqs);
+    let distinct = || {
+        lines
+            .iter()
+            .enumerate()
+            .filter(move |(i, irq)| !lines[..*i].contains(irq))
+            .map(|(_, &irq)| irq)
+    };
+    for irq in distinct() {
         nvic.set_priority(IrqNumber(irq), priority);
     }
-    for irq in lines(irqs) {
+    for irq in distinct() {
         nvic.unmask(IrqNumber(irq));
     }
 }

@@ -1095,7 +1095,7 @@ unsafe impl<R: Registers, O: Options> Hardware for FlexCanHw<R, O> {
         let c = self.configuration();
         let filters = (c.primary_filter_capacity() + c.secondary_filter_capacity()) as u16;
         Capabilities::new(
-            crate::settings::CAN_CLOCK_HZ,
+            self.system.can_clock_hz(),
             Limits::FLEXCAN_KINETIS,
             ModeSupport {
                 loop_back: true,
@@ -1112,7 +1112,10 @@ unsafe impl<R: Registers, O: Options> Hardware for FlexCanHw<R, O> {
             RX_FIFO_DEPTH as u8,
             Some(16),
         )
-        .with_timing_rule(crate::settings::timing_rule(Some(self.bus_clock_hz)))
+        .with_timing_rule(crate::settings::timing_rule_for(
+            self.system.can_clock_hz(),
+            Some(self.bus_clock_hz),
+        ))
     }
 
     fn bus_mode(&self) -> BusMode {
