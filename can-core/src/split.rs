@@ -371,6 +371,61 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
         })
     }
 
+    /// [`State::split`] with the controller **built in place** in the state (no move of
+    /// the controller through the configuration path, so the configuration's stack
+    /// stays small whatever the controller's size): `init` gets the state's empty
+    /// controller storage, configures the controller there and returns it
+    /// (`Ok(slot.write(..))`, or a backend's in-place constructor such as
+    /// `twocan_bxcan::BxCan::can1_in`). Once only, as `split`.
+    ///
+    /// Errors: `init`'s error (the state stays unsplit; the backend's constructor says
+    /// what it gives back); [`Error::WrongMode`] when the state was split already (then
+    /// `init` is not called); [`Error::InvalidArgument`] when the controller's transmit
+    /// order is not `Q`'s (the controller is dropped in place, the state stays
+    /// unsplit) or when `init` returns a controller that is not the slot's.
+    #[allow(clippy::type_complexity)]
+    pub fn split_with(
+        &self,
+        init: impl FnOnce(&mut core::mem::MaybeUninit<H>) -> Result<&mut H, Error>,
+    ) -> Result<Parts<'_, H, RX, Q, RX1, DONE>, Error> {
+        let Some(claim) = self.hw.claim() else {
+            return Err(Error::WrongMode);
+        };
+        let adopt = |hw: &H| {
+            let adopted = critical_section::with(|cs| {
+                // SAFETY: the queue is only touched inside a critical section.
+                unsafe { &mut *self.queue.borrow(cs).get() }.adopt(hw.tx_policy())
+            });
+            if adopted {
+                Ok(())
+            } else {
+                Err(Error::InvalidArgument)
+            }
+        };
+        let (_, (map, status)) = claim
+            .publish_in_place(init, adopt, |hw| {
+                // SAFETY: not published yet: this is the only context that sees it.
+                let map = unsafe { hw.filter_map() };
+                let status = hw.error_status();
+                self.state
+                    .store(state_code(status.state), Ordering::Relaxed);
+                (map, status)
+            })
+            .map_err(|e| e.unwrap_or(Error::InvalidArgument))?;
+        self.refresh_timestamps();
+        Ok(Parts {
+            tx: Tx { s: self, next: 0 },
+            rx: Rx { s: self, map },
+            tx_irq: TxIrq { s: self },
+            rx0_irq: RxIrq { s: self },
+            rx1_irq: RxIrq { s: self },
+            status_irq: StatusIrq {
+                s: self,
+                last: status.state,
+            },
+        })
+    }
+
     /// Stores `hardware` in a state owned exclusively (the one-struct
     /// [`crate::Driver`]); returns the filter map and status for its handles.
     pub(crate) fn install(&mut self, hardware: H) -> (H::FilterMap, ErrorStatus) {
@@ -1552,5 +1607,59 @@ mod tests {
             Poll::Pending => panic!("woken without a completion"),
         }
         assert_eq!(state.traffic().sent, u32::MAX);
+    }
+}
+
+#[cfg(all(test, feature = "mock"))]
+mod in_place_tests {
+    use super::State;
+    use crate::mock::MockHardware;
+    use crate::{Error, FifoQueue, Frame, TxOutcome, TxPolicy};
+
+    /// `split_with` builds the controller in the state's slot, publishes it once, and
+    /// leaves the state unsplit when the closure fails, returns another controller, or
+    /// the transmit order is not the queue's.
+    #[test]
+    fn split_with_builds_in_place_once() {
+        let state: State<MockHardware, 8, FifoQueue<4>> = State::new();
+        assert_eq!(
+            state.split_with(|_| Err(Error::Timeout)).err(),
+            Some(Error::Timeout)
+        );
+        assert!(state.hardware().is_none());
+        let other: &'static mut MockHardware = Box::leak(Box::new(MockHardware::new(1)));
+        assert_eq!(
+            state.split_with(move |_| Ok(other)).err(),
+            Some(Error::InvalidArgument),
+            "a controller outside the slot is refused"
+        );
+        assert_eq!(
+            state
+                .split_with(|slot| Ok(
+                    slot.write(MockHardware::new(1).with_policy(TxPolicy::Priority))
+                ))
+                .err(),
+            Some(Error::InvalidArgument),
+            "a transmit order other than the queue's is refused"
+        );
+        assert!(state.hardware().is_none());
+        let mut p = state
+            .split_with(|slot| Ok(slot.write(MockHardware::new(2))))
+            .ok()
+            .unwrap();
+        assert!(state.hardware().is_some());
+        assert_eq!(
+            state
+                .split_with(|slot| Ok(slot.write(MockHardware::new(2))))
+                .err(),
+            Some(Error::WrongMode)
+        );
+        let token =
+            p.tx.try_send(&Frame::standard(0x10, &[1]).unwrap())
+                .unwrap();
+        state.hardware().unwrap().complete_all();
+        p.tx_irq.on_interrupt();
+        let done = p.tx.take_completion().unwrap();
+        assert_eq!((done.token, done.outcome), (token, TxOutcome::Sent));
     }
 }
