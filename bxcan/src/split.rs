@@ -21,6 +21,10 @@
 //! `CAN_RDLxR`, `CAN_RDHxR`) with the FIFO number in the reserved bits 7:4 of the
 //! second word; the thread side decodes it and maps `(FIFO, FMI)` to the user's filter.
 
+mod in_place;
+
+pub use in_place::{InPlace, Unconfigured};
+
 use core::cell::UnsafeCell;
 use core::sync::atomic::{AtomicBool, AtomicU32, AtomicU8, Ordering};
 
