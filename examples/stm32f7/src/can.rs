@@ -1,13 +1,19 @@
 //! The split driver of a bxCAN instance as the examples use it: its shared state in a
 //! `static` ([`CanState`]), its interrupt handles in the instance's [`Vectors`], which
 //! the example's four vectors run (TX, RX0, RX1, SCE: one handler per line, RM0410
-//! §40.8), and `start`, which puts the handles in place **before** it unmasks the lines.
+//! §40.8), and `start`, which configures the controller **in place** in the state
+//! (`State::split_with` with an in-place constructor such as `BxCan::can1_in`: no
+//! controller, plan or filter map moves through the configuration, issue 21) and puts
+//! the handles in place **before** it unmasks the lines. Filter lists known at compile
+//! time are planned at compile time (`const_plan!`); lists known at run time use the
+//! planner with its working memory in [`PLANNER`].
 
+use twocan_bxcan::planner::Scratch;
 use twocan_bxcan::regs::CanRegs;
 use twocan_bxcan::BxCan;
 use twocan_core::irq_cell::IrqCell;
 use twocan_core::split::{Rx, Rx0Irq, Rx1Irq, State, StatusIrq, Tx, TxIrq};
-use twocan_core::{FifoQueue, Registers};
+use twocan_core::{FifoQueue, Registers, TakeOnce};
 
 /// Receive ring per FIFO, transmit queue and completion ring sizes of the examples.
 pub const RX: usize = 32;
@@ -15,6 +21,11 @@ pub const RX: usize = 32;
 pub const TX: usize = 16;
 /// See [`RX`].
 pub const COMPLETIONS: usize = 8;
+
+/// The planner's working memory for filter lists known only at run time (about 90 KB
+/// of `.bss`, never on the stack), lent once: plan into it with
+/// `twocan_bxcan::planner::plan_in`, install the plan, plan the next list into it.
+pub static PLANNER: TakeOnce<Scratch> = TakeOnce::new(Scratch::new());
 
 /// A transmit queue in request order (`TXFP = 1`, the driver's default).
 pub type Queue = FifoQueue<TX>;
@@ -73,19 +84,23 @@ impl<R: Registers + 'static, F: Registers + 'static> Vectors<R, F> {
     }
 }
 
-/// Splits `state` over `hw`, puts the interrupt handles in `vectors`, then unmasks
-/// `irqs` (TX, RX0, RX1, SCE): each line only once the handle its vector runs is in
-/// place (`IrqCell::put` gives the token that unmasks it). Returns the thread-side
-/// halves; `None` when `state` was split already.
+/// Configures the controller in place in `state` (`init`: an in-place constructor,
+/// e.g. `BxCan::can1_in`), splits it, puts the interrupt handles in `vectors`, then
+/// unmasks `irqs` (TX, RX0, RX1, SCE): each line only once the handle its vector runs
+/// is in place (`IrqCell::put` gives the token that unmasks it). Returns the
+/// thread-side halves; `None` when the configuration failed or `state` was split
+/// already.
 #[cfg(target_os = "none")]
 pub fn start<R: Registers + Send + Sync + 'static, F: Registers + Send + Sync + 'static>(
     state: &'static CanState<R, F>,
     vectors: &'static Vectors<R, F>,
-    hw: BxCan<R, F>,
+    init: impl FnOnce(
+        &mut core::mem::MaybeUninit<BxCan<R, F>>,
+    ) -> Result<&mut BxCan<R, F>, twocan_core::Error>,
     irqs: [stm32f7xx_hal::pac::Interrupt; 4],
     nvic: &mut cortex_m::peripheral::NVIC,
 ) -> Option<(CanTxHalf<R, F>, CanRxHalf<R, F>)> {
-    let parts = state.split(hw).ok()?;
+    let parts = state.split_with(init).ok()?;
     let [tx, rx0, rx1, sce] = irqs;
     let lines = &mut crate::rt::Lines(nvic);
     let priority = crate::rt::CAN_PRIORITY;

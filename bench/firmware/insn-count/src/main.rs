@@ -178,12 +178,9 @@ fn ours_configure() -> OurParts {
     // SAFETY: `REGS` is the RAM stand-in for CAN1's registers; this driver alone uses it
     // from now on (the `bxcan` crate has given it up).
     let regs = unsafe { Mmio::new(REGS) };
-    let Ok(hw) = variant::configure::<20>(regs) else {
-        fail("twocan: configure");
-    };
-    match CAN.split(hw) {
+    match variant::start::<20>(&CAN, regs) {
         Ok(p) => p,
-        Err(_) => fail("twocan: split"),
+        Err(_) => fail("twocan: configure"),
     }
 }
 

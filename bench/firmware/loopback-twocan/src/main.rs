@@ -35,16 +35,15 @@ const POLLS: u32 = 1_000_000;
 #[no_mangle]
 static BENCH_CAN_STATE: variant::OurState = variant::OurState::new();
 
-fn start() -> Result<variant::Hw, Error> {
+fn start() -> Result<variant::OurParts, Error> {
     // SAFETY: CAN1's register block (RM0410 §2.2.2), clocked by `stm32f7::clocks`;
     // nothing else in this firmware touches it.
     let regs = unsafe { Mmio::new(CAN1_BASE) };
-    variant::configure::<0>(regs)
+    variant::start::<0>(&BENCH_CAN_STATE, regs)
 }
 
-fn loop_back(hw: variant::Hw) -> Result<bool, Error> {
+fn loop_back(mut p: variant::OurParts) -> Result<bool, Error> {
     let frame = Frame::standard(ID, &DATA)?;
-    let mut p = BENCH_CAN_STATE.split(hw).map_err(|(e, _)| e)?;
     p.tx.try_send(&frame).map_err(|_| Error::WrongMode)?;
     for _ in 0..POLLS {
         p.tx_irq.on_interrupt();

@@ -24,7 +24,7 @@ mod firmware {
     use static_cell::StaticCell;
     use stm32f7xx_hal::pac::interrupt;
     use twocan_app::asynch::{echo, EchoStats};
-    use twocan_bxcan::{hal, FifoPolicy, Recovery};
+    use twocan_bxcan::{const_plan, hal, BxCan, PlanOptions, Recovery};
     use twocan_core::Filter;
     use twocan_stm32f7::board::BIT_RATE;
     use twocan_stm32f7::can::{self, CanRxHalf, CanState, CanTxHalf, Vectors};
@@ -80,22 +80,18 @@ mod firmware {
             .config(BIT_RATE)
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS))
             .recovery(Recovery::Automatic);
-        let mut init = can1
+        // The HAL's configuration gives the registers back; the controller is then
+        // configured in place in `CAN1` with a plan computed at compile time. One FIFO
+        // keeps the frames in arrival order.
+        let (regs, _) = can1
             .configure(&config)
-            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        // One FIFO keeps the frames in arrival order.
-        let plan = init
-            .can()
-            .plan(&[Filter::pass_all()], FifoPolicy::Fifo0)
-            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        if init.set_filters(&plan).is_err() {
-            rt::halt(CAN_BLINKS);
-        }
-        let can = init.enable().unwrap_or_else(|_| rt::halt(CAN_BLINKS));
+            .unwrap_or_else(|_| rt::halt(CAN_BLINKS))
+            .release();
+        let plan = const_plan!([Filter::pass_all()], PlanOptions::new(14));
         let (tx, rx) = can::start(
             &CAN1,
             &CAN1_VECTORS,
-            can.into_split(),
+            |slot| BxCan::can1_in(slot, regs, &config, plan).map_err(|f| f.error),
             rt::CAN1_IRQS,
             &mut boot.core.NVIC,
         )

@@ -12,7 +12,7 @@ mod firmware {
     use core::sync::atomic::{AtomicU32, Ordering};
 
     use stm32f7xx_hal::pac::interrupt;
-    use twocan_bxcan::{hal, FifoPolicy};
+    use twocan_bxcan::{const_plan, hal, BxCan, PlanOptions};
     use twocan_core::{Filter, Frame};
     use twocan_stm32f7::can::{self, CanState, Vectors};
     use twocan_stm32f7::rt::{self, CAN_BLINKS};
@@ -55,21 +55,17 @@ mod firmware {
             .config(125_000)
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS))
             .loopback(true);
-        let mut init = can1
+        // The HAL's configuration gives the registers back; the controller is then
+        // configured in place in `CAN1` with a plan computed at compile time.
+        let (regs, _) = can1
             .configure(&config)
-            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        let plan = init
-            .can()
-            .plan(&[Filter::pass_all()], FifoPolicy::Fifo0)
-            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        if init.set_filters(&plan).is_err() {
-            rt::halt(CAN_BLINKS);
-        }
-        let can = init.enable().unwrap_or_else(|_| rt::halt(CAN_BLINKS));
+            .unwrap_or_else(|_| rt::halt(CAN_BLINKS))
+            .release();
+        let plan = const_plan!([Filter::pass_all()], PlanOptions::new(14));
         let (mut tx, mut rx) = can::start(
             &CAN1,
             &CAN1_VECTORS,
-            can.into_split(),
+            |slot| BxCan::can1_in(slot, regs, &config, plan).map_err(|f| f.error),
             rt::CAN1_IRQS,
             &mut boot.core.NVIC,
         )
