@@ -32,6 +32,7 @@ pub mod controller;
 pub mod dispatch;
 pub mod driver;
 pub mod error;
+pub mod features;
 pub mod filter;
 pub mod filter_set;
 pub mod frame;
@@ -66,6 +67,7 @@ pub use embedded_can::{ExtendedId, Id, StandardId};
 pub use error::{
     AtomicLastError, Error, ErrorCounters, ErrorState, ErrorStatistics, LastErrorCode,
 };
+pub use features::{Features, Full, Lean};
 pub use filter::{Filter, FilterError, Format, FrameKind};
 pub use frame::{Frame, FrameError, RxFrame};
 pub use hardware::{Completion, Hardware, Settled, StatusEvents, Token, TxFailure};
