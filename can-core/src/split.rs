@@ -1768,4 +1768,30 @@ mod in_place_tests {
         let done = p.tx.take_completion().unwrap();
         assert_eq!((done.token, done.outcome), (token, TxOutcome::Sent));
     }
+
+    /// The lean feature set moves the same frames with the same tokens, counts no
+    /// traffic and takes no room for it.
+    #[test]
+    fn lean_moves_frames_and_counts_nothing() {
+        use crate::{Full, Lean};
+        type LeanState = State<MockHardware, 8, FifoQueue<4>, 0, 0, Lean>;
+        type FullState = State<MockHardware, 8, FifoQueue<4>, 0, 0, Full>;
+        assert!(core::mem::size_of::<LeanState>() + 7 * 4 <= core::mem::size_of::<FullState>());
+        let state: LeanState = State::new();
+        let mut p = state
+            .split_with(|slot| Ok(slot.write(MockHardware::new(3).with_loopback(true))))
+            .ok()
+            .unwrap();
+        let frame = Frame::standard(0x321, &[1, 2, 3]).unwrap();
+        p.tx.try_send(&frame).unwrap();
+        state.hardware().unwrap().complete_all();
+        p.tx_irq.on_interrupt();
+        p.rx0_irq.on_interrupt();
+        let rx = p.rx.receive().unwrap();
+        assert_eq!(rx.frame, frame);
+        assert_eq!(rx.timestamp, None);
+        assert!(p.tx.take_completion().is_none(), "no completion ring");
+        let t = state.traffic();
+        assert_eq!((t.queued, t.sent, t.received), (0, 0, 0));
+    }
 }

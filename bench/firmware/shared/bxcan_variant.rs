@@ -14,7 +14,8 @@
 //!   lookup capacity;
 //! - **lean**: a `const` filter plan (`const_plan!`, the planner not linked) and a map
 //!   with no lookup key (the plan has no merged slot), no completion ring ([`DONE`] =
-//!   0), time stamps off. The driver has no switch for its statistics yet: they stay.
+//!   0), time stamps off (`CAN_MCR.TTCM` = 0) and the split driver's `Lean` feature
+//!   set (no traffic statistics, no time stamps read).
 
 // Each firmware that includes this module uses a part of it.
 #![allow(dead_code)]
@@ -64,6 +65,9 @@ pub const TIMESTAMPS: bool = false;
 /// Identifiers of the filter map's merged-filter lookup.
 #[cfg(feature = "lean")]
 pub const KEYS: usize = 0;
+/// The split driver's compile-time feature set: no statistics, no time stamps.
+#[cfg(feature = "lean")]
+pub type Fe = twocan_core::Lean;
 
 /// Planner options: CAN1's banks at reset (`CAN2SB` = 14, RM0410 §40.9.4), FIFO 0.
 pub const OPTIONS: PlanOptions = PlanOptions::new(14);
@@ -89,6 +93,9 @@ pub const DONE: usize = 8;
 pub const TIMESTAMPS: bool = true;
 #[cfg(feature = "full")]
 pub const KEYS: usize = twocan_bxcan::filters::LOOKUP_KEYS;
+/// The split driver's compile-time feature set: statistics and time stamps.
+#[cfg(feature = "full")]
+pub type Fe = twocan_core::Full;
 
 /// The planner's working memory (about 90 KB of `.bss`), lent once.
 #[cfg(feature = "full")]
@@ -115,13 +122,13 @@ pub type Hw = BxCan<Mmio, Mmio, KEYS>;
 /// The transmit queue.
 pub type Q = FifoQueue<TXQ>;
 /// The shared state a `static` holds.
-pub type OurState = State<Hw, RX, Q, 0, DONE>;
+pub type OurState = State<Hw, RX, Q, 0, DONE, Fe>;
 /// The handles of `State::split`.
-pub type OurParts = Parts<'static, Hw, RX, Q, 0, DONE>;
-pub type OurTx = Tx<'static, Hw, RX, Q, 0, DONE>;
-pub type OurRx = Rx<'static, Hw, RX, Q, 0, DONE>;
-pub type OurTxIrq = TxIrq<'static, Hw, RX, Q, 0, DONE>;
-pub type OurRxIrq = Rx0Irq<'static, Hw, RX, Q, 0, DONE>;
+pub type OurParts = Parts<'static, Hw, RX, Q, 0, DONE, Fe>;
+pub type OurTx = Tx<'static, Hw, RX, Q, 0, DONE, Fe>;
+pub type OurRx = Rx<'static, Hw, RX, Q, 0, DONE, Fe>;
+pub type OurTxIrq = TxIrq<'static, Hw, RX, Q, 0, DONE, Fe>;
+pub type OurRxIrq = Rx0Irq<'static, Hw, RX, Q, 0, DONE, Fe>;
 
 /// Configures CAN1 at `regs` ([`CONFIG`], the variant's filters) in place in `state`
 /// and splits it. `RETRIES` more attempts after a mode request that timed out (the QEMU
