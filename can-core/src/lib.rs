@@ -76,7 +76,7 @@ pub use io::{AsyncCanRx, AsyncCanTx};
 pub use io::{CanRx, CanTx};
 pub use mailbox::{MailboxId, MailboxState, TxOutcome, TxPolicy};
 pub use priority::Priority;
-pub use registers::{Mmio, Registers};
+pub use registers::{Fixed, Mmio, Registers};
 pub use split::State;
 pub use split::{AbortRequest, Parts, StateChange};
 pub use spsc::BufferStats;

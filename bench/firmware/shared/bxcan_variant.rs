@@ -27,7 +27,7 @@ compile_error!("enable feature `lean` or `full`");
 
 use twocan_bxcan::{BxCan, Config, PlanOptions, PlanRef};
 use twocan_core::split::{Parts, Rx, Rx0Irq, State, Tx, TxIrq};
-use twocan_core::{Error, FifoQueue, Filter, Mmio, TxPolicy};
+use twocan_core::{Error, FifoQueue, Filter, Fixed, TxPolicy};
 
 pub const APB1_HZ: u32 = 54_000_000;
 pub const BITRATE: u32 = 500_000;
@@ -117,8 +117,11 @@ pub const FILTER_INDEX: u16 = 0;
 
 // ------------------------------------------------------------------ both
 
+/// CAN1's registers at the firmware's `CAN_BASE`, a constant: the per-frame code reaches
+/// them with no base to load (`twocan_core::Fixed`).
+pub type Regs = Fixed<{ crate::CAN_BASE }>;
 /// The controller the split driver holds.
-pub type Hw = BxCan<Mmio, Mmio, KEYS>;
+pub type Hw = BxCan<Regs, Regs, KEYS>;
 /// The transmit queue.
 pub type Q = FifoQueue<TXQ>;
 /// The shared state a `static` holds.
@@ -135,7 +138,7 @@ pub type OurRxIrq = Rx0Irq<'static, Hw, RX, Q, 0, DONE, Fe>;
 /// stand-in acknowledges from an interrupt whose rate follows host time; 0 on
 /// hardware).
 #[inline(always)]
-pub fn start<const RETRIES: u32>(state: &'static OurState, regs: Mmio) -> Result<OurParts, Error> {
+pub fn start<const RETRIES: u32>(state: &'static OurState, regs: Regs) -> Result<OurParts, Error> {
     with_plan(|plan| {
         state.split_with(|slot| {
             let mut attempt = Hw::can1_in(slot, regs, &CONFIG, plan);
