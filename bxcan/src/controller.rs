@@ -68,13 +68,13 @@ impl<R: Registers> Can<R, R> {
     /// Errors: [`Error::Timeout`] when INAK does not come (no clock, stuck peripheral),
     /// with the registers handed back in [`Failed::value`].
     pub fn can1(regs: R, config: &Config) -> Result<Init<R, R>, Failed<Can<R, R>>> {
-        Can::new(regs, None, Instance::Can1, config).configure(config)
+        Can::configured(regs, None, Instance::Can1, config)
     }
 
     /// Configures CAN3 (F76x/F77x: single CAN with its own 14 filter banks); as
     /// [`Can::can1`].
     pub fn can3(regs: R, config: &Config) -> Result<Init<R, R>, Failed<Can<R, R>>> {
-        Can::new(regs, None, Instance::Can3, config).configure(config)
+        Can::configured(regs, None, Instance::Can3, config)
     }
 }
 
@@ -90,7 +90,7 @@ impl<R: Registers, F: Registers> Can<R, F> {
         filters: F,
         config: &Config,
     ) -> Result<Init<R, F>, Failed<Can<R, F>>> {
-        Can::new(regs, Some(filters), Instance::Can1, config).configure(config)
+        Can::configured(regs, Some(filters), Instance::Can1, config)
     }
 
     /// Configures CAN2 (the slave): `regs` are CAN2's registers, `can1_filters` reaches
@@ -108,7 +108,7 @@ impl<R: Registers, F: Registers> Can<R, F> {
         can1_filters: F,
         config: &Config,
     ) -> Result<Init<R, F>, Failed<Can<R, F>>> {
-        Can::new(regs, Some(can1_filters), Instance::Can2, config).configure(config)
+        Can::configured(regs, Some(can1_filters), Instance::Can2, config)
     }
 }
 
@@ -121,6 +121,26 @@ impl<R: Registers, F: Registers, const K: usize> Can<R, F, K> {
             instance,
             config: *config,
             fmi: FmiMap::empty(),
+        }
+    }
+
+    /// A new controller of `instance`, configured: the registers are written before
+    /// the value is built, and the value is built once, in the result (no move of the
+    /// map through this call's frame).
+    fn configured(
+        regs: R,
+        filter_regs: Option<F>,
+        instance: Instance,
+        config: &Config,
+    ) -> Result<Init<R, F, K>, Failed<Can<R, F, K>>> {
+        match enter_configuration(&regs, filter_regs.as_ref(), instance, config) {
+            Ok(()) => Ok(Init {
+                can: Can::new(regs, filter_regs, instance, config),
+            }),
+            Err(error) => Err(Failed {
+                error,
+                value: Can::new(regs, filter_regs, instance, config),
+            }),
         }
     }
 

@@ -38,6 +38,8 @@ impl<T> TakeOnce<T> {
     }
 
     /// The value, the first time (`None` ever after).
+    // `&'static self` lends `&'static mut T`: the compare-and-swap makes it unique.
+    #[allow(clippy::mut_from_ref)]
     pub fn take(&'static self) -> Option<&'static mut T> {
         self.taken
             .compare_exchange(false, true, Ordering::Acquire, Ordering::Relaxed)

@@ -71,7 +71,7 @@ impl<R: Registers, const K: usize> BxCan<R, R, K> {
     /// `config` and the filters of `plan`, on the bus when this returns `Ok`: the
     /// sequence of [`crate::Can::can1`], [`crate::Init::set_filters`],
     /// [`crate::Init::enable`] and [`crate::Can::into_split`], without moving the
-    /// controller (see the [module docs](self)). `K`: the lookup capacity of the
+    /// controller (see `split::in_place` in the source). `K`: the lookup capacity of the
     /// controller's filter map (0 for a plan without merged slots).
     ///
     /// Errors, with the slot and the registers back ([`Unconfigured`]):
