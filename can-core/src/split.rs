@@ -471,6 +471,15 @@ impl<
         self.hw.take()
     }
 
+    /// Gives the controller back once no handle borrows the state any more (it takes
+    /// the state by value, so the handles are gone; a `static` state keeps its
+    /// controller for ever). Frames and completions still in the rings and the queue go
+    /// with the state; the controller keeps its configuration and its mailboxes.
+    /// `None` when the state was never split.
+    pub fn into_hardware(mut self) -> Option<H> {
+        self.uninstall()
+    }
+
     /// The controller, once [`State::split`] stored it (any context).
     pub fn hardware(&self) -> Option<&H> {
         self.hw.get()
@@ -1288,34 +1297,6 @@ impl<
     /// The map from hardware match index to user filter index in force.
     pub fn filter_map(&self) -> &H::FilterMap {
         &self.map
-    }
-}
-
-impl<
-        H: Hardware,
-        const RX: usize,
-        Q: TxQueue,
-        const RX1: usize,
-        const DONE: usize,
-        Fe: Features,
-    > crate::io::CanTx for Tx<'_, H, RX, Q, RX1, DONE, Fe>
-{
-    fn try_send(&mut self, frame: &Frame) -> nb::Result<Token, Error> {
-        Tx::try_send(self, frame)
-    }
-}
-
-impl<
-        H: Hardware,
-        const RX: usize,
-        Q: TxQueue,
-        const RX1: usize,
-        const DONE: usize,
-        Fe: Features,
-    > crate::io::CanRx for Rx<'_, H, RX, Q, RX1, DONE, Fe>
-{
-    fn receive(&mut self) -> nb::Result<RxFrame, Error> {
-        Rx::receive(self)
     }
 }
 
