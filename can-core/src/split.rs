@@ -1714,12 +1714,18 @@ mod in_place_tests {
             Some(Error::Timeout)
         );
         assert!(state.hardware().is_none());
-        let other: &'static mut MockHardware = Box::leak(Box::new(MockHardware::new(1)));
+        let other_ptr = Box::into_raw(Box::new(MockHardware::new(1)));
+        // SAFETY: a fresh box, not freed before the end of the test; this is the only
+        // reference made from it.
+        let other: &'static mut MockHardware = unsafe { &mut *other_ptr };
         assert_eq!(
             state.split_with(move |_| Ok(other)).err(),
             Some(Error::InvalidArgument),
             "a controller outside the slot is refused"
         );
+        // SAFETY: `other_ptr` came from `Box::into_raw` above; the refused `&mut` was
+        // dropped by `split_with`, nothing refers to the box any more.
+        drop(unsafe { Box::from_raw(other_ptr) });
         assert_eq!(
             state
                 .split_with(|slot| Ok(
