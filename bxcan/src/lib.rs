@@ -22,7 +22,9 @@
 //! handle ([`regs::CanRegs`], a [`twocan_core::Mmio`] window over the instance's block:
 //! safe code reaches no other address) with no `unsafe` in the program; the state is a
 //! `static`, and the handlers go to the TX, RX0, RX1 and SCE vectors before those are
-//! unmasked (see `examples/stm32f7/src/can.rs`). Compiled by the same test:
+//! unmasked: with feature `rt` the library defines those vectors and does it
+//! (`rt::IrqState::start`, and `stop` for the way back; see
+//! `examples/stm32f7/src/can.rs`). Compiled by the same test:
 //!
 #![cfg_attr(
     feature = "hal-stm32f7",
@@ -49,6 +51,9 @@
 //! - [`instance`]: CAN1/CAN2/CAN3 and what the firmware must do (RCC, AF9);
 //! - `hal` (feature `hal-stm32f7`): the hand-over from `stm32f7xx-hal` (singletons,
 //!   clocks, typed pins; CAN2 only with CAN1's filter-block handle);
+//! - `rt` (feature `rt`): the interrupt entry points `CAN1_TX` ... in the library, the
+//!   handlers installed before the lines are unmasked, priorities applied, and the way
+//!   back (`IrqState::start`, `IrqState::stop`);
 //! - [`regs`]: the register map.
 //!
 //! # Critical sections
@@ -83,6 +88,12 @@ pub mod instance;
 mod mailbox;
 mod mode;
 pub mod planner;
+// The library's interrupt entry points and their handler slots (feature `rt`): the
+// `unsafe` of a slot written once and of the NVIC calls.
+#[cfg(feature = "rt")]
+#[cfg_attr(docsrs, doc(cfg(feature = "rt")))]
+#[allow(unsafe_code)]
+pub mod rt;
 // Interrupt-shared state: the `Hardware` contract and the per-mailbox frame cell.
 #[allow(unsafe_code)]
 pub mod split;

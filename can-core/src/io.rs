@@ -360,7 +360,7 @@ mod tests {
         assert_eq!(CanStatus::error_stats(&p.rx).stuff, 1);
         assert_eq!(
             CanStatus::capabilities(&p.tx),
-            crate::Hardware::capabilities(hw)
+            crate::Hardware::capabilities(&*hw)
         );
     }
 

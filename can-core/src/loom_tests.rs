@@ -136,3 +136,34 @@ fn irq_cell_hands_the_handle_to_one_context_at_a_time() {
         assert!(cell.run(|m| assert_eq!(*m, Marked(ran, ran))));
     });
 }
+
+/// The way back (`State::unsplit` over `OnceSlot::take_shared`) against a reader in
+/// another context (`State::hardware`'s lease): either the reader's lease is seen and
+/// the value stays, or the reader sees nothing; a reader never holds a value being
+/// moved out (loom reports the access as a race, the check below a torn value).
+#[test]
+fn once_slot_take_waits_for_leases() {
+    loom::model(|| {
+        let slot: Arc<OnceSlot<Marked>> = Arc::new(OnceSlot::new());
+        slot.claim().expect("empty").publish(Marked(3, 3), |_| ());
+        let reader = {
+            let slot = slot.clone();
+            thread::spawn(move || slot.lease().map(|v| assert_eq!(*v, Marked(3, 3))))
+        };
+        // SAFETY: no handle exists; the only other reference is the reader's lease.
+        let taken = unsafe { slot.take_shared() };
+        let read = reader.join().unwrap();
+        match taken {
+            Ok(v) => assert_eq!(v, Marked(3, 3)),
+            Err(leased) => {
+                assert!(leased, "the value was there");
+                // A reader counted while it looked, then gave up (it saw TAKING),
+                // refuses too: the taker tries again, as `unsplit`'s caller does.
+                let _ = read;
+                // SAFETY: as above; the reader is gone.
+                assert_eq!(unsafe { slot.take_shared() }, Ok(Marked(3, 3)));
+            }
+        }
+        assert!(slot.lease().is_none(), "empty after the take");
+    });
+}

@@ -5,6 +5,27 @@
 //! interrupt handlers of [`twocan_core::split`] in firmware, or the one-struct
 //! [`twocan_core::Driver`] for polling code.
 //!
+//! An ACAN sketch's `begin` is one call here too (features `rt` and a board feature,
+//! target `thumbv7em-none-eabihf`; module `acan`): it takes the module, begins with
+//! ACAN's defaults on the board's default pins, puts the driver in the library's
+//! `static` state, wires the interrupts and returns the transmit and receive halves.
+//! The five steps it runs stay available (see below and `rt`).
+//!
+#![cfg_attr(
+    all(
+        feature = "rt",
+        any(feature = "teensy32", feature = "teensy35", feature = "teensy36")
+    ),
+    doc = concat!("```no_run\n", include_str!("../doc/one_call.rs"), "```")
+)]
+#![cfg_attr(
+    not(all(
+        feature = "rt",
+        any(feature = "teensy32", feature = "teensy35", feature = "teensy36")
+    )),
+    doc = concat!("```ignore\n", include_str!("../doc/one_call.rs"), "```")
+)]
+//!
 //! ACAN §4's LoopBackDemo, on the host over the behavioural model of the module
 //! (feature `model`) and twocan-sim's simulated bus:
 //!
@@ -62,8 +83,9 @@
 //! | §4 `ACANSettings`, §16, table 7 | [`Settings`] (bit timing from [`twocan_core::timing`]) |
 //! | §6 `ACAN::can0`, `ACAN::can1` | `Can0::take()`, `Can1::take()` ([`instance`]); [`Target`] on the host |
 //! | §7 alternate pins, §16.7.5–6 | [`Settings`] fields, [`Board::pins`], [`system`]; typed: `pin` (board features) |
+//! | `ACAN::can0.begin (settings)` as one call | `acan::can0` / `acan::can0_with` (features `rt` + board) |
 //! | §15 `begin` wiring the interrupt, §16.7.4 `mMessageIRQPriority` | `rt::IrqState::start` (feature `rt`) |
-//! | `end` | [`FlexCan::end`], `Can0::end` / `Can1::end` ([`end`]) |
+//! | `end` | `acan::end_can0`; [`FlexCan::end`], `Can0::end` / `Can1::end` ([`end`]); `rt::IrqState::stop` |
 //! | §8, §9 `tryToSend`, transmit buffer | [`twocan_core::Driver::try_send`], `tx_stats` ([`controller`] explains the mailboxes) |
 //! | §10 `receive`, receive buffer | [`twocan_core::Driver::receive`], `rx_stats` |
 //! | §11 `mConfiguration` | [`Configuration`] |
@@ -83,6 +105,13 @@
 #![cfg_attr(docsrs, feature(doc_cfg))]
 #![deny(missing_docs)]
 
+// The one call per module (ACAN's `begin`/`end`): take, begin, state, interrupts.
+#[cfg(all(
+    feature = "rt",
+    any(feature = "teensy32", feature = "teensy35", feature = "teensy36")
+))]
+#[cfg_attr(docsrs, doc(cfg(feature = "rt")))]
+pub mod acan;
 pub mod begin;
 pub mod begin_error;
 pub mod board;

@@ -18,12 +18,11 @@ mod firmware {
     use core::sync::atomic::{AtomicU32, Ordering};
 
     use critical_section::Mutex;
-    use stm32f7xx_hal::pac::interrupt;
     use twocan_app::{App, AppStats};
-    use twocan_bxcan::{hal, planner, BxCan, FifoPolicy, Recovery};
+    use twocan_bxcan::{hal, planner, BxCan, FifoPolicy, Instance, Recovery};
     use twocan_core::ErrorState;
     use twocan_stm32f7::board::BIT_RATE;
-    use twocan_stm32f7::can::{self, CanState, Vectors};
+    use twocan_stm32f7::can::{self, CanState};
     use twocan_stm32f7::rt::{self, CAN_BLINKS};
     use twocan_stm32f7::time::{self, Every};
 
@@ -32,7 +31,6 @@ mod firmware {
     const PEER: u8 = 1;
 
     static CAN1: CanState = CanState::new();
-    static CAN1_VECTORS: Vectors = Vectors::new();
 
     /// The application's counters, copied after each step (`None` before the first).
     pub static STATS: Mutex<RefCell<Option<AppStats>>> = Mutex::new(RefCell::new(None));
@@ -42,23 +40,6 @@ mod firmware {
     /// The worst fault-confinement state reported so far: 0 error active, 1 warning,
     /// 2 error passive, 3 bus-off (`ErrorState` in declaration order).
     pub static WORST_STATE: AtomicU32 = AtomicU32::new(0);
-
-    #[interrupt]
-    fn CAN1_TX() {
-        CAN1_VECTORS.on_tx();
-    }
-    #[interrupt]
-    fn CAN1_RX0() {
-        CAN1_VECTORS.on_rx0();
-    }
-    #[interrupt]
-    fn CAN1_RX1() {
-        CAN1_VECTORS.on_rx1();
-    }
-    #[interrupt]
-    fn CAN1_SCE() {
-        CAN1_VECTORS.on_sce();
-    }
 
     #[cortex_m_rt::entry]
     fn main() -> ! {
@@ -92,9 +73,8 @@ mod firmware {
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         let (mut tx, mut rx) = can::start(
             &CAN1,
-            &CAN1_VECTORS,
+            Instance::Can1,
             |slot| BxCan::can1_in(slot, regs, &config, plan).map_err(|f| f.error),
-            rt::CAN1_IRQS,
             &mut boot.core.NVIC,
         )
         .unwrap_or_else(|| rt::halt(CAN_BLINKS));
