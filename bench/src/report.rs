@@ -590,7 +590,10 @@ impl Report {
              completion ring (`DONE` = 0, fire and forget), time stamps off \
              (`CAN_MCR.TTCM` = 0) and the split driver's `Lean` feature set (no traffic \
              statistics, no time stamps read), registers at a compile-time base \
-             (`twocan_core::Fixed`); FlexCAN: see `flexcan_variant.rs`.\n\n\
+             (`twocan_core::Fixed`); FlexCAN: the controller's compile-time \
+             `options::Lean` (no time stamps, no filter switch while running: \
+             `into_split_with::<Lean>()`), but `begin` still compiles the list at run \
+             time.\n\n\
              Both bxCAN variants configure the controller in place in the `static` state \
              (`State::split_with`, `BxCan::can1_in`: no controller, plan or map moves \
              through the configuration); full plans at run time into a `static` scratch \
@@ -1185,7 +1188,11 @@ fn render_targets(s: &mut String, f: &Figures) {
              instructions and the bytes go; the flash of the full variants is mostly the \
              run-time planner; the per-frame paths still do more than the equivalents \
              (transmit bookkeeping: tokens, load order, the queue's critical section; the \
-             receive ring's raw words and generation check).\n",
+             receive ring's raw words and generation check). FlexCAN's lean and full \
+             controllers (`twocan_flexcan::options`) configure within the bound; what they \
+             still miss per frame is twocan-core's shared work (the transmit handler and \
+             its completion record, ring peaks, frame decoding), and in flash its \
+             transmit machinery.\n",
             missed.len()
         );
     }

@@ -48,8 +48,11 @@
 //!   implementation: who touches which register from which context;
 //! - [`filters`]: banks ([`Bank`]), direct configuration, match-index numbering, the
 //!   compiled [`FilterPlan`]; [`planner`]: portable filters → fewest banks, exactly;
+//! - [`chip`]: the STM32 parts as data ([`Chip`]: instances, bank counts, APB1 limits,
+//!   interrupt numbers, pins), chosen with [`Config::chip`];
 //! - [`instance`]: CAN1/CAN2/CAN3 and what the firmware must do (RCC, AF9);
-//! - `hal` (feature `hal-stm32f7`): the hand-over from `stm32f7xx-hal` (singletons,
+//! - `hal` (features `hal-stm32f7`, `hal-stm32f4`, `hal-stm32f1`): the hand-over from
+//!   `stm32f7xx-hal`, `stm32f4xx-hal` or `stm32f1xx-hal` (singletons,
 //!   clocks, typed pins; CAN2 only with CAN1's filter-block handle);
 //! - `rt` (feature `rt`): the interrupt entry points `CAN1_TX` ... in the library, the
 //!   handlers installed before the lines are unmasked, priorities applied, and the way
@@ -70,6 +73,8 @@
 
 pub mod regs;
 
+pub mod chip;
+
 #[cfg(feature = "model")]
 pub mod model;
 
@@ -79,9 +84,13 @@ mod error;
 pub mod filter_block;
 pub mod filters;
 pub mod fmi;
-// The hand-over from `stm32f7xx-hal`: the one `unsafe` turning a consumed PAC singleton
+// The hand-over from an STM32 HAL: the one `unsafe` turning a consumed PAC singleton
 // into a register window.
-#[cfg(feature = "hal-stm32f7")]
+#[cfg(any(
+    feature = "hal-stm32f7",
+    feature = "hal-stm32f4",
+    feature = "hal-stm32f1"
+))]
 #[allow(unsafe_code)]
 pub mod hal;
 pub mod instance;
@@ -99,6 +108,7 @@ pub mod rt;
 pub mod split;
 pub mod types;
 
+pub use chip::Chip;
 pub use config::{Config, ConfigError, Recovery};
 pub use controller::{Can, Failed, Init};
 pub use filters::{Bank, BankError, BankKind, Fifo, FilterPlan, PlanError, PlanRef, SizedPlan};

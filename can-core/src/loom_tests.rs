@@ -167,3 +167,33 @@ fn once_slot_take_waits_for_leases() {
         assert!(slot.lease().is_none(), "empty after the take");
     });
 }
+
+/// `IrqCell::take` (the way back) against a vector running the cell: the vector sees
+/// the whole handle or nothing, and the thread takes it only when no vector holds it
+/// (a take that finds it running gives up and is tried again).
+#[test]
+fn irq_cell_take_never_overlaps_a_run() {
+    loom::model(|| {
+        let cell: Arc<IrqCell<Marked>> = Arc::new(IrqCell::new());
+        let _ = cell.put(Marked(1, 1)).ok().expect("empty");
+        let vector = {
+            let cell = cell.clone();
+            thread::spawn(move || {
+                cell.run(|m| {
+                    assert_eq!(m.0, m.1, "a handle seen torn");
+                    m.0 += 1;
+                    m.1 += 1;
+                })
+            })
+        };
+        let taken = loop {
+            if let Some(v) = cell.take() {
+                break v;
+            }
+            thread::yield_now();
+        };
+        let ran = vector.join().unwrap();
+        assert_eq!(taken, if ran { Marked(2, 2) } else { Marked(1, 1) });
+        assert!(!cell.run(|_| unreachable!("taken")));
+    });
+}

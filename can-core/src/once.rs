@@ -169,8 +169,9 @@ impl<T> Drop for OnceSlot<T> {
     }
 }
 
-/// A reference to the value of a [`OnceSlot`], counted so that
-/// [`OnceSlot::take_shared`] waits for it (see the module docs).
+/// A reference to the controller of a `State` (`State::hardware`), counted while it
+/// lives: `State::unsplit` does not take the controller out meanwhile (it refuses with
+/// `UnsplitError::Leased`). Dereferences to the controller.
 pub struct Lease<'a, T> {
     slot: &'a OnceSlot<T>,
     value: &'a T,

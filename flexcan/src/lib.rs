@@ -120,8 +120,10 @@ pub mod controller;
 pub mod end;
 pub mod filters;
 mod handshake;
+pub mod installed;
 pub mod instance;
 mod message_buffer;
+pub mod options;
 #[cfg(any(feature = "teensy32", feature = "teensy35", feature = "teensy36"))]
 pub mod pin;
 pub mod planner;
@@ -144,7 +146,7 @@ mod idle_clock;
 #[cfg(feature = "model")]
 pub use idle_clock::IdleClocked;
 
-pub use begin::check;
+pub use begin::{check, BeginPlan};
 pub use begin_error::{BeginError, ConfigErrors};
 pub use board::{Board, Chip, InstancePins};
 pub use configuration::Configuration;

@@ -223,17 +223,18 @@ impl<R: Registers, F: Registers, const K: usize> BxCan<R, F, K> {
         )?;
         self.fmi.get_mut().fill(plan)?;
         let instance = self.instance;
+        let chip = config.get_chip();
         let programmed = match &self.filter_regs {
-            Some(f) => filter_block::program(f, instance, plan),
-            None => filter_block::program(&self.regs, instance, plan),
+            Some(f) => filter_block::program(f, chip, instance, plan),
+            None => filter_block::program(&self.regs, chip, instance, plan),
         };
         programmed.map_err(|_| Error::InvalidArgument)?;
         mode::request(&self.regs, Mode::Normal, config.get_wait_iterations())?;
         let listen_only = self.regs.read32(BTR) & (btr::SILM | btr::LBKM) == btr::SILM;
         *self.listen_only.get_mut() = listen_only;
         let fed = match &self.filter_regs {
-            Some(f) => filter_block::fed_fifos(f, instance),
-            None => filter_block::fed_fifos(&self.regs, instance),
+            Some(f) => filter_block::fed_fifos(f, chip, instance),
+            None => filter_block::fed_fifos(&self.regs, chip, instance),
         };
         *self.fed.get_mut() = fed;
         Ok(())
