@@ -585,15 +585,19 @@ impl Report {
              drivers; `bxcan_equiv.rs`, `flexcan_hand.rs` for the equivalents):\n\n\
              - **full**: completions (a token per frame, a completion ring of 8), receive \
              time stamps, traffic statistics, filters from the runtime planner;\n\
-             - **lean**: issue 21's lean driver (const filter plan, fire-and-forget \
-             transmit, no time stamps, no statistics) **is pending**: the lean build is \
-             today's driver in the closest configuration its API allows — no completion \
-             ring (`DONE` = 0); bxCAN: time stamps off, the one bank set by hand \
-             (`FilterPlan::manual`, planner not linked), a filter map with no lookup keys \
-             (`with_lookup_capacity::<0>`); FlexCAN: the controller's compile-time \
+             - **lean**: issue 21's lean driver — bxCAN: a `const` filter plan \
+             (`const_plan!`, the planner not linked), a filter map with no lookup key, no \
+             completion ring (`DONE` = 0, fire and forget), time stamps off \
+             (`CAN_MCR.TTCM` = 0) and the split driver's `Lean` feature set (no traffic \
+             statistics, no time stamps read), registers at a compile-time base \
+             (`twocan_core::Fixed`); FlexCAN: the controller's compile-time \
              `options::Lean` (no time stamps, no filter switch while running: \
              `into_split_with::<Lean>()`), but `begin` still compiles the list at run \
-             time; statistics stay on in both.\n\n\
+             time.\n\n\
+             Both bxCAN variants configure the controller in place in the `static` state \
+             (`State::split_with`, `BxCan::can1_in`: no controller, plan or map moves \
+             through the configuration); full plans at run time into a `static` scratch \
+             (`twocan_core::TakeOnce`).\n\n\
              bxCAN (STM32F767ZI): the same start-up (`shared/stm32f7.rs`: SYSCLK 108 MHz \
              from the PLL, APB1 54 MHz, CAN1 clock on), CAN1 in loop-back mode at \
              500 kbit/s (the same `CAN_BTR`, solved at compile time), one accept-all filter \
@@ -1084,10 +1088,8 @@ fn render_targets(s: &mut String, f: &Figures) {
         s,
         "Each line: ours / theirs, per opt-level (instructions from section 2, flash from \
          section 1, stack from section 2), against the issue's bound; \"met\" or by how \
-         much it is missed. **Lean** is issue 21's lean driver configuration — **still \
-         pending in the driver**: this run measures today's driver in the closest \
-         configuration its API allows (section 1 says which), so the lean lines show the \
-         distance from today's driver to the targets. **Full** has completions, time \
+         much it is missed. **Lean** is issue 21's lean driver configuration (section 1 \
+         says what each backend's lean build uses). **Full** has completions, time \
          stamps, statistics and the runtime planner. The equivalents do the same service \
          in each variant (section 1). Byte bounds: driver state ≤ the rings + \
          {} B; configuration stack ≤ {} B.\n",
@@ -1183,14 +1185,14 @@ fn render_targets(s: &mut String, f: &Figures) {
             s,
             "{} of the {bounded} bounded figures miss their bound. Why: the round trips \
              step by step and the per-region and stack tables of section 2 show where the \
-             instructions and the bytes go; the configuration stack and most of the flash \
-             come from the configuration path (filter plan, filter map and controller \
-             values moved by value; in the full variant the runtime planner); and the bxCAN \
-             lean lines measure today's driver, whose lean mode (issue 21) is pending. \
-             FlexCAN's lean and full controllers (`twocan_flexcan::options`) configure \
-             within the bound; what they still miss per frame is twocan-core's shared \
-             work (the transmit handler and its completion record, ring peaks, \
-             saturating counters, frame decoding), and in flash its transmit machinery.\n",
+             instructions and the bytes go; the flash of the full variants is mostly the \
+             run-time planner; the per-frame paths still do more than the equivalents \
+             (transmit bookkeeping: tokens, load order, the queue's critical section; the \
+             receive ring's raw words and generation check). FlexCAN's lean and full \
+             controllers (`twocan_flexcan::options`) configure within the bound; what they \
+             still miss per frame is twocan-core's shared work (the transmit handler and \
+             its completion record, ring peaks, frame decoding), and in flash its \
+             transmit machinery.\n",
             missed.len()
         );
     }

@@ -70,13 +70,13 @@ impl<R: Registers> Can<R, R> {
     /// before any register is touched, when the part ([`Config::chip`]) has no such
     /// instance (CAN2 on an F103, CAN3 on an F446).
     pub fn can1(regs: R, config: &Config) -> Result<Init<R, R>, Failed<Can<R, R>>> {
-        Can::new(regs, None, Instance::Can1, config).configure(config)
+        Can::configured(regs, None, Instance::Can1, config)
     }
 
     /// Configures CAN3 (F76x/F77x: single CAN with its own 14 filter banks); as
     /// [`Can::can1`].
     pub fn can3(regs: R, config: &Config) -> Result<Init<R, R>, Failed<Can<R, R>>> {
-        Can::new(regs, None, Instance::Can3, config).configure(config)
+        Can::configured(regs, None, Instance::Can3, config)
     }
 }
 
@@ -92,7 +92,7 @@ impl<R: Registers, F: Registers> Can<R, F> {
         filters: F,
         config: &Config,
     ) -> Result<Init<R, F>, Failed<Can<R, F>>> {
-        Can::new(regs, Some(filters), Instance::Can1, config).configure(config)
+        Can::configured(regs, Some(filters), Instance::Can1, config)
     }
 
     /// Configures CAN2 (the slave): `regs` are CAN2's registers, `can1_filters` reaches
@@ -110,7 +110,7 @@ impl<R: Registers, F: Registers> Can<R, F> {
         can1_filters: F,
         config: &Config,
     ) -> Result<Init<R, F>, Failed<Can<R, F>>> {
-        Can::new(regs, Some(can1_filters), Instance::Can2, config).configure(config)
+        Can::configured(regs, Some(can1_filters), Instance::Can2, config)
     }
 }
 
@@ -126,70 +126,36 @@ impl<R: Registers, F: Registers, const K: usize> Can<R, F, K> {
         }
     }
 
-    /// The instance must exist on the part ([`Config::chip`]), and the start bank rules
-    /// hold, before any register is written: CAN2's configured start
-    /// bank must agree with the block's `CAN2SB`; CAN1 may move `CAN2SB` only when no
-    /// bank it would affect is active ([`filter_block::check_can2sb`]).
-    fn check_start_bank(&self, config: &Config) -> Result<(), Error> {
-        // The part must have the instance (`Config::chip`).
-        if !config.get_chip().has(self.instance) {
-            return Err(Error::InvalidArgument);
-        }
-        let Some(start) = config.get_can2_start_bank() else {
-            return Ok(());
-        };
-        match self.instance {
-            Instance::Can2 => {
-                let current = match &self.filter_regs {
-                    Some(r) => filter_block::can2sb(r),
-                    None => filter_block::can2sb(&self.regs),
-                };
-                let first = |sb| config.get_chip().bank_range(Instance::Can2, sb).0;
-                if first(current) == first(start as u32) {
-                    Ok(())
-                } else {
-                    Err(Error::InvalidArgument)
-                }
-            }
-            Instance::Can1 => {
-                let r = match &self.filter_regs {
-                    Some(f) => filter_block::check_can2sb(f, start),
-                    None => filter_block::check_can2sb(&self.regs, start),
-                };
-                r.map_err(|_| Error::WrongMode)
-            }
-            Instance::Can3 => Ok(()),
+    /// A new controller of `instance`, configured: the registers are written before
+    /// the value is built, and the value is built once, in the result (no move of the
+    /// map through this call's frame).
+    fn configured(
+        regs: R,
+        filter_regs: Option<F>,
+        instance: Instance,
+        config: &Config,
+    ) -> Result<Init<R, F, K>, Failed<Can<R, F, K>>> {
+        match enter_configuration(&regs, filter_regs.as_ref(), instance, config) {
+            Ok(()) => Ok(Init {
+                can: Can::new(regs, filter_regs, instance, config),
+            }),
+            Err(error) => Err(Failed {
+                error,
+                value: Can::new(regs, filter_regs, instance, config),
+            }),
         }
     }
 
     fn configure(mut self, config: &Config) -> Result<Init<R, F, K>, Failed<Can<R, F, K>>> {
-        if let Err(error) = self.check_start_bank(config) {
+        let (regs, filter_regs) = (&self.regs, self.filter_regs.as_ref());
+        if let Err(error) = check_start_bank(regs, filter_regs, self.instance, config) {
             return Err(Failed { error, value: self });
         }
         self.config = *config;
-        let bound = config.get_wait_iterations();
-        if let Err(error) = mode::request(&self.regs, Mode::Stopped, bound) {
-            return Err(Failed { error, value: self });
+        match write_configuration(&self.regs, self.filter_regs.as_ref(), self.instance, config) {
+            Ok(()) => Ok(Init { can: self }),
+            Err(error) => Err(Failed { error, value: self }),
         }
-        let keep = mcr::INRQ;
-        self.regs.write32(MCR, keep | config.mcr_options());
-        self.regs.write32(BTR, config.btr_value());
-        self.regs.write32(IER, config.get_interrupts());
-        if let (Instance::Can1, Some(start)) = (self.instance, config.get_can2_start_bank()) {
-            // Checked again inside the critical section: CAN2's driver may have
-            // activated a bank since `check_start_bank`.
-            let r = match &self.filter_regs {
-                Some(f) => filter_block::set_can2sb(f, start),
-                None => filter_block::set_can2sb(&self.regs, start),
-            };
-            if r.is_err() {
-                return Err(Failed {
-                    error: Error::WrongMode,
-                    value: self,
-                });
-            }
-        }
-        Ok(Init { can: self })
     }
 
     /// Re-enters initialization mode with a new configuration (the filters stay).
@@ -303,6 +269,85 @@ impl<R: Registers, F: Registers, const K: usize> Can<R, F, K> {
         self.fmi = fmi;
         Ok(())
     }
+}
+
+/// The instance must exist on the part ([`Config::chip`]), and the start bank rules
+/// hold, before any register is written: CAN2's configured start bank must agree with
+/// the block's `CAN2SB`; CAN1 may move `CAN2SB` only when no bank it would affect is
+/// active ([`filter_block::check_can2sb`]).
+fn check_start_bank<R: Registers, F: Registers>(
+    regs: &R,
+    filter_regs: Option<&F>,
+    instance: Instance,
+    config: &Config,
+) -> Result<(), Error> {
+    // The part must have the instance (`Config::chip`).
+    if !config.get_chip().has(instance) {
+        return Err(Error::InvalidArgument);
+    }
+    let Some(start) = config.get_can2_start_bank() else {
+        return Ok(());
+    };
+    match instance {
+        Instance::Can2 => {
+            let current = match filter_regs {
+                Some(r) => filter_block::can2sb(r),
+                None => filter_block::can2sb(regs),
+            };
+            let first = |sb| config.get_chip().bank_range(Instance::Can2, sb).0;
+            if first(current) == first(start as u32) {
+                Ok(())
+            } else {
+                Err(Error::InvalidArgument)
+            }
+        }
+        Instance::Can1 => {
+            let r = match filter_regs {
+                Some(f) => filter_block::check_can2sb(f, start),
+                None => filter_block::check_can2sb(regs, start),
+            };
+            r.map_err(|_| Error::WrongMode)
+        }
+        Instance::Can3 => Ok(()),
+    }
+}
+
+/// Puts `instance` in initialization mode with `config` (RM0410 §40.4.1): the start
+/// bank rules checked first, then INRQ requested (leaving sleep) and INAK waited for
+/// (bounded), `CAN_MCR` options, `CAN_BTR`, `CAN_IER` and, for CAN1 with a start bank,
+/// `CAN_FMR.CAN2SB`. The one sequence of [`Can::can1`] (and the other entry points) and
+/// of the in-place constructors ([`crate::BxCan::can1_in`]).
+pub(crate) fn enter_configuration<R: Registers, F: Registers>(
+    regs: &R,
+    filter_regs: Option<&F>,
+    instance: Instance,
+    config: &Config,
+) -> Result<(), Error> {
+    check_start_bank(regs, filter_regs, instance, config)?;
+    write_configuration(regs, filter_regs, instance, config)
+}
+
+/// [`enter_configuration`] after its start bank check.
+fn write_configuration<R: Registers, F: Registers>(
+    regs: &R,
+    filter_regs: Option<&F>,
+    instance: Instance,
+    config: &Config,
+) -> Result<(), Error> {
+    mode::request(regs, Mode::Stopped, config.get_wait_iterations())?;
+    regs.write32(MCR, mcr::INRQ | config.mcr_options());
+    regs.write32(BTR, config.btr_value());
+    regs.write32(IER, config.get_interrupts());
+    if let (Instance::Can1, Some(start)) = (instance, config.get_can2_start_bank()) {
+        // Checked again inside the critical section: CAN2's driver may have activated
+        // a bank since `check_start_bank`.
+        let r = match filter_regs {
+            Some(f) => filter_block::set_can2sb(f, start),
+            None => filter_block::set_can2sb(regs, start),
+        };
+        r.map_err(|_| Error::WrongMode)?;
+    }
+    Ok(())
 }
 
 /// `CAN_ESR.LEC` as a last-error code (notes "Error management": 0 none, 1 stuff, 2 form,

@@ -859,27 +859,10 @@ impl<'a> PlanRef<'a> {
     /// See [`FilterPlan::fmi_map`].
     pub const fn fmi_map<const K: usize>(&self) -> Result<FmiMap<K>, PlanError> {
         let mut map = FmiMap::<K>::empty();
-        if map.keys.copy_from(self.keys, self.key_users).is_err() {
-            return Err(PlanError::TooManyLookupKeys {
-                needed: self.keys.len() as u16,
-                max: K as u16,
-            });
+        match map.fill(*self) {
+            Ok(()) => Ok(map),
+            Err(e) => Err(e),
         }
-        let mut next = [0usize; 2];
-        let mut b = 0;
-        while b < self.banks.len() {
-            let f = self.banks[b].fifo.index();
-            let mut s = 0;
-            while s < self.banks[b].kind.slots() {
-                if next[f] < MAX_FMI {
-                    map.map[f][next[f]] = self.users[b][s];
-                }
-                next[f] += 1;
-                s += 1;
-            }
-            b += 1;
-        }
-        Ok(map)
     }
 }
 
@@ -1435,6 +1418,61 @@ impl<const K: usize> FmiMap<K> {
         FmiMap {
             map: [[NO_FILTER; MAX_FMI]; 2],
             keys: KeyTable::new(),
+        }
+    }
+
+    /// Makes this map the map of `plan`, in place (no map value is built and moved:
+    /// how the in-place constructors, [`crate::BxCan::can1_in`], fill the controller's
+    /// map in its `static`). Each FIFO's match indices are numbered in bank order, each
+    /// bank giving as many as it has slots (RM0410 §40.7.4 "Filter match index").
+    ///
+    /// Errors: [`PlanError::TooManyLookupKeys`] when `plan` needs more lookup keys than
+    /// `K` (the map is then empty: nothing maps).
+    pub const fn fill(&mut self, plan: PlanRef<'_>) -> Result<(), PlanError> {
+        let mut f = 0;
+        while f < 2 {
+            let mut i = 0;
+            while i < MAX_FMI {
+                self.map[f][i] = NO_FILTER;
+                i += 1;
+            }
+            f += 1;
+        }
+        if self.keys.copy_from(plan.keys, plan.key_users).is_err() {
+            return Err(PlanError::TooManyLookupKeys {
+                needed: plan.keys.len() as u16,
+                max: K as u16,
+            });
+        }
+        let mut next = [0usize; 2];
+        let mut b = 0;
+        while b < plan.banks.len() {
+            let f = plan.banks[b].fifo.index();
+            let mut s = 0;
+            while s < plan.banks[b].kind.slots() {
+                if next[f] < MAX_FMI {
+                    self.map[f][next[f]] = plan.users[b][s];
+                }
+                next[f] += 1;
+                s += 1;
+            }
+            b += 1;
+        }
+        Ok(())
+    }
+
+    /// Writes an empty map ([`FmiMap::empty`]) at `map`, in place.
+    ///
+    /// # Safety
+    /// `map` is valid for writes and aligned (it may be uninitialised).
+    #[allow(unsafe_code)]
+    pub(crate) unsafe fn write_empty(map: *mut Self) {
+        // SAFETY: the caller's contract. `NO_FILTER` is `u16::MAX`, every byte 0xFF;
+        // an empty key table is all zeros (`KeyTable::new`), valid for its integer
+        // fields.
+        unsafe {
+            core::ptr::addr_of_mut!((*map).map).write_bytes(0xFF, 1);
+            core::ptr::addr_of_mut!((*map).keys).write_bytes(0, 1);
         }
     }
 

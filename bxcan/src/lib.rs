@@ -115,4 +115,4 @@ pub use filters::{Bank, BankError, BankKind, Fifo, FilterPlan, PlanError, PlanRe
 pub use fmi::fmi;
 pub use instance::Instance;
 pub use planner::{plan, plan_dual, DualPlan, FifoPolicy, PlanOptions};
-pub use split::{BxCan, RawFrame};
+pub use split::{BxCan, InPlace, RawFrame, Unconfigured};

@@ -466,6 +466,56 @@ where
         Ok((parts.tx, parts.rx))
     }
 
+    /// [`IrqState::start_on`] with the controller **configured in place** in this state
+    /// (issue 21: no controller, plan or filter map moves through the configuration,
+    /// whose stack stays a few hundred bytes): `init` is an in-place constructor of
+    /// `instance`'s controller, e.g. `|slot| BxCan::can1_in(slot, regs, &config,
+    /// plan).map_err(|f| f.error)` ([`State::split_with`]). The handlers are installed
+    /// and `lines` unmasked as by `start_on`.
+    ///
+    /// Errors: [`StartError::AlreadySplit`], [`StartError::AlreadyWired`] (then `init`
+    /// is not called); [`StartError::Split`] with `init`'s error, or
+    /// [`Error::InvalidArgument`] when the controller `init` built is not `instance`'s
+    /// or its transmit order is not the queue's (nothing is unmasked; a controller
+    /// configured by `init` stays as it is, off the driver).
+    #[allow(clippy::type_complexity)]
+    pub fn start_in_place_on<L: Copy>(
+        &'static self,
+        instance: Instance,
+        init: impl FnOnce(&mut MaybeUninit<Hw<R, F, K>>) -> Result<&mut Hw<R, F, K>, Error>,
+        lines: [L; 4],
+        priorities: Priorities,
+        nvic: &mut impl Nvic<L>,
+    ) -> Result<Halves<R, F, RX, Q, RX1, DONE, K>, StartError> {
+        if self.state.hardware().is_some() {
+            return Err(StartError::AlreadySplit);
+        }
+        if !slot(instance).wire(self) {
+            return Err(StartError::AlreadyWired);
+        }
+        let parts = self
+            .state
+            .split_with(|slot| {
+                let hw = init(slot)?;
+                if hw.instance() == instance {
+                    Ok(hw)
+                } else {
+                    Err(Error::InvalidArgument)
+                }
+            })
+            .map_err(|e| match e {
+                Error::WrongMode => StartError::AlreadySplit,
+                e => StartError::Split(e),
+            })?;
+        let filled = self.tx.put(parts.tx_irq).is_ok()
+            && self.rx0.put(parts.rx0_irq).is_ok()
+            && self.rx1.put(parts.rx1_irq).is_ok()
+            && self.sce.put(parts.status_irq).is_ok();
+        debug_assert!(filled, "split succeeds once per start");
+        enable(nvic, &lines, priorities);
+        Ok((parts.tx, parts.rx))
+    }
+
     /// The way back: masks `lines` (the instance's TX, RX0, RX1, SCE, as given to
     /// [`IrqState::start_on`]), takes the four handlers back out of their cells (no
     /// entry point runs them from now on), and gives them with the halves to
@@ -619,6 +669,21 @@ mod f7 {
             match lines(hw.instance()) {
                 Some(l) => self.start_on(hw, l, priorities, nvic),
                 None => Err((StartError::NoInterrupts, hw)),
+            }
+        }
+
+        /// [`IrqState::start_in_place_on`] with `instance`'s [`lines`] on the STM32F7.
+        #[allow(clippy::type_complexity)]
+        pub fn start_in_place(
+            &'static self,
+            instance: Instance,
+            init: impl FnOnce(&mut MaybeUninit<Hw<R, F, K>>) -> Result<&mut Hw<R, F, K>, Error>,
+            priorities: Priorities,
+            nvic: &mut impl Nvic<Interrupt>,
+        ) -> Result<Halves<R, F, RX, Q, RX1, DONE, K>, StartError> {
+            match lines(instance) {
+                Some(l) => self.start_in_place_on(instance, init, l, priorities, nvic),
+                None => Err(StartError::NoInterrupts),
             }
         }
 

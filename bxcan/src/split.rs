@@ -21,6 +21,10 @@
 //! `CAN_RDLxR`, `CAN_RDHxR`) with the FIFO number in the reserved bits 7:4 of the
 //! second word; the thread side decodes it and maps `(FIFO, FMI)` to the user's filter.
 
+mod in_place;
+
+pub use in_place::{InPlace, Unconfigured};
+
 use core::cell::UnsafeCell;
 use core::sync::atomic::{AtomicBool, AtomicU32, AtomicU8, Ordering};
 
@@ -392,6 +396,16 @@ impl<R: Registers, F: Registers, const K: usize> BxCan<R, F, K> {
             .map(|x| x as u8)
     }
 
+    /// The rare path of `read_rx`, out of line: acknowledges `FOVRx` and `FULLx` of
+    /// FIFO `x` (write 1 to clear, RM0410 §40.9.2 `CAN_RFxR`), `r` as read; whether
+    /// frames were lost (`FOVRx`).
+    #[cold]
+    #[inline(never)]
+    fn acknowledge_full(&self, x: usize, r: u32) -> bool {
+        self.regs.write32(rfxr(x), r & (rfxr::FOVR | rfxr::FULL));
+        r & rfxr::FOVR != 0
+    }
+
     fn status_now(&self) -> ErrorStatus {
         let m = self.regs.read32(MSR);
         let e = self.regs.read32(ESR);
@@ -688,8 +702,7 @@ unsafe impl<R: Registers, F: Registers, const K: usize> Hardware for BxCan<R, F,
         let x = queue & 1;
         let r = self.regs.read32(rfxr(x));
         if r & (rfxr::FOVR | rfxr::FULL) != 0 {
-            *overrun |= r & rfxr::FOVR != 0;
-            self.regs.write32(rfxr(x), r & (rfxr::FOVR | rfxr::FULL));
+            *overrun |= self.acknowledge_full(x, r);
         }
         if rfxr::FMP.get(r) == 0 {
             return None;

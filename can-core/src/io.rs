@@ -46,6 +46,7 @@ use crate::capabilities::Capabilities;
 use crate::controller::ErrorStatus;
 use crate::driver::Driver;
 use crate::error::{Error, ErrorStatistics};
+use crate::features::Features;
 use crate::frame::{Frame, RxFrame};
 use crate::hardware::{Completion, Hardware, Token};
 use crate::split::{AbortRequest, Rx, StateChange, TrafficStats, Tx};
@@ -132,8 +133,14 @@ pub trait AsyncCanRx: CanRx {
 /// `CanStatus` of a half: the shared state's statistics, the controller's status.
 macro_rules! status_of_a_half {
     ($half:ident) => {
-        impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize>
-            CanStatus for $half<'_, H, RX, Q, RX1, DONE>
+        impl<
+                H: Hardware,
+                const RX: usize,
+                Q: TxQueue,
+                const RX1: usize,
+                const DONE: usize,
+                Fe: Features,
+            > CanStatus for $half<'_, H, RX, Q, RX1, DONE, Fe>
         {
             fn traffic(&self) -> TrafficStats {
                 self.state().traffic()
@@ -154,8 +161,14 @@ macro_rules! status_of_a_half {
 status_of_a_half!(Tx);
 status_of_a_half!(Rx);
 
-impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize> CanTx
-    for Tx<'_, H, RX, Q, RX1, DONE>
+impl<
+        H: Hardware,
+        const RX: usize,
+        Q: TxQueue,
+        const RX1: usize,
+        const DONE: usize,
+        Fe: Features,
+    > CanTx for Tx<'_, H, RX, Q, RX1, DONE, Fe>
 {
     fn try_send(&mut self, frame: &Frame) -> nb::Result<Token, Error> {
         Tx::try_send(self, frame)
@@ -174,8 +187,14 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
     }
 }
 
-impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize> CanRx
-    for Rx<'_, H, RX, Q, RX1, DONE>
+impl<
+        H: Hardware,
+        const RX: usize,
+        Q: TxQueue,
+        const RX1: usize,
+        const DONE: usize,
+        Fe: Features,
+    > CanRx for Rx<'_, H, RX, Q, RX1, DONE, Fe>
 {
     fn receive(&mut self) -> nb::Result<RxFrame, Error> {
         Rx::receive(self)

@@ -220,6 +220,46 @@ impl<'a, T> Claim<'a, T> {
         slot.stage.store(READY, Ordering::Release);
         (value, r)
     }
+
+    /// Builds the value **in place** in the slot (no move of `T` through the caller's
+    /// stack): `init` gets the slot's uninitialised storage and returns it initialised
+    /// (the `&mut T` it returns must be that storage: any other reference is refused
+    /// with `Err(None)`). Then `check` may refuse it (`Err(e)`: the value is dropped in
+    /// place, the slot is empty again, `Err(Some(e))`); otherwise `before` runs on it
+    /// while no other context can see it, and it is published (release), as
+    /// [`Claim::publish`]. When `init` fails (`Err(e)` → `Err(Some(e))`) the slot is
+    /// empty again; whatever `init` wrote before failing is not dropped (leaked).
+    pub(crate) fn publish_in_place<E, R>(
+        self,
+        init: impl FnOnce(&'a mut MaybeUninit<T>) -> Result<&'a mut T, E>,
+        check: impl FnOnce(&T) -> Result<(), E>,
+        before: impl FnOnce(&T) -> R,
+    ) -> Result<(&'a T, R), Option<E>> {
+        let slot = self.slot;
+        // SAFETY: this claim moved the stage from EMPTY to CLAIMED: this context is the
+        // only one touching the value until READY is stored (or the claim is dropped),
+        // so a unique reference to the storage for the claim's lifetime is sound.
+        let storage: &'a mut MaybeUninit<T> = slot.value.with_mut(|p| unsafe { &mut *p });
+        let expected = storage.as_mut_ptr();
+        // On `Err`, `self` (the claim) is dropped: the slot is EMPTY again.
+        let built = init(storage).map_err(Some)?;
+        if !core::ptr::eq(built, expected) {
+            // Not the slot's storage: the slot may be uninitialised.
+            return Err(None);
+        }
+        if let Err(e) = check(built) {
+            // SAFETY: `built` is the slot's storage, initialised by `init`; it is
+            // dropped once here and the stage goes back to EMPTY (the claim's drop),
+            // so nothing reads it again.
+            unsafe { core::ptr::drop_in_place(built as *mut T) };
+            return Err(Some(e));
+        }
+        core::mem::forget(self);
+        let value: &'a T = built;
+        let r = before(value);
+        slot.stage.store(READY, Ordering::Release);
+        Ok((value, r))
+    }
 }
 
 impl<T> Drop for Claim<'_, T> {

@@ -125,6 +125,62 @@ impl<const END: usize, const START: usize> Registers for Mmio<END, START> {
     }
 }
 
+/// [`Mmio`] with the base address a constant (`BASE`): a zero-sized handle, so that
+/// per-frame code reaches each register at an address known at compile time, with no
+/// base to load (issue 21). The same window (`START..END`) and the same bounds: an
+/// offset outside it or not aligned is never accessed.
+#[derive(Debug)]
+pub struct Fixed<const BASE: usize, const END: usize = 0x400, const START: usize = 0> {
+    _owned: (),
+}
+
+impl<const BASE: usize, const END: usize, const START: usize> Fixed<BASE, END, START> {
+    /// Access to the registers `START..END` of the peripheral at `BASE`.
+    ///
+    /// # Safety
+    /// As [`Mmio::new`] with `base` = `BASE`.
+    pub const unsafe fn new() -> Self {
+        const {
+            assert!(
+                START < END && START.is_multiple_of(4) && END.is_multiple_of(4),
+                "empty window"
+            )
+        };
+        Fixed { _owned: () }
+    }
+}
+
+impl<const BASE: usize, const END: usize, const START: usize> Registers
+    for Fixed<BASE, END, START>
+{
+    #[inline(always)]
+    fn read32(&self, offset: usize) -> u32 {
+        if !Mmio::<END, START>::owns(offset) {
+            debug_assert!(
+                false,
+                "register offset {offset:#x} outside {START:#x}..{END:#x}"
+            );
+            return 0;
+        }
+        // SAFETY: `Fixed::new`'s contract covers every aligned offset of `START..END`
+        // from `BASE`, checked just above.
+        unsafe { core::ptr::read_volatile((BASE + offset) as *const u32) }
+    }
+
+    #[inline(always)]
+    fn write32(&self, offset: usize, value: u32) {
+        if !Mmio::<END, START>::owns(offset) {
+            debug_assert!(
+                false,
+                "register offset {offset:#x} outside {START:#x}..{END:#x}"
+            );
+            return;
+        }
+        // SAFETY: as for `read32`; writes go to a register of the owned window.
+        unsafe { core::ptr::write_volatile((BASE + offset) as *mut u32, value) }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

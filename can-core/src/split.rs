@@ -46,6 +46,7 @@ use core::sync::atomic::{AtomicU32, AtomicU8, Ordering};
 use crate::controller::{ErrorStatus, Mode};
 use crate::dispatch::Dispatcher;
 use crate::error::{Error, ErrorCounters, ErrorState, ErrorStatistics, LastErrorCode};
+use crate::features::{Features, Full, Tally};
 use crate::frame::{Frame, RxFrame};
 use crate::hardware::{Completion, Hardware, Settled, Token};
 use crate::mailbox::{TxOutcome, TxPolicy};
@@ -69,7 +70,9 @@ pub struct StateChange {
     pub counters: ErrorCounters,
 }
 
-/// Traffic counters (saturating), each written by one context.
+/// Traffic counters (wrapping: compare readings with wrapping differences), each
+/// written by one context; 0 under a feature set without statistics
+/// ([`crate::Lean`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct TrafficStats {
@@ -141,15 +144,15 @@ struct ErrorCounts {
 /// an atomic `fetch_add` would need LDREX/STREX (ARMv7-M has them, ARMv6-M does not)
 /// and costs a retry loop on the per-frame path; a plain load and store per queue
 /// works on every core and the readers add the two.
-struct QueueCounts {
-    received: Counter,
+struct QueueCounts<C> {
+    received: C,
     overruns: Counter,
 }
 
-impl QueueCounts {
+impl<C: Tally> QueueCounts<C> {
     const fn new() -> Self {
         QueueCounts {
-            received: Counter::new(),
+            received: C::NEW,
             overruns: Counter::new(),
         }
     }
@@ -200,6 +203,7 @@ pub struct State<
     Q: TxQueue = FifoQueue<8>,
     const RX1: usize = 0,
     const DONE: usize = 8,
+    Fe: Features = Full,
 > {
     /// The controller, published once by `split` (see [`OnceSlot`]).
     hw: OnceSlot<H>,
@@ -216,14 +220,14 @@ pub struct State<
     done: SpscRing<Completion, DONE>,
     changes: SpscRing<StateChange, STATE_CHANGES>,
     state: AtomicU8,
-    queued: Counter,
-    sent: Counter,
-    failed: Counter,
-    aborted: Counter,
+    queued: Fe::Counter,
+    sent: Fe::Counter,
+    failed: Fe::Counter,
+    aborted: Fe::Counter,
     /// Per hardware receive queue: each queue's handler is the one writer of its
     /// counters (bxCAN's RX0 and RX1 handlers may preempt each other); read as sums.
-    per_queue: [QueueCounts; 2],
-    dropped: Counter,
+    per_queue: [QueueCounts<Fe::Counter>; 2],
+    dropped: Fe::Counter,
     state_changes: Counter,
     errors: ErrorCounts,
     #[cfg(feature = "async")]
@@ -256,14 +260,21 @@ unsafe impl<
         Q: TxQueue + Send,
         const RX1: usize,
         const DONE: usize,
-    > Sync for State<H, RX, Q, RX1, DONE>
+        Fe: Features,
+    > Sync for State<H, RX, Q, RX1, DONE, Fe>
 where
     H::Raw: Send,
 {
 }
 
-impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize> Default
-    for State<H, RX, Q, RX1, DONE>
+impl<
+        H: Hardware,
+        const RX: usize,
+        Q: TxQueue,
+        const RX1: usize,
+        const DONE: usize,
+        Fe: Features,
+    > Default for State<H, RX, Q, RX1, DONE, Fe>
 {
     fn default() -> Self {
         Self::new()
@@ -271,25 +282,38 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
 }
 
 /// The handles [`State::split`] hands out, each for one context.
-pub struct Parts<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize>
-{
+pub struct Parts<
+    'a,
+    H: Hardware,
+    const RX: usize,
+    Q: TxQueue,
+    const RX1: usize,
+    const DONE: usize,
+    Fe: Features = Full,
+> {
     /// Transmit half (thread/task).
-    pub tx: Tx<'a, H, RX, Q, RX1, DONE>,
+    pub tx: Tx<'a, H, RX, Q, RX1, DONE, Fe>,
     /// Receive half (thread/task).
-    pub rx: Rx<'a, H, RX, Q, RX1, DONE>,
+    pub rx: Rx<'a, H, RX, Q, RX1, DONE, Fe>,
     /// Transmit interrupt handler (bxCAN TX line; FlexCAN message-buffer line).
-    pub tx_irq: TxIrq<'a, H, RX, Q, RX1, DONE>,
+    pub tx_irq: TxIrq<'a, H, RX, Q, RX1, DONE, Fe>,
     /// Receive interrupt handler of queue 0 (bxCAN RX0; FlexCAN message-buffer line).
-    pub rx0_irq: Rx0Irq<'a, H, RX, Q, RX1, DONE>,
+    pub rx0_irq: Rx0Irq<'a, H, RX, Q, RX1, DONE, Fe>,
     /// Receive interrupt handler of queue 1 (bxCAN RX1; unused on FlexCAN). A type of
     /// its own: it cannot be put where queue 0's handler belongs.
-    pub rx1_irq: Rx1Irq<'a, H, RX, Q, RX1, DONE>,
+    pub rx1_irq: Rx1Irq<'a, H, RX, Q, RX1, DONE, Fe>,
     /// Status interrupt handler (bxCAN SCE; FlexCAN bus-off, error, warning, wake-up).
-    pub status_irq: StatusIrq<'a, H, RX, Q, RX1, DONE>,
+    pub status_irq: StatusIrq<'a, H, RX, Q, RX1, DONE, Fe>,
 }
 
-impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize>
-    State<H, RX, Q, RX1, DONE>
+impl<
+        H: Hardware,
+        const RX: usize,
+        Q: TxQueue,
+        const RX1: usize,
+        const DONE: usize,
+        Fe: Features,
+    > State<H, RX, Q, RX1, DONE, Fe>
 {
     crate::sync::const_fn! {
         /// Empty, with no controller yet: all zeros.
@@ -306,12 +330,12 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
                 done: SpscRing::new(),
                 changes: SpscRing::new(),
                 state: AtomicU8::new(STATE_UNKNOWN),
-                queued: Counter::new(),
-                sent: Counter::new(),
-                failed: Counter::new(),
-                aborted: Counter::new(),
+                queued: Fe::Counter::NEW,
+                sent: Fe::Counter::NEW,
+                failed: Fe::Counter::NEW,
+                aborted: Fe::Counter::NEW,
                 per_queue: [QueueCounts::new(), QueueCounts::new()],
-                dropped: Counter::new(),
+                dropped: Fe::Counter::NEW,
                 state_changes: Counter::new(),
                 errors: ErrorCounts::new(),
                 #[cfg(feature = "async")]
@@ -333,7 +357,7 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
     /// reader in other contexts) only once it is written, through a release store that
     /// those readers load with acquire ordering.
     #[allow(clippy::type_complexity)]
-    pub fn split(&self, hardware: H) -> Result<Parts<'_, H, RX, Q, RX1, DONE>, (Error, H)> {
+    pub fn split(&self, hardware: H) -> Result<Parts<'_, H, RX, Q, RX1, DONE, Fe>, (Error, H)> {
         // Claim first: a losing `split` must not touch the winner's queue.
         let Some(claim) = self.hw.claim() else {
             return Err((Error::WrongMode, hardware));
@@ -357,6 +381,61 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
                 .store(state_code(status.state), Ordering::Relaxed);
             (map, status)
         });
+        self.refresh_timestamps();
+        Ok(Parts {
+            tx: Tx { s: self, next: 0 },
+            rx: Rx { s: self, map },
+            tx_irq: TxIrq { s: self },
+            rx0_irq: RxIrq { s: self },
+            rx1_irq: RxIrq { s: self },
+            status_irq: StatusIrq {
+                s: self,
+                last: status.state,
+            },
+        })
+    }
+
+    /// [`State::split`] with the controller **built in place** in the state (no move of
+    /// the controller through the configuration path, so the configuration's stack
+    /// stays small whatever the controller's size): `init` gets the state's empty
+    /// controller storage, configures the controller there and returns it
+    /// (`Ok(slot.write(..))`, or a backend's in-place constructor such as
+    /// `twocan_bxcan::BxCan::can1_in`). Once only, as `split`.
+    ///
+    /// Errors: `init`'s error (the state stays unsplit; the backend's constructor says
+    /// what it gives back); [`Error::WrongMode`] when the state was split already (then
+    /// `init` is not called); [`Error::InvalidArgument`] when the controller's transmit
+    /// order is not `Q`'s (the controller is dropped in place, the state stays
+    /// unsplit) or when `init` returns a controller that is not the slot's.
+    #[allow(clippy::type_complexity)]
+    pub fn split_with(
+        &self,
+        init: impl FnOnce(&mut core::mem::MaybeUninit<H>) -> Result<&mut H, Error>,
+    ) -> Result<Parts<'_, H, RX, Q, RX1, DONE, Fe>, Error> {
+        let Some(claim) = self.hw.claim() else {
+            return Err(Error::WrongMode);
+        };
+        let adopt = |hw: &H| {
+            let adopted = critical_section::with(|cs| {
+                // SAFETY: the queue is only touched inside a critical section.
+                unsafe { &mut *self.queue.borrow(cs).get() }.adopt(hw.tx_policy())
+            });
+            if adopted {
+                Ok(())
+            } else {
+                Err(Error::InvalidArgument)
+            }
+        };
+        let (_, (map, status)) = claim
+            .publish_in_place(init, adopt, |hw| {
+                // SAFETY: not published yet: this is the only context that sees it.
+                let map = unsafe { hw.filter_map() };
+                let status = hw.error_status();
+                self.state
+                    .store(state_code(status.state), Ordering::Relaxed);
+                (map, status)
+            })
+            .map_err(|e| e.unwrap_or(Error::InvalidArgument))?;
         self.refresh_timestamps();
         Ok(Parts {
             tx: Tx { s: self, next: 0 },
@@ -433,7 +512,7 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
             received: self.per_queue[0]
                 .received
                 .get()
-                .saturating_add(self.per_queue[1].received.get()),
+                .wrapping_add(self.per_queue[1].received.get()),
             rx_ring_overflows: self.rx0.stats().overflows + self.rx1.stats().overflows,
             rx_dropped: self.dropped.get(),
             completion_overflows: self.done.stats().overflows,
@@ -455,7 +534,7 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
             hardware_overruns: self.per_queue[0]
                 .overruns
                 .get()
-                .saturating_add(self.per_queue[1].overruns.get()),
+                .wrapping_add(self.per_queue[1].overruns.get()),
         }
     }
 
@@ -578,9 +657,22 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
             .store(self.queue_len.load(Ordering::Relaxed), Ordering::Relaxed);
     }
 
+    /// The raw frame's 16-bit time stamp, when the feature set reads them
+    /// ([`Features::TIMESTAMPS`]) and the hardware records one.
+    #[inline(always)]
+    fn raw_stamp(&self, raw: &H::Raw) -> Option<u16> {
+        if Fe::TIMESTAMPS {
+            self.hw().raw_timestamp(raw)
+        } else {
+            None
+        }
+    }
+
     #[inline]
     fn record(&self, mut done: Completion) {
-        if let Some(t) = done.timestamp {
+        if !Fe::TIMESTAMPS {
+            done.timestamp = None;
+        } else if let Some(t) = done.timestamp {
             done.timestamp = Some(self.widen(t.counter()));
         }
         match done.outcome {
@@ -707,8 +799,7 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
             match unsafe { self.hw().decode(&raw.raw, map) } {
                 Some(mut frame) => {
                     frame.timestamp = self
-                        .hw()
-                        .raw_timestamp(&raw.raw)
+                        .raw_stamp(&raw.raw)
                         .map(|t| Timestamp::from_parts(raw.wraps, t));
                     return Ok(frame);
                 }
@@ -727,8 +818,7 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
             }
             match (self.rx0.peek(), self.rx1.peek()) {
                 (Some(a), Some(b)) => {
-                    let hw = self.hw();
-                    let first = match (hw.raw_timestamp(&a.raw), hw.raw_timestamp(&b.raw)) {
+                    let first = match (self.raw_stamp(&a.raw), self.raw_stamp(&b.raw)) {
                         (Some(ta), Some(tb)) => (a.wraps, ta) <= (b.wraps, tb),
                         _ => true,
                     };
@@ -806,8 +896,16 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
 /// assert_eq!(p.tx.abort(a), AbortRequest::NotFound);
 /// # Ok::<(), twocan_core::Error>(())
 /// ```
-pub struct Tx<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize> {
-    pub(crate) s: &'a State<H, RX, Q, RX1, DONE>,
+pub struct Tx<
+    'a,
+    H: Hardware,
+    const RX: usize,
+    Q: TxQueue,
+    const RX1: usize,
+    const DONE: usize,
+    Fe: Features = Full,
+> {
+    pub(crate) s: &'a State<H, RX, Q, RX1, DONE, Fe>,
     pub(crate) next: u32,
 }
 
@@ -829,8 +927,15 @@ pub enum AbortRequest {
     NotFound,
 }
 
-impl<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize>
-    Tx<'a, H, RX, Q, RX1, DONE>
+impl<
+        'a,
+        H: Hardware,
+        const RX: usize,
+        Q: TxQueue,
+        const RX1: usize,
+        const DONE: usize,
+        Fe: Features,
+    > Tx<'a, H, RX, Q, RX1, DONE, Fe>
 {
     /// Accepts `frame` for transmission and returns its token; exactly one
     /// [`Completion`] with that token follows.
@@ -1031,7 +1136,7 @@ impl<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE:
     }
 
     /// The shared state (statistics, the controller).
-    pub fn state(&self) -> &'a State<H, RX, Q, RX1, DONE> {
+    pub fn state(&self) -> &'a State<H, RX, Q, RX1, DONE, Fe> {
         self.s
     }
 
@@ -1070,13 +1175,28 @@ impl<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE:
 /// assert_eq!((change.state, change.counters.tec), (ErrorState::Warning, 100));
 /// # Ok::<(), twocan_core::Error>(())
 /// ```
-pub struct Rx<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize> {
-    pub(crate) s: &'a State<H, RX, Q, RX1, DONE>,
+pub struct Rx<
+    'a,
+    H: Hardware,
+    const RX: usize,
+    Q: TxQueue,
+    const RX1: usize,
+    const DONE: usize,
+    Fe: Features = Full,
+> {
+    pub(crate) s: &'a State<H, RX, Q, RX1, DONE, Fe>,
     pub(crate) map: H::FilterMap,
 }
 
-impl<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize>
-    Rx<'a, H, RX, Q, RX1, DONE>
+impl<
+        'a,
+        H: Hardware,
+        const RX: usize,
+        Q: TxQueue,
+        const RX1: usize,
+        const DONE: usize,
+        Fe: Features,
+    > Rx<'a, H, RX, Q, RX1, DONE, Fe>
 {
     /// Takes the oldest received frame, decoded, with the index of the user's filter
     /// that accepted it and its time stamp. `WouldBlock` when none is waiting.
@@ -1173,7 +1293,7 @@ impl<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE:
     }
 
     /// The shared state (statistics, the controller).
-    pub fn state(&self) -> &'a State<H, RX, Q, RX1, DONE> {
+    pub fn state(&self) -> &'a State<H, RX, Q, RX1, DONE, Fe> {
         self.s
     }
 
@@ -1212,13 +1332,26 @@ impl<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE:
 /// assert_eq!(ids, [0x10, 0x11, 0x12]);
 /// # Ok::<(), twocan_core::Error>(())
 /// ```
-pub struct TxIrq<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize>
-{
-    pub(crate) s: &'a State<H, RX, Q, RX1, DONE>,
+pub struct TxIrq<
+    'a,
+    H: Hardware,
+    const RX: usize,
+    Q: TxQueue,
+    const RX1: usize,
+    const DONE: usize,
+    Fe: Features = Full,
+> {
+    pub(crate) s: &'a State<H, RX, Q, RX1, DONE, Fe>,
 }
 
-impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize>
-    TxIrq<'_, H, RX, Q, RX1, DONE>
+impl<
+        H: Hardware,
+        const RX: usize,
+        Q: TxQueue,
+        const RX1: usize,
+        const DONE: usize,
+        Fe: Features,
+    > TxIrq<'_, H, RX, Q, RX1, DONE, Fe>
 {
     /// Settles ended mailboxes (completions in order, with their tokens) and refills
     /// free mailboxes from the queue, in one critical section.
@@ -1271,14 +1404,15 @@ pub struct RxIrq<
     const RX1: usize,
     const DONE: usize,
     const QUEUE: usize,
+    Fe: Features = Full,
 > {
-    pub(crate) s: &'a State<H, RX, Q, RX1, DONE>,
+    pub(crate) s: &'a State<H, RX, Q, RX1, DONE, Fe>,
 }
 
 /// The receive interrupt handler of hardware queue 0 (bxCAN RX0 / FIFO 0, FlexCAN's Rx
 /// FIFO on the ORed message-buffer line).
-pub type Rx0Irq<'a, H, const RX: usize, Q, const RX1: usize, const DONE: usize> =
-    RxIrq<'a, H, RX, Q, RX1, DONE, 0>;
+pub type Rx0Irq<'a, H, const RX: usize, Q, const RX1: usize, const DONE: usize, Fe = Full> =
+    RxIrq<'a, H, RX, Q, RX1, DONE, 0, Fe>;
 
 /// The receive interrupt handler of hardware queue 1 (bxCAN RX1 / FIFO 1; a FlexCAN
 /// controller has no second queue: its handler finds nothing).
@@ -1299,8 +1433,8 @@ pub type Rx0Irq<'a, H, const RX: usize, Q, const RX1: usize, const DONE: usize> 
 /// let p = CAN.split(MockHardware::new(3)).ok().unwrap();
 /// let _ = RX0.put(p.rx1_irq); // queue 1's handler where queue 0's belongs: refused
 /// ```
-pub type Rx1Irq<'a, H, const RX: usize, Q, const RX1: usize, const DONE: usize> =
-    RxIrq<'a, H, RX, Q, RX1, DONE, 1>;
+pub type Rx1Irq<'a, H, const RX: usize, Q, const RX1: usize, const DONE: usize, Fe = Full> =
+    RxIrq<'a, H, RX, Q, RX1, DONE, 1, Fe>;
 
 impl<
         H: Hardware,
@@ -1309,7 +1443,8 @@ impl<
         const RX1: usize,
         const DONE: usize,
         const QUEUE: usize,
-    > RxIrq<'_, H, RX, Q, RX1, DONE, QUEUE>
+        Fe: Features,
+    > RxIrq<'_, H, RX, Q, RX1, DONE, QUEUE, Fe>
 {
     /// Moves every frame of the hardware queue into its ring as raw words and releases
     /// the hardware; a full ring counts the frame as an overflow. No decoding here.
@@ -1347,9 +1482,10 @@ unsafe fn drain<
     Q: TxQueue,
     const RX1: usize,
     const DONE: usize,
+    Fe: Features,
     const N: usize,
 >(
-    s: &State<H, RX, Q, RX1, DONE>,
+    s: &State<H, RX, Q, RX1, DONE, Fe>,
     q: usize,
     ring: &SpscRing<Stamped<H::Raw>, N>,
 ) {
@@ -1364,7 +1500,7 @@ unsafe fn drain<
             counts.received.inc();
             // Widened here, on the interrupt side: the counter's wraps are only known
             // while the frame is fresh.
-            let wraps = match hw.raw_timestamp(&raw) {
+            let wraps = match s.raw_stamp(&raw) {
                 Some(t) => s.widen_received(q, t).wraps(),
                 None => 0,
             };
@@ -1411,8 +1547,9 @@ pub struct StatusIrq<
     Q: TxQueue,
     const RX1: usize,
     const DONE: usize,
+    Fe: Features = Full,
 > {
-    pub(crate) s: &'a State<H, RX, Q, RX1, DONE>,
+    pub(crate) s: &'a State<H, RX, Q, RX1, DONE, Fe>,
     pub(crate) last: ErrorState,
 }
 
@@ -1420,8 +1557,14 @@ pub struct StatusIrq<
 /// reported an error).
 const MAX_STATUS_ROUNDS: u32 = 4;
 
-impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize>
-    StatusIrq<'_, H, RX, Q, RX1, DONE>
+impl<
+        H: Hardware,
+        const RX: usize,
+        Q: TxQueue,
+        const RX1: usize,
+        const DONE: usize,
+        Fe: Features,
+    > StatusIrq<'_, H, RX, Q, RX1, DONE, Fe>
 {
     /// Reads and acknowledges the error and wake-up causes: counts the bus error by
     /// kind, records a state change (with the counters) when the state moved.
@@ -1492,8 +1635,14 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
 // (`Send` exactly when the state is `Sync`, see above) plus data owned by its context.
 
 /// Reads any context may make.
-impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize>
-    State<H, RX, Q, RX1, DONE>
+impl<
+        H: Hardware,
+        const RX: usize,
+        Q: TxQueue,
+        const RX1: usize,
+        const DONE: usize,
+        Fe: Features,
+    > State<H, RX, Q, RX1, DONE, Fe>
 {
     /// The controller's error status, read now.
     pub fn error_status(&self) -> Option<ErrorStatus> {
@@ -1667,6 +1816,92 @@ mod tests {
             Poll::Ready(c) => assert_eq!((c.token, c.outcome), (token, TxOutcome::Sent)),
             Poll::Pending => panic!("woken without a completion"),
         }
-        assert_eq!(state.traffic().sent, u32::MAX);
+        assert_eq!(state.traffic().sent, 0, "the counter wraps");
+    }
+}
+
+#[cfg(all(test, feature = "mock"))]
+mod in_place_tests {
+    use super::State;
+    use crate::mock::MockHardware;
+    use crate::{Error, FifoQueue, Frame, TxOutcome, TxPolicy};
+
+    /// `split_with` builds the controller in the state's slot, publishes it once, and
+    /// leaves the state unsplit when the closure fails, returns another controller, or
+    /// the transmit order is not the queue's.
+    #[test]
+    fn split_with_builds_in_place_once() {
+        let state: State<MockHardware, 8, FifoQueue<4>> = State::new();
+        assert_eq!(
+            state.split_with(|_| Err(Error::Timeout)).err(),
+            Some(Error::Timeout)
+        );
+        assert!(state.hardware().is_none());
+        let other_ptr = Box::into_raw(Box::new(MockHardware::new(1)));
+        // SAFETY: a fresh box, not freed before the end of the test; this is the only
+        // reference made from it.
+        let other: &'static mut MockHardware = unsafe { &mut *other_ptr };
+        assert_eq!(
+            state.split_with(move |_| Ok(other)).err(),
+            Some(Error::InvalidArgument),
+            "a controller outside the slot is refused"
+        );
+        // SAFETY: `other_ptr` came from `Box::into_raw` above; the refused `&mut` was
+        // dropped by `split_with`, nothing refers to the box any more.
+        drop(unsafe { Box::from_raw(other_ptr) });
+        assert_eq!(
+            state
+                .split_with(|slot| Ok(
+                    slot.write(MockHardware::new(1).with_policy(TxPolicy::Priority))
+                ))
+                .err(),
+            Some(Error::InvalidArgument),
+            "a transmit order other than the queue's is refused"
+        );
+        assert!(state.hardware().is_none());
+        let mut p = state
+            .split_with(|slot| Ok(slot.write(MockHardware::new(2))))
+            .ok()
+            .unwrap();
+        assert!(state.hardware().is_some());
+        assert_eq!(
+            state
+                .split_with(|slot| Ok(slot.write(MockHardware::new(2))))
+                .err(),
+            Some(Error::WrongMode)
+        );
+        let token =
+            p.tx.try_send(&Frame::standard(0x10, &[1]).unwrap())
+                .unwrap();
+        state.hardware().unwrap().complete_all();
+        p.tx_irq.on_interrupt();
+        let done = p.tx.take_completion().unwrap();
+        assert_eq!((done.token, done.outcome), (token, TxOutcome::Sent));
+    }
+
+    /// The lean feature set moves the same frames with the same tokens, counts no
+    /// traffic and takes no room for it.
+    #[test]
+    fn lean_moves_frames_and_counts_nothing() {
+        use crate::{Full, Lean};
+        type LeanState = State<MockHardware, 8, FifoQueue<4>, 0, 0, Lean>;
+        type FullState = State<MockHardware, 8, FifoQueue<4>, 0, 0, Full>;
+        assert!(core::mem::size_of::<LeanState>() + 7 * 4 <= core::mem::size_of::<FullState>());
+        let state: LeanState = State::new();
+        let mut p = state
+            .split_with(|slot| Ok(slot.write(MockHardware::new(3).with_loopback(true))))
+            .ok()
+            .unwrap();
+        let frame = Frame::standard(0x321, &[1, 2, 3]).unwrap();
+        p.tx.try_send(&frame).unwrap();
+        state.hardware().unwrap().complete_all();
+        p.tx_irq.on_interrupt();
+        p.rx0_irq.on_interrupt();
+        let rx = p.rx.receive().unwrap();
+        assert_eq!(rx.frame, frame);
+        assert_eq!(rx.timestamp, None);
+        assert!(p.tx.take_completion().is_none(), "no completion ring");
+        let t = state.traffic();
+        assert_eq!((t.queued, t.sent, t.received), (0, 0, 0));
     }
 }

@@ -50,11 +50,12 @@ impl Counter {
         Counter(core::sync::atomic::AtomicU32::new(0))
     }
 
-    /// Adds `n` (from the counter's one writer context).
+    /// Adds `n` (from the counter's one writer context), wrapping: readers compare
+    /// readings with wrapping differences (no saturation test on the per-frame path).
     #[inline(always)]
     pub fn add(&self, n: u32) {
         let v = self.0.load(Ordering::Relaxed);
-        self.0.store(v.saturating_add(n), Ordering::Relaxed);
+        self.0.store(v.wrapping_add(n), Ordering::Relaxed);
     }
 
     /// Adds one (from the counter's one writer context).

@@ -3,16 +3,19 @@
 //! `#[path]` by `insn-count` (QEMU, RAM stand-in) and `loopback-twocan` (STM32F7), so the
 //! instruction counts and the flash figures are of the same configuration.
 //!
+//! Both configure the controller **in place** in the `static` state
+//! (`State::split_with` and `BxCan::can1_in`: no controller, plan or filter map moves
+//! through the configuration), with the filter map sized to the variant's plan:
+//!
 //! - **full**: every per-frame feature on — transmit completions (a completion ring of
 //!   [`DONE`] = 8), receive time stamps (`CAN_MCR.TTCM`), traffic statistics, and the
-//!   filters compiled by the runtime planner (`Init::can().plan`) from a filter list;
-//! - **lean**: the closest the current driver API comes to the lean driver of issue 21
-//!   (const filter plan, fire-and-forget transmit, no time stamps, no statistics): no
-//!   completion ring ([`DONE`] = 0), time stamps off, the one bank set by hand
-//!   (`FilterPlan::manual`, the planner not linked) and a filter map with no lookup
-//!   keys (`with_lookup_capacity::<0>`). The driver has no switch for its statistics
-//!   yet: they stay. **Pending**: when the lean driver lands, the lean block below is
-//!   the one place to switch to its types.
+//!   filters compiled at run time by the planner (`planner::plan_in`) from a filter
+//!   list, its working memory in a `static` ([`TakeOnce`]), and a map with the default
+//!   lookup capacity;
+//! - **lean**: a `const` filter plan (`const_plan!`, the planner not linked) and a map
+//!   with no lookup key (the plan has no merged slot), no completion ring ([`DONE`] =
+//!   0), time stamps off (`CAN_MCR.TTCM` = 0) and the split driver's `Lean` feature
+//!   set (no traffic statistics, no time stamps read).
 
 // Each firmware that includes this module uses a part of it.
 #![allow(dead_code)]
@@ -22,9 +25,9 @@ compile_error!("features `lean` and `full` are exclusive");
 #[cfg(not(any(feature = "lean", feature = "full")))]
 compile_error!("enable feature `lean` or `full`");
 
-use twocan_bxcan::{BxCan, Config, Init};
+use twocan_bxcan::{BxCan, Config, PlanOptions, PlanRef};
 use twocan_core::split::{Parts, Rx, Rx0Irq, State, Tx, TxIrq};
-use twocan_core::{Error, FifoQueue, Filter, Mmio, TxPolicy};
+use twocan_core::{Error, FifoQueue, Filter, Fixed, TxPolicy};
 
 pub const APB1_HZ: u32 = 54_000_000;
 pub const BITRATE: u32 = 500_000;
@@ -62,28 +65,23 @@ pub const TIMESTAMPS: bool = false;
 /// Identifiers of the filter map's merged-filter lookup.
 #[cfg(feature = "lean")]
 pub const KEYS: usize = 0;
+/// The split driver's compile-time feature set: no statistics, no time stamps.
+#[cfg(feature = "lean")]
+pub type Fe = twocan_core::Lean;
 
-/// Installs the filters: one accept-all mask bank to FIFO 0, set by hand.
+/// Planner options: CAN1's banks at reset (`CAN2SB` = 14, RM0410 §40.9.4), FIFO 0.
+pub const OPTIONS: PlanOptions = PlanOptions::new(14);
+
+/// The filters: [`FILTERS`] planned at compile time (one accept-all mask bank to FIFO 0).
 #[cfg(feature = "lean")]
 #[inline(always)]
-fn install_filters(init: &mut Init<Mmio, Mmio, KEYS>) -> Result<(), Error> {
-    use twocan_bxcan::{Bank, Fifo, FilterPlan};
-    let mut plan = FilterPlan::manual();
-    let bank = Bank::mask32(&FILTERS[0], Fifo::Fifo0).map_err(|_| Error::InvalidArgument)?;
-    plan.set_bank(0, bank)?;
-    init.set_filters(&plan)
+fn with_plan<T>(f: impl FnOnce(PlanRef<'_>) -> Result<T, Error>) -> Result<T, Error> {
+    f(twocan_bxcan::const_plan!(FILTERS, OPTIONS).as_ref())
 }
 
-/// The user's filter index the one frame comes back with: the bank slot's own index
-/// (`FilterPlan::slot_index`) for a plan set by hand.
+/// The user's filter index the one frame comes back with: its index in [`FILTERS`].
 #[cfg(feature = "lean")]
-pub const FILTER_INDEX: u16 = twocan_bxcan::FilterPlan::slot_index(0, 0);
-
-#[cfg(feature = "lean")]
-#[inline(always)]
-fn with_keys(init: Init<Mmio>) -> Init<Mmio, Mmio, KEYS> {
-    init.with_lookup_capacity::<KEYS>()
-}
+pub const FILTER_INDEX: u16 = 0;
 
 // ------------------------------------------------------------------ full
 
@@ -95,62 +93,64 @@ pub const DONE: usize = 8;
 pub const TIMESTAMPS: bool = true;
 #[cfg(feature = "full")]
 pub const KEYS: usize = twocan_bxcan::filters::LOOKUP_KEYS;
+/// The split driver's compile-time feature set: statistics and time stamps.
+#[cfg(feature = "full")]
+pub type Fe = twocan_core::Full;
 
-/// Installs the filters: [`FILTERS`] compiled by the runtime planner for this
-/// instance's banks.
+/// The planner's working memory (about 90 KB of `.bss`), lent once.
+#[cfg(feature = "full")]
+static SCRATCH: twocan_core::TakeOnce<twocan_bxcan::planner::Scratch<KEYS>> =
+    twocan_core::TakeOnce::new(twocan_bxcan::planner::Scratch::new());
+
+/// The filters: [`FILTERS`] compiled by the run-time planner into [`SCRATCH`].
 #[cfg(feature = "full")]
 #[inline(always)]
-fn install_filters(init: &mut Init<Mmio, Mmio, KEYS>) -> Result<(), Error> {
-    let plan = init.can().plan(&FILTERS, twocan_bxcan::FifoPolicy::Fifo0)?;
-    init.set_filters(&plan)
+fn with_plan<T>(f: impl FnOnce(PlanRef<'_>) -> Result<T, Error>) -> Result<T, Error> {
+    let scratch = SCRATCH.take().ok_or(Error::WrongMode)?;
+    let plan = twocan_bxcan::planner::plan_in(&FILTERS, OPTIONS, scratch)?;
+    f(plan.as_ref())
 }
 
 /// The user's filter index the one frame comes back with: its index in [`FILTERS`].
 #[cfg(feature = "full")]
 pub const FILTER_INDEX: u16 = 0;
 
-#[cfg(feature = "full")]
-#[inline(always)]
-fn with_keys(init: Init<Mmio>) -> Init<Mmio, Mmio, KEYS> {
-    init
-}
-
 // ------------------------------------------------------------------ both
 
+/// CAN1's registers at the firmware's `CAN_BASE`, a constant: the per-frame code reaches
+/// them with no base to load (`twocan_core::Fixed`).
+pub type Regs = Fixed<{ crate::CAN_BASE }>;
 /// The controller the split driver holds.
-pub type Hw = BxCan<Mmio, Mmio, KEYS>;
+pub type Hw = BxCan<Regs, Regs, KEYS>;
 /// The transmit queue.
 pub type Q = FifoQueue<TXQ>;
 /// The shared state a `static` holds.
-pub type OurState = State<Hw, RX, Q, 0, DONE>;
+pub type OurState = State<Hw, RX, Q, 0, DONE, Fe>;
 /// The handles of `State::split`.
-pub type OurParts = Parts<'static, Hw, RX, Q, 0, DONE>;
-pub type OurTx = Tx<'static, Hw, RX, Q, 0, DONE>;
-pub type OurRx = Rx<'static, Hw, RX, Q, 0, DONE>;
-pub type OurTxIrq = TxIrq<'static, Hw, RX, Q, 0, DONE>;
-pub type OurRxIrq = Rx0Irq<'static, Hw, RX, Q, 0, DONE>;
+pub type OurParts = Parts<'static, Hw, RX, Q, 0, DONE, Fe>;
+pub type OurTx = Tx<'static, Hw, RX, Q, 0, DONE, Fe>;
+pub type OurRx = Rx<'static, Hw, RX, Q, 0, DONE, Fe>;
+pub type OurTxIrq = TxIrq<'static, Hw, RX, Q, 0, DONE, Fe>;
+pub type OurRxIrq = Rx0Irq<'static, Hw, RX, Q, 0, DONE, Fe>;
 
-/// Configures CAN1 at `regs` ([`CONFIG`], the variant's filters) and starts it, ready
-/// for `State::split`. `RETRIES` more attempts after a mode request that timed out (the
-/// QEMU stand-in acknowledges from an interrupt whose rate follows host time; 0 on
+/// Configures CAN1 at `regs` ([`CONFIG`], the variant's filters) in place in `state`
+/// and splits it. `RETRIES` more attempts after a mode request that timed out (the QEMU
+/// stand-in acknowledges from an interrupt whose rate follows host time; 0 on
 /// hardware).
 #[inline(always)]
-pub fn configure<const RETRIES: u32>(regs: Mmio) -> Result<Hw, Error> {
-    let mut attempt = twocan_bxcan::Can::can1(regs, &CONFIG);
-    for _ in 0..RETRIES {
-        match attempt {
-            Err(f) if f.error == Error::Timeout => attempt = f.value.reconfigure(&CONFIG),
-            _ => break,
-        }
-    }
-    let mut init = with_keys(attempt.map_err(|f| f.error)?);
-    install_filters(&mut init)?;
-    let mut attempt = init.enable();
-    for _ in 0..RETRIES {
-        match attempt {
-            Err(f) if f.error == Error::Timeout => attempt = f.value.enable(),
-            _ => break,
-        }
-    }
-    Ok(attempt.map_err(|f| f.error)?.into_split())
+pub fn start<const RETRIES: u32>(state: &'static OurState, regs: Regs) -> Result<OurParts, Error> {
+    with_plan(|plan| {
+        state.split_with(|slot| {
+            let mut attempt = Hw::can1_in(slot, regs, &CONFIG, plan);
+            for _ in 0..RETRIES {
+                match attempt {
+                    Err(f) if f.error == Error::Timeout => {
+                        attempt = Hw::can1_in(f.value.slot, f.value.regs, &CONFIG, plan)
+                    }
+                    _ => break,
+                }
+            }
+            attempt.map_err(|f| f.error)
+        })
+    })
 }

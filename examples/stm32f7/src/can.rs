@@ -2,12 +2,18 @@
 //! its four interrupt handlers in one `static` ([`CanState`], the library's
 //! `twocan_bxcan::rt::IrqState`), run by the library's own entry points `CAN1_TX`,
 //! `CAN1_RX0`, `CAN1_RX1`, `CAN1_SCE` (and `CAN2_…`; one handler per line, RM0410
-//! §40.8): the examples define no CAN vector. `start` puts the handlers in place
-//! **before** it unmasks the lines.
+//! §40.8): the examples define no CAN vector. `start` configures the controller **in
+//! place** in the state (an in-place constructor such as `BxCan::can1_in`: no
+//! controller, plan or filter map moves through the configuration, issue 21) and puts
+//! the handlers in place **before** it unmasks the lines. Filter lists known at compile
+//! time are planned at compile time (`const_plan!`); lists known at run time use the
+//! planner with its working memory in [`PLANNER`].
 
+use twocan_bxcan::planner::Scratch;
 use twocan_bxcan::regs::CanRegs;
 use twocan_bxcan::rt::IrqState;
 use twocan_bxcan::types::{BxRx, BxTx};
+use twocan_core::TakeOnce;
 
 /// Receive ring per FIFO, transmit queue and completion ring sizes of the examples.
 pub const RX: usize = twocan_bxcan::types::RX_RING;
@@ -15,6 +21,11 @@ pub const RX: usize = twocan_bxcan::types::RX_RING;
 pub const TX: usize = twocan_bxcan::types::TX_QUEUE;
 /// See [`RX`].
 pub const COMPLETIONS: usize = twocan_bxcan::types::COMPLETIONS;
+
+/// The planner's working memory for filter lists known only at run time (about 90 KB
+/// of `.bss`, never on the stack), lent once: plan into it with
+/// `twocan_bxcan::planner::plan_in`, install the plan, plan the next list into it.
+pub static PLANNER: TakeOnce<Scratch> = TakeOnce::new(Scratch::new());
 
 /// A transmit queue in request order (`TXFP = 1`, the driver's default).
 pub type Queue = twocan_bxcan::types::Queue;
@@ -27,13 +38,18 @@ pub type CanTxHalf<R = CanRegs, F = CanRegs> = BxTx<'static, R, F>;
 /// The receive half.
 pub type CanRxHalf<R = CanRegs, F = CanRegs> = BxRx<'static, R, F>;
 
-/// Starts `state` over `hw` (`IrqState::start`: the four handlers installed, then each
-/// line of the instance given [`crate::rt::CAN_PRIORITY`] and unmasked). Returns the
-/// thread-side halves; `None` when the state runs a controller already.
+/// Configures `instance`'s controller in place in `state` (`init`: an in-place
+/// constructor, e.g. `BxCan::can1_in`) and starts it (`IrqState::start_in_place`: the
+/// four handlers installed, then each line of the instance given
+/// [`crate::rt::CAN_PRIORITY`] and unmasked). Returns the thread-side halves; `None`
+/// when the configuration failed or the state runs a controller already.
 #[cfg(target_os = "none")]
 pub fn start<R, F>(
     state: &'static CanState<R, F>,
-    hw: twocan_bxcan::BxCan<R, F>,
+    instance: twocan_bxcan::Instance,
+    init: impl FnOnce(
+        &mut core::mem::MaybeUninit<twocan_bxcan::BxCan<R, F>>,
+    ) -> Result<&mut twocan_bxcan::BxCan<R, F>, twocan_core::Error>,
     nvic: &mut cortex_m::peripheral::NVIC,
 ) -> Option<(CanTxHalf<R, F>, CanRxHalf<R, F>)>
 where
@@ -41,5 +57,5 @@ where
     F: twocan_core::Registers + Send + Sync + 'static,
 {
     let priorities = twocan_bxcan::rt::Priorities::all(crate::rt::CAN_PRIORITY);
-    state.start(hw, priorities, nvic).ok()
+    state.start_in_place(instance, init, priorities, nvic).ok()
 }

@@ -37,7 +37,7 @@ use twocan_bxcan::RawFrame;
 use twocan_core::split::{StateChange, STATE_CHANGES};
 use twocan_core::txqueue::Queued;
 use twocan_core::Completion;
-use twocan_core::{Frame, Mmio, RxFrame, TxOutcome};
+use twocan_core::{Frame, RxFrame, TxOutcome};
 
 #[path = "../../shared/qemu.rs"]
 mod qemu;
@@ -82,6 +82,9 @@ const REGIONS_ALL: [&str; 14] = [
     // full only
     "twocan.take_completion",
 ];
+
+/// The RAM stand-in for CAN1's registers, read by `variant::Regs`.
+const CAN_BASE: usize = REGS;
 
 const EMPTY: usize = 0;
 const OURS_SEND_DIRECT: usize = 1;
@@ -177,13 +180,10 @@ fn ours_take_completion(tx: &mut OurTx) -> Option<Completion> {
 fn ours_configure() -> OurParts {
     // SAFETY: `REGS` is the RAM stand-in for CAN1's registers; this driver alone uses it
     // from now on (the `bxcan` crate has given it up).
-    let regs = unsafe { Mmio::new(REGS) };
-    let Ok(hw) = variant::configure::<20>(regs) else {
-        fail("twocan: configure");
-    };
-    match CAN.split(hw) {
+    let regs = unsafe { variant::Regs::new() };
+    match variant::start::<20>(&CAN, regs) {
         Ok(p) => p,
-        Err(_) => fail("twocan: split"),
+        Err(_) => fail("twocan: configure"),
     }
 }
 

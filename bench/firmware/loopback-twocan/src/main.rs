@@ -18,12 +18,15 @@
 use cortex_m_rt::entry;
 use panic_halt as _;
 use twocan_bxcan::regs::CAN1_BASE;
-use twocan_core::{Error, Frame, Mmio};
+use twocan_core::{Error, Frame};
 
 #[path = "../../shared/stm32f7.rs"]
 mod startup;
 #[path = "../../shared/bxcan_variant.rs"]
 mod variant;
+
+/// CAN1's register block (RM0410 §2.2.2), read by `variant::Regs`.
+const CAN_BASE: usize = CAN1_BASE;
 
 const ID: u16 = 0x123;
 const DATA: [u8; 8] = [0x01, 0x23, 0x45, 0x67, 0x89, 0xAB, 0xCD, 0xEF];
@@ -35,16 +38,15 @@ const POLLS: u32 = 1_000_000;
 #[no_mangle]
 static BENCH_CAN_STATE: variant::OurState = variant::OurState::new();
 
-fn start() -> Result<variant::Hw, Error> {
+fn start() -> Result<variant::OurParts, Error> {
     // SAFETY: CAN1's register block (RM0410 §2.2.2), clocked by `stm32f7::clocks`;
     // nothing else in this firmware touches it.
-    let regs = unsafe { Mmio::new(CAN1_BASE) };
-    variant::configure::<0>(regs)
+    let regs = unsafe { variant::Regs::new() };
+    variant::start::<0>(&BENCH_CAN_STATE, regs)
 }
 
-fn loop_back(hw: variant::Hw) -> Result<bool, Error> {
+fn loop_back(mut p: variant::OurParts) -> Result<bool, Error> {
     let frame = Frame::standard(ID, &DATA)?;
-    let mut p = BENCH_CAN_STATE.split(hw).map_err(|(e, _)| e)?;
     p.tx.try_send(&frame).map_err(|_| Error::WrongMode)?;
     for _ in 0..POLLS {
         p.tx_irq.on_interrupt();

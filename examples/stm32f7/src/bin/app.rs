@@ -20,7 +20,7 @@ mod firmware {
     use critical_section::Mutex;
     use twocan_app::firmware::{FirmwareLoop, Published};
     use twocan_app::{App, AppStats};
-    use twocan_bxcan::{hal, FifoPolicy, Recovery};
+    use twocan_bxcan::{hal, planner, BxCan, FifoPolicy, Instance, Recovery};
     use twocan_stm32f7::board::BIT_RATE;
     use twocan_stm32f7::can::{self, CanState};
     use twocan_stm32f7::rt::{self, CAN_BLINKS};
@@ -59,19 +59,25 @@ mod firmware {
             .config(BIT_RATE)
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS))
             .recovery(Recovery::Automatic);
-        let mut init = can1
+        // The HAL's configuration gives the registers back (and the bank count for
+        // the planner); the application's list is planned at run time into the
+        // planner's `static` working memory, and the controller configured in place in
+        // `CAN1`.
+        let init = can1
             .configure(&config)
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        let plan = init
-            .can()
-            .plan(&app.filters(), FifoPolicy::Fifo0)
+        let options = init.can().plan_options(FifoPolicy::Fifo0);
+        let (regs, _) = init.release();
+        let scratch = can::PLANNER.take().unwrap_or_else(|| rt::halt(CAN_BLINKS));
+        let plan = planner::plan_in(&app.filters(), options, scratch)
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        if init.set_filters(&plan).is_err() {
-            rt::halt(CAN_BLINKS);
-        }
-        let can = init.enable().unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        let (mut tx, mut rx) = can::start(&CAN1, can.into_split(), &mut boot.core.NVIC)
-            .unwrap_or_else(|| rt::halt(CAN_BLINKS));
+        let (mut tx, mut rx) = can::start(
+            &CAN1,
+            Instance::Can1,
+            |slot| BxCan::can1_in(slot, regs, &config, plan).map_err(|f| f.error),
+            &mut boot.core.NVIC,
+        )
+        .unwrap_or_else(|| rt::halt(CAN_BLINKS));
         twocan_stm32f7::info!(
             "CAN1 on the bus with the application's {=usize} filters",
             app.filters().len()

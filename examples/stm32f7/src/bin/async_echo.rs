@@ -24,7 +24,7 @@ mod firmware {
     use embassy_executor::Executor;
     use static_cell::StaticCell;
     use twocan_app::asynch::{echo, EchoStats};
-    use twocan_bxcan::{hal, FifoPolicy, Recovery};
+    use twocan_bxcan::{const_plan, hal, BxCan, Instance, PlanOptions, Recovery};
     use twocan_core::Filter;
     use twocan_stm32f7::board::BIT_RATE;
     use twocan_stm32f7::can::{self, CanRxHalf, CanState, CanTxHalf};
@@ -62,20 +62,21 @@ mod firmware {
             .config(BIT_RATE)
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS))
             .recovery(Recovery::Automatic);
-        let mut init = can1
+        // The HAL's configuration gives the registers back; the controller is then
+        // configured in place in `CAN1` with a plan computed at compile time. One FIFO
+        // keeps the frames in arrival order.
+        let (regs, _) = can1
             .configure(&config)
-            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        // One FIFO keeps the frames in arrival order.
-        let plan = init
-            .can()
-            .plan(&[Filter::pass_all()], FifoPolicy::Fifo0)
-            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        if init.set_filters(&plan).is_err() {
-            rt::halt(CAN_BLINKS);
-        }
-        let can = init.enable().unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        let (tx, rx) = can::start(&CAN1, can.into_split(), &mut boot.core.NVIC)
-            .unwrap_or_else(|| rt::halt(CAN_BLINKS));
+            .unwrap_or_else(|_| rt::halt(CAN_BLINKS))
+            .release();
+        let plan = const_plan!([Filter::pass_all()], PlanOptions::new(14));
+        let (tx, rx) = can::start(
+            &CAN1,
+            Instance::Can1,
+            |slot| BxCan::can1_in(slot, regs, &config, plan).map_err(|f| f.error),
+            &mut boot.core.NVIC,
+        )
+        .unwrap_or_else(|| rt::halt(CAN_BLINKS));
         let led = boot.led;
         EXECUTOR.init(Executor::new()).run(|spawner| {
             spawner.spawn(echo_task(tx, rx, led).unwrap_or_else(|_| rt::halt(CAN_BLINKS)));

@@ -23,7 +23,7 @@ mod firmware {
     use twocan_app::{App, AppStats};
     use twocan_bxcan::hal::{self, Can1Filters};
     use twocan_bxcan::regs::ControlRegs;
-    use twocan_bxcan::{FifoPolicy, Recovery};
+    use twocan_bxcan::{planner, BxCan, FifoPolicy, Instance, Recovery};
     use twocan_stm32f7::board::BIT_RATE;
     use twocan_stm32f7::can::{self, CanState};
     use twocan_stm32f7::rt::{self, CAN_BLINKS};
@@ -57,32 +57,43 @@ mod firmware {
         let mut node1 = App::new(1, 2);
         let mut node2 = App::new(2, 1);
 
-        let mut init1 = can1
+        // The HAL's configuration gives the registers back (and each instance's bank
+        // count for the planner); each node's list is planned at run time into the
+        // planner's one `static` working memory (the controller keeps its own map, so
+        // the second plan may reuse it), and each controller is configured in place in
+        // its state.
+        let init1 = can1
             .configure(&config1)
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        let plan1 = init1
-            .can()
-            .plan(&node1.filters(), FifoPolicy::Fifo0)
-            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        if init1.set_filters(&plan1).is_err() {
-            rt::halt(CAN_BLINKS);
-        }
-        let mut init2 = can2
+        let options1 = init1.can().plan_options(FifoPolicy::Fifo0);
+        let (regs1, filters1) = init1.release();
+        let init2 = can2
             .configure(&base)
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        let plan2 = init2
-            .can()
-            .plan(&node2.filters(), FifoPolicy::Fifo1)
+        let options2 = init2.can().plan_options(FifoPolicy::Fifo1);
+        let (regs2, filters2) = init2.release();
+        let (Some(filters1), Some(filters2)) = (filters1, filters2) else {
+            rt::halt(CAN_BLINKS)
+        };
+        let scratch = can::PLANNER.take().unwrap_or_else(|| rt::halt(CAN_BLINKS));
+        let plan1 = planner::plan_in(&node1.filters(), options1, scratch)
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        if init2.set_filters(&plan2).is_err() {
-            rt::halt(CAN_BLINKS);
-        }
-        let can1 = init1.enable().unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        let can2 = init2.enable().unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        let (mut tx1, mut rx1) = can::start(&CAN1, can1.into_split(), &mut boot.core.NVIC)
-            .unwrap_or_else(|| rt::halt(CAN_BLINKS));
-        let (mut tx2, mut rx2) = can::start(&CAN2, can2.into_split(), &mut boot.core.NVIC)
-            .unwrap_or_else(|| rt::halt(CAN_BLINKS));
+        let (mut tx1, mut rx1) = can::start(
+            &CAN1,
+            Instance::Can1,
+            |slot| BxCan::can1_dual_in(slot, regs1, filters1, &config1, plan1).map_err(|f| f.error),
+            &mut boot.core.NVIC,
+        )
+        .unwrap_or_else(|| rt::halt(CAN_BLINKS));
+        let plan2 = planner::plan_in(&node2.filters(), options2, scratch)
+            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
+        let (mut tx2, mut rx2) = can::start(
+            &CAN2,
+            Instance::Can2,
+            |slot| BxCan::can2_in(slot, regs2, filters2, &base, plan2).map_err(|f| f.error),
+            &mut boot.core.NVIC,
+        )
+        .unwrap_or_else(|| rt::halt(CAN_BLINKS));
 
         let mut period = Every::new(time::millis(), 10);
         let mut shown = 0;

@@ -1,6 +1,6 @@
 //! The bxCAN filter planner with both receive FIFOs, in loop-back mode (no transceiver).
 //!
-//! Six portable filters are compiled by `twocan_bxcan::planner` with
+//! Six portable filters are compiled at compile time (`const_plan!`) with
 //! `FifoPolicy::Balanced`: the fewest filter banks (RM0410 §40.7.4 "Identifier
 //! filtering": 32-/16-bit, mask/list banks), spread over FIFO 0 and FIFO 1 without
 //! separating overlapping filters. Received frames come back with the user's filter
@@ -23,7 +23,7 @@
 mod firmware {
     use core::sync::atomic::{AtomicU32, Ordering};
 
-    use twocan_bxcan::{hal, FifoPolicy};
+    use twocan_bxcan::{const_plan, hal, BxCan, FifoPolicy, Instance, PlanOptions};
     use twocan_core::{Dispatcher, Filter, Format, Frame, FrameKind, RxFrame};
     use twocan_stm32f7::can::{self, CanState};
     use twocan_stm32f7::rt::{self, CAN_BLINKS};
@@ -40,16 +40,14 @@ mod firmware {
     /// Filter banks of the plan assigned to FIFO 0 and FIFO 1.
     pub static BANKS: [AtomicU32; 2] = [const { AtomicU32::new(0) }; 2];
 
-    fn filters() -> [Filter; FILTERS] {
-        [
-            Filter::exact(FrameKind::Data, Format::Standard, 0x100),
-            Filter::exact(FrameKind::Data, Format::Standard, 0x101),
-            Filter::exact(FrameKind::Remote, Format::Standard, 0x542),
-            Filter::masked(FrameKind::Data, Format::Standard, 0x7F0, 0x300),
-            Filter::exact(FrameKind::Data, Format::Extended, 0x12_3456),
-            Filter::masked(FrameKind::Data, Format::Extended, 0x1FFF_00FF, 0x18FF_0000),
-        ]
-    }
+    const FILTER_LIST: [Filter; FILTERS] = [
+        Filter::exact(FrameKind::Data, Format::Standard, 0x100),
+        Filter::exact(FrameKind::Data, Format::Standard, 0x101),
+        Filter::exact(FrameKind::Remote, Format::Standard, 0x542),
+        Filter::masked(FrameKind::Data, Format::Standard, 0x7F0, 0x300),
+        Filter::exact(FrameKind::Data, Format::Extended, 0x12_3456),
+        Filter::masked(FrameKind::Data, Format::Extended, 0x1FFF_00FF, 0x18FF_0000),
+    ];
 
     /// The frames sent, in order (the first six hit filters #0..#5, the last none).
     fn frames() -> [Result<Frame, twocan_core::FrameError>; 7] {
@@ -86,22 +84,23 @@ mod firmware {
             .config(125_000)
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS))
             .loopback(true);
-        let mut init = can1
+        // The HAL's configuration gives the registers back; the controller is then
+        // configured in place in `CAN1` with the plan computed at compile time.
+        let (regs, _) = can1
             .configure(&config)
-            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        let plan = init
-            .can()
-            .plan(&filters(), FifoPolicy::Balanced)
-            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
+            .unwrap_or_else(|_| rt::halt(CAN_BLINKS))
+            .release();
+        let plan = const_plan!(FILTER_LIST, PlanOptions::new(14).fifo(FifoPolicy::Balanced));
         for bank in plan.banks() {
             BANKS[bank.fifo.index()].fetch_add(1, Ordering::Relaxed);
         }
-        if init.set_filters(&plan).is_err() {
-            rt::halt(CAN_BLINKS);
-        }
-        let can = init.enable().unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        let (mut tx, mut rx) = can::start(&CAN1, can.into_split(), &mut boot.core.NVIC)
-            .unwrap_or_else(|| rt::halt(CAN_BLINKS));
+        let (mut tx, mut rx) = can::start(
+            &CAN1,
+            Instance::Can1,
+            |slot| BxCan::can1_in(slot, regs, &config, plan).map_err(|f| f.error),
+            &mut boot.core.NVIC,
+        )
+        .unwrap_or_else(|| rt::halt(CAN_BLINKS));
 
         let mut dispatcher: Dispatcher<(), FILTERS> = Dispatcher::new();
         for i in 0..FILTERS {

@@ -11,7 +11,7 @@
 mod firmware {
     use core::sync::atomic::{AtomicU32, Ordering};
 
-    use twocan_bxcan::{hal, FifoPolicy};
+    use twocan_bxcan::{const_plan, hal, BxCan, Instance, PlanOptions};
     use twocan_core::{Filter, Frame};
     use twocan_stm32f7::can::{self, CanState};
     use twocan_stm32f7::rt::{self, CAN_BLINKS};
@@ -36,19 +36,20 @@ mod firmware {
             .config(125_000)
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS))
             .loopback(true);
-        let mut init = can1
+        // The HAL's configuration gives the registers back; the controller is then
+        // configured in place in `CAN1` with a plan computed at compile time.
+        let (regs, _) = can1
             .configure(&config)
-            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        let plan = init
-            .can()
-            .plan(&[Filter::pass_all()], FifoPolicy::Fifo0)
-            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        if init.set_filters(&plan).is_err() {
-            rt::halt(CAN_BLINKS);
-        }
-        let can = init.enable().unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        let (mut tx, mut rx) = can::start(&CAN1, can.into_split(), &mut boot.core.NVIC)
-            .unwrap_or_else(|| rt::halt(CAN_BLINKS));
+            .unwrap_or_else(|_| rt::halt(CAN_BLINKS))
+            .release();
+        let plan = const_plan!([Filter::pass_all()], PlanOptions::new(14));
+        let (mut tx, mut rx) = can::start(
+            &CAN1,
+            Instance::Can1,
+            |slot| BxCan::can1_in(slot, regs, &config, plan).map_err(|f| f.error),
+            &mut boot.core.NVIC,
+        )
+        .unwrap_or_else(|| rt::halt(CAN_BLINKS));
 
         let message = Frame::standard(0x542, &[]).unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         let mut send = Every::new(time::millis(), 1000);

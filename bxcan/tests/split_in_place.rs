@@ -1,0 +1,135 @@
+//! The in-place constructors (`BxCan::can1_in` through `State::split_with`, issue 21):
+//! the same registers as the by-value path (`Can::can1`, `set_filters`, `enable`,
+//! `into_split`) for a `const` plan and a run-time plan of the same list, frames in and
+//! out with their filter index, and every failure handing the slot and the registers
+//! back (a retry after a timeout works).
+#![cfg(feature = "model")]
+
+mod common;
+
+use common::*;
+use twocan_bxcan::regs::{BTR, FA1R, FFA1R, FM1R, FMR, FS1R, IER, MCR};
+use twocan_bxcan::{const_plan, BxCan, Can, PlanOptions};
+use twocan_core::split::State;
+use twocan_core::{
+    Error, FifoQueue, Filter, Format, Frame, FrameKind, Hardware, Registers, TxPolicy,
+};
+
+const FILTERS: [Filter; 4] = [
+    Filter::standard(0x100),
+    Filter::standard(0x101),
+    Filter::masked(FrameKind::Data, Format::Extended, 0x1FFF_FF00, 0x0001_2300),
+    Filter::exact(FrameKind::Remote, Format::Standard, 0x542),
+];
+
+/// The configuration and filter registers (CAN1's whole block but the status ones).
+fn config_registers(r: &Clocked) -> Vec<u32> {
+    let mut v: Vec<u32> = [MCR, IER, BTR, FMR, FM1R, FS1R, FFA1R, FA1R]
+        .iter()
+        .map(|&o| r.model.read32(o))
+        .collect();
+    v.extend((0x240..0x320).step_by(4).map(|o| r.model.read32(o)));
+    v
+}
+
+fn attached() -> (Clocked, SharedBus) {
+    let bus = new_bus();
+    let model = twocan_bxcan::model::BxCanModel::can1();
+    bus.borrow_mut().attach("can1", model.clone());
+    (Clocked::new(model, &bus), bus)
+}
+
+#[test]
+fn in_place_writes_what_the_by_value_path_writes_and_moves_frames() {
+    let config = loopback_config(TxPolicy::Fifo);
+    const OPTIONS: PlanOptions = PlanOptions::new(14);
+    let plan = const_plan!(FILTERS, OPTIONS);
+    let runtime = twocan_bxcan::plan(&FILTERS, OPTIONS).unwrap();
+    assert_eq!(
+        plan.as_ref(),
+        runtime.as_ref(),
+        "const and run-time plans agree"
+    );
+
+    // By value.
+    let (regs_v, _bus_v) = attached();
+    let mut init = Can::can1(regs_v.clone(), &config)
+        .map_err(|f| f.error)
+        .unwrap();
+    init.set_filters(&runtime).unwrap();
+    let by_value = init.enable().map_err(|f| f.error).unwrap().into_split();
+
+    // In place, with the map sized to the plan (no lookup key).
+    let (regs, bus) = attached();
+    let state: State<BxCan<Clocked, Clocked, 0>, 8, FifoQueue<4>, 0, 4> = State::new();
+    let mut p = state
+        .split_with(|slot| BxCan::can1_in(slot, regs.clone(), &config, plan).map_err(|f| f.error))
+        .ok()
+        .unwrap();
+    assert_eq!(config_registers(&regs), config_registers(&regs_v));
+    let hw = state.hardware().unwrap();
+    assert_eq!(hw.mode(), by_value.mode());
+    assert_eq!(hw.fed_rx_queues(), by_value.fed_rx_queues());
+
+    let frames = [
+        (Frame::standard(0x101, &[1]).unwrap(), 1),
+        (Frame::extended(0x1_2345, &[2; 8]).unwrap(), 2),
+        (Frame::remote(0x542, false, 0).unwrap(), 3),
+        (Frame::standard(0x100, &[]).unwrap(), 0),
+    ];
+    for (f, _) in &frames {
+        nb::block!(p.tx.try_send(f)).unwrap();
+        run(&bus, 200);
+        p.tx_irq.on_interrupt();
+        p.rx0_irq.on_interrupt();
+    }
+    run(&bus, 500);
+    p.tx_irq.on_interrupt();
+    p.rx0_irq.on_interrupt();
+    for (f, index) in &frames {
+        let rx = p.rx.receive().unwrap();
+        assert_eq!((&rx.frame, rx.filter), (f, *index));
+    }
+    assert_eq!(state.traffic().sent, 4);
+}
+
+#[test]
+fn failures_hand_the_slot_and_registers_back_and_a_retry_works() {
+    let config = loopback_config(TxPolicy::Fifo);
+    let (regs, _bus) = attached();
+    let mut slot = core::mem::MaybeUninit::<BxCan<Clocked, Clocked, 0>>::uninit();
+
+    // A plan needing a lookup key does not fit K = 0: refused before any bank changes.
+    let merged = twocan_bxcan::plan(
+        &[
+            Filter::standard(0x100),
+            Filter::standard(0x102),
+            Filter::standard(0x104),
+            Filter::standard(0x106),
+            Filter::standard(0x108),
+        ],
+        PlanOptions::new(1),
+    )
+    .unwrap();
+    assert!(!merged.key_table().is_empty(), "one bank for five: merged");
+    let f = BxCan::can1_in(&mut slot, regs.clone(), &config, &merged)
+        .err()
+        .unwrap();
+    assert!(matches!(f.error, Error::FilterSpace { available: 0, .. }));
+    assert_eq!(regs.model.read32(FA1R), 0, "no bank was activated");
+    let back = f.value;
+
+    // No acknowledge: a timeout, everything back; then a retry with the same slot.
+    regs.model.set_ack_stuck(true);
+    let plan = const_plan!([Filter::pass_all()], PlanOptions::new(14));
+    let f = BxCan::can1_in(back.slot, back.regs, &config, plan)
+        .err()
+        .unwrap();
+    assert_eq!(f.error, Error::Timeout);
+    regs.model.set_ack_stuck(false);
+    let back = f.value;
+    let hw = BxCan::can1_in(back.slot, back.regs, &config, plan)
+        .map_err(|f| f.error)
+        .unwrap();
+    assert_eq!(hw.mode(), twocan_core::Mode::Normal);
+}
