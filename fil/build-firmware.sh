@@ -61,7 +61,7 @@ if ! has negative; then
 fi
 cargo build --quiet --release --target "$target" --manifest-path fil/firmware/Cargo.toml
 mkdir -p "$out/negative"
-for bin in kinetis-gate kinetis-stuck kinetis-no-wdog core-check stm32-gate stm32-stuck \
+for bin in kinetis-gate kinetis-stuck kinetis-storm kinetis-hang kinetis-no-wdog core-check stm32-gate stm32-stuck \
     imxrt-boot imxrt-gate imxrt-stuck imxrt-no-can-clock; do
     cp "$fw_rel/$bin" "$out/negative/"
 done

@@ -44,6 +44,14 @@ done
 work="$repo/target/planted"
 tree="$work/tree"
 export CARGO_TARGET_DIR="${PLANT_TARGET:-$work/target}"
+# Never the clone's own target folder: cargo names the artifacts of workspace crates by
+# their path relative to the workspace, so the patched copy's would replace the clone's.
+case "$(realpath -m "$CARGO_TARGET_DIR")" in
+"$(realpath -m "$repo/target")" | "$(realpath -m "$repo/fil/target")")
+    echo "PLANT_TARGET must not be the clone's own target folder" >&2
+    exit 2
+    ;;
+esac
 test_timeout="${PLANT_TEST_TIMEOUT:-120}"
 doc_timeout="${PLANT_DOC_TIMEOUT:-600}"
 fil_timeout="${PLANT_FIL_TIMEOUT:-900}"
