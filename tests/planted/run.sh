@@ -10,8 +10,9 @@
 # NAME: a patch's name without `.patch` (or a prefix such as `05`); all by default.
 # --base: the revision patched (default: HEAD of this clone). The worktree lives under
 # target/planted/ and is removed at the end; CARGO_TARGET_DIR for its builds is
-# target/planted/target (PLANT_TARGET overrides), so that the first run builds the
-# dependencies once and every later one rebuilds only what a patch touches.
+# target/planted/target (PLANT_TARGET overrides; PLANT_SHARE=1 shares the clone's own
+# target folders, see below), so that the first run builds the dependencies once and
+# every later one rebuilds only what a patch touches.
 #
 # Per bug, host: every test binary of `cargo test --workspace`, of twocan-bxcan with
 # `model`, of twocan-flexcan with `model,rt,teensy36` and of twocan-core with
@@ -43,15 +44,25 @@ while [ $# -gt 0 ]; do
 done
 work="$repo/target/planted"
 tree="$work/tree"
-export CARGO_TARGET_DIR="${PLANT_TARGET:-$work/target}"
-# Never the clone's own target folder: cargo names the artifacts of workspace crates by
-# their path relative to the workspace, so the patched copy's would replace the clone's.
-case "$(realpath -m "$CARGO_TARGET_DIR")" in
-"$(realpath -m "$repo/target")" | "$(realpath -m "$repo/fil/target")")
-    echo "PLANT_TARGET must not be the clone's own target folder" >&2
-    exit 2
-    ;;
-esac
+# Cargo names the artifacts of workspace crates by their path relative to the
+# workspace: builds of the patched copy in the clone's own target folders replace the
+# clone's artifacts while the copy exists. PLANT_SHARE=1 shares them all the same (no
+# dependency rebuilt: much faster) — build nothing in the clone during the run; the
+# clone's workspace crates are cleaned at the end so that its next build redoes them.
+share="${PLANT_SHARE:-0}"
+if [ "$share" = 1 ]; then
+    export CARGO_TARGET_DIR="$repo/target"
+    fil_target="$repo/fil/target"
+else
+    export CARGO_TARGET_DIR="${PLANT_TARGET:-$work/target}"
+    fil_target="$CARGO_TARGET_DIR"
+    case "$(realpath -m "$CARGO_TARGET_DIR")" in
+    "$(realpath -m "$repo/target")" | "$(realpath -m "$repo/fil/target")")
+        echo "PLANT_TARGET must not be the clone's own target folder (PLANT_SHARE=1 does that)" >&2
+        exit 2
+        ;;
+    esac
+fi
 test_timeout="${PLANT_TEST_TIMEOUT:-120}"
 doc_timeout="${PLANT_DOC_TIMEOUT:-600}"
 fil_timeout="${PLANT_FIL_TIMEOUT:-900}"
@@ -74,8 +85,16 @@ done
 cleanup() {
     git -C "$repo" worktree remove --force "$tree" >/dev/null 2>&1 || rm -rf "$tree"
     git -C "$repo" worktree prune
+    if [ "$share" = 1 ] && [ "${1:-}" = final ]; then
+        for p in twocan-core twocan-sim twocan-bxcan twocan-flexcan twocan-app twocan-host \
+            twocan-tests twocan-teensy twocan-stm32f7; do
+            (cd "$repo" && cargo clean -q -p "$p" 2>/dev/null)
+            (cd "$repo" && CARGO_TARGET_DIR="$fil_target" cargo clean -q \
+                --manifest-path fil/Cargo.toml -p "$p" 2>/dev/null)
+        done
+    fi
 }
-trap cleanup EXIT
+trap 'cleanup final' EXIT
 cleanup
 git -C "$repo" worktree add --detach -q "$tree" "$rev" || exit 2
 
@@ -176,8 +195,8 @@ run_fil() {
         return
     fi
     local out rc
-    out="$(cd "$tree" && FIL_ELF_DIR="$elf" FIL_REQUIRE_ELF=1 timeout "$fil_timeout" \
-        cargo test --release --manifest-path fil/Cargo.toml --no-fail-fast 2>&1)"
+    out="$(cd "$tree" && FIL_ELF_DIR="$elf" FIL_REQUIRE_ELF=1 CARGO_TARGET_DIR="$fil_target" \
+        timeout "$fil_timeout" cargo test --release --manifest-path fil/Cargo.toml --no-fail-fast 2>&1)"
     rc=$?
     rm -rf "$elf"
     local failing
