@@ -86,6 +86,7 @@ pub mod planner;
 // Interrupt-shared state: the `Hardware` contract and the per-mailbox frame cell.
 #[allow(unsafe_code)]
 pub mod split;
+pub mod types;
 
 pub use config::{Config, ConfigError, Recovery};
 pub use controller::{Can, Failed, Init};

@@ -3,7 +3,8 @@
 //! and kind-any filters mixed in. Every plan must be exact (in superset mode: accept a
 //! superset whose extra frames resolve to `None`), report for every delivered frame the
 //! index of the first user filter that matches it, and never take more banks than the
-//! list-only plan. Plans for the default driver (at most [`LOOKUP_KEYS`] lookup keys)
+//! list-only plan (the lists and probes are `twocan_test_support::filters`'). Plans for
+//! the default driver (at most [`LOOKUP_KEYS`] lookup keys)
 //! are exact too, and fit whenever the list-only plan does.
 
 use proptest::prelude::*;
@@ -17,78 +18,13 @@ type FilterPlan = twocan_bxcan::FilterPlan<MAX_LOOKUP_KEYS>;
 fn plan(filters: &[Filter], options: PlanOptions) -> Result<FilterPlan, PlanError> {
     plan_for::<MAX_LOOKUP_KEYS>(filters, options)
 }
-use twocan_core::{Filter, Format, Frame, FrameKind};
+use twocan_core::{Filter, Frame};
+use twocan_test_support::filters::{filter_list, first_match, probes};
 
-/// A filter list: blocks (dense runs), scattered identifiers, some masks and kind-any.
+/// A filter list: up to 3 blocks (dense runs) and 30 scattered filters, some masks and
+/// kind-any, shuffled.
 fn list() -> impl Strategy<Value = Vec<Filter>> {
-    let std_block = (0u32..0x7C0, 1u32..40).prop_map(|(start, len)| {
-        (start..(start + len).min(0x800))
-            .map(|i| Filter::standard(i as u16))
-            .collect::<Vec<_>>()
-    });
-    let ext_block = (0u32..0x1FFF_FF00, 1u32..24).prop_map(|(start, len)| {
-        (start..start + len)
-            .map(Filter::extended)
-            .collect::<Vec<_>>()
-    });
-    let scattered = prop::collection::vec(
-        prop_oneof![
-            (0u32..0x800).prop_map(|i| Filter::standard(i as u16)),
-            (0u32..0x2000_0000).prop_map(Filter::extended),
-            (0u32..0x800).prop_map(|i| Filter::exact(FrameKind::Remote, Format::Standard, i)),
-            (0u32..0x800).prop_map(|i| Filter::exact(FrameKind::Any, Format::Standard, i)),
-            (0u32..0x800, 0u32..4).prop_map(|(i, b)| {
-                let mask = 0x7FF & !((1 << b) - 1) << 2;
-                Filter::masked(FrameKind::Data, Format::Standard, mask, i & mask)
-            }),
-        ],
-        0..30,
-    );
-    (
-        prop::collection::vec(prop_oneof![std_block, ext_block], 0..4),
-        scattered,
-        any::<u64>(),
-    )
-        .prop_map(|(blocks, scattered, seed)| {
-            let mut all: Vec<Filter> = blocks.into_iter().flatten().chain(scattered).collect();
-            // Shuffle (deterministic from the seed) so blocks are not in order.
-            let mut s = seed | 1;
-            for i in (1..all.len()).rev() {
-                s ^= s << 13;
-                s ^= s >> 7;
-                s ^= s << 17;
-                all.swap(i, (s % (i as u64 + 1)) as usize);
-            }
-            all
-        })
-}
-
-fn first_match(filters: &[Filter], f: &Frame) -> Option<u16> {
-    filters.iter().position(|x| x.matches(f)).map(|i| i as u16)
-}
-
-/// The filters' identifiers and their neighbours in both formats and kinds, plus
-/// `extra` random identifiers.
-fn probes(filters: &[Filter], seed: u32) -> Vec<Frame> {
-    let mut out = Vec::new();
-    let mut push = |id: u32| {
-        out.push(Frame::standard((id & 0x7FF) as u16, &[]).unwrap());
-        out.push(Frame::remote(id & 0x7FF, false, 0).unwrap());
-        out.push(Frame::extended(id & 0x1FFF_FFFF, &[]).unwrap());
-        out.push(Frame::remote(id & 0x1FFF_FFFF, true, 0).unwrap());
-    };
-    for f in filters {
-        for d in [0u32, 1, 2, 3, 4, 8, 16, 32, 64] {
-            push(f.id ^ d);
-            push(f.id.wrapping_add(d));
-        }
-    }
-    let mut s = seed | 1;
-    for _ in 0..200 {
-        s = s.wrapping_mul(1_103_515_245).wrapping_add(12345);
-        push(s);
-    }
-    out
+    filter_list(0..4, 0..30)
 }
 
 fn check<const K: usize>(

@@ -51,7 +51,7 @@
 //! # Ok::<(), twocan_core::Error>(())
 //! ```
 
-use core::future::{poll_fn, Future};
+use core::future::poll_fn;
 use core::task::Poll;
 
 use atomic_waker::AtomicWaker;
@@ -71,6 +71,35 @@ impl Drop for Unregister<'_> {
     }
 }
 
+/// The one wait of this module: `take` what is there; if nothing, register the task's
+/// waker in `cell` and `take` again, so that what came in between is seen and no wake-up
+/// is missed. Only the poll that returns a value takes it (cancel-safe when `take` takes
+/// nothing it does not return), and a dropped future takes its waker back out.
+async fn take_or_wait<T>(cell: &AtomicWaker, mut take: impl FnMut() -> Option<T>) -> T {
+    let _unregister = Unregister(cell);
+    poll_fn(|cx| {
+        if let Some(v) = take() {
+            return Poll::Ready(v);
+        }
+        cell.register(cx.waker());
+        match take() {
+            Some(v) => Poll::Ready(v),
+            None => Poll::Pending,
+        }
+    })
+    .await
+}
+
+/// What `take_or_wait` takes from an `nb` call: the value or the error, nothing on
+/// `WouldBlock`.
+fn ready<T>(r: nb::Result<T, Error>) -> Option<Result<T, Error>> {
+    match r {
+        Ok(v) => Some(Ok(v)),
+        Err(nb::Error::Other(e)) => Some(Err(e)),
+        Err(nb::Error::WouldBlock) => None,
+    }
+}
+
 impl<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize>
     Tx<'a, H, RX, Q, RX1, DONE>
 {
@@ -82,24 +111,11 @@ impl<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE:
     /// Cancel-safe: a dropped future has not accepted the frame.
     pub async fn send(&mut self, frame: &Frame) -> Result<Token, Error> {
         let s = self.s;
-        let _unregister = Unregister(&s.wakers.tx_room);
-        poll_fn(|cx| {
-            for attempt in 0..2 {
-                match self.try_send(frame) {
-                    Ok(t) => return Poll::Ready(Ok(t)),
-                    Err(nb::Error::Other(e)) => return Poll::Ready(Err(e)),
-                    Err(nb::Error::WouldBlock) => {
-                        if !s.hardware().is_some_and(|h| h.on_bus()) {
-                            return Poll::Ready(Err(Error::WrongMode));
-                        }
-                        if attempt == 0 {
-                            // Register, then try again: room freed in between is seen.
-                            s.wakers.tx_room.register(cx.waker());
-                        }
-                    }
-                }
-            }
-            Poll::Pending
+        take_or_wait(&s.wakers.tx_room, || {
+            ready(self.try_send(frame)).or_else(|| {
+                // Queue full: nothing would free it while the controller is off the bus.
+                (!s.hardware().is_some_and(|h| h.on_bus())).then_some(Err(Error::WrongMode))
+            })
         })
         .await
     }
@@ -109,18 +125,7 @@ impl<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE:
     /// Cancel-safe: a completion is taken only by the poll that returns it.
     pub async fn completion(&mut self) -> Completion {
         let s = self.s;
-        let _unregister = Unregister(&s.wakers.tx_done);
-        poll_fn(|cx| {
-            if let Some(c) = self.take_completion() {
-                return Poll::Ready(c);
-            }
-            s.wakers.tx_done.register(cx.waker());
-            match self.take_completion() {
-                Some(c) => Poll::Ready(c),
-                None => Poll::Pending,
-            }
-        })
-        .await
+        take_or_wait(&s.wakers.tx_done, || self.take_completion()).await
     }
 
     /// Waits for the completion of `token`. Completions of other frames that come
@@ -184,21 +189,7 @@ impl<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE:
     /// Cancel-safe: a frame is taken from the ring only by the poll that returns it.
     pub async fn recv(&mut self) -> Result<RxFrame, Error> {
         let s = self.s;
-        let _unregister = Unregister(&s.wakers.rx);
-        poll_fn(|cx| {
-            match self.receive() {
-                Ok(f) => return Poll::Ready(Ok(f)),
-                Err(nb::Error::Other(e)) => return Poll::Ready(Err(e)),
-                Err(nb::Error::WouldBlock) => {}
-            }
-            s.wakers.rx.register(cx.waker());
-            match self.receive() {
-                Ok(f) => Poll::Ready(Ok(f)),
-                Err(nb::Error::Other(e)) => Poll::Ready(Err(e)),
-                Err(nb::Error::WouldBlock) => Poll::Pending,
-            }
-        })
-        .await
+        take_or_wait(&s.wakers.rx, || ready(self.receive())).await
     }
 
     /// Waits for the next error-state change (in order, with the counters at the
@@ -207,18 +198,7 @@ impl<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE:
     /// Cancel-safe: a change is taken only by the poll that returns it.
     pub async fn state_change(&mut self) -> StateChange {
         let s = self.s;
-        let _unregister = Unregister(&s.wakers.state);
-        poll_fn(|cx| {
-            if let Some(c) = self.take_state_change() {
-                return Poll::Ready(c);
-            }
-            s.wakers.state.register(cx.waker());
-            match self.take_state_change() {
-                Some(c) => Poll::Ready(c),
-                None => Poll::Pending,
-            }
-        })
-        .await
+        take_or_wait(&s.wakers.state, || self.take_state_change()).await
     }
 
     /// Waits for a frame or an error-state change, whichever comes first (a waiting
@@ -250,22 +230,6 @@ impl<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE:
             Poll::Pending
         })
         .await
-    }
-}
-
-impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize>
-    crate::io::AsyncCanTx for Tx<'_, H, RX, Q, RX1, DONE>
-{
-    fn send(&mut self, frame: &Frame) -> impl Future<Output = Result<Token, Error>> {
-        Tx::send(self, frame)
-    }
-}
-
-impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize>
-    crate::io::AsyncCanRx for Rx<'_, H, RX, Q, RX1, DONE>
-{
-    fn recv(&mut self) -> impl Future<Output = Result<RxFrame, Error>> {
-        Rx::recv(self)
     }
 }
 

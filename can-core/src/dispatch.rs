@@ -68,6 +68,14 @@ impl<Ctx, const N: usize> Default for Dispatcher<Ctx, N> {
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct NoSuchFilter(pub usize);
 
+impl core::fmt::Display for NoSuchFilter {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        write!(f, "no filter with index {} in the dispatcher", self.0)
+    }
+}
+
+impl core::error::Error for NoSuchFilter {}
+
 impl<Ctx, const N: usize> Dispatcher<Ctx, N> {
     /// A table with no call-backs.
     pub const fn new() -> Self {
@@ -139,6 +147,12 @@ impl<Ctx, const N: usize> Dispatcher<Ctx, N> {
 mod tests {
     use super::*;
     use crate::frame::Frame;
+
+    #[test]
+    fn no_such_filter_displays_its_index() {
+        let e: &dyn core::error::Error = &NoSuchFilter(7);
+        assert_eq!(e.to_string(), "no filter with index 7 in the dispatcher");
+    }
 
     #[derive(Default)]
     struct Ctx {

@@ -378,22 +378,6 @@ impl<H: Hardware, const RX: usize, const TX: usize, const RX1: usize> Driver<H, 
     }
 }
 
-impl<H: Hardware, const RX: usize, const TX: usize, const RX1: usize> crate::io::CanTx
-    for Driver<H, RX, TX, RX1>
-{
-    fn try_send(&mut self, frame: &Frame) -> nb::Result<Token, Error> {
-        Driver::try_send(self, frame)
-    }
-}
-
-impl<H: Hardware, const RX: usize, const TX: usize, const RX1: usize> crate::io::CanRx
-    for Driver<H, RX, TX, RX1>
-{
-    fn receive(&mut self) -> nb::Result<RxFrame, Error> {
-        Driver::receive(self)
-    }
-}
-
 impl<H: Hardware, const RX: usize, const TX: usize, const RX1: usize> embedded_can::nb::Can
     for Driver<H, RX, TX, RX1>
 {

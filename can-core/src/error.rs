@@ -1,4 +1,9 @@
-//! Error states, counters, last-error codes and the driver's error type.
+//! Error states, counters, last-error codes, the driver's error type and the errors of
+//! frames and filters ([`FrameError`], [`FilterError`], re-exported by their modules).
+//!
+//! The floor of the core: it names no other module but the bit-timing errors it wraps,
+//! so every module can return these types (`frame`, `filter` and `timestamp` among
+//! them) without a loop of imports.
 //!
 //! The fault-confinement states and thresholds are those of ISO 11898-1 §12.1.4:
 //! error-active while both counters are below 128 (with a warning level at 96, as both
@@ -152,6 +157,46 @@ impl ErrorStatistics {
     }
 }
 
+/// Why a frame could not be built.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum FrameError {
+    /// A standard identifier above `0x7FF`.
+    StandardIdOutOfRange(u32),
+    /// An extended identifier above `0x1FFF_FFFF`.
+    ExtendedIdOutOfRange(u32),
+    /// A data length code above 15 (the field has four bits; [`Frame::check_dlc`](crate::frame::Frame::check_dlc)).
+    DlcTooLarge(u8),
+    /// A DLC code that does not agree with the data: a code `0..=8` other than the
+    /// number of data bytes, or a code `9..=15` with fewer than 8 data bytes.
+    DlcMismatch {
+        /// The DLC code asked for.
+        dlc: u8,
+        /// The number of data bytes.
+        len: usize,
+    },
+    /// More than 8 data bytes.
+    TooMuchData(usize),
+    /// A data-bearing operation was asked of a remote frame.
+    DataOnRemoteFrame,
+    /// A word view that does not fit inside the frame's DLC.
+    OutOfBounds,
+}
+
+/// Why a filter does not conform.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum FilterError {
+    /// The identifier (acceptance value) is wider than the format allows.
+    IdOutOfRange,
+    /// The mask is wider than the format allows.
+    MaskOutOfRange,
+    /// The acceptance value has bits set where the mask is zero: it could never match.
+    AcceptanceOutsideMask,
+    /// [`Format::Any`](crate::filter::Format::Any) with a non-zero mask: an identifier comparison needs a format.
+    AnyFormatWithIdentifier,
+}
+
 /// The error type of every driver operation.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -168,9 +213,9 @@ pub enum Error {
     /// A receive FIFO overran: frames were lost in hardware.
     Overrun,
     /// A frame could not be built.
-    Frame(crate::frame::FrameError),
+    Frame(FrameError),
     /// A filter did not conform.
-    Filter(crate::filter::FilterError),
+    Filter(FilterError),
     /// An argument is out of range (mailbox index, filter index, ...).
     InvalidArgument,
     /// A filter list does not fit the hardware: it `needs` more filter space than is
@@ -204,14 +249,14 @@ impl embedded_can::Error for Error {
     }
 }
 
-impl From<crate::frame::FrameError> for Error {
-    fn from(e: crate::frame::FrameError) -> Self {
+impl From<FrameError> for Error {
+    fn from(e: FrameError) -> Self {
         Error::Frame(e)
     }
 }
 
-impl From<crate::filter::FilterError> for Error {
-    fn from(e: crate::filter::FilterError) -> Self {
+impl From<FilterError> for Error {
+    fn from(e: FilterError) -> Self {
         Error::Filter(e)
     }
 }
@@ -248,9 +293,9 @@ impl core::error::Error for Error {
     }
 }
 
-impl core::fmt::Display for crate::frame::FrameError {
+impl core::fmt::Display for FrameError {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        use crate::frame::FrameError as E;
+        use FrameError as E;
         match self {
             E::StandardIdOutOfRange(id) => {
                 write!(f, "standard identifier {id:#X} above 0x7FF")
@@ -269,11 +314,11 @@ impl core::fmt::Display for crate::frame::FrameError {
     }
 }
 
-impl core::error::Error for crate::frame::FrameError {}
+impl core::error::Error for FrameError {}
 
-impl core::fmt::Display for crate::filter::FilterError {
+impl core::fmt::Display for FilterError {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        use crate::filter::FilterError as E;
+        use FilterError as E;
         f.write_str(match self {
             E::IdOutOfRange => "filter identifier wider than its format",
             E::MaskOutOfRange => "filter mask wider than its format",
@@ -287,15 +332,7 @@ impl core::fmt::Display for crate::filter::FilterError {
     }
 }
 
-impl core::error::Error for crate::filter::FilterError {}
-
-impl core::fmt::Display for crate::dispatch::NoSuchFilter {
-    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        write!(f, "no filter with index {} in the dispatcher", self.0)
-    }
-}
-
-impl core::error::Error for crate::dispatch::NoSuchFilter {}
+impl core::error::Error for FilterError {}
 
 #[cfg(test)]
 mod tests {
@@ -336,8 +373,6 @@ mod tests {
 
     #[test]
     fn errors_display_and_chain() {
-        use crate::filter::FilterError;
-        use crate::frame::FrameError;
         use core::error::Error as _;
         let e = Error::from(FrameError::StandardIdOutOfRange(0x800));
         assert_eq!(e.to_string(), "invalid frame");
@@ -350,8 +385,6 @@ mod tests {
         );
         assert!(Error::Timeout.source().is_none());
         assert_eq!(Error::BusOff.to_string(), "the controller is bus-off");
-        let e: &dyn core::error::Error = &crate::dispatch::NoSuchFilter(7);
-        assert_eq!(e.to_string(), "no filter with index 7 in the dispatcher");
     }
 
     #[test]

@@ -9,6 +9,7 @@
 //! mask must fit the format (11 bits standard, 29 bits extended), and the acceptance value
 //! may not have a bit set outside the mask (such a filter could never match).
 
+pub use crate::error::FilterError;
 use crate::frame::Frame;
 
 /// Which frame kinds a filter accepts.
@@ -63,20 +64,6 @@ impl Format {
             Format::Extended | Format::Any => 0x1FFF_FFFF,
         }
     }
-}
-
-/// Why a filter does not conform.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub enum FilterError {
-    /// The identifier (acceptance value) is wider than the format allows.
-    IdOutOfRange,
-    /// The mask is wider than the format allows.
-    MaskOutOfRange,
-    /// The acceptance value has bits set where the mask is zero: it could never match.
-    AcceptanceOutsideMask,
-    /// `Format::Any` with a non-zero mask: an identifier comparison needs a format.
-    AnyFormatWithIdentifier,
 }
 
 /// A portable acceptance filter.

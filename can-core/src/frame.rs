@@ -28,38 +28,14 @@
 
 use embedded_can::{ExtendedId, Id, StandardId};
 
+pub use crate::error::FrameError;
+
 /// The largest data length of classical CAN, in bytes (and the largest DLC code that
 /// is also a length).
 pub const MAX_DLC: u8 = 8;
 
 /// The largest DLC code the four-bit field holds (ISO 11898-1: 9..=15 mean 8 bytes).
 pub const MAX_DLC_CODE: u8 = 15;
-
-/// Why a frame could not be built.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub enum FrameError {
-    /// A standard identifier above `0x7FF`.
-    StandardIdOutOfRange(u32),
-    /// An extended identifier above `0x1FFF_FFFF`.
-    ExtendedIdOutOfRange(u32),
-    /// A data length code above 15 (the field has four bits; [`Frame::check_dlc`]).
-    DlcTooLarge(u8),
-    /// A DLC code that does not agree with the data: a code `0..=8` other than the
-    /// number of data bytes, or a code `9..=15` with fewer than 8 data bytes.
-    DlcMismatch {
-        /// The DLC code asked for.
-        dlc: u8,
-        /// The number of data bytes.
-        len: usize,
-    },
-    /// More than 8 data bytes.
-    TooMuchData(usize),
-    /// A data-bearing operation was asked of a remote frame.
-    DataOnRemoteFrame,
-    /// A word view that does not fit inside the frame's DLC.
-    OutOfBounds,
-}
 
 /// Builds a standard [`Id`] from a raw value, checking its range.
 pub const fn standard_id(raw: u16) -> Result<Id, FrameError> {
@@ -557,13 +533,6 @@ impl Frame {
     /// Writes the 64-bit little-endian payload (the DLC must be 8).
     pub fn set_data_u64(&mut self, value: u64) -> Result<(), FrameError> {
         self.set_word(0, value.to_le_bytes())
-    }
-
-    /// The arbitration priority key of this frame: smaller wins bus arbitration.
-    ///
-    /// See [`crate::priority`] for the ordering.
-    pub const fn priority(&self) -> crate::priority::Priority {
-        crate::priority::Priority::of(self)
     }
 }
 

@@ -70,7 +70,7 @@ pub use frame::{Frame, FrameError, RxFrame};
 pub use hardware::{Completion, Hardware, Settled, StatusEvents, Token, TxFailure};
 #[cfg(feature = "async")]
 pub use io::{AsyncCanRx, AsyncCanTx};
-pub use io::{CanRx, CanTx};
+pub use io::{CanRx, CanStatus, CanTx};
 pub use mailbox::{MailboxId, MailboxState, TxOutcome, TxPolicy};
 pub use priority::Priority;
 pub use registers::{Mmio, Registers};

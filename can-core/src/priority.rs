@@ -21,6 +21,15 @@
 
 use crate::frame::Frame;
 
+impl Frame {
+    /// The arbitration priority key of this frame: smaller wins bus arbitration.
+    ///
+    /// See [`crate::priority`] for the ordering.
+    pub const fn priority(&self) -> Priority {
+        Priority::of(self)
+    }
+}
+
 /// Arbitration key: smaller wins. Totally ordered; equal only for identical arbitration fields.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]

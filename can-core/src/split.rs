@@ -392,6 +392,15 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
         self.hw.take()
     }
 
+    /// Gives the controller back once no handle borrows the state any more (it takes
+    /// the state by value, so the handles are gone; a `static` state keeps its
+    /// controller for ever). Frames and completions still in the rings and the queue go
+    /// with the state; the controller keeps its configuration and its mailboxes.
+    /// `None` when the state was never split.
+    pub fn into_hardware(mut self) -> Option<H> {
+        self.uninstall()
+    }
+
     /// The controller, once [`State::split`] stored it (any context).
     pub fn hardware(&self) -> Option<&H> {
         self.hw.get()
@@ -1168,22 +1177,6 @@ impl<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE:
     /// The map from hardware match index to user filter index in force.
     pub fn filter_map(&self) -> &H::FilterMap {
         &self.map
-    }
-}
-
-impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize> crate::io::CanTx
-    for Tx<'_, H, RX, Q, RX1, DONE>
-{
-    fn try_send(&mut self, frame: &Frame) -> nb::Result<Token, Error> {
-        Tx::try_send(self, frame)
-    }
-}
-
-impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize> crate::io::CanRx
-    for Rx<'_, H, RX, Q, RX1, DONE>
-{
-    fn receive(&mut self) -> nb::Result<RxFrame, Error> {
-        Rx::receive(self)
     }
 }
 

@@ -100,6 +100,7 @@ pub mod settings;
 pub mod split;
 mod status;
 pub mod system;
+pub mod types;
 
 pub mod regs;
 #[cfg(feature = "rt")]

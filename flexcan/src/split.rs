@@ -841,13 +841,22 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
         self.freeze_for_switch(mode)?;
         FlexCan::write_filters(&self.regs, filters);
         // The FIFO holds at most its depth; the receive interrupt may pop some too.
-        // Each frame popped here is counted (`take_filter_switch_discards`).
+        // Each frame popped here is counted (`take_filter_switch_discards`). The test
+        // of BUF5I and its acknowledgement run in one critical section: a receive
+        // interrupt popping the last frame between them would leave the write with
+        // nothing to pop and the count one too high.
         let mut popped = 0;
         for _ in 0..2 * RX_FIFO_DEPTH {
-            if self.regs.read32(IFLAG1) & iflag1::BUF5I == 0 {
+            let did_pop = critical_section::with(|_| {
+                let pending = self.regs.read32(IFLAG1) & iflag1::BUF5I != 0;
+                if pending {
+                    self.regs.write32(IFLAG1, iflag1::BUF5I);
+                }
+                pending
+            });
+            if !did_pop {
                 break;
             }
-            self.regs.write32(IFLAG1, iflag1::BUF5I);
             popped += 1;
         }
         self.discarded.fetch_add(popped, Ordering::Relaxed);

@@ -93,20 +93,7 @@ fn loop_back_synchronises_on_its_own_recessive_output() {
 
 /// A module set up for the bus: FIFO accepting everything, given SRXDIS, left in freeze.
 fn module(m: &mut FlexCanModel, srxdis: bool) {
-    m.modify32(regs::MCR, |v| v & !mcr::MDIS);
-    let mut v = m.read32(regs::MCR) | mcr::RFEN | mcr::IRMQ;
-    if srxdis {
-        v |= mcr::SRXDIS;
-    }
-    m.write32(regs::MCR, v);
-    for n in 0..8 {
-        m.write32(regs::rx_fifo_filter(n), 0);
-        m.write32(regs::rximr(n), 0);
-    }
-    for n in 8..16 {
-        m.write32(regs::mb_cs(n), 0);
-        m.write32(regs::rximr(n), u32::MAX);
-    }
+    support::accept_all_into_fifo(m, if srxdis { mcr::SRXDIS } else { 0 });
 }
 
 fn start(m: &mut FlexCanModel) {

@@ -26,16 +26,7 @@ impl<const RT1062: bool> Dut for FlexCan<RT1062> {
         } else {
             FlexCanModel::mk20dx256()
         };
-        m.modify32(regs::MCR, |v| v & !mcr::MDIS);
-        m.modify32(regs::MCR, |v| v | mcr::RFEN | mcr::IRMQ | mcr::SRXDIS);
-        for n in 0..8 {
-            m.write32(regs::rx_fifo_filter(n), 0);
-            m.write32(regs::rximr(n), 0);
-        }
-        for n in 8..16 {
-            m.write32(regs::mb_cs(n), 0);
-            m.write32(regs::rximr(n), u32::MAX);
-        }
+        support::accept_all_into_fifo(&m, mcr::SRXDIS);
         let id = bus.attach("dut", m.clone());
         m.modify32(regs::MCR, |v| v & !mcr::HALT);
         // Synchronisation: 11 recessive bits ("FlexCAN ... waits for 11 consecutive

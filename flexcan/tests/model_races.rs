@@ -27,18 +27,7 @@ const MB: usize = 8;
 /// written in freeze, on `bus`, synchronised.
 fn module(bus: &mut Bus, extra: u32, tec: Option<u32>) -> FlexCanModel {
     let m = FlexCanModel::mk20dx256();
-    m.modify32(regs::MCR, |v| v & !mcr::MDIS);
-    m.modify32(regs::MCR, |v| {
-        v | mcr::RFEN | mcr::IRMQ | mcr::SRXDIS | extra
-    });
-    for n in 0..8 {
-        m.write32(regs::rx_fifo_filter(n), 0);
-        m.write32(regs::rximr(n), 0);
-    }
-    for n in 8..16 {
-        m.write32(regs::mb_cs(n), 0);
-        m.write32(regs::rximr(n), u32::MAX);
-    }
+    support::accept_all_into_fifo(&m, mcr::SRXDIS | extra);
     if let Some(tec) = tec {
         m.write32(regs::ECR, ecr::TXERRCNT.val(tec));
     }

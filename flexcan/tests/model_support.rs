@@ -9,6 +9,24 @@ use twocan_flexcan::model::FlexCanModel;
 use twocan_flexcan::regs::{self, code, cs, ctrl1, ctrl2, id, iflag1, mcr, rxfir};
 use twocan_sim::{BusNode, BusTime, TxResult};
 
+/// Takes `m` out of module disable and sets up what the bus tests start from, still
+/// halted in freeze: the Rx FIFO (`RFEN`) with its eight ID filters accepting everything
+/// (individual masks 0, `IRMQ`), MB8..15 inactive and matching nothing (masks all ones),
+/// and `mcr_bits` besides (`SRXDIS`, ...). Kinetis RM, FlexCAN "Rx FIFO structure" and
+/// "Rx Individual Mask Registers".
+pub fn accept_all_into_fifo(m: &FlexCanModel, mcr_bits: u32) {
+    m.modify32(regs::MCR, |v| v & !mcr::MDIS);
+    m.modify32(regs::MCR, |v| v | mcr::RFEN | mcr::IRMQ | mcr_bits);
+    for n in 0..8 {
+        m.write32(regs::rx_fifo_filter(n), 0);
+        m.write32(regs::rximr(n), 0);
+    }
+    for n in 8..16 {
+        m.write32(regs::mb_cs(n), 0);
+        m.write32(regs::rximr(n), u32::MAX);
+    }
+}
+
 /// Bit times a test frame occupies on the simulated wire (any value will do).
 pub const FRAME_BITS: u64 = 100;
 

@@ -661,7 +661,8 @@ fn run_once_each(
 fn async_event_follows_the_error_state_of_an_unacknowledged_sender() {
     use std::pin::pin;
     use twocan_core::{ErrorState, RxEvent};
-    use twocan_host::asynch::{drive, split_bx, BxState};
+    use twocan_host::executor::drive;
+    use twocan_host::split::{split_bx, BxState};
 
     let mut h = Harness::new(500_000).expect("bit rate");
     let node = BxNode::stm32f767_can1(&mut h, &[Filter::pass_all()]).expect("bxCAN node");

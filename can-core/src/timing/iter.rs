@@ -109,16 +109,20 @@ impl Solutions {
     /// Whether the current (prescaler, quanta) is within tolerance (the rate only
     /// depends on prescaler × quanta).
     const fn pair_ok(&self) -> bool {
-        let t1 = self.tseg1_hi();
-        let t = Timing::from_tsegs(
+        self.timing_at(self.tseg1_hi())
+            .within_tolerance(self.tolerance_ppm)
+    }
+
+    /// The timing of the current (prescaler, quanta) with tseg1 = `t1`.
+    const fn timing_at(&self, t1: u32) -> Timing {
+        Timing::from_tsegs(
             self.clock_hz,
             self.bitrate,
             &self.limits,
             self.prescaler as u16,
             t1 as u8,
             (self.quanta - 1 - t1) as u8,
-        );
-        t.within_tolerance(self.tolerance_ppm)
+        )
     }
 }
 
@@ -130,14 +134,7 @@ impl Iterator for Solutions {
             return None;
         }
         let t1 = self.tseg1;
-        let t = Timing::from_tsegs(
-            self.clock_hz,
-            self.bitrate,
-            &self.limits,
-            self.prescaler as u16,
-            t1 as u8,
-            (self.quanta - 1 - t1) as u8,
-        );
+        let t = self.timing_at(t1);
         if t1 > self.tseg1_lo() {
             self.tseg1 -= 1;
         } else {

@@ -34,9 +34,6 @@
 //!   `SJW = sjw − 1`. bxCAN has no separate propagation segment: its limits give
 //!   `prop_seg` the range 0..=0 and `phase_seg1` holds the whole TS1.
 
-use super::error::TimingError;
-use super::rule::TimingRule;
-
 /// An inclusive range of counts (quanta, or prescaler steps).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -127,7 +124,8 @@ pub struct Limits {
     /// [`Limits::max_quanta`] are the fields' range narrowed by this one; the solver and
     /// [`crate::timing::Solutions`] search only inside it, and [`Timing::consistency`]
     /// (ACAN table 6) does not look at it: a timing outside it is
-    /// [`TimingError::ForbiddenByManual`] ([`crate::timing::TimingRule::check_timing`]).
+    /// [`TimingError::ForbiddenByManual`](crate::timing::TimingError::ForbiddenByManual)
+    /// ([`crate::timing::TimingRule::check_timing`]).
     ///
     /// [`Timing::consistency`]: crate::timing::Timing::consistency
     pub quanta: Bounds,
@@ -207,47 +205,6 @@ impl Limits {
         } else {
             fields
         }
-    }
-
-    /// The fastest bit rate these limits reach from `clock_hz` (smallest prescaler,
-    /// fewest quanta per bit), rounded down like every bit rate here
-    /// ([`Timing::actual_bitrate`](crate::timing::Timing::actual_bitrate), ACAN §16.3):
-    /// [`TimingRule::max_bitrate`] without a rule beyond these limits.
-    pub const fn max_bitrate(&self, clock_hz: u32) -> u32 {
-        TimingRule::new(clock_hz, *self).max_bitrate()
-    }
-
-    /// The slowest bit rate these limits reach from `clock_hz` (largest prescaler, most
-    /// quanta per bit), rounded down ([`TimingRule::min_bitrate`]).
-    pub const fn min_bitrate(&self, clock_hz: u32) -> u32 {
-        TimingRule::new(clock_hz, *self).min_bitrate()
-    }
-
-    /// [`TimingRule::check_bitrate`] for these limits alone (no rule beyond them):
-    /// [`TimingError::ClockZero`], [`TimingError::BitrateZero`],
-    /// [`TimingError::BitrateTooHigh`] above [`Limits::max_bitrate`],
-    /// [`TimingError::BitrateTooLow`] below [`Limits::min_bitrate`].
-    ///
-    /// ```
-    /// use twocan_core::timing::{Limits, TimingError};
-    /// const OK: Result<(), TimingError> = Limits::FLEXCAN.check_bitrate(16_000_000, 500_000);
-    /// assert_eq!(OK, Ok(()));
-    /// assert_eq!(Limits::FLEXCAN.max_bitrate(16_000_000), 3_200_000); // ACAN §16.1
-    /// assert_eq!(Limits::FLEXCAN_KINETIS.max_bitrate(16_000_000), 2_000_000); // 8 quanta
-    /// assert_eq!(Limits::FLEXCAN.min_bitrate(16_000_000), 2_500);
-    /// // 54 MHz / (1024 × 25) = 2,109.375 bit/s, rounded down.
-    /// assert_eq!(Limits::BXCAN.min_bitrate(54_000_000), 2_109);
-    /// assert_eq!(
-    ///     Limits::FLEXCAN.check_bitrate(16_000_000, 3_200_001),
-    ///     Err(TimingError::BitrateTooHigh)
-    /// );
-    /// assert_eq!(
-    ///     Limits::BXCAN.check_bitrate(54_000_000, 1),
-    ///     Err(TimingError::BitrateTooLow)
-    /// );
-    /// ```
-    pub const fn check_bitrate(&self, clock_hz: u32, bitrate: u32) -> Result<(), TimingError> {
-        TimingRule::new(clock_hz, *self).check_bitrate(bitrate)
     }
 
     /// Whether these limits can be used by the solver: every range non-empty (the

@@ -442,6 +442,51 @@ const fn matches_controller(made: &Limits, rule: &Limits) -> bool {
         }
 }
 
+/// The bit-rate range of bare limits: [`TimingRule`] with no rule beyond them (here, so
+/// that `limits` stays below the rule that reads it).
+impl Limits {
+    /// The fastest bit rate these limits reach from `clock_hz` (smallest prescaler,
+    /// fewest quanta per bit), rounded down like every bit rate here
+    /// ([`Timing::actual_bitrate`](crate::timing::Timing::actual_bitrate), ACAN §16.3):
+    /// [`TimingRule::max_bitrate`] without a rule beyond these limits.
+    pub const fn max_bitrate(&self, clock_hz: u32) -> u32 {
+        TimingRule::new(clock_hz, *self).max_bitrate()
+    }
+
+    /// The slowest bit rate these limits reach from `clock_hz` (largest prescaler, most
+    /// quanta per bit), rounded down ([`TimingRule::min_bitrate`]).
+    pub const fn min_bitrate(&self, clock_hz: u32) -> u32 {
+        TimingRule::new(clock_hz, *self).min_bitrate()
+    }
+
+    /// [`TimingRule::check_bitrate`] for these limits alone (no rule beyond them):
+    /// [`TimingError::ClockZero`], [`TimingError::BitrateZero`],
+    /// [`TimingError::BitrateTooHigh`] above [`Limits::max_bitrate`],
+    /// [`TimingError::BitrateTooLow`] below [`Limits::min_bitrate`].
+    ///
+    /// ```
+    /// use twocan_core::timing::{Limits, TimingError};
+    /// const OK: Result<(), TimingError> = Limits::FLEXCAN.check_bitrate(16_000_000, 500_000);
+    /// assert_eq!(OK, Ok(()));
+    /// assert_eq!(Limits::FLEXCAN.max_bitrate(16_000_000), 3_200_000); // ACAN §16.1
+    /// assert_eq!(Limits::FLEXCAN_KINETIS.max_bitrate(16_000_000), 2_000_000); // 8 quanta
+    /// assert_eq!(Limits::FLEXCAN.min_bitrate(16_000_000), 2_500);
+    /// // 54 MHz / (1024 × 25) = 2,109.375 bit/s, rounded down.
+    /// assert_eq!(Limits::BXCAN.min_bitrate(54_000_000), 2_109);
+    /// assert_eq!(
+    ///     Limits::FLEXCAN.check_bitrate(16_000_000, 3_200_001),
+    ///     Err(TimingError::BitrateTooHigh)
+    /// );
+    /// assert_eq!(
+    ///     Limits::BXCAN.check_bitrate(54_000_000, 1),
+    ///     Err(TimingError::BitrateTooLow)
+    /// );
+    /// ```
+    pub const fn check_bitrate(&self, clock_hz: u32, bitrate: u32) -> Result<(), TimingError> {
+        TimingRule::new(clock_hz, *self).check_bitrate(bitrate)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -18,7 +18,8 @@
 //! ```
 #![deny(missing_docs)]
 
-pub mod asynch;
+pub mod executor;
+pub mod split;
 
 use std::cell::RefCell;
 use std::rc::Rc;

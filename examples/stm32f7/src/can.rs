@@ -4,35 +4,34 @@
 //! §40.8), and `start`, which puts the handles in place **before** it unmasks the lines.
 
 use twocan_bxcan::regs::CanRegs;
-use twocan_bxcan::BxCan;
+use twocan_bxcan::types::{BxRx, BxRx0Irq, BxRx1Irq, BxState, BxStatusIrq, BxTx, BxTxIrq};
 use twocan_core::irq_cell::IrqCell;
-use twocan_core::split::{Rx, Rx0Irq, Rx1Irq, State, StatusIrq, Tx, TxIrq};
-use twocan_core::{FifoQueue, Registers};
+use twocan_core::Registers;
 
 /// Receive ring per FIFO, transmit queue and completion ring sizes of the examples.
-pub const RX: usize = 32;
+pub const RX: usize = twocan_bxcan::types::RX_RING;
 /// See [`RX`].
-pub const TX: usize = 16;
+pub const TX: usize = twocan_bxcan::types::TX_QUEUE;
 /// See [`RX`].
-pub const COMPLETIONS: usize = 8;
+pub const COMPLETIONS: usize = twocan_bxcan::types::COMPLETIONS;
 
 /// A transmit queue in request order (`TXFP = 1`, the driver's default).
-pub type Queue = FifoQueue<TX>;
+pub type Queue = twocan_bxcan::types::Queue;
 /// The shared state of an instance with registers `R` and filter registers `F` (a
 /// whole block by default; `ControlRegs` and `twocan_bxcan::hal::Can1Filters` for CAN1
 /// and CAN2 sharing CAN1's filters).
-pub type CanState<R = CanRegs, F = CanRegs> = State<BxCan<R, F>, RX, Queue, RX, COMPLETIONS>;
+pub type CanState<R = CanRegs, F = CanRegs> = BxState<R, F>;
 /// The transmit half.
-pub type CanTxHalf<R = CanRegs, F = CanRegs> = Tx<'static, BxCan<R, F>, RX, Queue, RX, COMPLETIONS>;
+pub type CanTxHalf<R = CanRegs, F = CanRegs> = BxTx<'static, R, F>;
 /// The receive half.
-pub type CanRxHalf<R = CanRegs, F = CanRegs> = Rx<'static, BxCan<R, F>, RX, Queue, RX, COMPLETIONS>;
+pub type CanRxHalf<R = CanRegs, F = CanRegs> = BxRx<'static, R, F>;
 
 /// The interrupt handles of one bxCAN instance.
 pub struct Vectors<R: Registers + 'static = CanRegs, F: Registers + 'static = CanRegs> {
-    tx: IrqCell<TxIrq<'static, BxCan<R, F>, RX, Queue, RX, COMPLETIONS>>,
-    rx0: IrqCell<Rx0Irq<'static, BxCan<R, F>, RX, Queue, RX, COMPLETIONS>>,
-    rx1: IrqCell<Rx1Irq<'static, BxCan<R, F>, RX, Queue, RX, COMPLETIONS>>,
-    sce: IrqCell<StatusIrq<'static, BxCan<R, F>, RX, Queue, RX, COMPLETIONS>>,
+    tx: IrqCell<BxTxIrq<'static, R, F>>,
+    rx0: IrqCell<BxRx0Irq<'static, R, F>>,
+    rx1: IrqCell<BxRx1Irq<'static, R, F>>,
+    sce: IrqCell<BxStatusIrq<'static, R, F>>,
 }
 
 impl<R: Registers + 'static, F: Registers + 'static> Default for Vectors<R, F> {
@@ -81,7 +80,7 @@ impl<R: Registers + 'static, F: Registers + 'static> Vectors<R, F> {
 pub fn start<R: Registers + Send + Sync + 'static, F: Registers + Send + Sync + 'static>(
     state: &'static CanState<R, F>,
     vectors: &'static Vectors<R, F>,
-    hw: BxCan<R, F>,
+    hw: twocan_bxcan::BxCan<R, F>,
     irqs: [stm32f7xx_hal::pac::Interrupt; 4],
     nvic: &mut cortex_m::peripheral::NVIC,
 ) -> Option<(CanTxHalf<R, F>, CanRxHalf<R, F>)> {

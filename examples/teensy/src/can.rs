@@ -9,22 +9,21 @@
 //! runs the transmit handler and the Rx FIFO's receive handler; the bus-off, error and
 //! Tx/Rx-warning vectors run the status handler.
 
-use twocan_core::split::{Rx, Tx};
-use twocan_core::FifoQueue;
 use twocan_flexcan::regs::FlexCanRegs;
 use twocan_flexcan::rt::IrqState;
-use twocan_flexcan::{FlexCanHw, RECEIVE_BUFFER_SIZE, TRANSMIT_BUFFER_SIZE};
+use twocan_flexcan::types::{FlexRx, FlexTx};
+use twocan_flexcan::{FlexCanHw, RECEIVE_BUFFER_SIZE};
 
 /// Completions kept for the thread side.
-pub const COMPLETIONS: usize = 8;
+pub const COMPLETIONS: usize = twocan_flexcan::types::COMPLETIONS;
 
 /// The controller on target registers.
 pub type Hw = FlexCanHw<FlexCanRegs>;
 /// ACAN's buffer sizes: receive 32, transmit 16 (ACAN table 7).
-pub type Queue = FifoQueue<TRANSMIT_BUFFER_SIZE>;
+pub type Queue = twocan_flexcan::types::Queue;
 /// The shared state and interrupt handlers a `static` holds.
 pub type CanState = IrqState<FlexCanRegs, RECEIVE_BUFFER_SIZE, Queue, COMPLETIONS>;
 /// The transmit half.
-pub type CanTxHalf = Tx<'static, Hw, RECEIVE_BUFFER_SIZE, Queue, 0, COMPLETIONS>;
+pub type CanTxHalf = FlexTx<'static>;
 /// The receive half.
-pub type CanRxHalf = Rx<'static, Hw, RECEIVE_BUFFER_SIZE, Queue, 0, COMPLETIONS>;
+pub type CanRxHalf = FlexRx<'static>;

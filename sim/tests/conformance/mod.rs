@@ -39,8 +39,47 @@ pub trait Dut: Sized {
     const REC_AFTER_PASSIVE_RECEPTION: u16;
 }
 
-fn peer() -> Rc<RefCell<SimNode>> {
-    SimNode::new().shared()
+/// What every case starts from: a bus at 500 kbit/s with the dut on it (it joins
+/// first), then `N` plain nodes attached in order, each kept by the case (the bus drives
+/// a clone).
+struct Case<D, const N: usize> {
+    bus: Bus,
+    dut: D,
+    /// The dut's place on the bus.
+    id: NodeId,
+    peers: [Rc<RefCell<SimNode>>; N],
+    /// The plain nodes' places on the bus.
+    ids: [NodeId; N],
+}
+
+impl<D: Dut, const N: usize> Case<D, N> {
+    fn new(peers: [(&str, SimNode); N]) -> Self {
+        let mut bus = Bus::new(500_000).unwrap();
+        let (dut, id) = D::join(&mut bus);
+        let peers = peers.map(|(name, node)| (name, node.shared()));
+        let ids = peers
+            .each_ref()
+            .map(|(name, node)| bus.attach(name, node.clone()));
+        Case {
+            bus,
+            dut,
+            id,
+            peers: peers.map(|(_, node)| node),
+            ids,
+        }
+    }
+}
+
+/// The most common start: the dut and one plain peer `p` ([`Case`]).
+fn with_peer<D: Dut>() -> (Bus, D, NodeId, Rc<RefCell<SimNode>>) {
+    let Case {
+        bus,
+        dut,
+        id,
+        peers: [p],
+        ..
+    } = Case::<D, 1>::new([("p", SimNode::new())]);
+    (bus, dut, id, p)
 }
 
 fn frame(id: u16) -> Frame {
@@ -72,10 +111,13 @@ fn ce_of(f: &Frame) -> u64 {
 /// apply. REC = 1. Wire: error delimiter ce+9..=ce+16, end ce+17, intermission: the record
 /// lasts ce+20 bits.
 pub fn rule_1_receiver_error<D: Dut>() {
-    let mut bus = Bus::new(500_000).unwrap();
-    let (dut, id) = D::join(&mut bus);
-    let t = SimNode::new().with_one_shot(true).shared();
-    bus.attach("t", t.clone());
+    let Case {
+        mut bus,
+        dut,
+        id,
+        peers: [t],
+        ..
+    } = Case::<D, 1>::new([("t", SimNode::new().with_one_shot(true))]);
     let f = frame(0x123);
     t.borrow_mut().send(f);
     bus.inject_next(Fault::Crc {
@@ -100,12 +142,16 @@ pub fn rule_1_receiver_error<D: Dut>() {
 /// transmitter (bit error at ce+3) flag ce+4..=ce+9, so the dut's first bit after its flag,
 /// ce+9, is dominant. Wire: last dominant ce+9, delimiter ce+10..=ce+17, end ce+18, +3.
 pub fn rule_2_dominant_after_own_flag<D: Dut>() {
-    let mut bus = Bus::new(500_000).unwrap();
-    let (dut, id) = D::join(&mut bus);
-    let t = SimNode::new().with_one_shot(true).shared();
-    let other = peer();
-    bus.attach("t", t.clone());
-    bus.attach("other", other.clone());
+    let Case {
+        mut bus,
+        dut,
+        id,
+        peers: [t, other],
+        ..
+    } = Case::<D, 2>::new([
+        ("t", SimNode::new().with_one_shot(true)),
+        ("other", SimNode::new()),
+    ]);
     let f = frame(0x321);
     t.borrow_mut().send(f);
     bus.inject_next(Fault::Crc {
@@ -122,10 +168,7 @@ pub fn rule_2_dominant_after_own_flag<D: Dut>() {
 /// then 7. An error-active transmitter is not suspended: the retransmission starts right
 /// after the intermission of the error frame.
 pub fn rule_3_and_7_transmitter<D: Dut>() {
-    let mut bus = Bus::new(500_000).unwrap();
-    let (mut dut, id) = D::join(&mut bus);
-    let p = peer();
-    bus.attach("p", p.clone());
+    let (mut bus, mut dut, id, p) = with_peer::<D>();
     let f = frame(0x0F0);
     bus.inject_from(id, 1, Fault::Bit { at: None });
     dut.send(&f);
@@ -167,10 +210,7 @@ fn make_passive<D: Dut>(bus: &mut Bus, dut: &mut D, id: NodeId, f: &Frame) -> Bo
 /// starts 8 bits after the intermission. After the ACK-error attempt (delimiter
 /// ce+8..=ce+15, end ce+16, intermission to ce+19), the retry starts at ce+19+8.
 pub fn rule_3_exception_1_ack_error_when_passive<D: Dut>() {
-    let mut bus = Bus::new(500_000).unwrap();
-    let (mut dut, id) = D::join(&mut bus);
-    let p = peer();
-    bus.attach("p", p.clone());
+    let (mut bus, mut dut, id, p) = with_peer::<D>();
     let f = frame(0x0F1);
     let last = make_passive(&mut bus, &mut dut, id, &f);
     bus.inject_next(Fault::Ack);
@@ -196,10 +236,13 @@ pub fn rule_3_exception_1_ack_error_when_passive<D: Dut>() {
 /// ce+2) and flags ce+3..=ce+8 after its ACK delimiter (CRC error at ce+2): the dut reads
 /// dominant bits during its passive flag, so TEC += 8 after all: 136.
 pub fn rule_3_exception_1_not_met_dominant_during_passive_flag<D: Dut>() {
-    let mut bus = Bus::new(500_000).unwrap();
-    let (mut dut, id) = D::join(&mut bus);
-    let p = peer();
-    let pid = bus.attach("p", p.clone());
+    let Case {
+        mut bus,
+        mut dut,
+        id,
+        peers: [p],
+        ids: [pid],
+    } = Case::<D, 1>::new([("p", SimNode::new())]);
     let f = frame(0x0F2);
     make_passive(&mut bus, &mut dut, id, &f);
     let rec_before = p.borrow().counters().rec;
@@ -219,12 +262,16 @@ pub fn rule_3_exception_1_not_met_dominant_during_passive_flag<D: Dut>() {
 /// 14 × 9 = 126 < 128) bring REC to 135; one good frame then sets it to the value its
 /// manual names (the node is then error-warning: REC ≥ 96).
 pub fn rule_8_reception_above_127<D: Dut>() {
-    let mut bus = Bus::new(500_000).unwrap();
-    let (dut, id) = D::join(&mut bus);
-    let t = SimNode::new().with_one_shot(true).shared();
-    let other = peer();
-    bus.attach("t", t.clone());
-    bus.attach("other", other.clone());
+    let Case {
+        mut bus,
+        dut,
+        id,
+        peers: [t, _],
+        ..
+    } = Case::<D, 2>::new([
+        ("t", SimNode::new().with_one_shot(true)),
+        ("other", SimNode::new()),
+    ]);
     for k in 0..15u64 {
         t.borrow_mut().send(frame(0x200 + k as u16));
         bus.inject_next(Fault::Crc {
@@ -252,10 +299,7 @@ pub fn rule_8_reception_above_127<D: Dut>() {
 /// and the dut receives its frame; the dut's frame follows right after (no new suspension:
 /// it was a receiver).
 pub fn suspend_transmission_other_node_starts_first<D: Dut>() {
-    let mut bus = Bus::new(500_000).unwrap();
-    let (mut dut, id) = D::join(&mut bus);
-    let p = peer();
-    bus.attach("p", p.clone());
+    let (mut bus, mut dut, id, p) = with_peer::<D>();
     let f = frame(0x0F3);
     let last = make_passive(&mut bus, &mut dut, id, &f);
     let g = frame(0x7FF);
@@ -275,10 +319,7 @@ pub fn suspend_transmission_other_node_starts_first<D: Dut>() {
 /// SOF and the first four identifier bits are dominant, so wire bit 5 is a recessive stuff
 /// bit inside the arbitration field. The retry succeeds; TEC stays 0 throughout.
 pub fn rule_3_exception_2_stuff_error_in_arbitration<D: Dut>() {
-    let mut bus = Bus::new(500_000).unwrap();
-    let (mut dut, id) = D::join(&mut bus);
-    let p = peer();
-    bus.attach("p", p.clone());
+    let (mut bus, mut dut, id, _) = with_peer::<D>();
     let f = Frame::standard(0x000, &[1]).unwrap();
     assert!(frame_bits(&f).arbitration_end > 5);
     bus.try_inject_from(id, 1, Fault::Bit { at: Some(5) })
@@ -298,10 +339,7 @@ pub fn rule_3_exception_2_stuff_error_in_arbitration<D: Dut>() {
 /// 8 (and starts a new flag). One bit error (rule 3: +8) whose error flag is hit at its
 /// third bit (rule 4: +8): TEC 16; the retry succeeds: 15.
 pub fn rule_4_bit_error_in_own_active_flag_transmitter<D: Dut>() {
-    let mut bus = Bus::new(500_000).unwrap();
-    let (mut dut, id) = D::join(&mut bus);
-    let p = peer();
-    bus.attach("p", p.clone());
+    let (mut bus, mut dut, id, _) = with_peer::<D>();
     let f = frame(0x0F5);
     bus.inject_from(id, 1, Fault::Bit { at: None });
     bus.try_inject_next(Fault::FlagBit { who: id, bit: 2 })
@@ -320,12 +358,16 @@ pub fn rule_4_bit_error_in_own_active_flag_transmitter<D: Dut>() {
 /// recessive, so rule 2 does not apply: REC = 1 + 8 = 9. Wire: last dominant ce+9, end
 /// ce+18, +3.
 pub fn rule_5_bit_error_in_own_active_flag_receiver<D: Dut>() {
-    let mut bus = Bus::new(500_000).unwrap();
-    let (dut, id) = D::join(&mut bus);
-    let t = SimNode::new().with_one_shot(true).shared();
-    let other = peer();
-    bus.attach("t", t.clone());
-    bus.attach("other", other.clone());
+    let Case {
+        mut bus,
+        dut,
+        id,
+        peers: [t, _],
+        ..
+    } = Case::<D, 2>::new([
+        ("t", SimNode::new().with_one_shot(true)),
+        ("other", SimNode::new()),
+    ]);
     let f = frame(0x322);
     t.borrow_mut().send(f);
     bus.inject_next(Fault::Crc {
@@ -344,10 +386,12 @@ pub fn rule_5_bit_error_in_own_active_flag_receiver<D: Dut>() {
 /// dominant from ce+8 for 16 bits: dominant bits 14 (ce+15) and 22 (ce+23) add 8 each:
 /// TEC 24.
 pub fn rule_6_dominant_bits_after_active_flag<D: Dut>() {
-    let mut bus = Bus::new(500_000).unwrap();
-    let (mut dut, _) = D::join(&mut bus);
-    let sniffer = SimNode::new().with_listen_only(true).shared();
-    bus.attach("sniffer", sniffer);
+    let Case {
+        mut bus,
+        mut dut,
+        peers: [_],
+        ..
+    } = Case::<D, 1>::new([("sniffer", SimNode::new().with_listen_only(true))]);
     let f = frame(0x0F6);
     let ce = frame_bits(&f).crc_end;
     bus.try_inject_next(Fault::StuckDominant {
@@ -368,10 +412,7 @@ pub fn rule_6_dominant_bits_after_active_flag<D: Dut>() {
 /// 1 applies: its passive flag ce+2..=ce+7 is all recessive), then the bus is held dominant
 /// from ce+8 for 8 bits: TEC 128 + 8 = 136.
 pub fn rule_6_dominant_bits_after_passive_flag<D: Dut>() {
-    let mut bus = Bus::new(500_000).unwrap();
-    let (mut dut, id) = D::join(&mut bus);
-    let p = peer();
-    bus.attach("p", p.clone());
+    let (mut bus, mut dut, id, _) = with_peer::<D>();
     let f = frame(0x0F7);
     let ce = frame_bits(&f).crc_end;
     make_passive(&mut bus, &mut dut, id, &f);
@@ -390,10 +431,7 @@ pub fn rule_6_dominant_bits_after_passive_flag<D: Dut>() {
 /// the counters move only by the success (rule 7): a TEC of 8 becomes 7. The attempt lasts
 /// ce + 25 bits and the intermission.
 pub fn overload_frame_leaves_the_counters<D: Dut>() {
-    let mut bus = Bus::new(500_000).unwrap();
-    let (mut dut, id) = D::join(&mut bus);
-    let p = peer();
-    bus.attach("p", p.clone());
+    let (mut bus, mut dut, id, p) = with_peer::<D>();
     let f = frame(0x0F8);
     let ce = frame_bits(&f).crc_end;
     bus.inject_from(id, 1, Fault::Bit { at: None });
@@ -421,10 +459,7 @@ pub fn overload_frame_leaves_the_counters<D: Dut>() {
 /// Played twice: dut transmitter (TEC 0 → 8, the peer's REC 8), dut receiver (REC 8).
 pub fn overload_rule_6_after_overload_flag<D: Dut>() {
     for dut_sends in [true, false] {
-        let mut bus = Bus::new(500_000).unwrap();
-        let (mut dut, _) = D::join(&mut bus);
-        let p = peer();
-        bus.attach("p", p.clone());
+        let (mut bus, mut dut, _, p) = with_peer::<D>();
         let f = frame(0x0F9);
         let ce = frame_bits(&f).crc_end;
         bus.try_inject_next(Fault::StuckDominant {
@@ -460,10 +495,13 @@ pub fn overload_rule_6_after_overload_flag<D: Dut>() {
 /// ce + 29 + 3 bits. Played twice: dut transmitter (TEC 8), dut receiver (REC 8).
 pub fn overload_rules_4_and_5_bit_error_in_overload_flag<D: Dut>() {
     for dut_sends in [true, false] {
-        let mut bus = Bus::new(500_000).unwrap();
-        let (mut dut, id) = D::join(&mut bus);
-        let p = peer();
-        let ip = bus.attach("p", p.clone());
+        let Case {
+            mut bus,
+            mut dut,
+            id,
+            peers: [p],
+            ids: [ip],
+        } = Case::<D, 1>::new([("p", SimNode::new())]);
         let f = frame(0x0FA);
         let ce = u64::from(frame_bits(&f).crc_end);
         bus.try_inject_next(Fault::StuckDominant {
@@ -503,12 +541,13 @@ pub fn overload_rules_4_and_5_bit_error_in_overload_flag<D: Dut>() {
 /// TEC 8; it sends the frame again, which every node receives: TEC 7, b's REC 8, the
 /// dut's REC still 0.
 pub fn overload_dominant_last_eof_bit<D: Dut>() {
-    let mut bus = Bus::new(500_000).unwrap();
-    let (dut, _) = D::join(&mut bus);
-    let t = peer();
-    let b = peer();
-    bus.attach("t", t.clone());
-    let ib = bus.attach("b", b.clone());
+    let Case {
+        mut bus,
+        dut,
+        peers: [t, b],
+        ids: [_, ib],
+        ..
+    } = Case::<D, 2>::new([("t", SimNode::new()), ("b", SimNode::new())]);
     let f = frame(0x0FB);
     t.borrow_mut().send(f);
     bus.inject_next(Fault::Form {
@@ -539,10 +578,13 @@ fn error_delimiter_setting<D: Dut>(
     dut_sends: bool,
     extra: impl FnOnce(NodeId, NodeId) -> Fault,
 ) -> (Box<TraceRecord>, D, Rc<RefCell<SimNode>>, Frame) {
-    let mut bus = Bus::new(500_000).unwrap();
-    let (mut dut, id) = D::join(&mut bus);
-    let o = SimNode::new().with_one_shot(true).shared();
-    let io = bus.attach("o", o.clone());
+    let Case {
+        mut bus,
+        mut dut,
+        id,
+        peers: [o],
+        ids: [io],
+    } = Case::<D, 1>::new([("o", SimNode::new().with_one_shot(true))]);
     let f = frame(0x124);
     let receiver = if dut_sends { io } else { id };
     bus.inject_next(Fault::Crc {
@@ -572,6 +614,27 @@ fn tx_rx_counters<D: Dut>(
     }
 }
 
+/// A fault in the error delimiter of [`error_delimiter_setting`] at delimiter bit `bit`,
+/// seen by the bus or (`dut_alone`) by the dut alone,
+/// played with the dut as transmitter and then as receiver: the transmitter ends with
+/// TEC `tec`, the receiver with REC `rec[0]` when the dut receives and `rec[1]` when it
+/// sends, the record lasts `ce + len` bits, and the dut stays error-active.
+fn delimiter_case<D: Dut>(dut_alone: bool, bit: u8, tec: u16, rec: [u16; 2], len: u64) {
+    for dut_sends in [true, false] {
+        let (r, dut, o, f) = error_delimiter_setting::<D>(dut_sends, |id, _| {
+            let who = if dut_alone { Sees::Node(id) } else { Sees::Bus };
+            Fault::DelimiterBit { who, bit }
+        });
+        assert!(r.refused.is_empty(), "{:?}", r.refused);
+        let (t, rx) = tx_rx_counters(dut_sends, &dut, &o);
+        let rec = rec[usize::from(dut_sends)];
+        assert_eq!(t, ErrorCounters { tec, rec: 0 }, "dut sends: {dut_sends}");
+        assert_eq!(rx, ErrorCounters { tec: 0, rec }, "dut sends: {dut_sends}");
+        assert_eq!(r.end - r.sof, ce_of(&f) + len, "dut sends: {dut_sends}");
+        assert_eq!(dut.state(), ErrorState::Active, "dut sends: {dut_sends}");
+    }
+}
+
 /// A dominant bit inside an error delimiter, on the bus (ISO 11898-1 §10.4.4.3: the error
 /// delimiter is 8 recessive bits; a dominant bit in it is a form error, §10.11.4; Bosch
 /// CAN 2.0B §3.2.3 / §7). In [`error_delimiter_setting`], delimiter bit 3 (ce+12) is
@@ -583,26 +646,7 @@ fn tx_rx_counters<D: Dut>(
 /// ce+27, intermission: the record lasts ce+30 bits. Played with the dut as transmitter
 /// and as receiver.
 pub fn delimiter_form_error_on_the_bus<D: Dut>() {
-    for dut_sends in [true, false] {
-        let (r, dut, o, f) = error_delimiter_setting::<D>(dut_sends, |_, _| Fault::DelimiterBit {
-            who: Sees::Bus,
-            bit: 3,
-        });
-        assert!(r.refused.is_empty(), "{:?}", r.refused);
-        let (t, rx) = tx_rx_counters(dut_sends, &dut, &o);
-        assert_eq!(
-            t,
-            ErrorCounters { tec: 16, rec: 0 },
-            "dut sends: {dut_sends}"
-        );
-        assert_eq!(
-            rx,
-            ErrorCounters { tec: 0, rec: 2 },
-            "dut sends: {dut_sends}"
-        );
-        assert_eq!(r.end - r.sof, ce_of(&f) + 30);
-        assert_eq!(dut.state(), ErrorState::Active);
-    }
+    delimiter_case::<D>(false, 3, 16, [2, 2], 30);
 }
 
 /// One node alone misreads an error delimiter bit as dominant (`Sees::Node`).
@@ -618,22 +662,7 @@ pub fn delimiter_form_error_on_the_bus<D: Dut>() {
 ///
 /// Either way: delimiter ce+20..=ce+27, end ce+28, +3: ce+31.
 pub fn delimiter_form_error_seen_by_one_node<D: Dut>() {
-    for dut_sends in [true, false] {
-        let (r, dut, o, f) = error_delimiter_setting::<D>(dut_sends, |id, _| Fault::DelimiterBit {
-            who: Sees::Node(id),
-            bit: 3,
-        });
-        assert!(r.refused.is_empty(), "{:?}", r.refused);
-        let (t, rx) = tx_rx_counters(dut_sends, &dut, &o);
-        assert_eq!(
-            t,
-            ErrorCounters { tec: 16, rec: 0 },
-            "dut sends: {dut_sends}"
-        );
-        let rec = if dut_sends { 2 } else { 10 };
-        assert_eq!(rx, ErrorCounters { tec: 0, rec }, "dut sends: {dut_sends}");
-        assert_eq!(r.end - r.sof, ce_of(&f) + 31);
-    }
+    delimiter_case::<D>(true, 3, 16, [10, 2], 31);
 }
 
 /// A dominant last bit of an error delimiter (ISO 11898-1 §10.4.5.2: "detection of a
@@ -642,25 +671,7 @@ pub fn delimiter_form_error_seen_by_one_node<D: Dut>() {
 /// both nodes send an overload flag ce+17..=ce+22 and delimiter ce+23..=ce+30; no counter
 /// moves (TEC 8, REC 1 as after the error alone). End ce+31, +3: ce+34.
 pub fn dominant_last_error_delimiter_bit_is_overload<D: Dut>() {
-    for dut_sends in [true, false] {
-        let (r, dut, o, f) = error_delimiter_setting::<D>(dut_sends, |_, _| Fault::DelimiterBit {
-            who: Sees::Bus,
-            bit: 7,
-        });
-        assert!(r.refused.is_empty(), "{:?}", r.refused);
-        let (t, rx) = tx_rx_counters(dut_sends, &dut, &o);
-        assert_eq!(
-            t,
-            ErrorCounters { tec: 8, rec: 0 },
-            "dut sends: {dut_sends}"
-        );
-        assert_eq!(
-            rx,
-            ErrorCounters { tec: 0, rec: 1 },
-            "dut sends: {dut_sends}"
-        );
-        assert_eq!(r.end - r.sof, ce_of(&f) + 34);
-    }
+    delimiter_case::<D>(false, 7, 8, [1, 1], 34);
 }
 
 /// An overload frame from a dominant first intermission bit (`Fault::IntermissionBit`,
@@ -678,10 +689,7 @@ pub fn dominant_last_error_delimiter_bit_is_overload<D: Dut>() {
 pub fn faults_in_an_overload_delimiter<D: Dut>() {
     for (bit, tec, rec, len) in [(7u8, 0u16, 0u16, 42u64), (2, 8, 1, 37)] {
         for dut_sends in [true, false] {
-            let mut bus = Bus::new(500_000).unwrap();
-            let (mut dut, _) = D::join(&mut bus);
-            let p = peer();
-            bus.attach("p", p.clone());
+            let (mut bus, mut dut, _, p) = with_peer::<D>();
             let f = frame(0x0FC);
             bus.try_inject_next(Fault::IntermissionBit {
                 who: Sees::Bus,
@@ -701,8 +709,7 @@ pub fn faults_in_an_overload_delimiter<D: Dut>() {
             let r = next_frame(&mut bus);
             assert!(r.refused.is_empty(), "{:?}", r.refused);
             assert_eq!(r.end - r.sof, ce_of(&f) + len, "bit {bit}");
-            let (d, o) = (dut.counters(), p.borrow().counters());
-            let (t, rx) = if dut_sends { (d, o) } else { (o, d) };
+            let (t, rx) = tx_rx_counters(dut_sends, &dut, &p);
             assert_eq!(
                 t,
                 ErrorCounters { tec, rec: 0 },
@@ -727,10 +734,7 @@ pub fn faults_in_an_overload_delimiter<D: Dut>() {
 /// delimiter ce+18..=ce+25, end ce+26, +3: ce+29 (the peer received the frame at ce+9,
 /// REC - 1 by rule 8, and drives nothing after it).
 pub fn delimiter_form_error_after_passive_ack_error<D: Dut>() {
-    let mut bus = Bus::new(500_000).unwrap();
-    let (mut dut, id) = D::join(&mut bus);
-    let p = peer();
-    bus.attach("p", p.clone());
+    let (mut bus, mut dut, id, p) = with_peer::<D>();
     let f = frame(0x0FD);
     make_passive(&mut bus, &mut dut, id, &f);
     let rec_before = p.borrow().counters().rec;
@@ -754,10 +758,7 @@ pub fn delimiter_form_error_after_passive_ack_error<D: Dut>() {
 /// delimiter bit in an attempt without error or overload frame (the frame is then sent
 /// as if no fault had been injected: 0 errors, TEC 0, length ce+10+3).
 pub fn delimiter_and_intermission_refusals<D: Dut>() {
-    let mut bus = Bus::new(500_000).unwrap();
-    let (mut dut, id) = D::join(&mut bus);
-    let p = peer();
-    bus.attach("p", p.clone());
+    let (mut bus, mut dut, id, p) = with_peer::<D>();
     for (fault, error) in [
         (
             Fault::DelimiterBit {
@@ -810,10 +811,7 @@ pub fn delimiter_and_intermission_refusals<D: Dut>() {
 /// of the last error frame (8 + 3 recessive bits) are the first sequence, so the retry
 /// starts 127 × 11 bits after that error frame ends.
 pub fn bus_off_and_recovery<D: Dut>() {
-    let mut bus = Bus::new(500_000).unwrap();
-    let (mut dut, id) = D::join(&mut bus);
-    let p = peer();
-    bus.attach("p", p.clone());
+    let (mut bus, mut dut, id, p) = with_peer::<D>();
     let f = frame(0x0F4);
     bus.inject_from(id, 32, Fault::Bit { at: None });
     dut.send(&f);
@@ -840,10 +838,7 @@ pub fn bus_off_and_recovery<D: Dut>() {
 /// the DLC field (the wire layout is the one that code gives, with no data field) and a
 /// plain receiver gets the same frame.
 pub fn remote_dlc_codes_on_the_wire<D: Dut>() {
-    let mut bus = Bus::new(500_000).unwrap();
-    let (mut dut, id) = D::join(&mut bus);
-    let p = peer();
-    bus.attach("p", p.clone());
+    let (mut bus, mut dut, id, p) = with_peer::<D>();
     let built: Vec<Frame> = (8..=15u8)
         .map(|code| Frame::remote(0x2A0 + u32::from(code), false, code).unwrap())
         .collect();

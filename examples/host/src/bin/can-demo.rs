@@ -8,7 +8,7 @@
 //!
 //! `--async` runs the application's async form (`App::publish_async`,
 //! `App::receive_async`) on the split drivers' async halves, polled by a host executor
-//! (`twocan_host::asynch::drive`) between the bus events.
+//! (`twocan_host::executor::drive`) between the bus events.
 
 use std::cell::RefCell;
 use std::fs::File;
@@ -22,7 +22,8 @@ use clap::error::ErrorKind;
 use clap::{CommandFactory, Parser};
 use twocan_app::App;
 use twocan_core::{AsyncCanRx, Frame};
-use twocan_host::asynch::{drive, split_bx, split_flex, BxState, FlexState};
+use twocan_host::executor::drive;
+use twocan_host::split::{split_bx, split_flex, BxState, FlexState};
 use twocan_host::{state_name, BxNode, FlexNode, Harness, Serviced};
 use twocan_sim::bits::{max_stuff_bits, INTERMISSION_BITS};
 use twocan_sim::trace::CandumpWriter;
