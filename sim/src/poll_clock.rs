@@ -19,7 +19,7 @@ use twocan_core::registers::Registers;
 /// after which the code under test is taken to spin for ever (see the
 /// [module docs](self)). Far above any real sequence: a FlexCAN or bxCAN handler makes
 /// a few dozen accesses per frame.
-pub const SPIN_LIMIT: u64 = 20_000_000;
+pub const SPIN_LIMIT: u64 = 2_000_000;
 
 /// The simulated bus, shared with the register wrappers that let time pass.
 pub type SharedBus = Rc<RefCell<Bus>>;
