@@ -286,10 +286,10 @@ fn wire_before(w: &World<'_>, t_us: u64, pred: impl Fn(&Frame) -> bool) -> (u32,
 
 /// Issue 27: each node's `AppStats` against the frames on the wire, per identifier, for
 /// node `a` (its counters `sa`, its last step in the slice ending at `a_last`) and its
-/// peer `b`: everything `a` queued is on the wire (`sent` = its heartbeats + measurements
-/// + requests + answers on the wire), one request every 10 heartbeats and one
-/// measurement every 4, an answer per request `a` handled; what `a` counted of `b`'s
-/// frames is what `b` put on the wire before `a`'s last step.
+/// peer `b`. Everything `a` queued is on the wire: its `sent` is the sum of its
+/// heartbeats, measurements, requests and answers on the wire; one request every 10
+/// heartbeats and one measurement every 4; an answer per request `a` handled. What `a`
+/// counted of `b`'s frames is what `b` put on the wire before `a`'s last step.
 fn assert_app_wire(w: &World<'_>, a: u32, b: u32, sa: Stats, a_last: u64, label: &str) {
     let data = |id: u32| move |f: &Frame| raw_id(f) == (id, false) && !is_remote(f);
     let all = |p: &dyn Fn(&Frame) -> bool| wire_count(w, p);
