@@ -321,6 +321,13 @@ fn a_storm_interleaved_with_systick_is_a_livelock() {
     // The consecutive-entry detector does not see it: SysTick breaks every run.
     assert!(b.stuck.is_empty(), "{:?}", b.stuck);
     let l = b.livelock.as_ref().expect("livelock reported");
+    assert!(
+        b.halted
+            .as_deref()
+            .is_some_and(|h| h.starts_with("livelock")),
+        "the board stops at the livelock: {:?}",
+        b.halted
+    );
     assert_eq!(l.kind, twocan_fil::machine::LivelockKind::NoThreadProgress);
     let window = l.at_ns - l.since_ns;
     assert!(
@@ -355,6 +362,13 @@ fn a_handler_that_never_returns_is_a_livelock() {
     assert!(b.faults.is_empty(), "{:?}", b.faults);
     assert!(b.stuck.is_empty(), "{:?}", b.stuck);
     let l = b.livelock.as_ref().expect("livelock reported");
+    assert!(
+        b.halted
+            .as_deref()
+            .is_some_and(|h| h.starts_with("livelock")),
+        "the board stops at the livelock: {:?}",
+        b.halted
+    );
     assert_eq!(
         l.kind,
         twocan_fil::machine::LivelockKind::HandlerNeverReturns {

@@ -293,12 +293,17 @@ impl Board {
                 .filter(|(_, n)| *n > 0)
                 .collect();
             let to_ns = |ps: u128| (ps / 1000) as u64;
-            self.livelock = Some(Livelock {
+            let found = Livelock {
                 kind,
                 since_ns: to_ns(since),
                 at_ns: to_ns(now),
                 taken,
-            });
+            };
+            // The board stops there: a livelocked core would otherwise be emulated
+            // instruction by instruction to the end of the run (minutes instead of
+            // seconds for a suite of such runs).
+            self.halted = Some(format!("livelock: {found}"));
+            self.livelock = Some(found);
         }
     }
 
