@@ -219,7 +219,7 @@ if [ "$fil" = 1 ]; then
     reset_tree
     echo "building the base's firmware once ($rev)"
     rm -rf "$base_elf"
-    if ! build_elf "$base_elf" "teensy stm32"; then
+    if ! build_elf "$base_elf" "teensy stm32 negative"; then
         echo "the base's firmware does not build: see $log" >&2
         exit 1
     fi
