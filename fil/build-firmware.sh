@@ -36,6 +36,23 @@ has stm32 && for board in nucleo-f767zi disco-f746g; do
         fi
     done
 done
+# The Blue Pill (Cortex-M3) and the NUCLEO-F446RE from one source (examples/stm32),
+# each built once for its core; can1-can2 on the NUCLEO only.
+for spec in bluepill:thumbv7m-none-eabi nucleo-f446re:thumbv7em-none-eabihf; do
+    IFS=: read -r board tgt <<<"$spec"
+    cargo build --quiet --release --target "$tgt" -p twocan-stm32 --features "$board" --bins
+    mkdir -p "$out/$board"
+    for bin in loopback filters app async-echo can1-can2; do
+        if [ -f "target/$tgt/release/stm32-$bin" ] && { [ "$bin" != can1-can2 ] || [ "$board" = nucleo-f446re ]; }; then
+            cp "target/$tgt/release/stm32-$bin" "$out/$board/"
+        fi
+    done
+done
+# The Blue Pill `app` at 250 kbit/s (feature bus-250k): the board at the wrong bit rate
+# of fil/tests/stm32_family.rs.
+cargo build --quiet --release --target thumbv7m-none-eabi -p twocan-stm32 \
+    --features bluepill,bus-250k --bin stm32-app
+cp target/thumbv7m-none-eabi/release/stm32-app "$out/bluepill/stm32-app-250k"
 # The defmt variants (the examples log through defmt-rtt; tests/defmt.rs decodes the log):
 # one board of each family, saved as <example>-defmt. DEFMT_LOG is read at compile time
 # (the examples' .cargo/config.toml sets it when cargo runs in their folders only).
@@ -75,7 +92,19 @@ cargo build --quiet --release --target "$m3" --manifest-path fil/firmware/Cargo.
 for bin in bluepill-can bluepill-gate bluepill-stuck; do
     cp "${CARGO_TARGET_DIR:-fil/firmware/target}/$m3/release/$bin" "$out/bluepill/"
 done
-# Teensy 4.1 (i.MX RT1062): the examples' ELFs go to $out/teensy41/ once examples/teensy
-# builds them (issue 24); the teensy41 profile's own test firmwares are the imxrt-* above.
-mkdir -p "$out/teensy41"
+# Teensy 4.1 (i.MX RT1062, examples/teensy4, issue 24) for the teensy41 profile; its own
+# test firmwares are the imxrt-* above. (The Teensy 4.0 build differs in the flash size
+# of its boot header only; CI cross-builds it.)
+for board in teensy41; do
+    cargo build --quiet --release --target "$target" -p twocan-teensy4 --features "$board" --bins
+    mkdir -p "$out/$board"
+    for bin in loopback filters app async-echo can1-can2; do
+        cp "$rel/teensy4-$bin" "$out/$board/"
+    done
+done
+# The Teensy 4.1 `app` as node 3 (feature app-node3): the third board of the three-board
+# run (tests/teensy41_examples.rs).
+cargo build --quiet --release --target "$target" -p twocan-teensy4 --features teensy41,app-node3 \
+    --bin teensy4-app
+cp "$rel/teensy4-app" "$out/teensy41/teensy4-app-node3"
 echo "firmware for the harness in $out"

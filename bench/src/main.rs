@@ -307,7 +307,7 @@ fn run() -> Result<()> {
             step("stack of the firmware examples under can-fil");
             for b in &mut section.builds {
                 let Some(board) = &b.board else { continue };
-                let st = stack::measure(can_fil, board, &b.elf)?;
+                let st = stack::measure(can_fil, fil_profile(board), &b.elf)?;
                 eprintln!(
                     "can-bench: {} on {board}: stack configuration {:?} B, whole run {} B",
                     b.bin, st.configuration, st.whole
@@ -406,6 +406,16 @@ fn run() -> Result<()> {
     Ok(())
 }
 
+/// The `can-fil` board profile a board feature's images run on: the Teensy 4.0 on the
+/// `teensy41` profile (one chip, the i.MX RT1062; the 4.0's image differs in the flash
+/// size its boot header states), every other board on its own.
+fn fil_profile(board: &str) -> &str {
+    match board {
+        "teensy40" => "teensy41",
+        b => b,
+    }
+}
+
 /// Features that select something other than a board.
 const NOT_BOARDS: [&str; 5] = ["defmt", "std", "log", "model", "mock"];
 
@@ -481,6 +491,12 @@ fn examples(paths: &Paths) -> Result<ExampleSection> {
 mod tests {
     use super::*;
     use clap::CommandFactory;
+
+    #[test]
+    fn teensy40_images_run_on_the_rt1062_profile() {
+        assert_eq!(fil_profile("teensy40"), "teensy41");
+        assert_eq!(fil_profile("teensy36"), "teensy36");
+    }
 
     #[test]
     fn options() {

@@ -18,7 +18,8 @@ use twocan_core::timing::{
 };
 use twocan_core::TxPolicy;
 
-use crate::regs::{btr, ier, mcr, FILTER_BANKS};
+use crate::chip::{self, Chip};
+use crate::regs::{btr, ier, mcr};
 
 /// Why a configuration was refused.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -31,8 +32,12 @@ pub enum ConfigError {
     /// or the `LBKM`/`SILM` mode bits, which the builder sets with
     /// [`Config::loopback`]/[`Config::silent`]).
     BtrReservedBits,
-    /// A CAN2 start bank above 28 (RM0410 `CAN_FMR.CAN2SB`).
+    /// A CAN2 start bank above 28 (RM0410 `CAN_FMR.CAN2SB`), or one on a part without
+    /// CAN2, where `CAN2SB` is reserved (RM0008 §24.9.4: the F103).
     StartBankOutOfRange,
+    /// The APB1 clock the timing was computed from is above the part's limit
+    /// ([`Chip::apb1_max_hz`], the datasheet's "general operating conditions").
+    ClockAboveChipLimit,
 }
 
 impl From<TimingError> for ConfigError {
@@ -134,6 +139,8 @@ pub struct Config {
     wait_iterations: u32,
     /// The APB1 clock the timing was computed from (0: unknown, a raw `CAN_BTR`).
     clock_hz: u32,
+    /// The part ([`Config::chip`]).
+    chip: &'static Chip,
 }
 
 impl Config {
@@ -155,6 +162,7 @@ impl Config {
             can2_start_bank: None,
             wait_iterations: DEFAULT_WAIT_ITERATIONS,
             clock_hz: 0,
+            chip: DEFAULT_CHIP,
         }
     }
 
@@ -347,13 +355,45 @@ impl Config {
     /// an empty plan on the instance first. CAN2 checks it against the shared block
     /// ([`twocan_core::Error::InvalidArgument`] if it disagrees). Ignored by CAN3.
     pub const fn can2_start_bank(self, bank: u8) -> Result<Self, ConfigError> {
-        if bank as usize > FILTER_BANKS {
+        if !self.chip.start_bank_valid(bank) {
             return Err(ConfigError::StartBankOutOfRange);
         }
         Ok(Config {
             can2_start_bank: Some(bank),
             ..self
         })
+    }
+
+    /// The part the controller is on ([`crate::chip`]; default [`DEFAULT_CHIP`], the
+    /// STM32F76x/F77x): the driver reads from it which instances exist
+    /// ([`crate::Can::can1`] & co. refuse another with
+    /// [`twocan_core::Error::InvalidArgument`]), the banks each owns (a single-CAN block
+    /// is never split: `CAN2SB` is not written there) and hence the planner's bank count
+    /// and the capabilities' filter counts.
+    ///
+    /// Errors: [`ConfigError::ClockAboveChipLimit`] when the timing's APB1 clock is above
+    /// the part's [`Chip::apb1_max_hz`]; [`ConfigError::StartBankOutOfRange`] when a CAN2
+    /// start bank was set and the part has no CAN2 (or fewer banks).
+    ///
+    /// ```
+    /// use twocan_bxcan::{chip, Config, ConfigError};
+    /// // A Blue Pill: APB1 at 36 MHz (its maximum, RM0008 §7.2), one CAN, 14 banks.
+    /// let c = Config::from_bitrate(36_000_000, 500_000).unwrap().chip(&chip::STM32F103);
+    /// assert!(c.is_ok());
+    /// // 42 MHz is above the F103's APB1 limit.
+    /// let c = Config::from_bitrate(42_000_000, 500_000).unwrap().chip(&chip::STM32F103);
+    /// assert_eq!(c.unwrap_err(), ConfigError::ClockAboveChipLimit);
+    /// ```
+    pub const fn chip(self, chip: &'static Chip) -> Result<Self, ConfigError> {
+        if !chip.clock_allowed(self.clock_hz) {
+            return Err(ConfigError::ClockAboveChipLimit);
+        }
+        if let Some(bank) = self.can2_start_bank {
+            if !chip.start_bank_valid(bank) {
+                return Err(ConfigError::StartBankOutOfRange);
+            }
+        }
+        Ok(Config { chip, ..self })
     }
 
     /// The bound, in register reads, on every wait for an acknowledge bit (default
@@ -445,7 +485,17 @@ impl Config {
     pub const fn get_wait_iterations(&self) -> u32 {
         self.wait_iterations
     }
+
+    /// The part ([`Config::chip`]).
+    pub const fn get_chip(&self) -> &'static Chip {
+        self.chip
+    }
 }
+
+/// The part a [`Config`] describes unless [`Config::chip`] says otherwise: the
+/// STM32F76x/F77x (CAN1 + CAN2 sharing 28 banks, CAN3 with 14), the driver's first
+/// target.
+pub const DEFAULT_CHIP: &Chip = &chip::STM32F76X_F77X;
 
 #[cfg(test)]
 mod tests {

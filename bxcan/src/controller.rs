@@ -66,7 +66,9 @@ impl<R: Registers> Can<R, R> {
     /// options, `CAN_BTR`, `CAN_IER` and, if configured, `CAN_FMR.CAN2SB`.
     ///
     /// Errors: [`Error::Timeout`] when INAK does not come (no clock, stuck peripheral),
-    /// with the registers handed back in [`Failed::value`].
+    /// with the registers handed back in [`Failed::value`]; [`Error::InvalidArgument`],
+    /// before any register is touched, when the part ([`Config::chip`]) has no such
+    /// instance (CAN2 on an F103, CAN3 on an F446).
     pub fn can1(regs: R, config: &Config) -> Result<Init<R, R>, Failed<Can<R, R>>> {
         Can::new(regs, None, Instance::Can1, config).configure(config)
     }
@@ -124,10 +126,15 @@ impl<R: Registers, F: Registers, const K: usize> Can<R, F, K> {
         }
     }
 
-    /// The start bank rules before any register is written: CAN2's configured start
+    /// The instance must exist on the part ([`Config::chip`]), and the start bank rules
+    /// hold, before any register is written: CAN2's configured start
     /// bank must agree with the block's `CAN2SB`; CAN1 may move `CAN2SB` only when no
     /// bank it would affect is active ([`filter_block::check_can2sb`]).
     fn check_start_bank(&self, config: &Config) -> Result<(), Error> {
+        // The part must have the instance (`Config::chip`).
+        if !config.get_chip().has(self.instance) {
+            return Err(Error::InvalidArgument);
+        }
         let Some(start) = config.get_can2_start_bank() else {
             return Ok(());
         };
@@ -137,7 +144,7 @@ impl<R: Registers, F: Registers, const K: usize> Can<R, F, K> {
                     Some(r) => filter_block::can2sb(r),
                     None => filter_block::can2sb(&self.regs),
                 };
-                let first = |sb| crate::instance::bank_range(Instance::Can2, sb).0;
+                let first = |sb| config.get_chip().bank_range(Instance::Can2, sb).0;
                 if first(current) == first(start as u32) {
                     Ok(())
                 } else {
@@ -245,8 +252,8 @@ impl<R: Registers, F: Registers, const K: usize> Can<R, F, K> {
     /// The banks (`start..end`, hardware numbering) this instance owns now.
     pub fn bank_range(&self) -> (usize, usize) {
         match &self.filter_regs {
-            Some(f) => filter_block::banks_of(f, self.instance),
-            None => filter_block::banks_of(&self.regs, self.instance),
+            Some(f) => filter_block::banks_of(f, self.config.get_chip(), self.instance),
+            None => filter_block::banks_of(&self.regs, self.config.get_chip(), self.instance),
         }
     }
 
@@ -287,9 +294,10 @@ impl<R: Registers, F: Registers, const K: usize> Can<R, F, K> {
         // The map first: a plan the map cannot hold is refused before any bank changes.
         let fmi = plan.fmi_map::<K>()?;
         let instance = self.instance;
+        let chip = self.config.get_chip();
         let r = match &mut self.filter_regs {
-            Some(f) => filter_block::program(f, instance, plan),
-            None => filter_block::program(&self.regs, instance, plan),
+            Some(f) => filter_block::program(f, chip, instance, plan),
+            None => filter_block::program(&self.regs, chip, instance, plan),
         };
         r.map_err(|_| Error::InvalidArgument)?;
         self.fmi = fmi;

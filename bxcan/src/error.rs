@@ -14,7 +14,10 @@ impl fmt::Display for ConfigError {
             ConfigError::BtrReservedBits => {
                 f.write_str("CAN_BTR value with bits outside BRP, TS1, TS2 and SJW")
             }
-            ConfigError::StartBankOutOfRange => f.write_str("CAN2 start bank above 28"),
+            ConfigError::StartBankOutOfRange => {
+                f.write_str("CAN2 start bank above 28, or on a part without CAN2")
+            }
+            ConfigError::ClockAboveChipLimit => f.write_str("APB1 clock above the part's limit"),
         }
     }
 }

@@ -20,6 +20,7 @@
 
 use twocan_core::Registers;
 
+use crate::chip::Chip;
 use crate::filters::PlanRef;
 use crate::instance::{bank_range, Instance};
 use crate::regs::{fa1r, ffa1r, fir1, fir2, fm1r, fmr, fs1r, FA1R, FFA1R, FM1R, FMR, FS1R};
@@ -29,15 +30,16 @@ pub(crate) fn can2sb<F: Registers>(regs: &F) -> u32 {
     fmr::CAN2SB.get(regs.read32(FMR))
 }
 
-/// The banks `instance` owns in the block behind `regs`.
-pub(crate) fn banks_of<F: Registers>(regs: &F, instance: Instance) -> (usize, usize) {
-    bank_range(instance, can2sb(regs))
+/// The banks `instance` of `chip` owns in the block behind `regs` ([`Chip::bank_range`]:
+/// a dual block split at `CAN2SB`, a single-CAN block whole).
+pub(crate) fn banks_of<F: Registers>(regs: &F, chip: &Chip, instance: Instance) -> (usize, usize) {
+    chip.bank_range(instance, can2sb(regs))
 }
 
 /// The FIFOs `instance`'s active banks feed in the block behind `regs`: bit 0 FIFO 0,
 /// bit 1 FIFO 1 (`CAN_FA1R.FACTx` and `CAN_FFA1R.FFAx` of its banks, RM0410 §40.9.4).
-pub(crate) fn fed_fifos<F: Registers>(regs: &F, instance: Instance) -> u8 {
-    let (start, end) = banks_of(regs, instance);
+pub(crate) fn fed_fifos<F: Registers>(regs: &F, chip: &Chip, instance: Instance) -> u8 {
+    let (start, end) = banks_of(regs, chip, instance);
     let ours = ((1u32 << (end - start)) - 1) << start;
     let active = regs.read32(FA1R) & ours;
     let to_fifo1 = regs.read32(FFA1R) & active;
@@ -108,40 +110,44 @@ pub(crate) struct TooManyBanks;
 /// range cannot change under the programming).
 pub(crate) fn program<'p, F: Registers>(
     regs: &F,
+    chip: &Chip,
     instance: Instance,
     plan: impl Into<PlanRef<'p>>,
 ) -> Result<(), TooManyBanks> {
     let plan = plan.into();
-    critical_section::with(|_| program_locked(regs, instance, plan))
+    critical_section::with(|_| program_locked(regs, chip, instance, plan))
 }
 
 /// As [`program`], running `then` still in filter initialization mode (`FINIT` = 1,
 /// nothing enters the FIFOs) after the banks are written.
 pub(crate) fn program_then<'p, F: Registers>(
     regs: &F,
+    chip: &Chip,
     instance: Instance,
     plan: impl Into<PlanRef<'p>>,
     then: impl FnOnce(),
 ) -> Result<(), TooManyBanks> {
     let plan = plan.into();
-    critical_section::with(|_| program_locked_then(regs, instance, plan, then))
+    critical_section::with(|_| program_locked_then(regs, chip, instance, plan, then))
 }
 
 fn program_locked<F: Registers>(
     regs: &F,
+    chip: &Chip,
     instance: Instance,
     plan: PlanRef<'_>,
 ) -> Result<(), TooManyBanks> {
-    program_locked_then(regs, instance, plan, || {})
+    program_locked_then(regs, chip, instance, plan, || {})
 }
 
 fn program_locked_then<F: Registers>(
     regs: &F,
+    chip: &Chip,
     instance: Instance,
     plan: PlanRef<'_>,
     then: impl FnOnce(),
 ) -> Result<(), TooManyBanks> {
-    let (start, end) = banks_of(regs, instance);
+    let (start, end) = banks_of(regs, chip, instance);
     if plan.bank_count() > end - start {
         return Err(TooManyBanks);
     }

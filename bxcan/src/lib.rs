@@ -22,7 +22,9 @@
 //! handle ([`regs::CanRegs`], a [`twocan_core::Mmio`] window over the instance's block:
 //! safe code reaches no other address) with no `unsafe` in the program; the state is a
 //! `static`, and the handlers go to the TX, RX0, RX1 and SCE vectors before those are
-//! unmasked (see `examples/stm32f7/src/can.rs`). Compiled by the same test:
+//! unmasked: with feature `rt` the library defines those vectors and does it
+//! (`rt::IrqState::start`, and `stop` for the way back; see
+//! `examples/stm32f7/src/can.rs`). Compiled by the same test:
 //!
 #![cfg_attr(
     feature = "hal-stm32f7",
@@ -46,9 +48,15 @@
 //!   implementation: who touches which register from which context;
 //! - [`filters`]: banks ([`Bank`]), direct configuration, match-index numbering, the
 //!   compiled [`FilterPlan`]; [`planner`]: portable filters → fewest banks, exactly;
+//! - [`chip`]: the STM32 parts as data ([`Chip`]: instances, bank counts, APB1 limits,
+//!   interrupt numbers, pins), chosen with [`Config::chip`];
 //! - [`instance`]: CAN1/CAN2/CAN3 and what the firmware must do (RCC, AF9);
-//! - `hal` (feature `hal-stm32f7`): the hand-over from `stm32f7xx-hal` (singletons,
+//! - `hal` (features `hal-stm32f7`, `hal-stm32f4`, `hal-stm32f1`): the hand-over from
+//!   `stm32f7xx-hal`, `stm32f4xx-hal` or `stm32f1xx-hal` (singletons,
 //!   clocks, typed pins; CAN2 only with CAN1's filter-block handle);
+//! - `rt` (feature `rt`): the interrupt entry points `CAN1_TX` ... in the library, the
+//!   handlers installed before the lines are unmasked, priorities applied, and the way
+//!   back (`IrqState::start`, `IrqState::stop`);
 //! - [`regs`]: the register map.
 //!
 //! # Critical sections
@@ -65,6 +73,8 @@
 
 pub mod regs;
 
+pub mod chip;
+
 #[cfg(feature = "model")]
 pub mod model;
 
@@ -74,20 +84,31 @@ mod error;
 pub mod filter_block;
 pub mod filters;
 pub mod fmi;
-// The hand-over from `stm32f7xx-hal`: the one `unsafe` turning a consumed PAC singleton
+// The hand-over from an STM32 HAL: the one `unsafe` turning a consumed PAC singleton
 // into a register window.
-#[cfg(feature = "hal-stm32f7")]
+#[cfg(any(
+    feature = "hal-stm32f7",
+    feature = "hal-stm32f4",
+    feature = "hal-stm32f1"
+))]
 #[allow(unsafe_code)]
 pub mod hal;
 pub mod instance;
 mod mailbox;
 mod mode;
 pub mod planner;
+// The library's interrupt entry points and their handler slots (feature `rt`): the
+// `unsafe` of a slot written once and of the NVIC calls.
+#[cfg(feature = "rt")]
+#[cfg_attr(docsrs, doc(cfg(feature = "rt")))]
+#[allow(unsafe_code)]
+pub mod rt;
 // Interrupt-shared state: the `Hardware` contract and the per-mailbox frame cell.
 #[allow(unsafe_code)]
 pub mod split;
 pub mod types;
 
+pub use chip::Chip;
 pub use config::{Config, ConfigError, Recovery};
 pub use controller::{Can, Failed, Init};
 pub use filters::{Bank, BankError, BankKind, Fifo, FilterPlan, PlanError, PlanRef, SizedPlan};

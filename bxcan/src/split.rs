@@ -137,8 +137,8 @@ impl<R: Registers, F: Registers, const K: usize> Can<R, F, K> {
     pub fn into_split(self) -> BxCan<R, F, K> {
         let listen_only = self.regs.read32(BTR) & (btr::SILM | btr::LBKM) == btr::SILM;
         let fed = match &self.filter_regs {
-            Some(f) => filter_block::fed_fifos(f, self.instance),
-            None => filter_block::fed_fifos(&self.regs, self.instance),
+            Some(f) => filter_block::fed_fifos(f, self.config.get_chip(), self.instance),
+            None => filter_block::fed_fifos(&self.regs, self.config.get_chip(), self.instance),
         };
         BxCan {
             regs: self.regs,
@@ -199,8 +199,8 @@ impl<R: Registers, F: Registers, const K: usize> BxCan<R, F, K> {
     /// The banks (`start..end`, hardware numbering) this instance owns now.
     pub fn bank_range(&self) -> (usize, usize) {
         match &self.filter_regs {
-            Some(f) => filter_block::banks_of(f, self.instance),
-            None => filter_block::banks_of(&self.regs, self.instance),
+            Some(f) => filter_block::banks_of(f, self.config.get_chip(), self.instance),
+            None => filter_block::banks_of(&self.regs, self.config.get_chip(), self.instance),
         }
     }
 
@@ -785,13 +785,21 @@ unsafe impl<R: Registers, F: Registers, const K: usize> Hardware for BxCan<R, F,
             self.generation.store(next, Ordering::Release);
         };
         let r = match &self.filter_regs {
-            Some(f) => filter_block::program_then(f, self.instance, filters, drain),
-            None => filter_block::program_then(&self.regs, self.instance, filters, drain),
+            Some(f) => {
+                filter_block::program_then(f, self.config.get_chip(), self.instance, filters, drain)
+            }
+            None => filter_block::program_then(
+                &self.regs,
+                self.config.get_chip(),
+                self.instance,
+                filters,
+                drain,
+            ),
         };
         r.map_err(|_| Error::InvalidArgument)?;
         let fed = match &self.filter_regs {
-            Some(f) => filter_block::fed_fifos(f, self.instance),
-            None => filter_block::fed_fifos(&self.regs, self.instance),
+            Some(f) => filter_block::fed_fifos(f, self.config.get_chip(), self.instance),
+            None => filter_block::fed_fifos(&self.regs, self.config.get_chip(), self.instance),
         };
         self.fed.store(fed, Ordering::Relaxed);
         // SAFETY: the receive half's context, the only one touching the map.

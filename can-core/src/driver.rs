@@ -86,7 +86,7 @@ impl<H: Hardware, const RX: usize, const TX: usize, const RX1: usize> Driver<H, 
 
     /// The controller (for backend-specific operations).
     pub fn hardware(&self) -> &H {
-        self.shared().hardware().expect("installed by new")
+        self.shared().owned_hardware().expect("installed by new")
     }
 
     fn shared(&self) -> &St<H, RX, TX, RX1> {

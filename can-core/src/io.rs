@@ -1,7 +1,7 @@
 //! The portable traits an application or a protocol stack is generic over: [`CanTx`] to
 //! send and follow what was sent, [`CanRx`] to receive and follow the error state, both
-//! with the statistics of [`CanStatus`]; with the `async` feature [`AsyncCanTx`] and
-//! [`AsyncCanRx`] add the waits.
+//! with the statistics of [`CanStatus`]; with the `async` feature `AsyncCanTx` and
+//! `AsyncCanRx` add the waits.
 //!
 //! The split driver's halves implement one each ([`Tx`], [`Rx`]), the one-struct
 //! [`Driver`] both, so the same code runs in firmware (halves in different contexts) and
@@ -341,7 +341,7 @@ mod tests {
         assert_eq!(CanStatus::error_stats(&p.rx).stuff, 1);
         assert_eq!(
             CanStatus::capabilities(&p.tx),
-            crate::Hardware::capabilities(hw)
+            crate::Hardware::capabilities(&*hw)
         );
     }
 

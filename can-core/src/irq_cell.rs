@@ -133,6 +133,27 @@ impl<T> IrqCell<T> {
         true
     }
 
+    /// Takes the handle back out (the way back of `State::unsplit`): the cell is empty
+    /// again, and a vector that runs it from now on does nothing. `None` when the cell
+    /// is empty or a context is running it at this moment (a handler preempted by the
+    /// caller; try again once it returned). Mask the lines that run the cell first, so
+    /// that none of them is left asserted with nobody to clear its cause.
+    pub fn take(&self) -> Option<T> {
+        // READY -> WRITING: no `run` and no `put` touches the value meanwhile.
+        if self
+            .state
+            .compare_exchange(READY, WRITING, Ordering::Acquire, Ordering::Relaxed)
+            .is_err()
+        {
+            return None;
+        }
+        // SAFETY: WRITING, taken from READY by this call: the value is initialised and
+        // this is the only context that reaches it; it is moved out once (EMPTY next).
+        let value = self.value.with(|p| unsafe { (*p).assume_init_read() });
+        self.state.store(EMPTY, Ordering::Release);
+        Some(value)
+    }
+
     /// Whether a handle was put in place.
     pub fn is_ready(&self) -> bool {
         matches!(self.state.load(Ordering::Acquire), READY | BUSY)
@@ -179,6 +200,22 @@ impl<T> Installed<'_, T> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn take_empties_the_cell_and_put_fills_it_again() {
+        let cell: IrqCell<u32> = IrqCell::new();
+        assert_eq!(cell.take(), None);
+        let _ = cell.put(5).unwrap();
+        assert!(cell.run(|v| {
+            assert_eq!(cell.take(), None, "not while it runs");
+            *v += 1;
+        }));
+        assert_eq!(cell.take(), Some(6));
+        assert!(!cell.is_ready());
+        assert!(!cell.run(|_| unreachable!("taken")));
+        let _ = cell.put(7).unwrap();
+        assert!(cell.run(|v| assert_eq!(*v, 7)));
+    }
 
     #[test]
     fn a_second_context_is_turned_away_while_the_first_runs() {

@@ -72,10 +72,11 @@ pub use hardware::{Completion, Hardware, Settled, StatusEvents, Token, TxFailure
 pub use io::{AsyncCanRx, AsyncCanTx};
 pub use io::{CanRx, CanStatus, CanTx};
 pub use mailbox::{MailboxId, MailboxState, TxOutcome, TxPolicy};
+pub use once::Lease;
 pub use priority::Priority;
 pub use registers::{Mmio, Registers};
 pub use split::State;
-pub use split::{AbortRequest, Parts, StateChange};
+pub use split::{AbortRequest, Leftovers, Parts, StateChange, UnsplitError};
 pub use spsc::BufferStats;
 pub use spsc::SpscRing;
 pub use timestamp::Timestamp;

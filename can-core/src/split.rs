@@ -49,7 +49,7 @@ use crate::error::{Error, ErrorCounters, ErrorState, ErrorStatistics, LastErrorC
 use crate::frame::{Frame, RxFrame};
 use crate::hardware::{Completion, Hardware, Settled, Token};
 use crate::mailbox::{TxOutcome, TxPolicy};
-use crate::once::OnceSlot;
+use crate::once::{Lease, OnceSlot};
 use crate::spsc::{BufferStats, Counter, SpscRing};
 use crate::timestamp::{Extender, Timestamp};
 use crate::txqueue::{FifoQueue, Queued, TxQueue};
@@ -393,16 +393,24 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
     }
 
     /// Gives the controller back once no handle borrows the state any more (it takes
-    /// the state by value, so the handles are gone; a `static` state keeps its
-    /// controller for ever). Frames and completions still in the rings and the queue go
-    /// with the state; the controller keeps its configuration and its mailboxes.
-    /// `None` when the state was never split.
+    /// the state by value, so the handles are gone; a `static` state gives it back
+    /// with [`State::unsplit`]). Frames and completions still in the rings and the
+    /// queue go with the state; the controller keeps its configuration and its
+    /// mailboxes. `None` when the state was never split.
     pub fn into_hardware(mut self) -> Option<H> {
         self.uninstall()
     }
 
-    /// The controller, once [`State::split`] stored it (any context).
-    pub fn hardware(&self) -> Option<&H> {
+    /// The controller, once [`State::split`] stored it (any context). The reference is
+    /// a [`Lease`]: while it lives, [`State::unsplit`] refuses to take the controller
+    /// out ([`UnsplitError::Leased`]); drop it before ending the controller.
+    pub fn hardware(&self) -> Option<Lease<'_, H>> {
+        self.hw.lease()
+    }
+
+    /// The controller of a state owned exclusively ([`crate::Driver`]): no `unsplit`
+    /// can run while `&self` lives there.
+    pub(crate) fn owned_hardware(&self) -> Option<&H> {
         self.hw.get()
     }
 
@@ -1028,7 +1036,7 @@ impl<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE:
     }
 
     /// The controller.
-    pub fn hardware(&self) -> &'a H {
+    pub fn hardware(&self) -> &H {
         self.s.hw()
     }
 }
@@ -1170,7 +1178,7 @@ impl<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE:
     }
 
     /// The controller.
-    pub fn hardware(&self) -> &'a H {
+    pub fn hardware(&self) -> &H {
         self.s.hw()
     }
 
@@ -1495,6 +1503,121 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
     /// What the controller can do, as configured now.
     pub fn capabilities(&self) -> Option<crate::capabilities::Capabilities> {
         self.hardware().map(|h| h.capabilities())
+    }
+}
+
+/// What [`State::unsplit`] found still in the state and discarded (the controller is
+/// about to be ended: ACAN's `end` drops its buffers the same way). Take what matters
+/// before (`receive`, `take_completion`, `abort_all` then the transmit handler).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Leftovers {
+    /// Frames accepted by `try_send` and still in the software queue: never loaded
+    /// into a mailbox, they get no completion. (Frames in mailboxes are the
+    /// controller's: ending it stops them.)
+    pub queued: usize,
+    /// Received frames not taken from the receive rings.
+    pub received: usize,
+    /// Completions not taken.
+    pub completions: usize,
+    /// Error-state changes not taken.
+    pub state_changes: usize,
+}
+
+/// Why [`State::unsplit`] gave the handles back.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum UnsplitError {
+    /// A handle came from another state.
+    Foreign,
+    /// A reference from [`State::hardware`] is alive (in some context), or was being
+    /// made at that very moment: drop it and try again.
+    Leased,
+}
+
+impl core::fmt::Display for UnsplitError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(match self {
+            UnsplitError::Foreign => "a handle belongs to another state",
+            UnsplitError::Leased => "a reference to the controller is alive",
+        })
+    }
+}
+
+impl core::error::Error for UnsplitError {}
+
+/// The way back (issue 22 item 11).
+impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize>
+    State<H, RX, Q, RX1, DONE>
+{
+    /// Takes the controller back out of the state, given every handle [`State::split`]
+    /// made: the halves, and the interrupt handlers taken back out of their vectors'
+    /// cells (`IrqCell::take`) **after** the lines that run them were masked. With all
+    /// six handles here, no context can reach the controller through a handle any
+    /// more; a reference from [`State::hardware`] still alive refuses
+    /// ([`UnsplitError::Leased`]). What the rings and the queue still hold is discarded
+    /// and counted ([`Leftovers`]); the statistics stay. The state is empty again:
+    /// [`State::split`] may store a controller anew (after `end` and `begin`, say).
+    ///
+    /// On error every handle comes back, untouched.
+    #[allow(clippy::type_complexity, clippy::result_large_err)]
+    pub fn unsplit<'a>(
+        &'a self,
+        parts: Parts<'a, H, RX, Q, RX1, DONE>,
+    ) -> Result<(H, Leftovers), (UnsplitError, Parts<'a, H, RX, Q, RX1, DONE>)> {
+        let ours = [
+            parts.tx.s,
+            parts.rx.s,
+            parts.tx_irq.s,
+            parts.rx0_irq.s,
+            parts.rx1_irq.s,
+            parts.status_irq.s,
+        ]
+        .iter()
+        .all(|s| core::ptr::eq(*s, self));
+        if !ours {
+            return Err((UnsplitError::Foreign, parts));
+        }
+        // SAFETY: the six handles, the only users of `hw()` (`get_unchecked`), are
+        // here and are dropped below without being used again; `get` is used only by
+        // the one-struct driver, whose state is never split; references from
+        // `hardware()` are leases, which `take_shared` counts.
+        let hw = match unsafe { self.hw.take_shared() } {
+            Ok(hw) => hw,
+            // Not published: impossible with handles of this state (`split` made them
+            // after publishing, and only `unsplit` empties the slot, consuming them).
+            Err(false) => return Err((UnsplitError::Foreign, parts)),
+            Err(true) => return Err((UnsplitError::Leased, parts)),
+        };
+        let mut left = Leftovers::default();
+        // SAFETY: the consumer handles of the rings (`Rx`, `Tx`) and the producer
+        // handles (the interrupt handlers, `Tx`'s slow path inside the critical
+        // section) are all here: no other context pops or pushes.
+        unsafe {
+            while self.rx0.pop().is_some() {
+                left.received += 1;
+            }
+            while self.rx1.pop().is_some() {
+                left.received += 1;
+            }
+            while self.done.pop().is_some() {
+                left.completions += 1;
+            }
+            while self.changes.pop().is_some() {
+                left.state_changes += 1;
+            }
+        }
+        critical_section::with(|cs| {
+            // SAFETY: the queue is only touched inside a critical section.
+            let queue = unsafe { &mut *self.queue.borrow(cs).get() };
+            while queue.pop().is_some() {
+                left.queued += 1;
+            }
+        });
+        self.queue_len.store(0, Ordering::Relaxed);
+        self.state.store(STATE_UNKNOWN, Ordering::Relaxed);
+        drop(parts);
+        Ok((hw, left))
     }
 }
 

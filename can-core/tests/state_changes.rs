@@ -23,7 +23,7 @@ fn split_halves_count_the_changes_the_ring_cannot_hold() {
     let mut p = CAN.split(MockHardware::new(3)).map_err(|(e, _)| e).unwrap();
     let hw = CAN.hardware().unwrap();
     // 12 changes, none taken: the first 8 stay, 4 are counted as lost.
-    alternate(hw, || p.status_irq.on_interrupt(), 6);
+    alternate(&hw, || p.status_irq.on_interrupt(), 6);
     let t = CAN.traffic();
     assert_eq!(STATE_CHANGES, 8);
     assert_eq!(t.state_changes, 12);

@@ -33,78 +33,68 @@
 //! [`BeginError::Hardware`]`(`[`Error::Timeout`]`)`.
 
 use twocan_core::timing::{TimingError, TimingRule};
-use twocan_core::{BusMode, BusOffRecovery, Error, Filter, Registers};
+use twocan_core::{BusMode, BusOffRecovery, Error, Filter, LastErrorCode, Mode, Registers};
 
 use crate::begin_error::{BeginError, ConfigErrors};
+use crate::can_clock::CanClock;
 use crate::configuration::{Configuration, DATA_MAILBOX, MESSAGE_BUFFERS};
 use crate::controller::FlexCan;
 use crate::filters::FilterTable;
 use crate::handshake;
+use crate::imxrt::ImxrtPlan;
+use crate::installed::PlannedTable;
 use crate::instance::Target;
-use crate::regs::{self, code, cs, ctrl1, ctrl2, iflag1, mcr, CTRL1, CTRL2, IFLAG1, IMASK1, MCR};
-use crate::settings::{Settings, CAN_CLOCK_HZ};
-use crate::system::{choose_pins, SystemPlan};
+use crate::options::Options;
+use crate::regs::{
+    self, code, cs, ctrl1, ctrl2, iflag1, mcr, CTRL1, CTRL2, IFLAG1, IFLAG2, IMASK1, IMASK2, MCR,
+};
+use crate::settings::Settings;
+use crate::split::{FlexCanHw, Parts};
+use crate::system::{choose_pins, PortPlan, SystemPlan};
 
-/// Everything `begin` will write, computed before anything is written.
+/// Everything `begin` will write but the filter table, computed before anything is
+/// written (the lists are checked; the table is built once, inside the controller
+/// `begin` returns, so that no table-sized value moves through the configuration).
 #[derive(Debug, Clone)]
 struct Plan {
     system: SystemPlan,
     mcr: u32,
     ctrl1: u32,
     configuration: Configuration,
-    table: FilterTable,
+    /// The module's message buffers (16 or 64, [`crate::Chip::message_buffers`]).
+    message_buffers: usize,
 }
 
 /// The checks of ACAN table 5, all of them, then the register values.
-fn plan(
+const fn plan(
     target: Target,
     settings: &Settings,
-    primary: &[Filter],
-    secondary: &[Filter],
+    configuration: Configuration,
+    filter_errors: ConfigErrors,
 ) -> Result<Plan, ConfigErrors> {
     let mut errors = timing_errors(&settings.timing_rule(), settings);
     let timing_bits = settings.timing.flexcan_ctrl1();
     if timing_bits.is_err() {
-        errors |= ConfigErrors::BIT_TIMING_INCONSISTENT;
+        errors = errors.union(ConfigErrors::BIT_TIMING_INCONSISTENT);
     }
 
-    let table = FilterTable::compile(settings.configuration, primary, secondary);
-    if let Err(e) = &table {
-        errors |= *e;
-    }
+    errors = errors.union(filter_errors);
 
-    let pins = match target.board.pins(target.instance) {
-        None => {
-            errors |= ConfigErrors::NO_SUCH_INSTANCE;
+    let chip = target.board.chip();
+    if !settings.can_clock.fits(chip) {
+        errors = errors.union(ConfigErrors::CLOCK_NOT_ON_CHIP);
+    }
+    let system = match (chip.is_imxrt(), target.clock_gate()) {
+        (_, None) => {
+            errors = errors.union(ConfigErrors::NO_SUCH_INSTANCE);
             None
         }
-        Some(pins) => match choose_pins(
-            pins,
-            settings.use_alternate_tx_pin,
-            settings.use_alternate_rx_pin,
-        ) {
-            Ok(chosen) => Some(chosen),
-            Err((no_tx, no_rx)) => {
-                if no_tx {
-                    errors |= ConfigErrors::NO_ALTERNATE_TX_PIN;
-                }
-                if no_rx {
-                    errors |= ConfigErrors::NO_ALTERNATE_RX_PIN;
-                }
-                None
-            }
-        },
+        (true, Some(gate)) => imxrt_system(target, gate, settings, &mut errors),
+        (false, Some(gate)) => kinetis_system(target, gate, settings, &mut errors),
     };
 
-    match (errors.is_empty(), timing_bits, table, pins) {
-        (true, Ok(timing_bits), Ok(table), Some((tx, rx))) => {
-            let system = SystemPlan::new(
-                target.instance.clock_gate(),
-                tx,
-                rx,
-                settings.tx_pin_open_collector,
-                settings.rx_pin_pull_up,
-            );
+    match (errors.is_empty(), timing_bits, system) {
+        (true, Ok(timing_bits), Some(system)) => {
             let mut mcr = mcr::FRZ
                 | mcr::HALT
                 | mcr::RFEN
@@ -122,7 +112,7 @@ fn plan(
             if settings.loop_back {
                 ctrl1 |= ctrl1::LPB;
             }
-            if settings.bus_off_recovery == BusOffRecovery::Manual {
+            if matches!(settings.bus_off_recovery, BusOffRecovery::Manual) {
                 ctrl1 |= ctrl1::BOFFREC;
             }
             if settings.error_interrupts {
@@ -133,11 +123,76 @@ fn plan(
                 system,
                 mcr,
                 ctrl1,
-                configuration: settings.configuration,
-                table,
+                configuration,
+                message_buffers: chip.message_buffers(),
             })
         }
         _ => Err(errors),
+    }
+}
+
+/// The Kinetis SIM/PORT plan: the pins of ACAN §7 (alternates on request).
+const fn kinetis_system(
+    target: Target,
+    gate: (usize, u32),
+    settings: &Settings,
+    errors: &mut ConfigErrors,
+) -> Option<SystemPlan> {
+    let Some(pins) = target.board.pins(target.instance) else {
+        return None;
+    };
+    match choose_pins(
+        pins,
+        settings.use_alternate_tx_pin,
+        settings.use_alternate_rx_pin,
+    ) {
+        Ok((tx, rx)) => Some(SystemPlan::Kinetis(PortPlan::new(
+            gate,
+            tx,
+            rx,
+            settings.tx_pin_open_collector,
+            settings.rx_pin_pull_up,
+        ))),
+        Err((no_tx, no_rx)) => {
+            if no_tx {
+                *errors = errors.union(ConfigErrors::NO_ALTERNATE_TX_PIN);
+            }
+            if no_rx {
+                *errors = errors.union(ConfigErrors::NO_ALTERNATE_RX_PIN);
+            }
+            None
+        }
+    }
+}
+
+/// The RT1062 CCM/IOMUXC plan: the board's one pin pair (no alternates on the Teensy
+/// 4.x, so asking for one is [`ConfigErrors::NO_ALTERNATE_TX_PIN`] /
+/// [`ConfigErrors::NO_ALTERNATE_RX_PIN`]), the clock root of the settings.
+const fn imxrt_system(
+    target: Target,
+    gate: (usize, u32),
+    settings: &Settings,
+    errors: &mut ConfigErrors,
+) -> Option<SystemPlan> {
+    let Some(pins) = target.board.imx_pins(target.instance) else {
+        return None;
+    };
+    if settings.use_alternate_tx_pin {
+        *errors = errors.union(ConfigErrors::NO_ALTERNATE_TX_PIN);
+    }
+    if settings.use_alternate_rx_pin {
+        *errors = errors.union(ConfigErrors::NO_ALTERNATE_RX_PIN);
+    }
+    match settings.can_clock {
+        CanClock::Imxrt(root) if errors.is_empty() => Some(SystemPlan::Imxrt(ImxrtPlan::new(
+            gate,
+            root,
+            pins.tx,
+            pins.rx,
+            settings.tx_pin_open_collector,
+            settings.rx_pin_pull_up,
+        ))),
+        _ => None,
     }
 }
 
@@ -150,20 +205,24 @@ fn plan(
 /// counts, ACAN §15.2.2; [`ConfigErrors::BIT_TIMING_FORBIDDEN`] for the Kinetis
 /// manual's rules); the timing too far from the wished rate
 /// ([`ConfigErrors::BIT_RATE_TOO_FAR`], ACAN §15.2.1).
-fn timing_errors(rule: &TimingRule, settings: &Settings) -> ConfigErrors {
+const fn timing_errors(rule: &TimingRule, settings: &Settings) -> ConfigErrors {
     let mut errors = ConfigErrors::NONE;
     match rule.check_bitrate(settings.wished_bit_rate()) {
         Ok(()) => {}
-        Err(TimingError::ForbiddenByManual) => errors |= ConfigErrors::BIT_TIMING_FORBIDDEN,
-        Err(_) => errors |= ConfigErrors::BIT_RATE_OUT_OF_RANGE,
+        Err(TimingError::ForbiddenByManual) => {
+            errors = errors.union(ConfigErrors::BIT_TIMING_FORBIDDEN)
+        }
+        Err(_) => errors = errors.union(ConfigErrors::BIT_RATE_OUT_OF_RANGE),
     }
     if !settings.bit_rate_close_to_wished() {
-        errors |= ConfigErrors::BIT_RATE_TOO_FAR;
+        errors = errors.union(ConfigErrors::BIT_RATE_TOO_FAR);
     }
     match rule.check_timing(&settings.timing) {
         Ok(()) => {}
-        Err(TimingError::ForbiddenByManual) => errors |= ConfigErrors::BIT_TIMING_FORBIDDEN,
-        Err(_) => errors |= ConfigErrors::BIT_TIMING_INCONSISTENT,
+        Err(TimingError::ForbiddenByManual) => {
+            errors = errors.union(ConfigErrors::BIT_TIMING_FORBIDDEN)
+        }
+        Err(_) => errors = errors.union(ConfigErrors::BIT_TIMING_INCONSISTENT),
     }
     errors
 }
@@ -171,7 +230,7 @@ fn timing_errors(rule: &TimingRule, settings: &Settings) -> ConfigErrors {
 /// The error `begin` gives before any other check: the wished rate outside the range of
 /// the driver's rule ([`TimingRule::check_bitrate`]; a rule that accepts nothing is left
 /// to the flags, [`ConfigErrors::BIT_TIMING_FORBIDDEN`]).
-fn bitrate_error(settings: &Settings) -> Option<TimingError> {
+const fn bitrate_error(settings: &Settings) -> Option<TimingError> {
     match settings
         .timing_rule()
         .check_bitrate(settings.wished_bit_rate())
@@ -181,8 +240,14 @@ fn bitrate_error(settings: &Settings) -> Option<TimingError> {
     }
 }
 
-/// Writes the plan (steps 2–5 of the module docs).
-fn configure<R: Registers>(regs: &mut R, plan: &Plan, polls: u32) -> Result<(), Error> {
+/// Writes the plan, and the filter table with `write_table` (steps 2–5 of the module
+/// docs).
+fn configure<R: Registers>(
+    regs: &mut R,
+    plan: &Plan,
+    write_table: impl FnOnce(&R),
+    polls: u32,
+) -> Result<(), Error> {
     handshake::disable(regs, polls)?;
     regs.modify32(CTRL1, |v| v & !ctrl1::CLKSRC);
     handshake::enable(regs, polls)?;
@@ -196,7 +261,7 @@ fn configure<R: Registers>(regs: &mut R, plan: &Plan, polls: u32) -> Result<(), 
         let kept = v & ctrl2::TASD.mask();
         kept | ctrl2::RFFN.val(plan.configuration.rffn() as u32) | ctrl2::RRS
     });
-    FlexCan::<R>::write_filters(regs, &plan.table);
+    write_table(regs);
     // Masks of the transmit mailboxes: a remote-frame mailbox briefly receives after
     // its transmission; exact matching keeps it to its own identifier.
     for n in plan.configuration.primary_filter_capacity()..MESSAGE_BUFFERS as usize {
@@ -212,6 +277,11 @@ fn configure<R: Registers>(regs: &mut R, plan: &Plan, polls: u32) -> Result<(), 
     }
     regs.write32(IFLAG1, u32::MAX);
     regs.write32(IMASK1, iflag1::BUF5I | iflag1::BUF7I | tx_flags);
+    if plan.message_buffers > 32 {
+        // MB32 and above lie beyond `MAXMB` (15): never flagged, masked anyway.
+        regs.write32(IFLAG2, u32::MAX);
+        regs.write32(IMASK2, 0);
+    }
     handshake::unfreeze(regs, polls)
 }
 
@@ -241,7 +311,8 @@ pub fn check(
     primary: &[Filter],
     secondary: &[Filter],
 ) -> ConfigErrors {
-    match plan(target, settings, primary, secondary) {
+    let filters = FilterTable::check(settings.configuration, primary, secondary);
+    match plan(target, settings, settings.configuration, filters) {
         Ok(_) => ConfigErrors::NONE,
         Err(e) => e,
     }
@@ -261,7 +332,7 @@ impl<R: Registers> FlexCan<R> {
     /// [`crate::regs::SystemRegs`], as `Can0::begin` uses; host: [`crate::HostSystem`]).
     /// `regs` may be `&mut M` to keep the registers (a model) after an error.
     pub fn begin<S: Registers>(
-        mut regs: R,
+        regs: R,
         sys: &mut S,
         target: Target,
         settings: &Settings,
@@ -271,34 +342,292 @@ impl<R: Registers> FlexCan<R> {
         if let Some(e) = bitrate_error(settings) {
             return Err(BeginError::Timing(e));
         }
-        let plan = plan(target, settings, primary, secondary).map_err(BeginError::Config)?;
+        let filters = FilterTable::check(settings.configuration, primary, secondary);
+        let plan =
+            plan(target, settings, settings.configuration, filters).map_err(BeginError::Config)?;
         plan.system.apply(sys);
         let polls = settings.handshake_bound();
-        configure(&mut regs, &plan, polls)?;
-        let bus_mode = if settings.listen_only {
-            BusMode::ListenOnly
-        } else if settings.loop_back {
-            BusMode::LoopBack
-        } else {
-            BusMode::Normal
-        };
-        Ok(FlexCan::configured(
+        let bus_mode = bus_mode_of(settings);
+        // The table is built once, in the controller, and written from there.
+        let mut controller = FlexCan::configured(
             regs,
             target,
-            plan.table,
+            FilterTable::build(plan.configuration, primary, secondary),
             bus_mode,
             settings.bus_off_recovery,
             polls,
             settings.message_irq_priority,
             plan.system,
-            settings.bus_clock_hz.unwrap_or(CAN_CLOCK_HZ),
+            settings.bus_clock_hz.unwrap_or(settings.can_clock.hz()),
+        );
+        let table = &controller.table;
+        configure(
+            &mut controller.regs,
+            &plan,
+            |r| FlexCan::write_filters(r, table),
+            polls,
+        )?;
+        Ok(controller)
+    }
+
+    /// [`FlexCan::begin`] compiling the lists straight into `slot`, a table in a
+    /// `static` ([`crate::filters::TableSlot`]), and giving the split controller with
+    /// the options `O` ([`crate::options::FullInSlot`]) that keeps the reference: every
+    /// feature of [`FlexCan::begin`] + [`FlexCan::into_split`] (filter switches, time
+    /// stamps), without a table-sized value on the configuration's stack or in the
+    /// driver state. On an error the slot comes back with it (to try again).
+    ///
+    /// ```
+    /// use twocan_core::Filter;
+    /// use twocan_flexcan::filters::TableSlot;
+    /// use twocan_flexcan::options::FullInSlot;
+    /// use twocan_flexcan::{Board, FlexCan, FlexCanHw, HostSystem, Instance, Settings, Target};
+    /// use twocan_flexcan::{model::FlexCanModel, IdleClocked};
+    ///
+    /// static TABLE: TableSlot = TableSlot::new();
+    /// let model = IdleClocked::new(FlexCanModel::mk66fx1m0());
+    /// let target = Target::new(Board::Teensy36, Instance::Can0);
+    /// let hw: FlexCanHw<_, FullInSlot> = FlexCan::begin_in(
+    ///     model,
+    ///     &mut HostSystem::new(),
+    ///     target,
+    ///     &Settings::new(500_000),
+    ///     &[Filter::standard(0x100)],
+    ///     &[],
+    ///     TABLE.take().unwrap(),
+    /// )
+    /// .map_err(|(e, _)| format!("{e:?}"))?;
+    /// # let _ = hw;
+    /// # Ok::<(), String>(())
+    /// ```
+    #[allow(clippy::type_complexity)]
+    pub fn begin_in<S: Registers, O: Options<Table = &'static mut FilterTable>>(
+        mut regs: R,
+        sys: &mut S,
+        target: Target,
+        settings: &Settings,
+        primary: &[Filter],
+        secondary: &[Filter],
+        slot: &'static mut FilterTable,
+    ) -> Result<FlexCanHw<R, O>, (BeginError, &'static mut FilterTable)> {
+        if let Some(e) = bitrate_error(settings) {
+            return Err((BeginError::Timing(e), slot));
+        }
+        let filters = FilterTable::check(settings.configuration, primary, secondary);
+        let plan = match plan(target, settings, settings.configuration, filters) {
+            Ok(p) => p,
+            Err(e) => return Err((BeginError::Config(e), slot)),
+        };
+        plan.system.apply(sys);
+        let polls = settings.handshake_bound();
+        slot.fill(plan.configuration, primary, secondary);
+        let table: &FilterTable = slot;
+        if let Err(e) = configure(
+            &mut regs,
+            &plan,
+            |r| FlexCan::write_filters(r, table),
+            polls,
+        ) {
+            return Err((BeginError::Hardware(e), slot));
+        }
+        Ok(FlexCanHw::from_parts(
+            regs,
+            target,
+            slot,
+            Parts {
+                bus_mode: bus_mode_of(settings),
+                recovery: settings.bus_off_recovery,
+                polls,
+                irq_priority: settings.message_irq_priority,
+                mode: Mode::Normal,
+                last_error: LastErrorCode::None,
+                system: plan.system,
+                bus_clock_hz: settings.bus_clock_hz.unwrap_or(settings.can_clock.hz()),
+            },
         ))
+    }
+
+    /// `begin` with a filter table planned at compile time ([`crate::const_plan!`],
+    /// [`crate::filters::SizedTable::planned`]), straight to the split controller with
+    /// the options `O` ([`crate::options::Lean`], or a firmware's own whose table is a
+    /// [`PlannedTable`]): no filter list is checked or compiled at run time and no
+    /// table-sized value is built — the controller keeps a few words pointing into the
+    /// plan, whose elements and masks are written as [`FlexCan::begin`] writes a
+    /// compiled list's. The plan's configuration replaces `settings.configuration`.
+    /// The same checks of the settings as `begin` (ACAN table 5, the filter flags
+    /// aside: the plan fits by construction), the same initialization sequence.
+    ///
+    /// ```
+    /// use twocan_core::Filter;
+    /// use twocan_flexcan::options::Lean;
+    /// use twocan_flexcan::planner::PlanOptions;
+    /// use twocan_flexcan::{const_plan, Board, FlexCan, FlexCanHw, HostSystem, Instance};
+    /// use twocan_flexcan::{model::FlexCanModel, IdleClocked, Settings, Target};
+    ///
+    /// const FILTERS: [Filter; 2] = [Filter::standard(0x100), Filter::extended(0x1234)];
+    /// let plan = const_plan!(FILTERS, PlanOptions::choose()).planned();
+    /// // The model, its clock running while the driver waits for an acknowledge.
+    /// let model = IdleClocked::new(FlexCanModel::mk66fx1m0());
+    /// let target = Target::new(Board::Teensy36, Instance::Can0);
+    /// let mut settings = Settings::new(500_000);
+    /// settings.loop_back = true;
+    /// let hw: FlexCanHw<_, Lean> =
+    ///     FlexCan::begin_planned(model, &mut HostSystem::new(), target, &settings, plan)
+    ///         .map_err(|e| format!("{e:?}"))?;
+    /// assert_eq!(hw.configuration(), plan.configuration());
+    /// # Ok::<(), String>(())
+    /// ```
+    pub fn begin_planned<S: Registers, O: Options<Table = PlannedTable>>(
+        regs: R,
+        sys: &mut S,
+        target: Target,
+        settings: &Settings,
+        table: PlannedTable,
+    ) -> Result<FlexCanHw<R, O>, BeginError> {
+        let checked = BeginPlan::new(target, settings, table.configuration())?;
+        Self::begin_checked(regs, sys, &checked, table)
+    }
+
+    /// [`FlexCan::begin_planned`] with the settings checked beforehand ([`BeginPlan`]):
+    /// with a `const` plan of `const` settings, no check of the settings links into the
+    /// firmware — `begin` is the initialization sequence alone. `table` must be planned
+    /// for the configuration `checked` was made for ([`Error::InvalidArgument`]
+    /// otherwise, nothing written).
+    pub fn begin_checked<S: Registers, O: Options<Table = PlannedTable>>(
+        mut regs: R,
+        sys: &mut S,
+        checked: &BeginPlan,
+        table: PlannedTable,
+    ) -> Result<FlexCanHw<R, O>, BeginError> {
+        let plan = &checked.plan;
+        if table.configuration() != plan.configuration {
+            return Err(BeginError::Hardware(Error::InvalidArgument));
+        }
+        plan.system.apply(sys);
+        configure(
+            &mut regs,
+            plan,
+            |r| {
+                FlexCan::write_table(
+                    r,
+                    table.rejects_all(),
+                    table.elements(),
+                    table.individual_masks(),
+                    table.global_mask(),
+                )
+            },
+            checked.polls,
+        )?;
+        Ok(FlexCanHw::from_parts(
+            regs,
+            checked.target,
+            table,
+            Parts {
+                bus_mode: checked.bus_mode,
+                recovery: checked.recovery,
+                polls: checked.polls,
+                irq_priority: checked.irq_priority,
+                mode: Mode::Normal,
+                last_error: LastErrorCode::None,
+                system: plan.system,
+                bus_clock_hz: checked.bus_clock_hz,
+            },
+        ))
+    }
+}
+
+/// What `begin` writes for `settings` on `target` with a table planned for a
+/// configuration, every check of ACAN table 5 done (the filter flags aside): made once,
+/// by a `const fn`, so that `const` settings are checked at compile time
+/// ([`BeginPlan::new_or_panic`]) and [`FlexCan::begin_checked`] links no check.
+///
+/// ```
+/// use twocan_flexcan::begin::BeginPlan;
+/// use twocan_flexcan::{Board, Configuration, Instance, Settings, Target};
+///
+/// const T36: Target = Target::new(Board::Teensy36, Instance::Can0);
+/// const CHECKED: BeginPlan =
+///     BeginPlan::new_or_panic(T36, &Settings::new(500_000), Configuration::Filters8_0);
+/// assert!(BeginPlan::new(T36, &Settings::new(2_000_000), Configuration::Filters8_0).is_err());
+/// # let _ = CHECKED;
+/// ```
+#[derive(Debug, Clone)]
+pub struct BeginPlan {
+    target: Target,
+    plan: Plan,
+    polls: u32,
+    bus_mode: BusMode,
+    recovery: BusOffRecovery,
+    irq_priority: u8,
+    bus_clock_hz: u32,
+}
+
+impl BeginPlan {
+    /// The checks `begin` makes of `settings` on `target` (ACAN table 5 and the bit-rate
+    /// range first, as [`FlexCan::begin`]), and the register values, for a table of
+    /// `configuration` (which replaces `settings.configuration`).
+    pub const fn new(
+        target: Target,
+        settings: &Settings,
+        configuration: Configuration,
+    ) -> Result<Self, BeginError> {
+        if let Some(e) = bitrate_error(settings) {
+            return Err(BeginError::Timing(e));
+        }
+        match plan(target, settings, configuration, ConfigErrors::NONE) {
+            Ok(plan) => Ok(BeginPlan {
+                target,
+                plan,
+                polls: settings.handshake_bound(),
+                bus_mode: bus_mode_of(settings),
+                recovery: settings.bus_off_recovery,
+                irq_priority: settings.message_irq_priority,
+                bus_clock_hz: match settings.bus_clock_hz {
+                    Some(hz) => hz,
+                    None => settings.can_clock.hz(),
+                },
+            }),
+            Err(e) => Err(BeginError::Config(e)),
+        }
+    }
+
+    /// [`BeginPlan::new`], panicking on an error: in a `const` item, settings that
+    /// `begin` would refuse are a compile-time error.
+    pub const fn new_or_panic(
+        target: Target,
+        settings: &Settings,
+        configuration: Configuration,
+    ) -> Self {
+        match Self::new(target, settings, configuration) {
+            Ok(p) => p,
+            Err(BeginError::Timing(_)) => {
+                panic!("twocan_flexcan::BeginPlan: bit rate outside the driver's range")
+            }
+            Err(_) => panic!("twocan_flexcan::BeginPlan: settings refused (ACAN table 5)"),
+        }
+    }
+
+    /// The configuration the plan is made for.
+    pub const fn configuration(&self) -> Configuration {
+        self.plan.configuration
+    }
+}
+
+/// The bus mode the settings ask for (ACAN §4: listen-only, loop-back).
+const fn bus_mode_of(settings: &Settings) -> BusMode {
+    if settings.listen_only {
+        BusMode::ListenOnly
+    } else if settings.loop_back {
+        BusMode::LoopBack
+    } else {
+        BusMode::Normal
     }
 }
 
 #[cfg(all(
     target_os = "none",
-    any(feature = "teensy32", feature = "teensy35", feature = "teensy36")
+    any(feature = "teensy32", feature = "teensy35", feature = "teensy36"),
+    not(any(feature = "teensy40", feature = "teensy41"))
 ))]
 mod firmware {
     use twocan_core::Filter;
@@ -329,7 +658,7 @@ mod firmware {
             let target = self.target();
             // SAFETY: the token is unique (taken once) and consumed here, so this is
             // the only access to FlexCAN0, at its reference-manual base address.
-            let regs = unsafe { FlexCanRegs::new(target.instance.base()) };
+            let regs = unsafe { FlexCanRegs::new(regs::CAN0_BASE) };
             FlexCan::begin(regs, &mut system(), target, settings, primary, secondary)
                 .map_err(|e| (self, e))
         }
@@ -346,7 +675,7 @@ mod firmware {
         ) -> Result<FlexCan<FlexCanRegs>, (Self, BeginError)> {
             let target = self.target();
             // SAFETY: as for `Can0::begin`, for FlexCAN1.
-            let regs = unsafe { FlexCanRegs::new(target.instance.base()) };
+            let regs = unsafe { FlexCanRegs::new(regs::CAN1_BASE) };
             FlexCan::begin(regs, &mut system(), target, settings, primary, secondary)
                 .map_err(|e| (self, e))
         }

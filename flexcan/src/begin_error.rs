@@ -63,6 +63,11 @@ bitflags::bitflags! {
         /// reports it; `begin` refuses such a rate before any other check, with
         /// [`BeginError::Timing`].
         const BIT_RATE_OUT_OF_RANGE = 1 << 10;
+        /// Bit 11 (not in ACAN): the settings' CAN clock ([`crate::Settings::can_clock`])
+        /// is not one the target's chip gives its FlexCAN modules: the 16 MHz
+        /// oscillator on a Teensy 3.x, a CCM clock root (divider 1–64, at most 80 MHz,
+        /// IMXRT1060RM "CCM_CSCMR2") on a Teensy 4.x.
+        const CLOCK_NOT_ON_CHIP = 1 << 11;
     }
 }
 
@@ -195,7 +200,8 @@ mod tests {
         );
         assert_eq!(ConfigErrors::BIT_TIMING_FORBIDDEN.bits(), 0x200);
         assert_eq!(ConfigErrors::BIT_RATE_OUT_OF_RANGE.bits(), 0x400);
-        assert_eq!(ConfigErrors::ALL.count(), 11);
+        assert_eq!(ConfigErrors::CLOCK_NOT_ON_CHIP.bits(), 0x800);
+        assert_eq!(ConfigErrors::ALL.count(), 12);
         assert_eq!(BeginError::Config(e).flags(), e);
         assert_eq!(
             BeginError::from(twocan_core::Error::Timeout).flags(),

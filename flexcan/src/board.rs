@@ -13,10 +13,11 @@
 //! `crate::pin` gives each pin of the selected board's row a type (ACAN's alternate-pin
 //! choice checked at compile time), derived from [`Board::pins`].
 
+use crate::imxrt::pads::{self, ImxPins};
 use crate::instance::Instance;
 use crate::regs::pins::{self, CanPin};
 
-/// A Teensy 3.x board.
+/// A Teensy board with FlexCAN.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Board {
@@ -26,6 +27,10 @@ pub enum Board {
     Teensy35,
     /// Teensy 3.6 (MK66FX1M0).
     Teensy36,
+    /// Teensy 4.0 (i.MX RT1062): CAN1, CAN2, CAN3 (pins 30/31 on the underside).
+    Teensy40,
+    /// Teensy 4.1 (i.MX RT1062): CAN1, CAN2, CAN3.
+    Teensy41,
 }
 
 /// The microcontroller of a board.
@@ -38,6 +43,24 @@ pub enum Chip {
     Mk64fx512,
     /// Kinetis K66, MK66FX1M0VMD18 (180 MHz).
     Mk66fx1m0,
+    /// i.MX RT1062 (Cortex-M7, 600 MHz): three FlexCAN modules of 64 message buffers,
+    /// one interrupt line each, clocked by the CCM's CAN clock root.
+    Imxrt1062,
+}
+
+impl Chip {
+    /// Whether the chip is an i.MX RT (CCM, IOMUXC) rather than a Kinetis (SIM, PORT).
+    pub const fn is_imxrt(self) -> bool {
+        matches!(self, Chip::Imxrt1062)
+    }
+
+    /// Message buffers per FlexCAN module (Kinetis: 16; IMXRT1060RM: 64).
+    pub const fn message_buffers(self) -> usize {
+        match self {
+            Chip::Mk20dx256 | Chip::Mk64fx512 | Chip::Mk66fx1m0 => crate::regs::NUM_MB,
+            Chip::Imxrt1062 => crate::imxrt::MESSAGE_BUFFERS,
+        }
+    }
 }
 
 /// The Tx and Rx pins of one instance, default and alternate (ACAN §7 table 3).
@@ -55,19 +78,46 @@ pub struct InstancePins {
 
 impl Board {
     /// Every board.
-    pub const ALL: [Board; 3] = [Board::Teensy32, Board::Teensy35, Board::Teensy36];
+    pub const ALL: [Board; 5] = [
+        Board::Teensy32,
+        Board::Teensy35,
+        Board::Teensy36,
+        Board::Teensy40,
+        Board::Teensy41,
+    ];
+    /// The Teensy 3.x boards (Kinetis).
+    pub const KINETIS: [Board; 3] = [Board::Teensy32, Board::Teensy35, Board::Teensy36];
+    /// The Teensy 4.x boards (i.MX RT1062).
+    pub const IMXRT: [Board; 2] = [Board::Teensy40, Board::Teensy41];
 
     /// The board the cargo features select. Precedence when several are enabled:
-    /// `teensy36`, then `teensy35`, then `teensy32` (not an error).
-    #[cfg(feature = "teensy36")]
+    /// `teensy41`, `teensy40`, `teensy36`, `teensy35`, then `teensy32` (not an error).
+    #[cfg(feature = "teensy41")]
+    pub const DEFAULT: Board = Board::Teensy41;
+    /// The board the cargo features select.
+    #[cfg(all(feature = "teensy40", not(feature = "teensy41")))]
+    pub const DEFAULT: Board = Board::Teensy40;
+    /// The board the cargo features select.
+    #[cfg(all(
+        feature = "teensy36",
+        not(any(feature = "teensy40", feature = "teensy41"))
+    ))]
     pub const DEFAULT: Board = Board::Teensy36;
     /// The board the cargo features select.
-    #[cfg(all(feature = "teensy35", not(feature = "teensy36")))]
+    #[cfg(all(
+        feature = "teensy35",
+        not(any(feature = "teensy36", feature = "teensy40", feature = "teensy41"))
+    ))]
     pub const DEFAULT: Board = Board::Teensy35;
     /// The board the cargo features select.
     #[cfg(all(
         feature = "teensy32",
-        not(any(feature = "teensy35", feature = "teensy36"))
+        not(any(
+            feature = "teensy35",
+            feature = "teensy36",
+            feature = "teensy40",
+            feature = "teensy41"
+        ))
     ))]
     pub const DEFAULT: Board = Board::Teensy32;
 
@@ -77,19 +127,44 @@ impl Board {
             Board::Teensy32 => Chip::Mk20dx256,
             Board::Teensy35 => Chip::Mk64fx512,
             Board::Teensy36 => Chip::Mk66fx1m0,
+            Board::Teensy40 | Board::Teensy41 => Chip::Imxrt1062,
         }
     }
 
-    /// Whether the board has `instance` (ACAN §6 table 2: `can1` on the Teensy 3.6 only).
+    /// Whether the board has `instance` (ACAN §6 table 2: `can1` on the Teensy 3.6 only
+    /// among the 3.x; the Teensy 4.x have CAN1, CAN2 and CAN3, no `Can0`).
     pub const fn has(self, instance: Instance) -> bool {
-        match instance {
-            Instance::Can0 => true,
-            Instance::Can1 => matches!(self, Board::Teensy36),
+        match (self, instance) {
+            (Board::Teensy40 | Board::Teensy41, Instance::Can0) => false,
+            (Board::Teensy40 | Board::Teensy41, _) => true,
+            (_, Instance::Can0) => true,
+            (Board::Teensy36, Instance::Can1) => true,
+            _ => false,
         }
     }
 
-    /// The pins of `instance` on this board (ACAN §7 table 3); `None` if the board
-    /// does not have it.
+    /// The pins of `instance` on a Teensy 4.x ([`crate::imxrt::pads`]); `None` on the
+    /// other boards and for `Can0`.
+    pub const fn imx_pins(self, instance: Instance) -> Option<ImxPins> {
+        match (self, instance) {
+            (Board::Teensy40 | Board::Teensy41, Instance::Can1) => Some(ImxPins {
+                tx: pads::CAN1_TX,
+                rx: pads::CAN1_RX,
+            }),
+            (Board::Teensy40 | Board::Teensy41, Instance::Can2) => Some(ImxPins {
+                tx: pads::CAN2_TX,
+                rx: pads::CAN2_RX,
+            }),
+            (Board::Teensy40 | Board::Teensy41, Instance::Can3) => Some(ImxPins {
+                tx: pads::CAN3_TX,
+                rx: pads::CAN3_RX,
+            }),
+            _ => None,
+        }
+    }
+
+    /// The pins of `instance` on a Teensy 3.x (ACAN §7 table 3); `None` if the board
+    /// does not have it, and on the Teensy 4.x (see [`Board::imx_pins`]).
     pub const fn pins(self, instance: Instance) -> Option<InstancePins> {
         match (self, instance) {
             (Board::Teensy32, Instance::Can0) => Some(InstancePins {
@@ -110,7 +185,7 @@ impl Board {
                 alternate_tx: None,
                 alternate_rx: None,
             }),
-            (Board::Teensy32 | Board::Teensy35, Instance::Can1) => None,
+            _ => None,
         }
     }
 }
@@ -148,8 +223,29 @@ mod tests {
         );
         assert!(Board::Teensy32.pins(Instance::Can1).is_none());
         assert!(Board::Teensy35.pins(Instance::Can1).is_none());
-        for b in Board::ALL {
+        for b in Board::KINETIS {
             assert_eq!(b.has(Instance::Can1), b.pins(Instance::Can1).is_some());
         }
+        for b in Board::ALL {
+            for i in Instance::ALL {
+                let pins = b.pins(i).is_some() || b.imx_pins(i).is_some();
+                assert_eq!(b.has(i), pins, "{b:?} {i:?}");
+            }
+        }
+        let t41 = |i| {
+            let p = Board::Teensy41.imx_pins(i).unwrap();
+            (p.tx.teensy_pin, p.rx.teensy_pin)
+        };
+        assert_eq!(
+            [
+                t41(Instance::Can1),
+                t41(Instance::Can2),
+                t41(Instance::Can3)
+            ],
+            [(22, 23), (1, 0), (31, 30)]
+        );
+        assert_eq!(Board::Teensy40.chip(), Chip::Imxrt1062);
+        assert_eq!(Chip::Imxrt1062.message_buffers(), 64);
+        assert_eq!(Chip::Mk66fx1m0.message_buffers(), 16);
     }
 }

@@ -146,18 +146,36 @@ impl<R: Registers> FlexCan<R> {
     /// rejected" for an empty list): Freeze mode only (Kinetis RM, MCR: IDAM is
     /// writable in Freeze mode only).
     pub(crate) fn write_filters(regs: &R, table: &FilterTable) {
-        let idam = if table.rejects_all() {
+        Self::write_table(
+            regs,
+            table.rejects_all(),
+            table.elements(),
+            table.individual_masks(),
+            table.global_mask(),
+        );
+    }
+
+    /// [`FlexCan::write_filters`] from the table's parts (a [`FilterTable`] or a
+    /// [`crate::installed::PlannedTable`]).
+    pub(crate) fn write_table(
+        regs: &R,
+        reject_all: bool,
+        elements: &[u32],
+        individual_masks: &[u32],
+        global_mask: u32,
+    ) {
+        let idam = if reject_all {
             regs::mcr::IDAM_FORMAT_D
         } else {
             regs::mcr::IDAM_FORMAT_A
         };
         regs.modify32(regs::MCR, |v| regs::mcr::IDAM.replace(v, idam));
-        for (i, e) in table.elements().iter().enumerate() {
+        for (i, e) in elements.iter().enumerate() {
             regs.write32(regs::rx_fifo_filter(i), *e);
         }
-        for (i, m) in table.individual_masks().iter().enumerate() {
+        for (i, m) in individual_masks.iter().enumerate() {
             regs.write32(regs::rximr(i), *m);
         }
-        regs.write32(regs::RXFGMASK, table.global_mask());
+        regs.write32(regs::RXFGMASK, global_mask);
     }
 }

@@ -17,12 +17,19 @@
 //!    ([`crate::system::SystemPlan::release`]).
 //!
 //! `end` takes the un-split [`FlexCan`]: no interrupt handler can reach a controller
-//! the caller holds by value. A controller given to the one-struct
-//! [`twocan_core::Driver`] comes back with [`twocan_core::Driver::release`] and
-//! [`crate::FlexCanHw::into_controller`]. One given to a `static`
-//! [`twocan_core::split::State`] (the split halves and interrupt handlers, or
-//! `rt::IrqState` with feature `rt`) stays there for the life of the program: that
-//! state has no way back, so such a controller cannot be ended.
+//! the caller holds by value. The way back to it (issue 22 item 11):
+//!
+//! - from the one-struct [`twocan_core::Driver`]: [`twocan_core::Driver::release`],
+//!   then [`crate::FlexCanHw::into_controller`];
+//! - from the split driver under the library's interrupts (feature `rt`):
+//!   `rt::IrqState::stop` masks the lines, takes the handlers back and returns the
+//!   controller, then [`crate::FlexCanHw::into_controller`] and `Can0::end`;
+//! - from a `static` [`twocan_core::split::State`] whose handlers the application runs
+//!   itself: mask the lines, take the handlers back (`IrqCell::take`), and give them
+//!   with the halves to [`twocan_core::split::State::unsplit`].
+//!
+//! The state is empty again afterwards: the same `static` takes the controller begun
+//! anew.
 
 use twocan_core::{Error, Registers};
 
@@ -76,7 +83,8 @@ impl<R: Registers> FlexCan<R> {
 
 #[cfg(all(
     target_os = "none",
-    any(feature = "teensy32", feature = "teensy35", feature = "teensy36")
+    any(feature = "teensy32", feature = "teensy35", feature = "teensy36"),
+    not(any(feature = "teensy40", feature = "teensy41"))
 ))]
 mod firmware {
     use super::*;

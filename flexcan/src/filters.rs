@@ -171,6 +171,20 @@ impl FilterTable {
         primary: &[Filter],
         secondary: &[Filter],
     ) -> Result<Self, ConfigErrors> {
+        let errors = Self::check(configuration, primary, secondary);
+        if !errors.is_empty() {
+            return Err(errors);
+        }
+        Ok(Self::build(configuration, primary, secondary))
+    }
+
+    /// The errors [`FilterTable::compile`] reports for these lists (none: it compiles),
+    /// without building the table.
+    pub(crate) fn check(
+        configuration: Configuration,
+        primary: &[Filter],
+        secondary: &[Filter],
+    ) -> ConfigErrors {
         let mut errors = ConfigErrors::NONE;
         if primary.len() > configuration.primary_filter_capacity() {
             errors |= ConfigErrors::TOO_MANY_PRIMARY_FILTERS;
@@ -184,14 +198,29 @@ impl FilterTable {
         if !secondary.iter().all(secondary_conforms) {
             errors |= ConfigErrors::SECONDARY_FILTER_NOT_CONFORM;
         }
-        if !errors.is_empty() {
-            return Err(errors);
-        }
-        Ok(Self::build(configuration, primary, secondary))
+        errors
     }
 
-    /// Builds a table from lists already checked.
-    fn build(configuration: Configuration, primary: &[Filter], secondary: &[Filter]) -> Self {
+    /// Builds a table from lists already checked ([`FilterTable::check`]).
+    pub(crate) fn build(
+        configuration: Configuration,
+        primary: &[Filter],
+        secondary: &[Filter],
+    ) -> Self {
+        let mut t = Self::zeroed();
+        t.fill(configuration, primary, secondary);
+        t
+    }
+
+    /// [`FilterTable::build`] in place, field by field: no table-sized value on the
+    /// stack (a table in a `static`, [`TableSlot`]).
+    pub(crate) fn fill(
+        &mut self,
+        configuration: Configuration,
+        primary: &[Filter],
+        secondary: &[Filter],
+    ) {
+        let t = self;
         let p = primary.len();
         let s = secondary.len();
         let capacity_p = configuration.primary_filter_capacity();
@@ -217,19 +246,17 @@ impl FilterTable {
             }
         };
 
-        let mut t = FilterTable {
-            configuration,
-            elements: [0; MAX_TABLE_ELEMENTS],
-            individual_masks: [FULL_MASK; MAX_PRIMARY_FILTERS],
-            global_mask,
-            hits: [Hit::Filter(0); MAX_TABLE_ELEMENTS],
-            secondary: [Filter::pass_all(); MAX_SECONDARY_FILTERS],
-            primary_count: p as u8,
-            secondary_count: s as u8,
-            keys: KeyTable::new(),
-            extra: 0,
-            reject_all: primary.is_empty() && secondary.is_empty(),
-        };
+        t.configuration = configuration;
+        t.elements = [0; MAX_TABLE_ELEMENTS];
+        t.individual_masks = [FULL_MASK; MAX_PRIMARY_FILTERS];
+        t.global_mask = global_mask;
+        t.hits = [Hit::Filter(0); MAX_TABLE_ELEMENTS];
+        t.secondary = [Filter::pass_all(); MAX_SECONDARY_FILTERS];
+        t.primary_count = p as u8;
+        t.secondary_count = s as u8;
+        t.keys.clear();
+        t.extra = 0;
+        t.reject_all = primary.is_empty() && secondary.is_empty();
         t.secondary[..s].copy_from_slice(secondary);
 
         for i in 0..capacity_p {
@@ -257,7 +284,54 @@ impl FilterTable {
             t.elements[capacity_p + j] = element;
             t.hits[capacity_p + j] = hit;
         }
-        t
+    }
+}
+
+/// Room for one [`FilterTable`] in a `static`, handed out once as `&'static mut`
+/// ([`TableSlot::take`]): `begin` compiles the lists straight into it
+/// ([`crate::FlexCan::begin_in`]) and the split controller keeps the reference
+/// ([`crate::options::FullInSlot`]), so that no table-sized value moves through the
+/// configuration.
+///
+/// ```
+/// use twocan_flexcan::filters::TableSlot;
+/// static TABLE: TableSlot = TableSlot::new();
+/// assert!(TABLE.take().is_some());
+/// assert!(TABLE.take().is_none()); // once
+/// ```
+pub struct TableSlot {
+    table: core::cell::UnsafeCell<FilterTable>,
+    taken: core::sync::atomic::AtomicBool,
+}
+
+// SAFETY: the table is reached only through the one `&'static mut` that `take` hands
+// out (the atomic flag makes it once), so no two contexts share it through the slot.
+unsafe impl Sync for TableSlot {}
+
+impl TableSlot {
+    /// An empty slot (all zeros: it lives in `.bss`).
+    pub const fn new() -> Self {
+        TableSlot {
+            table: core::cell::UnsafeCell::new(FilterTable::zeroed()),
+            taken: core::sync::atomic::AtomicBool::new(false),
+        }
+    }
+
+    /// The table, the first time only.
+    // The one `&mut` comes from the cell, handed out once (the flag).
+    #[allow(clippy::mut_from_ref)]
+    pub fn take(&'static self) -> Option<&'static mut FilterTable> {
+        if self.taken.swap(true, core::sync::atomic::Ordering::AcqRel) {
+            return None;
+        }
+        // SAFETY: the flag was clear, so this is the only reference ever handed out.
+        Some(unsafe { &mut *self.table.get() })
+    }
+}
+
+impl Default for TableSlot {
+    fn default() -> Self {
+        Self::new()
     }
 }
 

@@ -11,16 +11,25 @@
 //! board as a [`Target`].
 
 use crate::board::{Board, Chip};
+use crate::imxrt;
 use crate::regs;
 
-/// A FlexCAN module of the Kinetis parts (ACAN §6 table 2).
+/// A FlexCAN module, by the name its chip's reference manual gives it: FlexCAN0 and
+/// FlexCAN1 on the Kinetis parts (ACAN §6 table 2), CAN1, CAN2 and CAN3 on the i.MX
+/// RT1062 (IMXRT1060RM, "System Memory Map"). `Can1` names a module of either family;
+/// its base, gate and interrupts depend on the chip ([`Instance::base`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Instance {
     /// FlexCAN0 (`ACAN::can0`): every Teensy 3.x.
     Can0,
-    /// FlexCAN1 (`ACAN::can1`): Teensy 3.6 only.
+    /// FlexCAN1 (`ACAN::can1`): Teensy 3.6; CAN1 of the RT1062 (Teensy 4.x).
     Can1,
+    /// CAN2 of the RT1062 (Teensy 4.x).
+    Can2,
+    /// CAN3 of the RT1062 (Teensy 4.x), the CAN FD capable module (driven in classic
+    /// CAN).
+    Can3,
 }
 
 /// The interrupt numbers (NVIC IRQ numbers, vector number − 16) of one instance,
@@ -51,6 +60,26 @@ pub struct Irqs {
 }
 
 impl Irqs {
+    /// The RT1062's one line per module: every source on `line`.
+    const fn single(line: u16) -> Self {
+        Irqs {
+            message: line,
+            bus_off: line,
+            error: line,
+            tx_warning: line,
+            rx_warning: line,
+            wake_up: line,
+        }
+    }
+
+    /// Whether every source shares one line (the RT1062).
+    pub const fn is_single_line(&self) -> bool {
+        self.message == self.bus_off
+            && self.message == self.error
+            && self.message == self.tx_warning
+            && self.message == self.rx_warning
+    }
+
     const fn from(first: u16) -> Self {
         Irqs {
             message: first,
@@ -64,30 +93,55 @@ impl Irqs {
 }
 
 impl Instance {
-    /// Base address of the module's registers (K20/K64/K66 memory maps).
-    pub const fn base(self) -> usize {
-        match self {
-            Instance::Can0 => regs::CAN0_BASE,
-            Instance::Can1 => regs::CAN1_BASE,
+    /// Every instance name.
+    pub const ALL: [Instance; 4] = [
+        Instance::Can0,
+        Instance::Can1,
+        Instance::Can2,
+        Instance::Can3,
+    ];
+
+    /// Base address of the module's registers on `chip` (K20/K64/K66 memory maps,
+    /// IMXRT1060RM "System Memory Map"); `None` if the chip lacks it.
+    pub const fn base(self, chip: Chip) -> Option<usize> {
+        match (self, chip.is_imxrt()) {
+            (Instance::Can0, false) => Some(regs::CAN0_BASE),
+            (Instance::Can1, false) => Some(regs::CAN1_BASE),
+            (Instance::Can1, true) => Some(imxrt::CAN1_BASE),
+            (Instance::Can2, true) => Some(imxrt::CAN2_BASE),
+            (Instance::Can3, true) => Some(imxrt::CAN3_BASE),
+            _ => None,
         }
     }
 
-    /// The SIM clock-gate register and bit of the module (SIM_SCGC6.FLEXCAN0,
-    /// SIM_SCGC3.FLEXCAN1).
-    pub const fn clock_gate(self) -> (usize, u32) {
-        match self {
-            Instance::Can0 => (regs::sim::SIM_SCGC6, regs::sim::SCGC6_FLEXCAN0),
-            Instance::Can1 => (regs::sim::SIM_SCGC3, regs::sim::SCGC3_FLEXCAN1),
+    /// The clock-gate register and bits of the module on `chip`: SIM_SCGC6.FLEXCAN0,
+    /// SIM_SCGC3.FLEXCAN1 (Kinetis "SIM"); on the RT1062 both 2-bit gates of the
+    /// module, its clock and its serial clock (`CCM_CCGR0[CG7, CG8]` for CAN1,
+    /// `CCGR0[CG9, CG10]` for CAN2, `CCGR7[CG3, CG4]` for CAN3, IMXRT1060RM "CCM Clock
+    /// Gating Register"). `None` if the chip lacks it.
+    pub const fn clock_gate(self, chip: Chip) -> Option<(usize, u32)> {
+        use crate::imxrt::ccm::{cg_on, CCM_CCGR0, CCM_CCGR7};
+        match (self, chip.is_imxrt()) {
+            (Instance::Can0, false) => Some((regs::sim::SIM_SCGC6, regs::sim::SCGC6_FLEXCAN0)),
+            (Instance::Can1, false) => Some((regs::sim::SIM_SCGC3, regs::sim::SCGC3_FLEXCAN1)),
+            (Instance::Can1, true) => Some((CCM_CCGR0, cg_on(7) | cg_on(8))),
+            (Instance::Can2, true) => Some((CCM_CCGR0, cg_on(9) | cg_on(10))),
+            (Instance::Can3, true) => Some((CCM_CCGR7, cg_on(3) | cg_on(4))),
+            _ => None,
         }
     }
 
-    /// The interrupt numbers of the module on `chip` (`None` if the chip lacks it).
+    /// The interrupt numbers of the module on `chip` (`None` if the chip lacks it). On
+    /// the RT1062 every field is the module's one line ([`Irqs::is_single_line`]).
     pub const fn irqs(self, chip: Chip) -> Option<Irqs> {
         match (self, chip) {
             (Instance::Can0, Chip::Mk20dx256) => Some(Irqs::from(29)),
             (Instance::Can0, Chip::Mk64fx512 | Chip::Mk66fx1m0) => Some(Irqs::from(75)),
             (Instance::Can1, Chip::Mk66fx1m0) => Some(Irqs::from(94)),
-            (Instance::Can1, Chip::Mk20dx256 | Chip::Mk64fx512) => None,
+            (Instance::Can1, Chip::Imxrt1062) => Some(Irqs::single(imxrt::CAN1_IRQ)),
+            (Instance::Can2, Chip::Imxrt1062) => Some(Irqs::single(imxrt::CAN2_IRQ)),
+            (Instance::Can3, Chip::Imxrt1062) => Some(Irqs::single(imxrt::CAN3_IRQ)),
+            _ => None,
         }
     }
 }
@@ -116,83 +170,159 @@ impl Target {
             None
         }
     }
+
+    /// The module's register base (`None` if the board lacks it).
+    pub const fn base(self) -> Option<usize> {
+        if self.board.has(self.instance) {
+            self.instance.base(self.board.chip())
+        } else {
+            None
+        }
+    }
+
+    /// The module's clock gate (`None` if the board lacks it).
+    pub const fn clock_gate(self) -> Option<(usize, u32)> {
+        if self.board.has(self.instance) {
+            self.instance.clock_gate(self.board.chip())
+        } else {
+            None
+        }
+    }
 }
 
-#[cfg(any(feature = "teensy32", feature = "teensy35", feature = "teensy36"))]
+#[cfg(feature = "model")]
+impl Target {
+    /// The behavioural model's chip for this module (feature `model`): the board's
+    /// chip, and on the RT1062 the instance (CAN3 differs from CAN1/CAN2). `Can0` on a
+    /// Teensy 4.x, which has none, gives CAN1's.
+    pub const fn model_chip(self) -> crate::model::Chip {
+        use crate::model::{Chip as M, Rt1062Can};
+        match (self.board.chip(), self.instance) {
+            (Chip::Mk20dx256, _) => M::Mk20dx256,
+            (Chip::Mk64fx512, _) => M::Mk64fx512,
+            (Chip::Mk66fx1m0, _) => M::Mk66fx1m0,
+            (Chip::Imxrt1062, Instance::Can2) => M::Imxrt1062(Rt1062Can::Can2),
+            (Chip::Imxrt1062, Instance::Can3) => M::Imxrt1062(Rt1062Can::Can3),
+            (Chip::Imxrt1062, _) => M::Imxrt1062(Rt1062Can::Can1),
+        }
+    }
+}
+
+#[cfg(any(
+    feature = "teensy32",
+    feature = "teensy35",
+    feature = "teensy36",
+    feature = "teensy40",
+    feature = "teensy41"
+))]
 pub use tokens::*;
 
-#[cfg(any(feature = "teensy32", feature = "teensy35", feature = "teensy36"))]
+#[cfg(any(
+    feature = "teensy32",
+    feature = "teensy35",
+    feature = "teensy36",
+    feature = "teensy40",
+    feature = "teensy41"
+))]
 mod tokens {
     use core::sync::atomic::{AtomicBool, Ordering};
 
     use super::{Instance, Target};
     use crate::board::Board;
 
-    static CAN0_TAKEN: AtomicBool = AtomicBool::new(false);
-    #[cfg(feature = "teensy36")]
-    static CAN1_TAKEN: AtomicBool = AtomicBool::new(false);
+    /// One ownership token per module: `take` gives it the first time only (an atomic
+    /// flag records the take), `returned` makes it again for `end`.
+    macro_rules! token {
+        ($(#[$m:meta])* $name:ident, $flag:ident, $instance:expr) => {
+            static $flag: AtomicBool = AtomicBool::new(false);
 
-    /// Ownership of FlexCAN0 on [`Board::DEFAULT`] (ACAN `ACAN::can0`, §6).
-    #[derive(Debug)]
-    pub struct Can0 {
-        _private: (),
+            $(#[$m])*
+            #[derive(Debug)]
+            pub struct $name {
+                _private: (),
+            }
+
+            impl $name {
+                /// The token, the first time only.
+                pub fn take() -> Option<Self> {
+                    (!$flag.swap(true, Ordering::AcqRel)).then_some($name { _private: () })
+                }
+
+                /// The module this token owns.
+                pub const fn target(&self) -> Target {
+                    Target::new(Board::DEFAULT, $instance)
+                }
+
+                /// The token again, for `end`: the controller it comes from was made
+                /// from the one taken token (the flag stays set, so `take` still gives
+                /// `None`).
+                #[allow(dead_code)] // used by `end` on the target only
+                pub(crate) const fn returned() -> Self {
+                    $name { _private: () }
+                }
+            }
+        };
     }
 
-    impl Can0 {
-        /// The token, the first time only.
-        pub fn take() -> Option<Self> {
-            (!CAN0_TAKEN.swap(true, Ordering::AcqRel)).then_some(Can0 { _private: () })
-        }
+    #[cfg(all(
+        any(feature = "teensy32", feature = "teensy35", feature = "teensy36"),
+        not(any(feature = "teensy40", feature = "teensy41"))
+    ))]
+    token!(
+        /// Ownership of FlexCAN0 on [`Board::DEFAULT`] (ACAN `ACAN::can0`, §6).
+        Can0,
+        CAN0_TAKEN,
+        Instance::Can0
+    );
 
-        /// The module this token owns.
-        pub const fn target(&self) -> Target {
-            Target::new(Board::DEFAULT, Instance::Can0)
-        }
+    #[cfg(any(feature = "teensy36", feature = "teensy40", feature = "teensy41"))]
+    token!(
+        /// Ownership of FlexCAN1 on the Teensy 3.6 (ACAN `ACAN::can1`, §6), or of CAN1
+        /// on a Teensy 4.x (pins 22/23).
+        Can1,
+        CAN1_TAKEN,
+        Instance::Can1
+    );
 
-        /// The token again, for `end`: the controller it comes from was made from the
-        /// one taken token (the flag stays set, so `take` still gives `None`).
-        #[allow(dead_code)] // used by `Can0::end` on the target only
-        pub(crate) const fn returned() -> Self {
-            Can0 { _private: () }
-        }
-    }
+    #[cfg(any(feature = "teensy40", feature = "teensy41"))]
+    token!(
+        /// Ownership of CAN2 on a Teensy 4.x (pins 1/0).
+        Can2,
+        CAN2_TAKEN,
+        Instance::Can2
+    );
 
-    /// Ownership of FlexCAN1 on the Teensy 3.6 (ACAN `ACAN::can1`, §6).
-    #[cfg(feature = "teensy36")]
-    #[derive(Debug)]
-    pub struct Can1 {
-        _private: (),
-    }
-
-    #[cfg(feature = "teensy36")]
-    impl Can1 {
-        /// The token, the first time only.
-        pub fn take() -> Option<Self> {
-            (!CAN1_TAKEN.swap(true, Ordering::AcqRel)).then_some(Can1 { _private: () })
-        }
-
-        /// The module this token owns.
-        pub const fn target(&self) -> Target {
-            Target::new(Board::DEFAULT, Instance::Can1)
-        }
-
-        /// The token again, for `end` (see `Can0::returned`).
-        #[allow(dead_code)] // used by `Can1::end` on the target only
-        pub(crate) const fn returned() -> Self {
-            Can1 { _private: () }
-        }
-    }
+    #[cfg(any(feature = "teensy40", feature = "teensy41"))]
+    token!(
+        /// Ownership of CAN3 on a Teensy 4.x (pins 31/30), driven in classic CAN.
+        Can3,
+        CAN3_TAKEN,
+        Instance::Can3
+    );
 
     #[cfg(test)]
     mod tests {
+        #[allow(unused_imports)]
         use super::*;
 
+        #[cfg(not(any(feature = "teensy40", feature = "teensy41")))]
         #[test]
         fn taken_once() {
             let first = Can0::take();
             assert!(first.is_some());
             assert!(Can0::take().is_none());
             assert_eq!(first.unwrap().target().instance, Instance::Can0);
+        }
+
+        #[cfg(any(feature = "teensy40", feature = "teensy41"))]
+        #[test]
+        fn taken_once() {
+            let first = Can3::take();
+            assert!(first.is_some());
+            assert!(Can3::take().is_none());
+            let target = first.unwrap().target();
+            assert_eq!(target.instance, Instance::Can3);
+            assert_eq!(target.base(), Some(crate::imxrt::CAN3_BASE));
         }
     }
 }
@@ -222,5 +352,26 @@ mod tests {
         assert!(Target::new(Board::Teensy35, Instance::Can1)
             .irqs()
             .is_none());
+        let t41 = |i| Target::new(Board::Teensy41, i);
+        assert_eq!(t41(Instance::Can1).irqs().unwrap().message, 36);
+        assert_eq!(t41(Instance::Can2).irqs().unwrap().error, 37);
+        let can3 = t41(Instance::Can3).irqs().unwrap();
+        assert!(can3.is_single_line() && can3.bus_off == 154);
+        assert!(!can1.is_single_line());
+        assert!(t41(Instance::Can0).irqs().is_none());
+        assert_eq!(t41(Instance::Can1).base(), Some(0x401D_0000));
+        assert_eq!(t41(Instance::Can3).base(), Some(0x401D_8000));
+        assert_eq!(
+            Target::new(Board::Teensy36, Instance::Can1).base(),
+            Some(0x400A_4000)
+        );
+        assert_eq!(
+            t41(Instance::Can2).clock_gate(),
+            Some((0x400F_C068, 0xF << 18))
+        );
+        assert_eq!(
+            t41(Instance::Can3).clock_gate(),
+            Some((0x400F_C084, 0xF << 6))
+        );
     }
 }

@@ -5,6 +5,27 @@
 //! interrupt handlers of [`twocan_core::split`] in firmware, or the one-struct
 //! [`twocan_core::Driver`] for polling code.
 //!
+//! An ACAN sketch's `begin` is one call here too (features `rt` and a board feature,
+//! target `thumbv7em-none-eabihf`; module `acan`): it takes the module, begins with
+//! ACAN's defaults on the board's default pins, puts the driver in the library's
+//! `static` state, wires the interrupts and returns the transmit and receive halves.
+//! The five steps it runs stay available (see below and `rt`).
+//!
+#![cfg_attr(
+    all(
+        feature = "rt",
+        any(feature = "teensy32", feature = "teensy35", feature = "teensy36")
+    ),
+    doc = concat!("```no_run\n", include_str!("../doc/one_call.rs"), "```")
+)]
+#![cfg_attr(
+    not(all(
+        feature = "rt",
+        any(feature = "teensy32", feature = "teensy35", feature = "teensy36")
+    )),
+    doc = concat!("```ignore\n", include_str!("../doc/one_call.rs"), "```")
+)]
+//!
 //! ACAN §4's LoopBackDemo, on the host over the behavioural model of the module
 //! (feature `model`) and twocan-sim's simulated bus:
 //!
@@ -45,9 +66,16 @@
 //!
 //! | features enabled | `Board::DEFAULT` | `Can1` |
 //! |---|---|---|
-//! | `teensy36` (with or without the others) | `Teensy36` | yes |
+//! | `teensy41` (with or without the others) | `Teensy41` | yes (and `Can2`, `Can3`; no `Can0`) |
+//! | `teensy40`, not `teensy41` | `Teensy40` | yes (and `Can2`, `Can3`; no `Can0`) |
+//! | `teensy36`, no Teensy 4 feature | `Teensy36` | yes |
 //! | `teensy35`, maybe `teensy32`, not `teensy36` | `Teensy35` | no |
 //! | `teensy32` alone | `Teensy32` | no |
+//!
+//! On a Teensy 4.x (i.MX RT1062, [`imxrt`]) the tokens are `Can1`, `Can2`, `Can3` (CAN1 on
+//! pins 22/23, CAN2 on 1/0, CAN3 on 31/30), the settings name the CCM clock root
+//! (`Settings::with_clock(rate, CanClock::IMXRT_24MHZ)`), and with `rt` the entry points
+//! are `CAN1`, `CAN2`, `CAN3` (`rt_imxrt`), one line per module.
 //!
 //! So `teensy32` + `teensy36` builds for a Teensy 3.6: firmware for a Teensy 3.2 linked
 //! that way would drive the wrong pins. Check `Board::DEFAULT` (or `cargo tree -e
@@ -62,8 +90,9 @@
 //! | §4 `ACANSettings`, §16, table 7 | [`Settings`] (bit timing from [`twocan_core::timing`]) |
 //! | §6 `ACAN::can0`, `ACAN::can1` | `Can0::take()`, `Can1::take()` ([`instance`]); [`Target`] on the host |
 //! | §7 alternate pins, §16.7.5–6 | [`Settings`] fields, [`Board::pins`], [`system`]; typed: `pin` (board features) |
+//! | `ACAN::can0.begin (settings)` as one call | `acan::can0` / `acan::can0_with` (features `rt` + board) |
 //! | §15 `begin` wiring the interrupt, §16.7.4 `mMessageIRQPriority` | `rt::IrqState::start` (feature `rt`) |
-//! | `end` | [`FlexCan::end`], `Can0::end` / `Can1::end` ([`end`]) |
+//! | `end` | `acan::end_can0`; [`FlexCan::end`], `Can0::end` / `Can1::end` ([`end`]); `rt::IrqState::stop` |
 //! | §8, §9 `tryToSend`, transmit buffer | [`twocan_core::Driver::try_send`], `tx_stats` ([`controller`] explains the mailboxes) |
 //! | §10 `receive`, receive buffer | [`twocan_core::Driver::receive`], `rx_stats` |
 //! | §11 `mConfiguration` | [`Configuration`] |
@@ -83,17 +112,36 @@
 #![cfg_attr(docsrs, feature(doc_cfg))]
 #![deny(missing_docs)]
 
+// The one call per module (ACAN's `begin`/`end`): take, begin, state, interrupts.
+// Teensy 3.x only for now (its `Can0`); a Teensy 4 board feature turns it off.
+#[cfg(all(
+    feature = "rt",
+    any(feature = "teensy32", feature = "teensy35", feature = "teensy36"),
+    not(any(feature = "teensy40", feature = "teensy41"))
+))]
+#[cfg_attr(docsrs, doc(cfg(feature = "rt")))]
+pub mod acan;
 pub mod begin;
 pub mod begin_error;
 pub mod board;
+pub mod can_clock;
 pub mod configuration;
 pub mod controller;
 pub mod end;
 pub mod filters;
 mod handshake;
+pub mod imxrt;
+pub mod installed;
 pub mod instance;
 mod message_buffer;
-#[cfg(any(feature = "teensy32", feature = "teensy35", feature = "teensy36"))]
+pub mod options;
+#[cfg(all(
+    any(feature = "teensy32", feature = "teensy35", feature = "teensy36"),
+    not(any(feature = "teensy40", feature = "teensy41"))
+))]
+pub mod pin;
+#[cfg(any(feature = "teensy40", feature = "teensy41"))]
+#[path = "imxrt/pin.rs"]
 pub mod pin;
 pub mod planner;
 pub mod settings;
@@ -107,6 +155,13 @@ pub mod regs;
 #[cfg_attr(docsrs, doc(cfg(feature = "rt")))]
 pub mod rt;
 
+#[cfg(all(feature = "rt", any(feature = "teensy40", feature = "teensy41")))]
+#[cfg_attr(
+    docsrs,
+    doc(cfg(all(feature = "rt", any(feature = "teensy40", feature = "teensy41"))))
+)]
+pub mod rt_imxrt;
+
 #[cfg(feature = "model")]
 pub mod model;
 
@@ -115,20 +170,27 @@ mod idle_clock;
 #[cfg(feature = "model")]
 pub use idle_clock::IdleClocked;
 
-pub use begin::check;
+pub use begin::{check, BeginPlan};
 pub use begin_error::{BeginError, ConfigErrors};
 pub use board::{Board, Chip, InstancePins};
+pub use can_clock::CanClock;
 pub use configuration::Configuration;
 pub use controller::FlexCan;
 pub use filters::{FilterTable, SizedTable, UNKNOWN_FILTER};
-#[cfg(any(feature = "teensy32", feature = "teensy35", feature = "teensy36"))]
+#[cfg(all(
+    any(feature = "teensy32", feature = "teensy35", feature = "teensy36"),
+    not(any(feature = "teensy40", feature = "teensy41"))
+))]
 pub use instance::Can0;
-#[cfg(feature = "teensy36")]
+#[cfg(any(feature = "teensy36", feature = "teensy40", feature = "teensy41"))]
 pub use instance::Can1;
+#[cfg(any(feature = "teensy40", feature = "teensy41"))]
+pub use instance::{Can2, Can3};
 pub use instance::{Instance, Irqs, Target};
 pub use settings::{Settings, CAN_CLOCK_HZ, RECEIVE_BUFFER_SIZE, TRANSMIT_BUFFER_SIZE};
 pub use split::{FlexCanHw, InstalledFilters};
 pub use system::HostSystem;
+pub use system::{PortPlan, SystemPlan};
 
 /// The driver with ACAN's default buffer sizes: a receive ring of 32 frames and a
 /// transmit ring of 16 (ACAN table 7, §8.2, §10.1). Choose other sizes with

@@ -79,6 +79,69 @@ pub const BLOCK_END: usize = 0x8C0;
 /// Volatile access to one FlexCAN module's registers (offsets `0..BLOCK_END`).
 pub type FlexCanRegs = twocan_core::Mmio<BLOCK_END>;
 
+/// Volatile access to the FlexCAN module whose registers start at `BASE`, an address
+/// known at compile time (offsets `0..BLOCK_END`, as [`FlexCanRegs`]): the value is
+/// empty and every access is one load or store at `BASE + offset`, without reading a
+/// base address first. The window check of [`twocan_core::Mmio`] stays: an offset
+/// outside the module's registers reads 0 and writes nothing (a `debug_assert` in
+/// debug builds).
+///
+/// ```
+/// use twocan_flexcan::regs::{Can0At, FlexCanAt, CAN0_BASE};
+/// assert_eq!(core::mem::size_of::<Can0At>(), 0);
+/// let _ = CAN0_BASE;
+/// ```
+#[derive(Debug)]
+pub struct FlexCanAt<const BASE: usize> {
+    _owner: (),
+}
+
+/// FlexCAN0 at its compile-time address ([`CAN0_BASE`]).
+pub type Can0At = FlexCanAt<CAN0_BASE>;
+/// FlexCAN1 at its compile-time address ([`CAN1_BASE`], K66 only).
+pub type Can1At = FlexCanAt<CAN1_BASE>;
+
+impl<const BASE: usize> FlexCanAt<BASE> {
+    /// Access to the module at `BASE`.
+    ///
+    /// # Safety
+    /// `BASE .. BASE + BLOCK_END` must be the registers of one FlexCAN module (or memory
+    /// standing in for them), and nothing else may access them while this value lives
+    /// (as [`twocan_core::Mmio::new`]).
+    pub const unsafe fn new() -> Self {
+        FlexCanAt { _owner: () }
+    }
+}
+
+impl<const BASE: usize> twocan_core::Registers for FlexCanAt<BASE> {
+    #[inline(always)]
+    fn read32(&self, offset: usize) -> u32 {
+        if !FlexCanRegs::owns(offset) {
+            debug_assert!(
+                false,
+                "register offset {offset:#x} outside 0..{BLOCK_END:#x}"
+            );
+            return 0;
+        }
+        // SAFETY: `FlexCanAt::new`'s contract covers every aligned offset of
+        // `0..BLOCK_END`, checked just above.
+        unsafe { core::ptr::read_volatile((BASE + offset) as *const u32) }
+    }
+
+    #[inline(always)]
+    fn write32(&self, offset: usize, value: u32) {
+        if !FlexCanRegs::owns(offset) {
+            debug_assert!(
+                false,
+                "register offset {offset:#x} outside 0..{BLOCK_END:#x}"
+            );
+            return;
+        }
+        // SAFETY: as for `read32`; writes go to a register of the owned module.
+        unsafe { core::ptr::write_volatile((BASE + offset) as *mut u32, value) }
+    }
+}
+
 /// Volatile access to the SIM and PORT registers `begin` writes, by absolute address
 /// (base 0; the window from the SIM to the end of PORTE).
 pub type SystemRegs = twocan_core::Mmio<0x4004_E000, 0x4004_7000>;
@@ -109,8 +172,13 @@ pub const RX15MASK: usize = 0x18;
 pub const ECR: usize = 0x1C;
 /// Error and Status 1 register.
 pub const ESR1: usize = 0x20;
+/// Interrupt Masks 2 register (MB32–MB63; modules of more than 32 message buffers, the
+/// i.MX RT1062's: IMXRT1060RM, FlexCAN memory map).
+pub const IMASK2: usize = 0x24;
 /// Interrupt Masks 1 register.
 pub const IMASK1: usize = 0x28;
+/// Interrupt Flags 2 register (MB32–MB63; i.MX RT1062).
+pub const IFLAG2: usize = 0x2C;
 /// Interrupt Flags 1 register.
 pub const IFLAG1: usize = 0x30;
 /// Control 2 register.

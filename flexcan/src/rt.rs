@@ -29,6 +29,15 @@
 //! failure). The NVIC is reached through the [`Nvic`] trait, implemented for
 //! `cortex_m::peripheral::NVIC`, so host tests check the order with a recording one.
 //!
+//! # The way back
+//!
+//! [`IrqState::stop`] masks the lines, takes the handlers back out of their cells (the
+//! entry points do nothing from then on) and gives them with the halves to
+//! [`twocan_core::split::State::unsplit`]: the controller comes back, to
+//! [`FlexCanHw::into_controller`] and `Can0::end` (which gives the token back), and
+//! the same state starts again over a controller begun anew. The entry points of an
+//! instance stay wired to the first state started on it.
+//!
 //! # Priority
 //!
 //! Every line of the instance gets `Settings::message_irq_priority` (ACAN's
@@ -43,6 +52,9 @@
 //! static CAN0: AcanState = AcanState::new();
 //! let can = Can0::take().unwrap().begin(&Settings::new(500_000), &[], &[]).map_err(|(_, e)| e)?;
 //! let (tx, rx) = CAN0.start(can.into_split(), &mut core.NVIC).map_err(|(e, _)| e)?;
+//! // ... traffic; then the way back:
+//! let (hw, _leftovers) = CAN0.stop(tx, rx, &mut core.NVIC).map_err(|(e, _)| e)?;
+//! let token = Can0::end(hw.into_controller()).map_err(|(_, e)| e)?;
 //! ```
 
 use core::cell::UnsafeCell;
@@ -51,9 +63,9 @@ use core::mem::MaybeUninit;
 use core::sync::atomic::{AtomicU8, Ordering};
 
 use twocan_core::irq_cell::IrqCell;
-use twocan_core::split::{Rx, Rx0Irq, State, StatusIrq, Tx, TxIrq};
+use twocan_core::split::{Rx, Rx0Irq, Rx1Irq, State, StatusIrq, Tx, TxIrq};
 use twocan_core::txqueue::TxQueue;
-use twocan_core::{Error, FifoQueue, Registers};
+use twocan_core::{Error, FifoQueue, Leftovers, Parts, Registers, UnsplitError};
 
 use crate::instance::{Instance, Irqs};
 use crate::regs::FlexCanRegs;
@@ -79,6 +91,9 @@ pub trait Nvic {
     fn set_priority(&mut self, irq: IrqNumber, priority: u8);
     /// Unmasks (enables) device interrupt `irq`.
     fn unmask(&mut self, irq: IrqNumber);
+    /// Masks (disables) device interrupt `irq`: its vector is not entered from now on
+    /// ([`IrqState::stop`]).
+    fn mask(&mut self, irq: IrqNumber);
 }
 
 // SAFETY: an `IrqNumber` is made only from `Instance::irqs` (see its documentation):
@@ -106,6 +121,10 @@ impl Nvic for cortex_m::peripheral::NVIC {
         // applications this is for do not use; `start` calls it after the handler the
         // entry point runs is in place.
         unsafe { cortex_m::peripheral::NVIC::unmask(irq) };
+    }
+
+    fn mask(&mut self, irq: IrqNumber) {
+        cortex_m::peripheral::NVIC::mask(irq);
     }
 }
 
@@ -156,6 +175,13 @@ impl Slot {
             .is_ok()
     }
 
+    /// Whether the slot is wired to `handlers` already (a state started again after
+    /// [`IrqState::stop`]: the wiring stays).
+    fn wired_to(&self, handlers: &'static dyn Handlers) -> bool {
+        self.get()
+            .is_some_and(|h| core::ptr::addr_eq(h as *const dyn Handlers, handlers))
+    }
+
     fn unclaim(&self) {
         self.state.store(EMPTY, Ordering::Release);
     }
@@ -177,12 +203,14 @@ impl Slot {
     }
 }
 
-static SLOTS: [Slot; 2] = [Slot::new(), Slot::new()];
+static SLOTS: [Slot; 4] = [Slot::new(), Slot::new(), Slot::new(), Slot::new()];
 
 const fn slot(instance: Instance) -> &'static Slot {
     match instance {
         Instance::Can0 => &SLOTS[0],
         Instance::Can1 => &SLOTS[1],
+        Instance::Can2 => &SLOTS[2],
+        Instance::Can3 => &SLOTS[3],
     }
 }
 
@@ -204,9 +232,12 @@ pub fn is_wired(instance: Instance) -> bool {
     slot(instance).get().is_some()
 }
 
+/// The message line's handlers, and the second receive queue's (none on FlexCAN: kept
+/// only to give every handle back to `State::unsplit`).
 type Message<R, const RX: usize, Q, const DONE: usize> = (
     TxIrq<'static, FlexCanHw<R>, RX, Q, 0, DONE>,
     Rx0Irq<'static, FlexCanHw<R>, RX, Q, 0, DONE>,
+    Rx1Irq<'static, FlexCanHw<R>, RX, Q, 0, DONE>,
 );
 type Status<R, const RX: usize, Q, const DONE: usize> =
     StatusIrq<'static, FlexCanHw<R>, RX, Q, 0, DONE>;
@@ -283,6 +314,11 @@ impl<R: Registers + 'static, const RX: usize, Q: TxQueue + 'static, const DONE: 
     pub fn state(&self) -> &State<FlexCanHw<R>, RX, Q, 0, DONE> {
         &self.state
     }
+
+    /// Whether the message line's and the status lines' handlers are in place.
+    pub fn installed(&self) -> [bool; 2] {
+        [self.message.is_ready(), self.status.is_ready()]
+    }
 }
 
 impl<R, const RX: usize, Q, const DONE: usize> Handlers for IrqState<R, RX, Q, DONE>
@@ -293,7 +329,7 @@ where
 {
     #[inline]
     fn on_message(&self) -> bool {
-        self.message.run(|(tx, rx)| {
+        self.message.run(|(tx, rx, _)| {
             tx.on_interrupt();
             rx.on_interrupt();
         })
@@ -336,13 +372,18 @@ where
         };
         let priority = hw.message_irq_priority();
         let slot = slot(target.instance);
-        if !slot.claim() {
+        // Wired to this state already (started again after `stop`), or claimed now and
+        // published once the handlers are in place.
+        let again = slot.wired_to(self);
+        if !again && !slot.claim() {
             return Err((StartError::AlreadyWired, hw));
         }
         let parts = match self.state.split(hw) {
             Ok(parts) => parts,
             Err((e, hw)) => {
-                slot.unclaim();
+                if !again {
+                    slot.unclaim();
+                }
                 let e = match e {
                     Error::WrongMode => StartError::AlreadySplit,
                     e => StartError::Split(e),
@@ -350,26 +391,140 @@ where
                 return Err((e, hw));
             }
         };
-        // The cells are empty: only a successful split (once per state) fills them.
-        let filled = self.message.put((parts.tx_irq, parts.rx0_irq)).is_ok()
+        // The cells are empty: only a successful split fills them, and `stop` empties
+        // them before the controller leaves the state.
+        let filled = self
+            .message
+            .put((parts.tx_irq, parts.rx0_irq, parts.rx1_irq))
+            .is_ok()
             && self.status.put(parts.status_irq).is_ok();
-        debug_assert!(filled, "split succeeds once per state");
-        slot.publish(self);
+        debug_assert!(filled, "split succeeds once per start");
+        if !again {
+            slot.publish(self);
+        }
         enable(nvic, irqs, priority);
         Ok((parts.tx, parts.rx))
     }
+
+    /// The way back (issue 22 item 11): masks the instance's message, bus-off, error
+    /// and warning lines, takes the handlers back out of their cells (no entry point
+    /// runs them from now on), and gives them with the halves to
+    /// [`State::unsplit`]. Returns the controller, still running (end it with
+    /// [`FlexCanHw::into_controller`] then `Can0::end` / `Can1::end`, or
+    /// [`crate::FlexCan::end`]), and what the rings and the queue still held
+    /// (discarded). The state may be started again with a controller begun anew; the
+    /// entry points stay wired to it.
+    ///
+    /// On error the halves come back; with [`StopError::Leased`] the handlers are put
+    /// back and the lines unmasked again, with [`StopError::Running`] the lines stay
+    /// masked.
+    #[allow(clippy::type_complexity, clippy::result_large_err)]
+    pub fn stop(
+        &'static self,
+        tx: Tx<'static, FlexCanHw<R>, RX, Q, 0, DONE>,
+        rx: Rx<'static, FlexCanHw<R>, RX, Q, 0, DONE>,
+        nvic: &mut impl Nvic,
+    ) -> Result<(FlexCanHw<R>, Leftovers), (StopError, Halves<R, RX, Q, DONE>)> {
+        if !core::ptr::eq(tx.state(), &self.state) || !core::ptr::eq(rx.state(), &self.state) {
+            return Err((StopError::Foreign, (tx, rx)));
+        }
+        let Some(irqs) = tx.hardware().target().irqs() else {
+            return Err((StopError::Foreign, (tx, rx)));
+        };
+        for irq in lines(irqs) {
+            nvic.mask(IrqNumber(irq));
+        }
+        let ((tx_irq, rx0_irq, rx1_irq), status_irq) =
+            match (self.message.take(), self.status.take()) {
+                (Some(m), Some(s)) => (m, s),
+                (m, s) => {
+                    // A cell being run by a context the caller preempted: put back what was
+                    // taken, lines left masked.
+                    let _ = m.map(|h| self.message.put(h).is_ok());
+                    let _ = s.map(|h| self.status.put(h).is_ok());
+                    return Err((StopError::Running, (tx, rx)));
+                }
+            };
+        let parts = Parts {
+            tx,
+            rx,
+            tx_irq,
+            rx0_irq,
+            rx1_irq,
+            status_irq,
+        };
+        match self.state.unsplit(parts) {
+            Ok(done) => Ok(done),
+            Err((e, p)) => {
+                let filled = self.message.put((p.tx_irq, p.rx0_irq, p.rx1_irq)).is_ok()
+                    && self.status.put(p.status_irq).is_ok();
+                debug_assert!(filled, "emptied above");
+                let priority = p.tx.hardware().message_irq_priority();
+                enable(nvic, irqs, priority);
+                let e = match e {
+                    UnsplitError::Foreign => StopError::Foreign,
+                    UnsplitError::Leased => StopError::Leased,
+                };
+                Err((e, (p.tx, p.rx)))
+            }
+        }
+    }
 }
 
-/// Priority, then unmask, for each line `start` uses.
-fn enable(nvic: &mut impl Nvic, irqs: Irqs, priority: u8) {
-    for irq in [
+/// Why [`IrqState::stop`] did not stop; the halves come back with it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum StopError {
+    /// The halves are not this state's.
+    Foreign,
+    /// A handler was running in a context the caller preempted (`stop` called from an
+    /// interrupt of lower priority): the lines stay masked; call again from thread
+    /// mode.
+    Running,
+    /// A reference from `State::hardware` is alive: drop it and call again.
+    Leased,
+}
+
+impl fmt::Display for StopError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            StopError::Foreign => "the halves belong to another state",
+            StopError::Running => "a handler is running in a preempted context",
+            StopError::Leased => "a reference to the controller is alive",
+        })
+    }
+}
+
+impl core::error::Error for StopError {}
+
+/// The lines `start` unmasks and `stop` masks (not the wake-up line: `start` never
+/// enables wake-up).
+fn lines(irqs: Irqs) -> [u16; 5] {
+    [
         irqs.message,
         irqs.bus_off,
         irqs.error,
         irqs.tx_warning,
         irqs.rx_warning,
-    ] {
+    ]
+}
+
+/// The one priority on every line (they run two cells; the four status lines one),
+/// then each line unmasked: after the handlers are in place. A line shared by several
+/// sources (the i.MX RT1062 has one per module: [`Irqs::is_single_line`]) is set once.
+fn enable(nvic: &mut impl Nvic, irqs: Irqs, priority: u8) {
+    let lines = lines(irqs);
+    let distinct = || {
+        lines
+            .iter()
+            .enumerate()
+            .filter(move |(i, irq)| !lines[..*i].contains(irq))
+            .map(|(_, &irq)| irq)
+    };
+    for irq in distinct() {
         nvic.set_priority(IrqNumber(irq), priority);
+    }
+    for irq in distinct() {
         nvic.unmask(IrqNumber(irq));
     }
 }

@@ -25,6 +25,7 @@ use twocan_core::timing::{
 };
 use twocan_core::BusOffRecovery;
 
+use crate::can_clock::CanClock;
 use crate::configuration::{Configuration, MESSAGE_BUFFERS};
 
 /// The FlexCAN engine clock ACAN uses: the 16 MHz crystal oscillator of every
@@ -37,11 +38,20 @@ pub const CAN_CLOCK_HZ: u32 = 16_000_000;
 /// `bus_clock_hz` (`None`: the least the manual allows, the 16 MHz oscillator clock; see
 /// [`Settings::bus_clock_hz`]).
 pub const fn timing_rule(bus_clock_hz: Option<u32>) -> TimingRule {
+    timing_rule_for(CAN_CLOCK_HZ, bus_clock_hz)
+}
+
+/// [`timing_rule`] for the CAN clock `can_clock_hz` (the RT1062's clock root,
+/// [`CanClock::hz`]): the same CTRL1 ranges and, with the 16 message buffers the driver
+/// enables (`MCR.MAXMB` = 15 on both families), 16 bus clocks per CAN bit (IMXRT1060RM,
+/// FlexCAN "Arbitration and matching timing", as the Kinetis manuals). `None` as bus
+/// clock: the CAN clock itself.
+pub const fn timing_rule_for(can_clock_hz: u32, bus_clock_hz: Option<u32>) -> TimingRule {
     let bus = match bus_clock_hz {
         Some(hz) => hz,
-        None => CAN_CLOCK_HZ,
+        None => can_clock_hz,
     };
-    flexcan_rules::rule(CAN_CLOCK_HZ, bus, MESSAGE_BUFFERS, true)
+    flexcan_rules::rule(can_clock_hz, bus, MESSAGE_BUFFERS, true)
 }
 
 /// The bit rate of the default settings (ACAN table 7: `mWhishedBitRate` 250,000).
@@ -159,6 +169,12 @@ pub struct Settings {
     /// descriptions: "automatic recovering from Bus Off state disabled") and the module
     /// stays bus-off until [`twocan_core::Hardware::recover`].
     pub bus_off_recovery: BusOffRecovery,
+    /// The protocol engine clock the timing is computed for (not in ACAN, whose boards
+    /// all run on 16 MHz): [`CanClock::Oscillator16MHz`] on a Teensy 3.x (the
+    /// default), the CCM clock root on a Teensy 4.x ([`Settings::with_clock`]). `begin`
+    /// refuses a clock the target's chip cannot give with
+    /// [`crate::ConfigErrors::CLOCK_NOT_ON_CHIP`], and on the RT1062 sets the root.
+    pub can_clock: CanClock,
 }
 
 impl Default for Settings {
@@ -187,8 +203,24 @@ impl Settings {
     /// `ACANSettings (bitRate, tolerance)`: the tolerance does not change the
     /// computation, only the acceptance test).
     pub const fn with_tolerance(bit_rate: u32, tolerance_ppm: u32) -> Self {
+        Self::with_clock_and_tolerance(bit_rate, CanClock::Oscillator16MHz, tolerance_ppm)
+    }
+
+    /// Settings for `bit_rate` from `can_clock` (a Teensy 4.x: [`CanClock::Imxrt`], e.g.
+    /// [`CanClock::IMXRT_24MHZ`]), default tolerance. Usable in `const` items.
+    pub const fn with_clock(bit_rate: u32, can_clock: CanClock) -> Self {
+        Self::with_clock_and_tolerance(bit_rate, can_clock, DEFAULT_TOLERANCE_PPM)
+    }
+
+    /// Settings for `bit_rate` from `can_clock` accepted within `tolerance_ppm`.
+    pub const fn with_clock_and_tolerance(
+        bit_rate: u32,
+        can_clock: CanClock,
+        tolerance_ppm: u32,
+    ) -> Self {
         Settings {
-            timing: timing_for(bit_rate),
+            can_clock,
+            timing: timing_for(bit_rate, can_clock.hz()),
             tolerance_ppm,
             listen_only: false,
             self_reception: false,
@@ -240,7 +272,7 @@ impl Settings {
     /// The bit timing rule `begin` applies to these settings: [`timing_rule`] with
     /// [`Settings::bus_clock_hz`].
     pub const fn timing_rule(&self) -> TimingRule {
-        timing_rule(self.bus_clock_hz)
+        timing_rule_for(self.can_clock.hz(), self.bus_clock_hz)
     }
 
     /// Whether the actual bit rate is exactly the wished one (ACAN §16.4).
@@ -272,21 +304,21 @@ impl Settings {
 /// ([`timing_rule`]'s): the closest rate from the 16 MHz clock, always consistent. Rates
 /// the solver refuses (0, above 2 Mbit/s) get the slowest or fastest timing, still
 /// carrying the wished rate so that the distance shows.
-const fn timing_for(bit_rate: u32) -> Timing {
-    let limits = timing_rule(None).limits;
+const fn timing_for(bit_rate: u32, clock_hz: u32) -> Timing {
+    let limits = timing_rule_for(clock_hz, None).limits;
     let solvable = if bit_rate == 0 {
         1
-    } else if bit_rate as u64 * limits.min_quanta() as u64 > CAN_CLOCK_HZ as u64 {
-        CAN_CLOCK_HZ / limits.min_quanta()
+    } else if bit_rate as u64 * limits.min_quanta() as u64 > clock_hz as u64 {
+        clock_hz / limits.min_quanta()
     } else {
         bit_rate
     };
-    let mut t = match solve(CAN_CLOCK_HZ, solvable, &limits, SAMPLE_POINT_PERMILLE) {
+    let mut t = match solve(clock_hz, solvable, &limits, SAMPLE_POINT_PERMILLE) {
         Ok(t) => t,
         // Unreachable with the FlexCAN limits and a rate in range; keep ACAN's
         // table-7 timing rather than panic.
         Err(_) => Timing {
-            clock_hz: CAN_CLOCK_HZ,
+            clock_hz,
             bitrate: DEFAULT_BIT_RATE,
             limits,
             prescaler: 4,

@@ -32,7 +32,8 @@
 //! identifier, data) and `RXFIR.IDHIT`; the thread side decodes it and maps the hit
 //! to the user's filter ([`FilterTable::filter_index`]).
 
-use core::sync::atomic::{AtomicU32, AtomicU8, Ordering};
+use core::marker::PhantomData;
+use core::sync::atomic::{AtomicBool, AtomicU32, AtomicU8, Ordering};
 
 use twocan_core::hardware::{
     sort_by_token, Completion, ReceiveContext, Settled, StatusEvents, Token,
@@ -49,8 +50,10 @@ use crate::configuration::{Configuration, DATA_MAILBOX};
 use crate::controller::FlexCan;
 use crate::filters::{FilterTable, UNKNOWN_FILTER};
 use crate::handshake;
+use crate::installed::{InstalledTable, Unresolved};
 use crate::instance::Target;
 use crate::message_buffer::MbWords;
+use crate::options::{Full, Options};
 use crate::regs::{self, code, cs, ctrl1, esr1, iflag1, rxfir, ECR, ESR1, IFLAG1, RXFIR};
 use crate::status;
 use crate::system::SystemPlan;
@@ -77,6 +80,12 @@ const fn bus_mode_code(m: BusMode) -> u8 {
     }
 }
 
+/// Whether the transmit half is refused in bus mode `bus_mode` and mode `mode` (codes):
+/// listen-only, or sleep.
+const fn tx_refused(bus_mode: u8, mode: u8) -> bool {
+    bus_mode == bus_mode_code(BusMode::ListenOnly) || mode == MODE_SLEEP
+}
+
 /// Position of the filter generation in a raw frame's last word (`IDHIT` below it).
 const GENERATION_SHIFT: u32 = 16;
 
@@ -89,13 +98,20 @@ fn mode_code(m: Mode) -> u8 {
 }
 
 /// A FlexCAN instance shared by the halves and handlers of the split driver.
-pub struct FlexCanHw<R: Registers> {
+///
+/// `O` chooses at compile time what each frame pays for ([`crate::options`]): time
+/// stamps and filter switches with [`Full`] (the default), neither with
+/// [`crate::options::Lean`] ([`FlexCan::into_split_with`]).
+pub struct FlexCanHw<R: Registers, O: Options = Full> {
     regs: R,
     target: Target,
+    /// The transmit mailboxes' bits in `IFLAG1` (remote-frame mailboxes and MB15),
+    /// from the configuration.
+    tx_mask: u32,
     /// The installed filter table (ID table, masks, map from `IDHIT` to the user's
     /// index): touched only from the receive half's context (`decode`,
     /// `install_filters`), so one copy.
-    table: core::cell::UnsafeCell<FilterTable>,
+    table: core::cell::UnsafeCell<O::Table>,
     /// The table's message-buffer configuration (read from every context).
     configuration: Configuration,
     /// The [`BusMode`] (`CTRL1.LOM`/`LPB`) as its code (read by the transmit half).
@@ -107,6 +123,10 @@ pub struct FlexCanHw<R: Registers> {
     polls: AtomicU32,
     irq_priority: u8,
     mode: AtomicU8,
+    /// Whether the transmit half is refused ([`Error::WrongMode`]): listen-only or
+    /// sleep, from `bus_mode` and `mode` (one load on the transmit path). Written
+    /// after each of them, by the control context only.
+    tx_refused: AtomicBool,
     /// Filter list generation (low 16 bits), stamped on each raw frame by `read_rx`
     /// and compared by `decode`: frames read before the last `install_filters` are
     /// dropped. Written by `install_filters` only.
@@ -140,37 +160,84 @@ pub struct FlexCanHw<R: Registers> {
     /// Rx FIFO frames discarded by `install_filters` and not yet taken (receive half
     /// only).
     discarded: AtomicU32,
+    options: PhantomData<O>,
 }
 
 impl<R: Registers> FlexCan<R> {
     /// The controller for the split driver (`twocan_core::split::State::split`); the
-    /// installed filter table comes along.
+    /// installed filter table comes along. Every feature ([`Full`]); see
+    /// [`FlexCan::into_split_with`] for a leaner choice.
     pub fn into_split(self) -> FlexCanHw<R> {
-        let mode = self.mode;
-        let srxdis = self.bus_mode != BusMode::LoopBack
-            && self.regs.read32(regs::MCR) & regs::mcr::SRXDIS != 0;
+        self.into_split_with::<Full>()
+    }
+
+    /// The controller for the split driver with the compile-time choices `O`
+    /// ([`crate::options`]: [`Full`], [`crate::options::Lean`]).
+    pub fn into_split_with<O: Options<Table = FilterTable>>(self) -> FlexCanHw<R, O> {
+        let last_error = self.last_error.get();
+        FlexCanHw::from_parts(
+            self.regs,
+            self.target,
+            self.table,
+            Parts {
+                bus_mode: self.bus_mode,
+                recovery: self.recovery,
+                polls: self.polls,
+                irq_priority: self.irq_priority,
+                mode: self.mode,
+                last_error,
+                system: self.system,
+                bus_clock_hz: self.bus_clock_hz,
+            },
+        )
+    }
+}
+
+/// The small values a split controller starts from (a started [`FlexCan`]'s, or
+/// `begin_planned`'s).
+pub(crate) struct Parts {
+    pub(crate) bus_mode: BusMode,
+    pub(crate) recovery: BusOffRecovery,
+    pub(crate) polls: u32,
+    pub(crate) irq_priority: u8,
+    pub(crate) mode: Mode,
+    pub(crate) last_error: LastErrorCode,
+    pub(crate) system: SystemPlan,
+    pub(crate) bus_clock_hz: u32,
+}
+
+impl<R: Registers, O: Options> FlexCanHw<R, O> {
+    /// The split controller over `regs` with `table` installed.
+    pub(crate) fn from_parts(regs: R, target: Target, table: O::Table, p: Parts) -> Self {
+        let configuration = table.configuration();
+        let first = configuration.first_remote_mailbox() as u32;
+        let srxdis =
+            p.bus_mode != BusMode::LoopBack && regs.read32(regs::MCR) & regs::mcr::SRXDIS != 0;
         FlexCanHw {
-            regs: self.regs,
-            target: self.target,
-            configuration: self.table.configuration(),
-            table: core::cell::UnsafeCell::new(self.table),
-            bus_mode: AtomicU8::new(bus_mode_code(self.bus_mode)),
+            regs,
+            target,
+            tx_mask: (0xFFFF_u32 >> first << first) & 0xFFFF,
+            configuration,
+            table: core::cell::UnsafeCell::new(table),
+            bus_mode: AtomicU8::new(bus_mode_code(p.bus_mode)),
             srxdis,
-            recovery: self.recovery,
-            polls: AtomicU32::new(self.polls),
+            recovery: p.recovery,
+            polls: AtomicU32::new(p.polls),
             generation: AtomicU32::new(0),
-            irq_priority: self.irq_priority,
-            mode: AtomicU8::new(mode_code(mode)),
+            irq_priority: p.irq_priority,
+            mode: AtomicU8::new(mode_code(p.mode)),
+            tx_refused: AtomicBool::new(tx_refused(bus_mode_code(p.bus_mode), mode_code(p.mode))),
             tokens: [const { AtomicU32::new(0) }; MAX_TX],
-            last_error: AtomicLastError::new(self.last_error.get()),
+            last_error: AtomicLastError::new(p.last_error),
             unresolved: AtomicU32::new(0),
             loaded: AtomicU32::new(0),
             abort_wanted: AtomicU32::new(0),
-            system: self.system,
-            bus_clock_hz: self.bus_clock_hz,
+            system: p.system,
+            bus_clock_hz: p.bus_clock_hz,
             discarded: AtomicU32::new(0),
             caught: AtomicU32::new(0),
             unreported: AtomicU32::new(0),
+            options: PhantomData,
         }
     }
 }
@@ -203,7 +270,9 @@ pub trait InstalledFilters {
     fn filters(&self) -> FilterTable;
 }
 
-impl<R: Registers> InstalledFilters for ReceiveContext<'_, FlexCanHw<R>> {
+impl<R: Registers, O: Options<Table = FilterTable>> InstalledFilters
+    for ReceiveContext<'_, FlexCanHw<R, O>>
+{
     fn filters(&self) -> FilterTable {
         // SAFETY: the table is written only by `install_filters`, which the receive
         // half calls with `&mut self`; a `ReceiveContext` borrows that half (or the
@@ -212,7 +281,7 @@ impl<R: Registers> InstalledFilters for ReceiveContext<'_, FlexCanHw<R>> {
     }
 }
 
-impl<R: Registers> FlexCanHw<R> {
+impl<R: Registers, O: Options> FlexCanHw<R, O> {
     /// Which instance of which chip.
     pub const fn target(&self) -> Target {
         self.target
@@ -266,7 +335,9 @@ impl<R: Registers> FlexCanHw<R> {
     pub fn into_registers(self) -> R {
         self.regs
     }
+}
 
+impl<R: Registers, O: Options<Table = FilterTable>> FlexCanHw<R, O> {
     /// The controller back, as `begin` gave it (the reverse of
     /// [`FlexCan::into_split`]): for [`FlexCan::end`] after
     /// [`twocan_core::Driver::release`].
@@ -293,26 +364,30 @@ impl<R: Registers> FlexCanHw<R> {
         controller.last_error.set(last_error);
         controller
     }
+}
 
+impl<R: Registers, O: Options> FlexCanHw<R, O> {
     fn mode(&self) -> u8 {
         self.mode.load(Ordering::Relaxed)
-    }
-
-    /// The transmit mailboxes' bits in `IFLAG1`: remote-frame mailboxes and MB15.
-    fn tx_bits(&self) -> u32 {
-        let first = self.configuration().first_remote_mailbox() as u32;
-        (0xFFFF_u32 >> first << first) & 0xFFFF
     }
 
     /// Refused with [`Error::WrongMode`] in listen-only mode and while disabled (sleep).
     #[inline(always)]
     fn check_can_send(&self) -> Result<(), Error> {
-        if self.bus_mode.load(Ordering::Relaxed) == bus_mode_code(BusMode::ListenOnly)
-            || self.mode() == MODE_SLEEP
-        {
+        if self.tx_refused.load(Ordering::Relaxed) {
             return Err(Error::WrongMode);
         }
         Ok(())
+    }
+
+    /// `tx_refused` from `bus_mode` and `mode` (after a store to either; the control
+    /// context, their one writer).
+    fn note_tx_refused(&self) {
+        let refused = tx_refused(
+            self.bus_mode.load(Ordering::Relaxed),
+            self.mode.load(Ordering::Relaxed),
+        );
+        self.tx_refused.store(refused, Ordering::Relaxed);
     }
 
     /// MB15 for a data frame, the first free remote-frame mailbox for a remote frame.
@@ -400,6 +475,103 @@ impl<R: Registers> FlexCanHw<R> {
         self.abort_wanted.store(still, Ordering::Relaxed);
         if still != 0 {
             self.abort_mailboxes(still);
+        }
+    }
+
+    /// Settles transmit mailbox `mb`, whose `IFLAG1` bit is set (inside the driver's
+    /// critical section): its completion when it held a frame of ours (code `ABORT`:
+    /// aborted; anything else: sent, with the TIME STAMP the hardware wrote). The flag
+    /// is acknowledged and the mailbox made `INACTIVE` again (a remote-frame mailbox
+    /// became a receive mailbox for the answer; an aborted one shows `ABORT`).
+    #[inline(always)]
+    fn settle_one(&self, mb: usize) -> Option<Completion> {
+        // Every configuration's transmit mailboxes fit the token slots (`15 - mb` < 8).
+        const {
+            let first = Configuration::Filters8_0.first_remote_mailbox();
+            assert!(((DATA_MAILBOX - first) as usize) < MAX_TX)
+        };
+        let control = self.regs.read32(regs::mb_cs(mb));
+        let c = cs::CODE.get(control);
+        let bit = 1 << mb;
+        let was_loaded = self.loaded.fetch_and(!bit, Ordering::Relaxed) & bit != 0;
+        if c == code::RX_FULL || c == code::RX_OVERRUN {
+            self.count_caught(c);
+        }
+        // The token before the flag is acknowledged: once it is, the transmit half may
+        // load the mailbox with the next frame and its token. Transmit mailboxes are
+        // MB8..=MB15 in every configuration, so `15 - mb` is below 8.
+        let token = was_loaded.then(|| {
+            Token(
+                self.tokens[(DATA_MAILBOX as usize).wrapping_sub(mb) & (MAX_TX - 1)]
+                    .load(Ordering::Acquire),
+            )
+        });
+        self.regs.write32(IFLAG1, iflag1::buf(mb));
+        if c != code::TX_INACTIVE {
+            self.regs
+                .write32(regs::mb_cs(mb), cs::CODE.val(code::TX_INACTIVE));
+        }
+        // Without a frame of ours (an answer caught by a remote-frame mailbox turned
+        // receive mailbox): acknowledged, deactivated, no completion.
+        let token = token?;
+        let (outcome, timestamp) = if c == code::TX_ABORT {
+            (TxOutcome::Aborted, None)
+        } else {
+            // The 16-bit TIME STAMP: the driver widens it.
+            let stamp = cs::TIME_STAMP.get(control) as u16;
+            (
+                TxOutcome::Sent,
+                O::STAMPS.then(|| Timestamp::from_parts(0, stamp)),
+            )
+        };
+        Some(Completion {
+            token,
+            outcome,
+            cause: None,
+            timestamp,
+        })
+    }
+
+    /// A frame caught by a remote-frame mailbox turned receive mailbox (code `FULL`: 1,
+    /// `OVERRUN`: 2, the least it held), counted before the mailbox is made inactive
+    /// ([`FlexCanHw::remote_mailbox_catches`]). The transmit interrupt's rare case.
+    #[cold]
+    #[inline(never)]
+    fn count_caught(&self, c: u32) {
+        let caught = if c == code::RX_OVERRUN { 2 } else { 1 };
+        let n = self.caught.load(Ordering::Relaxed);
+        self.caught.store(n.wrapping_add(caught), Ordering::Relaxed);
+    }
+
+    /// Several transmit mailboxes ended in one interrupt (`ended`, their `IFLAG1`
+    /// bits): their completions in token order (the request order). Out of line: with
+    /// one frame in a mailbox at a time (`free_mailbox`), only `try_send_now`'s remote
+    /// frames come here.
+    #[cold]
+    #[inline(never)]
+    fn settle_many<G: FnMut(Settled)>(&self, ended: u32, f: &mut G) {
+        let mut out = [(
+            0u32,
+            Completion {
+                token: Token(0),
+                outcome: TxOutcome::Sent,
+                cause: None,
+                timestamp: None,
+            },
+        ); MAX_TX];
+        let mut n = 0;
+        for mb in (0..=DATA_MAILBOX as usize).filter(|&mb| ended & iflag1::buf(mb) != 0) {
+            if let Some(c) = self.settle_one(mb) {
+                if let Some(slot) = out.get_mut(n) {
+                    *slot = (c.token.0, c);
+                    n += 1;
+                }
+            }
+        }
+        let out = &mut out[..n];
+        sort_by_token(out);
+        for (_, c) in out.iter() {
+            f(Settled::Done(*c));
         }
     }
 
@@ -499,6 +671,7 @@ impl<R: Registers> FlexCanHw<R> {
             Mode::Normal => {
                 handshake::leave_freeze(&self.regs, polls)?;
                 self.mode.store(MODE_NORMAL, Ordering::Relaxed);
+                self.note_tx_refused();
                 return handshake::wait_synch(&self.regs, polls, |esr| {
                     self.latch(esr);
                 });
@@ -507,6 +680,7 @@ impl<R: Registers> FlexCanHw<R> {
             Mode::Sleep => handshake::disable(&self.regs, polls)?,
         }
         self.mode.store(mode_code(mode), Ordering::Relaxed);
+        self.note_tx_refused();
         Ok(())
     }
 }
@@ -522,10 +696,10 @@ impl<R: Registers> FlexCanHw<R> {
 // - `target`, `configuration`, `srxdis`, `recovery`, `irq_priority`, `system`,
 //   `bus_clock_hz`: read only; everything else is atomic.
 // `FlexCanHw` itself is `Send` (moved into the driver's state) exactly when `R` is.
-unsafe impl<R: Registers + Sync> Sync for FlexCanHw<R> where FilterTable: Send {}
+unsafe impl<R: Registers + Sync, O: Options> Sync for FlexCanHw<R, O> {}
 
 // SAFETY: as for `Sync`: each method stays within its context's registers.
-unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
+unsafe impl<R: Registers, O: Options> Hardware for FlexCanHw<R, O> {
     type Raw = RawFrame;
     type FilterMap = ();
     type Filters = FilterTable;
@@ -577,73 +751,15 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
         if self.mode() == MODE_SLEEP {
             return;
         }
-        let ended = self.regs.read32(IFLAG1) & self.tx_bits();
-        if ended == 0 {
-            self.retry_aborts();
-            return;
-        }
-        let mut out = [(
-            0u32,
-            Completion {
-                token: Token(0),
-                outcome: TxOutcome::Sent,
-                cause: None,
-                timestamp: None,
-            },
-        ); MAX_TX];
-        let mut n = 0;
-        for mb in (0..=DATA_MAILBOX as usize).filter(|&mb| ended & iflag1::buf(mb) != 0) {
-            let control = self.regs.read32(regs::mb_cs(mb));
-            let c = cs::CODE.get(control);
-            let was_loaded = self.loaded.fetch_and(!(1 << mb), Ordering::Relaxed) & (1 << mb) != 0;
-            let caught = match c {
-                code::RX_FULL => 1,
-                code::RX_OVERRUN => 2,
-                _ => 0,
-            };
-            if caught != 0 {
-                // Counted before the mailbox is made inactive (`remote_mailbox_catches`).
-                let n = self.caught.load(Ordering::Relaxed);
-                self.caught.store(n.wrapping_add(caught), Ordering::Relaxed);
+        let ended = self.regs.read32(IFLAG1) & self.tx_mask;
+        if ended & ended.wrapping_sub(1) != 0 {
+            // Several mailboxes ended (remote frames beside MB15): out of line.
+            self.settle_many(ended, &mut f);
+        } else if ended != 0 {
+            // One mailbox: no sorting, no list.
+            if let Some(c) = self.settle_one(ended.trailing_zeros() as usize) {
+                f(Settled::Done(c));
             }
-            if !was_loaded {
-                // A flag without a frame of ours (an answer caught by a remote-frame
-                // mailbox turned receive mailbox): acknowledge, deactivate, no completion.
-                self.regs.write32(IFLAG1, iflag1::buf(mb));
-                if c != code::TX_INACTIVE {
-                    self.regs
-                        .write32(regs::mb_cs(mb), cs::CODE.val(code::TX_INACTIVE));
-                }
-                continue;
-            }
-            let token = Token(self.tokens[DATA_MAILBOX as usize - mb].load(Ordering::Acquire));
-            let (outcome, timestamp) = if c == code::TX_ABORT {
-                (TxOutcome::Aborted, None)
-            } else {
-                // The 16-bit TIME STAMP: the driver widens it.
-                let stamp = cs::TIME_STAMP.get(control) as u16;
-                (TxOutcome::Sent, Some(Timestamp::from_parts(0, stamp)))
-            };
-            self.regs.write32(IFLAG1, iflag1::buf(mb));
-            if c != code::TX_INACTIVE {
-                self.regs
-                    .write32(regs::mb_cs(mb), cs::CODE.val(code::TX_INACTIVE));
-            }
-            out[n] = (
-                token.0,
-                Completion {
-                    token,
-                    outcome,
-                    cause: None,
-                    timestamp,
-                },
-            );
-            n += 1;
-        }
-        let out = &mut out[..n];
-        sort_by_token(out);
-        for (_, c) in out.iter() {
-            f(Settled::Done(*c));
         }
         self.retry_aborts();
     }
@@ -731,7 +847,7 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
         if self.mode() == MODE_SLEEP {
             return;
         }
-        self.abort_mailboxes(self.loaded.load(Ordering::Relaxed) & self.tx_bits());
+        self.abort_mailboxes(self.loaded.load(Ordering::Relaxed) & self.tx_mask);
     }
 
     /// `IFLAG1.BUF5I`: reads the Rx FIFO output (control/status first, Kinetis RM "Rx
@@ -753,7 +869,11 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
         }
         // The generation before the frame: a frame of the old list read while
         // `install_filters` drains the FIFO carries the old generation (never the new).
-        let generation = self.generation.load(Ordering::Acquire) << GENERATION_SHIFT;
+        let generation = if O::FILTER_SWITCH {
+            self.generation.load(Ordering::Acquire) << GENERATION_SHIFT
+        } else {
+            0
+        };
         let w = MbWords::read(&self.regs, 0);
         let raw = [
             w.cs,
@@ -772,10 +892,11 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
     #[inline]
     unsafe fn decode(&self, raw: &RawFrame, _map: &()) -> Option<RxFrame> {
         // SAFETY: the receive half's context, the only one touching the table.
-        let map = unsafe { &*self.table.get() };
+        let table = unsafe { &*self.table.get() };
         let [control, id, word0, word1, tagged] = *raw;
-        let current = self.generation.load(Ordering::Relaxed) & 0xFFFF;
-        if tagged >> GENERATION_SHIFT != current {
+        if O::FILTER_SWITCH
+            && tagged >> GENERATION_SHIFT != self.generation.load(Ordering::Relaxed) & 0xFFFF
+        {
             // Accepted by a filter list replaced since: dropped (counted by the driver).
             return None;
         }
@@ -787,12 +908,12 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
             word1,
         }
         .frame();
-        let filter = match map.filter_index(hit as usize, &frame) {
-            Some(i) => i,
+        let filter = match table.resolve(hit as usize, &frame) {
+            Ok(i) => i,
             // A superset element's extra identifier: dropped and counted by the driver.
-            None if map.hit(hit as usize) == Some(crate::filters::Hit::Lookup) => return None,
+            Err(Unresolved::Superset) => return None,
             // An IDHIT the table does not produce (stale, corrupted): kept, flagged.
-            None => {
+            Err(Unresolved::Unknown) => {
                 let n = self.unresolved.load(Ordering::Relaxed);
                 self.unresolved
                     .store(n.saturating_add(1), Ordering::Relaxed);
@@ -808,9 +929,11 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
     }
 
     /// The `TIME STAMP` field of the Rx FIFO output's C/S word: the free-running timer
-    /// at the start of the identifier field (Kinetis RM, "Message buffer structure").
+    /// at the start of the identifier field (Kinetis RM, "Message buffer structure");
+    /// `None` without [`Options::STAMPS`] (no stamp to widen).
+    #[inline(always)]
     fn raw_timestamp(&self, raw: &RawFrame) -> Option<u16> {
-        Some(MbWords::timestamp_of(raw[0]))
+        O::STAMPS.then(|| MbWords::timestamp_of(raw[0]))
     }
 
     /// `TIMER` (Kinetis RM, "Free Running Timer (CANx_TIMER)": readable at any time,
@@ -833,7 +956,13 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
     /// one the application set, so a transmit half waiting for room keeps waiting and
     /// the status handler records no `Stopped` change. A mailbox loaded meanwhile is
     /// sent once the module leaves Freeze mode.
+    ///
+    /// Refused with [`Error::Unsupported`] without [`Options::FILTER_SWITCH`]
+    /// ([`crate::options::Lean`]).
     unsafe fn install_filters(&self, filters: &FilterTable) -> Result<(), Error> {
+        if !O::FILTER_SWITCH || !<O::Table as InstalledTable>::REPLACEABLE {
+            return Err(Error::Unsupported);
+        }
         if filters.configuration() != self.configuration() {
             return Err(Error::InvalidArgument);
         }
@@ -862,7 +991,7 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
         self.discarded.fetch_add(popped, Ordering::Relaxed);
         // SAFETY: the receive half's context, the only one touching the table
         // (`ReceiveContext` borrows that half, so no copy is being read).
-        unsafe { *self.table.get() = filters.clone() };
+        unsafe { (*self.table.get()).replace(filters)? };
         let next = (self.generation.load(Ordering::Relaxed) + 1) & 0xFFFF;
         self.generation.store(next, Ordering::Release);
         self.resume_after_switch(mode)
@@ -966,7 +1095,7 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
         let c = self.configuration();
         let filters = (c.primary_filter_capacity() + c.secondary_filter_capacity()) as u16;
         Capabilities::new(
-            crate::settings::CAN_CLOCK_HZ,
+            self.system.can_clock_hz(),
             Limits::FLEXCAN_KINETIS,
             ModeSupport {
                 loop_back: true,
@@ -974,7 +1103,7 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
                 one_shot: false,
                 triple_sampling: true,
                 manual_recovery: true,
-                timestamps: true,
+                timestamps: O::STAMPS,
             },
             filters,
             filters,
@@ -983,7 +1112,10 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
             RX_FIFO_DEPTH as u8,
             Some(16),
         )
-        .with_timing_rule(crate::settings::timing_rule(Some(self.bus_clock_hz)))
+        .with_timing_rule(crate::settings::timing_rule_for(
+            self.system.can_clock_hz(),
+            Some(self.bus_clock_hz),
+        ))
     }
 
     fn bus_mode(&self) -> BusMode {
@@ -1042,6 +1174,7 @@ unsafe impl<R: Registers> Hardware for FlexCanHw<R> {
         self.regs
             .modify32(regs::MCR, |v| (v & !regs::mcr::SRXDIS) | srxdis);
         self.bus_mode.store(bus_mode_code(mode), Ordering::Relaxed);
+        self.note_tx_refused();
         Ok(())
     }
 }

@@ -1,6 +1,8 @@
-//! The chip-level registers `begin` writes besides the FlexCAN module: the SIM clock
-//! gates and the PORT pin control of the Tx and Rx pins (Kinetis reference manuals,
-//! chapters "SIM" and "PORT"; ACAN §7, §16.7.5, §16.7.6).
+//! The chip-level registers `begin` writes besides the FlexCAN module: on the Kinetis
+//! parts the SIM clock gates and the PORT pin control of the Tx and Rx pins (reference
+//! manuals, chapters "SIM" and "PORT"; ACAN §7, §16.7.5, §16.7.6), [`PortPlan`]; on the
+//! i.MX RT1062 the CCM clock root and gates and the IOMUXC pads,
+//! [`crate::imxrt::ImxrtPlan`]. [`SystemPlan`] is either, chosen by the target's chip.
 //!
 //! They are reached through a [`Registers`] whose offsets are absolute addresses. On
 //! the target that is [`crate::regs::SystemRegs`] at base 0 (see `Can0::begin`); on the host
@@ -12,6 +14,7 @@ use core::cell::{Ref, RefCell};
 use twocan_core::Registers;
 
 use crate::board::InstancePins;
+use crate::imxrt::ImxrtPlan;
 use crate::regs::pins::CanPin;
 use crate::regs::port::{PCR_MUX, PCR_ODE, PCR_PE, PCR_PS};
 use crate::regs::sim;
@@ -69,9 +72,79 @@ pub const fn rx_pcr(pin: CanPin, pull_up: bool) -> u32 {
 }
 
 /// What `begin` writes to the chip-level registers, computed before anything is
-/// written.
+/// written: the Kinetis or the i.MX RT form.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct SystemPlan {
+pub enum SystemPlan {
+    /// Kinetis: SIM gates and PORT pin control.
+    Kinetis(PortPlan),
+    /// i.MX RT1062: CCM clock root and gates, IOMUXC pads.
+    Imxrt(ImxrtPlan),
+}
+
+impl SystemPlan {
+    /// The Kinetis plan (`None` on the RT1062).
+    pub const fn kinetis(&self) -> Option<&PortPlan> {
+        match self {
+            SystemPlan::Kinetis(p) => Some(p),
+            SystemPlan::Imxrt(_) => None,
+        }
+    }
+
+    /// The RT1062 plan (`None` on a Kinetis part).
+    pub const fn imxrt(&self) -> Option<&ImxrtPlan> {
+        match self {
+            SystemPlan::Imxrt(p) => Some(p),
+            SystemPlan::Kinetis(_) => None,
+        }
+    }
+
+    /// The Teensy pin numbers of the Tx and Rx pins.
+    pub const fn teensy_pins(&self) -> (u8, u8) {
+        match self {
+            SystemPlan::Kinetis(p) => (p.tx.0.teensy_pin, p.rx.0.teensy_pin),
+            SystemPlan::Imxrt(p) => (p.tx.0.teensy_pin, p.rx.0.teensy_pin),
+        }
+    }
+
+    /// The protocol engine clock in Hz: the 16 MHz oscillator (Kinetis) or the CCM
+    /// clock root the plan sets (RT1062).
+    pub const fn can_clock_hz(&self) -> u32 {
+        match self {
+            SystemPlan::Kinetis(_) => crate::settings::CAN_CLOCK_HZ,
+            SystemPlan::Imxrt(p) => p.root.hz(),
+        }
+    }
+
+    /// The module's clock gate (register, bits).
+    pub const fn clock_gate(&self) -> (usize, u32) {
+        match self {
+            SystemPlan::Kinetis(p) => p.clock_gate,
+            SystemPlan::Imxrt(p) => p.clock_gate,
+        }
+    }
+
+    /// Enables the clocks and muxes the pins ([`PortPlan::apply`],
+    /// [`ImxrtPlan::apply`]).
+    pub fn apply<S: Registers>(&self, sys: &mut S) {
+        match self {
+            SystemPlan::Kinetis(p) => p.apply(sys),
+            SystemPlan::Imxrt(p) => p.apply(sys),
+        }
+    }
+
+    /// Releases the pins and the module's clock gate ([`PortPlan::release`],
+    /// [`ImxrtPlan::release`]).
+    pub fn release<S: Registers>(&self, sys: &mut S) {
+        match self {
+            SystemPlan::Kinetis(p) => p.release(sys),
+            SystemPlan::Imxrt(p) => p.release(sys),
+        }
+    }
+}
+
+/// The Kinetis chip-level writes: SIM clock gates, PORT pin control.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct PortPlan {
     /// The module's clock gate (register, bit).
     pub clock_gate: (usize, u32),
     /// The Tx pin and its PCR value.
@@ -80,7 +153,7 @@ pub struct SystemPlan {
     pub rx: (CanPin, u32),
 }
 
-impl SystemPlan {
+impl PortPlan {
     /// The plan for the chosen pins.
     pub const fn new(
         clock_gate: (usize, u32),
@@ -89,7 +162,7 @@ impl SystemPlan {
         open_collector: bool,
         pull_up: bool,
     ) -> Self {
-        SystemPlan {
+        PortPlan {
             clock_gate,
             tx: (tx, tx_pcr(tx, open_collector)),
             rx: (rx, rx_pcr(rx, pull_up)),
@@ -111,8 +184,8 @@ impl SystemPlan {
     }
 }
 
-impl SystemPlan {
-    /// Undoes [`SystemPlan::apply`] for the module (`end`): the Tx and Rx pins back to
+impl PortPlan {
+    /// Undoes [`PortPlan::apply`] for the module (`end`): the Tx and Rx pins back to
     /// their reset function — `PORTx_PCRn` written 0, `MUX` = 000 "pin disabled
     /// (analog)" with no pull or open drain ("PORT", "Pin Control Register n") — then
     /// the module's clock gate cleared (`SIM_SCGC6.FLEXCAN0` or `SIM_SCGC3.FLEXCAN1`,
@@ -177,7 +250,8 @@ mod tests {
         let (tx, rx) =
             choose_pins(Board::Teensy32.pins(Instance::Can0).unwrap(), true, false).unwrap();
         assert_eq!((tx.teensy_pin, rx.teensy_pin), (32, 4));
-        let plan = SystemPlan::new(Instance::Can0.clock_gate(), tx, rx, true, true);
+        let gate = Instance::Can0.clock_gate(Board::Teensy32.chip()).unwrap();
+        let plan = PortPlan::new(gate, tx, rx, true, true);
         let mut sys = HostSystem::new();
         plan.apply(&mut sys);
         assert_eq!(sys.read32(sim::SIM_SCGC6), sim::SCGC6_FLEXCAN0);

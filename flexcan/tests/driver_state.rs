@@ -245,7 +245,7 @@ fn pins_and_clock_gates_7_16_7_5_16_7_6() {
             sys.read32(rx_port.pcr(rx_pin)),
             PCR_MUX.val(2) | PCR_PE | PCR_PS
         );
-        let (gate, bit) = instance.clock_gate();
+        let (gate, bit) = target.clock_gate().unwrap();
         assert_ne!(sys.read32(gate) & bit, 0);
         assert_ne!(
             sys.read32(sim::SIM_SCGC5) & tx_port.scgc5_bit() & rx_port.scgc5_bit(),

@@ -29,7 +29,7 @@ fn round_trip(bus: &mut twocan_sim::Bus, can: &mut Drv, id: u16) {
 }
 
 fn gate(target: Target) -> (usize, u32) {
-    target.instance.clock_gate()
+    target.clock_gate().unwrap()
 }
 
 #[test]
@@ -58,7 +58,7 @@ fn end_releases_everything_and_begin_runs_again() {
 
         // The driver gives the controller back; `end` stops it.
         let controller = can.release().into_controller();
-        let released = controller.system();
+        let released = *controller.system().kinetis().unwrap();
         let (tx, rx) = (released.tx.0, released.rx.0);
         assert_ne!(sys.read32(tx.pcr()), 0, "{target:?}: Tx pin muxed by begin");
         let regs = controller.end(&mut sys).expect("end");
@@ -99,7 +99,7 @@ fn end_of_an_unsplit_controller_and_alternate_pins() {
         &[],
     )
     .unwrap();
-    let plan = controller.system();
+    let plan = *controller.system().kinetis().unwrap();
     // Teensy 3.5 alternates: pins 29 and 30 (ACAN §7 table 3).
     assert_eq!((plan.tx.0.teensy_pin, plan.rx.0.teensy_pin), (29, 30));
     let regs = controller.end(&mut sys).unwrap();
@@ -117,7 +117,7 @@ fn end_of_an_unsplit_controller_and_alternate_pins() {
         &[],
     )
     .unwrap();
-    assert_eq!(again.system().tx.0.teensy_pin, 3);
+    assert_eq!(again.system().teensy_pins().0, 3);
     assert_eq!(
         sys.read32(sim::SIM_SCGC6) & sim::SCGC6_FLEXCAN0,
         sim::SCGC6_FLEXCAN0
@@ -146,7 +146,10 @@ fn end_that_cannot_freeze_gives_the_controller_back_and_releases_nothing() {
         sim::SCGC6_FLEXCAN0,
         "the gate stays open: the module is still running"
     );
-    assert_ne!(sys.read32(controller.system().tx.0.pcr()), 0);
+    assert_ne!(
+        sys.read32(controller.system().kinetis().unwrap().tx.0.pcr()),
+        0
+    );
     // Once the module acknowledges again, `end` completes.
     model.set_freeze_ack_stuck(false);
     controller

@@ -74,6 +74,10 @@ struct Recorder {
     calls: Vec<(&'static str, u16, u8)>,
     handled_at_unmask: Vec<bool>,
     priorities: std::collections::HashMap<u16, u8>,
+    /// The state whose handlers `mask` looks at (`stop`'s order).
+    watch: Option<&'static Wired>,
+    /// At each mask: whether the state's handlers were still in place.
+    installed_at_mask: Vec<[bool; 2]>,
 }
 
 impl Recorder {
@@ -83,6 +87,8 @@ impl Recorder {
             calls: Vec::new(),
             handled_at_unmask: Vec::new(),
             priorities: Default::default(),
+            watch: None,
+            installed_at_mask: Vec::new(),
         }
     }
 }
@@ -109,6 +115,13 @@ impl Nvic for Recorder {
             .push(rt::dispatch(self.instance, line));
         let p = self.priorities.get(&irq).copied();
         self.calls.push(("unmask", irq, p.unwrap_or(0xFF)));
+    }
+
+    fn mask(&mut self, irq: IrqNumber) {
+        self.calls.push(("mask", irq.number(), 0));
+        if let Some(state) = self.watch {
+            self.installed_at_mask.push(state.installed());
+        }
     }
 }
 
@@ -247,7 +260,7 @@ fn can1_errors_leave_the_slot_free() {
     assert!(nvic.calls.is_empty());
     assert!(!rt::is_wired(Instance::Can1));
 
-    let _halves = state.start(hw, &mut nvic).map_err(|(e, _)| e).unwrap();
+    let (tx, rx) = state.start(hw, &mut nvic).map_err(|(e, _)| e).unwrap();
     assert!(rt::is_wired(Instance::Can1));
     assert_eq!(nvic.handled_at_unmask, [true; 5]);
     let unmasked: Vec<_> = nvic
@@ -261,4 +274,92 @@ fn can1_errors_leave_the_slot_free() {
         .calls
         .iter()
         .all(|c| c.2 == twocan_flexcan::settings::DEFAULT_IRQ_PRIORITY));
+    stop_end_begin_start_again(state, regs, nvic, (tx, rx));
+}
+
+type Halves = twocan_flexcan::rt::Halves<Regs, 32, twocan_core::FifoQueue<16>, 8>;
+
+/// Issue 22 item 11: the way back. `stop` masks the five lines while the handlers are
+/// still in place, then takes them back (the entry points do nothing from then on: a
+/// frame that arrives stays in the FIFO) and gives the controller back; it ends
+/// (module disabled, flags cleared, clock gate and pins released) and begins again,
+/// and the same state starts again over it.
+fn stop_end_begin_start_again(
+    state: &'static Wired,
+    regs: Regs,
+    mut nvic: Recorder,
+    (mut tx, mut rx): Halves,
+) {
+    use twocan_flexcan::rt::StopError;
+
+    nvic.watch = Some(state);
+    // (`rt::can1_ored_message_buffer` exists with `teensy36` only; it runs this.)
+    frame_arrives(regs, 0x55, &[5]);
+    assert!(rt::dispatch(Instance::Can1, Line::Message));
+    assert_eq!(rx.receive().map(|f| f.frame.raw_id()).ok(), Some(0x55));
+    tx.try_send(&Frame::standard(0x66, &[6]).unwrap()).unwrap();
+
+    // A reference from `hardware()` alive: refused, the handlers put back, the lines
+    // unmasked again.
+    let lease = state.state().hardware().unwrap();
+    nvic.calls.clear();
+    let Err((e, (tx, rx))) = state.stop(tx, rx, &mut nvic) else {
+        panic!("stopped while a reference to the controller was alive");
+    };
+    assert_eq!(e, StopError::Leased);
+    assert_eq!(state.installed(), [true; 2]);
+    assert_eq!(
+        nvic.calls.iter().filter(|c| c.0 == "unmask").count(),
+        5,
+        "{:?}",
+        nvic.calls
+    );
+    drop(lease);
+
+    nvic.calls.clear();
+    nvic.installed_at_mask.clear();
+    let (hw, left) = state.stop(tx, rx, &mut nvic).map_err(|(e, _)| e).unwrap();
+    let masked: Vec<u16> = nvic.calls.iter().map(|c| c.1).collect();
+    assert_eq!(masked, [94, 95, 96, 97, 98], "{:?}", nvic.calls);
+    assert!(nvic.calls.iter().all(|c| c.0 == "mask"));
+    assert_eq!(
+        nvic.installed_at_mask, [[true; 2]; 5],
+        "every line masked while its handler was in place"
+    );
+    assert_eq!(state.installed(), [false; 2]);
+    assert_eq!(left.queued, 0, "0x66 went to MB15 at once");
+    // No handler runs after the mask: a frame arriving now stays in the FIFO.
+    frame_arrives(regs, 0x77, &[7]);
+    assert!(!rt::dispatch(Instance::Can1, Line::Message));
+    assert!(!rt::dispatch(Instance::Can1, Line::Status));
+    assert_ne!(
+        regs.read32(IFLAG1) & iflag1::BUF5I,
+        0,
+        "nobody read the FIFO"
+    );
+
+    // End: module disabled, interrupt flags cleared.
+    let regs_back = hw
+        .into_controller()
+        .end(&mut HostSystem::new())
+        .map_err(|(_, e)| e)
+        .unwrap();
+    assert!(core::ptr::eq(regs_back, regs));
+    assert_ne!(regs.read32(MCR) & mcr::MDIS, 0, "module disabled");
+    assert_eq!(regs.read32(IFLAG1) & iflag1::BUF5I, 0, "flags cleared");
+
+    // Begin again, start the same state again: the entry points run it.
+    nvic.calls.clear();
+    nvic.handled_at_unmask.clear();
+    let hw = begin(regs_back, Instance::Can1, 0x20).into_split();
+    let (_tx, mut rx) = state.start(hw, &mut nvic).map_err(|(e, _)| e).unwrap();
+    assert_eq!(nvic.handled_at_unmask, [true; 5]);
+    assert!(nvic
+        .calls
+        .iter()
+        .filter(|c| c.0 == "unmask")
+        .all(|c| c.2 == 0x20));
+    frame_arrives(regs, 0x88, &[8]);
+    assert!(rt::dispatch(Instance::Can1, Line::Message));
+    assert_eq!(rx.receive().map(|f| f.frame.raw_id()).ok(), Some(0x88));
 }

@@ -3,7 +3,10 @@
 //! Runs with a board feature (`--features model,teensy36` etc.); the compile-time half
 //! (a pin the board lacks does not build) is the `compile_fail` examples of `pin`'s
 //! documentation.
-#![cfg(any(feature = "teensy32", feature = "teensy35", feature = "teensy36"))]
+#![cfg(all(
+    any(feature = "teensy32", feature = "teensy35", feature = "teensy36"),
+    not(any(feature = "teensy40", feature = "teensy41"))
+))]
 
 mod common;
 

@@ -21,8 +21,7 @@ use twocan_core::{
 };
 use twocan_flexcan::model::FlexCanModel;
 use twocan_flexcan::{
-    BeginError, Board, ConfigErrors, Configuration, FlexCanHw, Instance, Settings, Target,
-    CAN_CLOCK_HZ,
+    BeginError, Board, CanClock, ConfigErrors, Configuration, FlexCanHw, Instance, Settings, Target,
 };
 use twocan_host::{
     attach_plain, BxNode, FlexNode, Harness, Serviced, SetupError, RX_RING, STM32F767_APB1_HZ,
@@ -278,8 +277,56 @@ fn timing_refused(e: TimingError) -> TimingRefused {
 // ---------------------------------------------------------------------------------------
 // FlexCAN: can0 of a Teensy 3.6.
 
+/// Which FlexCAN module a [`FlexCanBackendOf`] drives, and the facts that differ between
+/// the parts: the module, its CAN clock and the bit-rate range that clock gives under the
+/// reference manuals' rule (8 to 25 quanta, `PRESDIV` up to 256, 16 bus clocks per bit
+/// with 16 message buffers, the bus clock taken equal to the CAN clock).
+pub trait FlexPart: 'static {
+    /// Name in messages.
+    const NAME: &'static str;
+    /// The module.
+    const TARGET: Target;
+    /// The protocol engine clock.
+    const CLOCK: CanClock;
+    /// The slowest rate: clock / (256 × 25).
+    const SLOWEST_BITRATE: u32;
+    /// The fastest rate: clock / 16 (16 bus clocks per bit), capped by 8 quanta.
+    const FASTEST_BITRATE: u32;
+}
+
+/// FlexCAN0 of a Teensy 3.6 (MK66FX1M0, 16 message buffers), 16 MHz oscillator.
+pub struct Teensy36Can0;
+
+impl FlexPart for Teensy36Can0 {
+    const NAME: &'static str = "FlexCAN (Teensy 3.6 can0)";
+    const TARGET: Target = Target::new(Board::Teensy36, Instance::Can0);
+    const CLOCK: CanClock = CanClock::Oscillator16MHz;
+    const SLOWEST_BITRATE: u32 = 2_500;
+    const FASTEST_BITRATE: u32 = 1_000_000;
+}
+
+/// CAN3 of a Teensy 4.1 (i.MX RT1062, 64 message buffers, the CAN FD capable module in
+/// classic CAN), the 24 MHz oscillator as CAN clock root.
+pub struct Teensy41Can3;
+
+impl FlexPart for Teensy41Can3 {
+    const NAME: &'static str = "FlexCAN (Teensy 4.1 CAN3)";
+    const TARGET: Target = Target::new(Board::Teensy41, Instance::Can3);
+    const CLOCK: CanClock = CanClock::IMXRT_24MHZ;
+    const SLOWEST_BITRATE: u32 = 3_750;
+    const FASTEST_BITRATE: u32 = 1_500_000;
+}
+
+/// A FlexCAN module through ACAN's `begin`: the driver is the same for every part, the
+/// part is data ([`FlexPart`]).
+pub struct FlexCanBackendOf<P: FlexPart>(core::marker::PhantomData<P>);
+
 /// FlexCAN can0 of a Teensy 3.6 through ACAN's `begin`.
-pub struct FlexCanBackend;
+pub type FlexCanBackend = FlexCanBackendOf<Teensy36Can0>;
+
+/// CAN3 of a Teensy 4.1 (i.MX RT1062) through the same `begin`: the third configuration
+/// of the conformance suite.
+pub type Rt1062Backend = FlexCanBackendOf<Teensy41Can3>;
 
 /// The limits the FlexCAN driver accepts (the fields and 8 quanta per bit).
 const LIMITS_FLEX: Limits = Limits::FLEXCAN_KINETIS;
@@ -293,7 +340,16 @@ pub fn teensy36_can0() -> Target {
 /// default 12/12 configuration, more in the 14/18 configuration (14 primary, the rest
 /// secondary). Gives the settings and the two lists.
 pub fn flexcan_lists(bit_rate: u32, filters: &[Filter]) -> (Settings, Vec<Filter>, Vec<Filter>) {
-    let mut s = Settings::new(bit_rate);
+    flexcan_lists_on(CanClock::Oscillator16MHz, bit_rate, filters)
+}
+
+/// [`flexcan_lists`] from the CAN clock `clock`.
+pub fn flexcan_lists_on(
+    clock: CanClock,
+    bit_rate: u32,
+    filters: &[Filter],
+) -> (Settings, Vec<Filter>, Vec<Filter>) {
+    let mut s = Settings::with_clock(bit_rate, clock);
     if filters.len() <= Configuration::Filters12_12.primary_filter_capacity() {
         (s, filters.to_vec(), Vec::new())
     } else {
@@ -364,13 +420,14 @@ impl Dut for FlexNode {
         self.model.frames_discarded()
     }
     fn bitrate_in_registers(&self) -> u32 {
-        flexcan_ctrl1_bitrate(self.model.peek32(twocan_flexcan::regs::CTRL1), CAN_CLOCK_HZ)
+        let clock = self.driver.hardware().capabilities().clock_hz;
+        flexcan_ctrl1_bitrate(self.model.peek32(twocan_flexcan::regs::CTRL1), clock)
     }
 }
 
-impl Backend for FlexCanBackend {
+impl<P: FlexPart> Backend for FlexCanBackendOf<P> {
     type Node = FlexNode;
-    const NAME: &'static str = "FlexCAN (Teensy 3.6 can0)";
+    const NAME: &'static str = P::NAME;
     const RX_FIFO_DEPTH: usize = 6;
     const OVERRUN: OverrunPolicy = OverrunPolicy::DiscardNew;
     const MAX_EXACT_STD_FILTERS: usize = 14 + 18;
@@ -388,14 +445,14 @@ impl Backend for FlexCanBackend {
     };
     const RX_QUEUES: u8 = 1;
     const TIMESTAMP_BITS: Option<u8> = Some(16);
-    const CLOCK_HZ: u32 = 16_000_000;
+    const CLOCK_HZ: u32 = P::CLOCK.hz();
     const LIMITS: Limits = Limits::FLEXCAN_KINETIS;
     const PERIPHERAL_CLOCK: Option<PeripheralClockRule> = Some(PeripheralClockRule {
-        peripheral_hz: 16_000_000,
+        peripheral_hz: P::CLOCK.hz(),
         min_clocks_per_bit: 16,
     });
-    const FASTEST_BITRATE: u32 = 1_000_000;
-    const SLOWEST_BITRATE: u32 = 2_500;
+    const FASTEST_BITRATE: u32 = P::FASTEST_BITRATE;
+    const SLOWEST_BITRATE: u32 = P::SLOWEST_BITRATE;
     const WAKEUP_EVENTS: bool = false;
     const TIMESTAMP_COUNTER_READABLE: bool = true;
 
@@ -405,33 +462,32 @@ impl Backend for FlexCanBackend {
         attach: impl FnOnce(&mut Bus, &str, Box<dyn BusNode>) -> NodeId,
     ) -> Result<FlexNode, Refused> {
         let rate = h.bus().borrow().bit_rate();
-        let (mut s, primary, secondary) = flexcan_lists(rate, &opts.filters);
+        let (mut s, primary, secondary) = flexcan_lists_on(P::CLOCK, rate, &opts.filters);
         s.bus_off_recovery = portable_recovery(opts.recovery);
-        FlexNode::begin_via(h, teensy36_can0(), &s, &primary, &secondary, attach)
-            .map_err(flexcan_refused)
+        FlexNode::begin_via(h, P::TARGET, &s, &primary, &secondary, attach).map_err(flexcan_refused)
     }
 
     fn check_timing(bitrate: u32, sample_point_permille: u16) -> Result<u32, TimingRefused> {
         // An application's settings for that rate and sample point (the solver within
         // the limits the driver accepts), given to `begin`.
-        let t = solve(CAN_CLOCK_HZ, bitrate, &LIMITS_FLEX, sample_point_permille)
+        let t = solve(P::CLOCK.hz(), bitrate, &LIMITS_FLEX, sample_point_permille)
             .map_err(timing_refused)?;
         Self::check_given_timing(&t)
     }
 
     fn check_given_timing(timing: &Timing) -> Result<u32, TimingRefused> {
-        let mut s = Settings::new(timing.bitrate);
+        let mut s = Settings::with_clock(timing.bitrate, P::CLOCK);
         s.timing = *timing;
-        let model = twocan_flexcan::model::FlexCanModel::mk66fx1m0();
+        let model = FlexCanModel::new(P::TARGET.model_chip());
         let r = twocan_flexcan::FlexCan::begin(
             twocan_flexcan::IdleClocked::new(model),
             &mut twocan_flexcan::HostSystem::new(),
-            teensy36_can0(),
+            P::TARGET,
             &s,
             &[Filter::pass_all()],
             &[],
         );
-        let flags = twocan_flexcan::check(teensy36_can0(), &s, &[Filter::pass_all()], &[]);
+        let flags = twocan_flexcan::check(P::TARGET, &s, &[Filter::pass_all()], &[]);
         match r {
             Ok(_) => {
                 assert_eq!(flags, ConfigErrors::NONE, "check() and begin() agree");
@@ -476,7 +532,7 @@ impl Backend for FlexCanBackend {
             hw.registers_mut().set_bus(h.bus());
             h.bus()
                 .borrow_mut()
-                .attach("teensy36-can0-moved", model.clone())
+                .attach(&format!("{}-moved", P::NAME), model.clone())
         })?;
         Ok((FlexNode { model, driver, id }, BitrateChange::FiltersKept))
     }

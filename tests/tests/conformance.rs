@@ -1,8 +1,9 @@
 //! Issue 6, item 2: one conformance suite, run on both controllers.
 //!
-//! Every test is a generic function over [`Backend`] (FlexCAN can0 of a Teensy 3.6 and
-//! bxCAN CAN1 of an STM32F767, each the real driver over its peripheral model on the
-//! simulated bus); the `suite!` macro at the end instantiates each for both. The other
+//! Every test is a generic function over [`Backend`] (FlexCAN can0 of a Teensy 3.6, FlexCAN
+//! CAN3 of a Teensy 4.1 (i.MX RT1062, issue 24) and bxCAN CAN1 of an STM32F767, each the
+//! real driver over its peripheral model on the simulated bus); the `suite!` macro at the
+//! end instantiates each for the three. The other
 //! side of the bus is a plain ISO node ([`SimNode`]), which counts on its own what it sent
 //! and received. Expected values come from the CAN rules (ISO 11898-1 counters, frame
 //! format), from the hardware manuals (FIFO depth, filter capacity) or from a hand-written
@@ -18,7 +19,7 @@ use twocan_host::Harness;
 use twocan_sim::{Fault, NodeId, Receivers, SimNode};
 use twocan_tests::backend::{
     harness_at, Backend, BxCanBackend, Dut, FlexCanBackend, ManualRecoveryCount, NodeOptions,
-    Recovery, Refused, TimingRefused,
+    Recovery, Refused, Rt1062Backend, TimingRefused,
 };
 use twocan_tests::support::{
     attach_peer, attach_sim, bytes, drain, ext_frame, first_match, frame_zoo, remote_frame, run,
@@ -533,8 +534,9 @@ fn capabilities_are_the_hardware_facts<B: Backend>() {
     assert_eq!(caps.timing_limits, B::LIMITS, "{}", B::NAME);
     assert_eq!(caps.peripheral_clock, B::PERIPHERAL_CLOCK, "{}", B::NAME);
     // FlexCAN: at least 8 quanta per bit (Kinetis RM), not the CTRL1 fields' 5.
+    // FlexCAN clocks: the Kinetis 16 MHz oscillator, the RT1062's 24 MHz root.
     let fewest_quanta = match B::CLOCK_HZ {
-        16_000_000 => 8,
+        16_000_000 | 24_000_000 => 8,
         _ => 3,
     };
     assert_eq!(
@@ -551,6 +553,8 @@ fn capabilities_are_the_hardware_facts<B: Backend>() {
     // 3.2 Mbit/s (5 quanta, ACAN §16.1).
     let (slowest, fastest) = match B::CLOCK_HZ {
         16_000_000 => (16_000_000 / (256 * 25), 1_000_000),
+        // The RT1062 (IMXRT1060RM, the same rule): 24 MHz / 16 bus clocks = 1.5 Mbit/s.
+        24_000_000 => (24_000_000 / (256 * 25), 24_000_000 / 16),
         54_000_000 => (54_000_000 / (1024 * 25), 18_000_000),
         c => panic!("unexpected clock {c}"),
     };
@@ -1080,7 +1084,7 @@ fn reported_timings_are_accepted_by_every_entry_point<B: Backend>() {
         .find_map(|n| register_timing(B::CLOCK_HZ, &l, n, short_q));
     let beyond: Vec<Timing> = faster.into_iter().chain(short).collect();
     let expected = match B::CLOCK_HZ {
-        16_000_000 => 2,
+        16_000_000 | 24_000_000 => 2,
         _ => 0,
     };
     assert_eq!(beyond.len(), expected, "{}: {beyond:?}", B::NAME);
@@ -1562,4 +1566,5 @@ macro_rules! suite {
 }
 
 suite!(flexcan, FlexCanBackend);
+suite!(flexcan_rt1062, Rt1062Backend);
 suite!(bxcan, BxCanBackend);

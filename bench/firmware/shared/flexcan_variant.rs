@@ -2,20 +2,23 @@
 //! selected by the firmware crate's cargo feature (`lean` or `full`, exactly one).
 //! Included with `#[path]` by `insn-count-flexcan` (QEMU, RAM stand-in) and
 //! `loopback-flexcan` (Teensy 3.6), generic over the register handle `R` (the stand-in
-//! or FlexCAN0's `FlexCanRegs`).
+//! or FlexCAN0's `Can0At`).
 //!
 //! Both: FlexCAN0 of a Teensy 3.6 at 500 kbit/s from the 16 MHz oscillator clock,
 //! loop-back with self reception, the 8-filter Rx FIFO partition (`Filters8_0`), one
-//! pass-all filter, request-order transmit through MB15.
+//! pass-all filter, request-order transmit through MB15. The register handle is
+//! `FlexCanAt` (the module's address known at compile time).
 //!
 //! - **full**: transmit completions (a completion ring of [`DONE`] = 8), receive and
-//!   transmit time stamps, traffic statistics, the filter list compiled by `begin`'s
-//!   runtime planner;
-//! - **lean**: the closest the current driver API comes to issue 21's lean driver: no
-//!   completion ring ([`DONE`] = 0). The FlexCAN driver has no switch yet for its time
-//!   stamps (always widened), its statistics, or a filter plan made at compile time
-//!   (`begin` always compiles the list): **pending** — when the lean driver lands, the
-//!   lean block below is the one place to switch to its types.
+//!   transmit time stamps, traffic statistics, the filter list compiled at run time by
+//!   `FlexCan::begin_in` straight into a `static` `TableSlot`
+//!   (`twocan_flexcan::options::FullInSlot`: filter switches too);
+//! - **lean**: no completion ring ([`DONE`] = 0) and the controller's lean choices
+//!   (`twocan_flexcan::options::Lean`: no time stamps, no filter switch while running,
+//!   the filter table planned at compile time by `const_plan!` and the settings checked
+//!   at compile time (`BeginPlan`), written by `FlexCan::begin_checked`, which keeps a
+//!   few words pointing into the plan).
+//!   Statistics stay on (twocan-core's counters).
 
 // Each firmware that includes this module uses a part of it.
 #![allow(dead_code)]
@@ -62,6 +65,9 @@ pub const VARIANT: &str = "lean";
 /// Completion ring capacity (0: completions off).
 #[cfg(feature = "lean")]
 pub const DONE: usize = 0;
+/// The controller's compile-time choices: no time stamps, no filter switch.
+#[cfg(feature = "lean")]
+pub type Opts = twocan_flexcan::options::Lean;
 
 // ------------------------------------------------------------------ full
 
@@ -69,11 +75,15 @@ pub const DONE: usize = 0;
 pub const VARIANT: &str = "full";
 #[cfg(feature = "full")]
 pub const DONE: usize = 8;
+/// The controller's compile-time choices: time stamps, filter switches, the table in a
+/// `static` slot that `begin_in` compiles into.
+#[cfg(feature = "full")]
+pub type Opts = twocan_flexcan::options::FullInSlot;
 
 // ------------------------------------------------------------------ both
 
 /// The controller the split driver holds.
-pub type Hw<R> = FlexCanHw<R>;
+pub type Hw<R> = FlexCanHw<R, Opts>;
 /// The transmit queue.
 pub type Q = FifoQueue<TXQ>;
 /// The shared state a `static` holds.
@@ -93,14 +103,43 @@ pub fn configure<const RETRIES: u32, R: Registers, S: Registers>(
     regs: impl Fn() -> R,
     sys: &mut S,
 ) -> Result<Hw<R>, BeginError> {
-    let mut attempt = FlexCan::begin(regs(), sys, TARGET, &SETTINGS, &FILTERS, &[]);
-    for _ in 0..RETRIES {
-        match attempt {
-            Err(BeginError::Hardware(Error::Timeout)) => {
-                attempt = FlexCan::begin(regs(), sys, TARGET, &SETTINGS, &FILTERS, &[])
+    #[cfg(feature = "lean")]
+    {
+        // The filter table planned and the settings checked at compile time, written
+        // by `begin_checked` (no check links into the firmware).
+        use twocan_flexcan::planner::PlanOptions;
+        use twocan_flexcan::{const_plan, BeginPlan};
+        const CHECKED: BeginPlan =
+            BeginPlan::new_or_panic(TARGET, &SETTINGS, Configuration::Filters8_0);
+        let plan = const_plan!(FILTERS, PlanOptions::new(Configuration::Filters8_0)).planned();
+        let mut retries = 0;
+        loop {
+            match FlexCan::begin_checked(regs(), sys, &CHECKED, plan) {
+                Err(BeginError::Hardware(Error::Timeout)) if retries < RETRIES => retries += 1,
+                attempt => return attempt,
             }
-            _ => break,
         }
     }
-    Ok(attempt?.into_split())
+    #[cfg(feature = "full")]
+    {
+        // `begin` compiles the list at run time straight into the table's `static`.
+        let Some(mut slot) = TABLE.take() else {
+            return Err(BeginError::Hardware(Error::InvalidArgument));
+        };
+        let mut retries = 0;
+        loop {
+            match FlexCan::begin_in(regs(), sys, TARGET, &SETTINGS, &FILTERS, &[], slot) {
+                Err((BeginError::Hardware(Error::Timeout), back)) if retries < RETRIES => {
+                    retries += 1;
+                    slot = back;
+                }
+                Err((e, _)) => return Err(e),
+                Ok(hw) => return Ok(hw),
+            }
+        }
+    }
 }
+
+/// The full variant's filter table (`begin_in` compiles into it).
+#[cfg(feature = "full")]
+static TABLE: twocan_flexcan::filters::TableSlot = twocan_flexcan::filters::TableSlot::new();

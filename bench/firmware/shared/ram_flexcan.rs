@@ -40,7 +40,7 @@ use core::ptr::{read_volatile, write_volatile};
 
 use twocan_core::Registers;
 use twocan_flexcan::regs::{
-    self, code, cs, esr1, iflag1, mcr, FlexCanRegs, BLOCK_END, ESR1, IFLAG1, MCR, RXFIR,
+    self, code, cs, esr1, iflag1, mcr, FlexCanAt, BLOCK_END, ESR1, IFLAG1, MCR, RXFIR,
 };
 
 /// The FlexCAN register block in RAM.
@@ -73,9 +73,10 @@ pub fn reg_write(offset: usize, value: u32) {
     unsafe { write_volatile((REGS + offset) as *mut u32, value) }
 }
 
-/// The register block for our driver: `Mmio` volatile accesses, with the
-/// write-1-to-clear rule of `IFLAG1` and `ESR1` played on RAM (module docs).
-pub struct RamFlexCanRegs(FlexCanRegs);
+/// The register block for our driver: volatile accesses at the block's compile-time
+/// address (`FlexCanAt`, as `Can0At` on a Teensy), with the write-1-to-clear rule of
+/// `IFLAG1` and `ESR1` played on RAM (module docs).
+pub struct RamFlexCanRegs(FlexCanAt<REGS>);
 
 impl RamFlexCanRegs {
     /// The stand-in at [`REGS`].
@@ -84,7 +85,7 @@ impl RamFlexCanRegs {
     /// One driver at a time uses the stand-in.
     pub unsafe fn new() -> Self {
         // SAFETY: the caller's contract; `REGS` is RAM reserved for the stand-in.
-        RamFlexCanRegs(unsafe { FlexCanRegs::new(REGS) })
+        RamFlexCanRegs(unsafe { FlexCanAt::new() })
     }
 }
 

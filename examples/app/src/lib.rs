@@ -23,11 +23,29 @@
 
 #[cfg(feature = "async")]
 pub mod asynch;
+pub mod firmware;
 
 use twocan_core::{CanRx, CanTx, Dispatcher, Filter, Format, Frame, FrameKind, RxFrame};
 
 /// Number of filters of the application's list.
 pub const FILTER_COUNT: usize = 4;
+
+/// The filter list of node `node` talking with `peer` ([`App::filters`]), as a `const fn`:
+/// firmware with little RAM compiles it into a filter plan at build time (e.g. bxCAN's
+/// `const_plan!`) instead of planning at run time.
+pub const fn filters_for(node: u8, peer: u8) -> [Filter; FILTER_COUNT] {
+    [
+        Filter::standard(0x100 + peer as u16),
+        Filter::masked(
+            FrameKind::Data,
+            Format::Extended,
+            0x1FFF_FF00,
+            0x18FF_0000 | (peer as u32) << 8,
+        ),
+        Filter::exact(FrameKind::Remote, Format::Standard, 0x200 + node as u32),
+        Filter::exact(FrameKind::Data, Format::Standard, 0x200 + peer as u32),
+    ]
+}
 
 /// Filter index: the peer's heartbeat.
 pub const F_HEARTBEAT: usize = 0;
@@ -107,23 +125,9 @@ impl App {
         }
     }
 
-    /// The portable filter list, in the order of the `F_*` indices.
+    /// The portable filter list, in the order of the `F_*` indices ([`filters_for`]).
     pub fn filters(&self) -> [Filter; FILTER_COUNT] {
-        [
-            Filter::standard(0x100 + self.peer as u16),
-            Filter::masked(
-                FrameKind::Data,
-                Format::Extended,
-                0x1FFF_FF00,
-                0x18FF_0000 | (self.peer as u32) << 8,
-            ),
-            Filter::exact(
-                FrameKind::Remote,
-                Format::Standard,
-                0x200 + self.node as u32,
-            ),
-            Filter::exact(FrameKind::Data, Format::Standard, 0x200 + self.peer as u32),
-        ]
+        filters_for(self.node, self.peer)
     }
 
     /// Runs one period of the application with a one-struct driver (something that both

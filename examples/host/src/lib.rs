@@ -173,11 +173,7 @@ impl FlexNode {
         secondary: &[Filter],
         attach: impl FnOnce(&mut Bus, &str, Box<dyn BusNode>) -> NodeId,
     ) -> Result<Self, SetupError> {
-        let model = match target.board {
-            Board::Teensy32 => FlexCanModel::mk20dx256(),
-            Board::Teensy35 => FlexCanModel::mk64fx512(),
-            Board::Teensy36 => FlexCanModel::mk66fx1m0(),
-        };
+        let model = FlexCanModel::new(target.model_chip());
         let name = format!("{:?}-{:?}", target.board, target.instance).to_lowercase();
         let id = attach(&mut h.bus.borrow_mut(), &name, Box::new(model.clone()));
         // MCR for the mode acknowledges, ESR1 for the synchronisation after freeze.

@@ -1,6 +1,6 @@
 //! Moving a simulated board between the one-struct [`twocan_core::Driver`] and the split
 //! driver: [`split_flex`] and [`split_bx`] take the controller out of a [`FlexNode`] /
-//! [`BxNode`] and split a [`State`] of the caller over it — the transmit and receive
+//! [`BxNode`] and split a [`State`](twocan_core::State) of the caller over it — the transmit and receive
 //! halves for the application, the interrupt handlers as [`Serviced`] nodes that run
 //! when the model raises a line, as the chips' vectors would. [`unsplit_flex`] and
 //! [`unsplit_bx`] go back: the halves and handlers are given up, the state hands the

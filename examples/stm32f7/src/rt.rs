@@ -159,46 +159,9 @@ pub fn boot() -> Boot {
 }
 
 /// Priority of the CAN interrupt lines: one for all (0, the highest, as after reset).
-/// Each line runs its own handler cell; a cell run from several lines would need them
-/// at one priority (`twocan_core::irq_cell`, "One priority per cell"), which
-/// `Installed::enable` gives.
+/// Each line runs its own handler cell (`twocan_bxcan::rt`), so the lines could have
+/// different priorities; the examples keep one.
 pub const CAN_PRIORITY: u8 = 0;
-
-/// The NVIC as `twocan_core::irq_cell::Installed::enable` uses it: only a cell that
-/// holds its handler unmasks the lines that run it ([`crate::can::start`]).
-pub struct Lines<'a>(pub &'a mut cortex_m::peripheral::NVIC);
-
-impl twocan_core::irq_cell::Nvic<pac::Interrupt> for Lines<'_> {
-    fn set_priority(&mut self, line: pac::Interrupt, priority: u8) {
-        // SAFETY: this crate's critical sections mask every interrupt
-        // (`critical-section-single-core`), none is built from priorities; the line is
-        // still masked.
-        unsafe { self.0.set_priority(line, priority) };
-    }
-
-    fn unmask(&mut self, line: pac::Interrupt) {
-        // SAFETY: this crate's critical sections mask every interrupt (none is built
-        // from NVIC masks); `Installed::enable` calls this after the handle the line's
-        // vector runs is in place.
-        unsafe { cortex_m::peripheral::NVIC::unmask(line) };
-    }
-}
-
-/// CAN1's interrupts.
-pub const CAN1_IRQS: [pac::Interrupt; 4] = [
-    pac::Interrupt::CAN1_TX,
-    pac::Interrupt::CAN1_RX0,
-    pac::Interrupt::CAN1_RX1,
-    pac::Interrupt::CAN1_SCE,
-];
-
-/// CAN2's interrupts.
-pub const CAN2_IRQS: [pac::Interrupt; 4] = [
-    pac::Interrupt::CAN2_TX,
-    pac::Interrupt::CAN2_RX0,
-    pac::Interrupt::CAN2_RX1,
-    pac::Interrupt::CAN2_SCE,
-];
 
 #[cortex_m_rt::exception]
 fn SysTick() {

@@ -689,15 +689,18 @@ impl<'a> Machine<'a> {
     }
 
     /// Paints the stack (`crate::stack`): from cortex-m-rt's `_stack_end` up to the
-    /// initial stack pointer of the vector table. Call before running.
+    /// initial stack pointer reset loaded (from the vector table, or the one a boot ROM
+    /// found through its image header: the i.MX RT1062's). Call before running.
     pub fn paint_stack(&mut self) -> Result<(), String> {
         let bottom = self
             .image
             .symbol("_stack_end")
             .map(|s| s.address)
             .ok_or("stack: the ELF has no `_stack_end` symbol (cortex-m-rt 0.7.4 or newer)")?;
-        let vtor = self.uc.get_data().scb.vtor;
-        let top = read_u32(&self.uc, vtor).ok_or("stack: no initial stack pointer")? & !7;
+        let top = reg(&self.uc, RegisterARM::MSP) & !7;
+        if top == 0 {
+            return Err("stack: no initial stack pointer".into());
+        }
         let paint = crate::stack::paint(&mut self.uc, bottom, top)?;
         self.uc.get_data_mut().stack = Some(paint);
         Ok(())

@@ -7,7 +7,25 @@ use super::exceptions::halt;
 use super::Board;
 use crate::profile::Access;
 
+/// The peripheral bit-band alias (ARMv7-M ARM §B3.1; on the profiles that have it): one
+/// word at `0x4200_0000 + 32 × byte + 4 × bit` per bit of the byte at `0x4000_0000 +
+/// byte`, for the first MiB of the peripheral space.
+const BIT_BAND_ALIAS: std::ops::Range<u32> = 0x4200_0000..0x4400_0000;
+
+/// The word address and bit number a bit-band alias address stands for.
+fn bit_band_target(addr: u32) -> (u32, u32) {
+    let off = addr - BIT_BAND_ALIAS.start;
+    let byte = 0x4000_0000 + off / 32;
+    let bit = (off / 4) % 8;
+    (byte & !3, (byte & 3) * 8 + bit)
+}
+
 pub(super) fn periph_read(uc: &mut Unicorn<'_, Board>, addr: u32, size: usize) -> u64 {
+    if BIT_BAND_ALIAS.contains(&addr) && uc.get_data().profile.peripheral_bit_band() {
+        let (word, bit) = bit_band_target(addr);
+        let v = periph_read(uc, word, 4) as u32;
+        return u64::from((v >> bit) & 1);
+    }
     let b = uc.get_data_mut();
     if let Some(i) = b
         .cans
@@ -71,6 +89,18 @@ pub(super) fn periph_read(uc: &mut Unicorn<'_, Board>, addr: u32, size: usize) -
 }
 
 pub(super) fn periph_write(uc: &mut Unicorn<'_, Board>, addr: u32, size: usize, value: u32) {
+    if BIT_BAND_ALIAS.contains(&addr) && uc.get_data().profile.peripheral_bit_band() {
+        // A read-modify-write of the target word (the bus does it as one locked transfer).
+        let (word, bit) = bit_band_target(addr);
+        let v = periph_read(uc, word, 4) as u32;
+        let v = if value & 1 != 0 {
+            v | (1 << bit)
+        } else {
+            v & !(1 << bit)
+        };
+        periph_write(uc, word, 4, v);
+        return;
+    }
     let b = uc.get_data_mut();
     if let Some(i) = b
         .cans
@@ -130,5 +160,24 @@ pub(super) fn periph_write(uc: &mut Unicorn<'_, Board>, addr: u32, size: usize, 
             let _ = uc.emu_stop();
         }
         Access::Reset(why) => halt(uc, format!("chip reset: {why}")),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::bit_band_target;
+
+    #[test]
+    fn bit_band_aliases_map_to_their_bit() {
+        // RCC_APB1ENR (0x4002_101C) bit 25 on the F1; RCC_CR (0x4002_3800) bit 16 on the F4.
+        assert_eq!(
+            bit_band_target(0x4200_0000 + 0x2_101C * 32 + 25 * 4),
+            (0x4002_101C, 25)
+        );
+        assert_eq!(
+            bit_band_target(0x4200_0000 + 0x2_3800 * 32 + 16 * 4),
+            (0x4002_3800, 16)
+        );
+        assert_eq!(bit_band_target(0x4242_0000), (0x4002_1000, 0));
     }
 }

@@ -164,6 +164,14 @@ pub trait Profile {
     }
     /// Number of external interrupts.
     fn irq_count(&self) -> u32;
+    /// Whether the core maps the peripheral bit-band alias (0x4200_0000..0x4400_0000 onto
+    /// 0x4000_0000..0x4010_0000, one word per bit: ARMv7-M ARM §B3.1 "bit-banding", an
+    /// option of the Cortex-M3/M4 that the STM32F1/F4 implement, RM0008 §3.3.2, RM0390
+    /// §2.2.5; the Cortex-M7 has none). The HALs of those families set RCC enable and
+    /// reset bits through it.
+    fn peripheral_bit_band(&self) -> bool {
+        false
+    }
     /// Implemented NVIC priority bits.
     fn priority_bits(&self) -> u8 {
         4

@@ -292,6 +292,10 @@ impl Profile for Stm32f1 {
         unicorn_engine::ArmCpuModel::CORTEX_M3 as i32
     }
 
+    fn peripheral_bit_band(&self) -> bool {
+        true
+    }
+
     fn memory(&self) -> Vec<Memory> {
         vec![
             Memory {

@@ -116,6 +116,10 @@ impl Profile for Stm32f4 {
         unicorn_engine::ArmCpuModel::CORTEX_M4 as i32
     }
 
+    fn peripheral_bit_band(&self) -> bool {
+        true
+    }
+
     fn memory(&self) -> Vec<Memory> {
         vec![
             Memory {

@@ -16,13 +16,15 @@ pub use twocan_flexcan::IdleClocked as Ticking;
 /// The driver over the model with receive ring `RX` and transmit ring `TX`.
 pub type Can<const RX: usize, const TX: usize> = Driver<FlexCanHw<Ticking>, RX, TX>;
 
-/// A fresh model of the board's chip.
+/// A fresh model of the board's chip (a Teensy 4.x: its CAN1; see [`model_of`]).
 pub fn model_for(board: Board) -> FlexCanModel {
-    match board {
-        Board::Teensy32 => FlexCanModel::mk20dx256(),
-        Board::Teensy35 => FlexCanModel::mk64fx512(),
-        Board::Teensy36 => FlexCanModel::mk66fx1m0(),
-    }
+    model_of(Target::new(board, Instance::Can1))
+}
+
+/// A fresh model of the target's module: the chip's, and on the RT1062 the instance's
+/// (CAN3 differs from CAN1/CAN2).
+pub fn model_of(target: Target) -> FlexCanModel {
+    FlexCanModel::new(target.model_chip())
 }
 
 /// `begin` on `target` over a fresh model; gives the model handle and the driver.
@@ -49,7 +51,7 @@ pub fn begin_on_exact<const RX: usize, const TX: usize>(
     primary: &[Filter],
     secondary: &[Filter],
 ) -> Result<(FlexCanModel, Can<RX, TX>), BeginError> {
-    let model = model_for(target.board);
+    let model = model_of(target);
     model.scramble_ram(0x5EED);
     let controller = FlexCan::begin(
         Ticking::new(model.clone()),

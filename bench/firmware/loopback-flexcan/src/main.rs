@@ -15,7 +15,7 @@
 use cortex_m_rt::entry;
 use panic_halt as _;
 use twocan_core::{Frame, Mmio};
-use twocan_flexcan::regs::{FlexCanRegs, SystemRegs, CAN0_BASE};
+use twocan_flexcan::regs::{Can0At, SystemRegs};
 
 #[path = "../../shared/kinetis.rs"]
 mod startup;
@@ -27,7 +27,7 @@ const DATA: [u8; 8] = [0x01, 0x23, 0x45, 0x67, 0x89, 0xAB, 0xCD, 0xEF];
 /// Bound on the polls for the looped-back frame (a frame lasts ~250 µs at 500 kbit/s).
 const POLLS: u32 = 1_000_000;
 
-type R = FlexCanRegs;
+type R = Can0At;
 
 /// The driver's shared state (exported under a fixed name so that can-bench can read its
 /// size from the ELF).
@@ -37,7 +37,7 @@ static BENCH_CAN_STATE: variant::OurState<R> = variant::OurState::new();
 fn start() -> Option<variant::Hw<R>> {
     // SAFETY: FlexCAN0's register block (K66 RM memory map "CAN0"); nothing else in this
     // firmware touches it.
-    let regs = || unsafe { FlexCanRegs::new(CAN0_BASE) };
+    let regs = || unsafe { Can0At::new() };
     // SAFETY: base 0 with absolute offsets, the window SIM..PORTE: `begin` only touches
     // the clock gates and the PCRs of FlexCAN0's pins.
     let mut sys: SystemRegs = unsafe { Mmio::new(0) };

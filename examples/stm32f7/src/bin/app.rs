@@ -15,15 +15,14 @@
 #[cfg(target_os = "none")]
 mod firmware {
     use core::cell::RefCell;
-    use core::sync::atomic::{AtomicU32, Ordering};
+    use core::sync::atomic::AtomicU32;
 
     use critical_section::Mutex;
-    use stm32f7xx_hal::pac::interrupt;
+    use twocan_app::firmware::{FirmwareLoop, Published};
     use twocan_app::{App, AppStats};
     use twocan_bxcan::{hal, FifoPolicy, Recovery};
-    use twocan_core::ErrorState;
     use twocan_stm32f7::board::BIT_RATE;
-    use twocan_stm32f7::can::{self, CanState, Vectors};
+    use twocan_stm32f7::can::{self, CanState};
     use twocan_stm32f7::rt::{self, CAN_BLINKS};
     use twocan_stm32f7::time::{self, Every};
 
@@ -32,7 +31,6 @@ mod firmware {
     const PEER: u8 = 1;
 
     static CAN1: CanState = CanState::new();
-    static CAN1_VECTORS: Vectors = Vectors::new();
 
     /// The application's counters, copied after each step (`None` before the first).
     pub static STATS: Mutex<RefCell<Option<AppStats>>> = Mutex::new(RefCell::new(None));
@@ -42,23 +40,6 @@ mod firmware {
     /// The worst fault-confinement state reported so far: 0 error active, 1 warning,
     /// 2 error passive, 3 bus-off (`ErrorState` in declaration order).
     pub static WORST_STATE: AtomicU32 = AtomicU32::new(0);
-
-    #[interrupt]
-    fn CAN1_TX() {
-        CAN1_VECTORS.on_tx();
-    }
-    #[interrupt]
-    fn CAN1_RX0() {
-        CAN1_VECTORS.on_rx0();
-    }
-    #[interrupt]
-    fn CAN1_RX1() {
-        CAN1_VECTORS.on_rx1();
-    }
-    #[interrupt]
-    fn CAN1_SCE() {
-        CAN1_VECTORS.on_sce();
-    }
 
     #[cortex_m_rt::entry]
     fn main() -> ! {
@@ -89,45 +70,34 @@ mod firmware {
             rt::halt(CAN_BLINKS);
         }
         let can = init.enable().unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        let (mut tx, mut rx) = can::start(
-            &CAN1,
-            &CAN1_VECTORS,
-            can.into_split(),
-            rt::CAN1_IRQS,
-            &mut boot.core.NVIC,
-        )
-        .unwrap_or_else(|| rt::halt(CAN_BLINKS));
+        let (mut tx, mut rx) = can::start(&CAN1, can.into_split(), &mut boot.core.NVIC)
+            .unwrap_or_else(|| rt::halt(CAN_BLINKS));
         twocan_stm32f7::info!(
             "CAN1 on the bus with the application's {=usize} filters",
             app.filters().len()
         );
-        let mut steps: u32 = 0;
-
+        let published = Published {
+            stats: &STATS,
+            state_changes: &STATE_CHANGES,
+            worst_state: &WORST_STATE,
+        };
+        let mut main_loop = FirmwareLoop::new();
         let mut period = Every::new(time::millis(), 10);
-        let mut shown = 0;
         loop {
             if period.due(time::millis()) {
-                app.handle(&mut rx);
-                app.publish(&mut tx);
-                while tx.take_completion().is_some() {}
-                let stats = app.stats();
-                while let Some(c) = rx.take_state_change() {
-                    STATE_CHANGES.fetch_add(1, Ordering::Relaxed);
-                    if c.state <= ErrorState::BusOff {
-                        WORST_STATE.fetch_max(c.state as u32, Ordering::Relaxed);
-                    }
+                let step = main_loop.step_split(&mut app, &mut tx, &mut rx, &published, |c| {
                     twocan_stm32f7::warn!(
                         "CAN1 error state {} (TEC {=u16}, REC {=u16})",
                         c.state,
                         c.counters.tec,
                         c.counters.rec
                     );
-                }
-                steps = steps.wrapping_add(1);
-                if steps.is_multiple_of(100) {
+                });
+                let stats = step.stats;
+                if step.log {
                     twocan_stm32f7::info!(
                         "step {=u32}: sent {=u32}, heartbeats {=u32} (gaps {=u32}, duplicates {=u32}), measurements {=u32}, requests {=u32}, answers {=u32}, queue full {=u32}",
-                        steps,
+                        step.steps,
                         stats.sent,
                         stats.heartbeats,
                         stats.heartbeat_gaps,
@@ -138,9 +108,7 @@ mod firmware {
                         stats.tx_full
                     );
                 }
-                critical_section::with(|cs| *STATS.borrow_ref_mut(cs) = Some(stats));
-                if stats.heartbeats >= shown + 50 {
-                    shown = stats.heartbeats;
+                if step.blink {
                     boot.led.toggle();
                 }
             }

@@ -3,8 +3,9 @@
 //! identifier plus one (`twocan_app::asynch::echo`), through `rx.recv().await` and
 //! `tx.send().await` of the split driver's halves.
 //!
-//! The four bxCAN vectors (TX, RX0, RX1, SCE, RM0410 §40.8) run the driver's handlers
-//! as in the other examples (`can::start` puts them in place, then unmasks the lines);
+//! The library's four bxCAN entry points (TX, RX0, RX1, SCE, RM0410 §40.8) run the
+//! driver's handlers as in the other examples (`can::start` puts them in place, then
+//! unmasks the lines);
 //! the handlers wake the waiting task through its waker, and the executor sleeps in
 //! `WFE` between wakes. Pins: NUCLEO-F767ZI PD0 = RX, PD1 = TX; 32F746G-DISCO PB8 = RX,
 //! PB9 = TX, through a transceiver, 120 Ω at each end. With a USB-CAN adapter on the
@@ -22,37 +23,18 @@ mod firmware {
 
     use embassy_executor::Executor;
     use static_cell::StaticCell;
-    use stm32f7xx_hal::pac::interrupt;
     use twocan_app::asynch::{echo, EchoStats};
     use twocan_bxcan::{hal, FifoPolicy, Recovery};
     use twocan_core::Filter;
     use twocan_stm32f7::board::BIT_RATE;
-    use twocan_stm32f7::can::{self, CanRxHalf, CanState, CanTxHalf, Vectors};
+    use twocan_stm32f7::can::{self, CanRxHalf, CanState, CanTxHalf};
     use twocan_stm32f7::rt::{self, Led, CAN_BLINKS};
 
     static CAN1: CanState = CanState::new();
-    static CAN1_VECTORS: Vectors = Vectors::new();
     static EXECUTOR: StaticCell<Executor> = StaticCell::new();
 
     /// Echoes sent so far (for a debugger).
     pub static ECHOED: AtomicU32 = AtomicU32::new(0);
-
-    #[interrupt]
-    fn CAN1_TX() {
-        CAN1_VECTORS.on_tx();
-    }
-    #[interrupt]
-    fn CAN1_RX0() {
-        CAN1_VECTORS.on_rx0();
-    }
-    #[interrupt]
-    fn CAN1_RX1() {
-        CAN1_VECTORS.on_rx1();
-    }
-    #[interrupt]
-    fn CAN1_SCE() {
-        CAN1_VECTORS.on_sce();
-    }
 
     /// Receives and echoes, forever; drains the completions it does not wait for.
     #[embassy_executor::task]
@@ -92,14 +74,8 @@ mod firmware {
             rt::halt(CAN_BLINKS);
         }
         let can = init.enable().unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        let (tx, rx) = can::start(
-            &CAN1,
-            &CAN1_VECTORS,
-            can.into_split(),
-            rt::CAN1_IRQS,
-            &mut boot.core.NVIC,
-        )
-        .unwrap_or_else(|| rt::halt(CAN_BLINKS));
+        let (tx, rx) = can::start(&CAN1, can.into_split(), &mut boot.core.NVIC)
+            .unwrap_or_else(|| rt::halt(CAN_BLINKS));
         let led = boot.led;
         EXECUTOR.init(Executor::new()).run(|spawner| {
             spawner.spawn(echo_task(tx, rx, led).unwrap_or_else(|_| rt::halt(CAN_BLINKS)));

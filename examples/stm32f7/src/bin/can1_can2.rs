@@ -20,61 +20,24 @@ mod firmware {
     use core::cell::RefCell;
 
     use critical_section::Mutex;
-    use stm32f7xx_hal::pac::interrupt;
     use twocan_app::{App, AppStats};
     use twocan_bxcan::hal::{self, Can1Filters};
     use twocan_bxcan::regs::ControlRegs;
     use twocan_bxcan::{FifoPolicy, Recovery};
     use twocan_stm32f7::board::BIT_RATE;
-    use twocan_stm32f7::can::{self, CanState, Vectors};
+    use twocan_stm32f7::can::{self, CanState};
     use twocan_stm32f7::rt::{self, CAN_BLINKS};
     use twocan_stm32f7::time::{self, Every};
 
     // Each controller owns its control registers and shares CAN1's filter block (RM0410
     // §40.9.4) through the `Can1Filters` handle of the hand-over.
     type Shared = CanState<ControlRegs, Can1Filters>;
-    type SharedVectors = Vectors<ControlRegs, Can1Filters>;
     static CAN1: Shared = Shared::new();
-    static CAN1_VECTORS: SharedVectors = SharedVectors::new();
     static CAN2: Shared = Shared::new();
-    static CAN2_VECTORS: SharedVectors = SharedVectors::new();
 
     /// The counters of node 1 (CAN1) and node 2 (CAN2), copied after each step
     /// (`None` before the first).
     pub static STATS: Mutex<RefCell<Option<[AppStats; 2]>>> = Mutex::new(RefCell::new(None));
-
-    #[interrupt]
-    fn CAN1_TX() {
-        CAN1_VECTORS.on_tx();
-    }
-    #[interrupt]
-    fn CAN1_RX0() {
-        CAN1_VECTORS.on_rx0();
-    }
-    #[interrupt]
-    fn CAN1_RX1() {
-        CAN1_VECTORS.on_rx1();
-    }
-    #[interrupt]
-    fn CAN1_SCE() {
-        CAN1_VECTORS.on_sce();
-    }
-    #[interrupt]
-    fn CAN2_TX() {
-        CAN2_VECTORS.on_tx();
-    }
-    #[interrupt]
-    fn CAN2_RX0() {
-        CAN2_VECTORS.on_rx0();
-    }
-    #[interrupt]
-    fn CAN2_RX1() {
-        CAN2_VECTORS.on_rx1();
-    }
-    #[interrupt]
-    fn CAN2_SCE() {
-        CAN2_VECTORS.on_sce();
-    }
 
     #[cortex_m_rt::entry]
     fn main() -> ! {
@@ -116,22 +79,10 @@ mod firmware {
         }
         let can1 = init1.enable().unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         let can2 = init2.enable().unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        let (mut tx1, mut rx1) = can::start(
-            &CAN1,
-            &CAN1_VECTORS,
-            can1.into_split(),
-            rt::CAN1_IRQS,
-            &mut boot.core.NVIC,
-        )
-        .unwrap_or_else(|| rt::halt(CAN_BLINKS));
-        let (mut tx2, mut rx2) = can::start(
-            &CAN2,
-            &CAN2_VECTORS,
-            can2.into_split(),
-            rt::CAN2_IRQS,
-            &mut boot.core.NVIC,
-        )
-        .unwrap_or_else(|| rt::halt(CAN_BLINKS));
+        let (mut tx1, mut rx1) = can::start(&CAN1, can1.into_split(), &mut boot.core.NVIC)
+            .unwrap_or_else(|| rt::halt(CAN_BLINKS));
+        let (mut tx2, mut rx2) = can::start(&CAN2, can2.into_split(), &mut boot.core.NVIC)
+            .unwrap_or_else(|| rt::halt(CAN_BLINKS));
 
         let mut period = Every::new(time::millis(), 10);
         let mut shown = 0;

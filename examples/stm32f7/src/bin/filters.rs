@@ -23,17 +23,15 @@
 mod firmware {
     use core::sync::atomic::{AtomicU32, Ordering};
 
-    use stm32f7xx_hal::pac::interrupt;
     use twocan_bxcan::{hal, FifoPolicy};
     use twocan_core::{Dispatcher, Filter, Format, Frame, FrameKind, RxFrame};
-    use twocan_stm32f7::can::{self, CanState, Vectors};
+    use twocan_stm32f7::can::{self, CanState};
     use twocan_stm32f7::rt::{self, CAN_BLINKS};
     use twocan_stm32f7::time::{self, Every};
 
     const FILTERS: usize = 6;
 
     static CAN1: CanState = CanState::new();
-    static CAN1_VECTORS: Vectors = Vectors::new();
 
     /// Frames per filter index.
     pub static HITS: [AtomicU32; FILTERS] = [const { AtomicU32::new(0) }; FILTERS];
@@ -41,23 +39,6 @@ mod firmware {
     pub static ERRORS: AtomicU32 = AtomicU32::new(0);
     /// Filter banks of the plan assigned to FIFO 0 and FIFO 1.
     pub static BANKS: [AtomicU32; 2] = [const { AtomicU32::new(0) }; 2];
-
-    #[interrupt]
-    fn CAN1_TX() {
-        CAN1_VECTORS.on_tx();
-    }
-    #[interrupt]
-    fn CAN1_RX0() {
-        CAN1_VECTORS.on_rx0();
-    }
-    #[interrupt]
-    fn CAN1_RX1() {
-        CAN1_VECTORS.on_rx1();
-    }
-    #[interrupt]
-    fn CAN1_SCE() {
-        CAN1_VECTORS.on_sce();
-    }
 
     fn filters() -> [Filter; FILTERS] {
         [
@@ -119,14 +100,8 @@ mod firmware {
             rt::halt(CAN_BLINKS);
         }
         let can = init.enable().unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        let (mut tx, mut rx) = can::start(
-            &CAN1,
-            &CAN1_VECTORS,
-            can.into_split(),
-            rt::CAN1_IRQS,
-            &mut boot.core.NVIC,
-        )
-        .unwrap_or_else(|| rt::halt(CAN_BLINKS));
+        let (mut tx, mut rx) = can::start(&CAN1, can.into_split(), &mut boot.core.NVIC)
+            .unwrap_or_else(|| rt::halt(CAN_BLINKS));
 
         let mut dispatcher: Dispatcher<(), FILTERS> = Dispatcher::new();
         for i in 0..FILTERS {

@@ -11,37 +11,18 @@
 mod firmware {
     use core::sync::atomic::{AtomicU32, Ordering};
 
-    use stm32f7xx_hal::pac::interrupt;
     use twocan_bxcan::{hal, FifoPolicy};
     use twocan_core::{Filter, Frame};
-    use twocan_stm32f7::can::{self, CanState, Vectors};
+    use twocan_stm32f7::can::{self, CanState};
     use twocan_stm32f7::rt::{self, CAN_BLINKS};
     use twocan_stm32f7::time::{self, Every};
 
     static CAN1: CanState = CanState::new();
-    static CAN1_VECTORS: Vectors = Vectors::new();
 
     /// Frames handed to the driver.
     pub static SENT: AtomicU32 = AtomicU32::new(0);
     /// Frames received back.
     pub static RECEIVED: AtomicU32 = AtomicU32::new(0);
-
-    #[interrupt]
-    fn CAN1_TX() {
-        CAN1_VECTORS.on_tx();
-    }
-    #[interrupt]
-    fn CAN1_RX0() {
-        CAN1_VECTORS.on_rx0();
-    }
-    #[interrupt]
-    fn CAN1_RX1() {
-        CAN1_VECTORS.on_rx1();
-    }
-    #[interrupt]
-    fn CAN1_SCE() {
-        CAN1_VECTORS.on_sce();
-    }
 
     #[cortex_m_rt::entry]
     fn main() -> ! {
@@ -66,14 +47,8 @@ mod firmware {
             rt::halt(CAN_BLINKS);
         }
         let can = init.enable().unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        let (mut tx, mut rx) = can::start(
-            &CAN1,
-            &CAN1_VECTORS,
-            can.into_split(),
-            rt::CAN1_IRQS,
-            &mut boot.core.NVIC,
-        )
-        .unwrap_or_else(|| rt::halt(CAN_BLINKS));
+        let (mut tx, mut rx) = can::start(&CAN1, can.into_split(), &mut boot.core.NVIC)
+            .unwrap_or_else(|| rt::halt(CAN_BLINKS));
 
         let message = Frame::standard(0x542, &[]).unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         let mut send = Every::new(time::millis(), 1000);

@@ -16,11 +16,11 @@
 #[cfg(target_os = "none")]
 mod firmware {
     use core::cell::RefCell;
-    use core::sync::atomic::{AtomicU32, Ordering};
+    use core::sync::atomic::AtomicU32;
 
     use critical_section::Mutex;
+    use twocan_app::firmware::{FirmwareLoop, Published};
     use twocan_app::{App, AppStats};
-    use twocan_core::ErrorState;
     use twocan_flexcan::pin::{Pin3, Pin4};
     use twocan_flexcan::{Can0, Settings};
     use twocan_teensy::can::CanState;
@@ -64,33 +64,28 @@ mod firmware {
             "CAN0 on the bus with the application's {=usize} filters",
             app.filters().len()
         );
-        let mut steps: u32 = 0;
-
+        let published = Published {
+            stats: &STATS,
+            state_changes: &STATE_CHANGES,
+            worst_state: &WORST_STATE,
+        };
+        let mut main_loop = FirmwareLoop::new();
         let mut period = Every::new(time::millis(), 10);
-        let mut shown = 0;
         loop {
             if period.due(time::millis()) {
-                app.handle(&mut rx);
-                app.publish(&mut tx);
-                while tx.take_completion().is_some() {}
-                let stats = app.stats();
-                while let Some(c) = rx.take_state_change() {
-                    STATE_CHANGES.fetch_add(1, Ordering::Relaxed);
-                    if c.state <= ErrorState::BusOff {
-                        WORST_STATE.fetch_max(c.state as u32, Ordering::Relaxed);
-                    }
+                let step = main_loop.step_split(&mut app, &mut tx, &mut rx, &published, |c| {
                     twocan_teensy::warn!(
                         "CAN0 error state {} (TEC {=u16}, REC {=u16})",
                         c.state,
                         c.counters.tec,
                         c.counters.rec
                     );
-                }
-                steps = steps.wrapping_add(1);
-                if steps.is_multiple_of(100) {
+                });
+                let stats = step.stats;
+                if step.log {
                     twocan_teensy::info!(
                         "step {=u32}: sent {=u32}, heartbeats {=u32} (gaps {=u32}, duplicates {=u32}), measurements {=u32}, requests {=u32}, answers {=u32}, queue full {=u32}",
-                        steps,
+                        step.steps,
                         stats.sent,
                         stats.heartbeats,
                         stats.heartbeat_gaps,
@@ -101,9 +96,7 @@ mod firmware {
                         stats.tx_full
                     );
                 }
-                critical_section::with(|cs| *STATS.borrow_ref_mut(cs) = Some(stats));
-                if stats.heartbeats >= shown + 50 {
-                    shown = stats.heartbeats;
+                if step.blink {
                     boot.led.toggle();
                 }
             }

@@ -3,6 +3,9 @@
 //! every second; every frame received toggles the LED. `SENT` and `RECEIVED` can be
 //! read with a debugger.
 //!
+//! Started with the one call of `twocan_flexcan::acan` (ACAN's `begin`): token, begin
+//! on the default pins (3 and 4), the library's `static` state, interrupts wired.
+//!
 //! Blink codes when it stops: 2–4 clock start-up, 5 FlexCAN `begin`, 6 panic.
 #![cfg_attr(target_os = "none", no_std, no_main)]
 
@@ -11,14 +14,10 @@ mod firmware {
     use core::sync::atomic::{AtomicU32, Ordering};
 
     use twocan_core::Frame;
-    use twocan_flexcan::pin::{Pin3, Pin4};
-    use twocan_flexcan::{Can0, Settings};
-    use twocan_teensy::can::CanState;
+    use twocan_flexcan::{acan, Settings};
     use twocan_teensy::configs::LOOPBACK_FILTERS;
     use twocan_teensy::rt::{self, CAN_BLINKS};
     use twocan_teensy::time::{self, Every};
-
-    static CAN0: CanState = CanState::new();
 
     /// Frames handed to the driver.
     pub static SENT: AtomicU32 = AtomicU32::new(0);
@@ -33,13 +32,9 @@ mod firmware {
     fn main() -> ! {
         let mut boot = rt::boot();
         twocan_teensy::info!("teensy-loopback: CAN0 in loop-back, a frame every second");
-        let token = Can0::take().unwrap_or_else(|| rt::halt(CAN_BLINKS));
-        let can = token
-            .begin_on(Pin3, Pin4, &SETTINGS, &LOOPBACK_FILTERS, &[])
-            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        let (mut tx, mut rx) = CAN0
-            .start(can.into_split(), &mut boot.core.NVIC)
-            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
+        let (mut tx, mut rx) =
+            acan::can0_with(&SETTINGS, &LOOPBACK_FILTERS, &[], &mut boot.core.NVIC)
+                .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
 
         let message = Frame::standard(0x542, &[]).unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         let mut send = Every::new(time::millis(), 1000);

@@ -1,0 +1,146 @@
+//! Hand-over from `stm32f1xx-hal` (0.11, on `stm32f1` 0.16; feature `hal-stm32f1`): the
+//! CAN of an STM32F103 (low- to XL-density performance line; the Blue Pill's F103C8)
+//! built from the HAL's PAC singletons, its `Rcc`, its `AFIO_MAPR` and the CAN pins, with
+//! no `unsafe` in the program. The handle and what it does are the generic
+//! [`crate::hal`]'s; this module has the F103's pins, remap and RCC. The connectivity
+//! line (F105/F107: CAN1 + CAN2) is not covered.
+//!
+//! # USB
+//!
+//! The F103's CAN and USB share a dedicated 512-byte SRAM and "cannot be used
+//! concurrently" (RM0008 §24.2, note): [`can`] takes the USB singleton with the CAN's, so
+//! a program that holds the CAN cannot start the USB peripheral through the HAL. They
+//! come back together ([`HandedOver::free`], [`crate::hal::Parked::free`]).
+//!
+//! # Pins
+//!
+//! The F1 has no alternate-function numbers: the CAN's pins are chosen by
+//! `AFIO_MAPR.CAN_REMAP` (RM0008 §9.3.3, §9.4.2), which [`can`] writes for the pair it is
+//! given; TX must be an alternate-function push-pull output, RX an input, floating or
+//! pull-up (RM0008 §9.1.11 Table 27):
+//!
+//! | `CAN_REMAP` | RX   | TX   |
+//! |-------------|------|------|
+//! | 00          | PA11 | PA12 |
+//! | 10          | PB8  | PB9  |
+//! | 11          | PD0  | PD1  |
+//!
+//! Only these pairs implement [`CanPins`]: a pin of another pair, RX and TX swapped, or
+//! TX not in alternate push-pull mode does not compile. (PD0/PD1: 100- and 144-pin
+//! packages; the 48-pin F103C8 has no PD0/PD1 to split from the HAL's ports.)
+//!
+//! The examples below are not compiled by `cargo test` (`ignore`), for the reason given
+//! in the `f4` module's notes (the HAL cannot share a host build with the tests'
+//! `critical-section/std`).
+//!
+//! ```ignore
+//! use stm32f1xx_hal::{pac, prelude::*, rcc};
+//! use twocan_bxcan::hal::f1;
+//! let dp = pac::Peripherals::take().unwrap();
+//! let mut flash = dp.FLASH.constrain();
+//! let mut rcc = dp.RCC.freeze(rcc::Config::hse(8.MHz()).sysclk(72.MHz()).pclk1(36.MHz()), &mut flash.acr);
+//! let mut afio = dp.AFIO.constrain(&mut rcc);
+//! let mut gpiob = dp.GPIOB.split(&mut rcc);
+//! let rx = gpiob.pb8.into_floating_input(&mut gpiob.crh);
+//! let tx = gpiob.pb9.into_alternate_push_pull(&mut gpiob.crh);
+//! let can = f1::can(dp.CAN, dp.USB, tx, rx, &mut afio.mapr, &mut rcc);
+//! let config = can.config(500_000).unwrap(); // for the STM32F103: 14 banks, APB1 ≤ 36 MHz
+//! let init = can.configure(&config).map_err(|f| f.error).unwrap();
+//! ```
+//!
+//! RX and TX of different pairs do not compile (`compile_fail`):
+//!
+//! ```ignore
+//! let tx = gpioa.pa12.into_alternate_push_pull(&mut gpioa.crh);
+//! let rx = gpiob.pb8.into_floating_input(&mut gpiob.crh);
+//! let can = f1::can(dp.CAN, dp.USB, tx, rx, &mut afio.mapr, &mut rcc);
+//! ```
+
+use stm32f1xx_hal::afio::MAPR;
+use stm32f1xx_hal::gpio::{Alternate, Floating, Input, Pin, PullUp, PushPull};
+use stm32f1xx_hal::pac;
+use stm32f1xx_hal::rcc::{Enable, Rcc, Reset};
+
+use crate::chip;
+use crate::hal::{sealed, HalParts, HandedOver, PacCan};
+use crate::instance::Instance;
+use crate::regs::CanRegs;
+
+/// A (TX, RX) pin pair of the F103's CAN, with its `AFIO_MAPR.CAN_REMAP` value.
+pub trait CanPins: sealed::Sealed {
+    /// The `CAN_REMAP` value that routes the CAN to this pair (RM0008 §9.3.3).
+    const REMAP: u8;
+}
+
+macro_rules! can_pin_pairs {
+    ($($remap:literal: ($tp:literal, $tn:literal), ($rp:literal, $rn:literal);)+) => {
+        $(
+            can_pin_pairs!(@one $remap, $tp, $tn, $rp, $rn, Floating);
+            can_pin_pairs!(@one $remap, $tp, $tn, $rp, $rn, PullUp);
+        )+
+    };
+    (@one $remap:literal, $tp:literal, $tn:literal, $rp:literal, $rn:literal, $pull:ty) => {
+        impl sealed::Sealed
+            for (Pin<$tp, $tn, Alternate<PushPull>>, Pin<$rp, $rn, Input<$pull>>)
+        {
+        }
+        impl CanPins for (Pin<$tp, $tn, Alternate<PushPull>>, Pin<$rp, $rn, Input<$pull>>) {
+            const REMAP: u8 = $remap;
+        }
+    };
+}
+
+// RM0008 §9.3.3 Table 36 "CAN alternate function remapping".
+can_pin_pairs! {
+    0b00: ('A', 12), ('A', 11);
+    0b10: ('B', 9), ('B', 8);
+    0b11: ('D', 1), ('D', 0);
+}
+
+impl sealed::Sealed for (pac::CAN, pac::USB) {}
+impl PacCan for (pac::CAN, pac::USB) {
+    type Window = CanRegs;
+    fn base() -> usize {
+        pac::CAN::ptr() as usize
+    }
+}
+
+/// The F103's CAN (its whole block, 14 filter banks), with its singleton, USB's, and the
+/// pins.
+pub type Can<TX, RX> = HandedOver<CanRegs, CanRegs, HalParts<(pac::CAN, pac::USB), TX, RX>>;
+
+/// Hands the F103's CAN over: routes it to the pin pair (`AFIO_MAPR.CAN_REMAP`), enables
+/// and resets its clock (`RCC_APB1ENR.CANEN`, `RCC_APB1RSTR.CANRST`; RM0008 §7.3.8,
+/// §7.3.5), and keeps the USB singleton out of the program's reach while it holds the
+/// CAN. The handle configures for [`chip::STM32F103`] ([`HandedOver::config`]).
+pub fn can<TX, RX>(
+    can: pac::CAN,
+    usb: pac::USB,
+    tx: TX,
+    rx: RX,
+    mapr: &mut MAPR,
+    rcc: &mut Rcc,
+) -> Can<TX, RX>
+where
+    (TX, RX): CanPins,
+{
+    let remap = <(TX, RX) as CanPins>::REMAP;
+    // SAFETY: `CAN_REMAP` is a 2-bit field; the values come from the pairs' table above
+    // (RM0008 §9.4.2).
+    mapr.modify_mapr(|_, w| unsafe { w.can_remap().bits(remap) });
+    pac::CAN::enable(rcc);
+    pac::CAN::reset(rcc);
+    let apb1_hz = rcc.clocks.pclk1().raw();
+    // SAFETY: the CAN's singleton, consumed here (with USB's, the other user of its
+    // SRAM); its clock was just enabled.
+    unsafe {
+        crate::hal::whole(
+            (can, usb),
+            tx,
+            rx,
+            Instance::Can1,
+            apb1_hz,
+            Some(&chip::STM32F103),
+        )
+    }
+}

@@ -1,0 +1,126 @@
+//! The portable application (`twocan_app::App`, the same module as the host demo) on
+//! CAN1 at 500 kbit/s: the NUCLEO-F446RE as node 2 talking with node 1 — the Teensy
+//! `app` example is node 1 — and the Blue Pill as node 3 talking with node 2 (the three
+//! on one bus, `Board::app`), over a bus with transceivers (Blue Pill: CAN on PB8 = RX, PB9 = TX;
+//! NUCLEO-F446RE: CAN1 on PA11 = RX, PA12 = TX; 120 Ω at each end).
+//!
+//! The application's portable filters are compiled by the bxCAN planner into FIFO 0
+//! (one FIFO keeps the frames in arrival order). It runs every 10 ms; the LED toggles
+//! every 50 heartbeats from the peer. `STATS` mirrors the counters for a debugger,
+//! `STATE_CHANGES` / `WORST_STATE` the error-state changes the driver reports.
+//!
+//! Without a transceiver (or with CANRX not recessive) `enable` times out waiting for 11
+//! recessive bits (RM0008 §24.4.1, RM0390 §30.4.1): blink code 5. 6: panic.
+#![cfg_attr(target_os = "none", no_std, no_main)]
+
+#[cfg(target_os = "none")]
+mod firmware {
+    use core::cell::RefCell;
+    use core::sync::atomic::AtomicU32;
+
+    use critical_section::Mutex;
+    use twocan_app::firmware::{FirmwareLoop, Published};
+    use twocan_app::{App, AppStats};
+    use twocan_bxcan::{const_plan, Can, FifoPolicy, Recovery};
+    use twocan_stm32::board::BIT_RATE;
+    use twocan_stm32::board::CAN1_BANKS;
+    use twocan_stm32::can::{self, CanState};
+    use twocan_stm32::rt::{self, CAN_BLINKS};
+    use twocan_stm32::time::{self, Every};
+    use twocan_stm32::BOARD;
+
+    /// This node and its peer (per board: `Board::app`).
+    const NODE: u8 = BOARD.app.0;
+    const PEER: u8 = BOARD.app.1;
+
+    static CAN1: CanState = CanState::new();
+    twocan_stm32::can1_vectors!();
+
+    /// The application's counters, copied after each step (`None` before the first).
+    pub static STATS: Mutex<RefCell<Option<AppStats>>> = Mutex::new(RefCell::new(None));
+
+    /// Error-state changes the driver reported (`take_state_change`), for a debugger.
+    pub static STATE_CHANGES: AtomicU32 = AtomicU32::new(0);
+    /// The worst fault-confinement state reported so far: 0 error active, 1 warning,
+    /// 2 error passive, 3 bus-off (`ErrorState` in declaration order).
+    pub static WORST_STATE: AtomicU32 = AtomicU32::new(0);
+
+    #[cortex_m_rt::entry]
+    fn main() -> ! {
+        let mut boot = rt::boot();
+        twocan_stm32::info!(
+            "stm32-app: node {=u8}, peer {=u8}, CAN1 at {=u32} bit/s",
+            NODE,
+            PEER,
+            BIT_RATE
+        );
+        let mut app = App::new(NODE, PEER);
+        // The bit timing is solved for the APB1 clock the HAL set, for the board's part.
+        let config = BOARD
+            .config(boot.apb1_hz, BIT_RATE)
+            .unwrap_or_else(|_| rt::halt(CAN_BLINKS))
+            .recovery(Recovery::Automatic);
+        let mut init =
+            Can::can1(boot.can1.whole(), &config).unwrap_or_else(|_| rt::halt(CAN_BLINKS));
+        // The application's filters (`twocan_app::filters_for`, the list `app.filters()`
+        // returns) planned at build time (`const_plan!`, see `stm32-loopback`).
+        let plan = const_plan!(
+            twocan_app::filters_for(NODE, PEER),
+            CAN1_BANKS.fifo(FifoPolicy::Fifo0)
+        );
+        if init.set_filters(plan).is_err() {
+            rt::halt(CAN_BLINKS);
+        }
+        let can = init.enable().unwrap_or_else(|_| rt::halt(CAN_BLINKS));
+        let (mut tx, mut rx) =
+            can::start(&CAN1, can.into_split(), rt::CAN1_IRQS, &mut boot.core.NVIC)
+                .unwrap_or_else(|| rt::halt(CAN_BLINKS));
+        twocan_stm32::info!(
+            "CAN1 on the bus with the application's {=usize} filters",
+            app.filters().len()
+        );
+        let published = Published {
+            stats: &STATS,
+            state_changes: &STATE_CHANGES,
+            worst_state: &WORST_STATE,
+        };
+        let mut main_loop = FirmwareLoop::new();
+        let mut period = Every::new(time::millis(), 10);
+        loop {
+            if period.due(time::millis()) {
+                let step = main_loop.step_split(&mut app, &mut tx, &mut rx, &published, |c| {
+                    twocan_stm32::warn!(
+                        "CAN1 error state {} (TEC {=u16}, REC {=u16})",
+                        c.state,
+                        c.counters.tec,
+                        c.counters.rec
+                    );
+                });
+                let stats = step.stats;
+                if step.log {
+                    twocan_stm32::info!(
+                        "step {=u32}: sent {=u32}, heartbeats {=u32} (gaps {=u32}, duplicates {=u32}), measurements {=u32}, requests {=u32}, answers {=u32}, queue full {=u32}",
+                        step.steps,
+                        stats.sent,
+                        stats.heartbeats,
+                        stats.heartbeat_gaps,
+                        stats.heartbeat_duplicates,
+                        stats.measurements,
+                        stats.requests,
+                        stats.answers,
+                        stats.tx_full
+                    );
+                }
+                if step.blink {
+                    boot.led.toggle();
+                }
+            }
+            cortex_m::asm::wfi();
+        }
+    }
+}
+
+#[cfg(not(target_os = "none"))]
+fn main() {
+    eprintln!("stm32-app: {}", twocan_stm32::HOST_NOTE);
+}

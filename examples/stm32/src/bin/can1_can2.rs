@@ -1,0 +1,115 @@
+//! NUCLEO-F446RE only: CAN1 and CAN2 talking to each other through their transceivers,
+//! each running the portable application (`twocan_app::App`): CAN1 is node 1, CAN2
+//! node 2, at 500 kbit/s.
+//!
+//! Wiring: a transceiver on CAN1 (PA11 = RX, PA12 = TX) and one on CAN2 (PB12 = RX,
+//! PB13 = TX), CANH to CANH and CANL to CANL, 120 Ω at each end.
+//!
+//! CAN2 has no filter banks of its own (RM0390 §30.3 "dual CAN"): CAN1 is configured
+//! with `CAN2SB = 14` (banks 0–13 for CAN1, 14–27 for CAN2), and CAN2's filters are
+//! written through CAN1's register block. Each node's portable filter list is planned
+//! for its own banks; the match indices come back as each node's own filter indices.
+//!
+//! The LED toggles every 50 heartbeats each node got from the other; `STATS` holds both
+//! nodes' counters. Blink codes: 5 bxCAN configuration (or no transceiver: `enable`
+//! waits for 11 recessive bits), 6 panic.
+#![cfg_attr(target_os = "none", no_std, no_main)]
+
+#[cfg(target_os = "none")]
+mod firmware {
+    use core::cell::RefCell;
+
+    use critical_section::Mutex;
+    use twocan_app::{App, AppStats};
+    use twocan_bxcan::regs::{ControlRegs, FilterRegs};
+    use twocan_bxcan::{const_plan, Can, FifoPolicy, Recovery};
+    use twocan_stm32::board::BIT_RATE;
+    use twocan_stm32::board::CAN1_BANKS;
+    use twocan_stm32::can::{self, CanState};
+    use twocan_stm32::rt::{self, CAN_BLINKS};
+    use twocan_stm32::time::{self, Every};
+    use twocan_stm32::BOARD;
+
+    // Each controller owns its control registers and shares CAN1's filter block (RM0390
+    // §30.9.4) through the `&'static FilterRegs` that `Can1::dual` lends.
+    type Shared = CanState<ControlRegs, &'static FilterRegs>;
+    static CAN1: Shared = Shared::new();
+    static CAN2: Shared = Shared::new();
+    twocan_stm32::can1_vectors!();
+    twocan_stm32::can2_vectors!();
+
+    /// The counters of node 1 (CAN1) and node 2 (CAN2), copied after each step
+    /// (`None` before the first).
+    pub static STATS: Mutex<RefCell<Option<[AppStats; 2]>>> = Mutex::new(RefCell::new(None));
+
+    #[cortex_m_rt::entry]
+    fn main() -> ! {
+        let mut boot = rt::boot();
+        // CAN1 in dual mode lends the filter block that CAN2 needs.
+        let (can1, filters) = boot.can1.dual();
+        let can2 = boot.can2.control();
+        let base = BOARD
+            .config(boot.apb1_hz, BIT_RATE)
+            .unwrap_or_else(|_| rt::halt(CAN_BLINKS))
+            .recovery(Recovery::Automatic);
+        let config1 = base
+            .can2_start_bank(14)
+            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
+        let mut node1 = App::new(1, 2);
+        let mut node2 = App::new(2, 1);
+
+        let mut init1 =
+            Can::can1_dual(can1, filters, &config1).unwrap_or_else(|_| rt::halt(CAN_BLINKS));
+        // Each node's filters (`twocan_app::filters_for`) planned at build time for its 14
+        // banks (`const_plan!`).
+        let plan1 = const_plan!(
+            twocan_app::filters_for(1, 2),
+            CAN1_BANKS.fifo(FifoPolicy::Fifo0)
+        );
+        if init1.set_filters(plan1).is_err() {
+            rt::halt(CAN_BLINKS);
+        }
+        let mut init2 = Can::can2(can2, filters, &base).unwrap_or_else(|_| rt::halt(CAN_BLINKS));
+        let plan2 = const_plan!(
+            twocan_app::filters_for(2, 1),
+            CAN1_BANKS.fifo(FifoPolicy::Fifo1)
+        );
+        if init2.set_filters(plan2).is_err() {
+            rt::halt(CAN_BLINKS);
+        }
+        let can1 = init1.enable().unwrap_or_else(|_| rt::halt(CAN_BLINKS));
+        let can2 = init2.enable().unwrap_or_else(|_| rt::halt(CAN_BLINKS));
+        let (mut tx1, mut rx1) =
+            can::start(&CAN1, can1.into_split(), rt::CAN1_IRQS, &mut boot.core.NVIC)
+                .unwrap_or_else(|| rt::halt(CAN_BLINKS));
+        let (mut tx2, mut rx2) =
+            can::start(&CAN2, can2.into_split(), rt::CAN2_IRQS, &mut boot.core.NVIC)
+                .unwrap_or_else(|| rt::halt(CAN_BLINKS));
+
+        let mut period = Every::new(time::millis(), 10);
+        let mut shown = 0;
+        loop {
+            if period.due(time::millis()) {
+                node1.handle(&mut rx1);
+                node1.publish(&mut tx1);
+                node2.handle(&mut rx2);
+                node2.publish(&mut tx2);
+                while tx1.take_completion().is_some() {}
+                while tx2.take_completion().is_some() {}
+                let stats = [node1.stats(), node2.stats()];
+                critical_section::with(|cs| *STATS.borrow_ref_mut(cs) = Some(stats));
+                let both = stats[0].heartbeats.min(stats[1].heartbeats);
+                if both >= shown + 50 {
+                    shown = both;
+                    boot.led.toggle();
+                }
+            }
+            cortex_m::asm::wfi();
+        }
+    }
+}
+
+#[cfg(not(target_os = "none"))]
+fn main() {
+    eprintln!("stm32-can1-can2: {}", twocan_stm32::HOST_NOTE);
+}

@@ -1,0 +1,78 @@
+//! ACAN's `LoopBackDemo` (ACAN manual §4) on bxCAN: CAN1 (the F103's `CAN`) in
+//! loop-back mode (RM0008 §24.5.2 / RM0390 §30.5.2 "Loop back mode": frames are
+//! received back internally, no transceiver needed), one pass-all filter bank, one
+//! standard data frame (identifier 0x542) every second; every frame received toggles the
+//! LED. `SENT` and `RECEIVED` can be read with a debugger.
+//!
+//! Blink codes when it stops: 5 bxCAN configuration, 6 panic.
+#![cfg_attr(target_os = "none", no_std, no_main)]
+
+#[cfg(target_os = "none")]
+mod firmware {
+    use core::sync::atomic::{AtomicU32, Ordering};
+
+    use twocan_bxcan::{const_plan, Can, FifoPolicy};
+    use twocan_core::{Filter, Frame};
+    use twocan_stm32::board::CAN1_BANKS;
+    use twocan_stm32::can::{self, CanState};
+    use twocan_stm32::rt::{self, CAN_BLINKS};
+    use twocan_stm32::time::{self, Every};
+    use twocan_stm32::BOARD;
+
+    static CAN1: CanState = CanState::new();
+    twocan_stm32::can1_vectors!();
+
+    /// Frames handed to the driver.
+    pub static SENT: AtomicU32 = AtomicU32::new(0);
+    /// Frames received back.
+    pub static RECEIVED: AtomicU32 = AtomicU32::new(0);
+
+    #[cortex_m_rt::entry]
+    fn main() -> ! {
+        let mut boot = rt::boot();
+        twocan_stm32::info!("stm32-loopback: CAN1 in loop-back, a frame every second");
+        // The bit timing is solved for the APB1 clock the HAL set, for the board's part.
+        let config = BOARD
+            .config(boot.apb1_hz, 125_000)
+            .unwrap_or_else(|_| rt::halt(CAN_BLINKS))
+            .loopback(true);
+        let mut init =
+            Can::can1(boot.can1.whole(), &config).unwrap_or_else(|_| rt::halt(CAN_BLINKS));
+        // Planned at build time (`const_plan!`): the run-time planner's working memory
+        // (about 90 KB) does not fit the F103C8's 20 KiB of RAM.
+        let plan = const_plan!([Filter::pass_all()], CAN1_BANKS.fifo(FifoPolicy::Fifo0));
+        if init.set_filters(plan).is_err() {
+            rt::halt(CAN_BLINKS);
+        }
+        let can = init.enable().unwrap_or_else(|_| rt::halt(CAN_BLINKS));
+        let (mut tx, mut rx) =
+            can::start(&CAN1, can.into_split(), rt::CAN1_IRQS, &mut boot.core.NVIC)
+                .unwrap_or_else(|| rt::halt(CAN_BLINKS));
+
+        let message = Frame::standard(0x542, &[]).unwrap_or_else(|_| rt::halt(CAN_BLINKS));
+        let mut send = Every::new(time::millis(), 1000);
+        let mut due = false;
+        loop {
+            due |= send.due(time::millis());
+            if due && tx.try_send(&message).is_ok() {
+                due = false;
+                SENT.fetch_add(1, Ordering::Relaxed);
+            }
+            while tx.take_completion().is_some() {}
+            while rx.receive().is_ok() {
+                RECEIVED.fetch_add(1, Ordering::Relaxed);
+                twocan_stm32::info!(
+                    "loop-back frame {=u32} received",
+                    RECEIVED.load(Ordering::Relaxed)
+                );
+                boot.led.toggle();
+            }
+            cortex_m::asm::wfi();
+        }
+    }
+}
+
+#[cfg(not(target_os = "none"))]
+fn main() {
+    eprintln!("stm32-loopback: {}", twocan_stm32::HOST_NOTE);
+}

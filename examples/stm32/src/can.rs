@@ -1,0 +1,49 @@
+//! The split driver of a bxCAN instance as the examples use it: its shared state and its
+//! four interrupt handlers in one `static` ([`CanState`], the library's
+//! `twocan_bxcan::rt::IrqState`, the same type as `twocan-stm32f7`'s), and `start`,
+//! which puts the handlers in place **before** it unmasks the part's lines. The vectors
+//! (`crate::can1_vectors!`, `crate::can2_vectors!`) call the library's
+//! `twocan_bxcan::rt::dispatch` with the instance and line: the library exports entry
+//! points for the STM32F7 only (`hal-stm32f7`), these parts' vector names are the board
+//! module's.
+
+use twocan_bxcan::regs::CanRegs;
+use twocan_bxcan::rt::IrqState;
+use twocan_bxcan::types::{BxRx, BxTx};
+
+/// Receive ring per FIFO, transmit queue and completion ring sizes of the examples.
+pub const RX: usize = twocan_bxcan::types::RX_RING;
+/// See [`RX`].
+pub const TX: usize = twocan_bxcan::types::TX_QUEUE;
+/// See [`RX`].
+pub const COMPLETIONS: usize = twocan_bxcan::types::COMPLETIONS;
+
+/// A transmit queue in request order (`TXFP = 1`, the driver's default).
+pub type Queue = twocan_bxcan::types::Queue;
+/// The shared state and interrupt handlers of an instance with registers `R` and filter
+/// registers `F` (a whole block by default; `ControlRegs` and `&'static FilterRegs` for
+/// CAN1 and CAN2 sharing CAN1's filters).
+pub type CanState<R = CanRegs, F = CanRegs> = IrqState<R, F, RX, Queue, RX, COMPLETIONS>;
+/// The transmit half.
+pub type CanTxHalf<R = CanRegs, F = CanRegs> = BxTx<'static, R, F>;
+/// The receive half.
+pub type CanRxHalf<R = CanRegs, F = CanRegs> = BxRx<'static, R, F>;
+
+/// Starts `state` over `hw` on the instance's four `lines` (`crate::rt::CAN1_IRQS`, …):
+/// the handlers installed, then each line given [`crate::rt::CAN_PRIORITY`] and
+/// unmasked (`IrqState::start_on`). Returns the thread-side halves; `None` when the
+/// state runs a controller already.
+#[cfg(target_os = "none")]
+pub fn start<R, F>(
+    state: &'static CanState<R, F>,
+    hw: twocan_bxcan::BxCan<R, F>,
+    lines: [crate::rt::Interrupt; 4],
+    nvic: &mut cortex_m::peripheral::NVIC,
+) -> Option<(CanTxHalf<R, F>, CanRxHalf<R, F>)>
+where
+    R: twocan_core::Registers + Send + Sync + 'static,
+    F: twocan_core::Registers + Send + Sync + 'static,
+{
+    let priorities = twocan_bxcan::rt::Priorities::all(crate::rt::CAN_PRIORITY);
+    state.start_on(hw, lines, priorities, nvic).ok()
+}

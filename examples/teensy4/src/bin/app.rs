@@ -1,0 +1,79 @@
+//! The portable application (`twocan_app::App`, the same module as the host demo and the
+//! Teensy 3 / STM32F7 `app` examples) on CAN1 of a Teensy 4.0 / 4.1 at 500 kbit/s, as
+//! node 1 talking with node 2 (pins 22 = CAN1 TX, 23 = CAN1 RX, through a transceiver).
+//! The application runs every 10 ms; `STATS` mirrors its counters, `STATE_CHANGES` /
+//! `WORST_STATE` the error-state changes the driver reports.
+#![cfg_attr(target_os = "none", no_std, no_main)]
+
+#[cfg(target_os = "none")]
+mod firmware {
+    use core::cell::RefCell;
+    use core::sync::atomic::{AtomicU32, Ordering};
+
+    use critical_section::Mutex;
+    use twocan_app::{App, AppStats};
+    use twocan_core::ErrorState;
+    use twocan_flexcan::pin::{Pin22, Pin23};
+    use twocan_flexcan::Can1;
+    use twocan_teensy4::can::CanState;
+    use twocan_teensy4::configs::{APP_NODES, BUS};
+    use twocan_teensy4::rt::{self, CAN_HALT};
+    use twocan_teensy4::time::{self, Every};
+
+    static CAN1: CanState = CanState::new();
+
+    /// The application's counters, copied after each step (`None` before the first).
+    pub static STATS: Mutex<RefCell<Option<AppStats>>> = Mutex::new(RefCell::new(None));
+    /// Error-state changes the driver reported.
+    pub static STATE_CHANGES: AtomicU32 = AtomicU32::new(0);
+    /// The worst fault-confinement state reported so far (`ErrorState` order).
+    pub static WORST_STATE: AtomicU32 = AtomicU32::new(0);
+
+    #[cortex_m_rt::entry]
+    fn main() -> ! {
+        let mut boot = rt::boot();
+        let (node, peer) = APP_NODES;
+        twocan_teensy4::info!(
+            "teensy4-app: node {=u8}, peer {=u8}, CAN1 at {=u32} bit/s",
+            node,
+            peer,
+            BUS.actual_bit_rate()
+        );
+        let mut app = App::new(node, peer);
+        let can = Can1::take()
+            .unwrap_or_else(|| rt::halt(CAN_HALT))
+            .begin_on(Pin22, Pin23, &BUS, &app.filters(), &[])
+            .unwrap_or_else(|_| rt::halt(CAN_HALT));
+        let (mut tx, mut rx) = CAN1
+            .start(can.into_split(), &mut boot.core.NVIC)
+            .unwrap_or_else(|_| rt::halt(CAN_HALT));
+        let mut period = Every::new(time::millis(), 10);
+        loop {
+            if period.due(time::millis()) {
+                app.handle(&mut rx);
+                app.publish(&mut tx);
+                while tx.take_completion().is_some() {}
+                while let Some(c) = rx.take_state_change() {
+                    STATE_CHANGES.fetch_add(1, Ordering::Relaxed);
+                    if c.state <= ErrorState::BusOff {
+                        WORST_STATE.fetch_max(c.state as u32, Ordering::Relaxed);
+                    }
+                    twocan_teensy4::warn!(
+                        "CAN1 error state {} (TEC {=u16}, REC {=u16})",
+                        c.state,
+                        c.counters.tec,
+                        c.counters.rec
+                    );
+                }
+                let stats = app.stats();
+                critical_section::with(|cs| *STATS.borrow_ref_mut(cs) = Some(stats));
+            }
+            cortex_m::asm::wfi();
+        }
+    }
+}
+
+#[cfg(not(target_os = "none"))]
+fn main() {
+    eprintln!("teensy4-app: {}", twocan_teensy4::HOST_NOTE);
+}

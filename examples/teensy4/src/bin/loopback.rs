@@ -1,0 +1,62 @@
+//! ACAN's `LoopBackDemo` (ACAN manual §4) on CAN1 of a Teensy 4.0 / 4.1: loop-back and
+//! self reception, so it needs no transceiver and no other node. One standard data frame
+//! (identifier 0x542) every second. `SENT` and `RECEIVED` count them for a debugger or
+//! `can-fil`; `rt::HALT` says why it stopped, if it did.
+#![cfg_attr(target_os = "none", no_std, no_main)]
+
+#[cfg(target_os = "none")]
+mod firmware {
+    use core::sync::atomic::{AtomicU32, Ordering};
+
+    use twocan_core::Frame;
+    use twocan_flexcan::pin::{Pin22, Pin23};
+    use twocan_flexcan::Can1;
+    use twocan_teensy4::can::CanState;
+    use twocan_teensy4::configs::{LOOPBACK, LOOPBACK_FILTERS};
+    use twocan_teensy4::rt::{self, CAN_HALT};
+    use twocan_teensy4::time::{self, Every};
+
+    static CAN1: CanState = CanState::new();
+
+    /// Frames handed to the driver.
+    pub static SENT: AtomicU32 = AtomicU32::new(0);
+    /// Frames received back.
+    pub static RECEIVED: AtomicU32 = AtomicU32::new(0);
+
+    #[cortex_m_rt::entry]
+    fn main() -> ! {
+        let mut boot = rt::boot();
+        twocan_teensy4::info!("teensy4-loopback: CAN1 in loop-back, a frame every second");
+        let can = Can1::take()
+            .unwrap_or_else(|| rt::halt(CAN_HALT))
+            .begin_on(Pin22, Pin23, &LOOPBACK, &LOOPBACK_FILTERS, &[])
+            .unwrap_or_else(|_| rt::halt(CAN_HALT));
+        let (mut tx, mut rx) = CAN1
+            .start(can.into_split(), &mut boot.core.NVIC)
+            .unwrap_or_else(|_| rt::halt(CAN_HALT));
+        let message = Frame::standard(0x542, &[]).unwrap_or_else(|_| rt::halt(CAN_HALT));
+        let mut send = Every::new(time::millis(), 1000);
+        let mut due = false;
+        loop {
+            due |= send.due(time::millis());
+            if due && tx.try_send(&message).is_ok() {
+                due = false;
+                SENT.fetch_add(1, Ordering::Relaxed);
+            }
+            while tx.take_completion().is_some() {}
+            while rx.receive().is_ok() {
+                RECEIVED.fetch_add(1, Ordering::Relaxed);
+                twocan_teensy4::info!(
+                    "loop-back frame {=u32} received",
+                    RECEIVED.load(Ordering::Relaxed)
+                );
+            }
+            cortex_m::asm::wfi();
+        }
+    }
+}
+
+#[cfg(not(target_os = "none"))]
+fn main() {
+    eprintln!("teensy4-loopback: {}", twocan_teensy4::HOST_NOTE);
+}
