@@ -72,39 +72,39 @@ if has stm32; then
         --features nucleo-f767zi,bus-250k --bin stm32f7-app
     cp "$rel/stm32f7-app" "$out/nucleo-f767zi/stm32f7-app-250k"
 fi
-if ! has negative; then
-    echo "firmware for the harness in $out ($families)"
-    exit 0
-fi
-cargo build --quiet --release --target "$target" --manifest-path fil/firmware/Cargo.toml
-mkdir -p "$out/negative"
-for bin in kinetis-gate kinetis-stuck kinetis-storm kinetis-hang kinetis-no-wdog core-check stm32-gate stm32-stuck \
-    imxrt-boot imxrt-gate imxrt-stuck imxrt-no-can-clock; do
-    cp "$fw_rel/$bin" "$out/negative/"
-done
-# The board-profile test programs (raw registers, no twocan API): the NUCLEO-F446RE's
-# (Cortex-M4F, the build above) and the Blue Pill's, built for the Cortex-M3.
-mkdir -p "$out/nucleo-f446re" "$out/bluepill"
-cp "$fw_rel/nucleo-f446re-can" "$out/nucleo-f446re/"
-m3=thumbv7m-none-eabi
-cargo build --quiet --release --target "$m3" --manifest-path fil/firmware/Cargo.toml \
-    --bin bluepill-can --bin bluepill-gate --bin bluepill-stuck
-for bin in bluepill-can bluepill-gate bluepill-stuck; do
-    cp "${CARGO_TARGET_DIR:-fil/firmware/target}/$m3/release/$bin" "$out/bluepill/"
-done
-# Teensy 4.1 (i.MX RT1062, examples/teensy4, issue 24) for the teensy41 profile; its own
-# test firmwares are the imxrt-* above. (The Teensy 4.0 build differs in the flash size
-# of its boot header only; CI cross-builds it.)
-for board in teensy41; do
-    cargo build --quiet --release --target "$target" -p twocan-teensy4 --features "$board" --bins
-    mkdir -p "$out/$board"
-    for bin in loopback filters app async-echo can1-can2; do
-        cp "$rel/teensy4-$bin" "$out/$board/"
+if has negative; then
+    cargo build --quiet --release --target "$target" --manifest-path fil/firmware/Cargo.toml
+    mkdir -p "$out/negative"
+    for bin in kinetis-gate kinetis-stuck kinetis-storm kinetis-hang kinetis-no-wdog core-check stm32-gate stm32-stuck \
+        imxrt-boot imxrt-gate imxrt-stuck imxrt-no-can-clock; do
+        cp "$fw_rel/$bin" "$out/negative/"
     done
-done
-# The Teensy 4.1 `app` as node 3 (feature app-node3): the third board of the three-board
-# run (tests/teensy41_examples.rs).
-cargo build --quiet --release --target "$target" -p twocan-teensy4 --features teensy41,app-node3 \
-    --bin teensy4-app
-cp "$rel/teensy4-app" "$out/teensy41/teensy4-app-node3"
-echo "firmware for the harness in $out"
+    # The board-profile test programs (raw registers, no twocan API): the NUCLEO-F446RE's
+    # (Cortex-M4F, the build above) and the Blue Pill's, built for the Cortex-M3.
+    mkdir -p "$out/nucleo-f446re" "$out/bluepill"
+    cp "$fw_rel/nucleo-f446re-can" "$out/nucleo-f446re/"
+    m3=thumbv7m-none-eabi
+    cargo build --quiet --release --target "$m3" --manifest-path fil/firmware/Cargo.toml \
+        --bin bluepill-can --bin bluepill-gate --bin bluepill-stuck
+    for bin in bluepill-can bluepill-gate bluepill-stuck; do
+        cp "${CARGO_TARGET_DIR:-fil/firmware/target}/$m3/release/$bin" "$out/bluepill/"
+    done
+fi
+if has teensy; then
+    # Teensy 4.1 (i.MX RT1062, examples/teensy4, issue 24) for the teensy41 profile; its own
+    # test firmwares are the imxrt-* above. (The Teensy 4.0 build differs in the flash size
+    # of its boot header only; CI cross-builds it.)
+    for board in teensy41; do
+        cargo build --quiet --release --target "$target" -p twocan-teensy4 --features "$board" --bins
+        mkdir -p "$out/$board"
+        for bin in loopback filters app async-echo can1-can2; do
+            cp "$rel/teensy4-$bin" "$out/$board/"
+        done
+    done
+    # The Teensy 4.1 `app` as node 3 (feature app-node3): the third board of the three-board
+    # run (tests/teensy41_examples.rs).
+    cargo build --quiet --release --target "$target" -p twocan-teensy4 --features teensy41,app-node3 \
+        --bin teensy4-app
+    cp "$rel/teensy4-app" "$out/teensy41/teensy4-app-node3"
+fi
+echo "firmware for the harness in $out ($families)"
