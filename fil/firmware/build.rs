@@ -19,6 +19,8 @@ fn main() {
         ("kinetis-gate", "kinetis.ld"),
         ("kinetis-stuck", "kinetis.ld"),
         ("kinetis-no-wdog", "kinetis.ld"),
+        ("kinetis-storm", "kinetis.ld"),
+        ("kinetis-hang", "kinetis.ld"),
         ("core-check", "kinetis.ld"),
         ("stm32-gate", "stm32f7.ld"),
         ("stm32-stuck", "stm32f7.ld"),

@@ -60,6 +60,26 @@ impl Model {
         }
     }
 
+    /// Whether the controller takes part in bus traffic (FlexCAN out of freeze and
+    /// disable; bxCAN in normal mode).
+    pub fn on_bus(&self) -> bool {
+        match self {
+            Model::FlexCan(m) => m.mode() == twocan_flexcan::model::ModelMode::Normal,
+            Model::BxCan(m) => m.state().mode == twocan_bxcan::model::Mode::Normal,
+        }
+    }
+
+    /// Frames the controller's receive FIFO(s) lost to an overrun so far.
+    pub fn frames_lost(&self) -> u64 {
+        match self {
+            Model::FlexCan(m) => m.frames_lost(),
+            Model::BxCan(m) => {
+                let s = m.state();
+                s.overruns[0] + s.overruns[1]
+            }
+        }
+    }
+
     /// `CTRL1[CLKSRC]` of a FlexCAN (false for bxCAN).
     pub fn clksrc(&self) -> bool {
         match self {

@@ -5,8 +5,8 @@
 //! can-fil --board teensy36 ELF [--board nucleo-f767zi ELF ...] --seconds S
 //!         [--bitrate B] [--trace FILE] [--quantum-us Q] [--stack]
 //! ```
-//! Exit status 0 only when every firmware ran without a fault, a stuck interrupt or a
-//! halt; 2 on bad arguments.
+//! Exit status 0 only when every firmware ran without a fault, a stuck interrupt, a
+//! livelock or a halt; 2 on bad arguments.
 
 use std::process::ExitCode;
 

@@ -103,6 +103,9 @@ pub fn render(world: &World<'_>) -> String {
                 s.at_ns / 1000
             );
         }
+        if let Some(l) = &b.livelock {
+            let _ = writeln!(out, "  LIVELOCK: {l}");
+        }
         if let Some(h) = &b.halted {
             let _ = writeln!(out, "  HALTED: {h}");
         }

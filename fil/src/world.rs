@@ -250,6 +250,7 @@ impl<'a> World<'a> {
             let t = (self.now_ps + self.quantum_ps).min(end);
             for m in &mut self.machines {
                 m.run_until(t);
+                m.board_mut().watch_progress();
                 m.drain_rtt();
             }
             self.check_bit_rates();
@@ -257,7 +258,9 @@ impl<'a> World<'a> {
             let bits = (t * u128::from(self.bus.bit_rate()) / 1_000_000_000_000) as u64;
             while self.bus.step_until(bits).is_some() {}
             for m in &mut self.machines {
-                m.board_mut().refresh_can_lines();
+                let b = m.board_mut();
+                b.refresh_can_lines();
+                b.note_join();
             }
             self.sample_states();
             self.now_ps = t;
@@ -265,10 +268,7 @@ impl<'a> World<'a> {
     }
 
     fn on_bus(model: &Model) -> bool {
-        match model {
-            Model::FlexCan(m) => m.mode() == twocan_flexcan::model::ModelMode::Normal,
-            Model::BxCan(m) => m.state().mode == twocan_bxcan::model::Mode::Normal,
-        }
+        model.on_bus()
     }
 
     /// Decodes each controller's bit rate when it joins the bus; arms the mismatch
@@ -352,11 +352,11 @@ impl<'a> World<'a> {
         }
     }
 
-    /// Whether every board ran without a fault, stuck interrupt or halt.
+    /// Whether every board ran without a fault, stuck interrupt, livelock or halt.
     pub fn clean(&self) -> bool {
         self.machines.iter().all(|m| {
             let b = m.board();
-            b.faults.is_empty() && b.stuck.is_empty() && b.halted.is_none()
+            b.faults.is_empty() && b.stuck.is_empty() && b.livelock.is_none() && b.halted.is_none()
         })
     }
 

@@ -5,7 +5,9 @@
 mod common;
 
 use common::*;
+use twocan_core::Frame;
 use twocan_fil::nvic::exc;
+use twocan_fil::world::World;
 
 const TEENSY: [&str; 3] = ["teensy32", "teensy35", "teensy36"];
 const STM32: [&str; 2] = ["nucleo-f767zi", "disco-f746g"];
@@ -235,6 +237,106 @@ fn assert_app_pair(a: Stats, b: Stats, b_sent_heartbeats: u32, label: &str) {
     assert!(b.sent > 0);
 }
 
+/// Runs `w` for `seconds` in slices of `SLICE_US`, then on until two slices pass with
+/// no `STATS` change on any board (no application step: every frame of the last steps
+/// is on the wire). Returns, per board, the end (µs) of the slice in which its `STATS`
+/// last changed (its last step lies within the `SLICE_US` before).
+const SLICE_US: u64 = 500;
+fn run_tracking_steps(w: &mut World<'_>, boards: usize, count: usize, seconds: f64) -> Vec<u64> {
+    let mut last = vec![0u64; boards];
+    let mut seen: Vec<Option<Vec<Stats>>> = vec![None; boards];
+    let mut quiet = 0;
+    let mut slices = 0u64;
+    let end_us = (seconds * 1e6) as u64;
+    loop {
+        w.run_for(u128::from(SLICE_US) * 1_000_000);
+        slices += 1;
+        let now = slices * SLICE_US;
+        let mut changed = false;
+        for b in 0..boards {
+            let bytes = w.machines[b].read_static("STATS").expect("STATS");
+            let now_stats = (bytes[4] == 1).then(|| app_stats(w, b, count));
+            if now_stats != seen[b] {
+                seen[b] = now_stats;
+                last[b] = now;
+                changed = true;
+            }
+        }
+        quiet = if changed { 0 } else { quiet + 1 };
+        if now >= end_us && quiet >= 2 {
+            return last;
+        }
+        assert!(now < end_us + 50_000, "no quiet 1 ms after the run");
+    }
+}
+
+/// Wire frames (error free) matching `pred` that ended before `t_us`, and before
+/// `t_us - SLICE_US`: the peer's step at a time within that slice counted the second
+/// number at least and the first at most.
+fn wire_before(w: &World<'_>, t_us: u64, pred: impl Fn(&Frame) -> bool) -> (u32, u32) {
+    let us = |bits: u64| bits * 2; // 500 kbit/s
+    let records = w.bus.trace().records();
+    let ok = records
+        .iter()
+        .filter(|r| !r.internal && r.is_error_free() && pred(&r.frame));
+    let hi = ok.clone().filter(|r| us(r.end) < t_us).count() as u32;
+    let lo = ok.filter(|r| us(r.end) + SLICE_US < t_us).count() as u32;
+    (lo, hi)
+}
+
+/// Issue 27: each node's `AppStats` against the frames on the wire, per identifier, for
+/// node `a` (its counters `sa`, its last step in the slice ending at `a_last`) and its
+/// peer `b`. Everything `a` queued is on the wire: its `sent` is the sum of its
+/// heartbeats, measurements, requests and answers on the wire; one request every 10
+/// heartbeats and one measurement every 4; an answer per request `a` handled. What `a`
+/// counted of `b`'s frames is what `b` put on the wire before `a`'s last step.
+fn assert_app_wire(w: &World<'_>, a: u32, b: u32, sa: Stats, a_last: u64, label: &str) {
+    let data = |id: u32| move |f: &Frame| raw_id(f) == (id, false) && !is_remote(f);
+    let all = |p: &dyn Fn(&Frame) -> bool| wire_count(w, p);
+    let hb = all(&data(0x100 + a));
+    let meas = all(&|f: &Frame| raw_id(f) == (0x18FF_0000 | a << 8, true));
+    let req = all(&|f: &Frame| raw_id(f) == (0x200 + b, false) && is_remote(f));
+    let ans = all(&data(0x200 + a));
+    assert_eq!(
+        sa.sent,
+        hb + meas + req + ans,
+        "{label}: sent = heartbeats {hb} + measurements {meas} + requests {req} + answers {ans} on the wire"
+    );
+    assert_eq!((meas, req), (hb / 4, hb / 10), "{label}: the schedule");
+    let within = |(lo, hi): (u32, u32), n: u32, what: &str| {
+        assert!(
+            lo <= n && n <= hi,
+            "{label}: {what} counted {n}, on the wire before the last step {lo}..={hi}"
+        );
+    };
+    within(
+        wire_before(w, a_last, data(0x100 + b)),
+        sa.heartbeats,
+        "heartbeats",
+    );
+    within(
+        wire_before(w, a_last, |f: &Frame| {
+            raw_id(f) == (0x18FF_0000 | b << 8, true)
+        }),
+        sa.measurements,
+        "measurements",
+    );
+    within(
+        wire_before(w, a_last, |f: &Frame| {
+            raw_id(f) == (0x200 + a, false) && is_remote(f)
+        }),
+        sa.requests,
+        "requests",
+    );
+    within(
+        wire_before(w, a_last, data(0x200 + b)),
+        sa.answers,
+        "answers",
+    );
+    // Every request handled was answered in the same step.
+    assert_eq!(ans, sa.requests, "{label}: one answer per request handled");
+}
+
 /// The `app` of a Teensy (node 1) and of an STM32F7 board (node 2) on one bus.
 #[test]
 fn teensy_and_stm32_apps_talk_through_the_portable_application() {
@@ -246,10 +348,12 @@ fn teensy_and_stm32_apps_talk_through_the_portable_application() {
         let Some(mut w) = world(500_000, &[(teensy, "teensy-app"), (stm32, "stm32f7-app")]) else {
             return;
         };
-        w.run_for(secs(1.5));
+        let last = run_tracking_steps(&mut w, 2, 1, 1.5);
         assert_clean(&w);
         let n1 = app_stats(&w, 0, 1)[0];
         let n2 = app_stats(&w, 1, 1)[0];
+        assert_app_wire(&w, 1, 2, n1, last[0], teensy);
+        assert_app_wire(&w, 2, 1, n2, last[1], stm32);
         let hb = |id: u32| wire_count(&w, |f| raw_id(f) == (id, false) && !is_remote(f));
         assert!(hb(0x101) >= 140, "{teensy}: {} heartbeats", hb(0x101));
         assert_app_pair(n1, n2, hb(0x102), teensy);
@@ -284,9 +388,11 @@ fn two_controllers_of_one_chip_exchange_frames() {
         let Some(mut w) = world(500_000, &[(board, bin)]) else {
             return;
         };
-        w.run_for(secs(1.2));
+        let last = run_tracking_steps(&mut w, 1, 2, 1.2);
         assert_clean(&w);
         let stats = app_stats(&w, 0, 2);
+        assert_app_wire(&w, 1, 2, stats[0], last[0], board);
+        assert_app_wire(&w, 2, 1, stats[1], last[0], board);
         let hb = |id: u32| wire_count(&w, |f| raw_id(f) == (id, false) && !is_remote(f));
         assert!(hb(0x101) >= 100 && hb(0x102) >= 100, "{board}");
         assert_app_pair(stats[0], stats[1], hb(0x102), board);

@@ -313,6 +313,106 @@ fn trace_of(records: &[twocan_sim::trace::TraceRecord]) -> Vec<(u64, Frame, bool
         .collect()
 }
 
+/// The oracle (issue 27): each node's application counters computed from the scenario
+/// alone — the two schedules of steps — with no driver code, so that a bug the
+/// firmware and the host demo share (both run the same driver) still fails. Each step
+/// (tick `k` = 1, 2, ...) of a node handles what arrived, then publishes the answers to
+/// the requests it just handled, a heartbeat, a measurement when `k % 4 == 0` and a
+/// status request when `k % 10 == 0` (`twocan_app::App::publish`). A frame published at
+/// a step reaches the peer within `ARRIVAL_US` (a few frames on an otherwise idle bus);
+/// the peer counts it at its first step after that. The schedules must keep every step
+/// of one node at least `ARRIVAL_US` away from the other's (asserted), so that no frame
+/// lands on the edge of a step. Without faults: no gap, no duplicate, nothing unhandled,
+/// the transmit queue never full.
+fn oracle(steps: &[Vec<u64>; 2]) -> [Stats; 2] {
+    const ARRIVAL_US: u64 = 1_000;
+    for (a, b) in [(0, 1), (1, 0)] {
+        for t in &steps[a] {
+            let near = steps[b].iter().find(|u| **u <= *t && *t < **u + ARRIVAL_US);
+            assert!(
+                near.is_none(),
+                "node {}'s step at {t} us is within {ARRIVAL_US} us of node {}'s at {near:?} us",
+                a + 1,
+                b + 1
+            );
+        }
+    }
+    // What each node publishes at each of its steps: (time, heartbeat, measurement,
+    // request, answers), answers depending on the peer's requests handled then.
+    let mut out = [Stats::default(), Stats::default()];
+    // Requests each node sent, by time.
+    let requests: [Vec<u64>; 2] = [0, 1].map(|n| {
+        steps[n]
+            .iter()
+            .enumerate()
+            .filter(|(k, _)| (k + 1) % 10 == 0)
+            .map(|(_, t)| *t)
+            .collect()
+    });
+    // Answers each node sent, by time: at each step, one per peer request that arrived
+    // since its previous step.
+    let answers: [Vec<u64>; 2] = [0, 1].map(|n| {
+        let peer = 1 - n;
+        let mut sent = Vec::new();
+        let mut prev = 0;
+        for t in &steps[n] {
+            let arrived = requests[peer]
+                .iter()
+                .filter(|r| prev <= **r + ARRIVAL_US && **r + ARRIVAL_US < *t)
+                .count();
+            sent.extend(std::iter::repeat_n(*t, arrived));
+            prev = *t;
+        }
+        sent
+    });
+    for n in 0..2 {
+        let peer = 1 - n;
+        let last = *steps[n].last().expect("steps");
+        let seen = |times: &[u64]| times.iter().filter(|t| **t + ARRIVAL_US < last).count() as u32;
+        let k = steps[n].len() as u32;
+        let s = &mut out[n];
+        s.sent = k + k / 4 + k / 10 + answers[n].len() as u32;
+        s.heartbeats = seen(&steps[peer]);
+        let measurements: Vec<u64> = steps[peer]
+            .iter()
+            .enumerate()
+            .filter(|(k, _)| (k + 1) % 4 == 0)
+            .map(|(_, t)| *t)
+            .collect();
+        s.measurements = seen(&measurements);
+        s.requests = seen(&requests[peer]);
+        s.answers = seen(&answers[peer]);
+    }
+    out
+}
+
+/// The oracle on the wire: per identifier, the frames of each node's schedule that ended
+/// before the end of the run (every step before `RUN_US - ARRIVAL`), counted in the bus
+/// trace (the simulated bus's record, not a driver's count).
+fn wire_matches_schedule(w: &World<'_>, steps: &[Vec<u64>; 2], apps: &[Stats; 2]) {
+    for n in 0..2u32 {
+        let mine = &steps[n as usize];
+        let k = mine.iter().filter(|t| **t + 1_000 < RUN_US).count() as u32;
+        let hb = wire_count(w, |f| raw_id(f) == (0x100 + n + 1, false) && !is_remote(f));
+        let ms = wire_count(w, |f| raw_id(f) == (0x18FF_0000 | (n + 1) << 8, true));
+        let rq = wire_count(w, |f| raw_id(f) == (0x200 + 2 - n, false) && is_remote(f));
+        let an = wire_count(w, |f| raw_id(f) == (0x200 + n + 1, false) && !is_remote(f));
+        assert_eq!(
+            (hb, ms, rq),
+            (k, k / 4, k / 10),
+            "node {}: heartbeats, measurements, requests on the wire",
+            n + 1
+        );
+        // The peer counted every answer this node put on the wire before its last step.
+        assert!(
+            an >= apps[1 - n as usize].answers,
+            "node {}: answers on the wire {an}, counted by the peer {}",
+            n + 1,
+            apps[1 - n as usize].answers
+        );
+    }
+}
+
 #[test]
 fn app_firmware_counts_what_the_host_demo_counts() {
     compare(None);
@@ -366,6 +466,30 @@ fn compare(faults: Faults) {
             fil.wire.iter().all(|w| w.tx_errors + w.rx_errors > 0),
             "{fil:?}"
         );
+    }
+    if faults.is_none() {
+        // The oracle: the counters the schedules give, for both runs.
+        let expected = oracle(&steps);
+        assert_eq!(fil.apps, expected, "firmware against the schedule");
+        assert_eq!(host.apps, expected, "host demo against the schedule");
+        wire_matches_schedule(&w, &steps, &fil.apps);
+    } else {
+        // Faults change what is received (retransmissions, double receptions), not
+        // what each application publishes: per step a heartbeat, a measurement every
+        // 4th, a request every 10th, and an answer per request it handled (all in the
+        // step that handled them).
+        for n in 0..2 {
+            for (what, apps) in [("firmware", &fil.apps), ("host", &host.apps)] {
+                let k = steps[n].len() as u32;
+                assert_eq!(
+                    apps[n].sent,
+                    k + k / 4 + k / 10 + apps[n].requests,
+                    "{what}: node {}: sent",
+                    n + 1
+                );
+                assert_eq!(apps[n].tx_full, 0, "{what}: node {}", n + 1);
+            }
+        }
     }
     let fil_trace = trace_of(w.bus.trace().records());
     // Not compared: the frames' start times. The host's bxCAN register wrapper lets bus

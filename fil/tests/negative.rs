@@ -178,8 +178,11 @@ fn a_node_at_the_wrong_bit_rate_gives_error_frames_and_error_state_changes() {
             bad.candump().contains("20000"),
             "SocketCAN error frames in the trace"
         );
-        // No firmware fault: the firmware copes with a bad bus.
-        assert!(bad.machines[0].board().faults.is_empty());
+        // Nothing else went wrong: no fault, no stuck line, no livelock, no unknown
+        // register, no rule violation — the firmware copes with a bad bus — and the
+        // control ran as clean.
+        assert_clean(&bad);
+        assert_clean(&ok);
     }
 }
 
@@ -241,7 +244,9 @@ fn two_boards_at_different_bit_rates_give_error_frames_and_error_state_changes()
     }
 
     // The STM32 at 250 kbit/s: the harness decodes its rate from CAN_BTR.
-    assert!(bad.clean(), "no fault: the firmwares cope with a bad bus");
+    // Nothing else went wrong: the firmwares cope with a bad bus (no fault, stuck line,
+    // livelock, unknown register or rule violation).
+    assert_clean(&bad);
     let (teensy_can, stm32_can) = (first(&bad, 0), first(&bad, 1));
     assert_eq!(stm32_can.bit_rate, Some(250_000));
     assert!(stm32_can.misclocked && !teensy_can.misclocked);
@@ -298,4 +303,104 @@ fn a_kinetis_firmware_that_leaves_the_watchdog_alone_is_reset() {
         let at = b.faults[0].at_ns;
         assert!((12_000..=13_000).contains(&at), "{board}: {at} ns");
     }
+}
+
+/// The livelock detector (issue 27): an interrupt storm interleaved with SysTick — which
+/// defeats the count of consecutive entries of one exception — and a handler that never
+/// returns (SysTick still entering and returning) both fail the run, with the exceptions
+/// taken over the window.
+#[test]
+fn a_storm_interleaved_with_systick_is_a_livelock() {
+    let Some(mut w) = world(500_000, &[("teensy36", "../negative/kinetis-storm")]) else {
+        return;
+    };
+    w.run_for(secs(0.05));
+    assert!(!w.clean());
+    let b = w.machines[0].board();
+    assert!(b.faults.is_empty(), "{:?}", b.faults);
+    // The consecutive-entry detector does not see it: SysTick breaks every run.
+    assert!(b.stuck.is_empty(), "{:?}", b.stuck);
+    let l = b.livelock.as_ref().expect("livelock reported");
+    assert!(
+        b.halted
+            .as_deref()
+            .is_some_and(|h| h.starts_with("livelock")),
+        "the board stops at the livelock: {:?}",
+        b.halted
+    );
+    assert_eq!(l.kind, twocan_fil::machine::LivelockKind::NoThreadProgress);
+    let window = l.at_ns - l.since_ns;
+    assert!(
+        (20_000_000..21_000_000).contains(&window),
+        "found one quantum after the bound: {l}"
+    );
+    let count = |e: u32| l.taken.iter().find(|(x, _)| *x == e).map_or(0, |(_, n)| *n);
+    let ticks = count(exc::SYSTICK);
+    assert!(
+        (15..=25).contains(&ticks),
+        "SysTick at about 1 kHz over 20 ms: {l}"
+    );
+    assert!(count(exc::IRQ0 + 75) > 10 * ticks, "{l}");
+    assert!(b.console.contains("pending IRQ 75"), "{:?}", b.console);
+    assert!(!b.console.contains("back in thread mode"));
+    let report = twocan_fil::report::render(&w);
+    assert!(
+        report.contains("LIVELOCK: no thread-mode progress"),
+        "{report}"
+    );
+    assert!(report.contains("SysTick x"), "{report}");
+}
+
+#[test]
+fn a_handler_that_never_returns_is_a_livelock() {
+    let Some(mut w) = world(500_000, &[("teensy36", "../negative/kinetis-hang")]) else {
+        return;
+    };
+    w.run_for(secs(0.05));
+    assert!(!w.clean());
+    let b = w.machines[0].board();
+    assert!(b.faults.is_empty(), "{:?}", b.faults);
+    assert!(b.stuck.is_empty(), "{:?}", b.stuck);
+    let l = b.livelock.as_ref().expect("livelock reported");
+    assert!(
+        b.halted
+            .as_deref()
+            .is_some_and(|h| h.starts_with("livelock")),
+        "the board stops at the livelock: {:?}",
+        b.halted
+    );
+    assert_eq!(
+        l.kind,
+        twocan_fil::machine::LivelockKind::HandlerNeverReturns {
+            exception: exc::IRQ0 + 75
+        }
+    );
+    // SysTick kept preempting it and returning: entries over the window.
+    let ticks = l
+        .taken
+        .iter()
+        .find(|(e, _)| *e == exc::SYSTICK)
+        .map_or(0, |(_, n)| *n);
+    assert!((15..=25).contains(&ticks), "{l}");
+    assert_eq!(b.taken.get(&(exc::IRQ0 + 75)), Some(&1), "entered once");
+    assert!(b.console.contains("for good"), "{:?}", b.console);
+    let report = twocan_fil::report::render(&w);
+    assert!(
+        report.contains("LIVELOCK: the IRQ 75 handler never returned"),
+        "{report}"
+    );
+}
+
+/// The control: a firmware that sleeps in thread mode between its interrupts is not a
+/// livelock however long it sleeps (sleeping in thread mode is waiting, not a lack of
+/// progress): the Teensy `loopback` example over 0.1 s.
+#[test]
+fn sleeping_in_thread_mode_is_not_a_livelock() {
+    let Some(mut w) = world(500_000, &[("teensy36", "teensy-loopback")]) else {
+        return;
+    };
+    w.run_for(secs(0.1));
+    assert_clean(&w);
+    let b = w.machines[0].board();
+    assert!(b.idle_cycles > 0, "the firmware sleeps: {}", b.idle_cycles);
 }

@@ -2,6 +2,11 @@
 //! a driver spins on a register — as real time passes while firmware waits for an
 //! acknowledge bit. Only back-to-back reads of the same poll register count as a spin:
 //! a single read (in an interrupt handler) does not move time.
+//!
+//! A watchdog bounds the code under test: [`SPIN_LIMIT`] register accesses in a row
+//! with no bus time passing (a handler that loops on a register the model never
+//! changes, as a receive handler that never releases its FIFO would) panic with the
+//! register last accessed, so that a test fails instead of hanging.
 
 use std::cell::{Cell, RefCell};
 use std::rc::Rc;
@@ -9,6 +14,12 @@ use std::vec::Vec;
 
 use crate::Bus;
 use twocan_core::registers::Registers;
+
+/// Register accesses in a row, through one [`PollClock`], with the bus time unchanged
+/// after which the code under test is taken to spin for ever (see the
+/// [module docs](self)). Far above any real sequence: a FlexCAN or bxCAN handler makes
+/// a few dozen accesses per frame.
+pub const SPIN_LIMIT: u64 = 2_000_000;
 
 /// The simulated bus, shared with the register wrappers that let time pass.
 pub type SharedBus = Rc<RefCell<Bus>>;
@@ -22,6 +33,8 @@ pub struct PollClock<R> {
     poll_registers: Vec<usize>,
     /// The poll register read last, if the last access was such a read.
     spinning: Cell<Option<usize>>,
+    /// The watchdog: the bus time last seen and the accesses made since it changed.
+    watchdog: Cell<(u64, u64)>,
 }
 
 impl<R> core::fmt::Debug for PollClock<R> {
@@ -46,6 +59,7 @@ impl<R> PollClock<R> {
             bus: bus.clone(),
             poll_registers: poll_registers.to_vec(),
             spinning: Cell::new(None),
+            watchdog: Cell::new((0, 0)),
         }
     }
 
@@ -62,8 +76,32 @@ impl<R> PollClock<R> {
     }
 }
 
+impl<R> PollClock<R> {
+    /// Counts one access; panics after [`SPIN_LIMIT`] of them with the bus time
+    /// unchanged (the bus is not looked at while it is borrowed: a model's access from
+    /// inside a bus step).
+    fn watch(&self, what: &str, offset: usize) {
+        let Ok(bus) = self.bus.try_borrow() else {
+            return;
+        };
+        let now = bus.now();
+        drop(bus);
+        let (seen, count) = self.watchdog.get();
+        let count = if seen == now { count + 1 } else { 0 };
+        self.watchdog.set((now, count));
+        if count >= SPIN_LIMIT {
+            panic!(
+                "PollClock watchdog: {count} register accesses with no bus time passing \
+                 (at bit time {now}, last a {what} of offset 0x{offset:03X}): the code \
+                 under test waits for a register that never changes"
+            );
+        }
+    }
+}
+
 impl<R: Registers> Registers for PollClock<R> {
     fn read32(&self, offset: usize) -> u32 {
+        self.watch("read", offset);
         if self.poll_registers.contains(&offset) {
             if self.spinning.replace(Some(offset)) == Some(offset) {
                 if let Ok(mut bus) = self.bus.try_borrow_mut() {
@@ -77,6 +115,7 @@ impl<R: Registers> Registers for PollClock<R> {
     }
 
     fn write32(&self, offset: usize, value: u32) {
+        self.watch("write", offset);
         self.spinning.set(None);
         self.regs.write32(offset, value)
     }

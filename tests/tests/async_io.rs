@@ -168,9 +168,18 @@ impl<'a> Sim<'a> {
         (sim, (f.tx, f.rx), (b.tx, b.rx))
     }
 
-    /// Runs the handler of every raised interrupt line, as the chips' vectors would.
+    /// Runs the handler of every raised interrupt line, as the chips' vectors would
+    /// (bounded: a line its handler never lowers fails the test instead of hanging it).
     fn service(&mut self) {
+        let mut rounds = 0u32;
         loop {
+            rounds += 1;
+            assert!(
+                rounds <= 10_000,
+                "an interrupt line stayed raised through 10,000 handler runs (FlexCAN {:?}, bxCAN {:?})",
+                self.flex_model.irq(),
+                self.bx_model.irq_lines()
+            );
             let mut any = false;
             if self.flex_model.irq_pending() {
                 // The ORed message-buffer vector and the status vectors.

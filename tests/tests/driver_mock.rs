@@ -16,10 +16,11 @@ fn frame(id: u16, byte: u8) -> Frame {
     Frame::standard(id, &[byte]).unwrap()
 }
 
-/// Lets the mock send everything, servicing the driver, until nothing waits.
+/// Lets the mock send everything, servicing the driver, until nothing waits (bounded:
+/// a test fails, it does not hang).
 fn drain<const RX: usize>(driver: &mut D<RX>) -> Vec<Frame> {
     let mut out = Vec::new();
-    loop {
+    for _ in 0..100_000 {
         driver.on_interrupt();
         match driver.hardware().complete() {
             Some(f) => out.push(f),
@@ -31,6 +32,11 @@ fn drain<const RX: usize>(driver: &mut D<RX>) -> Vec<Frame> {
             }
         }
     }
+    panic!(
+        "drain: {} frames still queued after 100,000 services ({} sent)",
+        driver.tx_stats().count,
+        out.len()
+    );
 }
 
 #[test]
@@ -55,7 +61,15 @@ fn interleaved_fifo_order_and_exact_completions_over_many_frames() {
     let mut tokens = Vec::new();
     let mut done = Vec::new();
     let mut next = 0u32;
+    let mut rounds = 0u32;
     while next < 1000 || d.tx_stats().count > 0 || sent.len() < 1000 {
+        rounds += 1;
+        assert!(
+            rounds < 100_000,
+            "waited 100,000 rounds for 1000 frames sent: {} queued, {} sent",
+            next,
+            sent.len()
+        );
         while next < 1000 {
             let id = ((next * 7919) % 0x7FF) as u16;
             match d.try_send(&Frame::standard(id, &next.to_le_bytes()).unwrap()) {

@@ -21,6 +21,59 @@ macro_rules! vector_table {
     };
 }
 
+/// As [`vector_table!`], with SysTick (exception 15) on `$systick`.
+#[macro_export]
+macro_rules! vector_table_systick {
+    ($reset:ident, $fault:ident, $systick:ident, $irq:literal, $handler:ident) => {
+        core::arch::global_asm!(
+            ".section .vectors,\"a\",%progbits",
+            ".word __stack_top",
+            concat!(".word ", stringify!($reset)),
+            ".rept 13",
+            concat!(".word ", stringify!($fault)),
+            ".endr",
+            concat!(".word ", stringify!($systick)),
+            concat!(".rept ", stringify!($irq)),
+            concat!(".word ", stringify!($fault)),
+            ".endr",
+            concat!(".word ", stringify!($handler)),
+        );
+    };
+}
+
+/// SysTick at `reload + 1` core clocks per period, its interrupt enabled (ARMv7-M
+/// B3.3.3: `SYST_RVR`, `SYST_CVR`, `SYST_CSR` ENABLE | TICKINT | CLKSOURCE).
+///
+/// # Safety
+/// Changes the SysTick configuration.
+pub unsafe fn systick_start(reload: u32) {
+    // SAFETY: the SysTick registers of every ARMv7-M core.
+    unsafe {
+        write32(0xE000_E014, reload);
+        write32(0xE000_E018, 0);
+        write32(0xE000_E010, 0b111);
+    }
+}
+
+/// Sets device interrupt `irq` pending and enabled in the NVIC at priority byte
+/// `priority` (ARMv7-M B3.4: `NVIC_IPRn`, `NVIC_ISPRn`, `NVIC_ISERn`).
+///
+/// # Safety
+/// The handler of `irq` runs as soon as the priorities allow.
+pub unsafe fn nvic_pend(irq: u32, priority: u8) {
+    let word = 0xE000_E400 + (irq & !3);
+    let shift = 8 * (irq & 3);
+    // SAFETY: the NVIC registers of every ARMv7-M core.
+    unsafe {
+        write32(
+            word,
+            (read32(word) & !(0xFF << shift)) | (u32::from(priority) << shift),
+        );
+        write32(0xE000_E200 + 4 * (irq / 32), 1 << (irq % 32));
+        write32(0xE000_E100 + 4 * (irq / 32), 1 << (irq % 32));
+    }
+}
+
 /// Reads a 32-bit register.
 ///
 /// # Safety

@@ -57,6 +57,67 @@ pub struct StuckIrq {
     pub at_ns: u64,
 }
 
+/// Simulated time without thread-mode progress (no instruction executed in thread mode,
+/// and the core not asleep in thread mode) after which a board is in a livelock, and the
+/// longest one activation of an exception handler may last. 20 ms: thousands of frame
+/// times at 500 kbit/s, twenty SysTick periods at 1 kHz; no example handler comes near
+/// it.
+pub const LIVELOCK_PS: u128 = 20_000_000_000;
+
+/// Why a board made no progress (see [`LIVELOCK_PS`]).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum LivelockKind {
+    /// Thread mode ran no instruction (exceptions kept preempting it, whichever they
+    /// were: a line whose cause is never cleared, interleaved with SysTick or not).
+    NoThreadProgress,
+    /// An activation of this exception handler did not return.
+    HandlerNeverReturns {
+        /// Exception number.
+        exception: u32,
+    },
+}
+
+/// A livelock: what the board did over the window without progress.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Livelock {
+    /// What was found.
+    pub kind: LivelockKind,
+    /// Core time (ns) of the last progress (or of the handler's entry).
+    pub since_ns: u64,
+    /// Core time (ns) when it was detected.
+    pub at_ns: u64,
+    /// Exceptions taken over the window, by exception number.
+    pub taken: Vec<(u32, u64)>,
+}
+
+impl std::fmt::Display for Livelock {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match &self.kind {
+            LivelockKind::NoThreadProgress => write!(f, "no thread-mode progress")?,
+            LivelockKind::HandlerNeverReturns { exception } => write!(
+                f,
+                "the {} handler never returned",
+                exception_name(*exception)
+            )?,
+        }
+        write!(
+            f,
+            " from t = {} us to t = {} us; exceptions taken meanwhile: ",
+            self.since_ns / 1000,
+            self.at_ns / 1000
+        )?;
+        if self.taken.is_empty() {
+            return write!(f, "none");
+        }
+        let list: Vec<String> = self
+            .taken
+            .iter()
+            .map(|(e, n)| format!("{} x{n}", exception_name(*e)))
+            .collect();
+        write!(f, "{}", list.join(", "))
+    }
+}
+
 /// The execution priority now.
 pub(super) fn execution_priority(uc: &Unicorn<'_, Board>) -> i32 {
     let primask = reg(uc, RegisterARM::PRIMASK) & 1 != 0;
@@ -127,6 +188,8 @@ pub(super) fn enter(uc: &mut Unicorn<'_, Board>, e: u32, ret: u32) -> Result<(),
     b.nvic.activate(e);
     b.depth += 1;
     *b.taken.entry(e).or_insert(0) += 1;
+    let now = b.time_ps();
+    b.active_since.insert(e, now);
     // Stuck-line detection: the same exception again and again, no thread progress.
     let (last, count, thread_at) = b.stuck_run;
     if last == e && b.thread_instructions == thread_at {
@@ -174,6 +237,7 @@ pub(super) fn exception_return(uc: &mut Unicorn<'_, Board>) {
     {
         let b = uc.get_data_mut();
         b.nvic.deactivate(e);
+        b.active_since.remove(&e);
         b.depth = b.depth.saturating_sub(1);
         b.check_irq = true;
         // ARMv7-M B1.5.18: an exception return sets the event register.

@@ -45,7 +45,9 @@ use crate::elf::Image;
 use crate::nvic::{exc, Nvic};
 use crate::profile::{Ctx, Profile};
 
-pub use exceptions::{exception_name, Fault, StuckIrq, STUCK_ENTRIES};
+pub use exceptions::{
+    exception_name, Fault, Livelock, LivelockKind, StuckIrq, LIVELOCK_PS, STUCK_ENTRIES,
+};
 use exceptions::{exception_return, halt, take_fault, take_pending};
 use peripherals::{periph_read, periph_write};
 use ppb::{ppb_read, ppb_write, Scb, SysTick};
@@ -98,6 +100,13 @@ pub struct Board {
     pub faults: Vec<Fault>,
     /// Stuck interrupt lines.
     pub stuck: Vec<StuckIrq>,
+    /// The first livelock found ([`LIVELOCK_PS`]).
+    pub livelock: Option<Livelock>,
+    /// Livelock watch: thread instructions, core time (ps) and exceptions taken at the
+    /// last thread-mode progress.
+    progress: (u64, u128, BTreeMap<u32, u64>),
+    /// Entry time (ps) of each active exception's current activation.
+    active_since: BTreeMap<u32, u128>,
     /// Accesses to registers the profile does not know: (address, first PC, read/write).
     pub unknown: BTreeMap<u32, (u32, &'static str, &'static str)>,
     /// Findings of the register rules.
@@ -113,6 +122,20 @@ pub struct Board {
     pub exited: Option<u32>,
     /// The painted stack and its marks (`--stack`, [`Machine::paint_stack`]).
     pub stack: Option<crate::stack::StackPaint>,
+    /// The CAN interrupt lines held low at the NVIC (their causes stay set in the
+    /// models): a receive interrupt delayed — by a long critical section, a
+    /// higher-priority handler — for as long as a test sets it.
+    pub hold_can_lines: bool,
+    /// A stall of the core, in ps, started when a CAN controller first joins the bus
+    /// (before the firmware's next instruction): as firmware busy elsewhere between
+    /// its controller going on the bus and its interrupt start-up (`split`/`start`), so
+    /// that bus traffic meanwhile leaves a CAN interrupt pending when the lines are
+    /// unmasked.
+    pub stall_on_join_ps: Option<u128>,
+    /// The end of the stall in progress (core time, ps).
+    stalled_until_ps: u128,
+    /// A controller of this board has joined the bus (the stall was considered).
+    joined: bool,
 }
 
 const S_REGS: [RegisterARM; 16] = [
@@ -223,10 +246,89 @@ impl Board {
         }
     }
 
-    /// Updates the NVIC levels from the CAN models' lines.
+    /// A stall counts as thread progress up to its end (the firmware is busy in thread
+    /// mode): the slack of one co-simulation step.
+    fn quantum_hint_ps(&self) -> u128 {
+        20_000_000
+    }
+
+    /// The livelock watch, called between slices of execution: thread mode progressed
+    /// (or the core sleeps in thread mode, waiting as it was told to), or the time since
+    /// its last progress, or since the entry of a handler still active, is checked
+    /// against [`LIVELOCK_PS`] whatever exceptions ran meanwhile (SysTick included).
+    pub fn watch_progress(&mut self) {
+        if self.livelock.is_some() || self.halted.is_some() {
+            return;
+        }
+        let now = self.time_ps();
+        let stalled = self.stalled_until_ps > now.saturating_sub(self.quantum_hint_ps());
+        if self.thread_instructions != self.progress.0
+            || (self.sleeping && self.depth == 0)
+            || stalled
+        {
+            self.progress = (self.thread_instructions, now, self.taken.clone());
+            // An exception still active from before is checked below all the same.
+        }
+        // The innermost activation older than the bound (an outer one only waits for
+        // it).
+        let stuck_handler = self
+            .active_since
+            .iter()
+            .filter(|(_, t)| now - **t > LIVELOCK_PS)
+            .max_by_key(|(_, t)| **t)
+            .map(|(e, t)| (*e, *t));
+        let kind = match stuck_handler {
+            Some((e, since)) => Some((LivelockKind::HandlerNeverReturns { exception: e }, since)),
+            _ if now - self.progress.1 > LIVELOCK_PS => {
+                Some((LivelockKind::NoThreadProgress, self.progress.1))
+            }
+            _ => None,
+        };
+        if let Some((kind, since)) = kind {
+            let before = &self.progress.2;
+            let taken = self
+                .taken
+                .iter()
+                .map(|(e, n)| (*e, n - before.get(e).copied().unwrap_or(0)))
+                .filter(|(_, n)| *n > 0)
+                .collect();
+            let to_ns = |ps: u128| (ps / 1000) as u64;
+            let found = Livelock {
+                kind,
+                since_ns: to_ns(since),
+                at_ns: to_ns(now),
+                taken,
+            };
+            // The board stops there: a livelocked core would otherwise be emulated
+            // instruction by instruction to the end of the run (minutes instead of
+            // seconds for a suite of such runs).
+            self.halted = Some(format!("livelock: {found}"));
+            self.livelock = Some(found);
+        }
+    }
+
+    /// Starts the stall of [`Board::stall_on_join_ps`] when a controller has just joined
+    /// the bus; whether it did.
+    pub fn note_join(&mut self) -> bool {
+        if self.joined || !self.cans.iter().any(|p| p.model.on_bus()) {
+            return false;
+        }
+        self.joined = true;
+        let Some(stall) = self.stall_on_join_ps else {
+            return false;
+        };
+        self.stalled_until_ps = self.time_ps() + stall;
+        self.stop_now();
+        true
+    }
+
+    /// Updates the NVIC levels from the CAN models' lines (held low while
+    /// [`Board::hold_can_lines`]).
     pub fn refresh_can_lines(&mut self) {
+        let hold = self.hold_can_lines;
         for port in &self.cans {
             for ((_, irq), level) in port.instance.irqs.iter().zip(port.model.lines()) {
+                let level = level && !hold;
                 if self.nvic.level(*irq) != level {
                     self.nvic.set_level(*irq, level);
                     self.check_irq = true;
@@ -341,6 +443,9 @@ impl<'a> Machine<'a> {
             taken: BTreeMap::new(),
             faults: Vec::new(),
             stuck: Vec::new(),
+            livelock: None,
+            progress: (0, 0, BTreeMap::new()),
+            active_since: BTreeMap::new(),
             unknown: BTreeMap::new(),
             findings: Vec::new(),
             console: String::new(),
@@ -352,6 +457,10 @@ impl<'a> Machine<'a> {
             check_irq: false,
             exited: None,
             stack: None,
+            hold_can_lines: false,
+            stall_on_join_ps: None,
+            stalled_until_ps: 0,
+            joined: false,
         };
         let mut uc = Unicorn::new_with_data(Arch::ARM, Mode::THUMB | Mode::MCLASS, board)
             .map_err(|e| format!("unicorn: {e:?}"))?;
@@ -640,6 +749,15 @@ impl<'a> Machine<'a> {
                         b.idle_cycles += c;
                     }
                     return;
+                }
+            }
+            {
+                let b = self.uc.get_data_mut();
+                if b.stalled_until_ps > b.time_ps() {
+                    // The stall: the core busy elsewhere (no instruction of the image).
+                    let c = b.cycles_until(b.stalled_until_ps.min(t_ps)).max(1);
+                    b.idle_cycles += c;
+                    continue;
                 }
             }
             if self.uc.get_data().sleeping {

@@ -51,6 +51,9 @@ pub(super) fn periph_read(uc: &mut Unicorn<'_, Board>, addr: u32, size: usize) -
         let off = (addr - b.cans[i].instance.base) as usize;
         let word = b.cans[i].model.read32(off & !3);
         b.refresh_can_lines();
+        if b.note_join() {
+            let _ = uc.emu_stop();
+        }
         return u64::from(crate::profile::extract(word, addr, size));
     }
     let ctx = b.ctx();
@@ -129,6 +132,9 @@ pub(super) fn periph_write(uc: &mut Unicorn<'_, Board>, addr: u32, size: usize, 
         };
         b.cans[i].model.write32(off & !3, v);
         b.refresh_can_lines();
+        if b.note_join() {
+            let _ = uc.emu_stop();
+        }
         return;
     }
     let ctx = b.ctx();

@@ -54,6 +54,12 @@ pub fn assert_clean(w: &World<'_>) {
         let b = m.board();
         assert!(b.faults.is_empty(), "{}: faults {:?}", b.name, b.faults);
         assert!(b.stuck.is_empty(), "{}: stuck {:?}", b.name, b.stuck);
+        assert!(
+            b.livelock.is_none(),
+            "{}: {}",
+            b.name,
+            b.livelock.as_ref().unwrap()
+        );
         assert!(b.halted.is_none(), "{}: halted {:?}", b.name, b.halted);
         assert!(
             b.unknown.is_empty(),
