@@ -30,8 +30,14 @@ fn begin_with<T: TxPin<Can0>, X: RxPin<Can0>>(tx: T, rx: X) {
         &[],
     )
     .expect("begin on typed pins");
-    assert_eq!(controller.system().tx.0, T::PIN);
-    assert_eq!(controller.system().rx.0, X::PIN);
+    assert_eq!(
+        controller.system().kinetis().expect("a Kinetis plan").tx.0,
+        T::PIN
+    );
+    assert_eq!(
+        controller.system().kinetis().expect("a Kinetis plan").rx.0,
+        X::PIN
+    );
     assert_eq!(PCR_MUX.get(sys.read32(T::PIN.pcr())), T::PIN.alt);
     assert_eq!(PCR_MUX.get(sys.read32(X::PIN.pcr())), X::PIN.alt);
     // Only those two PCRs were written (besides the SIM gates).
