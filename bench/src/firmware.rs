@@ -306,10 +306,11 @@ pub fn example_packages(paths: &Paths) -> Result<Vec<ExamplePackage>> {
 /// directory.
 pub fn example(paths: &Paths, package: &str, features: &[String]) -> Result<PathBuf> {
     let target_dir = paths.scratch("bench-examples");
+    let target = example_target(features);
     let mut c = cargo();
     c.current_dir(&paths.root)
         .arg("build")
-        .args(["--release", "--target", TARGET, "-p", package, "--bins"])
+        .args(["--release", "--target", target, "-p", package, "--bins"])
         .arg("--target-dir")
         .arg(&target_dir);
     if !features.is_empty() {
@@ -317,7 +318,23 @@ pub fn example(paths: &Paths, package: &str, features: &[String]) -> Result<Path
     }
     eprintln!("can-bench: {}", cmd::display(&c));
     cmd::run_ok(&mut c, BUILD_LIMIT).context(format!("building the example {package}"))?;
-    Ok(target_dir.join(TARGET).join("release"))
+    Ok(target_dir.join(target).join("release"))
+}
+
+/// Boards whose core is a Cortex-M3 (no FPU, no DSP instructions): their firmware builds
+/// for `thumbv7m-none-eabi`; every other board for [`TARGET`].
+const CORTEX_M3_BOARDS: &[&str] = &["bluepill"];
+
+/// The target an example builds for with the board `features`.
+fn example_target(features: &[String]) -> &'static str {
+    if features
+        .iter()
+        .any(|f| CORTEX_M3_BOARDS.contains(&f.as_str()))
+    {
+        "thumbv7m-none-eabi"
+    } else {
+        TARGET
+    }
 }
 
 /// Builds `can-fil` (the firmware-in-the-loop harness, `fil/`, its own workspace and
