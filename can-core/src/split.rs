@@ -362,37 +362,16 @@ impl<
         let Some(claim) = self.hw.claim() else {
             return Err((Error::WrongMode, hardware));
         };
-        let adopted = critical_section::with(|cs| {
-            // SAFETY: the queue is only touched inside a critical section.
-            unsafe { &mut *self.queue.borrow(cs).get() }.adopt(hardware.tx_policy())
-        });
-        if !adopted {
+        if !self.adopt_order(&hardware) {
             // Nothing was written: dropping the claim frees the state again.
             drop(claim);
             return Err((Error::InvalidArgument, hardware));
         }
         // Written, read while only this context can see it, then published (release):
         // every reader (`hardware()`, acquire) sees the controller whole.
-        let (_, (map, status)) = claim.publish(hardware, |hw| {
-            // SAFETY: not published yet: this is the only context that sees it.
-            let map = unsafe { hw.filter_map() };
-            let status = hw.error_status();
-            self.state
-                .store(state_code(status.state), Ordering::Relaxed);
-            (map, status)
-        });
+        let (_, (map, status)) = claim.publish(hardware, |hw| self.first_look(hw));
         self.refresh_timestamps();
-        Ok(Parts {
-            tx: Tx { s: self, next: 0 },
-            rx: Rx { s: self, map },
-            tx_irq: TxIrq { s: self },
-            rx0_irq: RxIrq { s: self },
-            rx1_irq: RxIrq { s: self },
-            status_irq: StatusIrq {
-                s: self,
-                last: status.state,
-            },
-        })
+        Ok(self.parts(map, status))
     }
 
     /// [`State::split`] with the controller **built in place** in the state (no move of
@@ -416,28 +395,43 @@ impl<
             return Err(Error::WrongMode);
         };
         let adopt = |hw: &H| {
-            let adopted = critical_section::with(|cs| {
-                // SAFETY: the queue is only touched inside a critical section.
-                unsafe { &mut *self.queue.borrow(cs).get() }.adopt(hw.tx_policy())
-            });
-            if adopted {
+            if self.adopt_order(hw) {
                 Ok(())
             } else {
                 Err(Error::InvalidArgument)
             }
         };
         let (_, (map, status)) = claim
-            .publish_in_place(init, adopt, |hw| {
-                // SAFETY: not published yet: this is the only context that sees it.
-                let map = unsafe { hw.filter_map() };
-                let status = hw.error_status();
-                self.state
-                    .store(state_code(status.state), Ordering::Relaxed);
-                (map, status)
-            })
+            .publish_in_place(init, adopt, |hw| self.first_look(hw))
             .map_err(|e| e.unwrap_or(Error::InvalidArgument))?;
         self.refresh_timestamps();
-        Ok(Parts {
+        Ok(self.parts(map, status))
+    }
+
+    /// Makes the queue take the controller's transmit order (the claimer only);
+    /// whether the orders agree.
+    fn adopt_order(&self, hw: &H) -> bool {
+        critical_section::with(|cs| {
+            // SAFETY: the queue is only touched inside a critical section.
+            unsafe { &mut *self.queue.borrow(cs).get() }.adopt(hw.tx_policy())
+        })
+    }
+
+    /// The filter map and error status of a controller not yet published, the state
+    /// recorded from it.
+    fn first_look(&self, hw: &H) -> (H::FilterMap, ErrorStatus) {
+        // SAFETY: not published yet: this is the only context that sees it.
+        let map = unsafe { hw.filter_map() };
+        let status = hw.error_status();
+        self.state
+            .store(state_code(status.state), Ordering::Relaxed);
+        (map, status)
+    }
+
+    /// The handles over a published controller (made once, by the one splitter).
+    #[allow(clippy::type_complexity)]
+    fn parts(&self, map: H::FilterMap, status: ErrorStatus) -> Parts<'_, H, RX, Q, RX1, DONE, Fe> {
+        Parts {
             tx: Tx { s: self, next: 0 },
             rx: Rx { s: self, map },
             tx_irq: TxIrq { s: self },
@@ -447,7 +441,7 @@ impl<
                 s: self,
                 last: status.state,
             },
-        })
+        }
     }
 
     /// Stores `hardware` in a state owned exclusively (the one-struct
