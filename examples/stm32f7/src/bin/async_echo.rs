@@ -33,7 +33,9 @@ mod firmware {
     static CAN1: CanState = CanState::new();
     static EXECUTOR: StaticCell<Executor> = StaticCell::new();
 
-    /// Echoes sent so far (for a debugger).
+    /// Echoes sent so far (for a debugger). `#[used]`: only ever stored to, the
+    /// optimiser would otherwise drop it (and the debugger's symbol with it).
+    #[used]
     pub static ECHOED: AtomicU32 = AtomicU32::new(0);
 
     /// Receives and echoes, forever; drains the completions it does not wait for.
