@@ -38,21 +38,23 @@ has stm32 && for board in nucleo-f767zi disco-f746g; do
 done
 # The Blue Pill (Cortex-M3) and the NUCLEO-F446RE from one source (examples/stm32),
 # each built once for its core; can1-can2 on the NUCLEO only.
-for spec in bluepill:thumbv7m-none-eabi nucleo-f446re:thumbv7em-none-eabihf; do
+has stm32 && for spec in bluepill:thumbv7m-none-eabi nucleo-f446re:thumbv7em-none-eabihf; do
     IFS=: read -r board tgt <<<"$spec"
     cargo build --quiet --release --target "$tgt" -p twocan-stm32 --features "$board" --bins
     mkdir -p "$out/$board"
     for bin in loopback filters app async-echo can1-can2; do
-        if [ -f "target/$tgt/release/stm32-$bin" ] && { [ "$bin" != can1-can2 ] || [ "$board" = nucleo-f446re ]; }; then
-            cp "target/$tgt/release/stm32-$bin" "$out/$board/"
+        if [ -f "$tdir/$tgt/release/stm32-$bin" ] && { [ "$bin" != can1-can2 ] || [ "$board" = nucleo-f446re ]; }; then
+            cp "$tdir/$tgt/release/stm32-$bin" "$out/$board/"
         fi
     done
 done
 # The Blue Pill `app` at 250 kbit/s (feature bus-250k): the board at the wrong bit rate
 # of fil/tests/stm32_family.rs.
-cargo build --quiet --release --target thumbv7m-none-eabi -p twocan-stm32 \
-    --features bluepill,bus-250k --bin stm32-app
-cp target/thumbv7m-none-eabi/release/stm32-app "$out/bluepill/stm32-app-250k"
+if has stm32; then
+    cargo build --quiet --release --target thumbv7m-none-eabi -p twocan-stm32 \
+        --features bluepill,bus-250k --bin stm32-app
+    cp "$tdir/thumbv7m-none-eabi/release/stm32-app" "$out/bluepill/stm32-app-250k"
+fi
 # The defmt variants (the examples log through defmt-rtt; tests/defmt.rs decodes the log):
 # one board of each family, saved as <example>-defmt. DEFMT_LOG is read at compile time
 # (the examples' .cargo/config.toml sets it when cargo runs in their folders only).
