@@ -7,6 +7,8 @@ use twocan_fil::elf::Image;
 use twocan_fil::profile;
 use twocan_fil::world::World;
 
+pub mod three;
+
 /// Where `fil/build-firmware.sh` puts the ELFs (`FIL_ELF_DIR` overrides).
 pub fn elf_dir() -> PathBuf {
     std::env::var_os("FIL_ELF_DIR")
