@@ -90,9 +90,9 @@
 //! | §4 `ACANSettings`, §16, table 7 | [`Settings`] (bit timing from [`twocan_core::timing`]) |
 //! | §6 `ACAN::can0`, `ACAN::can1` | `Can0::take()`, `Can1::take()` ([`instance`]); [`Target`] on the host |
 //! | §7 alternate pins, §16.7.5–6 | [`Settings`] fields, [`Board::pins`], [`system`]; typed: `pin` (board features) |
-//! | `ACAN::can0.begin (settings)` as one call | `acan::can0` / `acan::can0_with` (features `rt` + board) |
+//! | `ACAN::can0.begin (settings)` as one call | `acan::can0` / `acan::can0_with` (features `rt` + board); ACAN_T4 `ACAN_T4::can1.begin`: `acan::can1`..`can3` |
 //! | §15 `begin` wiring the interrupt, §16.7.4 `mMessageIRQPriority` | `rt::IrqState::start` (feature `rt`) |
-//! | `end` | `acan::end_can0`; [`FlexCan::end`], `Can0::end` / `Can1::end` ([`end`]); `rt::IrqState::stop` |
+//! | `end` | `acan::end_can0` (`end_can1`..`end_can3` on the Teensy 4.x); [`FlexCan::end`], `Can0::end` / `Can1::end` ([`end`]); `rt::IrqState::stop` |
 //! | §8, §9 `tryToSend`, transmit buffer | [`twocan_core::Driver::try_send`], `tx_stats` ([`controller`] explains the mailboxes) |
 //! | §10 `receive`, receive buffer | [`twocan_core::Driver::receive`], `rx_stats` |
 //! | §11 `mConfiguration` | [`Configuration`] |
@@ -112,12 +112,17 @@
 #![cfg_attr(docsrs, feature(doc_cfg))]
 #![deny(missing_docs)]
 
-// The one call per module (ACAN's `begin`/`end`): take, begin, state, interrupts.
-// Teensy 3.x only for now (its `Can0`); a Teensy 4 board feature turns it off.
+// The one call per module (ACAN's and ACAN_T4's `begin`/`end`): take, begin, state,
+// interrupts; `can0`/`can1` on the Teensy 3.x, `can1`..`can3` on the Teensy 4.x.
 #[cfg(all(
     feature = "rt",
-    any(feature = "teensy32", feature = "teensy35", feature = "teensy36"),
-    not(any(feature = "teensy40", feature = "teensy41"))
+    any(
+        feature = "teensy32",
+        feature = "teensy35",
+        feature = "teensy36",
+        feature = "teensy40",
+        feature = "teensy41"
+    )
 ))]
 #[cfg_attr(docsrs, doc(cfg(feature = "rt")))]
 pub mod acan;

@@ -431,7 +431,7 @@ where
         let Some(irqs) = tx.hardware().target().irqs() else {
             return Err((StopError::Foreign, (tx, rx)));
         };
-        for irq in lines(irqs) {
+        for irq in distinct_lines(irqs) {
             nvic.mask(IrqNumber(irq));
         }
         let ((tx_irq, rx0_irq, rx1_irq), status_irq) =
@@ -509,22 +509,23 @@ fn lines(irqs: Irqs) -> [u16; 5] {
     ]
 }
 
+/// [`lines`] with each line once (the i.MX RT1062 has one per module:
+/// [`Irqs::is_single_line`]).
+fn distinct_lines(irqs: Irqs) -> impl Iterator<Item = u16> + Clone {
+    let lines = lines(irqs);
+    (0..lines.len())
+        .filter(move |&i| !lines[..i].contains(&lines[i]))
+        .map(move |i| lines[i])
+}
+
 /// The one priority on every line (they run two cells; the four status lines one),
 /// then each line unmasked: after the handlers are in place. A line shared by several
 /// sources (the i.MX RT1062 has one per module: [`Irqs::is_single_line`]) is set once.
 fn enable(nvic: &mut impl Nvic, irqs: Irqs, priority: u8) {
-    let lines = lines(irqs);
-    let distinct = || {
-        lines
-            .iter()
-            .enumerate()
-            .filter(move |(i, irq)| !lines[..*i].contains(irq))
-            .map(|(_, &irq)| irq)
-    };
-    for irq in distinct() {
+    for irq in distinct_lines(irqs) {
         nvic.set_priority(IrqNumber(irq), priority);
     }
-    for irq in distinct() {
+    for irq in distinct_lines(irqs) {
         nvic.unmask(IrqNumber(irq));
     }
 }

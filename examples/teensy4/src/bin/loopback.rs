@@ -2,6 +2,10 @@
 //! self reception, so it needs no transceiver and no other node. One standard data frame
 //! (identifier 0x542) every second. `SENT` and `RECEIVED` count them for a debugger or
 //! `can-fil`; `rt::HALT` says why it stopped, if it did.
+//!
+//! Started with the one call of `twocan_flexcan::acan` (ACAN_T4's `begin`): token, begin
+//! on CAN1's default pins (22 and 23), the library's `static` state, the `CAN1` line
+//! wired.
 #![cfg_attr(target_os = "none", no_std, no_main)]
 
 #[cfg(target_os = "none")]
@@ -9,14 +13,10 @@ mod firmware {
     use core::sync::atomic::{AtomicU32, Ordering};
 
     use twocan_core::Frame;
-    use twocan_flexcan::pin::{Pin22, Pin23};
-    use twocan_flexcan::Can1;
-    use twocan_teensy4::can::CanState;
+    use twocan_flexcan::acan;
     use twocan_teensy4::configs::{LOOPBACK, LOOPBACK_FILTERS};
     use twocan_teensy4::rt::{self, CAN_HALT};
     use twocan_teensy4::time::{self, Every};
-
-    static CAN1: CanState = CanState::new();
 
     /// Frames handed to the driver.
     pub static SENT: AtomicU32 = AtomicU32::new(0);
@@ -27,13 +27,9 @@ mod firmware {
     fn main() -> ! {
         let mut boot = rt::boot();
         twocan_teensy4::info!("teensy4-loopback: CAN1 in loop-back, a frame every second");
-        let can = Can1::take()
-            .unwrap_or_else(|| rt::halt(CAN_HALT))
-            .begin_on(Pin22, Pin23, &LOOPBACK, &LOOPBACK_FILTERS, &[])
-            .unwrap_or_else(|_| rt::halt(CAN_HALT));
-        let (mut tx, mut rx) = CAN1
-            .start(can.into_split(), &mut boot.core.NVIC)
-            .unwrap_or_else(|_| rt::halt(CAN_HALT));
+        let (mut tx, mut rx) =
+            acan::can1_with(&LOOPBACK, &LOOPBACK_FILTERS, &[], &mut boot.core.NVIC)
+                .unwrap_or_else(|_| rt::halt(CAN_HALT));
         let message = Frame::standard(0x542, &[]).unwrap_or_else(|_| rt::halt(CAN_HALT));
         let mut send = Every::new(time::millis(), 1000);
         let mut due = false;

@@ -1,0 +1,267 @@
+//! The one call of the Teensy 4 (`acan::can1` ..., ACAN_T4's `begin`/`end`; features `rt`
+//! and `teensy40` or `teensy41`) over the behavioural model of CAN1: what `acan::start`
+//! and `acan::end` do with a module's token, its spare slot and its state — the board's
+//! one calls are these two over the target's tokens, which on the host reach no
+//! registers.
+//!
+//! The token here is the test's own [`acan::Module`]: taken once, it begins CAN1 of a
+//! Teensy 4.1 over the RT1062 model (64 message buffers) and ends back into a token. The
+//! NVIC records its calls; the "interrupt" is the exported `CAN1` entry point, run
+//! whenever the model raises its line.
+//!
+//! One test function: the entry points' slots are process-wide, and the model (`Rc`, one
+//! thread) is shared with the "interrupt" side only on this thread.
+#![cfg(all(feature = "rt", any(feature = "teensy40", feature = "teensy41")))]
+
+use std::cell::RefCell;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use twocan_core::{Error, FifoQueue, Filter, Frame, Registers, TxOutcome};
+use twocan_flexcan::acan::{self, Module, OneCallError, Spare};
+use twocan_flexcan::model::FlexCanModel;
+use twocan_flexcan::regs::{self, mcr};
+use twocan_flexcan::rt::{self, IrqNumber, IrqState, Nvic, StartError};
+use twocan_flexcan::{
+    rt_imxrt, BeginError, Board, ConfigErrors, FlexCan, HostSystem, IdleClocked, Instance,
+    Settings, Target,
+};
+use twocan_sim::Bus;
+
+/// The model's registers, declared shareable between "contexts" that are all this
+/// test's one thread.
+struct OneThread(IdleClocked);
+
+// SAFETY: the registers (an `Rc` model) are reached only from the thread that runs the
+// one test of this binary: the "interrupts" are the entry-point calls it makes.
+unsafe impl Send for OneThread {}
+// SAFETY: as above.
+unsafe impl Sync for OneThread {}
+
+impl Registers for OneThread {
+    fn read32(&self, offset: usize) -> u32 {
+        self.0.read32(offset)
+    }
+    fn write32(&self, offset: usize, value: u32) {
+        self.0.write32(offset, value)
+    }
+}
+
+const TARGET: Target = Target::new(Board::Teensy41, Instance::Can1);
+
+thread_local! {
+    /// The module the test's token owns.
+    static MODEL: RefCell<Option<FlexCanModel>> = const { RefCell::new(None) };
+}
+static TAKEN: AtomicBool = AtomicBool::new(false);
+
+/// The test's CAN1 token: `take` gives it once, as the target's `Can1::take`.
+struct HostCan1(FlexCanModel);
+
+impl Module for HostCan1 {
+    type Regs = OneThread;
+
+    fn take() -> Option<Self> {
+        if TAKEN.swap(true, Ordering::AcqRel) {
+            return None;
+        }
+        MODEL.with(|m| m.borrow().clone()).map(HostCan1)
+    }
+
+    fn begin(
+        self,
+        settings: &Settings,
+        primary: &[Filter],
+        secondary: &[Filter],
+    ) -> Result<FlexCan<OneThread>, (Self, BeginError)> {
+        let regs = OneThread(IdleClocked::new(self.0.clone()));
+        FlexCan::begin(
+            regs,
+            &mut HostSystem::new(),
+            TARGET,
+            settings,
+            primary,
+            secondary,
+        )
+        .map_err(|e| (self, e))
+    }
+
+    fn end(controller: FlexCan<OneThread>) -> Result<Self, (FlexCan<OneThread>, Error)> {
+        if controller.target() != TARGET {
+            return Err((controller, Error::InvalidArgument));
+        }
+        controller
+            .end(&mut HostSystem::new())
+            .map(|regs| HostCan1(regs.0.model().clone()))
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Call {
+    Priority(u16, u8),
+    Unmask(u16),
+    Mask(u16),
+}
+
+#[derive(Default)]
+struct Recorder(Vec<Call>);
+
+impl Nvic for Recorder {
+    fn set_priority(&mut self, irq: IrqNumber, priority: u8) {
+        self.0.push(Call::Priority(irq.number(), priority));
+    }
+    fn unmask(&mut self, irq: IrqNumber) {
+        self.0.push(Call::Unmask(irq.number()));
+    }
+    fn mask(&mut self, irq: IrqNumber) {
+        self.0.push(Call::Mask(irq.number()));
+    }
+}
+
+type State = IrqState<OneThread, 32, FifoQueue<16>, 8>;
+
+/// Runs the bus for `bits`, entering `CAN1` whenever the model raises its line.
+fn run(bus: &mut Bus, model: &FlexCanModel, bits: u64) -> u32 {
+    let until = bus.now() + bits;
+    let mut entered = 0;
+    loop {
+        while model.irq_pending() {
+            rt_imxrt::can1();
+            entered += 1;
+            assert!(entered < 10_000, "the line stays asserted");
+        }
+        if bus.step_until(until).is_none() {
+            break;
+        }
+    }
+    entered
+}
+
+/// The one call's loop-back settings: the board's defaults at 500 kbit/s.
+fn loop_back() -> Settings {
+    let mut s = acan::default_settings(500_000);
+    s.loop_back = true;
+    s.self_reception = true;
+    s
+}
+
+fn disabled(model: &FlexCanModel) -> bool {
+    model.read32(regs::MCR) & mcr::MDIS != 0
+}
+
+#[test]
+fn the_one_call_starts_runs_ends_and_starts_again() {
+    let model = FlexCanModel::new(TARGET.model_chip());
+    MODEL.with(|m| *m.borrow_mut() = Some(model.clone()));
+    let mut bus = Bus::new(500_000).unwrap();
+    bus.attach("can1", model.clone());
+    let spare: Spare<HostCan1> = Spare::new();
+    let state: &'static State = Box::leak(Box::new(State::new()));
+    let mut nvic = Recorder::default();
+
+    // The board's defaults: the RT1062's 24 MHz clock root, ACAN's priority 64.
+    let defaults = acan::default_settings(500_000);
+    assert_eq!(defaults.can_clock.hz(), 24_000_000);
+    assert_eq!(defaults.actual_bit_rate(), 500_000);
+    assert_eq!(defaults.message_irq_priority, 64);
+
+    // Start: CAN1's one line (36) at the settings' priority, after the handlers.
+    let (mut tx, mut rx) = acan::start(
+        &spare,
+        state,
+        &loop_back(),
+        &[Filter::pass_all()],
+        &[],
+        &mut nvic,
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(nvic.0, [Call::Priority(36, 64), Call::Unmask(36)]);
+    assert!(rt::is_wired(Instance::Can1));
+    assert_eq!(state.installed(), [true, true]);
+    assert!(!spare.holds());
+
+    // Frames go round through the model and come back, in order, with their
+    // completions in order.
+    let frames: Vec<Frame> = (0..5u8)
+        .map(|i| Frame::standard(0x100 + u16::from(i), &[i; 3]).unwrap())
+        .collect();
+    let tokens: Vec<_> = frames.iter().map(|f| tx.try_send(f).unwrap()).collect();
+    let entered = run(&mut bus, &model, 2_000);
+    assert!(entered >= 5, "{entered} entries of CAN1");
+    let got: Vec<Frame> = std::iter::from_fn(|| rx.receive().ok())
+        .map(|r| r.frame)
+        .collect();
+    assert_eq!(got, frames);
+    let done: Vec<_> = std::iter::from_fn(|| tx.take_completion()).collect();
+    assert_eq!(
+        done.iter().map(|c| c.token).collect::<Vec<_>>(),
+        tokens,
+        "completions in request order"
+    );
+    assert!(done.iter().all(|c| c.outcome == TxOutcome::Sent));
+
+    // While it runs, its token is nowhere: a second one call is `Taken`.
+    assert_eq!(
+        acan::start(&spare, state, &loop_back(), &[], &[], &mut nvic).map(|_| ()),
+        Err(OneCallError::Taken)
+    );
+
+    // The way back: the line masked, the module disabled, the token spare.
+    nvic.0.clear();
+    let left = acan::end(&spare, state, (tx, rx), &mut nvic)
+        .map_err(|(e, _)| e)
+        .unwrap();
+    assert_eq!((left.queued, left.received, left.completions), (0, 0, 0));
+    assert_eq!(nvic.0, [Call::Mask(36)]);
+    assert!(disabled(&model));
+    assert!(spare.holds());
+    assert_eq!(state.installed(), [false, false]);
+
+    // Again, on the same state (its entry point stays wired to it).
+    nvic.0.clear();
+    let (mut tx, mut rx) = acan::start(
+        &spare,
+        state,
+        &loop_back(),
+        &[Filter::pass_all()],
+        &[],
+        &mut nvic,
+    )
+    .unwrap();
+    assert_eq!(nvic.0, [Call::Priority(36, 64), Call::Unmask(36)]);
+    assert!(!disabled(&model));
+    tx.try_send(&frames[0]).unwrap();
+    run(&mut bus, &model, 500);
+    assert_eq!(rx.receive().unwrap().frame, frames[0]);
+    acan::end(&spare, state, (tx, rx), &mut nvic)
+        .map_err(|(e, _)| e)
+        .unwrap();
+
+    // A refused `begin` (a Kinetis clock on the RT1062) keeps the token.
+    let kinetis = Settings::new(500_000);
+    match acan::start(&spare, state, &kinetis, &[], &[], &mut nvic) {
+        Err(OneCallError::Begin(BeginError::Config(c))) => {
+            assert!(c.contains(ConfigErrors::CLOCK_NOT_ON_CHIP), "{c:?}")
+        }
+        other => panic!("{:?}", other.map(|_| ())),
+    }
+    assert!(spare.holds());
+
+    // A refused start (CAN1's entry point runs another state) ends the module again and
+    // keeps the token.
+    let other: &'static State = Box::leak(Box::new(State::new()));
+    nvic.0.clear();
+    assert_eq!(
+        acan::start(&spare, other, &loop_back(), &[], &[], &mut nvic).map(|_| ()),
+        Err(OneCallError::Start(StartError::AlreadyWired))
+    );
+    assert!(nvic.0.is_empty(), "nothing unmasked: {:?}", nvic.0);
+    assert!(disabled(&model));
+    assert!(spare.holds());
+
+    // And the first state starts once more from the spare token.
+    let halves = acan::start(&spare, state, &loop_back(), &[], &[], &mut nvic).unwrap();
+    assert!(!spare.holds());
+    acan::end(&spare, state, halves, &mut nvic)
+        .map_err(|(e, _)| e)
+        .unwrap();
+}
