@@ -14,7 +14,7 @@ use crate::settings::Settings;
 /// 0x401F_C000).
 pub type ImxSystemRegs = twocan_core::Mmio<0x401F_C000, 0x400F_C000>;
 
-fn system() -> ImxSystemRegs {
+pub(crate) fn system() -> ImxSystemRegs {
     // SAFETY: base 0 with absolute offsets, the window CCM..IOMUXC. `begin` and `end`
     // touch only CCM_CSCMR2 and the CCGR of their module (read-modify-writes in a
     // critical section) and the IOMUXC registers of their module's two pads and Rx daisy

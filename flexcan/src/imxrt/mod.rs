@@ -17,6 +17,12 @@ pub mod ccm;
 pub mod firmware;
 pub mod pads;
 pub mod plan;
+#[cfg(all(feature = "imxrt-ral", any(feature = "teensy40", feature = "teensy41")))]
+#[cfg_attr(
+    docsrs,
+    doc(cfg(all(feature = "imxrt-ral", any(feature = "teensy40", feature = "teensy41"))))
+)]
+pub mod ral;
 
 pub use ccm::{CanClockSource, ClockRoot};
 pub use pads::{ImxPin, ImxPins};
