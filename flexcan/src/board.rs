@@ -61,6 +61,51 @@ impl Chip {
             Chip::Imxrt1062 => crate::imxrt::MESSAGE_BUFFERS,
         }
     }
+
+    /// The largest `CTRL2[RFFN]` whose Rx FIFO and ID filter table (MB0 to
+    /// MB`5 + 2 × (RFFN + 1)`, reference manuals' table "Rx FIFO filter: possible
+    /// structures") leave the chip's message buffers room for a data mailbox and a
+    /// remote-frame mailbox: 3 on the Kinetis parts (ACAN's 14/18: MB14 remote, MB15
+    /// data), 0xF on the RT1062 (the table up to MB37, MB38–MB63 left).
+    pub const fn max_rffn(self) -> u8 {
+        let mut r: u8 = 15;
+        while r > 0 && crate::regs::rx_fifo_occupied_mbs(r as u32) + 2 > self.message_buffers() {
+            r -= 1;
+        }
+        r
+    }
+
+    /// The ID filter table elements at [`Chip::max_rffn`]: 8 × (RFFN + 1), 32 or 128.
+    pub const fn max_table_elements(self) -> usize {
+        crate::regs::rx_fifo_filter_count(self.max_rffn() as u32)
+    }
+
+    /// The table elements under individual masks (`RXIMRn`: ACAN's primary filters) at
+    /// [`Chip::max_rffn`]: one per message buffer the FIFO and its table occupy, at most
+    /// 32 (the manuals' table: "elements 0–31" from RFFN = 0xC on): 14 or 32.
+    pub const fn max_primary_filters(self) -> usize {
+        let occupied = crate::regs::rx_fifo_occupied_mbs(self.max_rffn() as u32);
+        if occupied < 32 {
+            occupied
+        } else {
+            32
+        }
+    }
+
+    /// The table elements under the global mask `RXFGMASK` (ACAN's secondary filters)
+    /// at [`Chip::max_rffn`]: 18 or 96.
+    pub const fn max_secondary_filters(self) -> usize {
+        self.max_table_elements() - self.max_primary_filters()
+    }
+
+    /// The largest `CTRL2[RFFN]` the driver accepts today: ACAN's four configurations
+    /// ([`crate::Configuration::ALL`], RFFN 0–3, in MB0–MB15) on every chip. On the
+    /// RT1062 this is below [`Chip::max_rffn`]: the larger tables need transmit
+    /// mailboxes above MB31 (`IMASK2`/`IFLAG2`), not served yet; the capabilities and
+    /// the planner report this limit.
+    pub const fn accepted_max_rffn(self) -> u8 {
+        crate::configuration::Configuration::Filters14_18.rffn()
+    }
 }
 
 /// The Tx and Rx pins of one instance, default and alternate (ACAN §7 table 3).
@@ -247,5 +292,42 @@ mod tests {
         assert_eq!(Board::Teensy40.chip(), Chip::Imxrt1062);
         assert_eq!(Chip::Imxrt1062.message_buffers(), 64);
         assert_eq!(Chip::Mk66fx1m0.message_buffers(), 16);
+    }
+
+    #[test]
+    fn rx_fifo_sizes_per_chip() {
+        // (max RFFN, elements, primary, secondary, accepted RFFN)
+        assert_eq!(
+            (
+                Chip::Mk66fx1m0.max_rffn(),
+                Chip::Mk66fx1m0.max_table_elements(),
+                Chip::Mk66fx1m0.max_primary_filters(),
+                Chip::Mk66fx1m0.max_secondary_filters(),
+                Chip::Mk66fx1m0.accepted_max_rffn()
+            ),
+            (3, 32, 14, 18, 3)
+        );
+        assert_eq!(
+            (
+                Chip::Imxrt1062.max_rffn(),
+                Chip::Imxrt1062.max_table_elements(),
+                Chip::Imxrt1062.max_primary_filters(),
+                Chip::Imxrt1062.max_secondary_filters(),
+                Chip::Imxrt1062.accepted_max_rffn()
+            ),
+            (15, 128, 32, 96, 3)
+        );
+        for chip in [
+            Chip::Mk20dx256,
+            Chip::Mk64fx512,
+            Chip::Mk66fx1m0,
+            Chip::Imxrt1062,
+        ] {
+            // The largest ACAN configuration is what every chip's sizes allow today.
+            let c = crate::Configuration::Filters14_18;
+            assert!(c.rffn() <= chip.max_rffn());
+            assert_eq!(chip.accepted_max_rffn(), c.rffn());
+            assert!(c.primary_filter_capacity() <= chip.max_primary_filters());
+        }
     }
 }

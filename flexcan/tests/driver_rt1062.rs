@@ -295,3 +295,68 @@ fn typed_pins_are_the_pads_begin_muxes() {
     check_pins::<Can2, _, _>(Instance::Can2, pin::Pin1, pin::Pin0);
     check_pins::<Can3, _, _>(Instance::Can3, pin::Pin31, pin::Pin30);
 }
+
+/// The Rx FIFO sizes per chip ([`twocan_flexcan::Chip`]) against the RT1062 model
+/// (written from the reference manual's table "Rx FIFO filter: possible structures"):
+/// the largest table fits the module with room left for transmit mailboxes, its
+/// individually masked elements are the model's; and what the driver accepts today is
+/// what the running controller reports: ACAN's 14/18 at most, MB0–MB15, `IMASK2` = 0.
+#[test]
+fn rx_fifo_sizes_are_data_per_chip_and_the_accepted_limit_is_reported() {
+    use twocan_flexcan::{Chip, Configuration};
+    for target in T41 {
+        let model = model_of(target);
+        let variant = model.variant();
+        let chip = target.board.chip();
+        assert_eq!(chip, Chip::Imxrt1062);
+        assert_eq!(chip.message_buffers(), model.message_buffers());
+        let rffn = u32::from(chip.max_rffn());
+        assert!(rffn <= variant.max_rffn(), "{target:?}");
+        assert_eq!(
+            chip.max_primary_filters(),
+            variant.rx_fifo_individually_masked(rffn),
+            "{target:?}"
+        );
+        assert_eq!(
+            chip.max_table_elements(),
+            twocan_flexcan::model::Variant::rx_fifo_filters(rffn)
+        );
+        assert_eq!(
+            (chip.max_primary_filters(), chip.max_secondary_filters()),
+            (32, 96)
+        );
+
+        // Accepted today: the largest ACAN configuration; the capabilities say so.
+        assert_eq!(chip.accepted_max_rffn(), Configuration::Filters14_18.rffn());
+        let mut settings = Settings::with_clock(500_000, CanClock::IMXRT_24MHZ);
+        settings.configuration = Configuration::Filters14_18;
+        let primary: Vec<Filter> = (0..14u32)
+            .map(|i| Filter::standard(0x100 + i as u16))
+            .collect();
+        let secondary: Vec<Filter> = (0..18u32)
+            .map(|i| Filter::standard(0x200 + i as u16))
+            .collect();
+        let (_, can) = begin_on_exact::<32, 16>(target, &settings, &primary, &secondary)
+            .unwrap_or_else(|e| panic!("{target:?}: {e:?}"));
+        let caps = can.hardware().capabilities();
+        assert_eq!(
+            (caps.max_standard_filters, caps.max_extended_filters),
+            (32, 32),
+            "{target:?}"
+        );
+        let r = can.hardware().registers();
+        assert_eq!(mcr::MAXMB.get(r.read32(regs::MCR)), 15);
+        assert_eq!(r.read32(regs::IMASK2), 0);
+        // One filter more than 14/18 holds is refused, with the ACAN errors.
+        let more: Vec<Filter> = (0..19u32)
+            .map(|i| Filter::standard(0x200 + i as u16))
+            .collect();
+        let e = begin_on_exact::<32, 16>(target, &settings, &primary, &more)
+            .map(|_| ())
+            .unwrap_err();
+        assert!(
+            matches!(e, BeginError::Config(c) if c.contains(ConfigErrors::TOO_MANY_SECONDARY_FILTERS)),
+            "{e:?}"
+        );
+    }
+}
