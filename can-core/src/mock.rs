@@ -16,7 +16,7 @@ use crate::controller::{ErrorStatus, Mode};
 use crate::error::{Error, ErrorCounters, ErrorState, LastErrorCode};
 use crate::filter::Filter;
 use crate::frame::{Frame, RxFrame};
-use crate::hardware::{Completion, Hardware, Settled, StatusEvents, Token};
+use crate::hardware::{Completion, FifoEvents, Hardware, Settled, StatusEvents, Token};
 use crate::mailbox::{MailboxId, MailboxState, TxOutcome, TxPolicy};
 
 /// Mock filter list: portable filters matched in order (the first match gives the index).
@@ -357,11 +357,11 @@ unsafe impl Hardware for MockHardware {
         })
     }
 
-    unsafe fn read_rx(&self, _queue: usize, overrun: &mut bool) -> Option<Frame> {
+    unsafe fn read_rx(&self, _queue: usize, events: &mut FifoEvents) -> Option<Frame> {
         self.with(|m| {
             if m.overrun {
                 m.overrun = false;
-                *overrun = true;
+                events.overrun = true;
             }
             m.fifo.pop_front()
         })

@@ -48,7 +48,7 @@ use crate::dispatch::Dispatcher;
 use crate::error::{Error, ErrorCounters, ErrorState, ErrorStatistics, LastErrorCode};
 use crate::features::{Features, Full, Tally};
 use crate::frame::{Frame, RxFrame};
-use crate::hardware::{Completion, Hardware, Settled, Token};
+use crate::hardware::{Completion, FifoEvents, Hardware, Settled, Token};
 use crate::mailbox::{TxOutcome, TxPolicy};
 use crate::once::{Lease, OnceSlot};
 use crate::spsc::{BufferStats, Counter, SpscRing};
@@ -147,6 +147,7 @@ struct ErrorCounts {
 struct QueueCounts<C> {
     received: C,
     overruns: Counter,
+    warnings: Counter,
 }
 
 impl<C: Tally> QueueCounts<C> {
@@ -154,6 +155,7 @@ impl<C: Tally> QueueCounts<C> {
         QueueCounts {
             received: C::NEW,
             overruns: Counter::new(),
+            warnings: Counter::new(),
         }
     }
 }
@@ -529,6 +531,10 @@ impl<
                 .overruns
                 .get()
                 .wrapping_add(self.per_queue[1].overruns.get()),
+            hardware_fifo_warnings: self.per_queue[0]
+                .warnings
+                .get()
+                .wrapping_add(self.per_queue[1].warnings.get()),
         }
     }
 
@@ -1485,11 +1491,11 @@ unsafe fn drain<
 ) {
     let hw = s.hw();
     let counts = &s.per_queue[q];
-    let mut overrun = false;
+    let mut events = FifoEvents::default();
     let mut any = false;
     // SAFETY: the caller's contract.
     unsafe {
-        while let Some(raw) = hw.read_rx(q, &mut overrun) {
+        while let Some(raw) = hw.read_rx(q, &mut events) {
             any = true;
             counts.received.inc();
             // Widened here, on the interrupt side: the counter's wraps are only known
@@ -1501,14 +1507,26 @@ unsafe fn drain<
             let _ = ring.push(Stamped { raw, wraps });
         }
     }
-    if overrun {
-        counts.overruns.inc();
+    if events != FifoEvents::default() {
+        fifo_events(counts, events);
     }
     #[cfg(feature = "async")]
     if any {
         s.wakers.rx.wake();
     }
     let _ = any;
+}
+
+/// Counts a drain's rare FIFO events, out of the per-frame path.
+#[cold]
+#[inline(never)]
+fn fifo_events<C>(counts: &QueueCounts<C>, events: FifoEvents) {
+    if events.overrun {
+        counts.overruns.inc();
+    }
+    if events.warning {
+        counts.warnings.inc();
+    }
 }
 
 /// The status (error, bus-off, wake-up) interrupt handler.
