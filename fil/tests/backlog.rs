@@ -34,6 +34,17 @@ fn peer_heartbeat(board: &str) -> u16 {
     }
 }
 
+/// The driver's (overruns, FIFO warnings) as the `app` firmware of board 0 published them
+/// (`OVERRUNS`, `FIFO_WARNINGS`: `ErrorStatistics` after its last step).
+fn driver_fifo_counts(w: &World<'_>) -> (u32, u32) {
+    let read = |name: &str| {
+        w.machines[0]
+            .read_u32_static(name)
+            .unwrap_or_else(|| panic!("{name} symbol"))
+    };
+    (read("OVERRUNS"), read("FIFO_WARNINGS"))
+}
+
 fn heartbeat(id: u16, n: u32) -> Frame {
     Frame::standard(id, &n.to_le_bytes()).expect("heartbeat")
 }
@@ -130,6 +141,11 @@ fn backlog(board: &str, bin: &str, depth: usize) {
         (n, 0, 0),
         "{what}: every heartbeat of the burst that fit, in order: {s:?}"
     );
+    assert_eq!(
+        driver_fifo_counts(&w),
+        (0, 1),
+        "{what}: the driver counted the warning/full flag once, no overrun"
+    );
     // 2. Three more than the FIFO holds.
     w.machines[0].board_mut().hold_can_lines = true;
     for _ in 0..depth + 3 {
@@ -161,6 +177,11 @@ fn backlog(board: &str, bin: &str, depth: usize) {
         "{what}: all but the three lost, one gap where they were lost: {s:?}"
     );
     assert_eq!(s.unhandled, 0, "{what}");
+    assert_eq!(
+        driver_fifo_counts(&w),
+        (1, 2),
+        "{what}: the driver counted one overrun and a second warning/full flag"
+    );
     // The plain node's frames were all acknowledged (the board received them on the
     // wire), and the board's run is clean: no fault, no stuck line, no livelock.
     assert_eq!(
