@@ -25,9 +25,10 @@ use twocan_fil::world::World;
 use twocan_sim::SimNode;
 
 /// The heartbeat the `app` firmware of `board` expects from its peer: the Teensy
-/// examples are node 1 (peer 2), the STM32 ones node 2 (peer 1).
+/// examples are node 1 (peer 2), the Blue Pill node 3 (peer 2), the other STM32 ones
+/// node 2 (peer 1).
 fn peer_heartbeat(board: &str) -> u16 {
-    if board.starts_with("teensy") {
+    if board.starts_with("teensy") || board == "bluepill" {
         0x102
     } else {
         0x101
@@ -211,6 +212,9 @@ fn a_receive_interrupt_pending_at_start_up_is_handled_on_every_board() {
         ("teensy36", "teensy-app"),
         ("nucleo-f767zi", "stm32f7-app"),
         ("disco-f746g", "stm32f7-app"),
+        ("bluepill", "stm32-app"),
+        ("nucleo-f446re", "stm32-app"),
+        ("teensy41", "teensy4-app"),
     ] {
         let what = format!("{board} {bin}");
         let Some(mut w) = world(500_000, &[(board, bin)]) else {
