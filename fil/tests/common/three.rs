@@ -110,7 +110,7 @@ fn tx_loaded(w: &World<'_>, b: usize) -> bool {
 const STEP_WINDOW_US: u64 = 10 * QUANTUM_US;
 
 /// Follows each board's application steps, one harness step at a time: a step ends with
-/// its `STATS` written (`sent` grows: every step publishes a heartbeat), and it began in
+/// its `STATS.sent` grown (every step publishes a heartbeat), and it began in
 /// the harness step in which its first frame was loaded into a transmit mailbox (the
 /// first one within [`STEP_WINDOW_US`] before that write in which the controller went
 /// from nothing to send to a frame to send; the write's own harness step when none).
@@ -120,7 +120,7 @@ const STEP_WINDOW_US: u64 = 10 * QUANTUM_US;
 #[derive(Default)]
 struct StepWatch {
     steps: [Vec<u64>; 3],
-    last: [Option<u32>; 3],
+    last: [u32; 3],
     loaded: [bool; 3],
     sent: [u64; 3],
     rises: [Vec<u64>; 3],
@@ -144,8 +144,9 @@ impl StepWatch {
             }
             self.loaded[b] = loaded;
             self.sent[b] = sent;
-            let now = sent_so_far(w, b);
-            if now != self.last[b] {
+            // `STATS` may be published before the step's first frame counts (`sent` 0).
+            let now = sent_so_far(w, b).unwrap_or(0);
+            if now > self.last[b] {
                 let first = self.rises[b]
                     .iter()
                     .copied()
