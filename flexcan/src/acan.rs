@@ -45,7 +45,7 @@ use crate::rt::{Halves, IrqState, Nvic, StartError, StopError};
 use crate::settings::{Settings, RECEIVE_BUFFER_SIZE, TRANSMIT_BUFFER_SIZE};
 
 /// The state of a module started by the one call: ACAN's buffer sizes (receive 32,
-/// transmit 16, table 7; ACAN_T4's defaults are the same), 8 completions.
+/// transmit 16, table 7), 8 completions.
 pub use crate::rt::AcanState;
 
 /// The transmit and receive halves of a module started by the one call.
