@@ -12,10 +12,10 @@
 //! ([`crate::imxrt::pads`]); the program must not give those pads to another function.
 //!
 //! - before `begin`, [`HandOver::free`] gives the instances back;
-//! - [`HandOver::begin`] configures the module as `Can1::begin` does and returns the
+//! - `HandOver::begin` configures the module as `Can1::begin` does and returns the
 //!   controller with a [`Parked`] value holding the instances;
 //! - when the controller comes back (from [`crate::FlexCanHw::into_controller`] after
-//!   the driver, or unsplit), [`Parked::free`] ends it ([`crate::FlexCan::end`]: module
+//!   the driver, or unsplit), `Parked::free` ends it ([`crate::FlexCan::end`]: module
 //!   stopped, pads and gates released) and gives the instances back — only in exchange
 //!   for the controller of that module, so the driver can no longer reach it.
 //!
@@ -123,7 +123,7 @@ impl<C: RalCan> HandOver<C> {
         )
     }
 
-    /// [`HandOver::begin`] over `regs` for the module and `sys` for the CCM and
+    /// `HandOver::begin` over `regs` for the module and `sys` for the CCM and
     /// IOMUXC (absolute offsets): on the host, the behavioural model and
     /// [`crate::HostSystem`].
     #[allow(clippy::result_large_err)]
@@ -148,7 +148,7 @@ impl<C: RalCan> HandOver<C> {
     }
 }
 
-/// The instances of a begun module, given back for its controller ([`Parked::free`]).
+/// The instances of a begun module, given back for its controller (`Parked::free`).
 pub struct Parked<C: RalCan> {
     can: C,
     ccm: Ccm,
@@ -168,7 +168,7 @@ impl<C: RalCan> Parked<C> {
             .map(|(can, ccm, _)| (can, ccm))
     }
 
-    /// [`Parked::free`] with `sys` for the CCM and IOMUXC; also gives the module's
+    /// `Parked::free` with `sys` for the CCM and IOMUXC; also gives the module's
     /// registers back (the model on the host).
     #[allow(clippy::result_large_err, clippy::type_complexity)]
     pub fn free_over<R: Registers, S: Registers>(
