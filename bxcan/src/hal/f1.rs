@@ -29,14 +29,16 @@
 //! TX not in alternate push-pull mode does not compile. (PD0/PD1: 100- and 144-pin
 //! packages; the 48-pin F103C8 has no PD0/PD1 to split from the HAL's ports.)
 //!
-//! The examples below are not compiled by `cargo test` (`ignore`), for the reason given
-//! in the `f4` module's notes (the HAL cannot share a host build with the tests'
-//! `critical-section/std`).
+//! The examples below are fenced `ignore` for rustdoc, for the reason given in the `f4`
+//! module's notes (the HAL cannot share a host build with the tests'
+//! `critical-section/std`); `tools/hal-doctests/run.sh` (CI) cross-builds each for
+//! `thumbv7m-none-eabi` instead: the first must build, the others must fail on
+//! [`CanPins`] (`compile_fail,E0277`).
 //!
 //! ```ignore
-//! use stm32f1xx_hal::{pac, prelude::*, rcc};
-//! use twocan_bxcan::hal::f1;
-//! let dp = pac::Peripherals::take().unwrap();
+//! # use stm32f1xx_hal::{pac, prelude::*, rcc};
+//! # use twocan_bxcan::hal::f1;
+//! # let dp = pac::Peripherals::take().unwrap();
 //! let mut flash = dp.FLASH.constrain();
 //! let mut rcc = dp.RCC.freeze(rcc::Config::hse(8.MHz()).sysclk(72.MHz()).pclk1(36.MHz()), &mut flash.acr);
 //! let mut afio = dp.AFIO.constrain(&mut rcc);
@@ -50,10 +52,62 @@
 //!
 //! RX and TX of different pairs do not compile (`compile_fail`):
 //!
-//! ```ignore
+//! ```ignore,compile_fail,E0277
+//! # use stm32f1xx_hal::{pac, prelude::*, rcc};
+//! # use twocan_bxcan::hal::f1;
+//! # let dp = pac::Peripherals::take().unwrap();
+//! # let mut flash = dp.FLASH.constrain();
+//! # let mut rcc = dp.RCC.freeze(rcc::Config::hsi(), &mut flash.acr);
+//! # let mut afio = dp.AFIO.constrain(&mut rcc);
+//! let mut gpioa = dp.GPIOA.split(&mut rcc);
+//! let mut gpiob = dp.GPIOB.split(&mut rcc);
 //! let tx = gpioa.pa12.into_alternate_push_pull(&mut gpioa.crh);
 //! let rx = gpiob.pb8.into_floating_input(&mut gpiob.crh);
 //! let can = f1::can(dp.CAN, dp.USB, tx, rx, &mut afio.mapr, &mut rcc);
+//! ```
+//!
+//! Nor the right pins in the wrong mode: TX as an open-drain alternate function, or as
+//! a plain output (`compile_fail`):
+//!
+//! ```ignore,compile_fail,E0277
+//! # use stm32f1xx_hal::{pac, prelude::*, rcc};
+//! # use twocan_bxcan::hal::f1;
+//! # let dp = pac::Peripherals::take().unwrap();
+//! # let mut flash = dp.FLASH.constrain();
+//! # let mut rcc = dp.RCC.freeze(rcc::Config::hsi(), &mut flash.acr);
+//! # let mut afio = dp.AFIO.constrain(&mut rcc);
+//! let mut gpiob = dp.GPIOB.split(&mut rcc);
+//! let rx = gpiob.pb8.into_floating_input(&mut gpiob.crh);
+//! let tx = gpiob.pb9.into_alternate_open_drain(&mut gpiob.crh);
+//! let can = f1::can(dp.CAN, dp.USB, tx, rx, &mut afio.mapr, &mut rcc);
+//! ```
+//!
+//! ```ignore,compile_fail,E0277
+//! # use stm32f1xx_hal::{pac, prelude::*, rcc};
+//! # use twocan_bxcan::hal::f1;
+//! # let dp = pac::Peripherals::take().unwrap();
+//! # let mut flash = dp.FLASH.constrain();
+//! # let mut rcc = dp.RCC.freeze(rcc::Config::hsi(), &mut flash.acr);
+//! # let mut afio = dp.AFIO.constrain(&mut rcc);
+//! let mut gpiob = dp.GPIOB.split(&mut rcc);
+//! let rx = gpiob.pb8.into_floating_input(&mut gpiob.crh);
+//! let tx = gpiob.pb9.into_push_pull_output(&mut gpiob.crh);
+//! let can = f1::can(dp.CAN, dp.USB, tx, rx, &mut afio.mapr, &mut rcc);
+//! ```
+//!
+//! Nor TX and RX swapped (`compile_fail`):
+//!
+//! ```ignore,compile_fail,E0277
+//! # use stm32f1xx_hal::{pac, prelude::*, rcc};
+//! # use twocan_bxcan::hal::f1;
+//! # let dp = pac::Peripherals::take().unwrap();
+//! # let mut flash = dp.FLASH.constrain();
+//! # let mut rcc = dp.RCC.freeze(rcc::Config::hsi(), &mut flash.acr);
+//! # let mut afio = dp.AFIO.constrain(&mut rcc);
+//! let mut gpiob = dp.GPIOB.split(&mut rcc);
+//! let rx = gpiob.pb8.into_floating_input(&mut gpiob.crh);
+//! let tx = gpiob.pb9.into_alternate_push_pull(&mut gpiob.crh);
+//! let can = f1::can(dp.CAN, dp.USB, rx, tx, &mut afio.mapr, &mut rcc);
 //! ```
 
 use stm32f1xx_hal::afio::MAPR;

@@ -25,7 +25,9 @@
 //!   carry the alternate function number (`Pin<'D', 1, Alternate<9>>`), and only the
 //!   pins of the data sheets' alternate-function tables implement [`TxPin`]/[`RxPin`]
 //!   for an instance — a wrong pin, or the right pin in the wrong function, does not
-//!   compile (`compile_fail` examples in each family module).
+//!   compile (`compile_fail` examples in each family module: rustdoc runs the F7's;
+//!   the F1's and F4's, whose HALs do not build on the host, are cross-built by
+//!   `tools/hal-doctests/run.sh`).
 //!
 //! # Giving the singleton and the pins back
 //!
