@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# The examples of the STM32F1/F4 HAL hand-over (`twocan_bxcan::hal::f1`, `hal::f4`),
+# The examples of the STM32F1/F4 HAL hand-over (`twocan_bxcan::hal::f1` and its
+# connectivity-line part, `hal::f4`),
 # cross-built: rustdoc cannot run them (their HALs turn on cortex-m's
 # `critical-section-single-core`, which cannot share a host build with the tests'
 # `critical-section/std`), so each example is fenced ```ignore for rustdoc and this
@@ -33,6 +34,7 @@ pin_traits='TxPin|RxPin|CanPins'
 specs=(
     "bxcan/src/hal/f4.rs thumbv7em-none-eabihf f4"
     "bxcan/src/hal/f1.rs thumbv7m-none-eabi f1"
+    "bxcan/src/hal/f1_connectivity.rs thumbv7m-none-eabi f107"
 )
 
 failures=0
