@@ -21,7 +21,7 @@ mod firmware {
     use critical_section::Mutex;
     use twocan_app::firmware::{FirmwareLoop, Published};
     use twocan_app::{App, AppStats};
-    use twocan_bxcan::{const_plan, Can, FifoPolicy, Recovery};
+    use twocan_bxcan::{const_plan, FifoPolicy, Recovery};
     use twocan_stm32::board::BIT_RATE;
     use twocan_stm32::board::CAN1_BANKS;
     use twocan_stm32::can::{self, CanState};
@@ -59,13 +59,17 @@ mod firmware {
             BIT_RATE
         );
         let mut app = App::new(NODE, PEER);
-        // The bit timing is solved for the APB1 clock the HAL set, for the board's part.
-        let config = BOARD
-            .config(boot.apb1_hz, BIT_RATE)
+        // The hand-over from the board's HAL: CAN1's PAC singleton and pins by value
+        // (`twocan_bxcan::hal::f1::can`, `hal::f4::can1`), its clock enabled; the bit
+        // timing solved for the APB1 frequency of the HAL's clocks, for the board's part.
+        let can1 = boot.can.can1();
+        let config = can1
+            .config(BIT_RATE)
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS))
             .recovery(Recovery::Automatic);
-        let mut init =
-            Can::can1(boot.can1.whole(), &config).unwrap_or_else(|_| rt::halt(CAN_BLINKS));
+        let mut init = can1
+            .configure(&config)
+            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         // The application's filters (`twocan_app::filters_for`, the list `app.filters()`
         // returns) planned at build time (`const_plan!`, see `stm32-loopback`).
         let plan = const_plan!(

@@ -21,18 +21,18 @@ mod firmware {
 
     use critical_section::Mutex;
     use twocan_app::{App, AppStats};
-    use twocan_bxcan::regs::{ControlRegs, FilterRegs};
-    use twocan_bxcan::{const_plan, Can, FifoPolicy, Recovery};
+    use twocan_bxcan::hal::Can1Filters;
+    use twocan_bxcan::regs::ControlRegs;
+    use twocan_bxcan::{const_plan, FifoPolicy, Recovery};
     use twocan_stm32::board::BIT_RATE;
     use twocan_stm32::board::CAN1_BANKS;
     use twocan_stm32::can::{self, CanState};
     use twocan_stm32::rt::{self, CAN_BLINKS};
     use twocan_stm32::time::{self, Every};
-    use twocan_stm32::BOARD;
 
     // Each controller owns its control registers and shares CAN1's filter block (RM0390
-    // §30.9.4) through the `&'static FilterRegs` that `Can1::dual` lends.
-    type Shared = CanState<ControlRegs, &'static FilterRegs>;
+    // §30.9.4) through the `Can1Filters` handle of the hand-over.
+    type Shared = CanState<ControlRegs, Can1Filters>;
     static CAN1: Shared = Shared::new();
     static CAN2: Shared = Shared::new();
     twocan_stm32::can1_vectors!();
@@ -45,11 +45,13 @@ mod firmware {
     #[cortex_m_rt::entry]
     fn main() -> ! {
         let mut boot = rt::boot();
-        // CAN1 in dual mode lends the filter block that CAN2 needs.
-        let (can1, filters) = boot.can1.dual();
-        let can2 = boot.can2.control();
-        let base = BOARD
-            .config(boot.apb1_hz, BIT_RATE)
+        // The hand-over from the HAL (`twocan_bxcan::hal::f4::can1_dual`, `f4::can2`): the
+        // singletons and pins by value, both clocks enabled; CAN1's hand-over gives the
+        // filter-block handle CAN2's needs.
+        let (can1, can2) = boot.can.dual();
+        // The bit timing solved for the APB1 frequency of the HAL's clocks.
+        let base = can1
+            .config(BIT_RATE)
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS))
             .recovery(Recovery::Automatic);
         let config1 = base
@@ -58,8 +60,9 @@ mod firmware {
         let mut node1 = App::new(1, 2);
         let mut node2 = App::new(2, 1);
 
-        let mut init1 =
-            Can::can1_dual(can1, filters, &config1).unwrap_or_else(|_| rt::halt(CAN_BLINKS));
+        let mut init1 = can1
+            .configure(&config1)
+            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         // Each node's filters (`twocan_app::filters_for`) planned at build time for its 14
         // banks (`const_plan!`).
         let plan1 = const_plan!(
@@ -69,7 +72,9 @@ mod firmware {
         if init1.set_filters(plan1).is_err() {
             rt::halt(CAN_BLINKS);
         }
-        let mut init2 = Can::can2(can2, filters, &base).unwrap_or_else(|_| rt::halt(CAN_BLINKS));
+        let mut init2 = can2
+            .configure(&base)
+            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         let plan2 = const_plan!(
             twocan_app::filters_for(2, 1),
             CAN1_BANKS.fifo(FifoPolicy::Fifo1)

@@ -11,13 +11,12 @@
 mod firmware {
     use core::sync::atomic::{AtomicU32, Ordering};
 
-    use twocan_bxcan::{const_plan, Can, FifoPolicy};
+    use twocan_bxcan::{const_plan, FifoPolicy};
     use twocan_core::{Filter, Frame};
     use twocan_stm32::board::CAN1_BANKS;
     use twocan_stm32::can::{self, CanState};
     use twocan_stm32::rt::{self, CAN_BLINKS};
     use twocan_stm32::time::{self, Every};
-    use twocan_stm32::BOARD;
 
     static CAN1: CanState = CanState::new();
     twocan_stm32::can1_vectors!();
@@ -31,13 +30,17 @@ mod firmware {
     fn main() -> ! {
         let mut boot = rt::boot();
         twocan_stm32::info!("stm32-loopback: CAN1 in loop-back, a frame every second");
-        // The bit timing is solved for the APB1 clock the HAL set, for the board's part.
-        let config = BOARD
-            .config(boot.apb1_hz, 125_000)
+        // The hand-over from the board's HAL: CAN1's PAC singleton and pins by value
+        // (`twocan_bxcan::hal::f1::can`, `hal::f4::can1`), its clock enabled; the bit
+        // timing solved for the APB1 frequency of the HAL's clocks, for the board's part.
+        let can1 = boot.can.can1();
+        let config = can1
+            .config(125_000)
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS))
             .loopback(true);
-        let mut init =
-            Can::can1(boot.can1.whole(), &config).unwrap_or_else(|_| rt::halt(CAN_BLINKS));
+        let mut init = can1
+            .configure(&config)
+            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         // Planned at build time (`const_plan!`): the run-time planner's working memory
         // (about 90 KB) does not fit the F103C8's 20 KiB of RAM.
         let plan = const_plan!([Filter::pass_all()], CAN1_BANKS.fifo(FifoPolicy::Fifo0));
