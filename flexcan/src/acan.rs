@@ -9,8 +9,9 @@
 //! `end`: the way back, after which [`can0`] runs again.
 //!
 //! The five steps stay available for programs that want control (their own state sizes,
-//! filters, pins, priorities, or their own vectors): `Can0::take`, `Can0::begin` /
-//! `begin_on` with pins, a `static` [`AcanState`] (or another [`IrqState`]),
+//! filters, pins, priorities, or their own vectors): `Can0::take`, `Can0::begin_in`
+//! into a `static` `filters::TableSlot` (or `begin` / `begin_on`, whose controller carries its
+//! table), a `static` [`IrqState`] ([`OneCallState`], `rt::AcanState`),
 //! [`IrqState::start`] with the NVIC, and the halves.
 //!
 //! **Filters:** the one call installs [`Filter::pass_all`], so that every frame is
@@ -29,32 +30,64 @@ use critical_section::Mutex;
 use twocan_core::{Filter, Leftovers};
 
 use crate::begin_error::BeginError;
+#[cfg(target_os = "none")]
+use crate::filters::{FilterTable, TableSlot};
+use crate::options::FullInSlot;
 use crate::regs::FlexCanRegs;
 #[allow(unused_imports)] // doc links
 use crate::rt::IrqState;
-use crate::rt::{AcanState, Halves, Nvic, StartError, StopError};
+use crate::rt::{Halves, Nvic, StartError, StopError};
 use crate::settings::{Settings, RECEIVE_BUFFER_SIZE, TRANSMIT_BUFFER_SIZE};
 #[cfg(target_os = "none")]
 use crate::Can0;
 #[cfg(all(target_os = "none", feature = "teensy36"))]
 use crate::Can1;
 
-/// The transmit and receive halves of a module started by the one call.
-pub type AcanHalves =
-    Halves<FlexCanRegs, RECEIVE_BUFFER_SIZE, twocan_core::FifoQueue<TRANSMIT_BUFFER_SIZE>, 8>;
+/// The state of a module started by the one call: ACAN's buffer sizes, every feature,
+/// the filter table compiled by `begin` straight into the module's `static`
+/// `TableSlot` ([`FullInSlot`]: no table-sized value moves through the one call, so
+/// it configures within a few hundred bytes of stack, issue 21).
+pub type OneCallState = IrqState<
+    FlexCanRegs,
+    RECEIVE_BUFFER_SIZE,
+    twocan_core::FifoQueue<TRANSMIT_BUFFER_SIZE>,
+    8,
+    FullInSlot,
+>;
 
-/// FlexCAN0's state and interrupt handlers (ACAN's buffer sizes), used by [`can0`].
-pub static CAN0: AcanState = AcanState::new();
+/// The transmit and receive halves of a module started by the one call.
+pub type AcanHalves = Halves<
+    FlexCanRegs,
+    RECEIVE_BUFFER_SIZE,
+    twocan_core::FifoQueue<TRANSMIT_BUFFER_SIZE>,
+    8,
+    FullInSlot,
+>;
+
+/// FlexCAN0's state and interrupt handlers, used by [`can0`].
+pub static CAN0: OneCallState = OneCallState::new();
 /// FlexCAN1's (Teensy 3.6), used by [`can1`].
 #[cfg(feature = "teensy36")]
-pub static CAN1: AcanState = AcanState::new();
+pub static CAN1: OneCallState = OneCallState::new();
+
+/// FlexCAN0's filter table, which the one call's `begin` compiles into.
+#[cfg(target_os = "none")]
+static TABLE0: TableSlot = TableSlot::new();
+/// FlexCAN1's.
+#[cfg(all(target_os = "none", feature = "teensy36"))]
+static TABLE1: TableSlot = TableSlot::new();
 
 /// Tokens given back by [`end_can0`] / [`end_can1`] or by a failed one call, for the
 /// next one call (a token is taken once from `Can0::take`).
 #[cfg(target_os = "none")]
-static SPARE0: Mutex<Cell<Option<Can0>>> = Mutex::new(Cell::new(None));
+static SPARE0: Spare<Can0> = Mutex::new(Cell::new(None));
 #[cfg(all(target_os = "none", feature = "teensy36"))]
-static SPARE1: Mutex<Cell<Option<Can1>>> = Mutex::new(Cell::new(None));
+static SPARE1: Spare<Can1> = Mutex::new(Cell::new(None));
+
+/// A module's token and filter table between one calls (both taken once from their
+/// `take`).
+#[cfg(target_os = "none")]
+type Spare<T> = Mutex<Cell<Option<(T, &'static mut FilterTable)>>>;
 
 /// Why a one call did not start or end the module.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -94,7 +127,7 @@ impl core::error::Error for OneCallError {}
 
 /// Defines the one call and its way back for one module.
 macro_rules! one_call {
-    ($(#[$m:meta])* $token:ident, $state:ident, $spare:ident, $start:ident, $start_with:ident, $end:ident, $name:literal) => {
+    ($(#[$m:meta])* $token:ident, $state:ident, $table:ident, $spare:ident, $start:ident, $start_with:ident, $end:ident, $name:literal) => {
         $(#[$m])*
         #[doc = concat!("ACAN `ACAN::", $name, ".begin (ACANSettings (bit_rate))`: ")]
         /// the module begun with ACAN's defaults at `bit_rate` on the board's default
@@ -123,23 +156,25 @@ macro_rules! one_call {
             #[cfg(target_os = "none")]
             {
                 let spare = critical_section::with(|cs| $spare.borrow(cs).take());
-                let Some(token) = spare.or_else($token::take) else {
+                let Some((token, slot)) = spare.or_else(|| Some(($token::take()?, $table.take()?)))
+                else {
                     return Err(OneCallError::Taken);
                 };
-                let controller = match token.begin(settings, primary, secondary) {
-                    Ok(c) => c,
-                    Err((token, e)) => {
-                        critical_section::with(|cs| $spare.borrow(cs).set(Some(token)));
+                let hw = match token.begin_in(settings, primary, secondary, slot) {
+                    Ok(hw) => hw,
+                    Err((token, e, slot)) => {
+                        critical_section::with(|cs| $spare.borrow(cs).set(Some((token, slot))));
                         return Err(OneCallError::Begin(e));
                     }
                 };
-                match $state.start(controller.into_split(), nvic) {
+                match $state.start(hw, nvic) {
                     Ok(halves) => Ok(halves),
                     Err((e, hw)) => {
-                        // End the module again; its token comes back unless it would
-                        // not stop (then it keeps running unwired, as after `begin`).
-                        if let Ok(token) = $token::end(hw.into_controller()) {
-                            critical_section::with(|cs| $spare.borrow(cs).set(Some(token)));
+                        // End the module again; its token and table come back unless it
+                        // would not stop (then it keeps running unwired, as after
+                        // `begin`).
+                        if let Ok(spare) = $token::end_split(hw) {
+                            critical_section::with(|cs| $spare.borrow(cs).set(Some(spare)));
                         }
                         Err(OneCallError::Start(e))
                     }
@@ -170,20 +205,21 @@ macro_rules! one_call {
                 let (hw, left) = $state
                     .stop(halves.0, halves.1, nvic)
                     .map_err(|(e, h)| (OneCallError::Stop(e), Some(h)))?;
-                let token = $token::end(hw.into_controller())
-                    .map_err(|(_, e)| (OneCallError::End(e), None))?;
-                critical_section::with(|cs| $spare.borrow(cs).set(Some(token)));
+                let spare =
+                    $token::end_split(hw).map_err(|(_, e)| (OneCallError::End(e), None))?;
+                critical_section::with(|cs| $spare.borrow(cs).set(Some(spare)));
                 Ok(left)
             }
         }
     };
 }
 
-one_call!(Can0, CAN0, SPARE0, can0, can0_with, end_can0, "can0");
+one_call!(Can0, CAN0, TABLE0, SPARE0, can0, can0_with, end_can0, "can0");
 one_call!(
     #[cfg(feature = "teensy36")]
     Can1,
     CAN1,
+    TABLE1,
     SPARE1,
     can1,
     can1_with,

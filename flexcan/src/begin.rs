@@ -611,6 +611,11 @@ impl BeginPlan {
     pub const fn configuration(&self) -> Configuration {
         self.plan.configuration
     }
+
+    /// The module the plan is made for.
+    pub const fn target(&self) -> Target {
+        self.target
+    }
 }
 
 /// The bus mode the settings ask for (ACAN §4: listen-only, loop-back).
@@ -680,4 +685,10 @@ mod firmware {
                 .map_err(|e| (self, e))
         }
     }
+    crate::token_begin::token_begin!(Can0, system);
+    crate::token_begin::token_end!(Can0, system);
+    #[cfg(feature = "teensy36")]
+    crate::token_begin::token_begin!(Can1, system);
+    #[cfg(feature = "teensy36")]
+    crate::token_begin::token_end!(Can1, system);
 }

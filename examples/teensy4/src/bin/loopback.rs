@@ -9,14 +9,16 @@ mod firmware {
     use core::sync::atomic::{AtomicU32, Ordering};
 
     use twocan_core::Frame;
-    use twocan_flexcan::pin::{Pin22, Pin23};
+    use twocan_flexcan::pin::{settings_for, Pin22, Pin23};
     use twocan_flexcan::Can1;
-    use twocan_teensy4::can::CanState;
+    use twocan_teensy4::can::{CanState, TableSlot};
     use twocan_teensy4::configs::{LOOPBACK, LOOPBACK_FILTERS};
     use twocan_teensy4::rt::{self, CAN_HALT};
     use twocan_teensy4::time::{self, Every};
 
     static CAN1: CanState = CanState::new();
+    /// CAN1's filter table (`begin_in` compiles the list straight into it).
+    static TABLE1: TableSlot = TableSlot::new();
 
     /// Frames handed to the driver.
     pub static SENT: AtomicU32 = AtomicU32::new(0);
@@ -29,10 +31,15 @@ mod firmware {
         twocan_teensy4::info!("teensy4-loopback: CAN1 in loop-back, a frame every second");
         let can = Can1::take()
             .unwrap_or_else(|| rt::halt(CAN_HALT))
-            .begin_on(Pin22, Pin23, &LOOPBACK, &LOOPBACK_FILTERS, &[])
+            .begin_in(
+                &settings_for(&LOOPBACK, Pin22, Pin23),
+                &LOOPBACK_FILTERS,
+                &[],
+                TABLE1.take().unwrap_or_else(|| rt::halt(CAN_HALT)),
+            )
             .unwrap_or_else(|_| rt::halt(CAN_HALT));
         let (mut tx, mut rx) = CAN1
-            .start(can.into_split(), &mut boot.core.NVIC)
+            .start(can, &mut boot.core.NVIC)
             .unwrap_or_else(|_| rt::halt(CAN_HALT));
         let message = Frame::standard(0x542, &[]).unwrap_or_else(|_| rt::halt(CAN_HALT));
         let mut send = Every::new(time::millis(), 1000);
