@@ -34,6 +34,8 @@ use crate::begin_error::BeginError;
 use crate::filters::{FilterTable, TableSlot};
 use crate::options::FullInSlot;
 use crate::regs::FlexCanRegs;
+#[cfg(target_os = "none")]
+use crate::rt::InPlaceError;
 #[allow(unused_imports)] // doc links
 use crate::rt::IrqState;
 use crate::rt::{Halves, Nvic, StartError, StopError};
@@ -102,7 +104,7 @@ pub enum OneCallError {
     /// is kept for the next call.
     Begin(BeginError),
     /// The interrupts could not be wired (the module's entry points run a state of
-    /// the five steps): the module was ended again; the token is kept.
+    /// the five steps): nothing was configured; the token is kept.
     Start(StartError),
     /// The way back refused (the halves come back with it).
     Stop(StopError),
@@ -155,30 +157,35 @@ macro_rules! one_call {
             }
             #[cfg(target_os = "none")]
             {
-                let spare = critical_section::with(|cs| $spare.borrow(cs).take());
-                let Some((token, slot)) = spare.or_else(|| Some(($token::take()?, $table.take()?)))
-                else {
+                let mut spare = critical_section::with(|cs| $spare.borrow(cs).take())
+                    .or_else(|| Some(($token::take()?, $table.take()?)));
+                let Some(target) = spare.as_ref().map(|(token, _)| token.target()) else {
                     return Err(OneCallError::Taken);
                 };
-                let hw = match token.begin_in(settings, primary, secondary, slot) {
-                    Ok(hw) => hw,
-                    Err((token, e, slot)) => {
-                        critical_section::with(|cs| $spare.borrow(cs).set(Some((token, slot))));
-                        return Err(OneCallError::Begin(e));
-                    }
-                };
-                match $state.start(hw, nvic) {
-                    Ok(halves) => Ok(halves),
-                    Err((e, hw)) => {
-                        // End the module again; its token and table come back unless it
-                        // would not stop (then it keeps running unwired, as after
-                        // `begin`).
-                        if let Ok(spare) = $token::end_split(hw) {
-                            critical_section::with(|cs| $spare.borrow(cs).set(Some(spare)));
-                        }
-                        Err(OneCallError::Start(e))
-                    }
+                // Configured in place in the state (`start_in_place`): neither the
+                // controller nor its table moves through the one call.
+                let started = $state.start_in_place(
+                    target,
+                    |hw| {
+                        let (token, slot) = spare.take().ok_or(None)?;
+                        token
+                            .begin_in_place(hw, settings, primary, secondary, slot)
+                            .map_err(|(token, e, slot)| {
+                                spare = Some((token, slot));
+                                Some(e)
+                            })
+                    },
+                    nvic,
+                );
+                // Not started: the token and the table wait for the next call.
+                if let Some(kept) = spare {
+                    critical_section::with(|cs| $spare.borrow(cs).set(Some(kept)));
                 }
+                started.map_err(|e| match e {
+                    InPlaceError::Init(Some(e)) => OneCallError::Begin(e),
+                    InPlaceError::Init(None) => OneCallError::Taken,
+                    InPlaceError::Start(e) => OneCallError::Start(e),
+                })
             }
         }
 

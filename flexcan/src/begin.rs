@@ -32,6 +32,8 @@
 //! Every wait is bounded by [`Settings::handshake_bound`]; a missing acknowledge is
 //! [`BeginError::Hardware`]`(`[`Error::Timeout`]`)`.
 
+use core::mem::MaybeUninit;
+
 use twocan_core::timing::{TimingError, TimingRule};
 use twocan_core::{BusMode, BusOffRecovery, Error, Filter, LastErrorCode, Mode, Registers};
 
@@ -402,7 +404,7 @@ impl<R: Registers> FlexCan<R> {
     /// ```
     #[allow(clippy::type_complexity)]
     pub fn begin_in<S: Registers, O: Options<Table = &'static mut FilterTable>>(
-        mut regs: R,
+        regs: R,
         sys: &mut S,
         target: Target,
         settings: &Settings,
@@ -410,6 +412,45 @@ impl<R: Registers> FlexCan<R> {
         secondary: &[Filter],
         slot: &'static mut FilterTable,
     ) -> Result<FlexCanHw<R, O>, (BeginError, &'static mut FilterTable)> {
+        let (regs, table, parts) =
+            Self::begin_in_parts(regs, sys, target, settings, primary, secondary, slot)?;
+        Ok(FlexCanHw::from_parts(regs, target, table, parts))
+    }
+
+    /// [`FlexCan::begin_in`] writing the split controller **in place** into `hw`
+    /// (the storage a `static` state lends: `twocan_core::split::State::split_with`,
+    /// `rt::IrqState::start_in_place`), so that the controller does not move through
+    /// the configuration either. Returns the controller written; on an error nothing is
+    /// written and the table's slot comes back.
+    #[allow(clippy::type_complexity, clippy::too_many_arguments)]
+    pub fn begin_in_place<'h, S: Registers, O: Options<Table = &'static mut FilterTable>>(
+        hw: &'h mut MaybeUninit<FlexCanHw<R, O>>,
+        regs: R,
+        sys: &mut S,
+        target: Target,
+        settings: &Settings,
+        primary: &[Filter],
+        secondary: &[Filter],
+        slot: &'static mut FilterTable,
+    ) -> Result<&'h mut FlexCanHw<R, O>, (BeginError, &'static mut FilterTable)> {
+        let (regs, table, parts) =
+            Self::begin_in_parts(regs, sys, target, settings, primary, secondary, slot)?;
+        Ok(hw.write(FlexCanHw::from_parts(regs, target, table, parts)))
+    }
+
+    /// What [`FlexCan::begin_in`] and [`FlexCan::begin_in_place`] share: the checks,
+    /// the lists compiled into `slot`, the module configured; the split controller's
+    /// small values.
+    #[allow(clippy::type_complexity)]
+    fn begin_in_parts<S: Registers>(
+        mut regs: R,
+        sys: &mut S,
+        target: Target,
+        settings: &Settings,
+        primary: &[Filter],
+        secondary: &[Filter],
+        slot: &'static mut FilterTable,
+    ) -> Result<(R, &'static mut FilterTable, Parts), (BeginError, &'static mut FilterTable)> {
         if let Some(e) = bitrate_error(settings) {
             return Err((BeginError::Timing(e), slot));
         }
@@ -430,21 +471,17 @@ impl<R: Registers> FlexCan<R> {
         ) {
             return Err((BeginError::Hardware(e), slot));
         }
-        Ok(FlexCanHw::from_parts(
-            regs,
-            target,
-            slot,
-            Parts {
-                bus_mode: bus_mode_of(settings),
-                recovery: settings.bus_off_recovery,
-                polls,
-                irq_priority: settings.message_irq_priority,
-                mode: Mode::Normal,
-                last_error: LastErrorCode::None,
-                system: plan.system,
-                bus_clock_hz: settings.bus_clock_hz.unwrap_or(settings.can_clock.hz()),
-            },
-        ))
+        let parts = Parts {
+            bus_mode: bus_mode_of(settings),
+            recovery: settings.bus_off_recovery,
+            polls,
+            irq_priority: settings.message_irq_priority,
+            mode: Mode::Normal,
+            last_error: LastErrorCode::None,
+            system: plan.system,
+            bus_clock_hz: settings.bus_clock_hz.unwrap_or(settings.can_clock.hz()),
+        };
+        Ok((regs, slot, parts))
     }
 
     /// `begin` with a filter table planned at compile time ([`crate::const_plan!`],
@@ -494,11 +531,35 @@ impl<R: Registers> FlexCan<R> {
     /// for the configuration `checked` was made for ([`Error::InvalidArgument`]
     /// otherwise, nothing written).
     pub fn begin_checked<S: Registers, O: Options<Table = PlannedTable>>(
-        mut regs: R,
+        regs: R,
         sys: &mut S,
         checked: &BeginPlan,
         table: PlannedTable,
     ) -> Result<FlexCanHw<R, O>, BeginError> {
+        let (regs, parts) = Self::begin_checked_parts(regs, sys, checked, table)?;
+        Ok(FlexCanHw::from_parts(regs, checked.target, table, parts))
+    }
+
+    /// [`FlexCan::begin_checked`] writing the split controller **in place** into `hw`
+    /// (see [`FlexCan::begin_in_place`]). On an error nothing is written.
+    pub fn begin_checked_in_place<'h, S: Registers, O: Options<Table = PlannedTable>>(
+        hw: &'h mut MaybeUninit<FlexCanHw<R, O>>,
+        regs: R,
+        sys: &mut S,
+        checked: &BeginPlan,
+        table: PlannedTable,
+    ) -> Result<&'h mut FlexCanHw<R, O>, BeginError> {
+        let (regs, parts) = Self::begin_checked_parts(regs, sys, checked, table)?;
+        Ok(hw.write(FlexCanHw::from_parts(regs, checked.target, table, parts)))
+    }
+
+    /// What [`FlexCan::begin_checked`] and [`FlexCan::begin_checked_in_place`] share.
+    fn begin_checked_parts<S: Registers>(
+        mut regs: R,
+        sys: &mut S,
+        checked: &BeginPlan,
+        table: PlannedTable,
+    ) -> Result<(R, Parts), BeginError> {
         let plan = &checked.plan;
         if table.configuration() != plan.configuration {
             return Err(BeginError::Hardware(Error::InvalidArgument));
@@ -518,21 +579,17 @@ impl<R: Registers> FlexCan<R> {
             },
             checked.polls,
         )?;
-        Ok(FlexCanHw::from_parts(
-            regs,
-            checked.target,
-            table,
-            Parts {
-                bus_mode: checked.bus_mode,
-                recovery: checked.recovery,
-                polls: checked.polls,
-                irq_priority: checked.irq_priority,
-                mode: Mode::Normal,
-                last_error: LastErrorCode::None,
-                system: plan.system,
-                bus_clock_hz: checked.bus_clock_hz,
-            },
-        ))
+        let parts = Parts {
+            bus_mode: checked.bus_mode,
+            recovery: checked.recovery,
+            polls: checked.polls,
+            irq_priority: checked.irq_priority,
+            mode: Mode::Normal,
+            last_error: LastErrorCode::None,
+            system: plan.system,
+            bus_clock_hz: checked.bus_clock_hz,
+        };
+        Ok((regs, parts))
     }
 }
 

@@ -67,7 +67,7 @@ use twocan_core::split::{Rx, Rx0Irq, Rx1Irq, State, StatusIrq, Tx, TxIrq};
 use twocan_core::txqueue::TxQueue;
 use twocan_core::{Error, Features, FifoQueue, Leftovers, Parts, Registers, UnsplitError};
 
-use crate::instance::{Instance, Irqs};
+use crate::instance::{Instance, Irqs, Target};
 use crate::options::{Full, Options};
 use crate::regs::FlexCanRegs;
 use crate::settings::{RECEIVE_BUFFER_SIZE, TRANSMIT_BUFFER_SIZE};
@@ -434,6 +434,76 @@ where
         Ok((parts.tx, parts.rx))
     }
 
+    /// [`IrqState::start`] with the controller **configured in place** in this state
+    /// (issue 21): `init` gets the state's empty controller storage and writes the
+    /// controller there (a token's `begin_in_place` or `begin_planned_in_place`, or
+    /// [`crate::FlexCan::begin_in_place`]), so that no controller moves through the
+    /// configuration. `target` is the module `init` configures: its entry points are
+    /// claimed before `init` runs, and a controller of another module is refused
+    /// ([`StartError::Split`] with [`Error::InvalidArgument`]; it stays configured,
+    /// unwired). The handlers are installed, then the lines unmasked at the
+    /// controller's `message_irq_priority`.
+    ///
+    /// Errors: [`InPlaceError::Init`] with `init`'s own error (the state stays unsplit,
+    /// the entry points unclaimed); [`InPlaceError::Start`] otherwise (`init` not
+    /// called, except for a controller of another module).
+    #[allow(clippy::type_complexity)]
+    pub fn start_in_place<E>(
+        &'static self,
+        target: Target,
+        init: impl FnOnce(&mut MaybeUninit<FlexCanHw<R, O>>) -> Result<&mut FlexCanHw<R, O>, E>,
+        nvic: &mut impl Nvic,
+    ) -> Result<Halves<R, RX, Q, DONE, O, Fe>, InPlaceError<E>> {
+        let Some(irqs) = target.irqs() else {
+            return Err(InPlaceError::Start(StartError::NoInterrupts));
+        };
+        if self.state.hardware().is_some() {
+            return Err(InPlaceError::Start(StartError::AlreadySplit));
+        }
+        let slot = slot(target.instance);
+        let again = slot.wired_to(self);
+        if !again && !slot.claim() {
+            return Err(InPlaceError::Start(StartError::AlreadyWired));
+        }
+        let mut failed = None;
+        let mut priority = 0;
+        let split = self.state.split_with(|storage| match init(storage) {
+            Ok(hw) if hw.target() == target => {
+                priority = hw.message_irq_priority();
+                Ok(hw)
+            }
+            Ok(_) => Err(Error::InvalidArgument),
+            Err(e) => {
+                failed = Some(e);
+                Err(Error::InvalidArgument)
+            }
+        });
+        let parts = match split {
+            Ok(parts) => parts,
+            Err(e) => {
+                if !again {
+                    slot.unclaim();
+                }
+                return Err(match (failed, e) {
+                    (Some(e), _) => InPlaceError::Init(e),
+                    (None, Error::WrongMode) => InPlaceError::Start(StartError::AlreadySplit),
+                    (None, e) => InPlaceError::Start(StartError::Split(e)),
+                });
+            }
+        };
+        let filled = self
+            .message
+            .put((parts.tx_irq, parts.rx0_irq, parts.rx1_irq))
+            .is_ok()
+            && self.status.put(parts.status_irq).is_ok();
+        debug_assert!(filled, "split succeeds once per start");
+        if !again {
+            slot.publish(self);
+        }
+        enable(nvic, irqs, priority);
+        Ok((parts.tx, parts.rx))
+    }
+
     /// The way back (issue 22 item 11): masks the instance's message, bus-off, error
     /// and warning lines, takes the handlers back out of their cells (no entry point
     /// runs them from now on), and gives them with the halves to
@@ -498,6 +568,27 @@ where
         }
     }
 }
+
+/// Why [`IrqState::start_in_place`] did not start.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum InPlaceError<E> {
+    /// The configuration `init` refused (its own error; nothing was wired).
+    Init(E),
+    /// As [`IrqState::start`].
+    Start(StartError),
+}
+
+impl<E: fmt::Display> fmt::Display for InPlaceError<E> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            InPlaceError::Init(e) => write!(f, "configuration: {e}"),
+            InPlaceError::Start(e) => e.fmt(f),
+        }
+    }
+}
+
+impl<E: fmt::Debug + fmt::Display> core::error::Error for InPlaceError<E> {}
 
 /// Why [`IrqState::stop`] did not stop; the halves come back with it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -56,6 +56,80 @@ macro_rules! token_begin {
                 .map_err(|(e, slot)| (self, e, slot))
             }
 
+            /// [`Self::begin_in`] writing the split controller **in place** into `hw`,
+            /// the storage a `static` state lends (`rt::IrqState::start_in_place`,
+            /// `State::split_with`): neither the table nor the controller moves
+            /// through the configuration ([`crate::FlexCan::begin_in_place`]). On error
+            /// nothing is written, and the token and the slot come back.
+            #[allow(clippy::type_complexity)]
+            pub fn begin_in_place<'h, O>(
+                self,
+                hw: &'h mut core::mem::MaybeUninit<$crate::FlexCanHw<$crate::regs::FlexCanRegs, O>>,
+                settings: &$crate::Settings,
+                primary: &[twocan_core::Filter],
+                secondary: &[twocan_core::Filter],
+                slot: &'static mut $crate::FilterTable,
+            ) -> Result<
+                &'h mut $crate::FlexCanHw<$crate::regs::FlexCanRegs, O>,
+                (Self, $crate::BeginError, &'static mut $crate::FilterTable),
+            >
+            where
+                O: $crate::options::Options<Table = &'static mut $crate::FilterTable>,
+            {
+                let target = self.target();
+                let Some(base) = target.base() else {
+                    return Err((
+                        self,
+                        $crate::BeginError::Config($crate::ConfigErrors::NO_SUCH_INSTANCE),
+                        slot,
+                    ));
+                };
+                // SAFETY: as for `begin_in`.
+                let regs = unsafe { $crate::regs::FlexCanRegs::new(base) };
+                $crate::FlexCan::begin_in_place(
+                    hw,
+                    regs,
+                    &mut $system(),
+                    target,
+                    settings,
+                    primary,
+                    secondary,
+                    slot,
+                )
+                .map_err(|(e, slot)| (self, e, slot))
+            }
+
+            /// [`Self::begin_planned`] writing the split controller **in place** into
+            /// `hw` ([`crate::FlexCan::begin_checked_in_place`]). On error nothing is
+            /// written and the token comes back.
+            pub fn begin_planned_in_place<'h, O>(
+                self,
+                hw: &'h mut core::mem::MaybeUninit<$crate::FlexCanHw<$crate::regs::FlexCanRegs, O>>,
+                checked: &$crate::BeginPlan,
+                table: $crate::installed::PlannedTable,
+            ) -> Result<
+                &'h mut $crate::FlexCanHw<$crate::regs::FlexCanRegs, O>,
+                (Self, $crate::BeginError),
+            >
+            where
+                O: $crate::options::Options<Table = $crate::installed::PlannedTable>,
+            {
+                let target = self.target();
+                let base = match target.base() {
+                    Some(base) if checked.target() == target => base,
+                    _ => {
+                        return Err((
+                            self,
+                            $crate::BeginError::Hardware(twocan_core::Error::InvalidArgument),
+                        ))
+                    }
+                };
+                // SAFETY: as for `begin_in`.
+                let regs = unsafe { $crate::regs::FlexCanRegs::new(base) };
+                $crate::FlexCan::begin_checked_in_place(hw, regs, &mut $system(), checked, table)
+                    .map_err(|e| (self, e))
+            }
+
             /// `begin` with a filter table planned at compile time
             /// ([`crate::const_plan!`]) and settings checked beforehand
             /// ([`crate::BeginPlan`], `const` for `const` settings), giving the split

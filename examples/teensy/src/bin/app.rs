@@ -56,16 +56,20 @@ mod firmware {
         let mut app = App::new(node, peer);
         let token = Can0::take().unwrap_or_else(|| rt::halt(CAN_BLINKS));
         // The application's portable filter list, as primary filters.
-        let can = token
-            .begin_in(
-                &settings_for(&SETTINGS, Pin3, Pin4),
-                &app.filters(),
-                &[],
-                TABLE0.take().unwrap_or_else(|| rt::halt(CAN_BLINKS)),
-            )
-            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         let (mut tx, mut rx) = CAN0
-            .start(can, &mut boot.core.NVIC)
+            .start_in_place(
+                token.target(),
+                |hw| {
+                    token.begin_in_place(
+                        hw,
+                        &const { settings_for(&SETTINGS, Pin3, Pin4) },
+                        &app.filters(),
+                        &[],
+                        TABLE0.take().unwrap_or_else(|| rt::halt(CAN_BLINKS)),
+                    )
+                },
+                &mut boot.core.NVIC,
+            )
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         twocan_teensy::info!(
             "CAN0 on the bus with the application's {=usize} filters",

@@ -59,16 +59,20 @@ mod firmware {
     fn main() -> ! {
         let mut boot = rt::boot();
         let token = Can0::take().unwrap_or_else(|| rt::halt(CAN_BLINKS));
-        let can = token
-            .begin_in(
-                &settings_for(&SETTINGS, Pin3, Pin4),
-                &twocan_teensy::configs::ECHO_FILTERS,
-                &[],
-                TABLE0.take().unwrap_or_else(|| rt::halt(CAN_BLINKS)),
-            )
-            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         let (tx, rx) = CAN0
-            .start(can, &mut boot.core.NVIC)
+            .start_in_place(
+                token.target(),
+                |hw| {
+                    token.begin_in_place(
+                        hw,
+                        &const { settings_for(&SETTINGS, Pin3, Pin4) },
+                        &twocan_teensy::configs::ECHO_FILTERS,
+                        &[],
+                        TABLE0.take().unwrap_or_else(|| rt::halt(CAN_BLINKS)),
+                    )
+                },
+                &mut boot.core.NVIC,
+            )
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         let led = boot.led;
         EXECUTOR.init(Executor::new()).run(|spawner| {

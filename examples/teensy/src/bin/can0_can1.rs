@@ -44,30 +44,38 @@ mod firmware {
         let mut node1 = App::new(n1, p1);
         let mut node2 = App::new(n2, p2);
 
-        let can0 = Can0::take()
-            .unwrap_or_else(|| rt::halt(CAN_BLINKS))
-            .begin_in(
-                &settings_for(&SETTINGS, Pin3, Pin4),
-                &node1.filters(),
-                &[],
-                TABLE0.take().unwrap_or_else(|| rt::halt(CAN_BLINKS)),
-            )
-            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        let can1 = Can1::take()
-            .unwrap_or_else(|| rt::halt(CAN_BLINKS))
-            .begin_in(
-                &settings_for(&SETTINGS, Pin33, Pin34),
-                &node2.filters(),
-                &[],
-                TABLE1.take().unwrap_or_else(|| rt::halt(CAN_BLINKS)),
-            )
-            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
+        let can0 = Can0::take().unwrap_or_else(|| rt::halt(CAN_BLINKS));
+        let can1 = Can1::take().unwrap_or_else(|| rt::halt(CAN_BLINKS));
         let nvic = &mut boot.core.NVIC;
         let (mut tx0, mut rx0) = CAN0
-            .start(can0, nvic)
+            .start_in_place(
+                can0.target(),
+                |hw| {
+                    can0.begin_in_place(
+                        hw,
+                        &const { settings_for(&SETTINGS, Pin3, Pin4) },
+                        &node1.filters(),
+                        &[],
+                        TABLE0.take().unwrap_or_else(|| rt::halt(CAN_BLINKS)),
+                    )
+                },
+                nvic,
+            )
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         let (mut tx1, mut rx1) = CAN1
-            .start(can1, nvic)
+            .start_in_place(
+                can1.target(),
+                |hw| {
+                    can1.begin_in_place(
+                        hw,
+                        &const { settings_for(&SETTINGS, Pin33, Pin34) },
+                        &node2.filters(),
+                        &[],
+                        TABLE1.take().unwrap_or_else(|| rt::halt(CAN_BLINKS)),
+                    )
+                },
+                nvic,
+            )
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
 
         let mut period = Every::new(time::millis(), 10);

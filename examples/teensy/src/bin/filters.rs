@@ -82,16 +82,20 @@ mod firmware {
         let primary = filters_example::primary();
         let secondary = filters_example::secondary();
         let token = Can0::take().unwrap_or_else(|| rt::halt(CAN_BLINKS));
-        let can = token
-            .begin_in(
-                &settings_for(&SETTINGS, Pin3, Pin4),
-                &primary,
-                &secondary,
-                TABLE0.take().unwrap_or_else(|| rt::halt(CAN_BLINKS)),
-            )
-            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         let (mut tx, mut rx) = CAN0
-            .start(can, &mut boot.core.NVIC)
+            .start_in_place(
+                token.target(),
+                |hw| {
+                    token.begin_in_place(
+                        hw,
+                        &const { settings_for(&SETTINGS, Pin3, Pin4) },
+                        &primary,
+                        &secondary,
+                        TABLE0.take().unwrap_or_else(|| rt::halt(CAN_BLINKS)),
+                    )
+                },
+                &mut boot.core.NVIC,
+            )
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
 
         let mut dispatcher: Dispatcher<(), FILTERS> = Dispatcher::new();

@@ -42,17 +42,21 @@ mod firmware {
             BUS.actual_bit_rate()
         );
         let mut app = App::new(node, peer);
-        let can = Can1::take()
-            .unwrap_or_else(|| rt::halt(CAN_HALT))
-            .begin_in(
-                &settings_for(&BUS, Pin22, Pin23),
-                &app.filters(),
-                &[],
-                TABLE1.take().unwrap_or_else(|| rt::halt(CAN_HALT)),
-            )
-            .unwrap_or_else(|_| rt::halt(CAN_HALT));
+        let can = Can1::take().unwrap_or_else(|| rt::halt(CAN_HALT));
         let (mut tx, mut rx) = CAN1
-            .start(can, &mut boot.core.NVIC)
+            .start_in_place(
+                can.target(),
+                |hw| {
+                    can.begin_in_place(
+                        hw,
+                        &const { settings_for(&BUS, Pin22, Pin23) },
+                        &app.filters(),
+                        &[],
+                        TABLE1.take().unwrap_or_else(|| rt::halt(CAN_HALT)),
+                    )
+                },
+                &mut boot.core.NVIC,
+            )
             .unwrap_or_else(|_| rt::halt(CAN_HALT));
         let mut period = Every::new(time::millis(), 10);
         loop {

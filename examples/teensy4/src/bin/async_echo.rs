@@ -40,17 +40,21 @@ mod firmware {
     #[cortex_m_rt::entry]
     fn main() -> ! {
         let mut boot = rt::boot();
-        let can = Can1::take()
-            .unwrap_or_else(|| rt::halt(CAN_HALT))
-            .begin_in(
-                &settings_for(&BUS, Pin22, Pin23),
-                &ECHO_FILTERS,
-                &[],
-                TABLE1.take().unwrap_or_else(|| rt::halt(CAN_HALT)),
-            )
-            .unwrap_or_else(|_| rt::halt(CAN_HALT));
+        let can = Can1::take().unwrap_or_else(|| rt::halt(CAN_HALT));
         let (tx, rx) = CAN1
-            .start(can, &mut boot.core.NVIC)
+            .start_in_place(
+                can.target(),
+                |hw| {
+                    can.begin_in_place(
+                        hw,
+                        &const { settings_for(&BUS, Pin22, Pin23) },
+                        &ECHO_FILTERS,
+                        &[],
+                        TABLE1.take().unwrap_or_else(|| rt::halt(CAN_HALT)),
+                    )
+                },
+                &mut boot.core.NVIC,
+            )
             .unwrap_or_else(|_| rt::halt(CAN_HALT));
         EXECUTOR.init(Executor::new()).run(|spawner| {
             spawner.spawn(echo_task(tx, rx).unwrap_or_else(|_| rt::halt(CAN_HALT)));

@@ -33,30 +33,38 @@ mod firmware {
         let [(n1, p1), (n2, p2)] = CAN1_CAN2_NODES;
         let mut node1 = App::new(n1, p1);
         let mut node2 = App::new(n2, p2);
-        let can1 = Can1::take()
-            .unwrap_or_else(|| rt::halt(CAN_HALT))
-            .begin_in(
-                &settings_for(&BUS, Pin22, Pin23),
-                &node1.filters(),
-                &[],
-                TABLE1.take().unwrap_or_else(|| rt::halt(CAN_HALT)),
-            )
-            .unwrap_or_else(|_| rt::halt(CAN_HALT));
-        let can2 = Can2::take()
-            .unwrap_or_else(|| rt::halt(CAN_HALT))
-            .begin_in(
-                &settings_for(&BUS, Pin1, Pin0),
-                &node2.filters(),
-                &[],
-                TABLE2.take().unwrap_or_else(|| rt::halt(CAN_HALT)),
-            )
-            .unwrap_or_else(|_| rt::halt(CAN_HALT));
+        let can1 = Can1::take().unwrap_or_else(|| rt::halt(CAN_HALT));
+        let can2 = Can2::take().unwrap_or_else(|| rt::halt(CAN_HALT));
         let nvic = &mut boot.core.NVIC;
         let (mut tx1, mut rx1) = CAN1
-            .start(can1, nvic)
+            .start_in_place(
+                can1.target(),
+                |hw| {
+                    can1.begin_in_place(
+                        hw,
+                        &const { settings_for(&BUS, Pin22, Pin23) },
+                        &node1.filters(),
+                        &[],
+                        TABLE1.take().unwrap_or_else(|| rt::halt(CAN_HALT)),
+                    )
+                },
+                nvic,
+            )
             .unwrap_or_else(|_| rt::halt(CAN_HALT));
         let (mut tx2, mut rx2) = CAN2
-            .start(can2, nvic)
+            .start_in_place(
+                can2.target(),
+                |hw| {
+                    can2.begin_in_place(
+                        hw,
+                        &const { settings_for(&BUS, Pin1, Pin0) },
+                        &node2.filters(),
+                        &[],
+                        TABLE2.take().unwrap_or_else(|| rt::halt(CAN_HALT)),
+                    )
+                },
+                nvic,
+            )
             .unwrap_or_else(|_| rt::halt(CAN_HALT));
         let mut period = Every::new(time::millis(), 10);
         loop {

@@ -63,17 +63,21 @@ mod firmware {
         let mut boot = rt::boot();
         let primary = filters_example::primary();
         let secondary = filters_example::secondary();
-        let can = Can1::take()
-            .unwrap_or_else(|| rt::halt(CAN_HALT))
-            .begin_in(
-                &settings_for(&SETTINGS, Pin22, Pin23),
-                &primary,
-                &secondary,
-                TABLE1.take().unwrap_or_else(|| rt::halt(CAN_HALT)),
-            )
-            .unwrap_or_else(|_| rt::halt(CAN_HALT));
+        let can = Can1::take().unwrap_or_else(|| rt::halt(CAN_HALT));
         let (mut tx, mut rx) = CAN1
-            .start(can, &mut boot.core.NVIC)
+            .start_in_place(
+                can.target(),
+                |hw| {
+                    can.begin_in_place(
+                        hw,
+                        &const { settings_for(&SETTINGS, Pin22, Pin23) },
+                        &primary,
+                        &secondary,
+                        TABLE1.take().unwrap_or_else(|| rt::halt(CAN_HALT)),
+                    )
+                },
+                &mut boot.core.NVIC,
+            )
             .unwrap_or_else(|_| rt::halt(CAN_HALT));
         let mut dispatcher: Dispatcher<(), FILTERS> = Dispatcher::new();
         let callbacks: [fn(&mut (), &RxFrame); FILTERS] = [on_0, on_1, on_2, on_3, on_4];

@@ -29,17 +29,21 @@ mod firmware {
     fn main() -> ! {
         let mut boot = rt::boot();
         twocan_teensy4::info!("teensy4-loopback: CAN1 in loop-back, a frame every second");
-        let can = Can1::take()
-            .unwrap_or_else(|| rt::halt(CAN_HALT))
-            .begin_in(
-                &settings_for(&LOOPBACK, Pin22, Pin23),
-                &LOOPBACK_FILTERS,
-                &[],
-                TABLE1.take().unwrap_or_else(|| rt::halt(CAN_HALT)),
-            )
-            .unwrap_or_else(|_| rt::halt(CAN_HALT));
+        let can = Can1::take().unwrap_or_else(|| rt::halt(CAN_HALT));
         let (mut tx, mut rx) = CAN1
-            .start(can, &mut boot.core.NVIC)
+            .start_in_place(
+                can.target(),
+                |hw| {
+                    can.begin_in_place(
+                        hw,
+                        &const { settings_for(&LOOPBACK, Pin22, Pin23) },
+                        &LOOPBACK_FILTERS,
+                        &[],
+                        TABLE1.take().unwrap_or_else(|| rt::halt(CAN_HALT)),
+                    )
+                },
+                &mut boot.core.NVIC,
+            )
             .unwrap_or_else(|_| rt::halt(CAN_HALT));
         let message = Frame::standard(0x542, &[]).unwrap_or_else(|_| rt::halt(CAN_HALT));
         let mut send = Every::new(time::millis(), 1000);
