@@ -40,6 +40,7 @@ use crate::rt::InPlaceError;
 use crate::rt::IrqState;
 use crate::rt::{Halves, Nvic, StartError, StopError};
 use crate::settings::{Settings, RECEIVE_BUFFER_SIZE, TRANSMIT_BUFFER_SIZE};
+use crate::BeginPlan;
 #[cfg(target_os = "none")]
 use crate::Can0;
 #[cfg(all(target_os = "none", feature = "teensy36"))]
@@ -129,7 +130,7 @@ impl core::error::Error for OneCallError {}
 
 /// Defines the one call and its way back for one module.
 macro_rules! one_call {
-    ($(#[$m:meta])* $token:ident, $state:ident, $table:ident, $spare:ident, $start:ident, $start_with:ident, $end:ident, $name:literal) => {
+    ($(#[$m:meta])* $token:ident, $state:ident, $table:ident, $spare:ident, $start:ident, $start_with:ident, $start_checked:ident, $end:ident, $name:literal) => {
         $(#[$m])*
         #[doc = concat!("ACAN `ACAN::", $name, ".begin (ACANSettings (bit_rate))`: ")]
         /// the module begun with ACAN's defaults at `bit_rate` on the board's default
@@ -157,6 +158,29 @@ macro_rules! one_call {
             }
             #[cfg(target_os = "none")]
             {
+                // The settings checked first (ACAN table 5), before the state lends its
+                // storage.
+                let checked = BeginPlan::new($token::TARGET, settings, settings.configuration)
+                    .map_err(OneCallError::Begin)?;
+                $start_checked(&checked, primary, secondary, nvic)
+            }
+        }
+
+        $(#[$m])*
+        #[doc = concat!("[`", stringify!($start_with), "`] with the settings checked beforehand: a `BeginPlan` for `", stringify!($token), "::TARGET`, `const` for `const` settings (no check of the settings runs then, and the configuration's stack is the smallest). A plan for another module is `Begin(Hardware(InvalidArgument))`.")]
+        pub fn $start_checked(
+            checked: &BeginPlan,
+            primary: &[Filter],
+            secondary: &[Filter],
+            nvic: &mut impl Nvic,
+        ) -> Result<AcanHalves, OneCallError> {
+            #[cfg(not(target_os = "none"))]
+            {
+                let _ = (checked, primary, secondary, nvic);
+                Err(OneCallError::NotOnTarget)
+            }
+            #[cfg(target_os = "none")]
+            {
                 let mut spare = critical_section::with(|cs| $spare.borrow(cs).take())
                     .or_else(|| Some(($token::take()?, $table.take()?)));
                 let Some(target) = spare.as_ref().map(|(token, _)| token.target()) else {
@@ -169,7 +193,7 @@ macro_rules! one_call {
                     |hw| {
                         let (token, slot) = spare.take().ok_or(None)?;
                         token
-                            .begin_in_place(hw, settings, primary, secondary, slot)
+                            .begin_in_place(hw, checked, primary, secondary, slot)
                             .map_err(|(token, e, slot)| {
                                 spare = Some((token, slot));
                                 Some(e)
@@ -221,7 +245,17 @@ macro_rules! one_call {
     };
 }
 
-one_call!(Can0, CAN0, TABLE0, SPARE0, can0, can0_with, end_can0, "can0");
+one_call!(
+    Can0,
+    CAN0,
+    TABLE0,
+    SPARE0,
+    can0,
+    can0_with,
+    can0_checked,
+    end_can0,
+    "can0"
+);
 one_call!(
     #[cfg(feature = "teensy36")]
     Can1,
@@ -230,6 +264,7 @@ one_call!(
     SPARE1,
     can1,
     can1_with,
+    can1_checked,
     end_can1,
     "can1"
 );

@@ -419,28 +419,50 @@ impl<R: Registers> FlexCan<R> {
 
     /// [`FlexCan::begin_in`] writing the split controller **in place** into `hw`
     /// (the storage a `static` state lends: `twocan_core::split::State::split_with`,
-    /// `rt::IrqState::start_in_place`), so that the controller does not move through
-    /// the configuration either. Returns the controller written; on an error nothing is
+    /// `rt::IrqState::start_in_place`), with the settings checked beforehand
+    /// ([`BeginPlan`]: at compile time for `const` settings, or before the state lends
+    /// its storage), so that neither the table nor the controller moves through the
+    /// configuration and the checks do not deepen it. The lists are checked against
+    /// the plan's configuration ([`BeginError::Config`] with the filter flags) and
+    /// compiled into `slot`. Returns the controller written; on an error nothing is
     /// written and the table's slot comes back.
-    #[allow(clippy::type_complexity, clippy::too_many_arguments)]
+    #[allow(clippy::type_complexity)]
+    #[inline(always)]
     pub fn begin_in_place<'h, S: Registers, O: Options<Table = &'static mut FilterTable>>(
         hw: &'h mut MaybeUninit<FlexCanHw<R, O>>,
-        regs: R,
+        mut regs: R,
         sys: &mut S,
-        target: Target,
-        settings: &Settings,
+        checked: &BeginPlan,
         primary: &[Filter],
         secondary: &[Filter],
         slot: &'static mut FilterTable,
     ) -> Result<&'h mut FlexCanHw<R, O>, (BeginError, &'static mut FilterTable)> {
-        let (regs, table, parts) =
-            Self::begin_in_parts(regs, sys, target, settings, primary, secondary, slot)?;
-        Ok(hw.write(FlexCanHw::from_parts(regs, target, table, parts)))
+        let plan = &checked.plan;
+        let filters = FilterTable::check(plan.configuration, primary, secondary);
+        if filters != ConfigErrors::NONE {
+            return Err((BeginError::Config(filters), slot));
+        }
+        plan.system.apply(sys);
+        slot.fill(plan.configuration, primary, secondary);
+        let table: &FilterTable = slot;
+        if let Err(e) = configure(
+            &mut regs,
+            plan,
+            |r| FlexCan::write_filters(r, table),
+            checked.polls,
+        ) {
+            return Err((BeginError::Hardware(e), slot));
+        }
+        Ok(hw.write(FlexCanHw::from_parts(
+            regs,
+            checked.target,
+            slot,
+            checked.parts(),
+        )))
     }
 
-    /// What [`FlexCan::begin_in`] and [`FlexCan::begin_in_place`] share: the checks,
-    /// the lists compiled into `slot`, the module configured; the split controller's
-    /// small values.
+    /// [`FlexCan::begin_in`] but the controller: the checks, the lists compiled into
+    /// `slot`, the module configured; the split controller's small values.
     #[allow(clippy::type_complexity)]
     fn begin_in_parts<S: Registers>(
         mut regs: R,
@@ -579,17 +601,7 @@ impl<R: Registers> FlexCan<R> {
             },
             checked.polls,
         )?;
-        let parts = Parts {
-            bus_mode: checked.bus_mode,
-            recovery: checked.recovery,
-            polls: checked.polls,
-            irq_priority: checked.irq_priority,
-            mode: Mode::Normal,
-            last_error: LastErrorCode::None,
-            system: plan.system,
-            bus_clock_hz: checked.bus_clock_hz,
-        };
-        Ok((regs, parts))
+        Ok((regs, checked.parts()))
     }
 }
 
@@ -672,6 +684,21 @@ impl BeginPlan {
     /// The module the plan is made for.
     pub const fn target(&self) -> Target {
         self.target
+    }
+
+    /// The split controller's small values, as the module is right after `begin`.
+    #[inline(always)]
+    fn parts(&self) -> Parts {
+        Parts {
+            bus_mode: self.bus_mode,
+            recovery: self.recovery,
+            polls: self.polls,
+            irq_priority: self.irq_priority,
+            mode: Mode::Normal,
+            last_error: LastErrorCode::None,
+            system: self.plan.system,
+            bus_clock_hz: self.bus_clock_hz,
+        }
     }
 }
 

@@ -208,6 +208,7 @@ pub(crate) struct Parts {
 
 impl<R: Registers, O: Options> FlexCanHw<R, O> {
     /// The split controller over `regs` with `table` installed.
+    #[inline(always)]
     pub(crate) fn from_parts(regs: R, target: Target, table: O::Table, p: Parts) -> Self {
         let configuration = table.configuration();
         let first = configuration.first_remote_mailbox() as u32;

@@ -58,14 +58,17 @@ macro_rules! token_begin {
 
             /// [`Self::begin_in`] writing the split controller **in place** into `hw`,
             /// the storage a `static` state lends (`rt::IrqState::start_in_place`,
-            /// `State::split_with`): neither the table nor the controller moves
-            /// through the configuration ([`crate::FlexCan::begin_in_place`]). On error
-            /// nothing is written, and the token and the slot come back.
+            /// `State::split_with`), with the settings checked beforehand
+            /// ([`crate::BeginPlan`], `const` for `const` settings): neither the table
+            /// nor the controller moves through the configuration
+            /// ([`crate::FlexCan::begin_in_place`]). A plan made for another module is
+            /// [`twocan_core::Error::InvalidArgument`]. On error nothing is written, and
+            /// the token and the slot come back.
             #[allow(clippy::type_complexity)]
             pub fn begin_in_place<'h, O>(
                 self,
                 hw: &'h mut core::mem::MaybeUninit<$crate::FlexCanHw<$crate::regs::FlexCanRegs, O>>,
-                settings: &$crate::Settings,
+                checked: &$crate::BeginPlan,
                 primary: &[twocan_core::Filter],
                 secondary: &[twocan_core::Filter],
                 slot: &'static mut $crate::FilterTable,
@@ -77,12 +80,15 @@ macro_rules! token_begin {
                 O: $crate::options::Options<Table = &'static mut $crate::FilterTable>,
             {
                 let target = self.target();
-                let Some(base) = target.base() else {
-                    return Err((
-                        self,
-                        $crate::BeginError::Config($crate::ConfigErrors::NO_SUCH_INSTANCE),
-                        slot,
-                    ));
+                let base = match target.base() {
+                    Some(base) if checked.target() == target => base,
+                    _ => {
+                        return Err((
+                            self,
+                            $crate::BeginError::Hardware(twocan_core::Error::InvalidArgument),
+                            slot,
+                        ))
+                    }
                 };
                 // SAFETY: as for `begin_in`.
                 let regs = unsafe { $crate::regs::FlexCanRegs::new(base) };
@@ -90,8 +96,7 @@ macro_rules! token_begin {
                     hw,
                     regs,
                     &mut $system(),
-                    target,
-                    settings,
+                    checked,
                     primary,
                     secondary,
                     slot,

@@ -22,7 +22,7 @@ mod firmware {
     use twocan_app::firmware::{FirmwareLoop, Published};
     use twocan_app::{App, AppStats};
     use twocan_flexcan::pin::{settings_for, Pin3, Pin4};
-    use twocan_flexcan::{Can0, Settings};
+    use twocan_flexcan::{BeginPlan, Can0, Settings};
     use twocan_teensy::can::{CanState, TableSlot};
     use twocan_teensy::rt::{self, CAN_BLINKS};
     use twocan_teensy::time::{self, Every};
@@ -62,7 +62,13 @@ mod firmware {
                 |hw| {
                     token.begin_in_place(
                         hw,
-                        &const { settings_for(&SETTINGS, Pin3, Pin4) },
+                        &const {
+                            BeginPlan::new_or_panic(
+                                Can0::TARGET,
+                                &settings_for(&SETTINGS, Pin3, Pin4),
+                                SETTINGS.configuration,
+                            )
+                        },
                         &app.filters(),
                         &[],
                         TABLE0.take().unwrap_or_else(|| rt::halt(CAN_BLINKS)),

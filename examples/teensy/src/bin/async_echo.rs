@@ -22,7 +22,7 @@ mod firmware {
     use static_cell::StaticCell;
     use twocan_app::asynch::{echo, EchoStats};
     use twocan_flexcan::pin::{settings_for, Pin3, Pin4};
-    use twocan_flexcan::{Can0, Settings};
+    use twocan_flexcan::{BeginPlan, Can0, Settings};
     use twocan_teensy::can::{CanRxHalf, CanState, CanTxHalf, TableSlot};
     use twocan_teensy::io::Mmio;
     use twocan_teensy::led::Led;
@@ -65,7 +65,13 @@ mod firmware {
                 |hw| {
                     token.begin_in_place(
                         hw,
-                        &const { settings_for(&SETTINGS, Pin3, Pin4) },
+                        &const {
+                            BeginPlan::new_or_panic(
+                                Can0::TARGET,
+                                &settings_for(&SETTINGS, Pin3, Pin4),
+                                SETTINGS.configuration,
+                            )
+                        },
                         &twocan_teensy::configs::ECHO_FILTERS,
                         &[],
                         TABLE0.take().unwrap_or_else(|| rt::halt(CAN_BLINKS)),

@@ -18,7 +18,7 @@ mod firmware {
     use critical_section::Mutex;
     use twocan_app::{App, AppStats};
     use twocan_flexcan::pin::{settings_for, Pin3, Pin33, Pin34, Pin4};
-    use twocan_flexcan::{Can0, Can1, Settings};
+    use twocan_flexcan::{BeginPlan, Can0, Can1, Settings};
     use twocan_teensy::can::{CanState, TableSlot};
     use twocan_teensy::rt::{self, CAN_BLINKS};
     use twocan_teensy::time::{self, Every};
@@ -53,7 +53,13 @@ mod firmware {
                 |hw| {
                     can0.begin_in_place(
                         hw,
-                        &const { settings_for(&SETTINGS, Pin3, Pin4) },
+                        &const {
+                            BeginPlan::new_or_panic(
+                                Can0::TARGET,
+                                &settings_for(&SETTINGS, Pin3, Pin4),
+                                SETTINGS.configuration,
+                            )
+                        },
                         &node1.filters(),
                         &[],
                         TABLE0.take().unwrap_or_else(|| rt::halt(CAN_BLINKS)),
@@ -68,7 +74,13 @@ mod firmware {
                 |hw| {
                     can1.begin_in_place(
                         hw,
-                        &const { settings_for(&SETTINGS, Pin33, Pin34) },
+                        &const {
+                            BeginPlan::new_or_panic(
+                                Can1::TARGET,
+                                &settings_for(&SETTINGS, Pin33, Pin34),
+                                SETTINGS.configuration,
+                            )
+                        },
                         &node2.filters(),
                         &[],
                         TABLE1.take().unwrap_or_else(|| rt::halt(CAN_BLINKS)),

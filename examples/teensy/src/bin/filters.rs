@@ -25,7 +25,7 @@ mod firmware {
 
     use twocan_core::{Dispatcher, Frame, RxFrame};
     use twocan_flexcan::pin::{settings_for, Pin3, Pin4};
-    use twocan_flexcan::{Can0, Settings};
+    use twocan_flexcan::{BeginPlan, Can0, Settings};
     use twocan_teensy::can::{CanState, TableSlot};
     use twocan_teensy::filters_example::{self, FILTERS};
     use twocan_teensy::rt::{self, CAN_BLINKS};
@@ -88,7 +88,13 @@ mod firmware {
                 |hw| {
                     token.begin_in_place(
                         hw,
-                        &const { settings_for(&SETTINGS, Pin3, Pin4) },
+                        &const {
+                            BeginPlan::new_or_panic(
+                                Can0::TARGET,
+                                &settings_for(&SETTINGS, Pin3, Pin4),
+                                SETTINGS.configuration,
+                            )
+                        },
                         &primary,
                         &secondary,
                         TABLE0.take().unwrap_or_else(|| rt::halt(CAN_BLINKS)),

@@ -14,7 +14,7 @@ mod firmware {
     use twocan_app::{App, AppStats};
     use twocan_core::ErrorState;
     use twocan_flexcan::pin::{settings_for, Pin22, Pin23};
-    use twocan_flexcan::Can1;
+    use twocan_flexcan::{BeginPlan, Can1};
     use twocan_teensy4::can::{CanState, TableSlot};
     use twocan_teensy4::configs::{APP_NODES, BUS};
     use twocan_teensy4::rt::{self, CAN_HALT};
@@ -49,7 +49,13 @@ mod firmware {
                 |hw| {
                     can.begin_in_place(
                         hw,
-                        &const { settings_for(&BUS, Pin22, Pin23) },
+                        &const {
+                            BeginPlan::new_or_panic(
+                                Can1::TARGET,
+                                &settings_for(&BUS, Pin22, Pin23),
+                                BUS.configuration,
+                            )
+                        },
                         &app.filters(),
                         &[],
                         TABLE1.take().unwrap_or_else(|| rt::halt(CAN_HALT)),

@@ -13,7 +13,7 @@ mod firmware {
     use static_cell::StaticCell;
     use twocan_app::asynch::{echo, EchoStats};
     use twocan_flexcan::pin::{settings_for, Pin22, Pin23};
-    use twocan_flexcan::Can1;
+    use twocan_flexcan::{BeginPlan, Can1};
     use twocan_teensy4::can::{CanRxHalf, CanState, CanTxHalf, TableSlot};
     use twocan_teensy4::configs::{BUS, ECHO_FILTERS};
     use twocan_teensy4::rt::{self, CAN_HALT};
@@ -47,7 +47,13 @@ mod firmware {
                 |hw| {
                     can.begin_in_place(
                         hw,
-                        &const { settings_for(&BUS, Pin22, Pin23) },
+                        &const {
+                            BeginPlan::new_or_panic(
+                                Can1::TARGET,
+                                &settings_for(&BUS, Pin22, Pin23),
+                                BUS.configuration,
+                            )
+                        },
                         &ECHO_FILTERS,
                         &[],
                         TABLE1.take().unwrap_or_else(|| rt::halt(CAN_HALT)),

@@ -11,7 +11,7 @@ mod firmware {
     use critical_section::Mutex;
     use twocan_app::{App, AppStats};
     use twocan_flexcan::pin::{settings_for, Pin0, Pin1, Pin22, Pin23};
-    use twocan_flexcan::{Can1, Can2};
+    use twocan_flexcan::{BeginPlan, Can1, Can2};
     use twocan_teensy4::can::{CanState, TableSlot};
     use twocan_teensy4::configs::{BUS, CAN1_CAN2_NODES};
     use twocan_teensy4::rt::{self, CAN_HALT};
@@ -42,7 +42,13 @@ mod firmware {
                 |hw| {
                     can1.begin_in_place(
                         hw,
-                        &const { settings_for(&BUS, Pin22, Pin23) },
+                        &const {
+                            BeginPlan::new_or_panic(
+                                Can1::TARGET,
+                                &settings_for(&BUS, Pin22, Pin23),
+                                BUS.configuration,
+                            )
+                        },
                         &node1.filters(),
                         &[],
                         TABLE1.take().unwrap_or_else(|| rt::halt(CAN_HALT)),
@@ -57,7 +63,13 @@ mod firmware {
                 |hw| {
                     can2.begin_in_place(
                         hw,
-                        &const { settings_for(&BUS, Pin1, Pin0) },
+                        &const {
+                            BeginPlan::new_or_panic(
+                                Can2::TARGET,
+                                &settings_for(&BUS, Pin1, Pin0),
+                                BUS.configuration,
+                            )
+                        },
                         &node2.filters(),
                         &[],
                         TABLE2.take().unwrap_or_else(|| rt::halt(CAN_HALT)),

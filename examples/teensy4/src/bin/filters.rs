@@ -11,7 +11,7 @@ mod firmware {
 
     use twocan_core::{Dispatcher, Frame, RxFrame};
     use twocan_flexcan::pin::{settings_for, Pin22, Pin23};
-    use twocan_flexcan::Can1;
+    use twocan_flexcan::{BeginPlan, Can1};
     use twocan_teensy4::can::{CanState, TableSlot};
     use twocan_teensy4::configs::FILTERS as SETTINGS;
     use twocan_teensy4::filters_example::{self, FILTERS};
@@ -70,7 +70,13 @@ mod firmware {
                 |hw| {
                     can.begin_in_place(
                         hw,
-                        &const { settings_for(&SETTINGS, Pin22, Pin23) },
+                        &const {
+                            BeginPlan::new_or_panic(
+                                Can1::TARGET,
+                                &settings_for(&SETTINGS, Pin22, Pin23),
+                                SETTINGS.configuration,
+                            )
+                        },
                         &primary,
                         &secondary,
                         TABLE1.take().unwrap_or_else(|| rt::halt(CAN_HALT)),

@@ -10,7 +10,7 @@ mod firmware {
 
     use twocan_core::Frame;
     use twocan_flexcan::pin::{settings_for, Pin22, Pin23};
-    use twocan_flexcan::Can1;
+    use twocan_flexcan::{BeginPlan, Can1};
     use twocan_teensy4::can::{CanState, TableSlot};
     use twocan_teensy4::configs::{LOOPBACK, LOOPBACK_FILTERS};
     use twocan_teensy4::rt::{self, CAN_HALT};
@@ -36,7 +36,13 @@ mod firmware {
                 |hw| {
                     can.begin_in_place(
                         hw,
-                        &const { settings_for(&LOOPBACK, Pin22, Pin23) },
+                        &const {
+                            BeginPlan::new_or_panic(
+                                Can1::TARGET,
+                                &settings_for(&LOOPBACK, Pin22, Pin23),
+                                LOOPBACK.configuration,
+                            )
+                        },
                         &LOOPBACK_FILTERS,
                         &[],
                         TABLE1.take().unwrap_or_else(|| rt::halt(CAN_HALT)),
