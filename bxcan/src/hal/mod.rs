@@ -60,7 +60,9 @@ use twocan_core::{Error, Registers};
 use crate::chip::Chip;
 use crate::config::{Config, ConfigError};
 use crate::controller::{Can, Failed, Init};
+use crate::filter_block;
 use crate::instance::Instance;
+use crate::planner::{FifoPolicy, PlanOptions};
 use crate::regs::{CanRegs, ControlRegs, FilterRegs};
 
 #[cfg(feature = "hal-stm32f1")]
@@ -431,9 +433,36 @@ impl<R: Registers, F: Registers, P> HandedOver<R, F, P> {
     }
 }
 
+impl<R: Registers, F: Registers, P> HandedOver<R, F, P> {
+    /// Planner options for this instance under `config`, before anything is
+    /// configured: its bank count and `fifo` (as `Can::plan_options` gives them after
+    /// [`HandedOver::configure`]). A dual block is split at `config`'s
+    /// [`Config::can2_start_bank`] when it sets one, otherwise at the `CAN2SB` the
+    /// filter registers hold now (RM0410 §40.9.4 "CAN filter master register").
+    pub fn plan_options(&self, config: &Config, fifo: FifoPolicy) -> PlanOptions {
+        let can2sb = match (config.get_can2_start_bank(), &self.filters) {
+            (Some(bank), _) => u32::from(bank),
+            (None, Some(f)) => filter_block::can2sb(f),
+            (None, None) => filter_block::can2sb(&self.regs),
+        };
+        let (start, end) = config.get_chip().bank_range(self.instance, can2sb);
+        PlanOptions::new((end - start) as u8).fifo(fifo)
+    }
+}
+
 // The error values hand the whole handle back (nothing is lost).
 #[allow(clippy::result_large_err)]
 impl<P> HandedOver<CanRegs, CanRegs, P> {
+    /// The register handle for an in-place constructor ([`crate::BxCan::can1_in`],
+    /// [`crate::BxCan::can3_in`], through `State::split_with` or
+    /// `rt::IrqState::start_in_place`), which configures the instance itself: nothing
+    /// is written here, and no controller or filter map is built on the stack (issue
+    /// 21). [`Error::InvalidArgument`] when `config` was computed for another clock
+    /// ([`HandedOver::accepts`]), with this handle back.
+    pub fn into_registers(self, config: &Config) -> Result<CanRegs, Failed<Self>> {
+        self.into_single(config)
+    }
+
     /// Configures the instance ([`Can::can1`] or [`Can::can3`]): initialization mode,
     /// options, bit timing.
     ///
@@ -447,6 +476,16 @@ impl<P> HandedOver<CanRegs, CanRegs, P> {
 
 #[allow(clippy::result_large_err)]
 impl<P> HandedOver<ControlRegs, Can1Filters, P> {
+    /// The control and filter register handles for an in-place constructor
+    /// ([`crate::BxCan::can1_dual_in`], [`crate::BxCan::can2_in`]); as the whole
+    /// block's [`HandedOver::into_registers`].
+    pub fn into_registers(
+        self,
+        config: &Config,
+    ) -> Result<(ControlRegs, Can1Filters), Failed<Self>> {
+        self.into_dual(config)
+    }
+
     /// Configures CAN1 ([`Can::can1_dual`]: `CAN2SB` is written when `config` sets
     /// [`Config::can2_start_bank`]) or CAN2 ([`Can::can2`]); errors as for a whole
     /// block's `configure`.
@@ -462,6 +501,13 @@ impl<P> HandedOver<ControlRegs, Can1Filters, P> {
 // the behavioural model.
 #[allow(clippy::result_large_err)]
 impl<R: Registers, P> HandedOver<R, R, P> {
+    fn into_single(self, config: &Config) -> Result<R, Failed<Self>> {
+        if !self.accepts(config) {
+            return Err(self.refuse(Error::InvalidArgument));
+        }
+        Ok(self.regs)
+    }
+
     fn configure_single(self, config: &Config) -> Result<Init<R, R>, Failed<Self>> {
         if !self.accepts(config) {
             return Err(self.refuse(Error::InvalidArgument));
@@ -487,6 +533,24 @@ impl<R: Registers, P> HandedOver<R, R, P> {
 
 #[allow(clippy::result_large_err)]
 impl<R: Registers, F: Registers, P> HandedOver<R, F, P> {
+    fn into_dual(self, config: &Config) -> Result<(R, F), Failed<Self>> {
+        if !self.accepts(config) {
+            return Err(self.refuse(Error::InvalidArgument));
+        }
+        match self {
+            HandedOver {
+                regs,
+                filters: Some(filters),
+                ..
+            } => Ok((regs, filters)),
+            // Not built by this module, whose dual handles always have one.
+            other => Err(Failed {
+                error: Error::InvalidArgument,
+                value: other,
+            }),
+        }
+    }
+
     fn configure_dual(self, config: &Config) -> Result<Init<R, F>, Failed<Self>> {
         let accepted = self.accepts(config);
         let HandedOver {
