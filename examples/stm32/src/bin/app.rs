@@ -21,7 +21,7 @@ mod firmware {
     use critical_section::Mutex;
     use twocan_app::firmware::{FirmwareLoop, Published};
     use twocan_app::{App, AppStats};
-    use twocan_bxcan::{const_plan, Can, FifoPolicy, Recovery};
+    use twocan_bxcan::{const_plan, BxCan, FifoPolicy, Instance, Recovery};
     use twocan_stm32::board::BIT_RATE;
     use twocan_stm32::board::CAN1_BANKS;
     use twocan_stm32::can::{self, CanState};
@@ -60,21 +60,23 @@ mod firmware {
             .config(boot.apb1_hz, BIT_RATE)
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS))
             .recovery(Recovery::Automatic);
-        let mut init =
-            Can::can1(boot.can1.whole(), &config).unwrap_or_else(|_| rt::halt(CAN_BLINKS));
+        // Configured in place in `CAN1` (`BxCan::can1_in`): no controller, filter map or
+        // plan moves through `main`.
+        let regs = boot.can1.whole();
         // The application's filters (`twocan_app::filters_for`, the list `app.filters()`
         // returns) planned at build time (`const_plan!`, see `stm32-loopback`).
         let plan = const_plan!(
             twocan_app::filters_for(NODE, PEER),
             CAN1_BANKS.fifo(FifoPolicy::Fifo0)
         );
-        if init.set_filters(plan).is_err() {
-            rt::halt(CAN_BLINKS);
-        }
-        let can = init.enable().unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        let (mut tx, mut rx) =
-            can::start(&CAN1, can.into_split(), rt::CAN1_IRQS, &mut boot.core.NVIC)
-                .unwrap_or_else(|| rt::halt(CAN_BLINKS));
+        let (mut tx, mut rx) = can::start(
+            &CAN1,
+            Instance::Can1,
+            |slot| BxCan::can1_in(slot, regs, &config, plan).map_err(|f| f.error),
+            rt::CAN1_IRQS,
+            &mut boot.core.NVIC,
+        )
+        .unwrap_or_else(|| rt::halt(CAN_BLINKS));
         twocan_stm32::info!(
             "CAN1 on the bus with the application's {=usize} filters",
             app.filters().len()

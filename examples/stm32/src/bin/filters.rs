@@ -23,7 +23,7 @@
 mod firmware {
     use core::sync::atomic::{AtomicU32, Ordering};
 
-    use twocan_bxcan::{const_plan, Can, FifoPolicy};
+    use twocan_bxcan::{const_plan, BxCan, FifoPolicy, Instance};
     use twocan_core::{Dispatcher, Filter, Format, Frame, FrameKind, RxFrame};
     use twocan_stm32::board::CAN1_BANKS;
     use twocan_stm32::can::{self, CanState};
@@ -84,20 +84,22 @@ mod firmware {
             .config(boot.apb1_hz, 125_000)
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS))
             .loopback(true);
-        let mut init =
-            Can::can1(boot.can1.whole(), &config).unwrap_or_else(|_| rt::halt(CAN_BLINKS));
+        // Configured in place in `CAN1` (`BxCan::can1_in`): no controller, filter map or
+        // plan moves through `main`.
+        let regs = boot.can1.whole();
         // Planned at build time (`const_plan!`, see `stm32-loopback`).
         let plan = const_plan!(LIST, CAN1_BANKS.fifo(FifoPolicy::Balanced));
         for bank in plan.banks() {
             BANKS[bank.fifo.index()].fetch_add(1, Ordering::Relaxed);
         }
-        if init.set_filters(plan).is_err() {
-            rt::halt(CAN_BLINKS);
-        }
-        let can = init.enable().unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        let (mut tx, mut rx) =
-            can::start(&CAN1, can.into_split(), rt::CAN1_IRQS, &mut boot.core.NVIC)
-                .unwrap_or_else(|| rt::halt(CAN_BLINKS));
+        let (mut tx, mut rx) = can::start(
+            &CAN1,
+            Instance::Can1,
+            |slot| BxCan::can1_in(slot, regs, &config, plan).map_err(|f| f.error),
+            rt::CAN1_IRQS,
+            &mut boot.core.NVIC,
+        )
+        .unwrap_or_else(|| rt::halt(CAN_BLINKS));
 
         let mut dispatcher: Dispatcher<(), FILTERS> = Dispatcher::new();
         for i in 0..FILTERS {
