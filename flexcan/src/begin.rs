@@ -564,6 +564,7 @@ impl<R: Registers> FlexCan<R> {
 
     /// [`FlexCan::begin_checked`] writing the split controller **in place** into `hw`
     /// (see [`FlexCan::begin_in_place`]). On an error nothing is written.
+    #[inline(always)]
     pub fn begin_checked_in_place<'h, S: Registers, O: Options<Table = PlannedTable>>(
         hw: &'h mut MaybeUninit<FlexCanHw<R, O>>,
         regs: R,
@@ -576,6 +577,7 @@ impl<R: Registers> FlexCan<R> {
     }
 
     /// What [`FlexCan::begin_checked`] and [`FlexCan::begin_checked_in_place`] share.
+    #[inline(always)]
     fn begin_checked_parts<S: Registers>(
         mut regs: R,
         sys: &mut S,
