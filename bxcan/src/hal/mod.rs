@@ -715,4 +715,73 @@ mod tests {
             "the filter handle comes back too"
         );
     }
+
+    #[test]
+    fn into_registers_hands_the_registers_over_untouched_and_plan_options_match_configure() {
+        let bus = bus();
+        // Whole block (CAN1 alone): the handle, nothing written; a config for another
+        // clock refused with the handle back.
+        let model = BxCanModel::can1();
+        let h = handed::<Regs>(
+            PollClock::new(model.clone(), &bus, MSR),
+            None,
+            Instance::Can1,
+        );
+        let mcr_at_reset = model.read32(MCR);
+        let config = h.config(500_000).unwrap();
+        let options = h.plan_options(&config, FifoPolicy::Fifo1);
+        let other = Config::from_bitrate(48_000_000, 500_000).unwrap();
+        let h = h.into_single(&other).unwrap_err();
+        assert_eq!(h.error, Error::InvalidArgument);
+        let regs = h.value.into_single(&config).map_err(|f| f.error).unwrap();
+        assert_eq!(model.read32(MCR), mcr_at_reset, "nothing configured");
+        // The options are the ones `configure` would give.
+        let h = HandedOver {
+            regs,
+            filters: None::<Regs>,
+            instance: Instance::Can1,
+            apb1_hz: 54_000_000,
+            chip: None,
+            parts: (),
+        };
+        let init = h.configure_single(&config).map_err(|f| f.error).unwrap();
+        assert_eq!(options, init.can().plan_options(FifoPolicy::Fifo1));
+
+        // Dual: CAN2's banks where the config splits the block (or, without a split in
+        // the config, where the register splits it now).
+        let (m1, m2) = BxCanModel::can1_can2();
+        let can1 = handed(
+            PollClock::new(m1.clone(), &bus, MSR),
+            Some(m1.clone()),
+            Instance::Can1,
+        );
+        let can2 = handed(
+            PollClock::new(m2.clone(), &bus, MSR),
+            Some(m1.clone()),
+            Instance::Can2,
+        );
+        let config1 = can1.config(500_000).unwrap().can2_start_bank(10).unwrap();
+        assert_eq!(
+            can1.plan_options(&config1, FifoPolicy::Fifo0),
+            PlanOptions::new(10)
+        );
+        assert_eq!(
+            can2.plan_options(&config1, FifoPolicy::Fifo1),
+            PlanOptions::new(18).fifo(FifoPolicy::Fifo1)
+        );
+        let base = Config::from_bitrate(54_000_000, 500_000).unwrap();
+        let at_reset = crate::regs::fmr::CAN2SB.get(m1.read32(FMR)) as u8;
+        assert_eq!(
+            can2.plan_options(&base, FifoPolicy::Fifo1),
+            PlanOptions::new(28 - at_reset).fifo(FifoPolicy::Fifo1)
+        );
+        let (_, f) = can2.into_dual(&base).map_err(|f| f.error).unwrap();
+        assert_eq!(f.read32(FMR), m1.read32(FMR), "CAN1's filter block");
+        let no_filters =
+            handed::<BxCanModel>(PollClock::new(m2.clone(), &bus, MSR), None, Instance::Can2);
+        assert_eq!(
+            no_filters.into_dual(&base).unwrap_err().error,
+            Error::InvalidArgument
+        );
+    }
 }
