@@ -28,7 +28,9 @@ pub use in_place::{InPlace, Unconfigured};
 use core::cell::UnsafeCell;
 use core::sync::atomic::{AtomicBool, AtomicU32, AtomicU8, Ordering};
 
-use twocan_core::hardware::{sort_by_token, Completion, Settled, StatusEvents, Token, TxFailure};
+use twocan_core::hardware::{
+    sort_by_token, Completion, FifoEvents, Settled, StatusEvents, Token, TxFailure,
+};
 use twocan_core::timing::frame_time::frame_in_flight_wait;
 use twocan_core::timing::{Limits, Timing, BXCAN_BTR_TIMING_MASK};
 use twocan_core::{
@@ -397,13 +399,14 @@ impl<R: Registers, F: Registers, const K: usize> BxCan<R, F, K> {
     }
 
     /// The rare path of `read_rx`, out of line: acknowledges `FOVRx` and `FULLx` of
-    /// FIFO `x` (write 1 to clear, RM0410 §40.9.2 `CAN_RFxR`), `r` as read; whether
-    /// frames were lost (`FOVRx`).
+    /// FIFO `x` (write 1 to clear, RM0410 §40.9.2 `CAN_RFxR`), `r` as read, and
+    /// records them in `events` (`FOVRx`: frames lost; `FULLx`: the FIFO was full).
     #[cold]
     #[inline(never)]
-    fn acknowledge_full(&self, x: usize, r: u32) -> bool {
+    fn acknowledge_full(&self, x: usize, r: u32, events: &mut FifoEvents) {
         self.regs.write32(rfxr(x), r & (rfxr::FOVR | rfxr::FULL));
-        r & rfxr::FOVR != 0
+        events.overrun |= r & rfxr::FOVR != 0;
+        events.warning |= r & rfxr::FULL != 0;
     }
 
     fn status_now(&self) -> ErrorStatus {
@@ -698,11 +701,11 @@ unsafe impl<R: Registers, F: Registers, const K: usize> Hardware for BxCan<R, F,
     /// `CAN_RFxR.FMPx` > 0: copies the output mailbox and releases it (`RFOMx`); an
     /// overrun (`FOVRx`, frames lost in hardware) is acknowledged with `FULLx`.
     #[inline(always)]
-    unsafe fn read_rx(&self, queue: usize, overrun: &mut bool) -> Option<RawFrame> {
+    unsafe fn read_rx(&self, queue: usize, events: &mut FifoEvents) -> Option<RawFrame> {
         let x = queue & 1;
         let r = self.regs.read32(rfxr(x));
         if r & (rfxr::FOVR | rfxr::FULL) != 0 {
-            *overrun |= self.acknowledge_full(x, r);
+            self.acknowledge_full(x, r, events);
         }
         if rfxr::FMP.get(r) == 0 {
             return None;

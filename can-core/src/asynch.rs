@@ -46,7 +46,8 @@
 //! #     let mut f = core::pin::pin!(f);
 //! #     let w = std::task::Waker::noop();
 //! #     let mut cx = core::task::Context::from_waker(w);
-//! #     loop { if let core::task::Poll::Ready(v) = f.as_mut().poll(&mut cx) { return v } }
+//! #     for _ in 0..10_000 { if let core::task::Poll::Ready(v) = f.as_mut().poll(&mut cx) { return v } }
+//! #     panic!("the future is still pending after 10,000 polls")
 //! # }
 //! # Ok::<(), twocan_core::Error>(())
 //! ```

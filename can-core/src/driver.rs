@@ -3,15 +3,16 @@
 //! `static` and no interrupt. Firmware that takes interrupts uses the split handles.
 //!
 //! ```
-//! use twocan_core::mock::MockHardware;
+//! use twocan_core::mock::{block, MockHardware};
 //! use twocan_core::{Driver, Frame, TxOutcome};
 //!
 //! let mut can: Driver<MockHardware, 8, 4> = Driver::new(MockHardware::new(3).with_loopback(true));
 //! let frame = Frame::standard(0x123, &[1, 2, 3])?;
-//! let token = nb::block!(can.try_send(&frame))?;
+//! // `nb::block!` in firmware; `block` is its bounded form for the mock.
+//! let token = block("room to send", || can.try_send(&frame))?;
 //! can.hardware().complete_all();          // the mock puts its mailboxes on the "bus"
 //! can.on_interrupt();                     // what the interrupt handlers would do
-//! assert_eq!(nb::block!(can.receive())?.frame, frame);
+//! assert_eq!(block("the frame back", || can.receive())?.frame, frame);
 //! let done = can.take_completion().unwrap();
 //! assert_eq!((done.token, done.outcome), (token, TxOutcome::Sent));
 //! # Ok::<(), twocan_core::Error>(())

@@ -140,6 +140,11 @@ pub struct ErrorStatistics {
     /// FlexCAN (`IFLAG1` bit 7) nor bxCAN (`FOVR`) counts the frames an overrun drops, so
     /// this counts occurrences, not lost frames (at least one frame per occurrence).
     pub hardware_overruns: u32,
+    /// Hardware receive FIFO warning occurrences seen by the interrupt handler: FlexCAN's
+    /// Rx FIFO held 5 of its 6 frames (`IFLAG1` bit 6), a bxCAN FIFO all 3 (`FULLx`).
+    /// Each means the receive interrupt was served late; frames are lost only when an
+    /// overrun follows.
+    pub hardware_fifo_warnings: u32,
 }
 
 impl ErrorStatistics {

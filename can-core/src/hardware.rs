@@ -276,12 +276,13 @@ pub unsafe trait Hardware {
     unsafe fn abort_all_mailboxes(&self);
 
     /// Receive interrupt of queue `queue`: copies the head of that hardware FIFO out and
-    /// releases it. `overrun` is set when the hardware reported lost frames (its flag is
-    /// acknowledged).
+    /// releases it. The FIFO's overrun and warning flags, when raised, are acknowledged
+    /// and recorded in `events` (left as they are otherwise: the caller accumulates them
+    /// over a drain).
     ///
     /// # Safety
     /// Called from this method's one context only (see the [module docs](self)).
-    unsafe fn read_rx(&self, queue: usize, overrun: &mut bool) -> Option<Self::Raw>;
+    unsafe fn read_rx(&self, queue: usize, events: &mut FifoEvents) -> Option<Self::Raw>;
 
     /// Receive half: the frame, its user filter index and time stamp. `None` when the
     /// frame must be dropped (the filter map has no user filter for it: e.g. the extra
@@ -445,4 +446,17 @@ mod tests {
         super::sort_by_token(&mut one);
         super::sort_by_token::<()>(&mut []);
     }
+}
+
+/// What a hardware receive FIFO reported while [`Hardware::read_rx`] read it (its flags
+/// acknowledged by the backend). Both are rare: the per-frame path only tests the flag
+/// register, and the receive handler counts them in
+/// [`ErrorStatistics`](crate::ErrorStatistics) once per drain in which they were seen.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct FifoEvents {
+    /// Frames were lost in hardware (FlexCAN `IFLAG1.BUF7I`, bxCAN `FOVRx`).
+    pub overrun: bool,
+    /// The FIFO reached its warning level: FlexCAN `IFLAG1.BUF6I` (the number of unread
+    /// frames rose from 4 to 5 of 6), bxCAN `FULLx` (3 of 3 frames, RM0410 §40.7.5).
+    pub warning: bool,
 }

@@ -14,31 +14,37 @@
 //!
 //! ```
 //! use twocan_core::io::{CanRx, CanTx};
-//! use twocan_core::mock::MockHardware;
+//! use twocan_core::mock::{block, MockHardware};
 //! use twocan_core::{Driver, Frame, TxOutcome};
 //!
-//! /// Sends `frame` and waits (polling `service`) for its completion.
-//! fn send_and_confirm<C: CanTx + CanRx>(can: &mut C, frame: &Frame, service: impl Fn(&mut C)) -> TxOutcome {
-//!     let token = nb::block!(can.try_send(frame)).expect("accepted");
-//!     loop {
+//! /// Sends `frame` and waits (polling `service`, at most `rounds` times) for its completion.
+//! fn send_and_confirm<C: CanTx + CanRx>(
+//!     can: &mut C,
+//!     frame: &Frame,
+//!     rounds: u32,
+//!     service: impl Fn(&mut C),
+//! ) -> Option<TxOutcome> {
+//!     let token = block("room to send", || can.try_send(frame)).expect("accepted");
+//!     for _ in 0..rounds {
 //!         service(can);
 //!         if let Some(done) = can.take_completion() {
 //!             if done.token == token {
-//!                 return done.outcome;
+//!                 return Some(done.outcome);
 //!             }
 //!         }
 //!     }
+//!     None
 //! }
 //!
 //! let mut can: Driver<MockHardware, 8, 4> = Driver::new(MockHardware::new(3).with_loopback(true));
 //! let frame = Frame::standard(0x7E0, &[2, 0x10, 0x03])?;
-//! let outcome = send_and_confirm(&mut can, &frame, |c| {
+//! let outcome = send_and_confirm(&mut can, &frame, 100, |c| {
 //!     c.hardware().complete_all();
 //!     c.on_interrupt();
 //! });
-//! assert_eq!(outcome, TxOutcome::Sent);
+//! assert_eq!(outcome, Some(TxOutcome::Sent));
 //! assert_eq!((CanRx::available(&can), can.traffic().sent), (1, 1));
-//! assert_eq!(nb::block!(can.receive())?.frame, frame);
+//! assert_eq!(block("the frame back", || can.receive())?.frame, frame);
 //! # Ok::<(), twocan_core::Error>(())
 //! ```
 
@@ -309,7 +315,8 @@ mod tests {
     fn send_n<T: CanTx>(tx: &mut T, n: u16) -> u32 {
         let first = tx.next_token();
         for i in 0..n {
-            let t = nb::block!(tx.try_send(&Frame::standard(0x100 + i, &[]).unwrap())).unwrap();
+            let f = Frame::standard(0x100 + i, &[]).unwrap();
+            let t = crate::mock::block("room to send", || tx.try_send(&f)).unwrap();
             assert_eq!(t.0, first.0 + u32::from(i));
         }
         tx.traffic().queued

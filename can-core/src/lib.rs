@@ -70,7 +70,7 @@ pub use error::{
 pub use features::{Features, Full, Lean};
 pub use filter::{Filter, FilterError, Format, FrameKind};
 pub use frame::{Frame, FrameError, RxFrame};
-pub use hardware::{Completion, Hardware, Settled, StatusEvents, Token, TxFailure};
+pub use hardware::{Completion, FifoEvents, Hardware, Settled, StatusEvents, Token, TxFailure};
 #[cfg(feature = "async")]
 pub use io::{AsyncCanRx, AsyncCanTx};
 pub use io::{CanRx, CanStatus, CanTx};

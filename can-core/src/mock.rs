@@ -16,7 +16,7 @@ use crate::controller::{ErrorStatus, Mode};
 use crate::error::{Error, ErrorCounters, ErrorState, LastErrorCode};
 use crate::filter::Filter;
 use crate::frame::{Frame, RxFrame};
-use crate::hardware::{Completion, Hardware, Settled, StatusEvents, Token};
+use crate::hardware::{Completion, FifoEvents, Hardware, Settled, StatusEvents, Token};
 use crate::mailbox::{MailboxId, MailboxState, TxOutcome, TxPolicy};
 
 /// Mock filter list: portable filters matched in order (the first match gives the index).
@@ -52,6 +52,38 @@ struct Inner {
     loopback: bool,
     fail_next: bool,
     bitrate: u32,
+}
+
+/// How many times [`block`] retries before it gives up.
+pub const BLOCK_LIMIT: u32 = 10_000;
+
+/// `nb::block!` with a bound, for tests and examples over the mock: retries `f` while it
+/// returns `WouldBlock`, at most [`BLOCK_LIMIT`] times, then panics naming `what` it
+/// waited for. Nothing runs between the retries (no interrupt, no bus), so a wait that
+/// is not over at once is a bug, and it fails instead of spinning for ever. Firmware
+/// waits with `nb::block!` (or services its interrupts meanwhile).
+///
+/// ```
+/// use twocan_core::mock::{block, MockHardware};
+/// use twocan_core::{Driver, Frame};
+///
+/// let mut can: Driver<MockHardware, 8, 4> = Driver::new(MockHardware::new(3));
+/// let frame = Frame::standard(0x1, &[])?;
+/// block("room for a frame", || can.try_send(&frame))?;
+/// let waited = std::panic::catch_unwind(move || block("a frame", || can.receive()));
+/// assert!(waited.is_err(), "nothing was received: the wait fails");
+/// # Ok::<(), twocan_core::Error>(())
+/// ```
+#[track_caller]
+pub fn block<T, E>(what: &str, mut f: impl FnMut() -> nb::Result<T, E>) -> Result<T, E> {
+    for _ in 0..BLOCK_LIMIT {
+        match f() {
+            Ok(v) => return Ok(v),
+            Err(nb::Error::Other(e)) => return Err(e),
+            Err(nb::Error::WouldBlock) => {}
+        }
+    }
+    panic!("still waiting for {what} after {BLOCK_LIMIT} tries (WouldBlock)")
 }
 
 /// An in-memory controller (see the [module docs](self)).
@@ -357,11 +389,11 @@ unsafe impl Hardware for MockHardware {
         })
     }
 
-    unsafe fn read_rx(&self, _queue: usize, overrun: &mut bool) -> Option<Frame> {
+    unsafe fn read_rx(&self, _queue: usize, events: &mut FifoEvents) -> Option<Frame> {
         self.with(|m| {
             if m.overrun {
                 m.overrun = false;
-                *overrun = true;
+                events.overrun = true;
             }
             m.fifo.pop_front()
         })

@@ -21,7 +21,7 @@
 //! interrupt lines after the split).
 //!
 //! ```
-//! use twocan_core::mock::MockHardware;
+//! use twocan_core::mock::{block, MockHardware};
 //! use twocan_core::split::State;
 //! use twocan_core::{FifoQueue, Frame, TxOutcome};
 //!
@@ -30,7 +30,7 @@
 //! let mut parts = CAN.split(MockHardware::new(3)).expect("taken once");
 //! assert!(CAN.split(MockHardware::new(3)).is_err(), "a second split is refused");
 //! let frame = Frame::standard(0x123, &[1, 2])?;
-//! let token = nb::block!(parts.tx.try_send(&frame))?;
+//! let token = block("room to send", || parts.tx.try_send(&frame))?; // nb::block! in firmware
 //! CAN.hardware().unwrap().complete_all();   // the mock "sends" its mailboxes
 //! parts.tx_irq.on_interrupt();              // in the transmit interrupt handler
 //! let done = parts.tx.take_completion().unwrap();
@@ -48,7 +48,7 @@ use crate::dispatch::Dispatcher;
 use crate::error::{Error, ErrorCounters, ErrorState, ErrorStatistics, LastErrorCode};
 use crate::features::{Features, Full, Tally};
 use crate::frame::{Frame, RxFrame};
-use crate::hardware::{Completion, Hardware, Settled, Token};
+use crate::hardware::{Completion, FifoEvents, Hardware, Settled, Token};
 use crate::mailbox::{TxOutcome, TxPolicy};
 use crate::once::{Lease, OnceSlot};
 use crate::spsc::{BufferStats, Counter, SpscRing};
@@ -147,6 +147,7 @@ struct ErrorCounts {
 struct QueueCounts<C> {
     received: C,
     overruns: Counter,
+    warnings: Counter,
 }
 
 impl<C: Tally> QueueCounts<C> {
@@ -154,6 +155,7 @@ impl<C: Tally> QueueCounts<C> {
         QueueCounts {
             received: C::NEW,
             overruns: Counter::new(),
+            warnings: Counter::new(),
         }
     }
 }
@@ -529,6 +531,10 @@ impl<
                 .overruns
                 .get()
                 .wrapping_add(self.per_queue[1].overruns.get()),
+            hardware_fifo_warnings: self.per_queue[0]
+                .warnings
+                .get()
+                .wrapping_add(self.per_queue[1].warnings.get()),
         }
     }
 
@@ -867,15 +873,16 @@ impl<
 /// The transmit half: send frames, take their completions, abort them.
 ///
 /// ```
-/// use twocan_core::mock::MockHardware;
+/// use twocan_core::mock::{block, MockHardware};
 /// use twocan_core::split::AbortRequest;
 /// use twocan_core::{FifoQueue, Frame, State, TxOutcome};
 ///
 /// static CAN: State<MockHardware, 8, FifoQueue<4>> = State::new();
 /// let mut p = CAN.split(MockHardware::new(1)).map_err(|(e, _)| e)?;
 /// // One mailbox: the first frame goes straight in, the second waits in the queue.
-/// let a = nb::block!(p.tx.try_send(&Frame::standard(0x100, &[1])?))?;
-/// let b = nb::block!(p.tx.try_send(&Frame::standard(0x101, &[2])?))?;
+/// let (fa, fb) = (Frame::standard(0x100, &[1])?, Frame::standard(0x101, &[2])?);
+/// let a = block("a mailbox", || p.tx.try_send(&fa))?;
+/// let b = block("room in the queue", || p.tx.try_send(&fb))?;
 /// assert_eq!(p.tx.stats().count, 1);
 /// // A queued frame can be taken back; its `Aborted` completion follows at once.
 /// assert_eq!(p.tx.abort(b), AbortRequest::Dequeued);
@@ -1144,7 +1151,7 @@ impl<
 /// the error state.
 ///
 /// ```
-/// use twocan_core::mock::MockHardware;
+/// use twocan_core::mock::{block, MockHardware};
 /// use twocan_core::{ErrorState, FifoQueue, Filter, Frame, LastErrorCode, State};
 ///
 /// static CAN: State<MockHardware, 8, FifoQueue<4>> = State::new();
@@ -1157,9 +1164,9 @@ impl<
 /// p.rx0_irq.on_interrupt();
 /// assert_eq!(p.rx.available(), 2);
 /// // Frames in arrival order, each with the index of the user's filter that took it.
-/// let first = nb::block!(p.rx.receive())?;
+/// let first = block("the first frame", || p.rx.receive())?;
 /// assert_eq!((first.frame.data(), first.filter), (&[7][..], 1));
-/// let second = nb::block!(p.rx.receive())?;
+/// let second = block("the second frame", || p.rx.receive())?;
 /// assert_eq!((second.frame.data(), second.filter), (&[8][..], 0));
 ///
 /// // Error-state changes arrive through the status handler.
@@ -1308,13 +1315,14 @@ impl<
 /// message-buffer line) or, on a host, wherever the bus is serviced.
 ///
 /// ```
-/// use twocan_core::mock::MockHardware;
+/// use twocan_core::mock::{block, MockHardware};
 /// use twocan_core::{FifoQueue, Frame, State};
 ///
 /// static CAN: State<MockHardware, 8, FifoQueue<4>> = State::new();
 /// let mut p = CAN.split(MockHardware::new(1)).map_err(|(e, _)| e)?;
 /// for id in [0x10, 0x11, 0x12] {
-///     nb::block!(p.tx.try_send(&Frame::standard(id, &[])?))?;
+///     let f = Frame::standard(id, &[])?;
+///     block("room to send", || p.tx.try_send(&f))?;
 /// }
 /// assert_eq!(p.tx.stats().count, 2); // one mailbox: two frames queued
 /// for _ in 0..3 {
@@ -1485,11 +1493,11 @@ unsafe fn drain<
 ) {
     let hw = s.hw();
     let counts = &s.per_queue[q];
-    let mut overrun = false;
+    let mut events = FifoEvents::default();
     let mut any = false;
     // SAFETY: the caller's contract.
     unsafe {
-        while let Some(raw) = hw.read_rx(q, &mut overrun) {
+        while let Some(raw) = hw.read_rx(q, &mut events) {
             any = true;
             counts.received.inc();
             // Widened here, on the interrupt side: the counter's wraps are only known
@@ -1501,14 +1509,26 @@ unsafe fn drain<
             let _ = ring.push(Stamped { raw, wraps });
         }
     }
-    if overrun {
-        counts.overruns.inc();
+    if events != FifoEvents::default() {
+        fifo_events(counts, events);
     }
     #[cfg(feature = "async")]
     if any {
         s.wakers.rx.wake();
     }
     let _ = any;
+}
+
+/// Counts a drain's rare FIFO events, out of the per-frame path.
+#[cold]
+#[inline(never)]
+fn fifo_events<C>(counts: &QueueCounts<C>, events: FifoEvents) {
+    if events.overrun {
+        counts.overruns.inc();
+    }
+    if events.warning {
+        counts.warnings.inc();
+    }
 }
 
 /// The status (error, bus-off, wake-up) interrupt handler.

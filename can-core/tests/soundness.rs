@@ -11,8 +11,9 @@ use twocan_core::mock::{MockFilterList, MockHardware};
 use twocan_core::split::State;
 use twocan_core::timing::Timing;
 use twocan_core::{
-    AnyQueue, BusMode, BusOffRecovery, Capabilities, Error, ErrorStatus, FifoQueue, Frame,
-    Hardware, MailboxId, MailboxState, Mode, RxFrame, Settled, StatusEvents, Token, TxPolicy,
+    AnyQueue, BusMode, BusOffRecovery, Capabilities, Error, ErrorStatus, FifoEvents, FifoQueue,
+    Frame, Hardware, MailboxId, MailboxState, Mode, RxFrame, Settled, StatusEvents, Token,
+    TxPolicy,
 };
 
 /// Rounds of each race: many natively, a few under Miri (each is slow there).
@@ -151,16 +152,16 @@ unsafe impl<M> Hardware for Fed<M> {
         // SAFETY: the caller's contract, passed on.
         unsafe { self.mock.abort_all_mailboxes() }
     }
-    unsafe fn read_rx(&self, queue: usize, overrun: &mut bool) -> Option<Frame> {
+    unsafe fn read_rx(&self, queue: usize, events: &mut FifoEvents) -> Option<Frame> {
         let left = &self.feed[queue];
         let n = left.load(Ordering::Relaxed);
         if n > 0 {
             left.store(n - 1, Ordering::Relaxed);
-            *overrun = true;
+            events.overrun = true;
             return Some(Frame::standard(queue as u16, &[]).unwrap());
         }
         // SAFETY: the caller's contract, passed on.
-        (queue == 0).then(|| unsafe { self.mock.read_rx(0, overrun) })?
+        (queue == 0).then(|| unsafe { self.mock.read_rx(0, events) })?
     }
     unsafe fn decode(&self, raw: &Frame, map: &MockFilterList) -> Option<RxFrame> {
         // SAFETY: the caller's contract, passed on.

@@ -25,13 +25,25 @@ use twocan_fil::world::World;
 use twocan_sim::SimNode;
 
 /// The heartbeat the `app` firmware of `board` expects from its peer: the Teensy
-/// examples are node 1 (peer 2), the STM32 ones node 2 (peer 1).
+/// examples are node 1 (peer 2), the Blue Pill node 3 (peer 2), the other STM32 ones
+/// node 2 (peer 1).
 fn peer_heartbeat(board: &str) -> u16 {
-    if board.starts_with("teensy") {
+    if board.starts_with("teensy") || board == "bluepill" {
         0x102
     } else {
         0x101
     }
+}
+
+/// The driver's (overruns, FIFO warnings) as the `app` firmware of board 0 published them
+/// (`OVERRUNS`, `FIFO_WARNINGS`: `ErrorStatistics` after its last step).
+fn driver_fifo_counts(w: &World<'_>) -> (u32, u32) {
+    let read = |name: &str| {
+        w.machines[0]
+            .read_u32_static(name)
+            .unwrap_or_else(|| panic!("{name} symbol"))
+    };
+    (read("OVERRUNS"), read("FIFO_WARNINGS"))
 }
 
 fn heartbeat(id: u16, n: u32) -> Frame {
@@ -130,6 +142,11 @@ fn backlog(board: &str, bin: &str, depth: usize) {
         (n, 0, 0),
         "{what}: every heartbeat of the burst that fit, in order: {s:?}"
     );
+    assert_eq!(
+        driver_fifo_counts(&w),
+        (0, 1),
+        "{what}: the driver counted the warning/full flag once, no overrun"
+    );
     // 2. Three more than the FIFO holds.
     w.machines[0].board_mut().hold_can_lines = true;
     for _ in 0..depth + 3 {
@@ -161,6 +178,11 @@ fn backlog(board: &str, bin: &str, depth: usize) {
         "{what}: all but the three lost, one gap where they were lost: {s:?}"
     );
     assert_eq!(s.unhandled, 0, "{what}");
+    assert_eq!(
+        driver_fifo_counts(&w),
+        (1, 2),
+        "{what}: the driver counted one overrun and a second warning/full flag"
+    );
     // The plain node's frames were all acknowledged (the board received them on the
     // wire), and the board's run is clean: no fault, no stuck line, no livelock.
     assert_eq!(
@@ -190,6 +212,9 @@ fn a_receive_interrupt_pending_at_start_up_is_handled_on_every_board() {
         ("teensy36", "teensy-app"),
         ("nucleo-f767zi", "stm32f7-app"),
         ("disco-f746g", "stm32f7-app"),
+        ("bluepill", "stm32-app"),
+        ("nucleo-f446re", "stm32-app"),
+        ("teensy41", "teensy4-app"),
     ] {
         let what = format!("{board} {bin}");
         let Some(mut w) = world(500_000, &[(board, bin)]) else {

@@ -36,7 +36,7 @@ use core::marker::PhantomData;
 use core::sync::atomic::{AtomicBool, AtomicU32, AtomicU8, Ordering};
 
 use twocan_core::hardware::{
-    sort_by_token, Completion, ReceiveContext, Settled, StatusEvents, Token,
+    sort_by_token, Completion, FifoEvents, ReceiveContext, Settled, StatusEvents, Token,
 };
 use twocan_core::timing::{Limits, Timing, FLEXCAN_CTRL1_TIMING_MASK};
 use twocan_core::{
@@ -868,16 +868,17 @@ unsafe impl<R: Registers, O: Options> Hardware for FlexCanHw<R, O> {
 
     /// `IFLAG1.BUF5I`: reads the Rx FIFO output (control/status first, Kinetis RM "Rx
     /// FIFO"), `RXFIR.IDHIT`, then pops it (write 1 to `BUF5I`). `BUF7I` (overflow:
-    /// frames lost) and `BUF6I` (warning) are acknowledged.
+    /// frames lost) and `BUF6I` (warning: 5 unread frames) are acknowledged and reported.
     #[inline(always)]
-    unsafe fn read_rx(&self, queue: usize, overrun: &mut bool) -> Option<RawFrame> {
+    unsafe fn read_rx(&self, queue: usize, events: &mut FifoEvents) -> Option<RawFrame> {
         if queue != 0 || self.mode() == MODE_SLEEP {
             return None;
         }
         let flags = self.regs.read32(IFLAG1);
         let fifo_acks = flags & (iflag1::BUF6I | iflag1::BUF7I);
         if fifo_acks != 0 {
-            *overrun |= flags & iflag1::BUF7I != 0;
+            events.overrun |= flags & iflag1::BUF7I != 0;
+            events.warning |= flags & iflag1::BUF6I != 0;
             self.regs.write32(IFLAG1, fifo_acks);
         }
         if flags & iflag1::BUF5I == 0 {

@@ -78,15 +78,15 @@ impl<R> PollClock<R> {
 
 impl<R> PollClock<R> {
     /// Counts one access; panics after [`SPIN_LIMIT`] of them with the bus time
-    /// unchanged (the bus is not looked at while it is borrowed: a model's access from
-    /// inside a bus step).
+    /// unchanged. While the bus is borrowed (an access from inside a bus step: a
+    /// handler run from a node's hook) its time cannot move, so the access counts
+    /// against the time last seen.
     fn watch(&self, what: &str, offset: usize) {
-        let Ok(bus) = self.bus.try_borrow() else {
-            return;
-        };
-        let now = bus.now();
-        drop(bus);
         let (seen, count) = self.watchdog.get();
+        let now = match self.bus.try_borrow() {
+            Ok(bus) => bus.now(),
+            Err(_) => seen,
+        };
         let count = if seen == now { count + 1 } else { 0 };
         self.watchdog.set((now, count));
         if count >= SPIN_LIMIT {
@@ -118,5 +118,56 @@ impl<R: Registers> Registers for PollClock<R> {
         self.watch("write", offset);
         self.spinning.set(None);
         self.regs.write32(offset, value)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// One register that never changes.
+    struct Constant;
+    impl Registers for Constant {
+        fn read32(&self, _offset: usize) -> u32 {
+            1
+        }
+        fn write32(&self, _offset: usize, _value: u32) {}
+    }
+
+    fn clock() -> PollClock<Constant> {
+        let bus: SharedBus = Rc::new(RefCell::new(Bus::new(500_000).expect("bus")));
+        PollClock::new(Constant, &bus, 0x04)
+    }
+
+    #[test]
+    #[should_panic(expected = "PollClock watchdog")]
+    fn a_spin_on_a_register_that_never_changes_fails() {
+        let c = clock();
+        for _ in 0..=SPIN_LIMIT {
+            c.read32(0x0C);
+        }
+    }
+
+    /// A handler run from inside a bus step (the bus borrowed, as a node's hook runs it)
+    /// that spins is caught too: the bus time cannot move while it is borrowed.
+    #[test]
+    #[should_panic(expected = "PollClock watchdog")]
+    fn a_spin_inside_a_bus_step_fails() {
+        let c = clock();
+        let _step = c.bus.borrow_mut();
+        for _ in 0..=SPIN_LIMIT {
+            c.read32(0x0C);
+        }
+    }
+
+    #[test]
+    fn accesses_with_time_passing_are_not_a_spin() {
+        let c = clock();
+        for _ in 0..3 {
+            for _ in 0..SPIN_LIMIT / 2 {
+                c.read32(0x0C);
+            }
+            c.bus.borrow_mut().run_for(1);
+        }
     }
 }

@@ -16,7 +16,8 @@
 #
 # Per bug, host: every test binary of `cargo test --workspace`, of twocan-bxcan with
 # `model`, of twocan-flexcan with `model,rt,teensy36` and of twocan-core with
-# `async,mock`, each run on its own under `timeout` (PLANT_TEST_TIMEOUT s, default 120);
+# `async,mock` (PLANT_WORKSPACE_ONLY=1: the first only), each run on its own under
+# `timeout` (PLANT_TEST_TIMEOUT s, default 120);
 # with --doctests, the doctests of the four library crates too (PLANT_DOC_TIMEOUT,
 # default 600 s per crate). FIL: the firmware of the family a patch touches is rebuilt
 # (can-core: both), the other family's ELFs are the base's, and the whole FIL suite runs
@@ -123,6 +124,10 @@ run_host() {
     local failed=0 hung=0 tests=0 bins=0 names_failed=() names_hung=()
     local configs=("--workspace" "-p twocan-bxcan --features model"
         "-p twocan-flexcan --features model,rt,teensy36" "-p twocan-core --features async,mock")
+    # PLANT_WORKSPACE_ONLY=1: `cargo test --workspace` alone (its feature unification
+    # already turns on the backends' `model` features and the core's `async,mock`: about
+    # half the build time on a busy machine).
+    [ "${PLANT_WORKSPACE_ONLY:-0}" = 1 ] && configs=("--workspace")
     for cfg in "${configs[@]}"; do
         # shellcheck disable=SC2086 # the package and its features are separate words
         mapfile -t exes < <(test_bins $cfg)

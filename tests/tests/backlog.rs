@@ -153,6 +153,11 @@ fn backlog<N: FifoFlags>(
 ) {
     let (peer, _) = attach_peer(h, "peer");
     let overruns = |d: &N| d.driver_ref().error_stats().hardware_overruns;
+    let warnings = |d: &N| d.driver_ref().error_stats().hardware_fifo_warnings;
+    assert!(
+        depth >= warn_at,
+        "{what}: a full FIFO is at its warning level"
+    );
 
     // 1. Exactly as many frames as the FIFO holds: the warning (or full) flag, no
     //    overrun; one service delivers them all in order and acknowledges the flag.
@@ -178,6 +183,11 @@ fn backlog<N: FifoFlags>(
     let got: Vec<Frame> = drain(dut).iter().map(|r| r.frame).collect();
     assert_eq!(got, fits, "{what}: every frame that fit, in order, intact");
     assert_eq!(overruns(dut), 0, "{what}: no overrun counted");
+    assert_eq!(
+        warnings(dut),
+        1,
+        "{what}: the warning/full flag counted once"
+    );
     assert_eq!(dut.hw_lost(), 0, "{what}: nothing lost in hardware");
 
     // 2. Three more than it holds: the first `depth` kept, 3 lost, one overrun counted.
@@ -202,6 +212,11 @@ fn backlog<N: FifoFlags>(
     );
     assert_eq!(dut.hw_lost(), 3, "{what}: 3 frames lost in hardware");
     assert_eq!(overruns(dut), 1, "{what}: one overrun counted");
+    assert_eq!(
+        warnings(dut),
+        2,
+        "{what}: the warning raised again, counted once"
+    );
 
     // 3. Serviced traffic afterwards: the overrun is not counted again (its flag was
     //    acknowledged), and frames flow as usual.
@@ -213,6 +228,11 @@ fn backlog<N: FifoFlags>(
     let got: Vec<Frame> = drain(dut).iter().map(|r| r.frame).collect();
     assert_eq!(got, after, "{what}: serviced frames after the overrun");
     assert_eq!(overruns(dut), 1, "{what}: still one overrun");
+    assert_eq!(
+        warnings(dut),
+        2,
+        "{what}: serviced traffic raises no warning"
+    );
     assert!(!dut.irq_pending(), "{what}: idle lines");
 
     // 4. A second overrun: counted once more, exactly.
@@ -226,6 +246,7 @@ fn backlog<N: FifoFlags>(
         "{what}: second overrun, the frames the FIFO kept"
     );
     assert_eq!(overruns(dut), 2, "{what}: two overruns counted");
+    assert_eq!(warnings(dut), 3, "{what}: three warnings counted");
     assert_eq!(dut.hw_lost(), 4, "{what}: 3 + 1 frames lost");
     // Every frame the peer sent is either delivered or counted lost.
     let delivered = dut.driver_ref().traffic().received;
@@ -276,6 +297,11 @@ fn delayed_handler<N: FifoFlags>(h: &mut Harness, dut: &mut N, depth: usize, wha
         dut.driver_ref().error_stats().hardware_overruns,
         0,
         "{what}"
+    );
+    assert_eq!(
+        dut.driver_ref().error_stats().hardware_fifo_warnings,
+        5,
+        "{what}: each of the 5 bursts filled the FIFO to its warning level once"
     );
     assert_eq!(dut.hw_lost(), 0, "{what}");
 }

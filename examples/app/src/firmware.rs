@@ -19,7 +19,15 @@
 //! static STATS: Mutex<RefCell<Option<AppStats>>> = Mutex::new(RefCell::new(None));
 //! static STATE_CHANGES: AtomicU32 = AtomicU32::new(0);
 //! static WORST_STATE: AtomicU32 = AtomicU32::new(0);
-//! let published = Published { stats: &STATS, state_changes: &STATE_CHANGES, worst_state: &WORST_STATE };
+//! static OVERRUNS: AtomicU32 = AtomicU32::new(0);
+//! static FIFO_WARNINGS: AtomicU32 = AtomicU32::new(0);
+//! let published = Published {
+//!     stats: &STATS,
+//!     state_changes: &STATE_CHANGES,
+//!     worst_state: &WORST_STATE,
+//!     overruns: &OVERRUNS,
+//!     fifo_warnings: &FIFO_WARNINGS,
+//! };
 //!
 //! let mut driver: Driver<MockHardware, 8, 4> = Driver::new(MockHardware::new(3));
 //! let mut app = App::new(1, 2);
@@ -34,7 +42,7 @@ use core::cell::RefCell;
 use core::sync::atomic::{AtomicU32, Ordering};
 
 use critical_section::Mutex;
-use twocan_core::{CanRx, CanTx, ErrorState, StateChange};
+use twocan_core::{CanRx, CanTx, ErrorState, ErrorStatistics, StateChange};
 
 use crate::{App, AppStats};
 
@@ -53,6 +61,12 @@ pub struct Published<'a> {
     /// The worst fault-confinement state reported so far: 0 error active, 1 warning,
     /// 2 error passive, 3 bus-off (`ErrorState` in declaration order).
     pub worst_state: &'a AtomicU32,
+    /// The driver's hardware receive FIFO overruns
+    /// ([`ErrorStatistics::hardware_overruns`](twocan_core::ErrorStatistics)).
+    pub overruns: &'a AtomicU32,
+    /// The driver's hardware receive FIFO warnings
+    /// ([`ErrorStatistics::hardware_fifo_warnings`](twocan_core::ErrorStatistics)).
+    pub fifo_warnings: &'a AtomicU32,
 }
 
 /// What one period did, for the board's log and LED.
@@ -100,6 +114,7 @@ impl FirmwareLoop {
             record(published, &c);
             on_change(&c);
         }
+        publish_errors(published, driver.error_stats());
         self.finish(app, published)
     }
 
@@ -119,6 +134,7 @@ impl FirmwareLoop {
             record(published, &c);
             on_change(&c);
         }
+        publish_errors(published, rx.error_stats());
         self.finish(app, published)
     }
 
@@ -147,4 +163,14 @@ fn record(published: &Published<'_>, c: &StateChange) {
             .worst_state
             .fetch_max(c.state as u32, Ordering::Relaxed);
     }
+}
+
+/// Copies the driver's receive FIFO event counts into `published`.
+fn publish_errors(published: &Published<'_>, e: ErrorStatistics) {
+    published
+        .overruns
+        .store(e.hardware_overruns, Ordering::Relaxed);
+    published
+        .fifo_warnings
+        .store(e.hardware_fifo_warnings, Ordering::Relaxed);
 }

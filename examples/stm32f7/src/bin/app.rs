@@ -40,6 +40,10 @@ mod firmware {
     /// The worst fault-confinement state reported so far: 0 error active, 1 warning,
     /// 2 error passive, 3 bus-off (`ErrorState` in declaration order).
     pub static WORST_STATE: AtomicU32 = AtomicU32::new(0);
+    /// The driver's receive FIFO overruns and warnings (`ErrorStatistics`), after each step.
+    pub static OVERRUNS: AtomicU32 = AtomicU32::new(0);
+    /// See [`OVERRUNS`].
+    pub static FIFO_WARNINGS: AtomicU32 = AtomicU32::new(0);
 
     #[cortex_m_rt::entry]
     fn main() -> ! {
@@ -85,6 +89,8 @@ mod firmware {
             stats: &STATS,
             state_changes: &STATE_CHANGES,
             worst_state: &WORST_STATE,
+            overruns: &OVERRUNS,
+            fifo_warnings: &FIFO_WARNINGS,
         };
         let mut main_loop = FirmwareLoop::new();
         let mut period = Every::new(time::millis(), 10);

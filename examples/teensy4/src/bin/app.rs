@@ -8,11 +8,11 @@
 #[cfg(target_os = "none")]
 mod firmware {
     use core::cell::RefCell;
-    use core::sync::atomic::{AtomicU32, Ordering};
+    use core::sync::atomic::AtomicU32;
 
     use critical_section::Mutex;
+    use twocan_app::firmware::{FirmwareLoop, Published};
     use twocan_app::{App, AppStats};
-    use twocan_core::ErrorState;
     use twocan_flexcan::pin::{settings_for, Pin22, Pin23};
     use twocan_flexcan::{BeginPlan, Can1};
     use twocan_teensy4::can::{CanState, TableSlot};
@@ -30,6 +30,10 @@ mod firmware {
     pub static STATE_CHANGES: AtomicU32 = AtomicU32::new(0);
     /// The worst fault-confinement state reported so far (`ErrorState` order).
     pub static WORST_STATE: AtomicU32 = AtomicU32::new(0);
+    /// The driver's receive FIFO overruns and warnings (`ErrorStatistics`), after each step.
+    pub static OVERRUNS: AtomicU32 = AtomicU32::new(0);
+    /// See [`OVERRUNS`].
+    pub static FIFO_WARNINGS: AtomicU32 = AtomicU32::new(0);
 
     #[cortex_m_rt::entry]
     fn main() -> ! {
@@ -64,26 +68,25 @@ mod firmware {
                 &mut boot.core.NVIC,
             )
             .unwrap_or_else(|_| rt::halt(CAN_HALT));
+        let published = Published {
+            stats: &STATS,
+            state_changes: &STATE_CHANGES,
+            worst_state: &WORST_STATE,
+            overruns: &OVERRUNS,
+            fifo_warnings: &FIFO_WARNINGS,
+        };
+        let mut main_loop = FirmwareLoop::new();
         let mut period = Every::new(time::millis(), 10);
         loop {
             if period.due(time::millis()) {
-                app.handle(&mut rx);
-                app.publish(&mut tx);
-                while tx.take_completion().is_some() {}
-                while let Some(c) = rx.take_state_change() {
-                    STATE_CHANGES.fetch_add(1, Ordering::Relaxed);
-                    if c.state <= ErrorState::BusOff {
-                        WORST_STATE.fetch_max(c.state as u32, Ordering::Relaxed);
-                    }
+                main_loop.step_split(&mut app, &mut tx, &mut rx, &published, |c| {
                     twocan_teensy4::warn!(
                         "CAN1 error state {} (TEC {=u16}, REC {=u16})",
                         c.state,
                         c.counters.tec,
                         c.counters.rec
                     );
-                }
-                let stats = app.stats();
-                critical_section::with(|cs| *STATS.borrow_ref_mut(cs) = Some(stats));
+                });
             }
             cortex_m::asm::wfi();
         }
