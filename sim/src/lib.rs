@@ -54,7 +54,7 @@ pub use bits::{crc15, frame_bits, FrameBits};
 pub use bus::{Bus, BusEvent, NodeId, SimError, StillBusy};
 pub use inject::{Fault, FaultError, FaultKind, FormField, RandomFaults, Receivers, Sees};
 pub use node::{BusNode, BusTime, ConfinementEvent, TxRequest, TxResult};
-pub use poll_clock::{PollClock, SharedBus};
+pub use poll_clock::{PollClock, SharedBus, SpinWatchdog, SPIN_LIMIT};
 pub use simple_node::SimNode;
 pub use stats::{BusStats, NodeStats};
 pub use trace::{NodeOutcome, NodeReport, Trace, TraceRecord};

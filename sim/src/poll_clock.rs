@@ -33,8 +33,44 @@ pub struct PollClock<R> {
     poll_registers: Vec<usize>,
     /// The poll register read last, if the last access was such a read.
     spinning: Cell<Option<usize>>,
-    /// The watchdog: the bus time last seen and the accesses made since it changed.
-    watchdog: Cell<(u64, u64)>,
+    watchdog: SpinWatchdog,
+}
+
+/// The watchdog of [`PollClock`], for other register wrappers of the test suites: counts
+/// register accesses made with the bus time unchanged and panics after [`SPIN_LIMIT`]
+/// of them, naming the access (see the [module docs](self)).
+#[derive(Clone, Debug, Default)]
+pub struct SpinWatchdog {
+    /// The bus time last seen and the accesses made since it changed.
+    seen: Cell<(u64, u64)>,
+}
+
+impl SpinWatchdog {
+    /// No access seen yet.
+    pub const fn new() -> Self {
+        SpinWatchdog {
+            seen: Cell::new((0, 0)),
+        }
+    }
+
+    /// Counts one access (`what`, e.g. "read", of register `offset`) at bus time `now`
+    /// (`None` when the caller cannot look at the bus: its time cannot move then, so the
+    /// access counts against the time last seen). Panics after [`SPIN_LIMIT`] accesses
+    /// in a row at one bus time.
+    #[track_caller]
+    pub fn access(&self, now: Option<u64>, what: &str, offset: usize) {
+        let (seen, count) = self.seen.get();
+        let now = now.unwrap_or(seen);
+        let count = if seen == now { count + 1 } else { 0 };
+        self.seen.set((now, count));
+        if count >= SPIN_LIMIT {
+            panic!(
+                "watchdog: {count} register accesses with no bus time passing \
+                 (at bit time {now}, last a {what} of offset 0x{offset:03X}): the code \
+                 under test waits for a register that never changes"
+            );
+        }
+    }
 }
 
 impl<R> core::fmt::Debug for PollClock<R> {
@@ -59,7 +95,7 @@ impl<R> PollClock<R> {
             bus: bus.clone(),
             poll_registers: poll_registers.to_vec(),
             spinning: Cell::new(None),
-            watchdog: Cell::new((0, 0)),
+            watchdog: SpinWatchdog::new(),
         }
     }
 
@@ -77,25 +113,12 @@ impl<R> PollClock<R> {
 }
 
 impl<R> PollClock<R> {
-    /// Counts one access; panics after [`SPIN_LIMIT`] of them with the bus time
-    /// unchanged. While the bus is borrowed (an access from inside a bus step: a
-    /// handler run from a node's hook) its time cannot move, so the access counts
-    /// against the time last seen.
+    /// Counts one access ([`SpinWatchdog::access`]; while the bus is borrowed — an
+    /// access from inside a bus step, a handler run from a node's hook — its time cannot
+    /// move).
     fn watch(&self, what: &str, offset: usize) {
-        let (seen, count) = self.watchdog.get();
-        let now = match self.bus.try_borrow() {
-            Ok(bus) => bus.now(),
-            Err(_) => seen,
-        };
-        let count = if seen == now { count + 1 } else { 0 };
-        self.watchdog.set((now, count));
-        if count >= SPIN_LIMIT {
-            panic!(
-                "PollClock watchdog: {count} register accesses with no bus time passing \
-                 (at bit time {now}, last a {what} of offset 0x{offset:03X}): the code \
-                 under test waits for a register that never changes"
-            );
-        }
+        let now = self.bus.try_borrow().ok().map(|bus| bus.now());
+        self.watchdog.access(now, what, offset);
     }
 }
 
@@ -140,7 +163,7 @@ mod tests {
     }
 
     #[test]
-    #[should_panic(expected = "PollClock watchdog")]
+    #[should_panic(expected = "watchdog: ")]
     fn a_spin_on_a_register_that_never_changes_fails() {
         let c = clock();
         for _ in 0..=SPIN_LIMIT {
@@ -151,7 +174,7 @@ mod tests {
     /// A handler run from inside a bus step (the bus borrowed, as a node's hook runs it)
     /// that spins is caught too: the bus time cannot move while it is borrowed.
     #[test]
-    #[should_panic(expected = "PollClock watchdog")]
+    #[should_panic(expected = "watchdog: ")]
     fn a_spin_inside_a_bus_step_fails() {
         let c = clock();
         let _step = c.bus.borrow_mut();

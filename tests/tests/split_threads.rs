@@ -51,11 +51,19 @@ struct WorldRegs {
     polls: &'static [usize],
     setup: Arc<AtomicBool>,
     spinning: Mutex<Cell<Option<usize>>>,
+    /// Fails the run when a driver spins on a register the model never changes (a
+    /// receive handler that never releases its FIFO) instead of hanging.
+    watchdog: Mutex<twocan_sim::SpinWatchdog>,
 }
 
 impl Registers for WorldRegs {
     fn read32(&self, offset: usize) -> u32 {
         let mut w = self.world.lock().unwrap();
+        let now = w.bus.now();
+        self.watchdog
+            .lock()
+            .unwrap()
+            .access(Some(now), "read", offset);
         if self.setup.load(Ordering::Relaxed) && self.polls.contains(&offset) {
             let spin = self.spinning.lock().unwrap();
             if spin.replace(Some(offset)) == Some(offset) {
@@ -71,6 +79,11 @@ impl Registers for WorldRegs {
     fn write32(&self, offset: usize, value: u32) {
         self.spinning.lock().unwrap().set(None);
         let w = self.world.lock().unwrap();
+        let now = w.bus.now();
+        self.watchdog
+            .lock()
+            .unwrap()
+            .access(Some(now), "write", offset);
         match self.which {
             Which::Bx => w.bx.write32(offset, value),
             Which::Flex => w.flex.write32(offset, value),
@@ -144,6 +157,7 @@ fn exchange(per_direction: u32) -> (u32, u32) {
         polls,
         setup: setup.clone(),
         spinning: Mutex::new(Cell::new(None)),
+        watchdog: Mutex::default(),
     };
 
     const BX_POLLS: &[usize] = &[twocan_bxcan::regs::MSR];
@@ -198,6 +212,8 @@ fn exchange(per_direction: u32) -> (u32, u32) {
         let (bx_state, flex_state) = (&bx_state, &flex_state);
         s.spawn(move || {
             let _stop = StopOnPanic(stop);
+            // (frames received by both nodes, bus time when that last changed)
+            let mut progress = (0u32, 0u64);
             while !done.load(Ordering::Acquire) && !stop.load(Ordering::Acquire) {
                 // Simulated time is ours to hold: the bus does not run ahead of a
                 // receiving thread the scheduler has left behind (its ring would
@@ -209,6 +225,23 @@ fn exchange(per_direction: u32) -> (u32, u32) {
                 let (bx_lines, flex_pending) = {
                     let mut w = world.lock().unwrap();
                     w.bus.run_for(40);
+                    // Bounded in bus time: the run fails when no frame is received
+                    // for a whole simulated second (the bus idles while the scheduler
+                    // leaves the application threads behind, never that long).
+                    let got =
+                        received[0].load(Ordering::Acquire) + received[1].load(Ordering::Acquire);
+                    let now = w.bus.now();
+                    if got != progress.0 {
+                        progress = (got, now);
+                    }
+                    assert!(
+                        now - progress.1 < u64::from(RATE),
+                        "no frame received for {} bit times: {} of {per_direction} \
+                         (bxCAN) and {} (FlexCAN)",
+                        now - progress.1,
+                        received[0].load(Ordering::Acquire),
+                        received[1].load(Ordering::Acquire)
+                    );
                     (w.bx.irq_lines(), w.flex.irq_pending())
                 };
                 if bx_lines.tx {

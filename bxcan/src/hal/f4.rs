@@ -26,11 +26,13 @@
 //! (PI9/PH13: the 176-pin F405/F407 only; a chip without them has no such pin to split
 //! from the HAL's ports.)
 //!
-//! The examples below are not compiled by `cargo test` (`ignore`): `stm32f4xx-hal`
-//! cannot be built on the host next to the tests' `critical-section/std` (see the
-//! feature's note in `Cargo.toml`); the ones marked `compile_fail` below are not checked
-//! by any build yet. What is checked wherever the module compiles: the table's pins
-//! implement the traits (a `const` item below).
+//! The examples below are fenced `ignore` for rustdoc: `stm32f4xx-hal` cannot be built on
+//! the host next to the tests' `critical-section/std` (see the feature's note in
+//! `Cargo.toml`), so `cargo test` cannot compile them. `tools/hal-doctests/run.sh` (CI)
+//! cross-builds each for `thumbv7em-none-eabihf` (STM32F446) instead: the plain ones must
+//! build; the `compile_fail,E0277` ones must fail, on [`TxPin`]/[`RxPin`]. Checked
+//! wherever the module compiles, too: the table's pins implement the traits (a `const`
+//! item below).
 //!
 //! CAN1 on PA11 (RX) and PA12 (TX), in AF9, on a NUCLEO-F446RE:
 //!
@@ -48,7 +50,7 @@
 //!
 //! CAN2's pins (PB12, PB13) given to CAN1 do not compile (`compile_fail`):
 //!
-//! ```ignore
+//! ```ignore,compile_fail,E0277
 //! # use stm32f4xx_hal::{pac, prelude::*, rcc::Config};
 //! # use twocan_bxcan::hal::f4;
 //! # let dp = pac::Peripherals::take().unwrap();
@@ -60,7 +62,7 @@
 //!
 //! Nor does the right pin in another alternate function (PB9 in AF4; `compile_fail`):
 //!
-//! ```ignore
+//! ```ignore,compile_fail,E0277
 //! # use stm32f4xx_hal::{pac, prelude::*, rcc::Config};
 //! # use twocan_bxcan::hal::f4;
 //! # let dp = pac::Peripherals::take().unwrap();
@@ -72,7 +74,7 @@
 //!
 //! Nor TX and RX swapped (`compile_fail`):
 //!
-//! ```ignore
+//! ```ignore,compile_fail,E0277
 //! # use stm32f4xx_hal::{pac, prelude::*, rcc::Config};
 //! # use twocan_bxcan::hal::f4;
 //! # let dp = pac::Peripherals::take().unwrap();

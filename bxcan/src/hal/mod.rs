@@ -2,7 +2,8 @@
 //! its clocks and CAN pins, with no `unsafe` in the program. One module per HAL
 //! (`f7`: `stm32f7xx-hal` 0.8, feature `hal-stm32f7`, its items also re-exported here;
 //! `f4`: `stm32f4xx-hal` 0.23, feature `hal-stm32f4`; `f1`: `stm32f1xx-hal` 0.11, feature
-//! `hal-stm32f1`, the STM32F103's CAN), over one generic piece (this
+//! `hal-stm32f1`, the STM32F103's CAN; `hal-stm32f1-connectivity`: the F105/F107's CAN1 and
+//! CAN2), over one generic piece (this
 //! module): the handle [`HandedOver`], the shared filter block [`Can1Filters`], giving
 //! the parts back ([`HandedOver::free`], [`HandedOver::park`], [`Parked::free`]), and
 //! `configure`. A family module adds only what its HAL spells differently: the pins
@@ -25,7 +26,9 @@
 //!   carry the alternate function number (`Pin<'D', 1, Alternate<9>>`), and only the
 //!   pins of the data sheets' alternate-function tables implement [`TxPin`]/[`RxPin`]
 //!   for an instance — a wrong pin, or the right pin in the wrong function, does not
-//!   compile (`compile_fail` examples in each family module).
+//!   compile (`compile_fail` examples in each family module: rustdoc runs the F7's;
+//!   the F1's and F4's, whose HALs do not build on the host, are cross-built by
+//!   `tools/hal-doctests/run.sh`).
 //!
 //! # Giving the singleton and the pins back
 //!

@@ -23,6 +23,8 @@ pub struct Clocked {
     pub bus: SharedBus,
     pub ticking: Rc<Cell<bool>>,
     pub bits_per_poll: u64,
+    /// Fails a test whose driver spins on a register the model never changes.
+    pub watchdog: Rc<twocan_sim::SpinWatchdog>,
 }
 
 impl Clocked {
@@ -32,7 +34,15 @@ impl Clocked {
             bus: bus.clone(),
             ticking: Rc::new(Cell::new(true)),
             bits_per_poll: 1,
+            watchdog: Rc::default(),
         }
+    }
+}
+
+impl Clocked {
+    fn watch(&self, what: &str, offset: usize) {
+        let now = self.bus.try_borrow().ok().map(|b| b.now());
+        self.watchdog.access(now, what, offset);
     }
 }
 
@@ -46,12 +56,14 @@ impl std::fmt::Debug for Clocked {
 
 impl Registers for Clocked {
     fn read32(&self, offset: usize) -> u32 {
+        self.watch("read", offset);
         if offset == MSR && self.ticking.get() {
             self.bus.borrow_mut().run_for(self.bits_per_poll);
         }
         self.model.read32(offset)
     }
     fn write32(&self, offset: usize, value: u32) {
+        self.watch("write", offset);
         self.model.write32(offset, value)
     }
 }

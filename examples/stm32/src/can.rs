@@ -22,8 +22,8 @@ pub const COMPLETIONS: usize = twocan_bxcan::types::COMPLETIONS;
 /// A transmit queue in request order (`TXFP = 1`, the driver's default).
 pub type Queue = twocan_bxcan::types::Queue;
 /// The shared state and interrupt handlers of an instance with registers `R` and filter
-/// registers `F` (a whole block by default; `ControlRegs` and `&'static FilterRegs` for
-/// CAN1 and CAN2 sharing CAN1's filters).
+/// registers `F` (a whole block by default; `ControlRegs` and
+/// `twocan_bxcan::hal::Can1Filters` for CAN1 and CAN2 sharing CAN1's filters).
 pub type CanState<R = CanRegs, F = CanRegs> = IrqState<R, F, RX, Queue, RX, COMPLETIONS>;
 /// The transmit half.
 pub type CanTxHalf<R = CanRegs, F = CanRegs> = BxTx<'static, R, F>;

@@ -11,8 +11,9 @@
 //!   clocks, CAN pins, LED), plain data;
 //! - `rt` (target only): one module per family (`rt/f1.rs`, `rt/f4.rs`) with the same
 //!   interface: clocks with the board's HAL after a bounded probe of the external
-//!   oscillator, the CAN singletons consumed into their register windows, pins, SysTick,
-//!   LED, halt; the CAN interrupt lines of the part;
+//!   oscillator, the CAN singletons and pins given to the library's HAL hand-over
+//!   (`twocan_bxcan::hal::f1`, `hal::f4`: no `unsafe` in the CAN set-up), SysTick, LED,
+//!   halt; the CAN interrupt lines of the part;
 //! - [`can`]: the split driver's state and interrupt handlers (the library's
 //!   `twocan_bxcan::rt::IrqState`, as in `twocan-stm32f7`), started on the part's lines;
 //! - [`time`], `log`: the very files of `twocan-teensy`;

@@ -24,7 +24,7 @@ mod firmware {
     use twocan_bxcan::{const_plan, BxCan, FifoPolicy, Instance, Recovery};
     use twocan_stm32::board::BIT_RATE;
     use twocan_stm32::board::CAN1_BANKS;
-    use twocan_stm32::can::{self, CanState};
+    use twocan_stm32::can::{self, CanRxHalf, CanState, CanTxHalf};
     use twocan_stm32::rt::{self, CAN_BLINKS};
     use twocan_stm32::time::{self, Every};
     use twocan_stm32::BOARD;
@@ -58,22 +58,27 @@ mod firmware {
             PEER,
             BIT_RATE
         );
-        let mut app = App::new(NODE, PEER);
-        // The bit timing is solved for the APB1 clock the HAL set, for the board's part.
-        let config = BOARD
-            .config(boot.apb1_hz, BIT_RATE)
+        // The hand-over from the board's HAL: CAN1's PAC singleton and pins by value
+        // (`twocan_bxcan::hal::f1::can`, `hal::f4::can1`), its clock enabled; the bit
+        // timing solved for the APB1 frequency of the HAL's clocks, for the board's part.
+        let can1 = boot.can.can1();
+        let config = can1
+            .config(BIT_RATE)
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS))
             .recovery(Recovery::Automatic);
-        // Configured in place in `CAN1` (`BxCan::can1_in`): no controller, filter map or
-        // plan moves through `main`.
-        let regs = boot.can1.whole();
+        // The registers for the in-place constructor (nothing configured yet): the
+        // controller is configured in place in `CAN1` (`BxCan::can1_in`), so no
+        // controller, filter map or plan moves through `main`.
+        let regs = can1
+            .into_registers(&config)
+            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         // The application's filters (`twocan_app::filters_for`, the list `app.filters()`
         // returns) planned at build time (`const_plan!`, see `stm32-loopback`).
         let plan = const_plan!(
             twocan_app::filters_for(NODE, PEER),
             CAN1_BANKS.fifo(FifoPolicy::Fifo0)
         );
-        let (mut tx, mut rx) = can::start(
+        let (tx, rx) = can::start(
             &CAN1,
             Instance::Can1,
             |slot| BxCan::can1_in(slot, regs, &config, plan).map_err(|f| f.error),
@@ -81,9 +86,18 @@ mod firmware {
             &mut boot.core.NVIC,
         )
         .unwrap_or_else(|| rt::halt(CAN_BLINKS));
+        run(tx, rx, boot.led)
+    }
+
+    /// The application after the configuration, in a function of its own (not
+    /// inlined): its state (the node, the loop, their call-backs' frames) takes stack
+    /// only once the configuration is done.
+    #[inline(never)]
+    fn run(mut tx: CanTxHalf, mut rx: CanRxHalf, mut led: rt::Led) -> ! {
+        let mut app = App::new(NODE, PEER);
         twocan_stm32::info!(
             "CAN1 on the bus with the application's {=usize} filters",
-            app.filters().len()
+            twocan_app::FILTER_COUNT
         );
         let published = Published {
             stats: &STATS,
@@ -120,7 +134,7 @@ mod firmware {
                     );
                 }
                 if step.blink {
-                    boot.led.toggle();
+                    led.toggle();
                 }
             }
             cortex_m::asm::wfi();

@@ -21,20 +21,20 @@ mod firmware {
 
     use critical_section::Mutex;
     use twocan_app::{App, AppStats};
-    use twocan_bxcan::regs::{ControlRegs, FilterRegs};
+    use twocan_bxcan::hal::Can1Filters;
+    use twocan_bxcan::regs::ControlRegs;
     use twocan_bxcan::{const_plan, BxCan, FifoPolicy, Instance, Recovery};
     use twocan_stm32::board::BIT_RATE;
     use twocan_stm32::board::CAN1_BANKS;
     use twocan_stm32::can::{self, CanRxHalf, CanState, CanTxHalf};
     use twocan_stm32::rt::{self, CAN_BLINKS};
     use twocan_stm32::time::{self, Every};
-    use twocan_stm32::BOARD;
 
     // Each controller owns its control registers and shares CAN1's filter block (RM0390
-    // §30.9.4) through the `&'static FilterRegs` that `Can1::dual` lends.
-    type Shared = CanState<ControlRegs, &'static FilterRegs>;
-    type SharedTx = CanTxHalf<ControlRegs, &'static FilterRegs>;
-    type SharedRx = CanRxHalf<ControlRegs, &'static FilterRegs>;
+    // §30.9.4) through the `Can1Filters` handle of the hand-over.
+    type Shared = CanState<ControlRegs, Can1Filters>;
+    type SharedTx = CanTxHalf<ControlRegs, Can1Filters>;
+    type SharedRx = CanRxHalf<ControlRegs, Can1Filters>;
     static CAN1: Shared = Shared::new();
     static CAN2: Shared = Shared::new();
     twocan_stm32::can1_vectors!();
@@ -47,19 +47,28 @@ mod firmware {
     #[cortex_m_rt::entry]
     fn main() -> ! {
         let mut boot = rt::boot();
-        // CAN1 in dual mode lends the filter block that CAN2 needs.
-        let (can1, filters) = boot.can1.dual();
-        let can2 = boot.can2.control();
-        let base = BOARD
-            .config(boot.apb1_hz, BIT_RATE)
+        // The hand-over from the HAL (`twocan_bxcan::hal::f4::can1_dual`, `f4::can2`): the
+        // singletons and pins by value, both clocks enabled; CAN1's hand-over gives the
+        // filter-block handle CAN2's needs.
+        let (can1, can2) = boot.can.dual();
+        // The bit timing solved for the APB1 frequency of the HAL's clocks.
+        let base = can1
+            .config(BIT_RATE)
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS))
             .recovery(Recovery::Automatic);
         let config1 = base
             .can2_start_bank(14)
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        // Each node's filters (`twocan_app::filters_for`) planned at build time for its 14
+        // The registers for the in-place constructors (nothing configured yet); each
+        // node's filters (`twocan_app::filters_for`) planned at build time for its 14
         // banks (`const_plan!`); each controller configured in place in its state
         // (`BxCan::can1_dual_in`, `BxCan::can2_in`): nothing large moves through `main`.
+        let (regs1, filters1) = can1
+            .into_registers(&config1)
+            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
+        let (regs2, filters2) = can2
+            .into_registers(&base)
+            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         let plan1 = const_plan!(
             twocan_app::filters_for(1, 2),
             CAN1_BANKS.fifo(FifoPolicy::Fifo0)
@@ -71,7 +80,7 @@ mod firmware {
         let (tx1, rx1) = can::start(
             &CAN1,
             Instance::Can1,
-            |slot| BxCan::can1_dual_in(slot, can1, filters, &config1, plan1).map_err(|f| f.error),
+            |slot| BxCan::can1_dual_in(slot, regs1, filters1, &config1, plan1).map_err(|f| f.error),
             rt::CAN1_IRQS,
             &mut boot.core.NVIC,
         )
@@ -79,7 +88,7 @@ mod firmware {
         let (tx2, rx2) = can::start(
             &CAN2,
             Instance::Can2,
-            |slot| BxCan::can2_in(slot, can2, filters, &base, plan2).map_err(|f| f.error),
+            |slot| BxCan::can2_in(slot, regs2, filters2, &base, plan2).map_err(|f| f.error),
             rt::CAN2_IRQS,
             &mut boot.core.NVIC,
         )

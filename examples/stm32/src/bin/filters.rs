@@ -29,7 +29,6 @@ mod firmware {
     use twocan_stm32::can::{self, CanRxHalf, CanState, CanTxHalf};
     use twocan_stm32::rt::{self, CAN_BLINKS};
     use twocan_stm32::time::{self, Every};
-    use twocan_stm32::BOARD;
 
     const FILTERS: usize = 6;
 
@@ -79,14 +78,20 @@ mod firmware {
     #[cortex_m_rt::entry]
     fn main() -> ! {
         let mut boot = rt::boot();
-        // The bit timing is solved for the APB1 clock the HAL set, for the board's part.
-        let config = BOARD
-            .config(boot.apb1_hz, 125_000)
+        // The hand-over from the board's HAL: CAN1's PAC singleton and pins by value
+        // (`twocan_bxcan::hal::f1::can`, `hal::f4::can1`), its clock enabled; the bit
+        // timing solved for the APB1 frequency of the HAL's clocks, for the board's part.
+        let can1 = boot.can.can1();
+        let config = can1
+            .config(125_000)
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS))
             .loopback(true);
-        // Configured in place in `CAN1` (`BxCan::can1_in`): no controller, filter map or
-        // plan moves through `main`.
-        let regs = boot.can1.whole();
+        // The registers for the in-place constructor (nothing configured yet): the
+        // controller is configured in place in `CAN1` (`BxCan::can1_in`), so no
+        // controller, filter map or plan moves through `main`.
+        let regs = can1
+            .into_registers(&config)
+            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         // Planned at build time (`const_plan!`, see `stm32-loopback`).
         let plan = const_plan!(LIST, CAN1_BANKS.fifo(FifoPolicy::Balanced));
         for bank in plan.banks() {

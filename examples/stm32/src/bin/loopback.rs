@@ -17,7 +17,6 @@ mod firmware {
     use twocan_stm32::can::{self, CanState};
     use twocan_stm32::rt::{self, CAN_BLINKS};
     use twocan_stm32::time::{self, Every};
-    use twocan_stm32::BOARD;
 
     static CAN1: CanState = CanState::new();
     twocan_stm32::can1_vectors!();
@@ -31,14 +30,20 @@ mod firmware {
     fn main() -> ! {
         let mut boot = rt::boot();
         twocan_stm32::info!("stm32-loopback: CAN1 in loop-back, a frame every second");
-        // The bit timing is solved for the APB1 clock the HAL set, for the board's part.
-        let config = BOARD
-            .config(boot.apb1_hz, 125_000)
+        // The hand-over from the board's HAL: CAN1's PAC singleton and pins by value
+        // (`twocan_bxcan::hal::f1::can`, `hal::f4::can1`), its clock enabled; the bit
+        // timing solved for the APB1 frequency of the HAL's clocks, for the board's part.
+        let can1 = boot.can.can1();
+        let config = can1
+            .config(125_000)
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS))
             .loopback(true);
-        // Configured in place in `CAN1` (`BxCan::can1_in`): no controller, filter map or
-        // plan moves through `main`.
-        let regs = boot.can1.whole();
+        // The registers for the in-place constructor (nothing configured yet): the
+        // controller is configured in place in `CAN1` (`BxCan::can1_in`), so no
+        // controller, filter map or plan moves through `main`.
+        let regs = can1
+            .into_registers(&config)
+            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         // Planned at build time (`const_plan!`): the run-time planner's working memory
         // (about 90 KB) does not fit the F103C8's 20 KiB of RAM.
         let plan = const_plan!([Filter::pass_all()], CAN1_BANKS.fifo(FifoPolicy::Fifo0));

@@ -2,35 +2,60 @@
 //! HSE 8 MHz crystal × 9 = 72 MHz SYSCLK, APB1 = 36 MHz (its maximum, and bxCAN's clock);
 //! without the crystal the HSI (8 MHz / 2 × 16 = 64 MHz, APB1 32 MHz). Flash wait states
 //! by the HAL (RM0008 §3.3.3). CAN on PB8 (RX, floating input) / PB9 (TX, alternate
-//! push-pull), `AFIO_MAPR.CAN_REMAP` = 10 (RM0008 §9.3.3, §9.1.11 Table 27). LED PC13.
+//! push-pull), `AFIO_MAPR.CAN_REMAP` = 10 (RM0008 §9.3.3, §9.1.11 Table 27), routed,
+//! clocked and reset by the hand-over (`twocan_bxcan::hal::f1::can`). LED PC13.
 //!
 //! The HAL waits without bound for `HSERDY` when told to use the HSE, so [`boot`] first
 //! probes the HSE with a bounded wait (RM0008 §7.3.1 `RCC_CR`).
 
-use stm32f1xx_hal::afio::AfioExt;
+use stm32f1xx_hal::afio::{AfioExt, MAPR};
 use stm32f1xx_hal::flash::FlashExt;
 use stm32f1xx_hal::gpio::{Alternate, Floating, GpioExt, Input, Output, PushPull, PB8, PB9, PC13};
-use stm32f1xx_hal::rcc::{self, Enable, RccExt, Reset};
+use stm32f1xx_hal::rcc::{self, Rcc, RccExt};
 use stm32f1xx_hal::time::{Hz, MHz};
+use twocan_bxcan::hal::f1;
 
 pub use stm32f1xx_hal::pac;
 /// The device interrupt numbers (`crate::can::start` takes the instance's four).
 pub use stm32f1xx_hal::pac::Interrupt;
 
-use super::{halt, Can1, HSE_POLLS, PANIC_BLINKS};
+use super::{halt, HSE_POLLS, PANIC_BLINKS};
 use crate::board::BOARD;
 
 /// The LED pin of the board (PC13, lit when low).
 pub type Led = PC13<Output<PushPull>>;
 
-/// What [`Can1`] holds on the F103: the CAN singleton, the USB singleton (CAN and USB
-/// share their SRAM, RM0008 §24.2: USB stays off while the program holds CAN), and the
-/// pins in their CAN function.
-pub struct Can1Parts {
-    _can: pac::CAN,
-    _usb: pac::USB,
-    _rx: PB8<Input<Floating>>,
-    _tx: PB9<Alternate<PushPull>>,
+/// The CAN handed over alone ([`CanParts::can1`]): its whole block, with the CAN and USB
+/// singletons and the pins (given back by `free`, `park`).
+pub type Can1 = f1::Can<PB9<Alternate<PushPull>>, PB8<Input<Floating>>>;
+
+/// What the hand-over of the F103's CAN takes (`twocan_bxcan::hal::f1::can`): the CAN
+/// singleton, the USB singleton (CAN and USB share their SRAM, RM0008 §24.2: USB stays
+/// off while the program holds CAN), the pins in their CAN function, and the AFIO remap
+/// register and RCC it writes.
+pub struct CanParts {
+    can: pac::CAN,
+    usb: pac::USB,
+    tx: PB9<Alternate<PushPull>>,
+    rx: PB8<Input<Floating>>,
+    mapr: MAPR,
+    rcc: Rcc,
+}
+
+impl CanParts {
+    /// The CAN alone, handed over: routed to PB8/PB9 (`CAN_REMAP` = 10), clocked and
+    /// reset, for the STM32F103 (its bit timing from the HAL's APB1 clock).
+    pub fn can1(self) -> Can1 {
+        let CanParts {
+            can,
+            usb,
+            tx,
+            rx,
+            mut mapr,
+            mut rcc,
+        } = self;
+        f1::can(can, usb, tx, rx, &mut mapr, &mut rcc)
+    }
 }
 
 /// CAN's interrupts (RM0008 §10.1.2: TX and RX0 share their lines with the USB device).
@@ -45,14 +70,12 @@ pub const CAN1_IRQS: [Interrupt; 4] = [
 pub struct Boot {
     /// The Cortex-M core peripherals (SysTick already running).
     pub core: cortex_m::Peripherals,
-    /// The APB1 clock the HAL set: bxCAN's clock.
-    pub apb1_hz: u32,
     /// Whether the HSE runs (else the clocks come from the HSI).
     pub hse: bool,
     /// The user LED, off.
     pub led: Led,
-    /// CAN, clocked and reset, its pins routed.
-    pub can1: Can1,
+    /// What the CAN's hand-over takes ([`CanParts::can1`]).
+    pub can: CanParts,
 }
 
 /// Starts the HSE crystal and waits at most `polls` reads for `HSERDY`; leaves it off
@@ -68,7 +91,8 @@ fn hse_starts(rcc: &pac::RCC, polls: u32) -> bool {
 }
 
 /// The common start of every example: clocks, SysTick, LED; CAN's singleton (and USB's)
-/// taken, its clock enabled and reset, its pins routed. Call once, first thing in `main`.
+/// and its pins (PB9 alternate push-pull, PB8 floating input) for the hand-over, which
+/// routes, clocks and resets it. Call once, first thing in `main`.
 pub fn boot() -> Boot {
     let (Some(mut core), Some(dp)) = (cortex_m::Peripherals::take(), pac::Peripherals::take())
     else {
@@ -86,36 +110,28 @@ pub fn boot() -> Boot {
             .pclk1(MHz(32).convert())
     };
     let mut rcc = dp.RCC.freeze(cfg, &mut flash.acr);
-    let apb1_hz = rcc.clocks.pclk1().raw();
     let hclk = rcc.clocks.hclk().raw();
 
-    // CAN_REMAP = 10: RX PB8, TX PB9 (RM0008 §9.3.3).
-    let mut afio = dp.AFIO.constrain(&mut rcc);
-    // SAFETY: `CAN_REMAP` is a 2-bit field; 0b10 is the documented PB8/PB9 mapping.
-    afio.mapr
-        .modify_mapr(|_, w| unsafe { w.can_remap().bits(0b10) });
+    let afio = dp.AFIO.constrain(&mut rcc);
     let mut gpiob = dp.GPIOB.split(&mut rcc);
     let rx = gpiob.pb8.into_floating_input(&mut gpiob.crh);
     let tx = gpiob.pb9.into_alternate_push_pull(&mut gpiob.crh);
     let mut gpioc = dp.GPIOC.split(&mut rcc);
     let mut led = gpioc.pc13.into_push_pull_output(&mut gpioc.crh);
     led.set_high();
-    pac::CAN::enable(&mut rcc);
-    pac::CAN::reset(&mut rcc);
 
     crate::time::start(&mut core.SYST, hclk);
     Boot {
         core,
-        apb1_hz,
         hse,
         led,
-        can1: Can1 {
-            _parts: Can1Parts {
-                _can: dp.CAN,
-                _usb: dp.USB,
-                _rx: rx,
-                _tx: tx,
-            },
+        can: CanParts {
+            can: dp.CAN,
+            usb: dp.USB,
+            tx,
+            rx,
+            mapr: afio.mapr,
+            rcc,
         },
     }
 }

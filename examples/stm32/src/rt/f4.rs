@@ -2,68 +2,72 @@
 //! §6.3): HSE = the ST-LINK's 8 MHz MCO in bypass, SYSCLK 90 MHz from the PLL, APB1
 //! 45 MHz (its maximum, DS10693 §6.3.1, and bxCAN's clock); 90 MHz needs no over-drive
 //! (RM0390 §5.1.4: only above 168 MHz). Without the HSE: the 16 MHz HSI, same targets.
-//! CAN1 on PA11/PA12, CAN2 on PB12/PB13, alternate function 9 (DS10693 Table 11). LED
-//! LD2 on PA5.
+//! CAN1 on PA11/PA12, CAN2 on PB12/PB13, alternate function 9 (DS10693 Table 11), clocked
+//! and reset by the hand-over (`twocan_bxcan::hal::f4`). LED LD2 on PA5.
 //!
 //! The HAL waits without bound for `HSERDY` when told to use the HSE, so [`boot`] first
 //! probes the HSE with a bounded wait (RM0390 §6.3.1 `RCC_CR`: `HSEBYP` written while the
 //! HSE is off, then `HSEON`, then `HSERDY`).
 
 use stm32f4xx_hal::gpio::{Alternate, GpioExt, Output, PushPull, PA11, PA12, PA5, PB12, PB13};
-use stm32f4xx_hal::rcc::{Config, Enable, RccExt, Reset};
+use stm32f4xx_hal::rcc::{Config, Rcc, RccExt};
 use stm32f4xx_hal::time::Hertz;
-use twocan_bxcan::regs::{ControlRegs, FilterRegs, Instance};
+use twocan_bxcan::hal::{f4, DualCan};
 
 pub use stm32f4xx_hal::pac;
 /// The device interrupt numbers (`crate::can::start` takes the instance's four).
 pub use stm32f4xx_hal::pac::Interrupt;
 
-use super::{base, halt, Can1, HSE_POLLS, PANIC_BLINKS};
+use super::{halt, HSE_POLLS, PANIC_BLINKS};
 use crate::board::BOARD;
 
 /// The LED pin of the board (LD2, PA5, lit when high).
 pub type Led = PA5<Output<PushPull>>;
 
-/// What [`Can1`] holds on the F446: CAN1's singleton and its pins in AF9.
-pub struct Can1Parts {
-    _can: pac::CAN1,
-    _rx: PA11<Alternate<9>>,
-    _tx: PA12<Alternate<9>>,
+/// CAN1 handed over alone ([`CanParts::can1`]): its whole block, with its singleton and
+/// pins (given back by `free`, `park`).
+pub type Can1 = f4::Can1<PA12<Alternate<9>>, PA11<Alternate<9>>>;
+/// CAN2 handed over ([`CanParts::dual`]): its control block and CAN1's filter block.
+pub type Can2 = f4::Can2<PB13<Alternate<9>>, PB12<Alternate<9>>>;
+
+/// What the hand-overs of CAN1 and CAN2 take (`twocan_bxcan::hal::f4`): their PAC
+/// singletons, their pins in AF9, and the RCC that enables and resets them.
+pub struct CanParts {
+    can1: pac::CAN1,
+    can1_pins: (PA12<Alternate<9>>, PA11<Alternate<9>>),
+    can2: pac::CAN2,
+    can2_pins: (PB13<Alternate<9>>, PB12<Alternate<9>>),
+    rcc: Rcc,
 }
 
-/// CAN2 handed over by [`boot`]: its singleton and pins in AF9.
-pub struct Can2 {
-    _can: pac::CAN2,
-    _rx: PB12<Alternate<9>>,
-    _tx: PB13<Alternate<9>>,
-}
-
-/// CAN1's filter registers (`CAN_FMR` .. `CAN_F27R2`), the block CAN1 and CAN2 share
-/// (RM0390 §30.9.4), reached only through [`Can1::dual`].
-// SAFETY: offsets 0x200..0x320 from CAN1's base are CAN1's filter registers (RM0390
-// §30.9.5), 32-bit accessible. A reference to this value is created only by `Can1::dual`,
-// which consumes CAN1's singleton, and gives CAN1 the control window below 0x200 only.
-static CAN1_FILTERS: FilterRegs = unsafe { FilterRegs::new(twocan_bxcan::regs::CAN1_BASE) };
-
-impl Can1 {
-    /// CAN1 as the master of a dual set-up: its control and mailbox registers, and the
-    /// filter block it shares with CAN2 (lend the reference to CAN2 too).
-    pub fn dual(self) -> (ControlRegs, &'static FilterRegs) {
-        // SAFETY: CAN1's control and mailbox registers (below 0x200 of the part's CAN1
-        // block); its singleton is consumed with this value; the filter registers above
-        // go to `CAN1_FILTERS` only.
-        let control = unsafe { ControlRegs::new(base(Instance::Can1)) };
-        (control, &CAN1_FILTERS)
+impl CanParts {
+    /// CAN1 alone, handed over (`f4::can1`: its whole block, filters included; CAN2 is
+    /// not built), clocked and reset, for the STM32F446 (its bit timing from the HAL's
+    /// APB1 clock).
+    pub fn can1(self) -> Can1 {
+        let CanParts {
+            can1,
+            can1_pins: (tx, rx),
+            mut rcc,
+            ..
+        } = self;
+        f4::can1(can1, tx, rx, &mut rcc).with_chip(BOARD.chip)
     }
-}
 
-impl Can2 {
-    /// CAN2's control and mailbox registers (CAN2 has no filter registers of its own:
-    /// it uses CAN1's block, RM0390 §30.2).
-    pub fn control(self) -> ControlRegs {
-        // SAFETY: CAN2's block at the part's base address; its singleton is consumed with
-        // this value, so no other handle to these registers exists.
-        unsafe { ControlRegs::new(base(Instance::Can2)) }
+    /// CAN1 and CAN2, handed over (`f4::can1_dual`, `f4::can2`): each its control block,
+    /// CAN1's filter block shared through the `Can1Filters` handle CAN1's hand-over gives
+    /// CAN2 (CAN2 has no filters of its own, RM0390 §30.2); both clocked and reset.
+    pub fn dual(self) -> (DualCan, Can2) {
+        let CanParts {
+            can1,
+            can1_pins: (tx1, rx1),
+            can2,
+            can2_pins: (tx2, rx2),
+            mut rcc,
+        } = self;
+        let (can1, filters) = f4::can1_dual(can1, tx1, rx1, &mut rcc);
+        let can2 = f4::can2(can2, tx2, rx2, &mut rcc, filters);
+        (can1.with_chip(BOARD.chip), can2.with_chip(BOARD.chip))
     }
 }
 
@@ -87,16 +91,12 @@ pub const CAN2_IRQS: [Interrupt; 4] = [
 pub struct Boot {
     /// The Cortex-M core peripherals (SysTick already running).
     pub core: cortex_m::Peripherals,
-    /// The APB1 clock the HAL set: bxCAN's clock.
-    pub apb1_hz: u32,
     /// Whether the HSE runs (else the clocks come from the HSI).
     pub hse: bool,
     /// The user LED, off.
     pub led: Led,
-    /// CAN1, clocked and reset, its pins in AF9.
-    pub can1: Can1,
-    /// CAN2, clocked and reset, its pins in AF9.
-    pub can2: Can2,
+    /// What the CAN hand-overs take ([`CanParts::can1`], [`CanParts::dual`]).
+    pub can: CanParts,
 }
 
 /// Starts the HSE (bypass or crystal as the board needs) and waits at most `polls` reads
@@ -112,8 +112,8 @@ fn hse_starts(rcc: &pac::RCC, polls: u32) -> bool {
 }
 
 /// The common start of every example: clocks, SysTick, LED; CAN1's and CAN2's
-/// singletons taken, their clocks enabled and reset, their pins in AF9. Call once,
-/// first thing in `main`.
+/// singletons and their pins in AF9 for the hand-over, which clocks and resets them.
+/// Call once, first thing in `main`.
 pub fn boot() -> Boot {
     let (Some(mut core), Some(dp)) = (cortex_m::Peripherals::take(), pac::Peripherals::take())
     else {
@@ -129,38 +129,26 @@ pub fn boot() -> Boot {
         cfg.sysclk(Hertz::from_raw(BOARD.sysclk_hz))
             .pclk1(Hertz::from_raw(BOARD.apb1_hz)),
     );
-    let apb1_hz = rcc.clocks.pclk1().raw();
     let hclk = rcc.clocks.hclk().raw();
 
     let gpioa = dp.GPIOA.split(&mut rcc);
     let gpiob = dp.GPIOB.split(&mut rcc);
     let mut led = gpioa.pa5.into_push_pull_output();
     led.set_low();
-    let (rx1, tx1) = (gpioa.pa11.into_alternate(), gpioa.pa12.into_alternate());
-    let (rx2, tx2) = (gpiob.pb12.into_alternate(), gpiob.pb13.into_alternate());
-    // CAN2 works through CAN1's filters and message RAM (RM0390 §30.2): both clocks on.
-    pac::CAN1::enable(&mut rcc);
-    pac::CAN1::reset(&mut rcc);
-    pac::CAN2::enable(&mut rcc);
-    pac::CAN2::reset(&mut rcc);
+    let can1_pins = (gpioa.pa12.into_alternate(), gpioa.pa11.into_alternate());
+    let can2_pins = (gpiob.pb13.into_alternate(), gpiob.pb12.into_alternate());
 
     crate::time::start(&mut core.SYST, hclk);
     Boot {
         core,
-        apb1_hz,
         hse,
         led,
-        can1: Can1 {
-            _parts: Can1Parts {
-                _can: dp.CAN1,
-                _rx: rx1,
-                _tx: tx1,
-            },
-        },
-        can2: Can2 {
-            _can: dp.CAN2,
-            _rx: rx2,
-            _tx: tx2,
+        can: CanParts {
+            can1: dp.CAN1,
+            can1_pins,
+            can2: dp.CAN2,
+            can2_pins,
+            rcc,
         },
     }
 }

@@ -1,15 +1,18 @@
 //! Target-only start-up, the same interface on both families: [`boot`] (clocks with the
-//! board's HAL, SysTick, LED, the CAN singletons consumed into their register windows),
-//! the part's CAN interrupt lines, [`halt`] and the panic handler. The family module
-//! (`f1.rs` for the Blue Pill, `f4.rs` for the NUCLEO-F446RE) holds what the HALs do
-//! differently; everything the examples see is named the same in both.
+//! board's HAL, SysTick, LED, the CAN singletons and pins), the part's CAN interrupt
+//! lines, [`halt`] and the panic handler. The family module (`f1.rs` for the Blue Pill,
+//! `f4.rs` for the NUCLEO-F446RE) holds what the HALs do differently; everything the
+//! examples see is named the same in both.
 //!
-//! **Register windows.** The program gets the CAN registers only through [`Can1`] and
-//! `Can2`, which hold the PAC singletons [`boot`] took (on the F103 the USB singleton
-//! too: CAN and USB share their SRAM, RM0008 §24.2, so the USB peripheral is kept out of
-//! the program's reach while CAN runs). Turning a singleton into the bounded window of
-//! `twocan_bxcan::regs` is this module's one `unsafe` per instance, at the register
-//! boundary; the base addresses are the part's, from `twocan_bxcan::chip`.
+//! **The HAL hand-over.** The program reaches the CAN registers only through the
+//! library's hand-over from the board's HAL (`twocan_bxcan::hal::f1`, `hal::f4`):
+//! [`boot`] keeps the PAC singletons, the pins in their CAN function and the HAL's RCC in
+//! `CanParts`, and `CanParts::can1` (both boards) or `CanParts::dual` (the F446's CAN1 +
+//! CAN2) gives them **by value** to the hand-over, which enables and resets the clocks
+//! and returns a handle whose `config` solves the bit timing from the HAL's APB1 clock
+//! and whose `configure` puts the controller in initialization mode. On the F103 the
+//! USB singleton goes with the CAN's: CAN and USB share their SRAM (RM0008 §24.2). No
+//! `unsafe` here but the halt path's LED.
 
 #[cfg(feature = "bluepill")]
 mod f1;
@@ -19,10 +22,6 @@ pub use f1::*;
 mod f4;
 #[cfg(feature = "nucleo-f446re")]
 pub use f4::*;
-
-use twocan_bxcan::regs::{CanRegs, Instance};
-
-use crate::board::BOARD;
 
 /// Blink code of a bxCAN configuration failure.
 pub const CAN_BLINKS: u8 = 5;
@@ -36,30 +35,6 @@ pub const HSE_POLLS: u32 = 200_000;
 
 /// Priority of the CAN interrupt lines: one for all (0, the highest, as after reset).
 pub const CAN_PRIORITY: u8 = 0;
-
-/// The base address of `instance` on the board's part (`twocan_bxcan::chip`).
-fn base(instance: Instance) -> usize {
-    match BOARD.chip.instance(instance) {
-        Some(c) => c.base as usize,
-        None => halt(CAN_BLINKS),
-    }
-}
-
-/// CAN1 (the F103's `CAN`) handed over by [`boot`]: its PAC singleton (and, on the F103,
-/// USB's) and its pins, in their CAN function.
-pub struct Can1 {
-    _parts: Can1Parts,
-}
-
-impl Can1 {
-    /// CAN1's whole register block (filters included): CAN1 alone.
-    pub fn whole(self) -> CanRegs {
-        // SAFETY: the block of CAN1 at the part's base address (`twocan_bxcan::chip`,
-        // RM0008 §3.3 / RM0390 §2.3); its PAC singleton was taken by `boot` and is
-        // consumed here with this value, so no other handle to these registers exists.
-        unsafe { CanRegs::new(base(Instance::Can1)) }
-    }
-}
 
 #[cortex_m_rt::exception]
 fn SysTick() {
