@@ -21,7 +21,7 @@ fw_rel="${CARGO_TARGET_DIR:-fil/firmware/target}/$target/release"
 has teensy && for board in teensy32 teensy35 teensy36; do
     cargo build --quiet --release --target "$target" -p twocan-teensy --features "$board" --bins
     mkdir -p "$out/$board"
-    for bin in loopback filters app async-echo can0-can1; do
+    for bin in loopback loopback-lean filters app async-echo can0-can1; do
         if [ -f "$rel/teensy-$bin" ] && { [ "$bin" != can0-can1 ] || [ "$board" = teensy36 ]; }; then
             cp "$rel/teensy-$bin" "$out/$board/"
         fi

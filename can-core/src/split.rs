@@ -1710,8 +1710,14 @@ impl core::fmt::Display for UnsplitError {
 impl core::error::Error for UnsplitError {}
 
 /// The way back (issue 22 item 11).
-impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usize>
-    State<H, RX, Q, RX1, DONE>
+impl<
+        H: Hardware,
+        const RX: usize,
+        Q: TxQueue,
+        const RX1: usize,
+        const DONE: usize,
+        Fe: Features,
+    > State<H, RX, Q, RX1, DONE, Fe>
 {
     /// Takes the controller back out of the state, given every handle [`State::split`]
     /// made: the halves, and the interrupt handlers taken back out of their vectors'
@@ -1726,8 +1732,8 @@ impl<H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE: usi
     #[allow(clippy::type_complexity, clippy::result_large_err)]
     pub fn unsplit<'a>(
         &'a self,
-        parts: Parts<'a, H, RX, Q, RX1, DONE>,
-    ) -> Result<(H, Leftovers), (UnsplitError, Parts<'a, H, RX, Q, RX1, DONE>)> {
+        parts: Parts<'a, H, RX, Q, RX1, DONE, Fe>,
+    ) -> Result<(H, Leftovers), (UnsplitError, Parts<'a, H, RX, Q, RX1, DONE, Fe>)> {
         let ours = [
             parts.tx.s,
             parts.rx.s,

@@ -45,6 +45,31 @@ fn loopback_frames_come_back_on_every_board() {
     }
 }
 
+/// `teensy-loopback-lean` (issue 21: fire-and-forget transmit, no statistics, no time
+/// stamps, the filter table planned at compile time): the same frames come back as with
+/// the default choice, through the same interrupt line.
+#[test]
+fn lean_loopback_frames_come_back_on_every_teensy() {
+    for board in TEENSY {
+        let Some(mut w) = world(500_000, &[(board, "teensy-loopback-lean")]) else {
+            return;
+        };
+        // One frame per second: three by 3.2 s.
+        w.run_for(secs(3.2));
+        assert_clean(&w);
+        let m = &w.machines[0];
+        assert_eq!(m.read_u32_static("SENT"), Some(3), "{board}");
+        assert_eq!(m.read_u32_static("RECEIVED"), Some(3), "{board}");
+        let b = m.board();
+        let rx_line = b.cans[0].instance.irqs[0].1;
+        assert!(
+            b.taken.get(&(16 + rx_line)).copied().unwrap_or(0) >= 3,
+            "{board}: {:?}",
+            b.taken
+        );
+    }
+}
+
 /// STM32F7 `filters`: each frame reaches the call-back of its filter, 0x777 none.
 #[test]
 fn stm32_filters_deliver_exactly_the_expected_identifiers() {

@@ -2,10 +2,12 @@
 //! sketch's `ACAN_T4::can1.begin (settings)` (feature `rt` and a board feature): the
 //! module's one call takes its token, begins with the board's defaults on the board's
 //! default pins receiving every frame (ACAN's `begin` with no filter; see below), splits
-//! the controller into the library's `static` state of the module (ACAN's buffer sizes,
-//! [`AcanState`]), wires the interrupts ([`IrqState::start`]: handlers, then
-//! `mMessageIRQPriority`, then the lines unmasked) and returns the transmit and receive
-//! halves. Its `end_*` is ACAN's `end`: the way back, after which the one call runs
+//! the controller **in place** into the library's `static` state of the module (ACAN's
+//! buffer sizes, [`OneCallState`], its filter table in a `static` [`TableSlot`]: nothing
+//! table-sized moves through the call), wires the interrupts
+//! ([`IrqState::start_in_place`]: handlers, then `mMessageIRQPriority`, then the lines
+//! unmasked) and returns the transmit and receive halves. The `*_checked` forms take
+//! the settings checked beforehand (a `const` [`BeginPlan`]). Its `end_*` is ACAN's `end`: the way back, after which the one call runs
 //! again.
 //!
 //! | board | one call | way back | default settings |
@@ -15,15 +17,17 @@
 //!
 //! The five steps stay available for programs that want control (their own state sizes,
 //! filters, pins, priorities, or their own vectors): `Can0::take` (`Can1::take` ...),
-//! `begin` / `begin_on` with pins, a `static` [`AcanState`] (or another [`IrqState`]),
-//! [`IrqState::start`] with the NVIC, and the halves.
+//! `begin_in` into a `static` [`TableSlot`] (or `begin` / `begin_on`, whose controller
+//! carries its table), a `static` `rt::AcanState` (or another [`IrqState`]),
+//! [`IrqState::start`] (or `start_in_place`) with the NVIC, and the halves.
 //!
 //! **Filters:** the one call installs [`Filter::pass_all`], so that every frame is
 //! received as with ACAN's `begin` without filters (`FlexCan::begin` with an empty list
 //! receives nothing, see `docs/differences.md`); give filters with the `*_with` form.
 //!
 //! **How it runs:** every one call is [`start`] (and every way back [`end`]) over the
-//! module's [`Module`] token, its [`Spare`] slot and its [`AcanState`]. Those two are
+//! module's [`Module`] token, its [`Spare`] slot, its [`TableSlot`] and its
+//! [`OneCallState`]. Those two are
 //! generic over the registers, so host tests run them over the behavioural model with
 //! a token of their own.
 //!
@@ -32,6 +36,7 @@
 
 use core::cell::Cell;
 use core::fmt;
+use core::mem::MaybeUninit;
 
 use critical_section::Mutex;
 use twocan_core::{Error, FifoQueue, Filter, Leftovers, Registers};
@@ -39,47 +44,66 @@ use twocan_core::{Error, FifoQueue, Filter, Leftovers, Registers};
 use crate::begin_error::BeginError;
 #[allow(unused_imports)] // doc links
 use crate::can_clock::CanClock;
-use crate::controller::FlexCan;
+use crate::filters::{FilterTable, TableSlot};
+use crate::options::FullInSlot;
 use crate::regs::FlexCanRegs;
-use crate::rt::{Halves, IrqState, Nvic, StartError, StopError};
+use crate::rt::{Halves, InPlaceError, IrqState, Nvic, StartError, StopError};
 use crate::settings::{Settings, RECEIVE_BUFFER_SIZE, TRANSMIT_BUFFER_SIZE};
+use crate::{BeginPlan, FlexCanHw, Target};
 
 /// The state of a module started by the one call: ACAN's buffer sizes (receive 32,
-/// transmit 16, table 7), 8 completions.
-pub use crate::rt::AcanState;
+/// transmit 16, table 7), 8 completions, every feature, the filter table compiled by
+/// `begin` straight into the module's `static` [`TableSlot`] ([`FullInSlot`]: no
+/// table-sized value moves through the one call, so it configures within a few hundred
+/// bytes of stack, issue 21).
+pub type OneCallState<R = FlexCanRegs> =
+    IrqState<R, RECEIVE_BUFFER_SIZE, FifoQueue<TRANSMIT_BUFFER_SIZE>, 8, FullInSlot>;
 
 /// The transmit and receive halves of a module started by the one call.
-pub type AcanHalves =
-    Halves<FlexCanRegs, RECEIVE_BUFFER_SIZE, twocan_core::FifoQueue<TRANSMIT_BUFFER_SIZE>, 8>;
+pub type AcanHalves<R = FlexCanRegs> =
+    Halves<R, RECEIVE_BUFFER_SIZE, FifoQueue<TRANSMIT_BUFFER_SIZE>, 8, FullInSlot>;
 
-/// A module's ownership token as the one call uses it: taken once, begun, and ended
-/// back into a token (`Can0`..`Can3` on the target; a host test's own over the model).
+/// A module's ownership token as the one call uses it: taken once, begun in place, and
+/// ended back into a token (`Can0`..`Can3` on the target; a host test's own over the
+/// model).
 pub trait Module: Sized {
     /// The module's registers.
     type Regs: Registers + 'static;
 
+    /// The module this token owns (what a [`BeginPlan`] for it names).
+    const TARGET: Target;
+
     /// The token the first time (`Can1::take` ...).
     fn take() -> Option<Self>;
 
-    /// ACAN's `begin` on the board's default pins ([`Settings`] says which; the
-    /// token comes back with the error).
-    #[allow(clippy::result_large_err)]
-    fn begin(
+    /// ACAN's `begin` on the board's default pins, with the settings checked
+    /// beforehand, written in place into `hw` with its lists compiled into `slot` (the
+    /// token and the slot come back with the error; nothing is written then).
+    #[allow(clippy::type_complexity)]
+    fn begin_in_place<'h>(
         self,
-        settings: &Settings,
+        hw: &'h mut MaybeUninit<FlexCanHw<Self::Regs, FullInSlot>>,
+        checked: &BeginPlan,
         primary: &[Filter],
         secondary: &[Filter],
-    ) -> Result<FlexCan<Self::Regs>, (Self, BeginError)>;
+        slot: &'static mut FilterTable,
+    ) -> Result<
+        &'h mut FlexCanHw<Self::Regs, FullInSlot>,
+        (Self, BeginError, &'static mut FilterTable),
+    >;
 
     /// ACAN's `end`: the module stopped, its pins and clock gates released, the token
-    /// back (the controller comes back with the error).
-    #[allow(clippy::result_large_err)]
-    fn end(controller: FlexCan<Self::Regs>) -> Result<Self, (FlexCan<Self::Regs>, Error)>;
+    /// and the table back (the controller comes back with the error).
+    #[allow(clippy::result_large_err, clippy::type_complexity)]
+    fn end_split(
+        hw: FlexCanHw<Self::Regs, FullInSlot>,
+    ) -> Result<(Self, &'static mut FilterTable), (FlexCanHw<Self::Regs, FullInSlot>, Error)>;
 }
 
-/// Where a token waits between one calls: given back by the way back or by a failed
-/// one call (a token is taken once from [`Module::take`]).
-pub struct Spare<M>(Mutex<Cell<Option<M>>>);
+/// Where a module's token and filter table wait between one calls: given back by the
+/// way back or by a failed one call (both are taken once: [`Module::take`],
+/// [`TableSlot::take`]).
+pub struct Spare<M>(Mutex<Cell<Option<(M, &'static mut FilterTable)>>>);
 
 impl<M> Spare<M> {
     /// Empty.
@@ -87,11 +111,11 @@ impl<M> Spare<M> {
         Spare(Mutex::new(Cell::new(None)))
     }
 
-    fn put(&self, token: M) {
-        critical_section::with(|cs| self.0.borrow(cs).set(Some(token)));
+    fn put(&self, kept: (M, &'static mut FilterTable)) {
+        critical_section::with(|cs| self.0.borrow(cs).set(Some(kept)));
     }
 
-    fn take(&self) -> Option<M> {
+    fn take(&self) -> Option<(M, &'static mut FilterTable)> {
         critical_section::with(|cs| self.0.borrow(cs).take())
     }
 
@@ -99,9 +123,9 @@ impl<M> Spare<M> {
     pub fn holds(&self) -> bool {
         critical_section::with(|cs| {
             let cell = self.0.borrow(cs);
-            let token = cell.take();
-            let held = token.is_some();
-            cell.set(token);
+            let kept = cell.take();
+            let held = kept.is_some();
+            cell.set(kept);
             held
         })
     }
@@ -113,68 +137,73 @@ impl<M> Default for Spare<M> {
     }
 }
 
-/// The halves the one call gives over `M`'s registers.
-pub type HalvesOf<M, const RX: usize, const TX: usize, const DONE: usize> =
-    Halves<<M as Module>::Regs, RX, FifoQueue<TX>, DONE>;
-
-/// The one call: the spare token or the first one, `begin` with `settings` and the
-/// filter lists, then `state` started (handlers in place, then the lines unmasked); the
-/// halves. A refused `begin` keeps the token in `spare`; a refused start ends the module
-/// again and keeps its token (unless the module would not stop: it keeps running
-/// unwired, as after `begin`).
+/// The one call: the spare token and table or the first ones, `begin` in place into
+/// `state` with the settings `checked` beforehand and the filter lists, then `state`
+/// started (handlers in place, then the lines unmasked; `IrqState::start_in_place`);
+/// the halves. Neither the controller nor its table moves through the call. A refused
+/// `begin` or start keeps the token and the table in `spare`.
 #[allow(clippy::result_large_err, clippy::type_complexity)]
-pub fn start<M: Module, const RX: usize, const TX: usize, const DONE: usize>(
+pub fn start<M: Module>(
     spare: &Spare<M>,
-    state: &'static IrqState<M::Regs, RX, FifoQueue<TX>, DONE>,
-    settings: &Settings,
+    table: &'static TableSlot,
+    state: &'static OneCallState<M::Regs>,
+    checked: &BeginPlan,
     primary: &[Filter],
     secondary: &[Filter],
     nvic: &mut impl Nvic,
-) -> Result<HalvesOf<M, RX, TX, DONE>, OneCallError>
+) -> Result<AcanHalves<M::Regs>, OneCallError>
 where
-    IrqState<M::Regs, RX, FifoQueue<TX>, DONE>: Sync,
+    OneCallState<M::Regs>: Sync,
 {
-    let Some(token) = spare.take().or_else(M::take) else {
+    let mut kept = spare.take().or_else(|| Some((M::take()?, table.take()?)));
+    if kept.is_none() {
         return Err(OneCallError::Taken);
-    };
-    let controller = match token.begin(settings, primary, secondary) {
-        Ok(c) => c,
-        Err((token, e)) => {
-            spare.put(token);
-            return Err(OneCallError::Begin(e));
-        }
-    };
-    match state.start(controller.into_split(), nvic) {
-        Ok(halves) => Ok(halves),
-        Err((e, hw)) => {
-            if let Ok(token) = M::end(hw.into_controller()) {
-                spare.put(token);
-            }
-            Err(OneCallError::Start(e))
-        }
     }
+    let started = state.start_in_place(
+        M::TARGET,
+        |hw| {
+            let (token, slot) = kept.take().ok_or(None)?;
+            token
+                .begin_in_place(hw, checked, primary, secondary, slot)
+                .map_err(|(token, e, slot)| {
+                    kept = Some((token, slot));
+                    Some(e)
+                })
+        },
+        nvic,
+    );
+    // Not started: the token and the table wait for the next call.
+    if let Some(k) = kept {
+        spare.put(k);
+    }
+    started.map_err(|e| match e {
+        InPlaceError::Init(Some(e)) => OneCallError::Begin(e),
+        InPlaceError::Init(None) => OneCallError::Taken,
+        InPlaceError::Start(e) => OneCallError::Start(e),
+    })
 }
 
 /// The way back from [`start`]: the lines masked, the handlers and the halves taken back
 /// ([`IrqState::stop`]), the module stopped and its pins and clock gates released
-/// ([`Module::end`]), its token in `spare` for the next one call. Returns what was left
-/// in the rings and the queue (discarded); on error the halves come back when the
-/// driver still runs (`None`: the module was stopped but did not acknowledge in time).
+/// ([`Module::end_split`]), its token and table in `spare` for the next one call.
+/// Returns what was left in the rings and the queue (discarded); on error the halves
+/// come back when the driver still runs (`None`: the module was stopped but did not
+/// acknowledge in time).
 #[allow(clippy::result_large_err, clippy::type_complexity)]
-pub fn end<M: Module, const RX: usize, const TX: usize, const DONE: usize>(
+pub fn end<M: Module>(
     spare: &Spare<M>,
-    state: &'static IrqState<M::Regs, RX, FifoQueue<TX>, DONE>,
-    halves: HalvesOf<M, RX, TX, DONE>,
+    state: &'static OneCallState<M::Regs>,
+    halves: AcanHalves<M::Regs>,
     nvic: &mut impl Nvic,
-) -> Result<Leftovers, (OneCallError, Option<HalvesOf<M, RX, TX, DONE>>)>
+) -> Result<Leftovers, (OneCallError, Option<AcanHalves<M::Regs>>)>
 where
-    IrqState<M::Regs, RX, FifoQueue<TX>, DONE>: Sync,
+    OneCallState<M::Regs>: Sync,
 {
     let (hw, left) = state
         .stop(halves.0, halves.1, nvic)
         .map_err(|(e, h)| (OneCallError::Stop(e), Some(h)))?;
-    let token = M::end(hw.into_controller()).map_err(|(_, e)| (OneCallError::End(e), None))?;
-    spare.put(token);
+    let kept = M::end_split(hw).map_err(|(_, e)| (OneCallError::End(e), None))?;
+    spare.put(kept);
     Ok(left)
 }
 
@@ -230,30 +259,40 @@ pub const fn default_settings(bit_rate: u32) -> Settings {
     }
 }
 
-/// The target's tokens as [`Module`]s: `begin` and `end` at the module's base address.
+/// The target's tokens as [`Module`]s: `begin_in_place` and `end_split` at the module's
+/// base address.
 #[cfg(target_os = "none")]
 macro_rules! module {
     ($token:ty) => {
         impl Module for $token {
             type Regs = FlexCanRegs;
+            const TARGET: Target = <$token>::TARGET;
 
             fn take() -> Option<Self> {
                 <$token>::take()
             }
 
-            fn begin(
+            fn begin_in_place<'h>(
                 self,
-                settings: &Settings,
+                hw: &'h mut MaybeUninit<FlexCanHw<FlexCanRegs, FullInSlot>>,
+                checked: &BeginPlan,
                 primary: &[Filter],
                 secondary: &[Filter],
-            ) -> Result<FlexCan<FlexCanRegs>, (Self, BeginError)> {
-                <$token>::begin(self, settings, primary, secondary)
+                slot: &'static mut FilterTable,
+            ) -> Result<
+                &'h mut FlexCanHw<FlexCanRegs, FullInSlot>,
+                (Self, BeginError, &'static mut FilterTable),
+            > {
+                <$token>::begin_in_place(self, hw, checked, primary, secondary, slot)
             }
 
-            fn end(
-                controller: FlexCan<FlexCanRegs>,
-            ) -> Result<Self, (FlexCan<FlexCanRegs>, Error)> {
-                <$token>::end(controller)
+            fn end_split(
+                hw: FlexCanHw<FlexCanRegs, FullInSlot>,
+            ) -> Result<
+                (Self, &'static mut FilterTable),
+                (FlexCanHw<FlexCanRegs, FullInSlot>, Error),
+            > {
+                <$token>::end_split(hw)
             }
         }
     };
@@ -276,10 +315,14 @@ module!(crate::Can3);
 
 /// Defines the one call and its way back for one module.
 macro_rules! one_call {
-    ($(#[$m:meta])* $token:ident, $state:ident, $spare:ident, $start:ident, $start_with:ident, $end:ident, $name:literal) => {
+    ($(#[$m:meta])* $token:ident, $state:ident, $table:ident, $spare:ident, $start:ident, $start_with:ident, $start_checked:ident, $end:ident, $name:literal) => {
         $(#[$m])*
         #[doc = concat!("The module's state and interrupt handlers (ACAN's buffer sizes), used by [`", stringify!($start), "`].")]
-        pub static $state: AcanState = AcanState::new();
+        pub static $state: OneCallState = OneCallState::new();
+
+        $(#[$m])*
+        #[cfg(target_os = "none")]
+        static $table: TableSlot = TableSlot::new();
 
         $(#[$m])*
         #[cfg(target_os = "none")]
@@ -313,7 +356,31 @@ macro_rules! one_call {
             }
             #[cfg(target_os = "none")]
             {
-                start(&$spare, &$state, settings, primary, secondary, nvic)
+                // The settings checked first (ACAN table 5), before the state lends its
+                // storage.
+                let checked =
+                    BeginPlan::new(crate::$token::TARGET, settings, settings.configuration)
+                        .map_err(OneCallError::Begin)?;
+                $start_checked(&checked, primary, secondary, nvic)
+            }
+        }
+
+        $(#[$m])*
+        #[doc = concat!("[`", stringify!($start_with), "`] with the settings checked beforehand: a `BeginPlan` for `", stringify!($token), "::TARGET`, `const` for `const` settings (no check of the settings runs then, and the configuration's stack is the smallest). A plan for another module is `Begin(Hardware(InvalidArgument))`.")]
+        pub fn $start_checked(
+            checked: &BeginPlan,
+            primary: &[Filter],
+            secondary: &[Filter],
+            nvic: &mut impl Nvic,
+        ) -> Result<AcanHalves, OneCallError> {
+            #[cfg(not(target_os = "none"))]
+            {
+                let _ = (checked, primary, secondary, nvic);
+                Err(OneCallError::NotOnTarget)
+            }
+            #[cfg(target_os = "none")]
+            {
+                start(&$spare, &$table, &$state, checked, primary, secondary, nvic)
             }
         }
 
@@ -345,9 +412,11 @@ one_call!(
     #[cfg(not(any(feature = "teensy40", feature = "teensy41")))]
     Can0,
     CAN0,
+    TABLE0,
     SPARE0,
     can0,
     can0_with,
+    can0_checked,
     end_can0,
     "can0"
 );
@@ -355,9 +424,11 @@ one_call!(
     #[cfg(any(feature = "teensy36", feature = "teensy40", feature = "teensy41"))]
     Can1,
     CAN1,
+    TABLE1,
     SPARE1,
     can1,
     can1_with,
+    can1_checked,
     end_can1,
     "can1"
 );
@@ -365,9 +436,11 @@ one_call!(
     #[cfg(any(feature = "teensy40", feature = "teensy41"))]
     Can2,
     CAN2,
+    TABLE2,
     SPARE2,
     can2,
     can2_with,
+    can2_checked,
     end_can2,
     "can2"
 );
@@ -375,9 +448,11 @@ one_call!(
     #[cfg(any(feature = "teensy40", feature = "teensy41"))]
     Can3,
     CAN3,
+    TABLE3,
     SPARE3,
     can3,
     can3_with,
+    can3_checked,
     end_can3,
     "can3"
 );

@@ -32,6 +32,8 @@
 //! Every wait is bounded by [`Settings::handshake_bound`]; a missing acknowledge is
 //! [`BeginError::Hardware`]`(`[`Error::Timeout`]`)`.
 
+use core::mem::MaybeUninit;
+
 use twocan_core::timing::{TimingError, TimingRule};
 use twocan_core::{BusMode, BusOffRecovery, Error, Filter, LastErrorCode, Mode, Registers};
 
@@ -402,7 +404,7 @@ impl<R: Registers> FlexCan<R> {
     /// ```
     #[allow(clippy::type_complexity)]
     pub fn begin_in<S: Registers, O: Options<Table = &'static mut FilterTable>>(
-        mut regs: R,
+        regs: R,
         sys: &mut S,
         target: Target,
         settings: &Settings,
@@ -410,6 +412,67 @@ impl<R: Registers> FlexCan<R> {
         secondary: &[Filter],
         slot: &'static mut FilterTable,
     ) -> Result<FlexCanHw<R, O>, (BeginError, &'static mut FilterTable)> {
+        let (regs, table, parts) =
+            Self::begin_in_parts(regs, sys, target, settings, primary, secondary, slot)?;
+        Ok(FlexCanHw::from_parts(regs, target, table, parts))
+    }
+
+    /// [`FlexCan::begin_in`] writing the split controller **in place** into `hw`
+    /// (the storage a `static` state lends: `twocan_core::split::State::split_with`,
+    /// `rt::IrqState::start_in_place`), with the settings checked beforehand
+    /// ([`BeginPlan`]: at compile time for `const` settings, or before the state lends
+    /// its storage), so that neither the table nor the controller moves through the
+    /// configuration and the checks do not deepen it. The lists are checked against
+    /// the plan's configuration ([`BeginError::Config`] with the filter flags) and
+    /// compiled into `slot`. Returns the controller written; on an error nothing is
+    /// written and the table's slot comes back.
+    #[allow(clippy::type_complexity)]
+    #[inline(always)]
+    pub fn begin_in_place<'h, S: Registers, O: Options<Table = &'static mut FilterTable>>(
+        hw: &'h mut MaybeUninit<FlexCanHw<R, O>>,
+        mut regs: R,
+        sys: &mut S,
+        checked: &BeginPlan,
+        primary: &[Filter],
+        secondary: &[Filter],
+        slot: &'static mut FilterTable,
+    ) -> Result<&'h mut FlexCanHw<R, O>, (BeginError, &'static mut FilterTable)> {
+        let plan = &checked.plan;
+        let filters = FilterTable::check(plan.configuration, primary, secondary);
+        if filters != ConfigErrors::NONE {
+            return Err((BeginError::Config(filters), slot));
+        }
+        plan.system.apply(sys);
+        slot.fill(plan.configuration, primary, secondary);
+        let table: &FilterTable = slot;
+        if let Err(e) = configure(
+            &mut regs,
+            plan,
+            |r| FlexCan::write_filters(r, table),
+            checked.polls,
+        ) {
+            return Err((BeginError::Hardware(e), slot));
+        }
+        Ok(hw.write(FlexCanHw::from_parts(
+            regs,
+            checked.target,
+            slot,
+            checked.parts(),
+        )))
+    }
+
+    /// [`FlexCan::begin_in`] but the controller: the checks, the lists compiled into
+    /// `slot`, the module configured; the split controller's small values.
+    #[allow(clippy::type_complexity)]
+    fn begin_in_parts<S: Registers>(
+        mut regs: R,
+        sys: &mut S,
+        target: Target,
+        settings: &Settings,
+        primary: &[Filter],
+        secondary: &[Filter],
+        slot: &'static mut FilterTable,
+    ) -> Result<(R, &'static mut FilterTable, Parts), (BeginError, &'static mut FilterTable)> {
         if let Some(e) = bitrate_error(settings) {
             return Err((BeginError::Timing(e), slot));
         }
@@ -430,21 +493,17 @@ impl<R: Registers> FlexCan<R> {
         ) {
             return Err((BeginError::Hardware(e), slot));
         }
-        Ok(FlexCanHw::from_parts(
-            regs,
-            target,
-            slot,
-            Parts {
-                bus_mode: bus_mode_of(settings),
-                recovery: settings.bus_off_recovery,
-                polls,
-                irq_priority: settings.message_irq_priority,
-                mode: Mode::Normal,
-                last_error: LastErrorCode::None,
-                system: plan.system,
-                bus_clock_hz: settings.bus_clock_hz.unwrap_or(settings.can_clock.hz()),
-            },
-        ))
+        let parts = Parts {
+            bus_mode: bus_mode_of(settings),
+            recovery: settings.bus_off_recovery,
+            polls,
+            irq_priority: settings.message_irq_priority,
+            mode: Mode::Normal,
+            last_error: LastErrorCode::None,
+            system: plan.system,
+            bus_clock_hz: settings.bus_clock_hz.unwrap_or(settings.can_clock.hz()),
+        };
+        Ok((regs, slot, parts))
     }
 
     /// `begin` with a filter table planned at compile time ([`crate::const_plan!`],
@@ -494,11 +553,37 @@ impl<R: Registers> FlexCan<R> {
     /// for the configuration `checked` was made for ([`Error::InvalidArgument`]
     /// otherwise, nothing written).
     pub fn begin_checked<S: Registers, O: Options<Table = PlannedTable>>(
-        mut regs: R,
+        regs: R,
         sys: &mut S,
         checked: &BeginPlan,
         table: PlannedTable,
     ) -> Result<FlexCanHw<R, O>, BeginError> {
+        let (regs, parts) = Self::begin_checked_parts(regs, sys, checked, table)?;
+        Ok(FlexCanHw::from_parts(regs, checked.target, table, parts))
+    }
+
+    /// [`FlexCan::begin_checked`] writing the split controller **in place** into `hw`
+    /// (see [`FlexCan::begin_in_place`]). On an error nothing is written.
+    #[inline(always)]
+    pub fn begin_checked_in_place<'h, S: Registers, O: Options<Table = PlannedTable>>(
+        hw: &'h mut MaybeUninit<FlexCanHw<R, O>>,
+        regs: R,
+        sys: &mut S,
+        checked: &BeginPlan,
+        table: PlannedTable,
+    ) -> Result<&'h mut FlexCanHw<R, O>, BeginError> {
+        let (regs, parts) = Self::begin_checked_parts(regs, sys, checked, table)?;
+        Ok(hw.write(FlexCanHw::from_parts(regs, checked.target, table, parts)))
+    }
+
+    /// What [`FlexCan::begin_checked`] and [`FlexCan::begin_checked_in_place`] share.
+    #[inline(always)]
+    fn begin_checked_parts<S: Registers>(
+        mut regs: R,
+        sys: &mut S,
+        checked: &BeginPlan,
+        table: PlannedTable,
+    ) -> Result<(R, Parts), BeginError> {
         let plan = &checked.plan;
         if table.configuration() != plan.configuration {
             return Err(BeginError::Hardware(Error::InvalidArgument));
@@ -518,21 +603,7 @@ impl<R: Registers> FlexCan<R> {
             },
             checked.polls,
         )?;
-        Ok(FlexCanHw::from_parts(
-            regs,
-            checked.target,
-            table,
-            Parts {
-                bus_mode: checked.bus_mode,
-                recovery: checked.recovery,
-                polls: checked.polls,
-                irq_priority: checked.irq_priority,
-                mode: Mode::Normal,
-                last_error: LastErrorCode::None,
-                system: plan.system,
-                bus_clock_hz: checked.bus_clock_hz,
-            },
-        ))
+        Ok((regs, checked.parts()))
     }
 }
 
@@ -611,6 +682,26 @@ impl BeginPlan {
     pub const fn configuration(&self) -> Configuration {
         self.plan.configuration
     }
+
+    /// The module the plan is made for.
+    pub const fn target(&self) -> Target {
+        self.target
+    }
+
+    /// The split controller's small values, as the module is right after `begin`.
+    #[inline(always)]
+    fn parts(&self) -> Parts {
+        Parts {
+            bus_mode: self.bus_mode,
+            recovery: self.recovery,
+            polls: self.polls,
+            irq_priority: self.irq_priority,
+            mode: Mode::Normal,
+            last_error: LastErrorCode::None,
+            system: self.plan.system,
+            bus_clock_hz: self.bus_clock_hz,
+        }
+    }
 }
 
 /// The bus mode the settings ask for (ACAN §4: listen-only, loop-back).
@@ -680,4 +771,10 @@ mod firmware {
                 .map_err(|e| (self, e))
         }
     }
+    crate::token_begin::token_begin!(Can0, system);
+    crate::token_begin::token_end!(Can0, system);
+    #[cfg(feature = "teensy36")]
+    crate::token_begin::token_begin!(Can1, system);
+    #[cfg(feature = "teensy36")]
+    crate::token_begin::token_end!(Can1, system);
 }

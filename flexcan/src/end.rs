@@ -35,7 +35,9 @@ use twocan_core::{Error, Registers};
 
 use crate::controller::FlexCan;
 use crate::handshake;
+use crate::options::Options;
 use crate::regs::{ctrl1, esr1, mcr, CTRL1, ESR1, IFLAG1, IMASK1, MCR};
+use crate::split::FlexCanHw;
 
 /// `CTRL1`'s interrupt masks `begin` may set.
 const CTRL1_IRQ_MASKS: u32 = ctrl1::ERRMSK | ctrl1::BOFFMSK | ctrl1::TWRNMSK | ctrl1::RWRNMSK;
@@ -65,20 +67,41 @@ impl<R: Registers> FlexCan<R> {
 
     /// Steps 1–3 of the module documentation ([`crate::system::SystemPlan::release`] is step 4).
     fn stop(&self) -> Result<(), Error> {
-        let regs = &self.regs;
-        // A module put to sleep (disabled) is enabled first: freeze is requested and
-        // acknowledged only while the module is enabled ("Freeze mode"), and the
-        // interrupt registers are written in freeze.
-        if regs.read32(MCR) & (mcr::MDIS | mcr::LPMACK) != 0 {
-            handshake::enable(regs, self.polls)?;
-        }
-        handshake::freeze(regs, self.polls)?;
-        regs.write32(IMASK1, 0);
-        regs.modify32(CTRL1, |v| v & !CTRL1_IRQ_MASKS);
-        regs.write32(IFLAG1, u32::MAX);
-        regs.write32(ESR1, ESR1_IRQ_FLAGS);
-        handshake::disable(regs, self.polls)
+        stop(&self.regs, self.polls)
     }
+}
+
+impl<R: Registers, O: Options> FlexCanHw<R, O> {
+    /// [`FlexCan::end`] for a split controller taken back out of its state
+    /// (`rt::IrqState::stop`, [`twocan_core::split::State::unsplit`]) whatever its
+    /// table ([`crate::options`]): stops the module, releases its pins and clock gate,
+    /// and gives the registers and the table back (for a `FullInSlot` controller, the
+    /// `static` table to begin into again). On a missing acknowledge the controller
+    /// comes back with [`Error::Timeout`], nothing of the chip level released.
+    #[allow(clippy::result_large_err)]
+    pub fn end<S: Registers>(self, sys: &mut S) -> Result<(R, O::Table), (Self, Error)> {
+        if let Err(e) = stop(self.registers(), self.handshake_polls()) {
+            return Err((self, e));
+        }
+        self.system_plan().release(sys);
+        Ok(self.into_registers_and_table())
+    }
+}
+
+/// Steps 1–3 of the module documentation on `regs`, each wait bounded by `polls`.
+fn stop<R: Registers>(regs: &R, polls: u32) -> Result<(), Error> {
+    // A module put to sleep (disabled) is enabled first: freeze is requested and
+    // acknowledged only while the module is enabled ("Freeze mode"), and the
+    // interrupt registers are written in freeze.
+    if regs.read32(MCR) & (mcr::MDIS | mcr::LPMACK) != 0 {
+        handshake::enable(regs, polls)?;
+    }
+    handshake::freeze(regs, polls)?;
+    regs.write32(IMASK1, 0);
+    regs.modify32(CTRL1, |v| v & !CTRL1_IRQ_MASKS);
+    regs.write32(IFLAG1, u32::MAX);
+    regs.write32(ESR1, ESR1_IRQ_FLAGS);
+    handshake::disable(regs, polls)
 }
 
 #[cfg(all(

@@ -248,10 +248,14 @@ mod tokens {
                     (!$flag.swap(true, Ordering::AcqRel)).then_some($name { _private: () })
                 }
 
-                /// The module this token owns.
+                /// The module this token owns (as a constant: [`Self::TARGET`]).
                 pub const fn target(&self) -> Target {
-                    Target::new(Board::DEFAULT, $instance)
+                    Self::TARGET
                 }
+
+                /// The module this token owns, for `const` items (a `BeginPlan` made
+                /// at compile time).
+                pub const TARGET: Target = Target::new(Board::DEFAULT, $instance);
 
                 /// The token again, for `end`: the controller it comes from was made
                 /// from the one taken token (the flag stays set, so `take` still gives

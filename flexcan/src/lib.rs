@@ -153,6 +153,8 @@ pub mod settings;
 pub mod split;
 mod status;
 pub mod system;
+#[allow(unused_macros, unused_imports)]
+mod token_begin;
 pub mod types;
 
 pub mod regs;

@@ -204,7 +204,16 @@ can_pin!(
 
 /// `settings` with the pin choice of `tx` and `rx` (ACAN `mUseAlternateTxPin`,
 /// `mUseAlternateRxPin`, §7): `begin` then muxes exactly those pins.
-pub fn settings_for<I, T: TxPin<I>, X: RxPin<I>>(settings: &Settings, _tx: T, _rx: X) -> Settings {
+/// A `const fn`, so that a firmware's `const` settings carry the pin choice and no
+/// copy of the settings is made at run time (`const { settings_for(&S, Pin3, Pin4) }`).
+pub const fn settings_for<I, T: TxPin<I>, X: RxPin<I>>(
+    settings: &Settings,
+    tx: T,
+    rx: X,
+) -> Settings {
+    // The pins are zero-sized markers: nothing to drop.
+    core::mem::forget(tx);
+    core::mem::forget(rx);
     let mut s = *settings;
     s.use_alternate_tx_pin = T::ALTERNATE;
     s.use_alternate_rx_pin = X::ALTERNATE;

@@ -65,9 +65,10 @@ use core::sync::atomic::{AtomicU8, Ordering};
 use twocan_core::irq_cell::IrqCell;
 use twocan_core::split::{Rx, Rx0Irq, Rx1Irq, State, StatusIrq, Tx, TxIrq};
 use twocan_core::txqueue::TxQueue;
-use twocan_core::{Error, FifoQueue, Leftovers, Parts, Registers, UnsplitError};
+use twocan_core::{Error, Features, FifoQueue, Leftovers, Parts, Registers, UnsplitError};
 
-use crate::instance::{Instance, Irqs};
+use crate::instance::{Instance, Irqs, Target};
+use crate::options::{Full, Options};
 use crate::regs::FlexCanRegs;
 use crate::settings::{RECEIVE_BUFFER_SIZE, TRANSMIT_BUFFER_SIZE};
 use crate::split::FlexCanHw;
@@ -234,26 +235,37 @@ pub fn is_wired(instance: Instance) -> bool {
 
 /// The message line's handlers, and the second receive queue's (none on FlexCAN: kept
 /// only to give every handle back to `State::unsplit`).
-type Message<R, const RX: usize, Q, const DONE: usize> = (
-    TxIrq<'static, FlexCanHw<R>, RX, Q, 0, DONE>,
-    Rx0Irq<'static, FlexCanHw<R>, RX, Q, 0, DONE>,
-    Rx1Irq<'static, FlexCanHw<R>, RX, Q, 0, DONE>,
+type Message<R, const RX: usize, Q, const DONE: usize, O, Fe> = (
+    TxIrq<'static, FlexCanHw<R, O>, RX, Q, 0, DONE, Fe>,
+    Rx0Irq<'static, FlexCanHw<R, O>, RX, Q, 0, DONE, Fe>,
+    Rx1Irq<'static, FlexCanHw<R, O>, RX, Q, 0, DONE, Fe>,
 );
-type Status<R, const RX: usize, Q, const DONE: usize> =
-    StatusIrq<'static, FlexCanHw<R>, RX, Q, 0, DONE>;
+type Status<R, const RX: usize, Q, const DONE: usize, O, Fe> =
+    StatusIrq<'static, FlexCanHw<R, O>, RX, Q, 0, DONE, Fe>;
 
 /// The split driver's state of one FlexCAN instance together with its interrupt
 /// handlers, for a `static`. `RX`: receive ring (frames); `Q`: transmit queue
-/// ([`FifoQueue`] keeps ACAN's send order); `DONE`: completion ring.
+/// ([`FifoQueue`] keeps ACAN's send order); `DONE`: completion ring (0: fire and
+/// forget); `O`: the controller's compile-time choices ([`crate::options`]: the
+/// owned table of [`crate::FlexCan::into_split`] by default, the `static` table of
+/// [`crate::FlexCan::begin_in`] with [`crate::options::FullInSlot`], the plan of
+/// [`crate::FlexCan::begin_planned`] with [`crate::options::Lean`]); `Fe`: the portable
+/// state's ([`twocan_core::Full`] or [`twocan_core::Lean`]: statistics, time stamps).
+///
+/// `start` takes the controller by value: with `FullInSlot` or `Lean` it holds a
+/// reference to its table, not the table, so no table-sized value moves through the
+/// configuration (issue 21).
 pub struct IrqState<
     R: Registers + 'static,
     const RX: usize,
     Q: TxQueue + 'static,
     const DONE: usize,
+    O: Options = Full,
+    Fe: Features = twocan_core::Full,
 > {
-    state: State<FlexCanHw<R>, RX, Q, 0, DONE>,
-    message: IrqCell<Message<R, RX, Q, DONE>>,
-    status: IrqCell<Status<R, RX, Q, DONE>>,
+    state: State<FlexCanHw<R, O>, RX, Q, 0, DONE, Fe>,
+    message: IrqCell<Message<R, RX, Q, DONE, O, Fe>>,
+    status: IrqCell<Status<R, RX, Q, DONE, O, Fe>>,
 }
 
 /// ACAN's buffer sizes (receive 32, transmit 16, table 7) on the target registers, with
@@ -290,16 +302,28 @@ impl fmt::Display for StartError {
 
 impl core::error::Error for StartError {}
 
-impl<R: Registers + 'static, const RX: usize, Q: TxQueue + 'static, const DONE: usize> Default
-    for IrqState<R, RX, Q, DONE>
+impl<
+        R: Registers + 'static,
+        const RX: usize,
+        Q: TxQueue + 'static,
+        const DONE: usize,
+        O: Options,
+        Fe: Features,
+    > Default for IrqState<R, RX, Q, DONE, O, Fe>
 {
     fn default() -> Self {
         Self::new()
     }
 }
 
-impl<R: Registers + 'static, const RX: usize, Q: TxQueue + 'static, const DONE: usize>
-    IrqState<R, RX, Q, DONE>
+impl<
+        R: Registers + 'static,
+        const RX: usize,
+        Q: TxQueue + 'static,
+        const DONE: usize,
+        O: Options,
+        Fe: Features,
+    > IrqState<R, RX, Q, DONE, O, Fe>
 {
     /// Empty (all zeros: `.bss`).
     pub const fn new() -> Self {
@@ -311,7 +335,7 @@ impl<R: Registers + 'static, const RX: usize, Q: TxQueue + 'static, const DONE: 
     }
 
     /// The split driver's shared state (statistics, error state).
-    pub fn state(&self) -> &State<FlexCanHw<R>, RX, Q, 0, DONE> {
+    pub fn state(&self) -> &State<FlexCanHw<R, O>, RX, Q, 0, DONE, Fe> {
         &self.state
     }
 
@@ -321,10 +345,12 @@ impl<R: Registers + 'static, const RX: usize, Q: TxQueue + 'static, const DONE: 
     }
 }
 
-impl<R, const RX: usize, Q, const DONE: usize> Handlers for IrqState<R, RX, Q, DONE>
+impl<R, const RX: usize, Q, const DONE: usize, O, Fe> Handlers for IrqState<R, RX, Q, DONE, O, Fe>
 where
     R: Registers + 'static,
     Q: TxQueue + 'static,
+    O: Options,
+    Fe: Features,
     Self: Sync,
 {
     #[inline]
@@ -342,15 +368,17 @@ where
 }
 
 /// The transmit and receive halves [`IrqState::start`] gives the thread side.
-pub type Halves<R, const RX: usize, Q, const DONE: usize> = (
-    Tx<'static, FlexCanHw<R>, RX, Q, 0, DONE>,
-    Rx<'static, FlexCanHw<R>, RX, Q, 0, DONE>,
+pub type Halves<R, const RX: usize, Q, const DONE: usize, O = Full, Fe = twocan_core::Full> = (
+    Tx<'static, FlexCanHw<R, O>, RX, Q, 0, DONE, Fe>,
+    Rx<'static, FlexCanHw<R, O>, RX, Q, 0, DONE, Fe>,
 );
 
-impl<R, const RX: usize, Q, const DONE: usize> IrqState<R, RX, Q, DONE>
+impl<R, const RX: usize, Q, const DONE: usize, O, Fe> IrqState<R, RX, Q, DONE, O, Fe>
 where
     R: Registers + 'static,
     Q: TxQueue + 'static,
+    O: Options,
+    Fe: Features,
     Self: Sync,
 {
     /// ACAN's `begin` interrupt set-up, after [`crate::FlexCan::begin`]: splits `hw`
@@ -363,9 +391,9 @@ where
     #[allow(clippy::type_complexity, clippy::result_large_err)]
     pub fn start(
         &'static self,
-        hw: FlexCanHw<R>,
+        hw: FlexCanHw<R, O>,
         nvic: &mut impl Nvic,
-    ) -> Result<Halves<R, RX, Q, DONE>, (StartError, FlexCanHw<R>)> {
+    ) -> Result<Halves<R, RX, Q, DONE, O, Fe>, (StartError, FlexCanHw<R, O>)> {
         let target = hw.target();
         let Some(irqs) = target.irqs() else {
             return Err((StartError::NoInterrupts, hw));
@@ -406,6 +434,76 @@ where
         Ok((parts.tx, parts.rx))
     }
 
+    /// [`IrqState::start`] with the controller **configured in place** in this state
+    /// (issue 21): `init` gets the state's empty controller storage and writes the
+    /// controller there (a token's `begin_in_place` or `begin_planned_in_place`, or
+    /// [`crate::FlexCan::begin_in_place`]), so that no controller moves through the
+    /// configuration. `target` is the module `init` configures: its entry points are
+    /// claimed before `init` runs, and a controller of another module is refused
+    /// ([`StartError::Split`] with [`Error::InvalidArgument`]; it stays configured,
+    /// unwired). The handlers are installed, then the lines unmasked at the
+    /// controller's `message_irq_priority`.
+    ///
+    /// Errors: [`InPlaceError::Init`] with `init`'s own error (the state stays unsplit,
+    /// the entry points unclaimed); [`InPlaceError::Start`] otherwise (`init` not
+    /// called, except for a controller of another module).
+    #[allow(clippy::type_complexity)]
+    pub fn start_in_place<E>(
+        &'static self,
+        target: Target,
+        init: impl FnOnce(&mut MaybeUninit<FlexCanHw<R, O>>) -> Result<&mut FlexCanHw<R, O>, E>,
+        nvic: &mut impl Nvic,
+    ) -> Result<Halves<R, RX, Q, DONE, O, Fe>, InPlaceError<E>> {
+        let Some(irqs) = target.irqs() else {
+            return Err(InPlaceError::Start(StartError::NoInterrupts));
+        };
+        if self.state.hardware().is_some() {
+            return Err(InPlaceError::Start(StartError::AlreadySplit));
+        }
+        let slot = slot(target.instance);
+        let again = slot.wired_to(self);
+        if !again && !slot.claim() {
+            return Err(InPlaceError::Start(StartError::AlreadyWired));
+        }
+        let mut failed = None;
+        let mut priority = 0;
+        let split = self.state.split_with(|storage| match init(storage) {
+            Ok(hw) if hw.target() == target => {
+                priority = hw.message_irq_priority();
+                Ok(hw)
+            }
+            Ok(_) => Err(Error::InvalidArgument),
+            Err(e) => {
+                failed = Some(e);
+                Err(Error::InvalidArgument)
+            }
+        });
+        let parts = match split {
+            Ok(parts) => parts,
+            Err(e) => {
+                if !again {
+                    slot.unclaim();
+                }
+                return Err(match (failed, e) {
+                    (Some(e), _) => InPlaceError::Init(e),
+                    (None, Error::WrongMode) => InPlaceError::Start(StartError::AlreadySplit),
+                    (None, e) => InPlaceError::Start(StartError::Split(e)),
+                });
+            }
+        };
+        let filled = self
+            .message
+            .put((parts.tx_irq, parts.rx0_irq, parts.rx1_irq))
+            .is_ok()
+            && self.status.put(parts.status_irq).is_ok();
+        debug_assert!(filled, "split succeeds once per start");
+        if !again {
+            slot.publish(self);
+        }
+        enable(nvic, irqs, priority);
+        Ok((parts.tx, parts.rx))
+    }
+
     /// The way back (issue 22 item 11): masks the instance's message, bus-off, error
     /// and warning lines, takes the handlers back out of their cells (no entry point
     /// runs them from now on), and gives them with the halves to
@@ -421,10 +519,10 @@ where
     #[allow(clippy::type_complexity, clippy::result_large_err)]
     pub fn stop(
         &'static self,
-        tx: Tx<'static, FlexCanHw<R>, RX, Q, 0, DONE>,
-        rx: Rx<'static, FlexCanHw<R>, RX, Q, 0, DONE>,
+        tx: Tx<'static, FlexCanHw<R, O>, RX, Q, 0, DONE, Fe>,
+        rx: Rx<'static, FlexCanHw<R, O>, RX, Q, 0, DONE, Fe>,
         nvic: &mut impl Nvic,
-    ) -> Result<(FlexCanHw<R>, Leftovers), (StopError, Halves<R, RX, Q, DONE>)> {
+    ) -> Result<(FlexCanHw<R, O>, Leftovers), (StopError, Halves<R, RX, Q, DONE, O, Fe>)> {
         if !core::ptr::eq(tx.state(), &self.state) || !core::ptr::eq(rx.state(), &self.state) {
             return Err((StopError::Foreign, (tx, rx)));
         }
@@ -470,6 +568,27 @@ where
         }
     }
 }
+
+/// Why [`IrqState::start_in_place`] did not start.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum InPlaceError<E> {
+    /// The configuration `init` refused (its own error; nothing was wired).
+    Init(E),
+    /// As [`IrqState::start`].
+    Start(StartError),
+}
+
+impl<E: fmt::Display> fmt::Display for InPlaceError<E> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            InPlaceError::Init(e) => write!(f, "configuration: {e}"),
+            InPlaceError::Start(e) => e.fmt(f),
+        }
+    }
+}
+
+impl<E: fmt::Debug + fmt::Display> core::error::Error for InPlaceError<E> {}
 
 /// Why [`IrqState::stop`] did not stop; the halves come back with it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

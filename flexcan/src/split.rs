@@ -208,6 +208,7 @@ pub(crate) struct Parts {
 
 impl<R: Registers, O: Options> FlexCanHw<R, O> {
     /// The split controller over `regs` with `table` installed.
+    #[inline(always)]
     pub(crate) fn from_parts(regs: R, target: Target, table: O::Table, p: Parts) -> Self {
         let configuration = table.configuration();
         let first = configuration.first_remote_mailbox() as u32;
@@ -334,6 +335,21 @@ impl<R: Registers, O: Options> FlexCanHw<R, O> {
     /// The register handle back (to run `begin` again).
     pub fn into_registers(self) -> R {
         self.regs
+    }
+
+    /// The register handle and the installed table back ([`FlexCanHw::end`]).
+    pub(crate) fn into_registers_and_table(self) -> (R, O::Table) {
+        (self.regs, self.table.into_inner())
+    }
+
+    /// The handshake bound `begin` (or a later bit rate) set.
+    pub(crate) fn handshake_polls(&self) -> u32 {
+        self.polls.load(Ordering::Relaxed)
+    }
+
+    /// The clock gate and pins `begin` set up.
+    pub(crate) fn system_plan(&self) -> &SystemPlan {
+        &self.system
     }
 }
 

@@ -14,16 +14,19 @@
 #![cfg(all(feature = "rt", any(feature = "teensy40", feature = "teensy41")))]
 
 use std::cell::RefCell;
+use std::mem::MaybeUninit;
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use twocan_core::{Error, FifoQueue, Filter, Frame, Registers, TxOutcome};
+use twocan_core::{Error, Filter, Frame, Registers, TxOutcome};
 use twocan_flexcan::acan::{self, Module, OneCallError, Spare};
+use twocan_flexcan::filters::{FilterTable, TableSlot};
 use twocan_flexcan::model::FlexCanModel;
+use twocan_flexcan::options::FullInSlot;
 use twocan_flexcan::regs::{self, mcr};
-use twocan_flexcan::rt::{self, IrqNumber, IrqState, Nvic, StartError};
+use twocan_flexcan::rt::{self, IrqNumber, Nvic, StartError};
 use twocan_flexcan::{
-    rt_imxrt, BeginError, Board, ConfigErrors, FlexCan, HostSystem, IdleClocked, Instance,
-    Settings, Target,
+    rt_imxrt, BeginError, BeginPlan, Board, ConfigErrors, FlexCan, FlexCanHw, HostSystem,
+    IdleClocked, Instance, Settings, Target,
 };
 use twocan_sim::Bus;
 
@@ -59,6 +62,7 @@ struct HostCan1(FlexCanModel);
 
 impl Module for HostCan1 {
     type Regs = OneThread;
+    const TARGET: Target = TARGET;
 
     fn take() -> Option<Self> {
         if TAKEN.swap(true, Ordering::AcqRel) {
@@ -67,32 +71,56 @@ impl Module for HostCan1 {
         MODEL.with(|m| m.borrow().clone()).map(HostCan1)
     }
 
-    fn begin(
+    fn begin_in_place<'h>(
         self,
-        settings: &Settings,
+        hw: &'h mut MaybeUninit<FlexCanHw<OneThread, FullInSlot>>,
+        checked: &BeginPlan,
         primary: &[Filter],
         secondary: &[Filter],
-    ) -> Result<FlexCan<OneThread>, (Self, BeginError)> {
+        slot: &'static mut FilterTable,
+    ) -> Result<
+        &'h mut FlexCanHw<OneThread, FullInSlot>,
+        (Self, BeginError, &'static mut FilterTable),
+    > {
         let regs = OneThread(IdleClocked::new(self.0.clone()));
-        FlexCan::begin(
+        FlexCan::begin_in_place(
+            hw,
             regs,
             &mut HostSystem::new(),
-            TARGET,
-            settings,
+            checked,
             primary,
             secondary,
+            slot,
         )
-        .map_err(|e| (self, e))
+        .map_err(|(e, slot)| (self, e, slot))
     }
 
-    fn end(controller: FlexCan<OneThread>) -> Result<Self, (FlexCan<OneThread>, Error)> {
-        if controller.target() != TARGET {
-            return Err((controller, Error::InvalidArgument));
+    fn end_split(
+        hw: FlexCanHw<OneThread, FullInSlot>,
+    ) -> Result<(Self, &'static mut FilterTable), (FlexCanHw<OneThread, FullInSlot>, Error)> {
+        if hw.target() != TARGET {
+            return Err((hw, Error::InvalidArgument));
         }
-        controller
-            .end(&mut HostSystem::new())
-            .map(|regs| HostCan1(regs.0.model().clone()))
+        hw.end(&mut HostSystem::new())
+            .map(|(regs, table)| (HostCan1(regs.0.model().clone()), table))
     }
+}
+
+/// CAN1's filter table, which the one call's `begin` compiles into.
+static TABLE: TableSlot = TableSlot::new();
+
+/// The one call with `settings` checked first, as the board's `can1_with` does.
+fn start(
+    spare: &Spare<HostCan1>,
+    state: &'static State,
+    settings: &Settings,
+    primary: &[Filter],
+    secondary: &[Filter],
+    nvic: &mut Recorder,
+) -> Result<acan::AcanHalves<OneThread>, OneCallError> {
+    let checked =
+        BeginPlan::new(TARGET, settings, settings.configuration).map_err(OneCallError::Begin)?;
+    acan::start(spare, &TABLE, state, &checked, primary, secondary, nvic)
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -117,7 +145,7 @@ impl Nvic for Recorder {
     }
 }
 
-type State = IrqState<OneThread, 32, FifoQueue<16>, 8>;
+type State = acan::OneCallState<OneThread>;
 
 /// Runs the bus for `bits`, entering `CAN1` whenever the model raises its line.
 fn run(bus: &mut Bus, model: &FlexCanModel, bits: u64) -> u32 {
@@ -165,7 +193,7 @@ fn the_one_call_starts_runs_ends_and_starts_again() {
     assert_eq!(defaults.message_irq_priority, 64);
 
     // Start: CAN1's one line (36) at the settings' priority, after the handlers.
-    let (mut tx, mut rx) = acan::start(
+    let (mut tx, mut rx) = start(
         &spare,
         state,
         &loop_back(),
@@ -201,7 +229,7 @@ fn the_one_call_starts_runs_ends_and_starts_again() {
 
     // While it runs, its token is nowhere: a second one call is `Taken`.
     assert_eq!(
-        acan::start(&spare, state, &loop_back(), &[], &[], &mut nvic).map(|_| ()),
+        start(&spare, state, &loop_back(), &[], &[], &mut nvic).map(|_| ()),
         Err(OneCallError::Taken)
     );
 
@@ -218,7 +246,7 @@ fn the_one_call_starts_runs_ends_and_starts_again() {
 
     // Again, on the same state (its entry point stays wired to it).
     nvic.0.clear();
-    let (mut tx, mut rx) = acan::start(
+    let (mut tx, mut rx) = start(
         &spare,
         state,
         &loop_back(),
@@ -238,7 +266,7 @@ fn the_one_call_starts_runs_ends_and_starts_again() {
 
     // A refused `begin` (a Kinetis clock on the RT1062) keeps the token.
     let kinetis = Settings::new(500_000);
-    match acan::start(&spare, state, &kinetis, &[], &[], &mut nvic) {
+    match start(&spare, state, &kinetis, &[], &[], &mut nvic) {
         Err(OneCallError::Begin(BeginError::Config(c))) => {
             assert!(c.contains(ConfigErrors::CLOCK_NOT_ON_CHIP), "{c:?}")
         }
@@ -251,7 +279,7 @@ fn the_one_call_starts_runs_ends_and_starts_again() {
     let other: &'static State = Box::leak(Box::new(State::new()));
     nvic.0.clear();
     assert_eq!(
-        acan::start(&spare, other, &loop_back(), &[], &[], &mut nvic).map(|_| ()),
+        start(&spare, other, &loop_back(), &[], &[], &mut nvic).map(|_| ()),
         Err(OneCallError::Start(StartError::AlreadyWired))
     );
     assert!(nvic.0.is_empty(), "nothing unmasked: {:?}", nvic.0);
@@ -259,7 +287,7 @@ fn the_one_call_starts_runs_ends_and_starts_again() {
     assert!(spare.holds());
 
     // And the first state starts once more from the spare token.
-    let halves = acan::start(&spare, state, &loop_back(), &[], &[], &mut nvic).unwrap();
+    let halves = start(&spare, state, &loop_back(), &[], &[], &mut nvic).unwrap();
     assert!(!spare.holds());
     acan::end(&spare, state, halves, &mut nvic)
         .map_err(|(e, _)| e)

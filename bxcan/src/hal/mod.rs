@@ -63,7 +63,9 @@ use twocan_core::{Error, Registers};
 use crate::chip::Chip;
 use crate::config::{Config, ConfigError};
 use crate::controller::{Can, Failed, Init};
+use crate::filter_block;
 use crate::instance::Instance;
+use crate::planner::{FifoPolicy, PlanOptions};
 use crate::regs::{CanRegs, ControlRegs, FilterRegs};
 
 #[cfg(feature = "hal-stm32f1")]
@@ -434,9 +436,36 @@ impl<R: Registers, F: Registers, P> HandedOver<R, F, P> {
     }
 }
 
+impl<R: Registers, F: Registers, P> HandedOver<R, F, P> {
+    /// Planner options for this instance under `config`, before anything is
+    /// configured: its bank count and `fifo` (as `Can::plan_options` gives them after
+    /// [`HandedOver::configure`]). A dual block is split at `config`'s
+    /// [`Config::can2_start_bank`] when it sets one, otherwise at the `CAN2SB` the
+    /// filter registers hold now (RM0410 §40.9.4 "CAN filter master register").
+    pub fn plan_options(&self, config: &Config, fifo: FifoPolicy) -> PlanOptions {
+        let can2sb = match (config.get_can2_start_bank(), &self.filters) {
+            (Some(bank), _) => u32::from(bank),
+            (None, Some(f)) => filter_block::can2sb(f),
+            (None, None) => filter_block::can2sb(&self.regs),
+        };
+        let (start, end) = config.get_chip().bank_range(self.instance, can2sb);
+        PlanOptions::new((end - start) as u8).fifo(fifo)
+    }
+}
+
 // The error values hand the whole handle back (nothing is lost).
 #[allow(clippy::result_large_err)]
 impl<P> HandedOver<CanRegs, CanRegs, P> {
+    /// The register handle for an in-place constructor ([`crate::BxCan::can1_in`],
+    /// [`crate::BxCan::can3_in`], through `State::split_with` or
+    /// `rt::IrqState::start_in_place`), which configures the instance itself: nothing
+    /// is written here, and no controller or filter map is built on the stack (issue
+    /// 21). [`Error::InvalidArgument`] when `config` was computed for another clock
+    /// ([`HandedOver::accepts`]), with this handle back.
+    pub fn into_registers(self, config: &Config) -> Result<CanRegs, Failed<Self>> {
+        self.into_single(config)
+    }
+
     /// Configures the instance ([`Can::can1`] or [`Can::can3`]): initialization mode,
     /// options, bit timing.
     ///
@@ -450,6 +479,16 @@ impl<P> HandedOver<CanRegs, CanRegs, P> {
 
 #[allow(clippy::result_large_err)]
 impl<P> HandedOver<ControlRegs, Can1Filters, P> {
+    /// The control and filter register handles for an in-place constructor
+    /// ([`crate::BxCan::can1_dual_in`], [`crate::BxCan::can2_in`]); as the whole
+    /// block's [`HandedOver::into_registers`].
+    pub fn into_registers(
+        self,
+        config: &Config,
+    ) -> Result<(ControlRegs, Can1Filters), Failed<Self>> {
+        self.into_dual(config)
+    }
+
     /// Configures CAN1 ([`Can::can1_dual`]: `CAN2SB` is written when `config` sets
     /// [`Config::can2_start_bank`]) or CAN2 ([`Can::can2`]); errors as for a whole
     /// block's `configure`.
@@ -465,6 +504,13 @@ impl<P> HandedOver<ControlRegs, Can1Filters, P> {
 // the behavioural model.
 #[allow(clippy::result_large_err)]
 impl<R: Registers, P> HandedOver<R, R, P> {
+    fn into_single(self, config: &Config) -> Result<R, Failed<Self>> {
+        if !self.accepts(config) {
+            return Err(self.refuse(Error::InvalidArgument));
+        }
+        Ok(self.regs)
+    }
+
     fn configure_single(self, config: &Config) -> Result<Init<R, R>, Failed<Self>> {
         if !self.accepts(config) {
             return Err(self.refuse(Error::InvalidArgument));
@@ -490,6 +536,24 @@ impl<R: Registers, P> HandedOver<R, R, P> {
 
 #[allow(clippy::result_large_err)]
 impl<R: Registers, F: Registers, P> HandedOver<R, F, P> {
+    fn into_dual(self, config: &Config) -> Result<(R, F), Failed<Self>> {
+        if !self.accepts(config) {
+            return Err(self.refuse(Error::InvalidArgument));
+        }
+        match self {
+            HandedOver {
+                regs,
+                filters: Some(filters),
+                ..
+            } => Ok((regs, filters)),
+            // Not built by this module, whose dual handles always have one.
+            other => Err(Failed {
+                error: Error::InvalidArgument,
+                value: other,
+            }),
+        }
+    }
+
     fn configure_dual(self, config: &Config) -> Result<Init<R, F>, Failed<Self>> {
         let accepted = self.accepts(config);
         let HandedOver {
@@ -652,6 +716,75 @@ mod tests {
         assert!(
             back.value.filters.is_some(),
             "the filter handle comes back too"
+        );
+    }
+
+    #[test]
+    fn into_registers_hands_the_registers_over_untouched_and_plan_options_match_configure() {
+        let bus = bus();
+        // Whole block (CAN1 alone): the handle, nothing written; a config for another
+        // clock refused with the handle back.
+        let model = BxCanModel::can1();
+        let h = handed::<Regs>(
+            PollClock::new(model.clone(), &bus, MSR),
+            None,
+            Instance::Can1,
+        );
+        let mcr_at_reset = model.read32(MCR);
+        let config = h.config(500_000).unwrap();
+        let options = h.plan_options(&config, FifoPolicy::Fifo1);
+        let other = Config::from_bitrate(48_000_000, 500_000).unwrap();
+        let h = h.into_single(&other).unwrap_err();
+        assert_eq!(h.error, Error::InvalidArgument);
+        let regs = h.value.into_single(&config).map_err(|f| f.error).unwrap();
+        assert_eq!(model.read32(MCR), mcr_at_reset, "nothing configured");
+        // The options are the ones `configure` would give.
+        let h = HandedOver {
+            regs,
+            filters: None::<Regs>,
+            instance: Instance::Can1,
+            apb1_hz: 54_000_000,
+            chip: None,
+            parts: (),
+        };
+        let init = h.configure_single(&config).map_err(|f| f.error).unwrap();
+        assert_eq!(options, init.can().plan_options(FifoPolicy::Fifo1));
+
+        // Dual: CAN2's banks where the config splits the block (or, without a split in
+        // the config, where the register splits it now).
+        let (m1, m2) = BxCanModel::can1_can2();
+        let can1 = handed(
+            PollClock::new(m1.clone(), &bus, MSR),
+            Some(m1.clone()),
+            Instance::Can1,
+        );
+        let can2 = handed(
+            PollClock::new(m2.clone(), &bus, MSR),
+            Some(m1.clone()),
+            Instance::Can2,
+        );
+        let config1 = can1.config(500_000).unwrap().can2_start_bank(10).unwrap();
+        assert_eq!(
+            can1.plan_options(&config1, FifoPolicy::Fifo0),
+            PlanOptions::new(10)
+        );
+        assert_eq!(
+            can2.plan_options(&config1, FifoPolicy::Fifo1),
+            PlanOptions::new(18).fifo(FifoPolicy::Fifo1)
+        );
+        let base = Config::from_bitrate(54_000_000, 500_000).unwrap();
+        let at_reset = crate::regs::fmr::CAN2SB.get(m1.read32(FMR)) as u8;
+        assert_eq!(
+            can2.plan_options(&base, FifoPolicy::Fifo1),
+            PlanOptions::new(28 - at_reset).fifo(FifoPolicy::Fifo1)
+        );
+        let (_, f) = can2.into_dual(&base).map_err(|f| f.error).unwrap();
+        assert_eq!(f.read32(FMR), m1.read32(FMR), "CAN1's filter block");
+        let no_filters =
+            handed::<BxCanModel>(PollClock::new(m2.clone(), &bus, MSR), None, Instance::Can2);
+        assert_eq!(
+            no_filters.into_dual(&base).unwrap_err().error,
+            Error::InvalidArgument
         );
     }
 }

@@ -1,7 +1,8 @@
 //! The split driver of a bxCAN instance as the examples use it: its shared state and its
 //! four interrupt handlers in one `static` ([`CanState`], the library's
 //! `twocan_bxcan::rt::IrqState`, the same type as `twocan-stm32f7`'s), and `start`,
-//! which puts the handlers in place **before** it unmasks the part's lines. The vectors
+//! which configures the controller in place in the state and puts the handlers in
+//! place **before** it unmasks the part's lines. The vectors
 //! (`crate::can1_vectors!`, `crate::can2_vectors!`) call the library's
 //! `twocan_bxcan::rt::dispatch` with the instance and line: the library exports entry
 //! points for the STM32F7 only (`hal-stm32f7`), these parts' vector names are the board
@@ -29,14 +30,20 @@ pub type CanTxHalf<R = CanRegs, F = CanRegs> = BxTx<'static, R, F>;
 /// The receive half.
 pub type CanRxHalf<R = CanRegs, F = CanRegs> = BxRx<'static, R, F>;
 
-/// Starts `state` over `hw` on the instance's four `lines` (`crate::rt::CAN1_IRQS`, …):
-/// the handlers installed, then each line given [`crate::rt::CAN_PRIORITY`] and
-/// unmasked (`IrqState::start_on`). Returns the thread-side halves; `None` when the
-/// state runs a controller already.
+/// Configures `instance`'s controller in place in `state` (`init`: an in-place
+/// constructor, e.g. `BxCan::can1_in`: no controller, plan or filter map moves through
+/// the configuration, issue 21) and starts it on the instance's four `lines`
+/// (`crate::rt::CAN1_IRQS`, …): the handlers installed, then each line given
+/// [`crate::rt::CAN_PRIORITY`] and unmasked (`IrqState::start_in_place_on`). Returns
+/// the thread-side halves; `None` when the configuration failed or the state runs a
+/// controller already.
 #[cfg(target_os = "none")]
 pub fn start<R, F>(
     state: &'static CanState<R, F>,
-    hw: twocan_bxcan::BxCan<R, F>,
+    instance: twocan_bxcan::Instance,
+    init: impl FnOnce(
+        &mut core::mem::MaybeUninit<twocan_bxcan::BxCan<R, F>>,
+    ) -> Result<&mut twocan_bxcan::BxCan<R, F>, twocan_core::Error>,
     lines: [crate::rt::Interrupt; 4],
     nvic: &mut cortex_m::peripheral::NVIC,
 ) -> Option<(CanTxHalf<R, F>, CanRxHalf<R, F>)>
@@ -45,5 +52,7 @@ where
     F: twocan_core::Registers + Send + Sync + 'static,
 {
     let priorities = twocan_bxcan::rt::Priorities::all(crate::rt::CAN_PRIORITY);
-    state.start_on(hw, lines, priorities, nvic).ok()
+    state
+        .start_in_place_on(instance, init, lines, priorities, nvic)
+        .ok()
 }

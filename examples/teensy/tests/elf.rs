@@ -49,6 +49,7 @@ fn firmware_dir() -> PathBuf {
 fn bins(board: &twocan_teensy::Board) -> Vec<&'static str> {
     let mut v = vec![
         "teensy-loopback",
+        "teensy-loopback-lean",
         "teensy-filters",
         "teensy-app",
         "teensy-async-echo",

@@ -65,3 +65,9 @@ macro_rules! begin_end {
 begin_end!(Can1, "CAN1");
 begin_end!(Can2, "CAN2");
 begin_end!(Can3, "CAN3");
+crate::token_begin::token_begin!(Can1, system);
+crate::token_begin::token_begin!(Can2, system);
+crate::token_begin::token_begin!(Can3, system);
+crate::token_begin::token_end!(Can1, system);
+crate::token_begin::token_end!(Can2, system);
+crate::token_begin::token_end!(Can3, system);

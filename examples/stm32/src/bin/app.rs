@@ -21,10 +21,10 @@ mod firmware {
     use critical_section::Mutex;
     use twocan_app::firmware::{FirmwareLoop, Published};
     use twocan_app::{App, AppStats};
-    use twocan_bxcan::{const_plan, FifoPolicy, Recovery};
+    use twocan_bxcan::{const_plan, BxCan, FifoPolicy, Instance, Recovery};
     use twocan_stm32::board::BIT_RATE;
     use twocan_stm32::board::CAN1_BANKS;
-    use twocan_stm32::can::{self, CanState};
+    use twocan_stm32::can::{self, CanRxHalf, CanState, CanTxHalf};
     use twocan_stm32::rt::{self, CAN_BLINKS};
     use twocan_stm32::time::{self, Every};
     use twocan_stm32::BOARD;
@@ -58,7 +58,6 @@ mod firmware {
             PEER,
             BIT_RATE
         );
-        let mut app = App::new(NODE, PEER);
         // The hand-over from the board's HAL: CAN1's PAC singleton and pins by value
         // (`twocan_bxcan::hal::f1::can`, `hal::f4::can1`), its clock enabled; the bit
         // timing solved for the APB1 frequency of the HAL's clocks, for the board's part.
@@ -67,8 +66,11 @@ mod firmware {
             .config(BIT_RATE)
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS))
             .recovery(Recovery::Automatic);
-        let mut init = can1
-            .configure(&config)
+        // The registers for the in-place constructor (nothing configured yet): the
+        // controller is configured in place in `CAN1` (`BxCan::can1_in`), so no
+        // controller, filter map or plan moves through `main`.
+        let regs = can1
+            .into_registers(&config)
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         // The application's filters (`twocan_app::filters_for`, the list `app.filters()`
         // returns) planned at build time (`const_plan!`, see `stm32-loopback`).
@@ -76,16 +78,26 @@ mod firmware {
             twocan_app::filters_for(NODE, PEER),
             CAN1_BANKS.fifo(FifoPolicy::Fifo0)
         );
-        if init.set_filters(plan).is_err() {
-            rt::halt(CAN_BLINKS);
-        }
-        let can = init.enable().unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        let (mut tx, mut rx) =
-            can::start(&CAN1, can.into_split(), rt::CAN1_IRQS, &mut boot.core.NVIC)
-                .unwrap_or_else(|| rt::halt(CAN_BLINKS));
+        let (tx, rx) = can::start(
+            &CAN1,
+            Instance::Can1,
+            |slot| BxCan::can1_in(slot, regs, &config, plan).map_err(|f| f.error),
+            rt::CAN1_IRQS,
+            &mut boot.core.NVIC,
+        )
+        .unwrap_or_else(|| rt::halt(CAN_BLINKS));
+        run(tx, rx, boot.led)
+    }
+
+    /// The application after the configuration, in a function of its own (not
+    /// inlined): its state (the node, the loop, their call-backs' frames) takes stack
+    /// only once the configuration is done.
+    #[inline(never)]
+    fn run(mut tx: CanTxHalf, mut rx: CanRxHalf, mut led: rt::Led) -> ! {
+        let mut app = App::new(NODE, PEER);
         twocan_stm32::info!(
             "CAN1 on the bus with the application's {=usize} filters",
-            app.filters().len()
+            twocan_app::FILTER_COUNT
         );
         let published = Published {
             stats: &STATS,
@@ -122,7 +134,7 @@ mod firmware {
                     );
                 }
                 if step.blink {
-                    boot.led.toggle();
+                    led.toggle();
                 }
             }
             cortex_m::asm::wfi();

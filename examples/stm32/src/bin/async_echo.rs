@@ -23,7 +23,7 @@ mod firmware {
     use embassy_executor::Executor;
     use static_cell::StaticCell;
     use twocan_app::asynch::{echo, EchoStats};
-    use twocan_bxcan::{const_plan, FifoPolicy, Recovery};
+    use twocan_bxcan::{const_plan, BxCan, FifoPolicy, Instance, Recovery};
     use twocan_core::Filter;
     use twocan_stm32::board::BIT_RATE;
     use twocan_stm32::board::CAN1_BANKS;
@@ -66,18 +66,23 @@ mod firmware {
             .config(BIT_RATE)
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS))
             .recovery(Recovery::Automatic);
-        let mut init = can1
-            .configure(&config)
+        // The registers for the in-place constructor (nothing configured yet): the
+        // controller is configured in place in `CAN1` (`BxCan::can1_in`), so no
+        // controller, filter map or plan moves through `main`.
+        let regs = can1
+            .into_registers(&config)
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         // One FIFO keeps the frames in arrival order.
         // Planned at build time (`const_plan!`, see `stm32-loopback`).
         let plan = const_plan!([Filter::pass_all()], CAN1_BANKS.fifo(FifoPolicy::Fifo0));
-        if init.set_filters(plan).is_err() {
-            rt::halt(CAN_BLINKS);
-        }
-        let can = init.enable().unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        let (tx, rx) = can::start(&CAN1, can.into_split(), rt::CAN1_IRQS, &mut boot.core.NVIC)
-            .unwrap_or_else(|| rt::halt(CAN_BLINKS));
+        let (tx, rx) = can::start(
+            &CAN1,
+            Instance::Can1,
+            |slot| BxCan::can1_in(slot, regs, &config, plan).map_err(|f| f.error),
+            rt::CAN1_IRQS,
+            &mut boot.core.NVIC,
+        )
+        .unwrap_or_else(|| rt::halt(CAN_BLINKS));
         let led = boot.led;
         EXECUTOR.init(Executor::new()).run(|spawner| {
             spawner.spawn(echo_task(tx, rx, led).unwrap_or_else(|_| rt::halt(CAN_BLINKS)));

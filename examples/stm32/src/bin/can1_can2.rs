@@ -23,16 +23,18 @@ mod firmware {
     use twocan_app::{App, AppStats};
     use twocan_bxcan::hal::Can1Filters;
     use twocan_bxcan::regs::ControlRegs;
-    use twocan_bxcan::{const_plan, FifoPolicy, Recovery};
+    use twocan_bxcan::{const_plan, BxCan, FifoPolicy, Instance, Recovery};
     use twocan_stm32::board::BIT_RATE;
     use twocan_stm32::board::CAN1_BANKS;
-    use twocan_stm32::can::{self, CanState};
+    use twocan_stm32::can::{self, CanRxHalf, CanState, CanTxHalf};
     use twocan_stm32::rt::{self, CAN_BLINKS};
     use twocan_stm32::time::{self, Every};
 
     // Each controller owns its control registers and shares CAN1's filter block (RM0390
     // §30.9.4) through the `Can1Filters` handle of the hand-over.
     type Shared = CanState<ControlRegs, Can1Filters>;
+    type SharedTx = CanTxHalf<ControlRegs, Can1Filters>;
+    type SharedRx = CanRxHalf<ControlRegs, Can1Filters>;
     static CAN1: Shared = Shared::new();
     static CAN2: Shared = Shared::new();
     twocan_stm32::can1_vectors!();
@@ -57,40 +59,52 @@ mod firmware {
         let config1 = base
             .can2_start_bank(14)
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        let mut node1 = App::new(1, 2);
-        let mut node2 = App::new(2, 1);
-
-        let mut init1 = can1
-            .configure(&config1)
+        // The registers for the in-place constructors (nothing configured yet); each
+        // node's filters (`twocan_app::filters_for`) planned at build time for its 14
+        // banks (`const_plan!`); each controller configured in place in its state
+        // (`BxCan::can1_dual_in`, `BxCan::can2_in`): nothing large moves through `main`.
+        let (regs1, filters1) = can1
+            .into_registers(&config1)
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        // Each node's filters (`twocan_app::filters_for`) planned at build time for its 14
-        // banks (`const_plan!`).
+        let (regs2, filters2) = can2
+            .into_registers(&base)
+            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         let plan1 = const_plan!(
             twocan_app::filters_for(1, 2),
             CAN1_BANKS.fifo(FifoPolicy::Fifo0)
         );
-        if init1.set_filters(plan1).is_err() {
-            rt::halt(CAN_BLINKS);
-        }
-        let mut init2 = can2
-            .configure(&base)
-            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         let plan2 = const_plan!(
             twocan_app::filters_for(2, 1),
             CAN1_BANKS.fifo(FifoPolicy::Fifo1)
         );
-        if init2.set_filters(plan2).is_err() {
-            rt::halt(CAN_BLINKS);
-        }
-        let can1 = init1.enable().unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        let can2 = init2.enable().unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        let (mut tx1, mut rx1) =
-            can::start(&CAN1, can1.into_split(), rt::CAN1_IRQS, &mut boot.core.NVIC)
-                .unwrap_or_else(|| rt::halt(CAN_BLINKS));
-        let (mut tx2, mut rx2) =
-            can::start(&CAN2, can2.into_split(), rt::CAN2_IRQS, &mut boot.core.NVIC)
-                .unwrap_or_else(|| rt::halt(CAN_BLINKS));
+        let (tx1, rx1) = can::start(
+            &CAN1,
+            Instance::Can1,
+            |slot| BxCan::can1_dual_in(slot, regs1, filters1, &config1, plan1).map_err(|f| f.error),
+            rt::CAN1_IRQS,
+            &mut boot.core.NVIC,
+        )
+        .unwrap_or_else(|| rt::halt(CAN_BLINKS));
+        let (tx2, rx2) = can::start(
+            &CAN2,
+            Instance::Can2,
+            |slot| BxCan::can2_in(slot, regs2, filters2, &base, plan2).map_err(|f| f.error),
+            rt::CAN2_IRQS,
+            &mut boot.core.NVIC,
+        )
+        .unwrap_or_else(|| rt::halt(CAN_BLINKS));
 
+        run([(tx1, rx1), (tx2, rx2)], boot.led)
+    }
+
+    /// The application after the configuration, in a function of its own (not
+    /// inlined): its state (the two nodes, their call-backs' frames) takes stack only
+    /// once the configuration is done. Node 1 on CAN1, node 2 on CAN2.
+    #[inline(never)]
+    fn run(halves: [(SharedTx, SharedRx); 2], mut led: rt::Led) -> ! {
+        let [(mut tx1, mut rx1), (mut tx2, mut rx2)] = halves;
+        let mut node1 = App::new(1, 2);
+        let mut node2 = App::new(2, 1);
         let mut period = Every::new(time::millis(), 10);
         let mut shown = 0;
         loop {
@@ -106,7 +120,7 @@ mod firmware {
                 let both = stats[0].heartbeats.min(stats[1].heartbeats);
                 if both >= shown + 50 {
                     shown = both;
-                    boot.led.toggle();
+                    led.toggle();
                 }
             }
             cortex_m::asm::wfi();

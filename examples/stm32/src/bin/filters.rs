@@ -23,10 +23,10 @@
 mod firmware {
     use core::sync::atomic::{AtomicU32, Ordering};
 
-    use twocan_bxcan::{const_plan, FifoPolicy};
+    use twocan_bxcan::{const_plan, BxCan, FifoPolicy, Instance};
     use twocan_core::{Dispatcher, Filter, Format, Frame, FrameKind, RxFrame};
     use twocan_stm32::board::CAN1_BANKS;
-    use twocan_stm32::can::{self, CanState};
+    use twocan_stm32::can::{self, CanRxHalf, CanState, CanTxHalf};
     use twocan_stm32::rt::{self, CAN_BLINKS};
     use twocan_stm32::time::{self, Every};
 
@@ -86,22 +86,34 @@ mod firmware {
             .config(125_000)
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS))
             .loopback(true);
-        let mut init = can1
-            .configure(&config)
+        // The registers for the in-place constructor (nothing configured yet): the
+        // controller is configured in place in `CAN1` (`BxCan::can1_in`), so no
+        // controller, filter map or plan moves through `main`.
+        let regs = can1
+            .into_registers(&config)
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         // Planned at build time (`const_plan!`, see `stm32-loopback`).
         let plan = const_plan!(LIST, CAN1_BANKS.fifo(FifoPolicy::Balanced));
         for bank in plan.banks() {
             BANKS[bank.fifo.index()].fetch_add(1, Ordering::Relaxed);
         }
-        if init.set_filters(plan).is_err() {
-            rt::halt(CAN_BLINKS);
-        }
-        let can = init.enable().unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        let (mut tx, mut rx) =
-            can::start(&CAN1, can.into_split(), rt::CAN1_IRQS, &mut boot.core.NVIC)
-                .unwrap_or_else(|| rt::halt(CAN_BLINKS));
+        let (tx, rx) = can::start(
+            &CAN1,
+            Instance::Can1,
+            |slot| BxCan::can1_in(slot, regs, &config, plan).map_err(|f| f.error),
+            rt::CAN1_IRQS,
+            &mut boot.core.NVIC,
+        )
+        .unwrap_or_else(|| rt::halt(CAN_BLINKS));
 
+        run(tx, rx, boot.led)
+    }
+
+    /// The application after the configuration, in a function of its own (not
+    /// inlined): its state (the dispatcher, the frame list) takes stack only once the
+    /// configuration is done.
+    #[inline(never)]
+    fn run(mut tx: CanTxHalf, mut rx: CanRxHalf, mut led: rt::Led) -> ! {
         let mut dispatcher: Dispatcher<(), FILTERS> = Dispatcher::new();
         for i in 0..FILTERS {
             if dispatcher.set(i, on_frame).is_err() {
@@ -131,7 +143,7 @@ mod firmware {
             let errors = ERRORS.load(Ordering::Relaxed) + dispatcher.unhandled();
             if rounds > rounds_seen && errors == 0 {
                 rounds_seen = rounds;
-                boot.led.toggle();
+                led.toggle();
             }
             cortex_m::asm::wfi();
         }

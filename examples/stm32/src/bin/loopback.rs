@@ -11,7 +11,7 @@
 mod firmware {
     use core::sync::atomic::{AtomicU32, Ordering};
 
-    use twocan_bxcan::{const_plan, FifoPolicy};
+    use twocan_bxcan::{const_plan, BxCan, FifoPolicy, Instance};
     use twocan_core::{Filter, Frame};
     use twocan_stm32::board::CAN1_BANKS;
     use twocan_stm32::can::{self, CanState};
@@ -38,19 +38,23 @@ mod firmware {
             .config(125_000)
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS))
             .loopback(true);
-        let mut init = can1
-            .configure(&config)
+        // The registers for the in-place constructor (nothing configured yet): the
+        // controller is configured in place in `CAN1` (`BxCan::can1_in`), so no
+        // controller, filter map or plan moves through `main`.
+        let regs = can1
+            .into_registers(&config)
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         // Planned at build time (`const_plan!`): the run-time planner's working memory
         // (about 90 KB) does not fit the F103C8's 20 KiB of RAM.
         let plan = const_plan!([Filter::pass_all()], CAN1_BANKS.fifo(FifoPolicy::Fifo0));
-        if init.set_filters(plan).is_err() {
-            rt::halt(CAN_BLINKS);
-        }
-        let can = init.enable().unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        let (mut tx, mut rx) =
-            can::start(&CAN1, can.into_split(), rt::CAN1_IRQS, &mut boot.core.NVIC)
-                .unwrap_or_else(|| rt::halt(CAN_BLINKS));
+        let (mut tx, mut rx) = can::start(
+            &CAN1,
+            Instance::Can1,
+            |slot| BxCan::can1_in(slot, regs, &config, plan).map_err(|f| f.error),
+            rt::CAN1_IRQS,
+            &mut boot.core.NVIC,
+        )
+        .unwrap_or_else(|| rt::halt(CAN_BLINKS));
 
         let message = Frame::standard(0x542, &[]).unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         let mut send = Every::new(time::millis(), 1000);

@@ -63,15 +63,14 @@ mod firmware {
             .config(BIT_RATE)
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS))
             .recovery(Recovery::Automatic);
-        // The HAL's configuration gives the registers back (and the bank count for
+        // The HAL's hand-over gives the registers (and the bank count for
         // the planner); the application's list is planned at run time into the
         // planner's `static` working memory, and the controller configured in place in
         // `CAN1`.
-        let init = can1
-            .configure(&config)
+        let options = can1.plan_options(&config, FifoPolicy::Fifo0);
+        let regs = can1
+            .into_registers(&config)
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        let options = init.can().plan_options(FifoPolicy::Fifo0);
-        let (regs, _) = init.release();
         let scratch = can::PLANNER.take().unwrap_or_else(|| rt::halt(CAN_BLINKS));
         let plan = planner::plan_in(&app.filters(), options, scratch)
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS));

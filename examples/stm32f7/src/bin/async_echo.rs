@@ -64,13 +64,12 @@ mod firmware {
             .config(BIT_RATE)
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS))
             .recovery(Recovery::Automatic);
-        // The HAL's configuration gives the registers back; the controller is then
+        // The HAL's hand-over gives the registers (nothing configured yet); the controller is then
         // configured in place in `CAN1` with a plan computed at compile time. One FIFO
         // keeps the frames in arrival order.
-        let (regs, _) = can1
-            .configure(&config)
-            .unwrap_or_else(|_| rt::halt(CAN_BLINKS))
-            .release();
+        let regs = can1
+            .into_registers(&config)
+            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         let plan = const_plan!([Filter::pass_all()], PlanOptions::new(14));
         let (tx, rx) = can::start(
             &CAN1,

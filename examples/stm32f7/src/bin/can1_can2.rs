@@ -20,18 +20,20 @@ mod firmware {
     use core::cell::RefCell;
 
     use critical_section::Mutex;
-    use twocan_app::{App, AppStats};
+    use twocan_app::{filters_for, App, AppStats};
     use twocan_bxcan::hal::{self, Can1Filters};
     use twocan_bxcan::regs::ControlRegs;
-    use twocan_bxcan::{planner, BxCan, FifoPolicy, Instance, Recovery};
+    use twocan_bxcan::{const_plan, BxCan, FifoPolicy, Instance, PlanOptions, Recovery};
     use twocan_stm32f7::board::BIT_RATE;
-    use twocan_stm32f7::can::{self, CanState};
-    use twocan_stm32f7::rt::{self, CAN_BLINKS};
+    use twocan_stm32f7::can::{self, CanRxHalf, CanState, CanTxHalf};
+    use twocan_stm32f7::rt::{self, Led, CAN_BLINKS};
     use twocan_stm32f7::time::{self, Every};
 
     // Each controller owns its control registers and shares CAN1's filter block (RM0410
     // §40.9.4) through the `Can1Filters` handle of the hand-over.
     type Shared = CanState<ControlRegs, Can1Filters>;
+    type SharedTx = CanTxHalf<ControlRegs, Can1Filters>;
+    type SharedRx = CanRxHalf<ControlRegs, Can1Filters>;
     static CAN1: Shared = Shared::new();
     static CAN2: Shared = Shared::new();
 
@@ -54,40 +56,33 @@ mod firmware {
         let config1 = base
             .can2_start_bank(14)
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        let mut node1 = App::new(1, 2);
-        let mut node2 = App::new(2, 1);
 
-        // The HAL's configuration gives the registers back (and each instance's bank
-        // count for the planner); each node's list is planned at run time into the
-        // planner's one `static` working memory (the controller keeps its own map, so
-        // the second plan may reuse it), and each controller is configured in place in
+        // The HAL's hand-over gives the registers, nothing configured yet; each node's
+        // list is planned at compile time for its 14 banks (`config1` splits the block
+        // at 14: CAN1 0-13, CAN2 14-27), and each controller is configured in place in
         // its state.
-        let init1 = can1
-            .configure(&config1)
+        let (regs1, filters1) = can1
+            .into_registers(&config1)
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        let options1 = init1.can().plan_options(FifoPolicy::Fifo0);
-        let (regs1, filters1) = init1.release();
-        let init2 = can2
-            .configure(&base)
+        let (regs2, filters2) = can2
+            .into_registers(&base)
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        let options2 = init2.can().plan_options(FifoPolicy::Fifo1);
-        let (regs2, filters2) = init2.release();
-        let (Some(filters1), Some(filters2)) = (filters1, filters2) else {
-            rt::halt(CAN_BLINKS)
-        };
-        let scratch = can::PLANNER.take().unwrap_or_else(|| rt::halt(CAN_BLINKS));
-        let plan1 = planner::plan_in(&node1.filters(), options1, scratch)
-            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        let (mut tx1, mut rx1) = can::start(
+        let plan1 = const_plan!(
+            filters_for(1, 2),
+            PlanOptions::new(14).fifo(FifoPolicy::Fifo0)
+        );
+        let plan2 = const_plan!(
+            filters_for(2, 1),
+            PlanOptions::new(14).fifo(FifoPolicy::Fifo1)
+        );
+        let (tx1, rx1) = can::start(
             &CAN1,
             Instance::Can1,
             |slot| BxCan::can1_dual_in(slot, regs1, filters1, &config1, plan1).map_err(|f| f.error),
             &mut boot.core.NVIC,
         )
         .unwrap_or_else(|| rt::halt(CAN_BLINKS));
-        let plan2 = planner::plan_in(&node2.filters(), options2, scratch)
-            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        let (mut tx2, mut rx2) = can::start(
+        let (tx2, rx2) = can::start(
             &CAN2,
             Instance::Can2,
             |slot| BxCan::can2_in(slot, regs2, filters2, &base, plan2).map_err(|f| f.error),
@@ -95,6 +90,18 @@ mod firmware {
         )
         .unwrap_or_else(|| rt::halt(CAN_BLINKS));
 
+        run([(tx1, rx1), (tx2, rx2)], boot.led)
+    }
+
+    /// The application after the configuration, in a function of its own (not
+    /// inlined): its state (the two nodes, their call-backs' frames) takes stack only
+    /// once the configuration is done. Node 1 on CAN1, node 2 on CAN2 (their filter
+    /// lists: `filters_for` above).
+    #[inline(never)]
+    fn run(halves: [(SharedTx, SharedRx); 2], mut led: Led) -> ! {
+        let [(mut tx1, mut rx1), (mut tx2, mut rx2)] = halves;
+        let mut node1 = App::new(1, 2);
+        let mut node2 = App::new(2, 1);
         let mut period = Every::new(time::millis(), 10);
         let mut shown = 0;
         loop {
@@ -110,7 +117,7 @@ mod firmware {
                 let both = stats[0].heartbeats.min(stats[1].heartbeats);
                 if both >= shown + 50 {
                     shown = both;
-                    boot.led.toggle();
+                    led.toggle();
                 }
             }
             cortex_m::asm::wfi();

@@ -25,7 +25,7 @@ mod firmware {
 
     use twocan_bxcan::{const_plan, hal, BxCan, FifoPolicy, Instance, PlanOptions};
     use twocan_core::{Dispatcher, Filter, Format, Frame, FrameKind, RxFrame};
-    use twocan_stm32f7::can::{self, CanState};
+    use twocan_stm32f7::can::{self, CanRxHalf, CanState, CanTxHalf};
     use twocan_stm32f7::rt::{self, CAN_BLINKS};
     use twocan_stm32f7::time::{self, Every};
 
@@ -84,17 +84,16 @@ mod firmware {
             .config(125_000)
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS))
             .loopback(true);
-        // The HAL's configuration gives the registers back; the controller is then
+        // The HAL's hand-over gives the registers (nothing configured yet); the controller is then
         // configured in place in `CAN1` with the plan computed at compile time.
-        let (regs, _) = can1
-            .configure(&config)
-            .unwrap_or_else(|_| rt::halt(CAN_BLINKS))
-            .release();
+        let regs = can1
+            .into_registers(&config)
+            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         let plan = const_plan!(FILTER_LIST, PlanOptions::new(14).fifo(FifoPolicy::Balanced));
         for bank in plan.banks() {
             BANKS[bank.fifo.index()].fetch_add(1, Ordering::Relaxed);
         }
-        let (mut tx, mut rx) = can::start(
+        let (tx, rx) = can::start(
             &CAN1,
             Instance::Can1,
             |slot| BxCan::can1_in(slot, regs, &config, plan).map_err(|f| f.error),
@@ -102,6 +101,14 @@ mod firmware {
         )
         .unwrap_or_else(|| rt::halt(CAN_BLINKS));
 
+        run(tx, rx, boot.led)
+    }
+
+    /// The application after the configuration, in a function of its own (not
+    /// inlined): its state (the dispatcher, the frame list) takes stack only once the
+    /// configuration is done.
+    #[inline(never)]
+    fn run(mut tx: CanTxHalf, mut rx: CanRxHalf, mut led: rt::Led) -> ! {
         let mut dispatcher: Dispatcher<(), FILTERS> = Dispatcher::new();
         for i in 0..FILTERS {
             if dispatcher.set(i, on_frame).is_err() {
@@ -131,7 +138,7 @@ mod firmware {
             let errors = ERRORS.load(Ordering::Relaxed) + dispatcher.unhandled();
             if rounds > rounds_seen && errors == 0 {
                 rounds_seen = rounds;
-                boot.led.toggle();
+                led.toggle();
             }
             cortex_m::asm::wfi();
         }

@@ -36,12 +36,11 @@ mod firmware {
             .config(125_000)
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS))
             .loopback(true);
-        // The HAL's configuration gives the registers back; the controller is then
+        // The HAL's hand-over gives the registers (nothing configured yet); the controller is then
         // configured in place in `CAN1` with a plan computed at compile time.
-        let (regs, _) = can1
-            .configure(&config)
-            .unwrap_or_else(|_| rt::halt(CAN_BLINKS))
-            .release();
+        let regs = can1
+            .into_registers(&config)
+            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         let plan = const_plan!([Filter::pass_all()], PlanOptions::new(14));
         let (mut tx, mut rx) = can::start(
             &CAN1,

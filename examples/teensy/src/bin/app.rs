@@ -21,13 +21,15 @@ mod firmware {
     use critical_section::Mutex;
     use twocan_app::firmware::{FirmwareLoop, Published};
     use twocan_app::{App, AppStats};
-    use twocan_flexcan::pin::{Pin3, Pin4};
-    use twocan_flexcan::{Can0, Settings};
-    use twocan_teensy::can::CanState;
+    use twocan_flexcan::pin::{settings_for, Pin3, Pin4};
+    use twocan_flexcan::{BeginPlan, Can0, Settings};
+    use twocan_teensy::can::{CanState, TableSlot};
     use twocan_teensy::rt::{self, CAN_BLINKS};
     use twocan_teensy::time::{self, Every};
 
     static CAN0: CanState = CanState::new();
+    /// CAN0's filter table (`begin_in` compiles the list straight into it).
+    static TABLE0: TableSlot = TableSlot::new();
 
     /// The application's counters, copied after each step (`None` before the first).
     pub static STATS: Mutex<RefCell<Option<AppStats>>> = Mutex::new(RefCell::new(None));
@@ -58,11 +60,26 @@ mod firmware {
         let mut app = App::new(node, peer);
         let token = Can0::take().unwrap_or_else(|| rt::halt(CAN_BLINKS));
         // The application's portable filter list, as primary filters.
-        let can = token
-            .begin_on(Pin3, Pin4, &SETTINGS, &app.filters(), &[])
-            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         let (mut tx, mut rx) = CAN0
-            .start(can.into_split(), &mut boot.core.NVIC)
+            .start_in_place(
+                token.target(),
+                |hw| {
+                    token.begin_in_place(
+                        hw,
+                        &const {
+                            BeginPlan::new_or_panic(
+                                Can0::TARGET,
+                                &settings_for(&SETTINGS, Pin3, Pin4),
+                                SETTINGS.configuration,
+                            )
+                        },
+                        &app.filters(),
+                        &[],
+                        TABLE0.take().unwrap_or_else(|| rt::halt(CAN_BLINKS)),
+                    )
+                },
+                &mut boot.core.NVIC,
+            )
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         twocan_teensy::info!(
             "CAN0 on the bus with the application's {=usize} filters",

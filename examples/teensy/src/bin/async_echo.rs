@@ -21,14 +21,16 @@ mod firmware {
     use embassy_executor::Executor;
     use static_cell::StaticCell;
     use twocan_app::asynch::{echo, EchoStats};
-    use twocan_flexcan::pin::{Pin3, Pin4};
-    use twocan_flexcan::{Can0, Settings};
-    use twocan_teensy::can::{CanRxHalf, CanState, CanTxHalf};
+    use twocan_flexcan::pin::{settings_for, Pin3, Pin4};
+    use twocan_flexcan::{BeginPlan, Can0, Settings};
+    use twocan_teensy::can::{CanRxHalf, CanState, CanTxHalf, TableSlot};
     use twocan_teensy::io::Mmio;
     use twocan_teensy::led::Led;
     use twocan_teensy::rt::{self, CAN_BLINKS};
 
     static CAN0: CanState = CanState::new();
+    /// CAN0's filter table (`begin_in` compiles the list straight into it).
+    static TABLE0: TableSlot = TableSlot::new();
     static EXECUTOR: StaticCell<Executor> = StaticCell::new();
 
     /// Echoes sent so far (for a debugger). `#[used]`: only ever stored to, the
@@ -57,17 +59,26 @@ mod firmware {
     fn main() -> ! {
         let mut boot = rt::boot();
         let token = Can0::take().unwrap_or_else(|| rt::halt(CAN_BLINKS));
-        let can = token
-            .begin_on(
-                Pin3,
-                Pin4,
-                &SETTINGS,
-                &twocan_teensy::configs::ECHO_FILTERS,
-                &[],
-            )
-            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         let (tx, rx) = CAN0
-            .start(can.into_split(), &mut boot.core.NVIC)
+            .start_in_place(
+                token.target(),
+                |hw| {
+                    token.begin_in_place(
+                        hw,
+                        &const {
+                            BeginPlan::new_or_panic(
+                                Can0::TARGET,
+                                &settings_for(&SETTINGS, Pin3, Pin4),
+                                SETTINGS.configuration,
+                            )
+                        },
+                        &twocan_teensy::configs::ECHO_FILTERS,
+                        &[],
+                        TABLE0.take().unwrap_or_else(|| rt::halt(CAN_BLINKS)),
+                    )
+                },
+                &mut boot.core.NVIC,
+            )
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         let led = boot.led;
         EXECUTOR.init(Executor::new()).run(|spawner| {

@@ -17,14 +17,18 @@ mod firmware {
 
     use critical_section::Mutex;
     use twocan_app::{App, AppStats};
-    use twocan_flexcan::pin::{Pin3, Pin33, Pin34, Pin4};
-    use twocan_flexcan::{Can0, Can1, Settings};
-    use twocan_teensy::can::CanState;
+    use twocan_flexcan::pin::{settings_for, Pin3, Pin33, Pin34, Pin4};
+    use twocan_flexcan::{BeginPlan, Can0, Can1, Settings};
+    use twocan_teensy::can::{CanState, TableSlot};
     use twocan_teensy::rt::{self, CAN_BLINKS};
     use twocan_teensy::time::{self, Every};
 
     static CAN0: CanState = CanState::new();
+    /// CAN0's filter table (`begin_in` compiles the list straight into it).
+    static TABLE0: TableSlot = TableSlot::new();
     static CAN1: CanState = CanState::new();
+    /// CAN1's filter table (`begin_in` compiles the list straight into it).
+    static TABLE1: TableSlot = TableSlot::new();
 
     /// The counters of node 1 (CAN0) and node 2 (CAN1), copied after each step
     /// (`None` before the first).
@@ -40,20 +44,50 @@ mod firmware {
         let mut node1 = App::new(n1, p1);
         let mut node2 = App::new(n2, p2);
 
-        let can0 = Can0::take()
-            .unwrap_or_else(|| rt::halt(CAN_BLINKS))
-            .begin_on(Pin3, Pin4, &SETTINGS, &node1.filters(), &[])
-            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
-        let can1 = Can1::take()
-            .unwrap_or_else(|| rt::halt(CAN_BLINKS))
-            .begin_on(Pin33, Pin34, &SETTINGS, &node2.filters(), &[])
-            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
+        let can0 = Can0::take().unwrap_or_else(|| rt::halt(CAN_BLINKS));
+        let can1 = Can1::take().unwrap_or_else(|| rt::halt(CAN_BLINKS));
         let nvic = &mut boot.core.NVIC;
         let (mut tx0, mut rx0) = CAN0
-            .start(can0.into_split(), nvic)
+            .start_in_place(
+                can0.target(),
+                |hw| {
+                    can0.begin_in_place(
+                        hw,
+                        &const {
+                            BeginPlan::new_or_panic(
+                                Can0::TARGET,
+                                &settings_for(&SETTINGS, Pin3, Pin4),
+                                SETTINGS.configuration,
+                            )
+                        },
+                        &node1.filters(),
+                        &[],
+                        TABLE0.take().unwrap_or_else(|| rt::halt(CAN_BLINKS)),
+                    )
+                },
+                nvic,
+            )
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         let (mut tx1, mut rx1) = CAN1
-            .start(can1.into_split(), nvic)
+            .start_in_place(
+                can1.target(),
+                |hw| {
+                    can1.begin_in_place(
+                        hw,
+                        &const {
+                            BeginPlan::new_or_panic(
+                                Can1::TARGET,
+                                &settings_for(&SETTINGS, Pin33, Pin34),
+                                SETTINGS.configuration,
+                            )
+                        },
+                        &node2.filters(),
+                        &[],
+                        TABLE1.take().unwrap_or_else(|| rt::halt(CAN_BLINKS)),
+                    )
+                },
+                nvic,
+            )
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
 
         let mut period = Every::new(time::millis(), 10);

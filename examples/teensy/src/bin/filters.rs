@@ -24,14 +24,16 @@ mod firmware {
     use core::sync::atomic::{AtomicU32, Ordering};
 
     use twocan_core::{Dispatcher, Frame, RxFrame};
-    use twocan_flexcan::pin::{Pin3, Pin4};
-    use twocan_flexcan::{Can0, Settings};
-    use twocan_teensy::can::CanState;
+    use twocan_flexcan::pin::{settings_for, Pin3, Pin4};
+    use twocan_flexcan::{BeginPlan, Can0, Settings};
+    use twocan_teensy::can::{CanState, TableSlot};
     use twocan_teensy::filters_example::{self, FILTERS};
     use twocan_teensy::rt::{self, CAN_BLINKS};
     use twocan_teensy::time::{self, Every};
 
     static CAN0: CanState = CanState::new();
+    /// CAN0's filter table (`begin_in` compiles the list straight into it).
+    static TABLE0: TableSlot = TableSlot::new();
 
     /// Frames per filter index.
     pub static HITS: [AtomicU32; FILTERS] = [const { AtomicU32::new(0) }; FILTERS];
@@ -80,11 +82,26 @@ mod firmware {
         let primary = filters_example::primary();
         let secondary = filters_example::secondary();
         let token = Can0::take().unwrap_or_else(|| rt::halt(CAN_BLINKS));
-        let can = token
-            .begin_on(Pin3, Pin4, &SETTINGS, &primary, &secondary)
-            .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         let (mut tx, mut rx) = CAN0
-            .start(can.into_split(), &mut boot.core.NVIC)
+            .start_in_place(
+                token.target(),
+                |hw| {
+                    token.begin_in_place(
+                        hw,
+                        &const {
+                            BeginPlan::new_or_panic(
+                                Can0::TARGET,
+                                &settings_for(&SETTINGS, Pin3, Pin4),
+                                SETTINGS.configuration,
+                            )
+                        },
+                        &primary,
+                        &secondary,
+                        TABLE0.take().unwrap_or_else(|| rt::halt(CAN_BLINKS)),
+                    )
+                },
+                &mut boot.core.NVIC,
+            )
             .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
 
         let mut dispatcher: Dispatcher<(), FILTERS> = Dispatcher::new();

@@ -4,7 +4,8 @@
 //! read with a debugger.
 //!
 //! Started with the one call of `twocan_flexcan::acan` (ACAN's `begin`): token, begin
-//! on the default pins (3 and 4), the library's `static` state, interrupts wired.
+//! on the default pins (3 and 4), the library's `static` state, interrupts wired; the
+//! settings checked at compile time (`can0_checked`).
 //!
 //! Blink codes when it stops: 2–4 clock start-up, 5 FlexCAN `begin`, 6 panic.
 #![cfg_attr(target_os = "none", no_std, no_main)]
@@ -14,7 +15,7 @@ mod firmware {
     use core::sync::atomic::{AtomicU32, Ordering};
 
     use twocan_core::Frame;
-    use twocan_flexcan::{acan, Settings};
+    use twocan_flexcan::{acan, BeginPlan, Can0, Settings};
     use twocan_teensy::configs::LOOPBACK_FILTERS;
     use twocan_teensy::rt::{self, CAN_BLINKS};
     use twocan_teensy::time::{self, Every};
@@ -28,12 +29,17 @@ mod firmware {
     /// (the bit-timing solver is `const`), so the solver is not in the image.
     const SETTINGS: Settings = twocan_teensy::configs::LOOPBACK;
 
+    /// The settings checked at compile time for FlexCAN0 (`can0_checked`: no check runs
+    /// on the board, and the configuration stays within a few hundred bytes of stack).
+    const CHECKED: BeginPlan =
+        BeginPlan::new_or_panic(Can0::TARGET, &SETTINGS, SETTINGS.configuration);
+
     #[cortex_m_rt::entry]
     fn main() -> ! {
         let mut boot = rt::boot();
         twocan_teensy::info!("teensy-loopback: CAN0 in loop-back, a frame every second");
         let (mut tx, mut rx) =
-            acan::can0_with(&SETTINGS, &LOOPBACK_FILTERS, &[], &mut boot.core.NVIC)
+            acan::can0_checked(&CHECKED, &LOOPBACK_FILTERS, &[], &mut boot.core.NVIC)
                 .unwrap_or_else(|_| rt::halt(CAN_BLINKS));
 
         let message = Frame::standard(0x542, &[]).unwrap_or_else(|_| rt::halt(CAN_BLINKS));

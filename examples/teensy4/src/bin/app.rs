@@ -13,14 +13,16 @@ mod firmware {
     use critical_section::Mutex;
     use twocan_app::firmware::{FirmwareLoop, Published};
     use twocan_app::{App, AppStats};
-    use twocan_flexcan::pin::{Pin22, Pin23};
-    use twocan_flexcan::Can1;
-    use twocan_teensy4::can::CanState;
+    use twocan_flexcan::pin::{settings_for, Pin22, Pin23};
+    use twocan_flexcan::{BeginPlan, Can1};
+    use twocan_teensy4::can::{CanState, TableSlot};
     use twocan_teensy4::configs::{APP_NODES, BUS};
     use twocan_teensy4::rt::{self, CAN_HALT};
     use twocan_teensy4::time::{self, Every};
 
     static CAN1: CanState = CanState::new();
+    /// CAN1's filter table (`begin_in` compiles the list straight into it).
+    static TABLE1: TableSlot = TableSlot::new();
 
     /// The application's counters, copied after each step (`None` before the first).
     pub static STATS: Mutex<RefCell<Option<AppStats>>> = Mutex::new(RefCell::new(None));
@@ -44,12 +46,27 @@ mod firmware {
             BUS.actual_bit_rate()
         );
         let mut app = App::new(node, peer);
-        let can = Can1::take()
-            .unwrap_or_else(|| rt::halt(CAN_HALT))
-            .begin_on(Pin22, Pin23, &BUS, &app.filters(), &[])
-            .unwrap_or_else(|_| rt::halt(CAN_HALT));
+        let can = Can1::take().unwrap_or_else(|| rt::halt(CAN_HALT));
         let (mut tx, mut rx) = CAN1
-            .start(can.into_split(), &mut boot.core.NVIC)
+            .start_in_place(
+                can.target(),
+                |hw| {
+                    can.begin_in_place(
+                        hw,
+                        &const {
+                            BeginPlan::new_or_panic(
+                                Can1::TARGET,
+                                &settings_for(&BUS, Pin22, Pin23),
+                                BUS.configuration,
+                            )
+                        },
+                        &app.filters(),
+                        &[],
+                        TABLE1.take().unwrap_or_else(|| rt::halt(CAN_HALT)),
+                    )
+                },
+                &mut boot.core.NVIC,
+            )
             .unwrap_or_else(|_| rt::halt(CAN_HALT));
         let published = Published {
             stats: &STATS,

@@ -12,13 +12,15 @@ mod firmware {
     use embassy_executor::Executor;
     use static_cell::StaticCell;
     use twocan_app::asynch::{echo, EchoStats};
-    use twocan_flexcan::pin::{Pin22, Pin23};
-    use twocan_flexcan::Can1;
-    use twocan_teensy4::can::{CanRxHalf, CanState, CanTxHalf};
+    use twocan_flexcan::pin::{settings_for, Pin22, Pin23};
+    use twocan_flexcan::{BeginPlan, Can1};
+    use twocan_teensy4::can::{CanRxHalf, CanState, CanTxHalf, TableSlot};
     use twocan_teensy4::configs::{BUS, ECHO_FILTERS};
     use twocan_teensy4::rt::{self, CAN_HALT};
 
     static CAN1: CanState = CanState::new();
+    /// CAN1's filter table (`begin_in` compiles the list straight into it).
+    static TABLE1: TableSlot = TableSlot::new();
     static EXECUTOR: StaticCell<Executor> = StaticCell::new();
 
     /// Echoes sent so far.
@@ -38,12 +40,27 @@ mod firmware {
     #[cortex_m_rt::entry]
     fn main() -> ! {
         let mut boot = rt::boot();
-        let can = Can1::take()
-            .unwrap_or_else(|| rt::halt(CAN_HALT))
-            .begin_on(Pin22, Pin23, &BUS, &ECHO_FILTERS, &[])
-            .unwrap_or_else(|_| rt::halt(CAN_HALT));
+        let can = Can1::take().unwrap_or_else(|| rt::halt(CAN_HALT));
         let (tx, rx) = CAN1
-            .start(can.into_split(), &mut boot.core.NVIC)
+            .start_in_place(
+                can.target(),
+                |hw| {
+                    can.begin_in_place(
+                        hw,
+                        &const {
+                            BeginPlan::new_or_panic(
+                                Can1::TARGET,
+                                &settings_for(&BUS, Pin22, Pin23),
+                                BUS.configuration,
+                            )
+                        },
+                        &ECHO_FILTERS,
+                        &[],
+                        TABLE1.take().unwrap_or_else(|| rt::halt(CAN_HALT)),
+                    )
+                },
+                &mut boot.core.NVIC,
+            )
             .unwrap_or_else(|_| rt::halt(CAN_HALT));
         EXECUTOR.init(Executor::new()).run(|spawner| {
             spawner.spawn(echo_task(tx, rx).unwrap_or_else(|_| rt::halt(CAN_HALT)));

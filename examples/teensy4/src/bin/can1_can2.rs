@@ -10,15 +10,19 @@ mod firmware {
 
     use critical_section::Mutex;
     use twocan_app::{App, AppStats};
-    use twocan_flexcan::pin::{Pin0, Pin1, Pin22, Pin23};
-    use twocan_flexcan::{Can1, Can2};
-    use twocan_teensy4::can::CanState;
+    use twocan_flexcan::pin::{settings_for, Pin0, Pin1, Pin22, Pin23};
+    use twocan_flexcan::{BeginPlan, Can1, Can2};
+    use twocan_teensy4::can::{CanState, TableSlot};
     use twocan_teensy4::configs::{BUS, CAN1_CAN2_NODES};
     use twocan_teensy4::rt::{self, CAN_HALT};
     use twocan_teensy4::time::{self, Every};
 
     static CAN1: CanState = CanState::new();
+    /// CAN1's filter table (`begin_in` compiles the list straight into it).
+    static TABLE1: TableSlot = TableSlot::new();
     static CAN2: CanState = CanState::new();
+    /// CAN2's filter table (`begin_in` compiles the list straight into it).
+    static TABLE2: TableSlot = TableSlot::new();
 
     /// The counters of node 1 (CAN1) and node 2 (CAN2), copied after each step.
     pub static STATS: Mutex<RefCell<Option<[AppStats; 2]>>> = Mutex::new(RefCell::new(None));
@@ -29,20 +33,50 @@ mod firmware {
         let [(n1, p1), (n2, p2)] = CAN1_CAN2_NODES;
         let mut node1 = App::new(n1, p1);
         let mut node2 = App::new(n2, p2);
-        let can1 = Can1::take()
-            .unwrap_or_else(|| rt::halt(CAN_HALT))
-            .begin_on(Pin22, Pin23, &BUS, &node1.filters(), &[])
-            .unwrap_or_else(|_| rt::halt(CAN_HALT));
-        let can2 = Can2::take()
-            .unwrap_or_else(|| rt::halt(CAN_HALT))
-            .begin_on(Pin1, Pin0, &BUS, &node2.filters(), &[])
-            .unwrap_or_else(|_| rt::halt(CAN_HALT));
+        let can1 = Can1::take().unwrap_or_else(|| rt::halt(CAN_HALT));
+        let can2 = Can2::take().unwrap_or_else(|| rt::halt(CAN_HALT));
         let nvic = &mut boot.core.NVIC;
         let (mut tx1, mut rx1) = CAN1
-            .start(can1.into_split(), nvic)
+            .start_in_place(
+                can1.target(),
+                |hw| {
+                    can1.begin_in_place(
+                        hw,
+                        &const {
+                            BeginPlan::new_or_panic(
+                                Can1::TARGET,
+                                &settings_for(&BUS, Pin22, Pin23),
+                                BUS.configuration,
+                            )
+                        },
+                        &node1.filters(),
+                        &[],
+                        TABLE1.take().unwrap_or_else(|| rt::halt(CAN_HALT)),
+                    )
+                },
+                nvic,
+            )
             .unwrap_or_else(|_| rt::halt(CAN_HALT));
         let (mut tx2, mut rx2) = CAN2
-            .start(can2.into_split(), nvic)
+            .start_in_place(
+                can2.target(),
+                |hw| {
+                    can2.begin_in_place(
+                        hw,
+                        &const {
+                            BeginPlan::new_or_panic(
+                                Can2::TARGET,
+                                &settings_for(&BUS, Pin1, Pin0),
+                                BUS.configuration,
+                            )
+                        },
+                        &node2.filters(),
+                        &[],
+                        TABLE2.take().unwrap_or_else(|| rt::halt(CAN_HALT)),
+                    )
+                },
+                nvic,
+            )
             .unwrap_or_else(|_| rt::halt(CAN_HALT));
         let mut period = Every::new(time::millis(), 10);
         loop {

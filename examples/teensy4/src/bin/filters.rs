@@ -10,15 +10,17 @@ mod firmware {
     use core::sync::atomic::{AtomicU32, Ordering};
 
     use twocan_core::{Dispatcher, Frame, RxFrame};
-    use twocan_flexcan::pin::{Pin22, Pin23};
-    use twocan_flexcan::Can1;
-    use twocan_teensy4::can::CanState;
+    use twocan_flexcan::pin::{settings_for, Pin22, Pin23};
+    use twocan_flexcan::{BeginPlan, Can1};
+    use twocan_teensy4::can::{CanState, TableSlot};
     use twocan_teensy4::configs::FILTERS as SETTINGS;
     use twocan_teensy4::filters_example::{self, FILTERS};
     use twocan_teensy4::rt::{self, CAN_HALT};
     use twocan_teensy4::time::{self, Every};
 
     static CAN1: CanState = CanState::new();
+    /// CAN1's filter table (`begin_in` compiles the list straight into it).
+    static TABLE1: TableSlot = TableSlot::new();
 
     /// Frames each filter's call-back received.
     pub static HITS: [AtomicU32; FILTERS] = [const { AtomicU32::new(0) }; FILTERS];
@@ -61,12 +63,27 @@ mod firmware {
         let mut boot = rt::boot();
         let primary = filters_example::primary();
         let secondary = filters_example::secondary();
-        let can = Can1::take()
-            .unwrap_or_else(|| rt::halt(CAN_HALT))
-            .begin_on(Pin22, Pin23, &SETTINGS, &primary, &secondary)
-            .unwrap_or_else(|_| rt::halt(CAN_HALT));
+        let can = Can1::take().unwrap_or_else(|| rt::halt(CAN_HALT));
         let (mut tx, mut rx) = CAN1
-            .start(can.into_split(), &mut boot.core.NVIC)
+            .start_in_place(
+                can.target(),
+                |hw| {
+                    can.begin_in_place(
+                        hw,
+                        &const {
+                            BeginPlan::new_or_panic(
+                                Can1::TARGET,
+                                &settings_for(&SETTINGS, Pin22, Pin23),
+                                SETTINGS.configuration,
+                            )
+                        },
+                        &primary,
+                        &secondary,
+                        TABLE1.take().unwrap_or_else(|| rt::halt(CAN_HALT)),
+                    )
+                },
+                &mut boot.core.NVIC,
+            )
             .unwrap_or_else(|_| rt::halt(CAN_HALT));
         let mut dispatcher: Dispatcher<(), FILTERS> = Dispatcher::new();
         let callbacks: [fn(&mut (), &RxFrame); FILTERS] = [on_0, on_1, on_2, on_3, on_4];

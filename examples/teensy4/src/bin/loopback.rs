@@ -13,7 +13,7 @@ mod firmware {
     use core::sync::atomic::{AtomicU32, Ordering};
 
     use twocan_core::Frame;
-    use twocan_flexcan::acan;
+    use twocan_flexcan::{acan, BeginPlan, Can1};
     use twocan_teensy4::configs::{LOOPBACK, LOOPBACK_FILTERS};
     use twocan_teensy4::rt::{self, CAN_HALT};
     use twocan_teensy4::time::{self, Every};
@@ -23,12 +23,17 @@ mod firmware {
     /// Frames received back.
     pub static RECEIVED: AtomicU32 = AtomicU32::new(0);
 
+    /// The settings checked at compile time for CAN1 (`can1_checked`: no check runs on
+    /// the board, and the configuration stays within a few hundred bytes of stack).
+    const CHECKED: BeginPlan =
+        BeginPlan::new_or_panic(Can1::TARGET, &LOOPBACK, LOOPBACK.configuration);
+
     #[cortex_m_rt::entry]
     fn main() -> ! {
         let mut boot = rt::boot();
         twocan_teensy4::info!("teensy4-loopback: CAN1 in loop-back, a frame every second");
         let (mut tx, mut rx) =
-            acan::can1_with(&LOOPBACK, &LOOPBACK_FILTERS, &[], &mut boot.core.NVIC)
+            acan::can1_checked(&CHECKED, &LOOPBACK_FILTERS, &[], &mut boot.core.NVIC)
                 .unwrap_or_else(|_| rt::halt(CAN_HALT));
         let message = Frame::standard(0x542, &[]).unwrap_or_else(|_| rt::halt(CAN_HALT));
         let mut send = Every::new(time::millis(), 1000);
