@@ -419,19 +419,7 @@ where
                 return Err((e, hw));
             }
         };
-        // The cells are empty: only a successful split fills them, and `stop` empties
-        // them before the controller leaves the state.
-        let filled = self
-            .message
-            .put((parts.tx_irq, parts.rx0_irq, parts.rx1_irq))
-            .is_ok()
-            && self.status.put(parts.status_irq).is_ok();
-        debug_assert!(filled, "split succeeds once per start");
-        if !again {
-            slot.publish(self);
-        }
-        enable(nvic, irqs, priority);
-        Ok((parts.tx, parts.rx))
+        Ok(self.install(parts, again, slot, irqs, priority, nvic))
     }
 
     /// [`IrqState::start`] with the controller **configured in place** in this state
@@ -491,6 +479,24 @@ where
                 });
             }
         };
+        Ok(self.install(parts, again, slot, irqs, priority, nvic))
+    }
+
+    /// The end of [`IrqState::start`] and [`IrqState::start_in_place`]: the split's
+    /// handlers into the cells the entry points read, the instance's slot published to
+    /// this state (unless it was already), **then** the lines given their priority and
+    /// unmasked; the halves.
+    fn install(
+        &'static self,
+        parts: Parts<'static, FlexCanHw<R, O>, RX, Q, 0, DONE, Fe>,
+        again: bool,
+        slot: &'static Slot,
+        irqs: Irqs,
+        priority: u8,
+        nvic: &mut impl Nvic,
+    ) -> Halves<R, RX, Q, DONE, O, Fe> {
+        // The cells are empty: only a successful split fills them, and `stop` empties
+        // them before the controller leaves the state.
         let filled = self
             .message
             .put((parts.tx_irq, parts.rx0_irq, parts.rx1_irq))
@@ -501,7 +507,7 @@ where
             slot.publish(self);
         }
         enable(nvic, irqs, priority);
-        Ok((parts.tx, parts.rx))
+        (parts.tx, parts.rx)
     }
 
     /// The way back (issue 22 item 11): masks the instance's message, bus-off, error
