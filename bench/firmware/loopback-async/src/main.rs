@@ -13,8 +13,8 @@ use core::task::{Context, Poll};
 
 use cortex_m_rt::entry;
 use panic_halt as _;
-use twocan_bxcan::{regs::CAN1_BASE, Bank, BxCan, Can, Config, Fifo, FilterPlan};
-use twocan_core::split::State;
+use twocan_bxcan::{regs::CAN1_BASE, BxCan, Config, PlanOptions};
+use twocan_core::split::{Parts, State};
 use twocan_core::{Error, FifoQueue, Filter, Frame, Mmio, TxPolicy};
 
 #[path = "../../shared/flag_waker.rs"]
@@ -34,20 +34,22 @@ const CONFIG: Config = match Config::from_bitrate(APB1_HZ, BITRATE) {
     Err(_) => panic!("no bit timing for 500 kbit/s from 54 MHz"),
 };
 
-static CAN: State<BxCan<Mmio>, 8, FifoQueue<8>> = State::new();
+/// One accept-all filter to FIFO 0, planned at compile time (CAN1's 14 banks at reset).
+const FILTERS: [Filter; 1] = [Filter::pass_all()];
 
-fn start() -> Result<BxCan<Mmio>, Error> {
+/// The controller: CAN1, no merged-filter lookup keys (the plan has none).
+type Hw = BxCan<Mmio, Mmio, 0>;
+
+static CAN: State<Hw, 8, FifoQueue<8>> = State::new();
+
+/// CAN1 configured in place in [`CAN`] (`State::split_with`, `BxCan::can1_in`: no
+/// controller, plan or filter map moves through the configuration), then split.
+fn start() -> Result<Parts<'static, Hw, 8, FifoQueue<8>, 0, 8>, Error> {
     // SAFETY: CAN1's register block (RM0410 §2.2.2), clocked by `stm32f7::clocks`;
     // nothing else in this firmware touches it.
     let regs = unsafe { Mmio::new(CAN1_BASE) };
-    let mut init = Can::can1(regs, &CONFIG).map_err(|_| Error::WrongMode)?;
-    let mut plan = FilterPlan::manual();
-    let bank =
-        Bank::mask32(&Filter::pass_all(), Fifo::Fifo0).map_err(|_| Error::InvalidArgument)?;
-    plan.set_bank(0, bank)?;
-    init.set_filters(&plan)?;
-    let can = init.enable().map_err(|_| Error::WrongMode)?;
-    Ok(can.into_split())
+    let plan = twocan_bxcan::const_plan!(FILTERS, PlanOptions::new(14));
+    CAN.split_with(|slot| Hw::can1_in(slot, regs, &CONFIG, plan).map_err(|f| f.error))
 }
 
 /// Polls `f` to completion, running `idle` (the interrupt lines' work) between polls.
@@ -66,9 +68,8 @@ fn run<F: Future>(f: F, mut idle: impl FnMut()) -> Option<F::Output> {
     None
 }
 
-fn loop_back(hw: BxCan<Mmio>) -> Result<bool, Error> {
+fn loop_back(mut p: Parts<'static, Hw, 8, FifoQueue<8>, 0, 8>) -> Result<bool, Error> {
     let frame = Frame::standard(ID, &DATA)?;
-    let mut p = CAN.split(hw).map_err(|(e, _)| e)?;
     let (tx_irq, rx0_irq) = (&mut p.tx_irq, &mut p.rx0_irq);
     let mut lines = || {
         tx_irq.on_interrupt();
