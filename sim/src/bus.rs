@@ -89,6 +89,8 @@
 
 use std::boxed::Box;
 use std::string::String;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Arc;
 use std::vec::Vec;
 
 use super::bits::{wire_bits, FrameBits, INTERMISSION_BITS};
@@ -220,10 +222,23 @@ struct Slot {
     stats: NodeStats,
 }
 
+/// The time of a [`Bus`], readable while the bus is borrowed ([`Bus::clock`]).
+#[derive(Clone, Debug, Default)]
+pub struct BusClock(Arc<AtomicU64>);
+
+impl BusClock {
+    /// The bus time, in bit times (as [`Bus::now`]).
+    pub fn now(&self) -> u64 {
+        self.0.load(Ordering::Relaxed)
+    }
+}
+
 /// A deterministic simulated CAN bus (see the [module docs](self)).
 pub struct Bus {
     bit_rate: u32,
     now: u64,
+    /// [`Bus::now`] for readers that cannot borrow the bus ([`Bus::clock`]).
+    clock: BusClock,
     slots: Vec<Slot>,
     trace: Trace,
     tracing: bool,
@@ -264,6 +279,7 @@ impl Bus {
         Ok(Bus {
             bit_rate,
             now: 0,
+            clock: BusClock::default(),
             slots: Vec::new(),
             trace: Trace::new(bit_rate),
             tracing: true,
@@ -312,6 +328,18 @@ impl Bus {
     /// The current bus time in bit times.
     pub fn now(&self) -> u64 {
         self.now
+    }
+
+    /// A handle on [`Bus::now`] that reads it without borrowing the bus: for register
+    /// wrappers whose accesses come from inside a bus step (a node's hook), where the
+    /// bus is borrowed ([`crate::PollClock`]'s watchdog).
+    pub fn clock(&self) -> BusClock {
+        self.clock.clone()
+    }
+
+    fn set_now(&mut self, now: u64) {
+        self.now = now;
+        self.clock.0.store(now, Ordering::Relaxed);
     }
 
     /// The current bus time in microseconds (rounded down).
@@ -615,7 +643,7 @@ impl Bus {
         if bits == 0 {
             return;
         }
-        self.now = self.now.saturating_add(bits);
+        self.set_now(self.now.saturating_add(bits));
         let now = self.now;
         for slot in &mut self.slots {
             slot.node.advance(bits, idle, now);
@@ -648,7 +676,7 @@ impl Bus {
                 None => node.advance(to - from, true, sof + to),
             }
         }
-        self.now = sof + to;
+        self.set_now(sof + to);
     }
 
     fn idle_to(&mut self, to: u64) -> BusEvent {
@@ -1007,7 +1035,7 @@ impl Bus {
             f.next += 1;
             self.advance_span(&f.wire, f.sof, f.done, at, &f.in_frame);
             f.done = f.done.max(at);
-            self.now = f.sof + f.done;
+            self.set_now(f.sof + f.done);
             let time = BusTime {
                 sof: f.sof,
                 now: self.now,
@@ -1044,7 +1072,7 @@ impl Bus {
         if limit < f.end {
             self.advance_span(&f.wire, f.sof, f.done, limit, &f.in_frame);
             f.done = f.done.max(limit);
-            self.now = f.sof + f.done;
+            self.set_now(f.sof + f.done);
             let recessive = f
                 .done
                 .checked_sub(1)
@@ -1059,7 +1087,7 @@ impl Bus {
         }
         self.advance_span(&f.wire, f.sof, f.done, f.end, &f.in_frame);
         f.done = f.done.max(f.end);
-        self.now = f.sof + f.done;
+        self.set_now(f.sof + f.done);
         let total = f.end + u64::from(INTERMISSION_BITS);
         let to = limit.min(total);
         if to > f.done {

@@ -51,7 +51,7 @@ pub mod stats;
 pub mod trace;
 
 pub use bits::{crc15, frame_bits, FrameBits};
-pub use bus::{Bus, BusEvent, NodeId, SimError, StillBusy};
+pub use bus::{Bus, BusClock, BusEvent, NodeId, SimError, StillBusy};
 pub use inject::{Fault, FaultError, FaultKind, FormField, RandomFaults, Receivers, Sees};
 pub use node::{BusNode, BusTime, ConfinementEvent, TxRequest, TxResult};
 pub use poll_clock::{PollClock, SharedBus, SpinWatchdog, SPIN_LIMIT};

@@ -12,7 +12,7 @@ use std::cell::{Cell, RefCell};
 use std::rc::Rc;
 use std::vec::Vec;
 
-use crate::Bus;
+use crate::{Bus, BusClock};
 use twocan_core::registers::Registers;
 
 /// Register accesses in a row, through one [`PollClock`], with the bus time unchanged
@@ -30,6 +30,8 @@ pub type SharedBus = Rc<RefCell<Bus>>;
 pub struct PollClock<R> {
     regs: R,
     bus: SharedBus,
+    /// The bus time, read without borrowing the bus (the watchdog's clock).
+    clock: BusClock,
     poll_registers: Vec<usize>,
     /// The poll register read last, if the last access was such a read.
     spinning: Cell<Option<usize>>,
@@ -93,6 +95,7 @@ impl<R> PollClock<R> {
         PollClock {
             regs,
             bus: bus.clone(),
+            clock: bus.borrow().clock(),
             poll_registers: poll_registers.to_vec(),
             spinning: Cell::new(None),
             watchdog: SpinWatchdog::new(),
@@ -108,17 +111,18 @@ impl<R> PollClock<R> {
     /// at another bit rate, brought to the same time, with the model attached to it).
     pub fn set_bus(&mut self, bus: &SharedBus) {
         self.bus = bus.clone();
+        self.clock = bus.borrow().clock();
         self.spinning.set(None);
     }
 }
 
 impl<R> PollClock<R> {
-    /// Counts one access ([`SpinWatchdog::access`]; while the bus is borrowed — an
-    /// access from inside a bus step, a handler run from a node's hook — its time cannot
-    /// move).
+    /// Counts one access ([`SpinWatchdog::access`]) at the bus time, read through the
+    /// bus's [`BusClock`]: also while the bus is borrowed (an access from inside a bus
+    /// step, a handler run from a node's hook, where the time moves from one hook to the
+    /// next but not within one).
     fn watch(&self, what: &str, offset: usize) {
-        let now = self.bus.try_borrow().ok().map(|bus| bus.now());
-        self.watchdog.access(now, what, offset);
+        self.watchdog.access(Some(self.clock.now()), what, offset);
     }
 }
 

@@ -25,6 +25,8 @@ pub struct Clocked {
     pub bits_per_poll: u64,
     /// Fails a test whose driver spins on a register the model never changes.
     pub watchdog: Rc<twocan_sim::SpinWatchdog>,
+    /// The bus time, read also while the bus is borrowed.
+    pub clock: twocan_sim::BusClock,
 }
 
 impl Clocked {
@@ -35,14 +37,14 @@ impl Clocked {
             ticking: Rc::new(Cell::new(true)),
             bits_per_poll: 1,
             watchdog: Rc::default(),
+            clock: bus.borrow().clock(),
         }
     }
 }
 
 impl Clocked {
     fn watch(&self, what: &str, offset: usize) {
-        let now = self.bus.try_borrow().ok().map(|b| b.now());
-        self.watchdog.access(now, what, offset);
+        self.watchdog.access(Some(self.clock.now()), what, offset);
     }
 }
 
