@@ -75,6 +75,40 @@ fn abort_before_start_of_frame_completes_as_aborted() {
     );
 }
 
+/// RM0410 §40.9.2 `CAN_TSR.ABRQx`: the abort request goes to the mailbox that holds the
+/// frame. With three frames pending, aborting the last one must abort exactly it: the
+/// other two go out, and only its completion says aborted.
+#[test]
+fn abort_of_one_of_three_pending_frames_aborts_that_frame_only() {
+    let (can, regs, bus, peer) = can1_and_peer(&config(), &pass_all());
+    regs.ticking.set(false);
+    let mut d = driver(can);
+    let frames = [std(0x331), std(0x332), std(0x333)];
+    let tokens: Vec<_> = frames.iter().map(|f| d.try_send(f).unwrap()).collect();
+    assert!(!bus.borrow().in_frame());
+    assert_eq!(d.abort(tokens[2]), AbortRequest::Requested);
+    settle(&bus);
+    d.on_interrupt();
+    let mut done = completions(&mut d);
+    done.sort_by_key(|c| c.token.0);
+    assert_eq!(
+        done.iter()
+            .map(|c| (c.token, c.outcome))
+            .collect::<Vec<_>>(),
+        vec![
+            (tokens[0], TxOutcome::Sent),
+            (tokens[1], TxOutcome::Sent),
+            (tokens[2], TxOutcome::Aborted)
+        ],
+        "only the aborted frame's mailbox was aborted"
+    );
+    assert_eq!(
+        peer.borrow().received_frames(),
+        frames[..2].to_vec(),
+        "the other two frames on the wire, the aborted one not"
+    );
+}
+
 #[test]
 fn one_shot_arbitration_loss_is_reported_with_its_cause() {
     let (can, regs, bus, peer) = can1_and_peer(&config().one_shot(true), &pass_all());
