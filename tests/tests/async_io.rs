@@ -245,6 +245,9 @@ fn run_tasks<'a>(sim: &mut Sim<'_>, tasks: Vec<Task<'a>>) -> u64 {
         })
         .collect();
     let mut polls = 0;
+    // Bus time of the last poll: the run fails when no task is woken for a simulated
+    // second (a task waiting for a frame that never comes while the bus idles on).
+    let mut last_poll = sim.h.now();
     loop {
         sim.service();
         let mut polled = false;
@@ -261,8 +264,15 @@ fn run_tasks<'a>(sim: &mut Sim<'_>, tasks: Vec<Task<'a>>) -> u64 {
         if tasks.iter().all(|(t, _, _)| t.is_none()) {
             return polls;
         }
-        if !polled {
+        if polled {
+            last_poll = sim.h.now();
+        } else {
             assert!(sim.step(), "hang: every task waits and the bus is idle");
+            let quiet = sim.h.now() - last_poll;
+            assert!(
+                quiet < 500_000,
+                "hang: no task woken for {quiet} bit times ({polls} polls so far)"
+            );
         }
     }
 }

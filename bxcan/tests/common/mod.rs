@@ -42,9 +42,20 @@ impl Clocked {
     }
 }
 
+/// Bus time after which a test over [`Clocked`] is taken to wait for ever (a frame that
+/// never comes, through a blocking API that polls the controller while time passes):
+/// 40 s at 500 kbit/s, far beyond any test of this crate.
+pub const BUS_TIME_LIMIT: u64 = 20_000_000;
+
 impl Clocked {
     fn watch(&self, what: &str, offset: usize) {
-        self.watchdog.access(Some(self.clock.now()), what, offset);
+        let now = self.clock.now();
+        self.watchdog.access(Some(now), what, offset);
+        assert!(
+            now < BUS_TIME_LIMIT,
+            "the test ran {now} bit times of bus time: it waits for something that never \
+             happens (last a {what} of offset 0x{offset:03X})"
+        );
     }
 }
 
