@@ -3,7 +3,7 @@
 //! standard data frame (identifier 0x542) every second, the LED toggled by every frame
 //! received; `SENT` and `RECEIVED` count them.
 //!
-//! What differs from `teensy-loopback` is the state's type, [`LeanState`] instead of
+//! What differs from `teensy-loopback` is the state's type, `can::LeanState` instead of
 //! `CanState` (one line), and the configuration it takes:
 //! - fire-and-forget transmit: no completion ring (`DONE` = 0), nothing to take back;
 //! - no traffic statistics and no time stamps (`twocan_core::Lean`);
