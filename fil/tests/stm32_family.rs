@@ -37,6 +37,9 @@ fn loopback_frames_come_back() {
         let m = &w.machines[0];
         assert_eq!(m.read_u32_static("SENT"), Some(3), "{board}");
         assert_eq!(m.read_u32_static("RECEIVED"), Some(3), "{board}");
+        // Each frame's withdrawn follower was aborted, and none came back.
+        assert_eq!(m.read_u32_static("WITHDRAWN"), Some(3), "{board}");
+        assert_eq!(m.read_u32_static("STRAY"), Some(0), "{board}");
         let ticks = m.board().taken.get(&exc::SYSTICK).copied().unwrap_or(0);
         assert!(
             (3_100..=3_200).contains(&ticks),

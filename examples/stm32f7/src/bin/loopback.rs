@@ -23,6 +23,11 @@ mod firmware {
     pub static SENT: AtomicU32 = AtomicU32::new(0);
     /// Frames received back.
     pub static RECEIVED: AtomicU32 = AtomicU32::new(0);
+    /// Frames withdrawn: after each frame, a second one (identifier 0x543) is queued
+    /// behind it and aborted at once; it must never come back.
+    pub static WITHDRAWN: AtomicU32 = AtomicU32::new(0);
+    /// Frames received that are not the one sent (a withdrawn frame that went out).
+    pub static STRAY: AtomicU32 = AtomicU32::new(0);
 
     #[cortex_m_rt::entry]
     fn main() -> ! {
@@ -51,6 +56,7 @@ mod firmware {
         .unwrap_or_else(|| rt::halt(CAN_BLINKS));
 
         let message = Frame::standard(0x542, &[]).unwrap_or_else(|_| rt::halt(CAN_BLINKS));
+        let withdrawn = Frame::standard(0x543, &[]).unwrap_or_else(|_| rt::halt(CAN_BLINKS));
         let mut send = Every::new(time::millis(), 1000);
         let mut due = false;
         loop {
@@ -58,9 +64,20 @@ mod firmware {
             if due && tx.try_send(&message).is_ok() {
                 due = false;
                 SENT.fetch_add(1, Ordering::Relaxed);
+                // A second frame waits in another mailbox while the first is on the
+                // wire: its abort (RM0410 §40.7.3 "Abort") must take it back.
+                if let Ok(token) = tx.try_send(&withdrawn) {
+                    if tx.abort(token) != twocan_core::AbortRequest::NotFound {
+                        WITHDRAWN.fetch_add(1, Ordering::Relaxed);
+                    }
+                }
             }
             while tx.take_completion().is_some() {}
-            while rx.receive().is_ok() {
+            while let Ok(frame) = rx.receive() {
+                if frame.frame != message {
+                    STRAY.fetch_add(1, Ordering::Relaxed);
+                    continue;
+                }
                 RECEIVED.fetch_add(1, Ordering::Relaxed);
                 twocan_stm32f7::info!(
                     "loop-back frame {=u32} received",
