@@ -56,6 +56,19 @@ macro_rules! token_begin {
                 .map_err(|(e, slot)| (self, e, slot))
             }
 
+            /// The module's registers for a begin with `checked`: `None` when the plan
+            /// was made for another module (or the board has no such module).
+            fn checked_regs(
+                &self,
+                checked: &$crate::BeginPlan,
+            ) -> Option<$crate::regs::FlexCanRegs> {
+                let target = self.target();
+                let base = target.base().filter(|_| checked.target() == target)?;
+                // SAFETY: as for `begin_in`: the token is unique and the caller consumes
+                // it (giving it back only with an error, after the handle is gone).
+                Some(unsafe { $crate::regs::FlexCanRegs::new(base) })
+            }
+
             /// [`Self::begin_in`] writing the split controller **in place** into `hw`,
             /// the storage a `static` state lends (`rt::IrqState::start_in_place`,
             /// `State::split_with`), with the settings checked beforehand
@@ -79,19 +92,13 @@ macro_rules! token_begin {
             where
                 O: $crate::options::Options<Table = &'static mut $crate::FilterTable>,
             {
-                let target = self.target();
-                let base = match target.base() {
-                    Some(base) if checked.target() == target => base,
-                    _ => {
-                        return Err((
-                            self,
-                            $crate::BeginError::Hardware(twocan_core::Error::InvalidArgument),
-                            slot,
-                        ))
-                    }
+                let Some(regs) = self.checked_regs(checked) else {
+                    return Err((
+                        self,
+                        $crate::BeginError::Hardware(twocan_core::Error::InvalidArgument),
+                        slot,
+                    ));
                 };
-                // SAFETY: as for `begin_in`.
-                let regs = unsafe { $crate::regs::FlexCanRegs::new(base) };
                 $crate::FlexCan::begin_in_place(
                     hw,
                     regs,
@@ -119,18 +126,12 @@ macro_rules! token_begin {
             where
                 O: $crate::options::Options<Table = $crate::installed::PlannedTable>,
             {
-                let target = self.target();
-                let base = match target.base() {
-                    Some(base) if checked.target() == target => base,
-                    _ => {
-                        return Err((
-                            self,
-                            $crate::BeginError::Hardware(twocan_core::Error::InvalidArgument),
-                        ))
-                    }
+                let Some(regs) = self.checked_regs(checked) else {
+                    return Err((
+                        self,
+                        $crate::BeginError::Hardware(twocan_core::Error::InvalidArgument),
+                    ));
                 };
-                // SAFETY: as for `begin_in`.
-                let regs = unsafe { $crate::regs::FlexCanRegs::new(base) };
                 $crate::FlexCan::begin_checked_in_place(hw, regs, &mut $system(), checked, table)
                     .map_err(|e| (self, e))
             }
@@ -150,18 +151,12 @@ macro_rules! token_begin {
             where
                 O: $crate::options::Options<Table = $crate::installed::PlannedTable>,
             {
-                let target = self.target();
-                let base = match target.base() {
-                    Some(base) if checked.target() == target => base,
-                    _ => {
-                        return Err((
-                            self,
-                            $crate::BeginError::Hardware(twocan_core::Error::InvalidArgument),
-                        ))
-                    }
+                let Some(regs) = self.checked_regs(checked) else {
+                    return Err((
+                        self,
+                        $crate::BeginError::Hardware(twocan_core::Error::InvalidArgument),
+                    ));
                 };
-                // SAFETY: as for `begin_in`.
-                let regs = unsafe { $crate::regs::FlexCanRegs::new(base) };
                 $crate::FlexCan::begin_checked(regs, &mut $system(), checked, table)
                     .map_err(|e| (self, e))
             }
