@@ -48,8 +48,8 @@ use crate::instance::Instance;
 use crate::mailbox;
 use crate::mode;
 use crate::regs::{
-    btr, esr, msr, rdhxr, rdlxr, rdtxr, rfxr, rixr, tdtxr, tixr, tsr, BTR, ESR, MSR, TSR,
-    TX_MAILBOXES,
+    btr, esr, ier, msr, rdhxr, rdlxr, rdtxr, rfxr, rixr, tdtxr, tixr, tsr, BTR, ESR, IER, MSR,
+    TSR, TX_MAILBOXES,
 };
 
 /// Frames one receive FIFO holds (RM0410 §40.7.5).
@@ -69,6 +69,15 @@ fn free_of(t: u32, code: usize) -> Option<u8> {
         return Some(code as u8);
     }
     (0..TX_MAILBOXES).find(|&x| ok(x)).map(|x| x as u8)
+}
+
+/// Any empty mailbox in `CAN_TSR` value `t`, lowest first, acknowledged or not: the
+/// slow path of `free_mailbox_quiet`, when `CODE` names none.
+#[cold]
+fn free_of_quiet(t: u32) -> Option<u8> {
+    (0..TX_MAILBOXES)
+        .find(|&x| t & tsr::tme(x) != 0)
+        .map(|x| x as u8)
 }
 
 /// One received frame as the receive interrupt copies it: `CAN_RIxR`, `CAN_RDTxR` (FIFO
@@ -484,6 +493,55 @@ unsafe impl<R: Registers, F: Registers, const K: usize> Hardware for BxCan<R, F,
             return Ok(free.and_then(|m| self.after_ties(t, frame, m)));
         }
         Ok(free)
+    }
+
+    /// The quiet transmit mode is offered: `CAN_IER.TMEIE` gates the transmit line
+    /// (RM0410 §40.8 "Interrupts": the line is `TMEIE` and any `RQCPx`), and a
+    /// mailbox may be reloaded before its `RQCPx` is acknowledged (setting `TXRQ`
+    /// clears `RQCPx`, RM0410 §40.9.2 `CAN_TSR`).
+    const QUIET_TX: bool = true;
+
+    /// Request order only (the quiet mode's queue; `TXFP` = 1 sends the mailboxes in
+    /// the order of their requests, RM0410 §40.7.3): any empty mailbox, `CODE` first,
+    /// whether or not its `RQCPx` was acknowledged. Refused in listen-only mode as
+    /// [`Hardware::free_mailbox`] is.
+    #[inline(always)]
+    fn free_mailbox_quiet(&self, frame: &Frame) -> Result<Option<u8>, Error> {
+        if self.config.get_tx_policy() != TxPolicy::Fifo {
+            // Not the quiet mode's order (unreachable through the split driver, whose
+            // request-order queue is adopted only by a request-order controller).
+            return self.free_mailbox(frame);
+        }
+        if self.listen_only.load(Ordering::Relaxed) {
+            return Err(Error::WrongMode);
+        }
+        let t = self.regs.read32(TSR);
+        let code = tsr::CODE.get(t) as usize;
+        // `TMEx` of `CODE` is checked: `CODE` names an empty mailbox only when one is.
+        if code < TX_MAILBOXES && t & tsr::tme(code) != 0 {
+            return Ok(Some(code as u8));
+        }
+        Ok(free_of_quiet(t))
+    }
+
+    /// Writes back the `RQCPx` bits `CAN_TSR` shows (write 1 to clear; RM0410 §40.9.2),
+    /// which lowers the transmit line; nothing is reported. The `aborting` marks of
+    /// these mailboxes are left as they are: the quiet mode never reads them (no
+    /// outcome is reported), and a reload writes new tokens.
+    unsafe fn acknowledge_ended(&self) {
+        let rq = self.regs.read32(TSR) & RQCP_ALL;
+        if rq != 0 {
+            self.regs.write32(TSR, rq);
+        }
+    }
+
+    /// `CAN_IER` as configured, with `TMEIE` cleared when `on` is false (`CAN_IER` is
+    /// written by the configuration and, once split, only here, inside the driver's
+    /// critical section).
+    unsafe fn set_tx_interrupt(&self, on: bool) {
+        let ier = self.config.get_interrupts();
+        self.regs
+            .write32(IER, if on { ier } else { ier & !ier::TMEIE });
     }
 
     /// Notes "Transmission handling": DLC, data, then identifier with `TXRQ`.

@@ -134,7 +134,8 @@ impl<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE:
     /// use [`Tx::completion`] to see every one.
     ///
     /// Fails at once with [`Error::InvalidArgument`] for a token this half has not handed
-    /// out (at or after [`Tx::next_token`], within half the token space), and with
+    /// out (at or after [`Tx::next_token`], within half the token space), with
+    /// [`Error::WrongMode`] when completions are off (`DONE` = 0), and with
     /// [`Error::Overrun`] when the completion ring overflowed during the wait and holds
     /// no more completions: the one of `token` may have been lost. A completion lost
     /// before the call is not detected (the wait would not end): a ring of `DONE`
@@ -146,6 +147,10 @@ impl<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE:
     pub async fn completed(&mut self, token: Token) -> Result<Completion, Error> {
         if token.0.wrapping_sub(self.next) < 0x8000_0000 {
             return Err(Error::InvalidArgument);
+        }
+        if DONE == 0 {
+            // Completions are off (no ring): none will come.
+            return Err(Error::WrongMode);
         }
         let s = self.s;
         let overflows = s.traffic().completion_overflows;

@@ -17,7 +17,12 @@
 //! | receive and transmit time stamps ([`crate::RxFrame::timestamp`], `Completion::timestamp`) | widened and reported | not read, `None` |
 //!
 //! Transmit completions are the `DONE` parameter (0: no completion ring, fire and
-//! forget). Rare events stay counted in both (hardware overruns, ring and queue
+//! forget). With `DONE` = 0, [`Lean`] and a request-order queue ([`crate::FifoQueue`]),
+//! nothing is left for the transmit interrupt to report: on a controller that offers it
+//! ([`crate::Hardware::QUIET_TX`], bxCAN), the driver then enables that interrupt only
+//! while frames wait in its queue, and the direct path loads a mailbox whether or not
+//! its last end was acknowledged — a frame sent with an empty queue costs no
+//! interrupt. Rare events stay counted in both (hardware overruns, ring and queue
 //! overflows, error counts, state changes): they cost nothing on the per-frame path.
 //! Counters wrap (compare readings with wrapping differences).
 //!
@@ -77,6 +82,8 @@ impl Tally for NoTally {
 pub trait Features: 'static {
     /// Receive and transmit time stamps are read from the hardware and widened.
     const TIMESTAMPS: bool;
+    /// Whether the traffic statistics count ([`Features::Counter`] is a [`Counter`]).
+    const COUNTS: bool;
     /// How the traffic counters are stored.
     type Counter: Tally;
 }
@@ -87,6 +94,7 @@ pub enum Full {}
 
 impl Features for Full {
     const TIMESTAMPS: bool = true;
+    const COUNTS: bool = true;
     type Counter = Counter;
 }
 
@@ -96,5 +104,6 @@ pub enum Lean {}
 
 impl Features for Lean {
     const TIMESTAMPS: bool = false;
+    const COUNTS: bool = false;
     type Counter = NoTally;
 }

@@ -171,6 +171,19 @@ impl defmt::Format for Frame {
     }
 }
 
+/// The mask of the data bytes a data frame of each DLC code carries, over the
+/// little-endian 64-bit value of its eight data bytes: codes 0..=8 keep that many bytes,
+/// 9..=15 keep eight (ISO 11898-1 classic CAN: DLC values above 8 mean 8 bytes).
+const DATA_MASK: [u64; 16] = {
+    let mut m = [u64::MAX; 16];
+    let mut n = 0;
+    while n < 8 {
+        m[n] = (1u64 << (8 * n)) - 1;
+        n += 1;
+    }
+    m
+};
+
 impl Frame {
     /// The one DLC rule (module docs): whether a frame of this kind (`remote`) with
     /// `data_len` data bytes may carry the DLC code `dlc`. ISO 11898-1 (classical CAN):
@@ -329,19 +342,13 @@ impl Frame {
         let id_mask = if extended { ID_BITS } else { 0x7FF };
         let word = word & (EXTENDED_BIT | REMOTE_BIT | id_mask);
         let dlc = dlc & MAX_DLC_CODE;
-        let keep = if word & REMOTE_BIT != 0 {
+        // Bytes beyond the data length cleared with one mask over the little-endian
+        // 64-bit value, looked up by the DLC code (a load instead of shifts, a byte
+        // loop or a `memset` call); a remote frame keeps none.
+        let mask = if word & REMOTE_BIT != 0 {
             0
-        } else if dlc > MAX_DLC {
-            MAX_DLC
         } else {
-            dlc
-        };
-        // Bytes beyond `keep` cleared with one mask over the little-endian 64-bit value
-        // (a few shifts instead of a byte loop or a `memset` call).
-        let mask = if keep >= 8 {
-            u64::MAX
-        } else {
-            (1u64 << (8 * keep as u32)) - 1
+            DATA_MASK[dlc as usize]
         };
         let bytes = (u64::from_le_bytes(data) & mask).to_le_bytes();
         Frame {

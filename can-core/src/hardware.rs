@@ -221,6 +221,42 @@ pub unsafe trait Hardware {
         self.free_mailbox(frame)
     }
 
+    /// Whether the controller supports the quiet transmit mode of a driver with no
+    /// completions to report (`DONE` = 0, [`crate::Lean`], a request-order queue): its
+    /// transmit interrupt enabled only while frames are queued
+    /// ([`Hardware::set_tx_interrupt`]), ended mailboxes acknowledged wholesale
+    /// ([`Hardware::acknowledge_ended`]) and reloaded without it
+    /// ([`Hardware::free_mailbox_quiet`]). `false` by default: the driver then runs as
+    /// with completions.
+    const QUIET_TX: bool = false;
+
+    /// Quiet mode ([`Hardware::QUIET_TX`], request order): an empty mailbox for
+    /// `frame`, whether or not its last end was acknowledged (the outcome is not
+    /// reported). The default is [`Hardware::free_mailbox`].
+    fn free_mailbox_quiet(&self, frame: &Frame) -> Result<Option<u8>, Error> {
+        self.free_mailbox(frame)
+    }
+
+    /// Quiet mode: acknowledges every ended mailbox without reporting it. The default
+    /// settles them and drops the reports.
+    ///
+    /// # Safety
+    /// As for [`Hardware::settle`].
+    unsafe fn acknowledge_ended(&self) {
+        // SAFETY: the caller's contract is `settle`'s.
+        unsafe { self.settle(|_| {}) }
+    }
+
+    /// Quiet mode: the transmit interrupt on (frames are queued) or off, as far as the
+    /// configuration enables it. The default does nothing (the interrupt stays as
+    /// configured).
+    ///
+    /// # Safety
+    /// Called inside the driver's critical section (the transmit interrupt's context).
+    unsafe fn set_tx_interrupt(&self, on: bool) {
+        let _ = on;
+    }
+
     /// Loads `frame` into `mailbox` (returned by [`Hardware::free_mailbox`]), remembers
     /// `token` for its completion, and requests transmission.
     ///

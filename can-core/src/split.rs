@@ -317,6 +317,16 @@ impl<
         Fe: Features,
     > State<H, RX, Q, RX1, DONE, Fe>
 {
+    /// The quiet transmit mode ([`Hardware::QUIET_TX`]), settled at compile time: no
+    /// completion ring (`DONE` = 0), no statistics or time stamps to record, a queue
+    /// in request order (nothing is ever displaced), on a controller that offers it.
+    /// The transmit interrupt then runs only while frames wait in the queue, and
+    /// acknowledges ended mailboxes without reporting them (with the `async` feature,
+    /// a frame it moves from the queue to a mailbox wakes the senders waiting for
+    /// room).
+    pub const QUIET_TX: bool =
+        H::QUIET_TX && DONE == 0 && !Fe::COUNTS && !Fe::TIMESTAMPS && Q::ALWAYS_FIFO;
+
     crate::sync::const_fn! {
         /// Empty, with no controller yet: all zeros.
         pub fn new() -> Self {
@@ -424,6 +434,11 @@ impl<
     fn first_look(&self, hw: &H) -> (H::FilterMap, ErrorStatus) {
         // SAFETY: not published yet: this is the only context that sees it.
         let map = unsafe { hw.filter_map() };
+        if Self::QUIET_TX {
+            // Nothing queued yet: the transmit interrupt waits for the first queued
+            // frame. SAFETY: not published yet, so no other context runs the driver.
+            unsafe { hw.set_tx_interrupt(false) };
+        }
         let status = hw.error_status();
         self.state
             .store(state_code(status.state), Ordering::Relaxed);
@@ -680,9 +695,14 @@ impl<
             TxOutcome::Failed => self.failed.inc(),
             TxOutcome::Aborted => self.aborted.inc(),
         }
-        // SAFETY: completions are produced only inside the critical section (transmit
-        // interrupt, transmit half's slow path), so producers never overlap.
-        let _ = unsafe { self.done.push(done) };
+        // With `DONE` = 0 completions are off: nothing is kept, nothing counted (the
+        // branch is settled at compile time).
+        if DONE != 0 {
+            // SAFETY: completions are produced only inside the critical section
+            // (transmit interrupt, transmit half's slow path), so producers never
+            // overlap.
+            let _ = unsafe { self.done.push(done) };
+        }
         // The event the transmit handler wakes on (inside the critical section, as
         // every `record`).
         #[cfg(feature = "async")]
@@ -704,16 +724,42 @@ impl<
         false
     }
 
+    /// Moves `queue_len` one up (`up`) or down and returns the new length, with a load
+    /// and a store instead of a read-modify-write: every change happens inside the
+    /// driver's critical section (one writer at a time), and the transmit half's direct
+    /// path only loads it. `store`: the ordering of the store (release where the
+    /// direct path must see what came before).
+    #[inline(always)]
+    fn queue_len_step(&self, up: bool, store: Ordering) -> u32 {
+        let len = self.queue_len.load(Ordering::Relaxed);
+        let len = if up {
+            len.wrapping_add(1)
+        } else {
+            len.wrapping_sub(1)
+        };
+        self.queue_len.store(len, store);
+        len
+    }
+
     /// The transmit interrupt's work, inside the critical section `cs`: settle ended
     /// mailboxes, put displaced frames back, refill free mailboxes from the queue.
     fn service_tx(&self, q: &mut Q) {
         let hw = self.hw();
         // SAFETY (every block below): the caller holds the critical section, the
         // transmit interrupt's context for `settle`/`load`/`displace`.
-        unsafe { self.settle_into(q) };
+        if Self::QUIET_TX {
+            unsafe { hw.acknowledge_ended() };
+        } else {
+            unsafe { self.settle_into(q) };
+        }
         let mut displaced = false;
         while let Some(next) = q.peek() {
-            match hw.free_mailbox(&next.frame) {
+            let free = if Self::QUIET_TX {
+                hw.free_mailbox_quiet(&next.frame)
+            } else {
+                hw.free_mailbox(&next.frame)
+            };
+            match free {
                 Ok(Some(m)) => {
                     let e = *next;
                     q.pop();
@@ -722,7 +768,12 @@ impl<
                     // direct path: a core running it beside this one (host threads)
                     // must not pick the mailbox being loaded here (release: the load's
                     // register writes come first).
-                    self.queue_len.fetch_sub(1, Ordering::Release);
+                    self.queue_len_step(false, Ordering::Release);
+                    // Queue room freed: in the quiet mode no completion says so.
+                    #[cfg(feature = "async")]
+                    if Self::QUIET_TX {
+                        self.tx_event.store(true, Ordering::Relaxed);
+                    }
                 }
                 Ok(None) => {
                     // The displaced frame comes back through `settle` while `next` still
@@ -740,12 +791,16 @@ impl<
                     // transmit half cannot take it). An abort of a pending mailbox ends at
                     // once: settle again so the frame takes the mailbox now; otherwise
                     // the abort's completion interrupt does it.
-                    self.queue_len.fetch_add(1, Ordering::Relaxed);
+                    self.queue_len_step(true, Ordering::Relaxed);
                     displaced = true;
                     unsafe { self.settle_into(q) };
                 }
                 Err(_) => break,
             }
+        }
+        if Self::QUIET_TX && q.is_empty() {
+            // Nothing left to refill: no interrupt until a frame is queued again.
+            unsafe { hw.set_tx_interrupt(false) };
         }
     }
 
@@ -770,7 +825,7 @@ impl<
                 // Were it refused, the frame would still get its one completion.
                 if q.push(Queued { token, frame }).is_err() {
                     debug_assert!(false, "no room kept for a displaced frame");
-                    self.queue_len.fetch_sub(1, Ordering::Relaxed);
+                    self.queue_len_step(false, Ordering::Relaxed);
                     self.record(Completion {
                         token,
                         outcome: TxOutcome::Aborted,
@@ -780,7 +835,7 @@ impl<
                 }
             }
             Settled::DoneDisplacing(c) => {
-                self.queue_len.fetch_sub(1, Ordering::Relaxed);
+                self.queue_len_step(false, Ordering::Relaxed);
                 self.record(c);
             }
         }
@@ -958,7 +1013,12 @@ impl<
         // Relaxed: on the direct path this half reads no memory that the transmit
         // interrupt writes, only the hardware's mailbox status (`free_mailbox`).
         if s.queue_len.load(Ordering::Relaxed) == 0 {
-            match hw.free_mailbox(frame) {
+            let free = if State::<H, RX, Q, RX1, DONE, Fe>::QUIET_TX {
+                hw.free_mailbox_quiet(frame)
+            } else {
+                hw.free_mailbox(frame)
+            };
+            match free {
                 Ok(Some(m)) => {
                     // SAFETY: the transmit half's direct path: the queue is empty and only
                     // this half fills it, so the interrupt's refill loads nothing and
@@ -1008,8 +1068,13 @@ impl<
                 s.queue_overflows.inc();
                 return Err(nb::Error::WouldBlock);
             }
-            let len = s.queue_len.fetch_add(1, Ordering::Relaxed) + 1;
+            let len = s.queue_len_step(true, Ordering::Relaxed);
             s.note_queue_peak(len);
+            if State::<H, RX, Q, RX1, DONE, Fe>::QUIET_TX {
+                // SAFETY: inside the critical section. A frame waits: the interrupt
+                // refills (`service_tx` turns it off again if the queue empties now).
+                unsafe { hw.set_tx_interrupt(true) };
+            }
             s.service_tx(q);
             Ok(self.accept(token))
         })
@@ -1028,7 +1093,14 @@ impl<
             return Err(nb::Error::Other(Error::BusOff));
         }
         let token = Token(self.next);
-        let load = || match hw.free_mailbox_now(frame) {
+        let free = || {
+            if State::<H, RX, Q, RX1, DONE, Fe>::QUIET_TX {
+                hw.free_mailbox_quiet(frame)
+            } else {
+                hw.free_mailbox_now(frame)
+            }
+        };
+        let load = || match free() {
             Ok(Some(m)) => {
                 // SAFETY: either the queue is empty (the direct path of `try_send`), or
                 // the caller holds the critical section, which keeps the interrupt's
@@ -1070,7 +1142,7 @@ impl<
             // SAFETY: the queue is only touched inside a critical section.
             let q = unsafe { &mut *s.queue.borrow(cs).get() };
             if q.remove(token) {
-                s.queue_len.fetch_sub(1, Ordering::Relaxed);
+                s.queue_len_step(false, Ordering::Relaxed);
                 s.record(Completion {
                     token,
                     outcome: TxOutcome::Aborted,
@@ -1101,7 +1173,7 @@ impl<
             let q = unsafe { &mut *s.queue.borrow(cs).get() };
             let mut dropped = 0;
             while let Some(e) = q.pop() {
-                s.queue_len.fetch_sub(1, Ordering::Relaxed);
+                s.queue_len_step(false, Ordering::Relaxed);
                 s.record(Completion {
                     token: e.token,
                     outcome: TxOutcome::Aborted,
@@ -1758,6 +1830,12 @@ impl<
             Err(false) => return Err((UnsplitError::Foreign, parts)),
             Err(true) => return Err((UnsplitError::Leased, parts)),
         };
+        if Self::QUIET_TX {
+            // The transmit interrupt back as configured for whoever takes the
+            // controller. SAFETY: every handle is here, so no other context runs the
+            // driver; the critical section keeps the interrupt's own handler out.
+            critical_section::with(|_| unsafe { hw.set_tx_interrupt(true) });
+        }
         let mut left = Leftovers::default();
         // SAFETY: the consumer handles of the rings (`Rx`, `Tx`) and the producer
         // handles (the interrupt handlers, `Tx`'s slow path inside the critical

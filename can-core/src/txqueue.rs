@@ -30,6 +30,9 @@ pub trait TxQueue {
     fn adopt(&mut self, policy: TxPolicy) -> bool {
         policy == self.policy()
     }
+    /// Whether the queue keeps the request order whatever it is asked to adopt (so
+    /// that the transmit interrupt never displaces a mailbox for it).
+    const ALWAYS_FIFO: bool = false;
     /// Capacity.
     const CAPACITY: usize;
     /// An empty queue (for `const` construction of the driver state).
@@ -77,6 +80,7 @@ impl<const N: usize> TxQueue for FifoQueue<N> {
     fn policy(&self) -> TxPolicy {
         TxPolicy::Fifo
     }
+    const ALWAYS_FIFO: bool = true;
     const CAPACITY: usize = N;
     const EMPTY: Self = FifoQueue {
         head: 0,

@@ -7,9 +7,10 @@
 //! submission order (request order: all frames; identifier priority: frames of equal
 //! priority).
 
-use twocan_core::{FifoQueue, Frame, PriorityQueue, TxPolicy};
+use twocan_core::{FifoQueue, Frame, Lean, PriorityQueue, Registers, State, TxPolicy};
 use twocan_tests::preempt::{
-    bxcan_rig, flexcan_rig, flexcan_rig_with, sweep, BxHw, FlexHw, Step, Swept,
+    bxcan_rig, bxcan_rig_with, flexcan_rig, flexcan_rig_with, run_script, sweep, BxHw, FlexHw,
+    Step, Swept, RX,
 };
 
 /// Frames of one identifier, told apart by their data.
@@ -136,6 +137,12 @@ fn bx_priority() -> twocan_tests::preempt::Rig<BxHw, PriorityQueue<4>> {
     bxcan_rig(TxPolicy::Priority)
 }
 
+/// bxCAN in the quiet transmit mode: no completion ring, `Lean`, request order (the
+/// transmit interrupt on only while frames are queued).
+fn bx_quiet() -> twocan_tests::preempt::Rig<BxHw, FifoQueue<4>, 0, Lean> {
+    bxcan_rig_with(TxPolicy::Fifo)
+}
+
 fn flex() -> twocan_tests::preempt::Rig<FlexHw, FifoQueue<4>> {
     flexcan_rig()
 }
@@ -149,6 +156,10 @@ sweeps! {
     bxcan_request_order_mixed_send: bx_fifo, Fifo, mixed(N), sends;
     bxcan_request_order_mixed_abort: bx_fifo, Fifo, mixed(N), sends_and_aborts;
     bxcan_request_order_mixed_abort_on_the_wire: bx_fifo, Fifo, mixed(N), aborts_on_the_wire;
+    bxcan_quiet_one_identifier_send: bx_quiet, Fifo, one_identifier(N), sends;
+    bxcan_quiet_one_identifier_abort: bx_quiet, Fifo, one_identifier(N), sends_and_aborts;
+    bxcan_quiet_mixed_send: bx_quiet, Fifo, mixed(N), sends;
+    bxcan_quiet_mixed_abort_on_the_wire: bx_quiet, Fifo, mixed(N), aborts_on_the_wire;
     bxcan_priority_one_identifier_send: bx_priority, Priority, one_identifier(N), sends;
     bxcan_priority_one_identifier_abort: bx_priority, Priority, one_identifier(N), sends_and_aborts;
     bxcan_priority_one_identifier_abort_on_the_wire: bx_priority, Priority, one_identifier(N), aborts_on_the_wire;
@@ -195,4 +206,55 @@ fn flexcan_abort_during_a_retry_loop_takes_effect() {
         !rig.bus.borrow().in_frame() && rig.bus.borrow_mut().step().is_none(),
         "no more attempts"
     );
+}
+
+/// The quiet mode is what `bx_quiet` runs (settled at compile time), and in it the
+/// transmit interrupt is enabled exactly while frames wait in the queue: after a burst
+/// that had to queue, the queue drains through the interrupt and `CAN_IER.TMEIE` is
+/// off again; frames sent one at a time with the bus idle in between leave without
+/// any transmit interrupt (the line never rises).
+#[test]
+fn bxcan_quiet_mode_enables_the_transmit_interrupt_only_while_frames_wait() {
+    assert!(State::<BxHw, RX, FifoQueue<4>, RX, 0, Lean>::QUIET_TX);
+    assert!(!State::<BxHw, RX, FifoQueue<4>, RX, 0, twocan_core::Full>::QUIET_TX);
+    assert!(!State::<BxHw, RX, FifoQueue<4>, RX, 8, Lean>::QUIET_TX);
+    assert!(!State::<BxHw, RX, PriorityQueue<4>, RX, 0, Lean>::QUIET_TX);
+    let ier = |rig: &twocan_tests::preempt::Rig<BxHw, FifoQueue<4>, 0, Lean>| {
+        rig.state
+            .hardware()
+            .unwrap()
+            .registers()
+            .read32(twocan_bxcan::regs::IER)
+    };
+    let tmeie = twocan_bxcan::regs::ier::TMEIE;
+
+    // Split: nothing queued, the interrupt off; the other enables as configured.
+    let rig = bx_quiet();
+    assert_eq!(ier(&rig) & tmeie, 0);
+    assert_ne!(ier(&rig) & twocan_bxcan::regs::ier::FMPIE0, 0);
+    // A burst of eight: three go to the mailboxes, the rest queue and are refilled
+    // from the interrupt; at the end the queue is empty and the interrupt off.
+    let burst: Vec<Step> = one_identifier(8).into_iter().map(Step::Send).collect();
+    let rig = bx_quiet();
+    let state = rig.state;
+    let o = run_script(rig, &burst, None);
+    o.check(TxPolicy::Fifo, "quiet burst");
+    assert_eq!(o.wire.len(), 8);
+    let hw = state.hardware().unwrap();
+    assert_eq!(hw.registers().read32(twocan_bxcan::regs::IER) & tmeie, 0);
+    drop(hw);
+
+    // One at a time, the bus idle in between: no transmit interrupt at all.
+    let mut rig = bx_quiet();
+    let bus = rig.bus.clone();
+    for k in 0..6u8 {
+        let f = Frame::standard(0x200, &[k]).unwrap();
+        rig.tx.try_send(&f).unwrap();
+        for _ in 0..4 {
+            bus.borrow_mut().step();
+            assert_eq!(ier(&rig) & tmeie, 0, "frame {k}: the interrupt stays off");
+        }
+    }
+    assert_eq!(rig.peer.borrow().received_frames().len(), 6);
+    assert_eq!(rig.tx.stats().count, 0);
 }
