@@ -501,17 +501,17 @@ unsafe impl<R: Registers, F: Registers, const K: usize> Hardware for BxCan<R, F,
     /// clears `RQCPx`, RM0410 §40.9.2 `CAN_TSR`).
     const QUIET_TX: bool = true;
 
-    /// Request order only (the quiet mode's queue; `TXFP` = 1 sends the mailboxes in
-    /// the order of their requests, RM0410 §40.7.3): any empty mailbox, `CODE` first,
+    /// Request order only (the quiet mode's queue, adopted only by a controller with
+    /// `TXFP` = 1, which sends the mailboxes in the order of their requests, RM0410
+    /// §40.7.3; in identifier priority this would break the order): any empty mailbox, `CODE` first,
     /// whether or not its `RQCPx` was acknowledged. Refused in listen-only mode as
     /// [`Hardware::free_mailbox`] is.
     #[inline(always)]
     fn free_mailbox_quiet(&self, frame: &Frame) -> Result<Option<u8>, Error> {
-        if self.config.get_tx_policy() != TxPolicy::Fifo {
-            // Not the quiet mode's order (unreachable through the split driver, whose
-            // request-order queue is adopted only by a request-order controller).
-            return self.free_mailbox(frame);
-        }
+        // The quiet mode's queue is adopted only by a request-order controller, whose
+        // order (`config`) never changes while split.
+        debug_assert!(self.config.get_tx_policy() == TxPolicy::Fifo);
+        let _ = frame;
         if self.listen_only.load(Ordering::Relaxed) {
             return Err(Error::WrongMode);
         }

@@ -171,11 +171,11 @@ impl defmt::Format for Frame {
     }
 }
 
-/// The mask of the data bytes a data frame of each DLC code carries, over the
-/// little-endian 64-bit value of its eight data bytes: codes 0..=8 keep that many bytes,
-/// 9..=15 keep eight (ISO 11898-1 classic CAN: DLC values above 8 mean 8 bytes).
-const DATA_MASK: [u64; 16] = {
-    let mut m = [u64::MAX; 16];
+/// The mask of the data bytes a data frame of DLC 0..=7 carries (that many), over the
+/// little-endian 64-bit value of its eight data bytes (codes 8..=15 keep all eight,
+/// ISO 11898-1 classic CAN).
+const DATA_MASK: [u64; 8] = {
+    let mut m = [0; 8];
     let mut n = 0;
     while n < 8 {
         m[n] = (1u64 << (8 * n)) - 1;
@@ -342,15 +342,17 @@ impl Frame {
         let id_mask = if extended { ID_BITS } else { 0x7FF };
         let word = word & (EXTENDED_BIT | REMOTE_BIT | id_mask);
         let dlc = dlc & MAX_DLC_CODE;
-        // Bytes beyond the data length cleared with one mask over the little-endian
-        // 64-bit value, looked up by the DLC code (a load instead of shifts, a byte
-        // loop or a `memset` call); a remote frame keeps none.
-        let mask = if word & REMOTE_BIT != 0 {
-            0
+        // Bytes beyond the data length cleared: none for eight bytes (a compare),
+        // else one mask over the little-endian 64-bit value, looked up by the DLC (a
+        // load instead of shifts, a byte loop or a `memset` call); a remote frame
+        // keeps none.
+        let bytes = if word & REMOTE_BIT != 0 {
+            [0; 8]
+        } else if dlc >= MAX_DLC {
+            data
         } else {
-            DATA_MASK[dlc as usize]
+            (u64::from_le_bytes(data) & DATA_MASK[(dlc & 7) as usize]).to_le_bytes()
         };
-        let bytes = (u64::from_le_bytes(data) & mask).to_le_bytes();
         Frame {
             word,
             dlc,

@@ -1056,7 +1056,12 @@ impl<
                     return Err(nb::Error::WouldBlock);
                 }
             }
-            if let Err(e) = hw.free_mailbox(frame) {
+            let mode = if State::<H, RX, Q, RX1, DONE, Fe>::QUIET_TX {
+                hw.free_mailbox_quiet(frame)
+            } else {
+                hw.free_mailbox(frame)
+            };
+            if let Err(e) = mode {
                 return Err(nb::Error::Other(e));
             }
             if q.push(Queued {
