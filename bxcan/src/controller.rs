@@ -6,7 +6,7 @@ use twocan_core::{Error, LastErrorCode, Mode, Registers};
 
 use crate::config::Config;
 use crate::filter_block;
-use crate::filters::{Fifo, FilterPlan, FmiMap, PlanRef, LOOKUP_KEYS};
+use crate::filters::{Fifo, FilterPlan, FmiMap, PlanRef, LOOKUP_KEYS, MAX_FMI};
 use crate::instance::Instance;
 use crate::mode;
 use crate::planner::{self, FifoPolicy, PlanOptions, Scratch};
@@ -41,20 +41,30 @@ impl<T> From<Failed<T>> for Error {
 /// `K` is how many identifiers of merged filters the driver can map back to the user's
 /// filter index ([`FmiMap`], 6 bytes each, [`LOOKUP_KEYS`] by default); change it with
 /// [`Init::with_lookup_capacity`].
-pub struct Can<R: Registers, F: Registers = R, const K: usize = LOOKUP_KEYS> {
+pub struct Can<
+    R: Registers,
+    F: Registers = R,
+    const K: usize = LOOKUP_KEYS,
+    const M: usize = MAX_FMI,
+> {
     pub(crate) regs: R,
     pub(crate) filter_regs: Option<F>,
     pub(crate) instance: Instance,
     pub(crate) config: Config,
-    pub(crate) fmi: FmiMap<K>,
+    pub(crate) fmi: FmiMap<K, M>,
 }
 
 /// A controller in initialization mode (RM0410 §40.4.1), configured but off the bus.
 /// Install filters with [`Init::set_filters`], then go on the bus with [`Init::enable`].
 #[must_use = "the controller stays in initialization mode, off the bus, until `enable` is called"]
 #[derive(Debug)]
-pub struct Init<R: Registers, F: Registers = R, const K: usize = LOOKUP_KEYS> {
-    can: Can<R, F, K>,
+pub struct Init<
+    R: Registers,
+    F: Registers = R,
+    const K: usize = LOOKUP_KEYS,
+    const M: usize = MAX_FMI,
+> {
+    can: Can<R, F, K, M>,
 }
 
 // The error values hand the whole controller back (nothing is lost on a timeout); its
@@ -115,7 +125,7 @@ impl<R: Registers, F: Registers> Can<R, F> {
 }
 
 #[allow(clippy::result_large_err)]
-impl<R: Registers, F: Registers, const K: usize> Can<R, F, K> {
+impl<R: Registers, F: Registers, const K: usize, const M: usize> Can<R, F, K, M> {
     fn new(regs: R, filter_regs: Option<F>, instance: Instance, config: &Config) -> Self {
         Can {
             regs,
@@ -134,7 +144,7 @@ impl<R: Registers, F: Registers, const K: usize> Can<R, F, K> {
         filter_regs: Option<F>,
         instance: Instance,
         config: &Config,
-    ) -> Result<Init<R, F, K>, Failed<Can<R, F, K>>> {
+    ) -> Result<Init<R, F, K, M>, Failed<Can<R, F, K, M>>> {
         match enter_configuration(&regs, filter_regs.as_ref(), instance, config) {
             Ok(()) => Ok(Init {
                 can: Can::new(regs, filter_regs, instance, config),
@@ -146,7 +156,7 @@ impl<R: Registers, F: Registers, const K: usize> Can<R, F, K> {
         }
     }
 
-    fn configure(mut self, config: &Config) -> Result<Init<R, F, K>, Failed<Can<R, F, K>>> {
+    fn configure(mut self, config: &Config) -> Result<Init<R, F, K, M>, Failed<Can<R, F, K, M>>> {
         let (regs, filter_regs) = (&self.regs, self.filter_regs.as_ref());
         if let Err(error) = check_start_bank(regs, filter_regs, self.instance, config) {
             return Err(Failed { error, value: self });
@@ -159,7 +169,7 @@ impl<R: Registers, F: Registers, const K: usize> Can<R, F, K> {
     }
 
     /// Re-enters initialization mode with a new configuration (the filters stay).
-    pub fn reconfigure(self, config: &Config) -> Result<Init<R, F, K>, Failed<Can<R, F, K>>> {
+    pub fn reconfigure(self, config: &Config) -> Result<Init<R, F, K, M>, Failed<Can<R, F, K, M>>> {
         self.configure(config)
     }
 
@@ -170,7 +180,7 @@ impl<R: Registers, F: Registers, const K: usize> Can<R, F, K> {
     ///
     /// Errors: [`Error::Timeout`] when `SLAK` does not come, with this value handed back.
     #[allow(clippy::result_large_err, clippy::type_complexity)]
-    pub fn master_reset(self) -> Result<(R, Option<F>), Failed<Can<R, F, K>>> {
+    pub fn master_reset(self) -> Result<(R, Option<F>), Failed<Can<R, F, K, M>>> {
         self.regs.write32(MCR, mcr::RESET);
         let bound = self.bound();
         match mode::wait_msr(
@@ -258,7 +268,7 @@ impl<R: Registers, F: Registers, const K: usize> Can<R, F, K> {
 
     fn write_filters(&mut self, plan: PlanRef<'_>) -> Result<(), Error> {
         // The map first: a plan the map cannot hold is refused before any bank changes.
-        let fmi = plan.fmi_map::<K>()?;
+        let fmi = plan.fmi_map_sized::<K, M>()?;
         let instance = self.instance;
         let chip = self.config.get_chip();
         let r = match &mut self.filter_regs {
@@ -365,12 +375,20 @@ pub fn lec(code: u32) -> LastErrorCode {
 }
 
 #[allow(clippy::result_large_err)]
-impl<R: Registers, F: Registers, const K: usize> Init<R, F, K> {
+impl<R: Registers, F: Registers, const K: usize, const M: usize> Init<R, F, K, M> {
     /// The same controller with room for `K2` identifiers in its merged-filter lookup
     /// ([`FmiMap`]; `K` = [`LOOKUP_KEYS`] unless chosen): call before
     /// [`Init::set_filters`] (the map starts empty again). Plans whose merged or
     /// superset slots need more are refused with [`Error::FilterSpace`].
-    pub fn with_lookup_capacity<const K2: usize>(self) -> Init<R, F, K2> {
+    pub fn with_lookup_capacity<const K2: usize>(self) -> Init<R, F, K2, M> {
+        self.with_map_capacity::<K2, M>()
+    }
+
+    /// [`Init::with_lookup_capacity`] with room for `M2` match indices per FIFO too
+    /// ([`FmiMap`]; [`MAX_FMI`] unless chosen: a `const` plan's
+    /// [`crate::filters::PlanRef::match_indices`] is the least). Plans that number more
+    /// are refused with [`Error::FilterSpace`].
+    pub fn with_map_capacity<const K2: usize, const M2: usize>(self) -> Init<R, F, K2, M2> {
         let c = self.can;
         Init {
             can: Can {
@@ -394,12 +412,12 @@ impl<R: Registers, F: Registers, const K: usize> Init<R, F, K> {
     }
 
     /// The controller, still in initialization mode (to plan filters for its banks).
-    pub fn can(&self) -> &Can<R, F, K> {
+    pub fn can(&self) -> &Can<R, F, K, M> {
         &self.can
     }
 
     /// The controller, still in initialization mode, mutably.
-    pub fn can_mut(&mut self) -> &mut Can<R, F, K> {
+    pub fn can_mut(&mut self) -> &mut Can<R, F, K, M> {
         &mut self.can
     }
 
@@ -407,7 +425,7 @@ impl<R: Registers, F: Registers, const K: usize> Init<R, F, K> {
     /// hardware gives after 11 recessive bits on CANRX (RM0410 §40.4.2).
     ///
     /// Errors: [`Error::Timeout`], with this value handed back in [`Failed::value`].
-    pub fn enable(self) -> Result<Can<R, F, K>, Failed<Init<R, F, K>>> {
+    pub fn enable(self) -> Result<Can<R, F, K, M>, Failed<Init<R, F, K, M>>> {
         let bound = self.can.bound();
         match mode::request(&self.can.regs, Mode::Normal, bound) {
             Ok(()) => Ok(self.can),

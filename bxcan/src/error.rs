@@ -74,6 +74,10 @@ impl fmt::Display for PlanError {
                 f,
                 "the merged filters leave {needed} identifiers to the driver's lookup, which holds {max}"
             ),
+            PlanError::TooManyMatchIndices { needed, max } => write!(
+                f,
+                "the filters number {needed} match indices in a FIFO, the driver's map holds {max}"
+            ),
             PlanError::BankOutOfRange => f.write_str("filter bank index above 27"),
         }
     }

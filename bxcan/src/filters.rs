@@ -457,6 +457,14 @@ pub enum PlanError {
         /// The lookup capacity.
         max: u16,
     },
+    /// The plan numbers more match indices in a FIFO than the controller's map holds
+    /// (its `M`, sized for a smaller plan: [`PlanRef::match_indices`]).
+    TooManyMatchIndices {
+        /// Match indices the plan numbers in its busier FIFO.
+        needed: u16,
+        /// The map's room per FIFO.
+        max: u16,
+    },
     /// A bank index beyond the filter block (0..28).
     BankOutOfRange,
 }
@@ -560,6 +568,11 @@ impl PlanError {
                 .number(needed as u32)
                 .text(" lookup keys, the capacity is ")
                 .number(max as u32),
+            PlanError::TooManyMatchIndices { needed, max } => m
+                .text("the plan numbers ")
+                .number(needed as u32)
+                .text(" match indices in a FIFO, the map holds ")
+                .number(max as u32),
             PlanError::BankOutOfRange => m.text("a bank index above 27"),
         };
         panic!("{}", m.as_str())
@@ -589,7 +602,8 @@ impl From<PlanError> for twocan_core::Error {
                 needed: can1_needed.saturating_add(can2_needed),
                 available: available as u16,
             },
-            PlanError::TooManyLookupKeys { needed, max } => twocan_core::Error::FilterSpace {
+            PlanError::TooManyLookupKeys { needed, max }
+            | PlanError::TooManyMatchIndices { needed, max } => twocan_core::Error::FilterSpace {
                 needed,
                 available: max,
             },
@@ -858,10 +872,36 @@ impl<'a> PlanRef<'a> {
 
     /// See [`FilterPlan::fmi_map`].
     pub const fn fmi_map<const K: usize>(&self) -> Result<FmiMap<K>, PlanError> {
-        let mut map = FmiMap::<K>::empty();
+        self.fmi_map_sized::<K, MAX_FMI>()
+    }
+
+    /// [`PlanRef::fmi_map`] with room for `M` match indices per FIFO
+    /// ([`PlanRef::match_indices`] at least).
+    pub const fn fmi_map_sized<const K: usize, const M: usize>(
+        &self,
+    ) -> Result<FmiMap<K, M>, PlanError> {
+        let mut map = FmiMap::<K, M>::empty();
         match map.fill(*self) {
             Ok(()) => Ok(map),
             Err(e) => Err(e),
+        }
+    }
+
+    /// The match indices the plan numbers in its busier FIFO: each bank gives as many
+    /// as it has slots, active or not (RM0410 §40.7.4 "Filter match index"). The
+    /// smallest `M` of a driver map ([`FmiMap`]) that holds the plan: a `const` plan
+    /// sizes its controller's map with it (`BxCan<R, F, K, { PLAN.match_indices() }>`).
+    pub const fn match_indices(&self) -> usize {
+        let mut next = [0usize; 2];
+        let mut b = 0;
+        while b < self.banks.len() {
+            next[self.banks[b].fifo.index()] += self.banks[b].kind.slots();
+            b += 1;
+        }
+        if next[0] > next[1] {
+            next[0]
+        } else {
+            next[1]
         }
     }
 }
@@ -1212,6 +1252,18 @@ impl<const K: usize> FilterPlan<K> {
         self.as_ref().fmi_map::<K2>()
     }
 
+    /// See [`PlanRef::fmi_map_sized`].
+    pub const fn fmi_map_sized<const K2: usize, const M2: usize>(
+        &self,
+    ) -> Result<FmiMap<K2, M2>, PlanError> {
+        self.as_ref().fmi_map_sized::<K2, M2>()
+    }
+
+    /// See [`PlanRef::match_indices`].
+    pub const fn match_indices(&self) -> usize {
+        self.as_ref().match_indices()
+    }
+
     /// The user index reported for a frame stored in `fifo` with match index `fmi`
     /// ([`NO_FILTER`] if no slot has it, [`LOOKUP`] if it depends on the identifier).
     pub const fn user_index(&self, fifo: Fifo, fmi: u8) -> u16 {
@@ -1402,21 +1454,37 @@ impl<const B: usize, const K: usize> SizedPlan<B, K> {
     pub const fn fmi_map<const K2: usize>(&self) -> Result<FmiMap<K2>, PlanError> {
         self.as_ref().fmi_map::<K2>()
     }
+
+    /// See [`PlanRef::fmi_map_sized`].
+    pub const fn fmi_map_sized<const K2: usize, const M2: usize>(
+        &self,
+    ) -> Result<FmiMap<K2, M2>, PlanError> {
+        self.as_ref().fmi_map_sized::<K2, M2>()
+    }
+
+    /// See [`PlanRef::match_indices`].
+    pub const fn match_indices(&self) -> usize {
+        self.as_ref().match_indices()
+    }
 }
 
 /// Map from (FIFO, filter match index) to the user's filter index, kept by the
 /// controller for [`twocan_core::RxFrame::filter`].
 #[derive(Debug, Clone, PartialEq, Eq)]
-pub struct FmiMap<const K: usize = LOOKUP_KEYS> {
-    map: [[u16; MAX_FMI]; 2],
+///
+/// `K`: the capacity of its merged-filter lookup (identifiers); `M`: the match indices
+/// it holds per FIFO, [`MAX_FMI`] (every bank of the block, four slots each) unless a
+/// `const` plan sizes it ([`PlanRef::match_indices`]): 4 bytes per index.
+pub struct FmiMap<const K: usize = LOOKUP_KEYS, const M: usize = MAX_FMI> {
+    map: [[u16; M]; 2],
     keys: KeyTable<K>,
 }
 
-impl<const K: usize> FmiMap<K> {
+impl<const K: usize, const M: usize> FmiMap<K, M> {
     /// A map where nothing maps ([`NO_FILTER`] everywhere).
     pub const fn empty() -> Self {
         FmiMap {
-            map: [[NO_FILTER; MAX_FMI]; 2],
+            map: [[NO_FILTER; M]; 2],
             keys: KeyTable::new(),
         }
     }
@@ -1427,16 +1495,23 @@ impl<const K: usize> FmiMap<K> {
     /// bank giving as many as it has slots (RM0410 §40.7.4 "Filter match index").
     ///
     /// Errors: [`PlanError::TooManyLookupKeys`] when `plan` needs more lookup keys than
-    /// `K` (the map is then empty: nothing maps).
+    /// `K`, [`PlanError::TooManyMatchIndices`] when it numbers more match indices in a
+    /// FIFO than `M` (the map is then empty: nothing maps).
     pub const fn fill(&mut self, plan: PlanRef<'_>) -> Result<(), PlanError> {
         let mut f = 0;
         while f < 2 {
             let mut i = 0;
-            while i < MAX_FMI {
+            while i < M {
                 self.map[f][i] = NO_FILTER;
                 i += 1;
             }
             f += 1;
+        }
+        if plan.match_indices() > M {
+            return Err(PlanError::TooManyMatchIndices {
+                needed: plan.match_indices() as u16,
+                max: M as u16,
+            });
         }
         if self.keys.copy_from(plan.keys, plan.key_users).is_err() {
             return Err(PlanError::TooManyLookupKeys {
@@ -1450,7 +1525,7 @@ impl<const K: usize> FmiMap<K> {
             let f = plan.banks[b].fifo.index();
             let mut s = 0;
             while s < plan.banks[b].kind.slots() {
-                if next[f] < MAX_FMI {
+                if next[f] < M {
                     self.map[f][next[f]] = plan.users[b][s];
                 }
                 next[f] += 1;

@@ -77,7 +77,7 @@ use twocan_core::split::{Rx, Rx0Irq, Rx1Irq, State, StatusIrq, Tx, TxIrq};
 use twocan_core::txqueue::TxQueue;
 use twocan_core::{Error, Leftovers, Parts, Registers, UnsplitError};
 
-use crate::filters::{FmiMap, LOOKUP_KEYS};
+use crate::filters::{FmiMap, LOOKUP_KEYS, MAX_FMI};
 use crate::instance::Instance;
 use crate::split::BxCan;
 
@@ -259,7 +259,7 @@ pub fn is_wired(instance: Instance) -> bool {
     slot(instance).get().is_some()
 }
 
-type Hw<R, F, const K: usize> = BxCan<R, F, K>;
+type Hw<R, F, const K: usize, const M: usize> = BxCan<R, F, K, M>;
 
 /// The split driver's state of one bxCAN instance together with its four interrupt
 /// handlers, for a `static` (all zeros: `.bss`). `RX`/`RX1`: the FIFO 0 and FIFO 1
@@ -273,18 +273,28 @@ pub struct IrqState<
     const RX1: usize,
     const DONE: usize,
     const K: usize = LOOKUP_KEYS,
+    const M: usize = MAX_FMI,
 > {
-    state: State<Hw<R, F, K>, RX, Q, RX1, DONE>,
-    tx: IrqCell<TxIrq<'static, Hw<R, F, K>, RX, Q, RX1, DONE>>,
-    rx0: IrqCell<Rx0Irq<'static, Hw<R, F, K>, RX, Q, RX1, DONE>>,
-    rx1: IrqCell<Rx1Irq<'static, Hw<R, F, K>, RX, Q, RX1, DONE>>,
-    sce: IrqCell<StatusIrq<'static, Hw<R, F, K>, RX, Q, RX1, DONE>>,
+    state: State<Hw<R, F, K, M>, RX, Q, RX1, DONE>,
+    tx: IrqCell<TxIrq<'static, Hw<R, F, K, M>, RX, Q, RX1, DONE>>,
+    rx0: IrqCell<Rx0Irq<'static, Hw<R, F, K, M>, RX, Q, RX1, DONE>>,
+    rx1: IrqCell<Rx1Irq<'static, Hw<R, F, K, M>, RX, Q, RX1, DONE>>,
+    sce: IrqCell<StatusIrq<'static, Hw<R, F, K, M>, RX, Q, RX1, DONE>>,
 }
 
 /// The transmit and receive halves [`IrqState::start_on`] gives the thread side.
-pub type Halves<R, F, const RX: usize, Q, const RX1: usize, const DONE: usize, const K: usize> = (
-    Tx<'static, Hw<R, F, K>, RX, Q, RX1, DONE>,
-    Rx<'static, Hw<R, F, K>, RX, Q, RX1, DONE>,
+pub type Halves<
+    R,
+    F,
+    const RX: usize,
+    Q,
+    const RX1: usize,
+    const DONE: usize,
+    const K: usize,
+    const M: usize,
+> = (
+    Tx<'static, Hw<R, F, K, M>, RX, Q, RX1, DONE>,
+    Rx<'static, Hw<R, F, K, M>, RX, Q, RX1, DONE>,
 );
 
 /// Why [`IrqState::start_on`] did not start; the controller comes back with it, and
@@ -347,8 +357,16 @@ impl fmt::Display for StopError {
 
 impl core::error::Error for StopError {}
 
-impl<R, F, const RX: usize, Q, const RX1: usize, const DONE: usize, const K: usize> Default
-    for IrqState<R, F, RX, Q, RX1, DONE, K>
+impl<
+        R,
+        F,
+        const RX: usize,
+        Q,
+        const RX1: usize,
+        const DONE: usize,
+        const K: usize,
+        const M: usize,
+    > Default for IrqState<R, F, RX, Q, RX1, DONE, K, M>
 where
     R: Registers + 'static,
     F: Registers + 'static,
@@ -359,8 +377,16 @@ where
     }
 }
 
-impl<R, F, const RX: usize, Q, const RX1: usize, const DONE: usize, const K: usize>
-    IrqState<R, F, RX, Q, RX1, DONE, K>
+impl<
+        R,
+        F,
+        const RX: usize,
+        Q,
+        const RX1: usize,
+        const DONE: usize,
+        const K: usize,
+        const M: usize,
+    > IrqState<R, F, RX, Q, RX1, DONE, K, M>
 where
     R: Registers + 'static,
     F: Registers + 'static,
@@ -378,7 +404,7 @@ where
     }
 
     /// The split driver's shared state (statistics, error state).
-    pub fn state(&self) -> &State<Hw<R, F, K>, RX, Q, RX1, DONE> {
+    pub fn state(&self) -> &State<Hw<R, F, K, M>, RX, Q, RX1, DONE> {
         &self.state
     }
 
@@ -393,8 +419,16 @@ where
     }
 }
 
-impl<R, F, const RX: usize, Q, const RX1: usize, const DONE: usize, const K: usize> Handlers
-    for IrqState<R, F, RX, Q, RX1, DONE, K>
+impl<
+        R,
+        F,
+        const RX: usize,
+        Q,
+        const RX1: usize,
+        const DONE: usize,
+        const K: usize,
+        const M: usize,
+    > Handlers for IrqState<R, F, RX, Q, RX1, DONE, K, M>
 where
     R: Registers + 'static,
     F: Registers + 'static,
@@ -412,13 +446,21 @@ where
     }
 }
 
-impl<R, F, const RX: usize, Q, const RX1: usize, const DONE: usize, const K: usize>
-    IrqState<R, F, RX, Q, RX1, DONE, K>
+impl<
+        R,
+        F,
+        const RX: usize,
+        Q,
+        const RX1: usize,
+        const DONE: usize,
+        const K: usize,
+        const M: usize,
+    > IrqState<R, F, RX, Q, RX1, DONE, K, M>
 where
     R: Registers + 'static,
     F: Registers + 'static,
     Q: TxQueue + 'static,
-    FmiMap<K>: Send,
+    FmiMap<K, M>: Send,
     Self: Sync,
 {
     /// Splits `hw` into this state, installs the four handlers behind the instance's
@@ -434,11 +476,11 @@ where
     #[allow(clippy::type_complexity, clippy::result_large_err)]
     pub fn start_on<L: Copy>(
         &'static self,
-        hw: Hw<R, F, K>,
+        hw: Hw<R, F, K, M>,
         lines: [L; 4],
         priorities: Priorities,
         nvic: &mut impl Nvic<L>,
-    ) -> Result<Halves<R, F, RX, Q, RX1, DONE, K>, (StartError, Hw<R, F, K>)> {
+    ) -> Result<Halves<R, F, RX, Q, RX1, DONE, K, M>, (StartError, Hw<R, F, K, M>)> {
         if self.state.hardware().is_some() {
             return Err((StartError::AlreadySplit, hw));
         }
@@ -482,11 +524,11 @@ where
     pub fn start_in_place_on<L: Copy>(
         &'static self,
         instance: Instance,
-        init: impl FnOnce(&mut MaybeUninit<Hw<R, F, K>>) -> Result<&mut Hw<R, F, K>, Error>,
+        init: impl FnOnce(&mut MaybeUninit<Hw<R, F, K, M>>) -> Result<&mut Hw<R, F, K, M>, Error>,
         lines: [L; 4],
         priorities: Priorities,
         nvic: &mut impl Nvic<L>,
-    ) -> Result<Halves<R, F, RX, Q, RX1, DONE, K>, StartError> {
+    ) -> Result<Halves<R, F, RX, Q, RX1, DONE, K, M>, StartError> {
         if self.state.hardware().is_some() {
             return Err(StartError::AlreadySplit);
         }
@@ -526,11 +568,12 @@ where
     #[allow(clippy::type_complexity, clippy::result_large_err)]
     pub fn stop_on<L: Copy>(
         &'static self,
-        tx: Tx<'static, Hw<R, F, K>, RX, Q, RX1, DONE>,
-        rx: Rx<'static, Hw<R, F, K>, RX, Q, RX1, DONE>,
+        tx: Tx<'static, Hw<R, F, K, M>, RX, Q, RX1, DONE>,
+        rx: Rx<'static, Hw<R, F, K, M>, RX, Q, RX1, DONE>,
         lines: [L; 4],
         nvic: &mut impl Nvic<L>,
-    ) -> Result<(Hw<R, F, K>, Leftovers), (StopError, Halves<R, F, RX, Q, RX1, DONE, K>)> {
+    ) -> Result<(Hw<R, F, K, M>, Leftovers), (StopError, Halves<R, F, RX, Q, RX1, DONE, K, M>)>
+    {
         if !core::ptr::eq(tx.state(), &self.state) || !core::ptr::eq(rx.state(), &self.state) {
             return Err((StopError::Foreign, (tx, rx)));
         }
@@ -648,13 +691,21 @@ mod f7 {
         }
     }
 
-    impl<R, F, const RX: usize, Q, const RX1: usize, const DONE: usize, const K: usize>
-        IrqState<R, F, RX, Q, RX1, DONE, K>
+    impl<
+            R,
+            F,
+            const RX: usize,
+            Q,
+            const RX1: usize,
+            const DONE: usize,
+            const K: usize,
+            const M: usize,
+        > IrqState<R, F, RX, Q, RX1, DONE, K, M>
     where
         R: Registers + 'static,
         F: Registers + 'static,
         Q: TxQueue + 'static,
-        FmiMap<K>: Send,
+        FmiMap<K, M>: Send,
         Self: Sync,
     {
         /// [`IrqState::start_on`] with the controller's instance's [`lines`] on the
@@ -662,10 +713,10 @@ mod f7 {
         #[allow(clippy::type_complexity, clippy::result_large_err)]
         pub fn start(
             &'static self,
-            hw: Hw<R, F, K>,
+            hw: Hw<R, F, K, M>,
             priorities: Priorities,
             nvic: &mut impl Nvic<Interrupt>,
-        ) -> Result<Halves<R, F, RX, Q, RX1, DONE, K>, (StartError, Hw<R, F, K>)> {
+        ) -> Result<Halves<R, F, RX, Q, RX1, DONE, K, M>, (StartError, Hw<R, F, K, M>)> {
             match lines(hw.instance()) {
                 Some(l) => self.start_on(hw, l, priorities, nvic),
                 None => Err((StartError::NoInterrupts, hw)),
@@ -677,10 +728,10 @@ mod f7 {
         pub fn start_in_place(
             &'static self,
             instance: Instance,
-            init: impl FnOnce(&mut MaybeUninit<Hw<R, F, K>>) -> Result<&mut Hw<R, F, K>, Error>,
+            init: impl FnOnce(&mut MaybeUninit<Hw<R, F, K, M>>) -> Result<&mut Hw<R, F, K, M>, Error>,
             priorities: Priorities,
             nvic: &mut impl Nvic<Interrupt>,
-        ) -> Result<Halves<R, F, RX, Q, RX1, DONE, K>, StartError> {
+        ) -> Result<Halves<R, F, RX, Q, RX1, DONE, K, M>, StartError> {
             match lines(instance) {
                 Some(l) => self.start_in_place_on(instance, init, l, priorities, nvic),
                 None => Err(StartError::NoInterrupts),
@@ -691,10 +742,10 @@ mod f7 {
         #[allow(clippy::type_complexity, clippy::result_large_err)]
         pub fn stop(
             &'static self,
-            tx: Tx<'static, Hw<R, F, K>, RX, Q, RX1, DONE>,
-            rx: Rx<'static, Hw<R, F, K>, RX, Q, RX1, DONE>,
+            tx: Tx<'static, Hw<R, F, K, M>, RX, Q, RX1, DONE>,
+            rx: Rx<'static, Hw<R, F, K, M>, RX, Q, RX1, DONE>,
             nvic: &mut impl Nvic<Interrupt>,
-        ) -> Result<(Hw<R, F, K>, Leftovers), (StopError, Halves<R, F, RX, Q, RX1, DONE, K>)>
+        ) -> Result<(Hw<R, F, K, M>, Leftovers), (StopError, Halves<R, F, RX, Q, RX1, DONE, K, M>)>
         {
             let instance = tx.hardware().instance();
             match lines(instance) {

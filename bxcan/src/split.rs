@@ -43,13 +43,13 @@ use twocan_core::{MailboxId, MailboxState};
 use crate::config::{Config, Recovery};
 use crate::controller::{lec, Can};
 use crate::filter_block;
-use crate::filters::{Fifo, FilterPlan, FmiMap, LOOKUP_KEYS};
+use crate::filters::{Fifo, FilterPlan, FmiMap, LOOKUP_KEYS, MAX_FMI};
 use crate::instance::Instance;
 use crate::mailbox;
 use crate::mode;
 use crate::regs::{
-    btr, esr, ier, msr, rdhxr, rdlxr, rdtxr, rfxr, rixr, tdtxr, tixr, tsr, BTR, ESR, IER, MSR,
-    TSR, TX_MAILBOXES,
+    btr, esr, ier, msr, rdhxr, rdlxr, rdtxr, rfxr, rixr, tdtxr, tixr, tsr, BTR, ESR, IER, MSR, TSR,
+    TX_MAILBOXES,
 };
 
 /// Frames one receive FIFO holds (RM0410 §40.7.5).
@@ -88,14 +88,19 @@ pub type RawFrame = [u32; 5];
 /// A bxCAN instance shared by the halves and handlers of the split driver.
 ///
 /// `K`: the capacity of the merged-filter lookup ([`FmiMap`]), as the [`Can`] it came from.
-pub struct BxCan<R: Registers, F: Registers = R, const K: usize = LOOKUP_KEYS> {
+pub struct BxCan<
+    R: Registers,
+    F: Registers = R,
+    const K: usize = LOOKUP_KEYS,
+    const M: usize = MAX_FMI,
+> {
     regs: R,
     filter_regs: Option<F>,
     instance: Instance,
     config: Config,
     /// The installed filters' map from (FIFO, FMI) to the user's index: touched only
     /// from the receive half's context (`decode`, `install_filters`), so one copy.
-    fmi: UnsafeCell<FmiMap<K>>,
+    fmi: UnsafeCell<FmiMap<K, M>>,
     /// Token of the frame in each mailbox (written before `TXRQ`).
     tokens: [AtomicU32; TX_MAILBOXES],
     /// When each mailbox was loaded: the count of loads before it (written before
@@ -141,15 +146,17 @@ pub struct BxCan<R: Registers, F: Registers = R, const K: usize = LOOKUP_KEYS> {
 //   plain data;
 // - `instance`, `config`: read only; everything else is atomic.
 // `BxCan` itself is `Send` (moved into the driver's state) exactly when `R` and `F` are.
-unsafe impl<R: Registers + Sync, F: Registers + Sync, const K: usize> Sync for BxCan<R, F, K> where
-    FmiMap<K>: Send
+unsafe impl<R: Registers + Sync, F: Registers + Sync, const K: usize, const M: usize> Sync
+    for BxCan<R, F, K, M>
+where
+    FmiMap<K, M>: Send,
 {
 }
 
-impl<R: Registers, F: Registers, const K: usize> Can<R, F, K> {
+impl<R: Registers, F: Registers, const K: usize, const M: usize> Can<R, F, K, M> {
     /// The controller for the split driver (`twocan_core::split::State::split`); the
     /// installed filters come along.
-    pub fn into_split(self) -> BxCan<R, F, K> {
+    pub fn into_split(self) -> BxCan<R, F, K, M> {
         let listen_only = self.regs.read32(BTR) & (btr::SILM | btr::LBKM) == btr::SILM;
         let fed = match &self.filter_regs {
             Some(f) => filter_block::fed_fifos(f, self.config.get_chip(), self.instance),
@@ -177,11 +184,11 @@ impl<R: Registers, F: Registers, const K: usize> Can<R, F, K> {
     }
 }
 
-impl<R: Registers, F: Registers, const K: usize> BxCan<R, F, K> {
+impl<R: Registers, F: Registers, const K: usize, const M: usize> BxCan<R, F, K, M> {
     /// Back to the configuration-level controller (for [`Can::reconfigure`]); the
     /// filters installed (and their map) come along. Transmit bookkeeping is dropped:
     /// take it back only when no frame is in flight.
-    pub fn into_can(self) -> Can<R, F, K> {
+    pub fn into_can(self) -> Can<R, F, K, M> {
         Can {
             regs: self.regs,
             filter_regs: self.filter_regs,
@@ -194,7 +201,9 @@ impl<R: Registers, F: Registers, const K: usize> BxCan<R, F, K> {
     /// Software master reset of a controller taken back from the driver
     /// ([`Can::master_reset`]: every controller register to its reset value).
     #[allow(clippy::result_large_err, clippy::type_complexity)]
-    pub fn master_reset(self) -> Result<(R, Option<F>), crate::controller::Failed<Can<R, F, K>>> {
+    pub fn master_reset(
+        self,
+    ) -> Result<(R, Option<F>), crate::controller::Failed<Can<R, F, K, M>>> {
         self.into_can().master_reset()
     }
 
@@ -455,7 +464,9 @@ impl<R: Registers, F: Registers, const K: usize> BxCan<R, F, K> {
 
 // SAFETY: each method touches the registers its context owns (module docs); `displaced`
 // only from `displace`/`settle` (transmit interrupt context).
-unsafe impl<R: Registers, F: Registers, const K: usize> Hardware for BxCan<R, F, K> {
+unsafe impl<R: Registers, F: Registers, const K: usize, const M: usize> Hardware
+    for BxCan<R, F, K, M>
+{
     type Raw = RawFrame;
     type FilterMap = ();
     type Filters = FilterPlan<K>;
@@ -839,7 +850,7 @@ unsafe impl<R: Registers, F: Registers, const K: usize> Hardware for BxCan<R, F,
     /// generation: `decode` drops them.
     unsafe fn install_filters(&self, filters: &FilterPlan<K>) -> Result<(), Error> {
         // The map first: a plan it cannot hold is refused before any bank changes.
-        let fmi = filters.fmi_map::<K>()?;
+        let fmi = filters.fmi_map_sized::<K, M>()?;
         let drain = || {
             for x in 0..2 {
                 // At most three frames per FIFO (RM0410 §40.7.5); the receive

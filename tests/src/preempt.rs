@@ -43,8 +43,8 @@ use twocan_bxcan::{BxCan, Can, Config as BxConfig, PlanOptions};
 use twocan_core::split::{Rx, Tx};
 use twocan_core::txqueue::TxQueue;
 use twocan_core::{
-    AbortRequest, Completion, Features, Filter, Frame, Full, Hardware, Priority, Registers,
-    State, Token, TxOutcome, TxPolicy,
+    AbortRequest, Completion, Features, Filter, Frame, Full, Hardware, Priority, Registers, State,
+    Token, TxOutcome, TxPolicy,
 };
 use twocan_flexcan::model::FlexCanModel;
 use twocan_flexcan::{FlexCan, FlexCanHw, HostSystem, Settings};
@@ -240,8 +240,12 @@ impl<R: Registers> Registers for Preempted<R> {
 /// `D`: the completion ring's capacity ([`DONE`]; 0: completions off), `Fe`: the
 /// driver's feature set ([`Full`]; [`twocan_core::Lean`] with `D` = 0 and a
 /// request-order queue is the quiet transmit mode on bxCAN).
-pub struct Rig<H: Hardware + 'static, Q: TxQueue + 'static, const D: usize = DONE, Fe: Features = Full>
-{
+pub struct Rig<
+    H: Hardware + 'static,
+    Q: TxQueue + 'static,
+    const D: usize = DONE,
+    Fe: Features = Full,
+> {
     /// The shared state (leaked: the handles borrow it for the rig's life).
     pub state: &'static State<H, RX, Q, RX, D, Fe>,
     /// The transmit half.
@@ -569,7 +573,10 @@ impl Outcome {
     /// scenario aborts), in an order the transmit order allows.
     fn check_quiet(&self, policy: TxPolicy, what: &str) {
         assert_eq!(self.queue_count, 0, "{what}: queue count at the end");
-        assert!(self.completions.is_empty(), "{what}: completions without a ring");
+        assert!(
+            self.completions.is_empty(),
+            "{what}: completions without a ring"
+        );
         let mut index = HashMap::new();
         for (i, (_, f)) in self.accepted.iter().enumerate() {
             assert!(

@@ -15,7 +15,8 @@
 //! - **lean**: a `const` filter plan (`const_plan!`, the planner not linked) and a map
 //!   with no lookup key (the plan has no merged slot), no completion ring ([`DONE`] =
 //!   0), time stamps off (`CAN_MCR.TTCM` = 0) and the split driver's `Lean` feature
-//!   set (no traffic statistics, no time stamps read).
+//!   set (no traffic statistics, no time stamps read); the filter map holds exactly
+//!   the plan's match indices ([`FMIS`]).
 
 // Each firmware that includes this module uses a part of it.
 #![allow(dead_code)]
@@ -83,6 +84,10 @@ fn with_plan<T>(f: impl FnOnce(PlanRef<'_>) -> Result<T, Error>) -> Result<T, Er
 #[cfg(feature = "lean")]
 pub const FILTER_INDEX: u16 = 0;
 
+/// Match indices the filter map holds per FIFO: exactly what the `const` plan numbers.
+#[cfg(feature = "lean")]
+pub const FMIS: usize = twocan_bxcan::const_plan!(FILTERS, OPTIONS).match_indices();
+
 // ------------------------------------------------------------------ full
 
 #[cfg(feature = "full")]
@@ -115,13 +120,18 @@ fn with_plan<T>(f: impl FnOnce(PlanRef<'_>) -> Result<T, Error>) -> Result<T, Er
 #[cfg(feature = "full")]
 pub const FILTER_INDEX: u16 = 0;
 
+/// Match indices the filter map holds per FIFO: every bank's (the run-time planner may
+/// number any).
+#[cfg(feature = "full")]
+pub const FMIS: usize = twocan_bxcan::filters::MAX_FMI;
+
 // ------------------------------------------------------------------ both
 
 /// CAN1's registers at the firmware's `CAN_BASE`, a constant: the per-frame code reaches
 /// them with no base to load (`twocan_core::Fixed`).
 pub type Regs = Fixed<{ crate::CAN_BASE }>;
 /// The controller the split driver holds.
-pub type Hw = BxCan<Regs, Regs, KEYS>;
+pub type Hw = BxCan<Regs, Regs, KEYS, FMIS>;
 /// The transmit queue.
 pub type Q = FifoQueue<TXQ>;
 /// The shared state a `static` holds.
