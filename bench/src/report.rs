@@ -586,10 +586,13 @@ impl Report {
              - **full**: completions (a token per frame, a completion ring of 8), receive \
              time stamps, traffic statistics, filters from the runtime planner;\n\
              - **lean**: issue 21's lean driver — bxCAN: a `const` filter plan \
-             (`const_plan!`, the planner not linked), a filter map with no lookup key, no \
+             (`const_plan!`, the planner not linked), a filter map sized to the plan (no \
+             lookup key, exactly the plan's match indices: `BxCan<R, F, 0, M>`), no \
              completion ring (`DONE` = 0, fire and forget), time stamps off \
              (`CAN_MCR.TTCM` = 0) and the split driver's `Lean` feature set (no traffic \
-             statistics, no time stamps read), registers at a compile-time base \
+             statistics, no time stamps read), which with a request-order queue is its \
+             quiet transmit mode (`State::QUIET_TX`: the transmit interrupt enabled only \
+             while frames wait in the queue), registers at a compile-time base \
              (`twocan_core::Fixed`); FlexCAN: the controller's compile-time \
              `options::Lean` (no time stamps, no filter switch while running: \
              `into_split_with::<Lean>()`), but `begin` still compiles the list at run \
@@ -891,9 +894,12 @@ impl Report {
              ring's peak figure). The frame is a standard data frame, identifier 0x123, \
              8 bytes. **Round trips** are summed from the regions the firmware names for \
              its configuration (the `roundtrip` lines it prints): the send, every handler \
-             the configuration runs per frame (our drivers' transmit handler runs in both \
-             variants, since they enable the transmit interrupt; the lean equivalents have \
-             none — fire-and-forget needs none), the take, and with completions the \
+             the configuration runs per frame (our transmit handler runs in the full \
+             variants and in FlexCAN's lean one, which enable the transmit interrupt; \
+             bxCAN's lean variant is the quiet transmit mode, whose transmit interrupt is \
+             off while nothing is queued — the firmware checks `CAN_IER.TMEIE` after each \
+             direct send — so a frame sent directly runs no handler; the lean \
+             equivalents have none — fire-and-forget needs none), the take, and with completions the \
              completion's take. On FlexCAN one interrupt line runs both handlers; each is \
              measured on its own, on both sides.\n",
             insn.window,
@@ -1186,12 +1192,21 @@ fn render_targets(s: &mut String, f: &Figures) {
             "{} of the {bounded} bounded figures miss their bound. Why: the round trips \
              step by step and the per-region and stack tables of section 2 show where the \
              instructions and the bytes go; the flash of the full variants is mostly the \
-             run-time planner; the per-frame paths still do more than the equivalents \
-             (transmit bookkeeping: tokens, load order, the queue's critical section; the \
-             receive ring's raw words and generation check). FlexCAN's lean and full \
-             controllers (`twocan_flexcan::options`) configure within the bound; what they \
-             still miss per frame is twocan-core's shared work (the transmit handler and \
-             its completion record, ring peaks, frame decoding), and in flash its \
+             run-time planner; the per-frame paths still do more than the equivalents. \
+             Send: the checks the portable API promises (bus-off, listen-only, an empty \
+             queue before a direct load, so that order is kept), the token and the load \
+             order kept per mailbox (`abort` and `mailbox_state` need them), and the \
+             portable `Frame` encoded into the mailbox registers, where the `bxcan` crate's \
+             frame is kept in register form. Receive: the ring holds the raw words and the \
+             thread side decodes them into the portable `Frame` (identifier, DLC, data \
+             beyond the length cleared), checks the filter generation (filters may change \
+             while running) and maps (FIFO, FMI) to the user's index; the equivalents \
+             hand over the crate's frame and the FMI. Lean flash: the transmit queue, its \
+             critical-section path and the error and state handling that every split \
+             driver links. FlexCAN's lean and full controllers \
+             (`twocan_flexcan::options`) configure within the bound; FlexCAN has no quiet \
+             transmit mode yet, so its lean round trip still runs the transmit handler \
+             (and twocan-core's shared work: ring peaks, frame decoding), and in flash its \
              transmit machinery.\n",
             missed.len()
         );

@@ -133,3 +133,73 @@ fn failures_hand_the_slot_and_registers_back_and_a_retry_works() {
         .unwrap();
     assert_eq!(hw.mode(), twocan_core::Mode::Normal);
 }
+
+/// A map sized to the `const` plan (`M` = its match indices, issue 21): the same user
+/// indices as the full-size map, a fraction of its bytes, and a later list that numbers
+/// more match indices than it holds refused with a typed error, the old filters kept.
+#[test]
+fn a_map_sized_to_the_const_plan_resolves_and_refuses_a_larger_list() {
+    const OPTIONS: PlanOptions = PlanOptions::new(14);
+    const M: usize = const_plan!(FILTERS, OPTIONS).match_indices();
+    let runtime = twocan_bxcan::plan(&FILTERS, OPTIONS).unwrap();
+    assert_eq!(M, runtime.match_indices());
+    assert!((1..twocan_bxcan::filters::MAX_FMI).contains(&M), "{M}");
+    assert!(
+        size_of::<twocan_bxcan::filters::FmiMap<0, M>>() * 8
+            <= size_of::<twocan_bxcan::filters::FmiMap<0>>(),
+        "the sized map is at most an eighth of the full one"
+    );
+    // The map's own capacity check: the plan fits exactly, one fewer is refused.
+    assert!(runtime.fmi_map_sized::<0, M>().is_ok());
+    assert_eq!(
+        runtime.fmi_map_sized::<0, { M - 1 }>(),
+        Err(twocan_bxcan::filters::PlanError::TooManyMatchIndices {
+            needed: M as u16,
+            max: M as u16 - 1
+        })
+    );
+
+    let config = loopback_config(TxPolicy::Fifo);
+    let (regs, bus) = attached();
+    let state: State<BxCan<Clocked, Clocked, 0, M>, 8, FifoQueue<4>, 0, 4> = State::new();
+    let mut p = state
+        .split_with(|slot| {
+            BxCan::can1_in(slot, regs.clone(), &config, const_plan!(FILTERS, OPTIONS))
+                .map_err(|f| f.error)
+        })
+        .ok()
+        .unwrap();
+
+    // Sixteen exact identifiers: more match indices than the map holds.
+    let larger: Vec<Filter> = (0..16u16)
+        .map(|k| Filter::standard(0x013 + 0x71 * k))
+        .collect();
+    let larger = twocan_bxcan::plan(&larger, OPTIONS).unwrap();
+    assert!(
+        larger.match_indices() > M,
+        "{} vs {M}",
+        larger.match_indices()
+    );
+    let larger = twocan_bxcan::FilterPlan::<0>::from_ref(larger.as_ref()).unwrap();
+    assert!(matches!(
+        p.rx.set_filters(&larger),
+        Err(Error::FilterSpace { .. })
+    ));
+
+    // The old list still in force, each frame with its user index.
+    let frames = [
+        (Frame::extended(0x1_2345, &[2; 8]).unwrap(), 2),
+        (Frame::standard(0x101, &[1]).unwrap(), 1),
+        (Frame::remote(0x542, false, 0).unwrap(), 3),
+    ];
+    for (f, _) in &frames {
+        nb::block!(p.tx.try_send(f)).unwrap();
+        run(&bus, 200);
+        p.tx_irq.on_interrupt();
+        p.rx0_irq.on_interrupt();
+    }
+    for (f, index) in &frames {
+        let rx = p.rx.receive().unwrap();
+        assert_eq!((&rx.frame, rx.filter), (f, *index));
+    }
+}
