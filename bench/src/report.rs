@@ -587,7 +587,8 @@ impl Report {
              time stamps, traffic statistics, filters from the runtime planner;\n\
              - **lean**: issue 21's lean driver — bxCAN: a `const` filter plan \
              (`const_plan!`, the planner not linked), a filter map sized to the plan (no \
-             lookup key, exactly the plan's match indices: `BxCan<R, F, 0, M>`), no \
+             lookup key, exactly the plan's match indices) and fixed (no filter generation \
+             per frame: `BxCan<R, F, 0, M, false>`), no \
              completion ring (`DONE` = 0, fire and forget), time stamps off \
              (`CAN_MCR.TTCM` = 0) and the split driver's `Lean` feature set (no traffic \
              statistics, no time stamps read), which with a request-order queue is its \
@@ -1199,8 +1200,8 @@ fn render_targets(s: &mut String, f: &Figures) {
              portable `Frame` encoded into the mailbox registers, where the `bxcan` crate's \
              frame is kept in register form. Receive: the ring holds the raw words and the \
              thread side decodes them into the portable `Frame` (identifier, DLC, data \
-             beyond the length cleared), checks the filter generation (filters may change \
-             while running) and maps (FIFO, FMI) to the user's index; the equivalents \
+             beyond the length cleared), checks the filter generation where filters may \
+             change while running (full) and maps (FIFO, FMI) to the user's index; the equivalents \
              hand over the crate's frame and the FMI. Lean flash: the transmit queue, its \
              critical-section path and the error and state handling that every split \
              driver links. FlexCAN's lean and full controllers \

@@ -259,7 +259,7 @@ pub fn is_wired(instance: Instance) -> bool {
     slot(instance).get().is_some()
 }
 
-type Hw<R, F, const K: usize, const M: usize> = BxCan<R, F, K, M>;
+type Hw<R, F, const K: usize, const M: usize, const SWITCH: bool> = BxCan<R, F, K, M, SWITCH>;
 
 /// The split driver's state of one bxCAN instance together with its four interrupt
 /// handlers, for a `static` (all zeros: `.bss`). `RX`/`RX1`: the FIFO 0 and FIFO 1
@@ -274,12 +274,13 @@ pub struct IrqState<
     const DONE: usize,
     const K: usize = LOOKUP_KEYS,
     const M: usize = MAX_FMI,
+    const SWITCH: bool = true,
 > {
-    state: State<Hw<R, F, K, M>, RX, Q, RX1, DONE>,
-    tx: IrqCell<TxIrq<'static, Hw<R, F, K, M>, RX, Q, RX1, DONE>>,
-    rx0: IrqCell<Rx0Irq<'static, Hw<R, F, K, M>, RX, Q, RX1, DONE>>,
-    rx1: IrqCell<Rx1Irq<'static, Hw<R, F, K, M>, RX, Q, RX1, DONE>>,
-    sce: IrqCell<StatusIrq<'static, Hw<R, F, K, M>, RX, Q, RX1, DONE>>,
+    state: State<Hw<R, F, K, M, SWITCH>, RX, Q, RX1, DONE>,
+    tx: IrqCell<TxIrq<'static, Hw<R, F, K, M, SWITCH>, RX, Q, RX1, DONE>>,
+    rx0: IrqCell<Rx0Irq<'static, Hw<R, F, K, M, SWITCH>, RX, Q, RX1, DONE>>,
+    rx1: IrqCell<Rx1Irq<'static, Hw<R, F, K, M, SWITCH>, RX, Q, RX1, DONE>>,
+    sce: IrqCell<StatusIrq<'static, Hw<R, F, K, M, SWITCH>, RX, Q, RX1, DONE>>,
 }
 
 /// The transmit and receive halves [`IrqState::start_on`] gives the thread side.
@@ -292,9 +293,10 @@ pub type Halves<
     const DONE: usize,
     const K: usize,
     const M: usize,
+    const SWITCH: bool,
 > = (
-    Tx<'static, Hw<R, F, K, M>, RX, Q, RX1, DONE>,
-    Rx<'static, Hw<R, F, K, M>, RX, Q, RX1, DONE>,
+    Tx<'static, Hw<R, F, K, M, SWITCH>, RX, Q, RX1, DONE>,
+    Rx<'static, Hw<R, F, K, M, SWITCH>, RX, Q, RX1, DONE>,
 );
 
 /// Why [`IrqState::start_on`] did not start; the controller comes back with it, and
@@ -366,7 +368,8 @@ impl<
         const DONE: usize,
         const K: usize,
         const M: usize,
-    > Default for IrqState<R, F, RX, Q, RX1, DONE, K, M>
+        const SWITCH: bool,
+    > Default for IrqState<R, F, RX, Q, RX1, DONE, K, M, SWITCH>
 where
     R: Registers + 'static,
     F: Registers + 'static,
@@ -386,7 +389,8 @@ impl<
         const DONE: usize,
         const K: usize,
         const M: usize,
-    > IrqState<R, F, RX, Q, RX1, DONE, K, M>
+        const SWITCH: bool,
+    > IrqState<R, F, RX, Q, RX1, DONE, K, M, SWITCH>
 where
     R: Registers + 'static,
     F: Registers + 'static,
@@ -404,7 +408,7 @@ where
     }
 
     /// The split driver's shared state (statistics, error state).
-    pub fn state(&self) -> &State<Hw<R, F, K, M>, RX, Q, RX1, DONE> {
+    pub fn state(&self) -> &State<Hw<R, F, K, M, SWITCH>, RX, Q, RX1, DONE> {
         &self.state
     }
 
@@ -428,7 +432,8 @@ impl<
         const DONE: usize,
         const K: usize,
         const M: usize,
-    > Handlers for IrqState<R, F, RX, Q, RX1, DONE, K, M>
+        const SWITCH: bool,
+    > Handlers for IrqState<R, F, RX, Q, RX1, DONE, K, M, SWITCH>
 where
     R: Registers + 'static,
     F: Registers + 'static,
@@ -455,7 +460,8 @@ impl<
         const DONE: usize,
         const K: usize,
         const M: usize,
-    > IrqState<R, F, RX, Q, RX1, DONE, K, M>
+        const SWITCH: bool,
+    > IrqState<R, F, RX, Q, RX1, DONE, K, M, SWITCH>
 where
     R: Registers + 'static,
     F: Registers + 'static,
@@ -476,11 +482,12 @@ where
     #[allow(clippy::type_complexity, clippy::result_large_err)]
     pub fn start_on<L: Copy>(
         &'static self,
-        hw: Hw<R, F, K, M>,
+        hw: Hw<R, F, K, M, SWITCH>,
         lines: [L; 4],
         priorities: Priorities,
         nvic: &mut impl Nvic<L>,
-    ) -> Result<Halves<R, F, RX, Q, RX1, DONE, K, M>, (StartError, Hw<R, F, K, M>)> {
+    ) -> Result<Halves<R, F, RX, Q, RX1, DONE, K, M, SWITCH>, (StartError, Hw<R, F, K, M, SWITCH>)>
+    {
         if self.state.hardware().is_some() {
             return Err((StartError::AlreadySplit, hw));
         }
@@ -524,11 +531,13 @@ where
     pub fn start_in_place_on<L: Copy>(
         &'static self,
         instance: Instance,
-        init: impl FnOnce(&mut MaybeUninit<Hw<R, F, K, M>>) -> Result<&mut Hw<R, F, K, M>, Error>,
+        init: impl FnOnce(
+            &mut MaybeUninit<Hw<R, F, K, M, SWITCH>>,
+        ) -> Result<&mut Hw<R, F, K, M, SWITCH>, Error>,
         lines: [L; 4],
         priorities: Priorities,
         nvic: &mut impl Nvic<L>,
-    ) -> Result<Halves<R, F, RX, Q, RX1, DONE, K, M>, StartError> {
+    ) -> Result<Halves<R, F, RX, Q, RX1, DONE, K, M, SWITCH>, StartError> {
         if self.state.hardware().is_some() {
             return Err(StartError::AlreadySplit);
         }
@@ -568,12 +577,14 @@ where
     #[allow(clippy::type_complexity, clippy::result_large_err)]
     pub fn stop_on<L: Copy>(
         &'static self,
-        tx: Tx<'static, Hw<R, F, K, M>, RX, Q, RX1, DONE>,
-        rx: Rx<'static, Hw<R, F, K, M>, RX, Q, RX1, DONE>,
+        tx: Tx<'static, Hw<R, F, K, M, SWITCH>, RX, Q, RX1, DONE>,
+        rx: Rx<'static, Hw<R, F, K, M, SWITCH>, RX, Q, RX1, DONE>,
         lines: [L; 4],
         nvic: &mut impl Nvic<L>,
-    ) -> Result<(Hw<R, F, K, M>, Leftovers), (StopError, Halves<R, F, RX, Q, RX1, DONE, K, M>)>
-    {
+    ) -> Result<
+        (Hw<R, F, K, M, SWITCH>, Leftovers),
+        (StopError, Halves<R, F, RX, Q, RX1, DONE, K, M, SWITCH>),
+    > {
         if !core::ptr::eq(tx.state(), &self.state) || !core::ptr::eq(rx.state(), &self.state) {
             return Err((StopError::Foreign, (tx, rx)));
         }
@@ -700,7 +711,9 @@ mod f7 {
             const DONE: usize,
             const K: usize,
             const M: usize,
-        > IrqState<R, F, RX, Q, RX1, DONE, K, M>
+            const SWITCH: bool,
+            const SWITCH: bool,
+        > IrqState<R, F, RX, Q, RX1, DONE, K, M, SWITCH>
     where
         R: Registers + 'static,
         F: Registers + 'static,
@@ -713,10 +726,13 @@ mod f7 {
         #[allow(clippy::type_complexity, clippy::result_large_err)]
         pub fn start(
             &'static self,
-            hw: Hw<R, F, K, M>,
+            hw: Hw<R, F, K, M, SWITCH>,
             priorities: Priorities,
             nvic: &mut impl Nvic<Interrupt>,
-        ) -> Result<Halves<R, F, RX, Q, RX1, DONE, K, M>, (StartError, Hw<R, F, K, M>)> {
+        ) -> Result<
+            Halves<R, F, RX, Q, RX1, DONE, K, M, SWITCH>,
+            (StartError, Hw<R, F, K, M, SWITCH>),
+        > {
             match lines(hw.instance()) {
                 Some(l) => self.start_on(hw, l, priorities, nvic),
                 None => Err((StartError::NoInterrupts, hw)),
@@ -728,10 +744,12 @@ mod f7 {
         pub fn start_in_place(
             &'static self,
             instance: Instance,
-            init: impl FnOnce(&mut MaybeUninit<Hw<R, F, K, M>>) -> Result<&mut Hw<R, F, K, M>, Error>,
+            init: impl FnOnce(
+                &mut MaybeUninit<Hw<R, F, K, M, SWITCH>>,
+            ) -> Result<&mut Hw<R, F, K, M, SWITCH>, Error>,
             priorities: Priorities,
             nvic: &mut impl Nvic<Interrupt>,
-        ) -> Result<Halves<R, F, RX, Q, RX1, DONE, K, M>, StartError> {
+        ) -> Result<Halves<R, F, RX, Q, RX1, DONE, K, M, SWITCH>, StartError> {
             match lines(instance) {
                 Some(l) => self.start_in_place_on(instance, init, l, priorities, nvic),
                 None => Err(StartError::NoInterrupts),
@@ -742,11 +760,13 @@ mod f7 {
         #[allow(clippy::type_complexity, clippy::result_large_err)]
         pub fn stop(
             &'static self,
-            tx: Tx<'static, Hw<R, F, K, M>, RX, Q, RX1, DONE>,
-            rx: Rx<'static, Hw<R, F, K, M>, RX, Q, RX1, DONE>,
+            tx: Tx<'static, Hw<R, F, K, M, SWITCH>, RX, Q, RX1, DONE>,
+            rx: Rx<'static, Hw<R, F, K, M, SWITCH>, RX, Q, RX1, DONE>,
             nvic: &mut impl Nvic<Interrupt>,
-        ) -> Result<(Hw<R, F, K, M>, Leftovers), (StopError, Halves<R, F, RX, Q, RX1, DONE, K, M>)>
-        {
+        ) -> Result<
+            (Hw<R, F, K, M, SWITCH>, Leftovers),
+            (StopError, Halves<R, F, RX, Q, RX1, DONE, K, M, SWITCH>),
+        > {
             let instance = tx.hardware().instance();
             match lines(instance) {
                 Some(l) => self.stop_on(tx, rx, l, nvic),

@@ -87,12 +87,18 @@ pub type RawFrame = [u32; 5];
 
 /// A bxCAN instance shared by the halves and handlers of the split driver.
 ///
-/// `K`: the capacity of the merged-filter lookup ([`FmiMap`]), as the [`Can`] it came from.
+/// `K`: the capacity of the merged-filter lookup ([`FmiMap`]), as the [`Can`] it came
+/// from; `M`: the match indices its map holds per FIFO ([`MAX_FMI`] unless a `const`
+/// plan sizes it); `SWITCH`: whether the receive half may replace the filters while the
+/// controller runs (each received frame then carries the filter generation, read in
+/// the receive interrupt and checked on the thread side; `false`:
+/// [`Can::into_split_fixed`], `set_filters` refused, nothing paid per frame).
 pub struct BxCan<
     R: Registers,
     F: Registers = R,
     const K: usize = LOOKUP_KEYS,
     const M: usize = MAX_FMI,
+    const SWITCH: bool = true,
 > {
     regs: R,
     filter_regs: Option<F>,
@@ -146,8 +152,13 @@ pub struct BxCan<
 //   plain data;
 // - `instance`, `config`: read only; everything else is atomic.
 // `BxCan` itself is `Send` (moved into the driver's state) exactly when `R` and `F` are.
-unsafe impl<R: Registers + Sync, F: Registers + Sync, const K: usize, const M: usize> Sync
-    for BxCan<R, F, K, M>
+unsafe impl<
+        R: Registers + Sync,
+        F: Registers + Sync,
+        const K: usize,
+        const M: usize,
+        const SWITCH: bool,
+    > Sync for BxCan<R, F, K, M, SWITCH>
 where
     FmiMap<K, M>: Send,
 {
@@ -155,8 +166,22 @@ where
 
 impl<R: Registers, F: Registers, const K: usize, const M: usize> Can<R, F, K, M> {
     /// The controller for the split driver (`twocan_core::split::State::split`); the
-    /// installed filters come along.
+    /// installed filters come along, and the receive half may replace them while it
+    /// runs (`set_filters`).
     pub fn into_split(self) -> BxCan<R, F, K, M> {
+        self.into_split_with()
+    }
+
+    /// [`Can::into_split`] with the filters fixed: the receive half's `set_filters` is
+    /// refused ([`Error::Unsupported`]), and in exchange no received frame carries or
+    /// checks a filter generation (issue 21: paid only where filters change).
+    pub fn into_split_fixed(self) -> BxCan<R, F, K, M, false> {
+        self.into_split_with()
+    }
+
+    /// [`Can::into_split`] with `SWITCH` (whether the filters may change while the
+    /// controller runs) chosen by the caller's type.
+    pub fn into_split_with<const SWITCH: bool>(self) -> BxCan<R, F, K, M, SWITCH> {
         let listen_only = self.regs.read32(BTR) & (btr::SILM | btr::LBKM) == btr::SILM;
         let fed = match &self.filter_regs {
             Some(f) => filter_block::fed_fifos(f, self.config.get_chip(), self.instance),
@@ -184,7 +209,9 @@ impl<R: Registers, F: Registers, const K: usize, const M: usize> Can<R, F, K, M>
     }
 }
 
-impl<R: Registers, F: Registers, const K: usize, const M: usize> BxCan<R, F, K, M> {
+impl<R: Registers, F: Registers, const K: usize, const M: usize, const SWITCH: bool>
+    BxCan<R, F, K, M, SWITCH>
+{
     /// Back to the configuration-level controller (for [`Can::reconfigure`]); the
     /// filters installed (and their map) come along. Transmit bookkeeping is dropped:
     /// take it back only when no frame is in flight.
@@ -464,8 +491,8 @@ impl<R: Registers, F: Registers, const K: usize, const M: usize> BxCan<R, F, K, 
 
 // SAFETY: each method touches the registers its context owns (module docs); `displaced`
 // only from `displace`/`settle` (transmit interrupt context).
-unsafe impl<R: Registers, F: Registers, const K: usize, const M: usize> Hardware
-    for BxCan<R, F, K, M>
+unsafe impl<R: Registers, F: Registers, const K: usize, const M: usize, const SWITCH: bool> Hardware
+    for BxCan<R, F, K, M, SWITCH>
 {
     type Raw = RawFrame;
     type FilterMap = ();
@@ -781,7 +808,12 @@ unsafe impl<R: Registers, F: Registers, const K: usize, const M: usize> Hardware
         }
         // The generation before the frame: a frame of the old list read while
         // `install_filters` drains the FIFOs carries the old generation (never the new).
-        let generation = self.generation.load(Ordering::Acquire);
+        // Filters fixed (`SWITCH` = false): no generation, nothing to read.
+        let generation = if SWITCH {
+            self.generation.load(Ordering::Acquire)
+        } else {
+            0
+        };
         let raw = [
             self.regs.read32(rixr(x)),
             self.regs.read32(rdtxr(x)) | (x as u32) << 4,
@@ -799,7 +831,7 @@ unsafe impl<R: Registers, F: Registers, const K: usize, const M: usize> Hardware
     #[inline]
     unsafe fn decode(&self, raw: &RawFrame, _map: &()) -> Option<RxFrame> {
         let [ir, dt, lo, hi, generation] = *raw;
-        if generation != self.generation.load(Ordering::Relaxed) {
+        if SWITCH && generation != self.generation.load(Ordering::Relaxed) {
             // Accepted by a filter list replaced since: dropped (counted by the driver).
             return None;
         }
@@ -848,7 +880,13 @@ unsafe impl<R: Registers, F: Registers, const K: usize, const M: usize> Hardware
     /// thread-side map is switched (`decode` runs in this context only, after this
     /// returns). Frames of the old list still in the driver's ring carry the old
     /// generation: `decode` drops them.
+    ///
+    /// Refused with [`Error::Unsupported`] when the filters are fixed (`SWITCH` =
+    /// false, [`Can::into_split_fixed`]): its frames carry no generation.
     unsafe fn install_filters(&self, filters: &FilterPlan<K>) -> Result<(), Error> {
+        if !SWITCH {
+            return Err(Error::Unsupported);
+        }
         // The map first: a plan it cannot hold is refused before any bank changes.
         let fmi = filters.fmi_map_sized::<K, M>()?;
         let drain = || {

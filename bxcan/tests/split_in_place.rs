@@ -203,3 +203,65 @@ fn a_map_sized_to_the_const_plan_resolves_and_refuses_a_larger_list() {
         assert_eq!((&rx.frame, rx.filter), (f, *index));
     }
 }
+
+/// Filters fixed (`SWITCH` = false, issue 21): frames arrive with their user indices and
+/// no generation is read or checked; a new list is refused with `Unsupported` and the
+/// old one stays in force.
+#[test]
+fn fixed_filters_refuse_a_switch_and_keep_receiving() {
+    const OPTIONS: PlanOptions = PlanOptions::new(14);
+    const M: usize = const_plan!(FILTERS, OPTIONS).match_indices();
+    let config = loopback_config(TxPolicy::Fifo);
+    let (regs, bus) = attached();
+    let state: State<BxCan<Clocked, Clocked, 0, M, false>, 8, FifoQueue<4>, 0, 4> = State::new();
+    let mut p = state
+        .split_with(|slot| {
+            BxCan::can1_in(slot, regs.clone(), &config, const_plan!(FILTERS, OPTIONS))
+                .map_err(|f| f.error)
+        })
+        .ok()
+        .unwrap();
+    let same =
+        twocan_bxcan::FilterPlan::<0>::from_ref(const_plan!(FILTERS, OPTIONS).as_ref()).unwrap();
+    assert_eq!(p.rx.set_filters(&same), Err(Error::Unsupported));
+    let frames = [
+        (Frame::standard(0x100, &[7]).unwrap(), 0),
+        (Frame::extended(0x1_2345, &[2; 8]).unwrap(), 2),
+    ];
+    for (f, _) in &frames {
+        nb::block!(p.tx.try_send(f)).unwrap();
+        run(&bus, 200);
+        p.tx_irq.on_interrupt();
+        p.rx0_irq.on_interrupt();
+    }
+    for (f, index) in &frames {
+        let rx = p.rx.receive().unwrap();
+        assert_eq!((&rx.frame, rx.filter), (f, *index));
+    }
+    assert_eq!(state.traffic().rx_dropped, 0);
+
+    // The by-value path gives the same choice.
+    let (regs_v, _bus_v) = attached();
+    let mut init = Can::can1(regs_v, &config).map_err(|f| f.error).unwrap();
+    init.set_filters(&same).unwrap();
+    let fixed = init
+        .enable()
+        .map_err(|f| f.error)
+        .unwrap()
+        .into_split_fixed();
+    let by_value: State<
+        BxCan<
+            Clocked,
+            Clocked,
+            { twocan_bxcan::filters::LOOKUP_KEYS },
+            { twocan_bxcan::filters::MAX_FMI },
+            false,
+        >,
+        8,
+    > = State::new();
+    let mut q = by_value.split(fixed).ok().unwrap();
+    let same_full =
+        twocan_bxcan::FilterPlan::<{ twocan_bxcan::filters::LOOKUP_KEYS }>::from_ref(same.as_ref())
+            .unwrap();
+    assert_eq!(q.rx.set_filters(&same_full), Err(Error::Unsupported));
+}

@@ -16,7 +16,8 @@
 //!   with no lookup key (the plan has no merged slot), no completion ring ([`DONE`] =
 //!   0), time stamps off (`CAN_MCR.TTCM` = 0) and the split driver's `Lean` feature
 //!   set (no traffic statistics, no time stamps read); the filter map holds exactly
-//!   the plan's match indices ([`FMIS`]).
+//!   the plan's match indices ([`FMIS`]), and the filters fixed ([`SWITCH`] = false: no
+//!   filter generation per frame).
 
 // Each firmware that includes this module uses a part of it.
 #![allow(dead_code)]
@@ -88,6 +89,11 @@ pub const FILTER_INDEX: u16 = 0;
 #[cfg(feature = "lean")]
 pub const FMIS: usize = twocan_bxcan::const_plan!(FILTERS, OPTIONS).match_indices();
 
+/// The filters stay as configured (`set_filters` refused): no filter generation per
+/// frame.
+#[cfg(feature = "lean")]
+pub const SWITCH: bool = false;
+
 // ------------------------------------------------------------------ full
 
 #[cfg(feature = "full")]
@@ -125,13 +131,17 @@ pub const FILTER_INDEX: u16 = 0;
 #[cfg(feature = "full")]
 pub const FMIS: usize = twocan_bxcan::filters::MAX_FMI;
 
+/// Filters may be replaced while running: each frame carries the filter generation.
+#[cfg(feature = "full")]
+pub const SWITCH: bool = true;
+
 // ------------------------------------------------------------------ both
 
 /// CAN1's registers at the firmware's `CAN_BASE`, a constant: the per-frame code reaches
 /// them with no base to load (`twocan_core::Fixed`).
 pub type Regs = Fixed<{ crate::CAN_BASE }>;
 /// The controller the split driver holds.
-pub type Hw = BxCan<Regs, Regs, KEYS, FMIS>;
+pub type Hw = BxCan<Regs, Regs, KEYS, FMIS, SWITCH>;
 /// The transmit queue.
 pub type Q = FifoQueue<TXQ>;
 /// The shared state a `static` holds.

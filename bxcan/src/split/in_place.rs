@@ -52,9 +52,16 @@ use crate::regs::{btr, BTR, TX_MAILBOXES};
 /// What an in-place constructor gives back when the configuration fails: the storage
 /// it was lent (uninitialised again) and the register handles, so that the caller can
 /// try again (e.g. after a [`Error::Timeout`] of a mode request) or use them otherwise.
-pub struct Unconfigured<'s, R: Registers, F: Registers, const K: usize, const M: usize> {
+pub struct Unconfigured<
+    's,
+    R: Registers,
+    F: Registers,
+    const K: usize,
+    const M: usize,
+    const SWITCH: bool,
+> {
     /// The storage, uninitialised.
-    pub slot: &'s mut MaybeUninit<BxCan<R, F, K, M>>,
+    pub slot: &'s mut MaybeUninit<BxCan<R, F, K, M, SWITCH>>,
     /// The instance's registers.
     pub regs: R,
     /// CAN1's filter registers, for CAN2 and a dual CAN1.
@@ -63,10 +70,10 @@ pub struct Unconfigured<'s, R: Registers, F: Registers, const K: usize, const M:
 
 /// The result of an in-place constructor: the configured controller, in its storage,
 /// or why not with everything it was given back.
-pub type InPlace<'s, R, F, const K: usize, const M: usize> =
-    Result<&'s mut BxCan<R, F, K, M>, Failed<Unconfigured<'s, R, F, K, M>>>;
+pub type InPlace<'s, R, F, const K: usize, const M: usize, const SWITCH: bool> =
+    Result<&'s mut BxCan<R, F, K, M, SWITCH>, Failed<Unconfigured<'s, R, F, K, M, SWITCH>>>;
 
-impl<R: Registers, const K: usize, const M: usize> BxCan<R, R, K, M> {
+impl<R: Registers, const K: usize, const M: usize, const SWITCH: bool> BxCan<R, R, K, M, SWITCH> {
     /// CAN1 (the master, its own whole register block), configured in `slot` with
     /// `config` and the filters of `plan`, on the bus when this returns `Ok`: the
     /// sequence of [`crate::Can::can1`], [`crate::Init::set_filters`],
@@ -86,7 +93,7 @@ impl<R: Registers, const K: usize, const M: usize> BxCan<R, R, K, M> {
         regs: R,
         config: &Config,
         plan: impl Into<PlanRef<'p>>,
-    ) -> InPlace<'s, R, R, K, M> {
+    ) -> InPlace<'s, R, R, K, M, SWITCH> {
         Self::configure_in(slot, regs, None, Instance::Can1, config, plan.into())
     }
 
@@ -97,12 +104,14 @@ impl<R: Registers, const K: usize, const M: usize> BxCan<R, R, K, M> {
         regs: R,
         config: &Config,
         plan: impl Into<PlanRef<'p>>,
-    ) -> InPlace<'s, R, R, K, M> {
+    ) -> InPlace<'s, R, R, K, M, SWITCH> {
         Self::configure_in(slot, regs, None, Instance::Can3, config, plan.into())
     }
 }
 
-impl<R: Registers, F: Registers, const K: usize, const M: usize> BxCan<R, F, K, M> {
+impl<R: Registers, F: Registers, const K: usize, const M: usize, const SWITCH: bool>
+    BxCan<R, F, K, M, SWITCH>
+{
     /// CAN1 as the master of a dual set-up (control registers `regs`, the shared filter
     /// block `filters`; see [`crate::Can::can1_dual`]), as [`BxCan::can1_in`].
     #[allow(clippy::result_large_err)]
@@ -112,7 +121,7 @@ impl<R: Registers, F: Registers, const K: usize, const M: usize> BxCan<R, F, K, 
         filters: F,
         config: &Config,
         plan: impl Into<PlanRef<'p>>,
-    ) -> InPlace<'s, R, F, K, M> {
+    ) -> InPlace<'s, R, F, K, M, SWITCH> {
         Self::configure_in(
             slot,
             regs,
@@ -132,7 +141,7 @@ impl<R: Registers, F: Registers, const K: usize, const M: usize> BxCan<R, F, K, 
         can1_filters: F,
         config: &Config,
         plan: impl Into<PlanRef<'p>>,
-    ) -> InPlace<'s, R, F, K, M> {
+    ) -> InPlace<'s, R, F, K, M, SWITCH> {
         Self::configure_in(
             slot,
             regs,
@@ -152,7 +161,7 @@ impl<R: Registers, F: Registers, const K: usize, const M: usize> BxCan<R, F, K, 
         instance: Instance,
         config: &Config,
         plan: PlanRef<'_>,
-    ) -> InPlace<'s, R, F, K, M> {
+    ) -> InPlace<'s, R, F, K, M, SWITCH> {
         let p = slot.as_mut_ptr();
         // SAFETY: `p` points to `slot`'s storage, valid for writes and aligned; each
         // field is written once through `addr_of_mut!` (no reference to the
