@@ -712,7 +712,6 @@ mod f7 {
             const K: usize,
             const M: usize,
             const SWITCH: bool,
-            const SWITCH: bool,
         > IrqState<R, F, RX, Q, RX1, DONE, K, M, SWITCH>
     where
         R: Registers + 'static,
