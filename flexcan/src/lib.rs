@@ -138,6 +138,7 @@ mod handshake;
 pub mod imxrt;
 pub mod installed;
 pub mod instance;
+pub mod layout;
 mod message_buffer;
 pub mod options;
 #[cfg(all(
@@ -194,6 +195,7 @@ pub use instance::Can1;
 #[cfg(any(feature = "teensy40", feature = "teensy41"))]
 pub use instance::{Can2, Can3};
 pub use instance::{Instance, Irqs, Target};
+pub use layout::LargeFilterTable;
 pub use settings::{Settings, CAN_CLOCK_HZ, RECEIVE_BUFFER_SIZE, TRANSMIT_BUFFER_SIZE};
 pub use split::{FlexCanHw, InstalledFilters};
 pub use system::HostSystem;
