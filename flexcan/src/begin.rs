@@ -712,7 +712,7 @@ impl<R: Registers, L: Layout> FlexCan<R, L> {
     /// settings.configuration = Configuration::Filters32_96;
     /// settings.loop_back = true;
     /// let secondary: Vec<Filter> = (0..96).map(|i| Filter::extended(0x1000 + i)).collect();
-    /// let model = IdleClocked::new(FlexCanModel::imxrt1062_can1());
+    /// let model = IdleClocked::new(FlexCanModel::new(target.model_chip()));
     /// let can = FlexCan::<_, Imxrt1062>::begin_with_layout(
     ///     model, &mut HostSystem::new(), target, &settings, &[], &secondary,
     /// )

@@ -890,10 +890,17 @@ impl<const K: usize, const ELEMS: usize, const PRIM: usize, const SEC: usize>
     /// The driver's table for a `const` [`SizedTable`] (for the split driver's
     /// `set_filters`; about 1 KB by value).
     ///
-    /// Errors: [`PlanError::TooManyLookupKeys`] when it needs more lookup keys than `K`.
+    /// Errors: [`PlanError::TooManyLookupKeys`] when it needs more lookup keys than `K`,
+    /// [`PlanError::ConfigurationTooLarge`] when its table is larger than this type holds.
     pub const fn from_sized<const E: usize, const P: usize, const K2: usize>(
         t: &SizedTable<E, P, K2>,
     ) -> Result<Self, PlanError> {
+        if !Self::holds(t.configuration) {
+            return Err(PlanError::ConfigurationTooLarge {
+                rffn: t.configuration.rffn(),
+                max_rffn: Self::MAX_RFFN,
+            });
+        }
         let mut out = Self::zeroed();
         out.configuration = t.configuration;
         out.individual_masks = [FULL_MASK; PRIM];
