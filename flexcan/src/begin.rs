@@ -21,10 +21,13 @@
 //!    (`CTRL1.CLKSRC` = 0, writable only while disabled), module enabled;
 //! 3. soft reset (`SOFTRST`, wait until it clears), freeze (wait `FRZACK`);
 //! 4. in freeze: `MCR` (Rx FIFO, individual masks, abort enable, self reception,
-//!    format A, 16 MBs, warnings), `CTRL1` (bit timing, listen-only, loop-back,
+//!    format A, 16 MBs — with the RT1062 layout, up to the data mailbox: `MAXMB`, IMXRT1060RM
+//!    MCR field MAXMB —, warnings), `CTRL1` (bit timing, listen-only, loop-back,
 //!    automatic bus-off recovery, error interrupt masks), `CTRL2` (`RFFN`, remote frames stored), the ID filter
 //!    table, `RXIMR`, `RXFGMASK`, the transmit mailboxes inactive, flags cleared,
-//!    `IMASK1` (FIFO frames available and overflow, every transmit mailbox);
+//!    `IMASK1` (FIFO frames available and overflow, every transmit mailbox; with the
+//!    RT1062 layout's transmit mailboxes above MB31, `IMASK2` for them, IMXRT1060RM
+//!    "Interrupt Masks 2 register (IMASK2)");
 //! 5. leave freeze (wait `FRZACK` and `NOTRDY` to clear), then wait until the module
 //!    is synchronised to the bus (`ESR1.SYNCH`, 11 recessive bits; internal in
 //!    loop-back mode): when `begin` returns, a frame starting on the bus is received.

@@ -1,4 +1,6 @@
-//! How the 16 message buffers are shared out (ACAN §3 table 1, §11 table 4).
+//! How the message buffers are shared out (ACAN §3 table 1, §11 table 4; on the
+//! RT1062 also the larger Rx FIFO tables of IMXRT1060RM, FlexCAN chapter, CTRL2 field
+//! RFFN and table "Rx FIFO filter: possible structures": [`Configuration`]).
 //!
 //! With the Rx FIFO enabled, MB0–MB5 are the FIFO itself and the ID filter table
 //! starts at MB6; `CTRL2.RFFN` sets the table to `8 × (RFFN + 1)` elements, each MB

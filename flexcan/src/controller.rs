@@ -25,7 +25,7 @@
 //! The receive handler reads the Rx FIFO output (MB0) and the `RXFIR.IDHIT` of the
 //! element that accepted it, then pops the FIFO by writing 1 to `IFLAG1.BUF5I` (the
 //! reading order of the reference manual). On the thread side `IDHIT` becomes the
-//! user's filter index through [`FilterTable::filter_index`] (an `IDHIT` that maps to
+//! user's filter index through [`crate::FilterTable::filter_index`] (an `IDHIT` that maps to
 //! no filter gives [`crate::UNKNOWN_FILTER`]); the TIME STAMP field becomes the
 //! frame's time stamp. A FIFO overflow (`IFLAG1.BUF7I`: at least one frame lost, the
 //! hardware does not count them) is counted as one overrun occurrence.

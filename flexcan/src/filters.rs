@@ -172,7 +172,7 @@ impl FilterTable {
     /// Checks and compiles the lists (ACAN §12–§13) into a table of ACAN's sizes (at
     /// most 32 elements: RFFN 0–3). Every problem is reported at once (ACAN table 5
     /// bits 2–5). [`FilterTable::compile_for`] compiles into a table of any size (the
-    /// RT1062's [`LargeFilterTable`]).
+    /// RT1062's [`crate::LargeFilterTable`]).
     pub fn compile(
         configuration: Configuration,
         primary: &[Filter],

@@ -6,6 +6,7 @@
 //! |---|---|---|
 //! | receive and transmit time stamps ([`Options::STAMPS`]) | the 16-bit `TIME STAMP` of the message buffer, widened by the driver | none: no `TIMER` read, no critical section in the receive handler |
 //! | filter lists replaced while running ([`Options::FILTER_SWITCH`]) | `set_filters`; each raw frame carries the filter generation, and frames of a replaced list are dropped | `set_filters` refused with [`twocan_core::Error::Unsupported`]: no generation word per frame |
+//! | the message-buffer layout ([`Options::Layout`], [`crate::layout`]) | the type parameter `L` of `Full<L>`, `FullInSlot<L>`, `Lean<L>`: [`Kinetis`] by default (MB0–MB15), [`crate::layout::Imxrt1062`] for the RT1062's tables up to 128 elements | the same |
 //! | the filter table kept ([`Options::Table`]) | an owned [`crate::FilterTable`] (about 1 KB, compiled by `begin` at run time) | a [`PlannedTable`]: a few words pointing into a `static` plan made at compile time ([`crate::const_plan!`]) |
 //!
 //! ```

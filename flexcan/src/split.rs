@@ -11,6 +11,11 @@
 //! - transmit half and transmit handler: `IFLAG1` read, the words of one transmit
 //!   mailbox that is inactive and settled (code `INACTIVE`, its `IFLAG1` bit clear);
 //! - transmit handler: `IFLAG1` write-1-to-clear of the transmit mailboxes' bits;
+//!
+//! (With the RT1062 layout, [`crate::layout::Imxrt1062`], the transmit mailboxes of the
+//! tables from RFFN 0xC on are MB32–MB45: what is said here of their `IFLAG1` bits holds
+//! of their `IFLAG2` bits, IMXRT1060RM "Interrupt Flags 2 register (IFLAG2)"; the Rx
+//! FIFO's flags stay in `IFLAG1`.)
 //! - transmit half (`abort`) and transmit handler (`settle`), inside the driver's critical
 //!   section: `ESR1` read for `TX` before an ABORT write (its clear-on-read error bits
 //!   are kept for the status handler, as every state read does), ABORT into the control
