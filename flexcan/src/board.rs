@@ -66,7 +66,9 @@ impl Chip {
     /// MB`5 + 2 × (RFFN + 1)`, reference manuals' table "Rx FIFO filter: possible
     /// structures") leave the chip's message buffers room for a data mailbox and a
     /// remote-frame mailbox: 3 on the Kinetis parts (ACAN's 14/18: MB14 remote, MB15
-    /// data), 0xF on the RT1062 (the table up to MB37, MB38–MB63 left).
+    /// data), 0xF on the RT1062 (IMXRT1060RM, FlexCAN chapter, CTRL2 field RFFN: the
+    /// table up to MB37, MB38–MB63 left; the driver's transmit mailboxes are MB38–MB45,
+    /// [`crate::Configuration::data_mailbox`]).
     pub const fn max_rffn(self) -> u8 {
         let mut r: u8 = 15;
         while r > 0 && crate::regs::rx_fifo_occupied_mbs(r as u32) + 2 > self.message_buffers() {

@@ -51,7 +51,7 @@ use twocan_core::{
 };
 use twocan_core::{MailboxId, MailboxState};
 
-use crate::begin::{first_remote, last_mailbox, tx_flag_base};
+use crate::begin::{last_mailbox, tx_flag_base};
 use crate::configuration::Configuration;
 use crate::controller::FlexCan;
 use crate::filters::{OwnedTable, UNKNOWN_FILTER};
@@ -219,7 +219,7 @@ impl<R: Registers, O: Options> FlexCanHw<R, O> {
     #[inline(always)]
     pub(crate) fn from_parts(regs: R, target: Target, table: O::Table, p: Parts) -> Self {
         let configuration = table.configuration();
-        let first = first_remote::<O::Layout>(configuration) as u32;
+        let first = configuration.first_remote_mailbox() as u32;
         let tx_mask = if O::Layout::IFLAG2 {
             // The transmit mailboxes `first..=data` as bits of their flag register.
             let data = last_mailbox::<O::Layout>(configuration) as u32;
@@ -475,7 +475,7 @@ impl<R: Registers, O: Options> FlexCanHw<R, O> {
         if !frame.is_remote() {
             return Ok(free(data).then_some(data as u8));
         }
-        let first = first_remote::<O::Layout>(self.configuration);
+        let first = self.configuration.first_remote_mailbox() as usize;
         Ok((first..data).find(|&mb| free(mb)).map(|mb| mb as u8))
     }
 
@@ -578,7 +578,7 @@ impl<R: Registers, O: Options> FlexCanHw<R, O> {
                 self.tokens[self.data_mb().wrapping_sub(mb) & (MAX_TX - 1)].load(Ordering::Acquire),
             )
         });
-        self.regs.write32(self.tx_flags(), bit);
+        self.regs.write32(self.tx_flags(), self.tx_bit(mb));
         if c != code::TX_INACTIVE {
             self.regs
                 .write32(regs::mb_cs(mb), cs::CODE.val(code::TX_INACTIVE));
@@ -838,7 +838,7 @@ unsafe impl<R: Registers, O: Options> Hardware for FlexCanHw<R, O> {
 
     /// MB15 (data) and the remote-frame mailboxes.
     fn mailbox_count(&self) -> u8 {
-        (1 + self.data_mb() - first_remote::<O::Layout>(self.configuration)) as u8
+        (1 + self.data_mb() - (self.configuration.first_remote_mailbox() as usize)) as u8
     }
 
     /// `MailboxId(0)` is MB15 (data), `MailboxId(1..=n)` the remote-frame mailboxes in
@@ -848,8 +848,8 @@ unsafe impl<R: Registers, O: Options> Hardware for FlexCanHw<R, O> {
         let c = self.configuration();
         let mb = match mailbox.0 {
             0 => self.data_mb(),
-            k if (k as usize) < 1 + self.data_mb() - first_remote::<O::Layout>(c) => {
-                first_remote::<O::Layout>(c) + k as usize - 1
+            k if (k as usize) < 1 + self.data_mb() - (c.first_remote_mailbox() as usize) => {
+                (c.first_remote_mailbox() as usize) + k as usize - 1
             }
             _ => return MailboxState::Empty,
         };
@@ -876,7 +876,7 @@ unsafe impl<R: Registers, O: Options> Hardware for FlexCanHw<R, O> {
             return false;
         }
         let loaded = self.loaded.load(Ordering::Relaxed);
-        let first = first_remote::<O::Layout>(self.configuration);
+        let first = self.configuration.first_remote_mailbox() as usize;
         let data = self.data_mb();
         let holder = (first..=data).find(|&mb| {
             loaded & self.tx_bit(mb) != 0

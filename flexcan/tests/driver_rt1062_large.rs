@@ -377,3 +377,36 @@ fn too_large_a_table_is_a_typed_error() {
         ConfigErrors::CONFIGURATION_NOT_ON_CHIP
     );
 }
+
+#[test]
+fn end_masks_the_mailboxes_above_mb31_and_begin_runs_again() {
+    let c = Configuration::Filters32_96;
+    let (_model, can) =
+        begin_large::<8, 8>(T41[0], &settings(c, true), &[Filter::pass_all()], &[]).unwrap();
+    let tx = (c.first_remote_mailbox()..=c.data_mailbox()).fold(0u32, |m, mb| m | 1 << (mb - 32));
+    assert_eq!(can.hardware().registers().read32(regs::IMASK2), tx);
+    let hw = can.release();
+    let (regs, _table) = hw.end(&mut HostSystem::new()).map_err(|(_, e)| e).unwrap();
+    assert_eq!(regs.read32(regs::IMASK2), 0);
+    assert_eq!(regs.read32(regs::IMASK1), 0);
+    assert_eq!(regs.read32(regs::IFLAG2), 0);
+    // The same registers begin again, with a table of another size.
+    let c = Configuration::Filters26_54;
+    let can = FlexCan::<_, Imxrt1062>::begin_with_layout(
+        regs,
+        &mut HostSystem::new(),
+        T41[0],
+        &settings(c, true),
+        &[Filter::pass_all()],
+        &[],
+    )
+    .unwrap();
+    let r = can.registers();
+    assert_eq!(
+        mcr::MAXMB.get(r.read32(regs::MCR)),
+        u32::from(c.data_mailbox())
+    );
+    assert_eq!(r.read32(regs::IMASK2), 0, "MB26–MB31: IMASK1");
+    let mut can: Large<8, 8> = Driver::new(can.into_split());
+    can.try_send(&std_data(0x42, &[])).unwrap();
+}
