@@ -1117,6 +1117,61 @@ macro_rules! const_plan {
     }};
 }
 
+/// [`plan_large`] with room for every key, or a compile-time error with a readable
+/// message: the first step of [`crate::const_plan_large!`].
+#[doc(hidden)]
+pub const fn plan_large_or_panic(
+    filters: &[Filter],
+    options: PlanOptions,
+) -> crate::filters::FilterTable<MAX_LOOKUP_KEYS, 128, 32, 96> {
+    match plan_sized::<MAX_LOOKUP_KEYS, 128, 32, 96>(filters, options) {
+        Ok(t) => t,
+        Err(e) => e.panic(),
+    }
+}
+
+/// [`crate::const_plan!`] for the RT1062 layout ([`crate::layout::Imxrt1062`]): the
+/// configuration chosen among RFFN 0 to 0xF (tables up to 128 elements, 32 primary and
+/// 96 secondary) or given, planned at compile time into a `&'static`
+/// [`SizedTable`](crate::filters::SizedTable) for `begin_planned` with
+/// [`crate::options::Lean`]`<Imxrt1062>` (its [`crate::BeginPlan`] made with
+/// `BeginPlan::<Imxrt1062>::new_with_layout`).
+///
+/// ```
+/// use twocan_core::{Filter, Frame};
+/// use twocan_flexcan::planner::PlanOptions;
+/// use twocan_flexcan::{const_plan_large, Configuration};
+///
+/// const IDS: [Filter; 100] = {
+///     let mut f = [Filter::pass_all(); 100];
+///     let mut i = 0;
+///     while i < 100 {
+///         f[i] = Filter::extended(0x1000 + 7 * i as u32);
+///         i += 1;
+///     }
+///     f
+/// };
+/// let table = const_plan_large!(IDS, PlanOptions::choose().merge(false));
+/// assert_eq!(table.configuration(), Configuration::Filters32_72);
+/// let (_, user) = table.evaluate(&Frame::extended(0x1000 + 7 * 99, &[]).unwrap()).unwrap();
+/// assert_eq!(user, Some(99));
+/// ```
+#[macro_export]
+macro_rules! const_plan_large {
+    ($filters:expr, $options:expr $(,)?) => {{
+        #[allow(long_running_const_eval)]
+        const FULL: $crate::FilterTable<{ $crate::filters::MAX_LOOKUP_KEYS }, 128, 32, 96> =
+            $crate::planner::plan_large_or_panic(&$filters, $options);
+        const SIZES: $crate::filters::TableSizes = FULL.sizes();
+        const TABLE: $crate::filters::SizedTable<
+            { SIZES.elements },
+            { SIZES.primary },
+            { SIZES.keys },
+        > = FULL.sized();
+        &TABLE
+    }};
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -5,8 +5,9 @@
 //! index, and the transmit mailboxes after the table — above MB31 from RFFN 0xC on,
 //! their flags in `IFLAG2`/`IMASK2`, `MCR[MAXMB]` = the data mailbox — completing
 //! every accepted frame exactly once, in order, remote frames included; aborts there;
-//! a filter switch of a 128-element table; and the typed errors of a table too large
-//! for the layout or the chip.
+//! a filter switch of a 128-element table; `end` and `begin` again; a 128-element plan
+//! made at compile time on the lean path; and the typed errors of a table too large for
+//! the layout or the chip.
 
 mod common;
 
@@ -409,4 +410,64 @@ fn end_masks_the_mailboxes_above_mb31_and_begin_runs_again() {
     assert_eq!(r.read32(regs::IMASK2), 0, "MB26–MB31: IMASK1");
     let mut can: Large<8, 8> = Driver::new(can.into_split());
     can.try_send(&std_data(0x42, &[])).unwrap();
+}
+
+/// The lean path with the RT1062 layout: a table of 128 elements planned at compile
+/// time, the settings checked for the layout beforehand, the controller read from flash
+/// ([`twocan_flexcan::options::Lean`]`<Imxrt1062>`), frames sent from MB38–MB45.
+#[test]
+fn a_const_plan_of_128_elements_on_the_lean_path() {
+    use twocan_flexcan::begin::BeginPlan;
+    use twocan_flexcan::const_plan_large;
+    use twocan_flexcan::options::Lean;
+    use twocan_flexcan::planner::PlanOptions;
+
+    const IDS: [Filter; 128] = {
+        let mut f = [Filter::pass_all(); 128];
+        let mut i = 0;
+        while i < 128 {
+            f[i] = Filter::extended(0x0040_0000 + 9 * i as u32);
+            i += 1;
+        }
+        f
+    };
+    let plan = const_plan_large!(IDS, PlanOptions::choose().merge(false)).planned();
+    assert_eq!(plan.configuration(), Configuration::Filters32_96);
+    let s = settings(plan.configuration(), true);
+    // The default layout refuses the plan's configuration; the RT1062 layout takes it.
+    assert!(BeginPlan::new(T41[2], &s, plan.configuration()).is_err());
+    let checked = BeginPlan::<Imxrt1062>::new_with_layout(T41[2], &s, plan.configuration())
+        .expect("the RT1062 layout takes RFFN 0xF");
+    let model = model_of(T41[2]);
+    let hw: FlexCanHw<_, Lean<Imxrt1062>> = FlexCan::begin_checked(
+        Ticking::new(model.clone()),
+        &mut HostSystem::new(),
+        &checked,
+        plan,
+    )
+    .unwrap();
+    let mut can: LeanLarge = Driver::new(hw);
+    let mut bus = bus_with(500_000, &[&model]);
+    for i in [0u32, 31, 32, 100, 127] {
+        let f = ext_data(0x0040_0000 + 9 * i, &[i as u8]);
+        can.try_send(&f).unwrap();
+        run(&mut bus, &mut [&mut can], 400);
+        let got: Vec<(Frame, u16)> = core::iter::from_fn(|| can.receive().ok())
+            .map(|r| (r.frame, r.filter))
+            .collect();
+        assert_eq!(got, vec![(f, i as u16)]);
+    }
+    assert_eq!(can.traffic().sent, 5);
+    assert_eq!(model.read32(regs::IFLAG2), 0, "every flag acknowledged");
+}
+
+/// The lean driver with the RT1062 layout.
+type LeanLarge = Driver<FlexCanHw<Ticking, twocan_flexcan::options::Lean<Imxrt1062>>, 32, 16>;
+
+impl Service for LeanLarge {
+    fn service(&mut self) {
+        if self.hardware().registers().irq_pending() {
+            self.on_interrupt();
+        }
+    }
 }
