@@ -72,7 +72,8 @@ pub type RawFrame = [u32; 5];
 /// Frames the Rx FIFO holds (Kinetis RM, "Rx FIFO": six deep).
 const RX_FIFO_DEPTH: usize = 6;
 
-/// Transmit mailboxes at most (MB15 and up to seven remote-frame mailboxes).
+/// Transmit mailboxes at most (the data mailbox, MB15 in ACAN's configurations, and up
+/// to seven remote-frame mailboxes: [`Configuration::data_mailbox`]).
 const MAX_TX: usize = 8;
 
 const MODE_NORMAL: u8 = 0;
@@ -460,7 +461,8 @@ impl<R: Registers, O: Options> FlexCanHw<R, O> {
         self.tx_refused.store(refused, Ordering::Relaxed);
     }
 
-    /// MB15 for a data frame, the first free remote-frame mailbox for a remote frame.
+    /// The data mailbox (MB15 in ACAN's configurations) for a data frame, the first free
+    /// remote-frame mailbox for a remote frame.
     #[inline(always)]
     fn free_now(&self, frame: &Frame) -> Result<Option<u8>, Error> {
         // The control word first, then the flag: a mailbox reading INACTIVE stays so
@@ -553,7 +555,7 @@ impl<R: Registers, O: Options> FlexCanHw<R, O> {
     /// became a receive mailbox for the answer; an aborted one shows `ABORT`).
     #[inline(always)]
     fn settle_one(&self, mb: usize) -> Option<Completion> {
-        // Every configuration's transmit mailboxes fit the token slots (`15 - mb` < 8).
+        // Every configuration's transmit mailboxes fit the token slots (`data - mb` < 8).
         const {
             let mut i = 0;
             while i < Configuration::EVERY.len() {
@@ -776,7 +778,8 @@ unsafe impl<R: Registers, O: Options> Hardware for FlexCanHw<R, O> {
     type FilterMap = ();
     type Filters = <O::Layout as Layout>::Table;
 
-    /// MB15 is the one data mailbox: request order (ACAN §3 "sequentiality").
+    /// One data mailbox (MB15 in ACAN's configurations): request order (ACAN §3
+    /// "sequentiality").
     fn tx_policy(&self) -> TxPolicy {
         TxPolicy::Fifo
     }
@@ -797,7 +800,7 @@ unsafe impl<R: Registers, O: Options> Hardware for FlexCanHw<R, O> {
         self.free_now(frame)
     }
 
-    /// Data frames: MB15; remote frames: the first free remote-frame mailbox (ACAN §9),
+    /// Data frames: the data mailbox (MB15 in ACAN's configurations); remote frames: the first free remote-frame mailbox (ACAN §9),
     /// whatever else is loaded. Free means code `INACTIVE` and its `IFLAG1` bit clear
     /// (settled). Refused with [`Error::WrongMode`] in listen-only mode and while
     /// disabled (sleep).
@@ -836,12 +839,12 @@ unsafe impl<R: Registers, O: Options> Hardware for FlexCanHw<R, O> {
         self.retry_aborts();
     }
 
-    /// MB15 (data) and the remote-frame mailboxes.
+    /// The data mailbox and the remote-frame mailboxes.
     fn mailbox_count(&self) -> u8 {
         (1 + self.data_mb() - (self.configuration.first_remote_mailbox() as usize)) as u8
     }
 
-    /// `MailboxId(0)` is MB15 (data), `MailboxId(1..=n)` the remote-frame mailboxes in
+    /// `MailboxId(0)` is the data mailbox (MB15 in ACAN's configurations), `MailboxId(1..=n)` the remote-frame mailboxes in
     /// increasing MB order: `Pending` while loaded (code `DATA`, flag clear), else
     /// `Empty` (FlexCAN shows no scheduled or transmitting state per mailbox).
     fn mailbox_state(&self, mailbox: MailboxId) -> MailboxState {
@@ -1162,9 +1165,12 @@ unsafe impl<R: Registers, O: Options> Hardware for FlexCanHw<R, O> {
     /// clock `begin` was given): the 16 MHz oscillator, [`Limits::FLEXCAN_KINETIS`]
     /// (8..=25 quanta per bit) and 16 bus clocks per CAN bit (Kinetis RM, FlexCAN
     /// chapter, "Arbitration and matching timing"; 1 Mbit/s from a 16 MHz bus clock,
-    /// 2 Mbit/s from 32 MHz and above); one ID table element per exact
+    /// 2 Mbit/s from 32 MHz and above; with the RT1062 layout's larger tables 17 or 30
+    /// for `MCR[MAXMB]` + 1 buffers, IMXRT1060RM same section,
+    /// [`crate::settings::timing_rule_for_buffers`]); one ID table element per exact
     /// filter of either format (format A), as many as the configuration's primary and
-    /// secondary elements (ACAN §11, table 4); MB15 and the remote-frame mailboxes;
+    /// secondary elements (ACAN §11, table 4; up to 128 with the RT1062 layout); the data
+    /// mailbox and the remote-frame mailboxes;
     /// the 6-frame Rx FIFO; the 16-bit free-running timer (Kinetis RM, TIMER).
     /// No one-shot mode on these modules. No wake-up events as configured: `MCR.WAKMSK`
     /// and `MCR.SLFWAK` are never set (Kinetis RM, MCR field descriptions), so the module

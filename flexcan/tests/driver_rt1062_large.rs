@@ -471,3 +471,55 @@ impl Service for LeanLarge {
         }
     }
 }
+
+/// The bit-timing rule follows the buffers the configuration enables (IMXRT1060RM,
+/// "Arbitration and matching timing": 16 peripheral clocks per CAN bit up to 16
+/// buffers, 30 above 32): at 1 Mbit/s with the peripheral clock the 24 MHz CAN clock
+/// (no bus clock given), 14/18 is taken and 32/96 (MB0–MB45) refused, by `check`,
+/// `begin` and the running controller's `set_bitrate` alike; with the RT1062's 150 MHz
+/// IPG clock given, both are taken.
+#[test]
+fn the_timing_rule_counts_the_enabled_buffers() {
+    let fast = |c: Configuration, bus: Option<u32>| {
+        let mut s = Settings::with_clock(1_000_000, CanClock::IMXRT_24MHZ);
+        s.configuration = c;
+        s.bus_clock_hz = bus;
+        s
+    };
+    let pass = [Filter::pass_all()];
+    for (c, ok) in [
+        (Configuration::Filters14_18, true),
+        (Configuration::Filters32_96, false),
+    ] {
+        let s = fast(c, None);
+        let e = check_with_layout::<Imxrt1062>(T41[0], &s, &pass, &[]);
+        assert_eq!(e.is_empty(), ok, "{c:?}: {e:?}");
+        assert_eq!(begin_large::<8, 8>(T41[0], &s, &pass, &[]).is_ok(), ok);
+        let s = fast(c, Some(150_000_000));
+        assert_eq!(
+            check_with_layout::<Imxrt1062>(T41[0], &s, &pass, &[]),
+            ConfigErrors::NONE
+        );
+    }
+    // The running controller applies the same rule: 32/96 at 500 kbit/s, then 1 Mbit/s
+    // refused with nothing written; the capabilities report the 30-clock rule.
+    let (_model, mut can) = begin_large::<8, 8>(
+        T41[0],
+        &settings(Configuration::Filters32_96, false),
+        &pass,
+        &[],
+    )
+    .unwrap();
+    let caps = can.capabilities();
+    assert!(caps.timing_rule().check_bitrate(1_000_000).is_err());
+    assert!(caps.timing_rule().check_bitrate(500_000).is_ok());
+    can.set_mode(twocan_core::Mode::Stopped).unwrap();
+    let ctrl1 = can.hardware().registers().read32(regs::CTRL1);
+    assert!(can.set_bitrate(1_000_000, 750).is_err());
+    assert_eq!(
+        can.hardware().registers().read32(regs::CTRL1),
+        ctrl1,
+        "nothing written"
+    );
+    assert!(can.set_bitrate(250_000, 750).is_ok());
+}
