@@ -309,7 +309,7 @@ fn configure<R: Registers, L: Layout>(
     } else {
         MESSAGE_BUFFERS as usize - 1
     };
-    let first = first_remote::<L>(plan.configuration);
+    let first = plan.configuration.first_remote_mailbox() as usize;
     let primary = if L::IFLAG2 {
         plan.configuration.primary_filter_capacity()
     } else {
@@ -345,15 +345,6 @@ fn configure<R: Registers, L: Layout>(
         regs.write32(IMASK2, high);
     }
     handshake::unfreeze(regs, polls)
-}
-
-/// The first remote-frame mailbox ([`Configuration::first_remote_mailbox`]) of a
-/// configuration the layout `L` takes, the RFFN seen bounded by the layout's
-/// ([`Configuration::rffn_at_most`]) so that the compiler knows the transmit mailboxes'
-/// range.
-#[inline(always)]
-pub(crate) const fn first_remote<L: Layout>(configuration: Configuration) -> usize {
-    6 + 2 * (configuration.rffn_at_most(L::MAX_RFFN) as usize + 1)
 }
 
 /// The first message buffer of the flag register that holds the transmit mailboxes'
