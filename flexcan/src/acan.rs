@@ -143,6 +143,8 @@ impl<M> Default for Spare<M> {
 /// the halves. Neither the controller nor its table moves through the call. A refused
 /// `begin` or start keeps the token and the table in `spare`.
 #[allow(clippy::result_large_err, clippy::type_complexity)]
+// Called once per module, with `checked` usually a `const`: inlined, its checks fold.
+#[inline]
 pub fn start<M: Module>(
     spare: &Spare<M>,
     table: &'static TableSlot,

@@ -21,10 +21,13 @@
 //!    (`CTRL1.CLKSRC` = 0, writable only while disabled), module enabled;
 //! 3. soft reset (`SOFTRST`, wait until it clears), freeze (wait `FRZACK`);
 //! 4. in freeze: `MCR` (Rx FIFO, individual masks, abort enable, self reception,
-//!    format A, 16 MBs, warnings), `CTRL1` (bit timing, listen-only, loop-back,
+//!    format A, 16 MBs — with the RT1062 layout, up to the data mailbox: `MAXMB`, IMXRT1060RM
+//!    MCR field MAXMB —, warnings), `CTRL1` (bit timing, listen-only, loop-back,
 //!    automatic bus-off recovery, error interrupt masks), `CTRL2` (`RFFN`, remote frames stored), the ID filter
 //!    table, `RXIMR`, `RXFGMASK`, the transmit mailboxes inactive, flags cleared,
-//!    `IMASK1` (FIFO frames available and overflow, every transmit mailbox);
+//!    `IMASK1` (FIFO frames available and overflow, every transmit mailbox; with the
+//!    RT1062 layout's transmit mailboxes above MB31, `IMASK2` for them, IMXRT1060RM
+//!    "Interrupt Masks 2 register (IMASK2)");
 //! 5. leave freeze (wait `FRZACK` and `NOTRDY` to clear), then wait until the module
 //!    is synchronised to the bus (`ESR1.SYNCH`, 11 recessive bits; internal in
 //!    loop-back mode): when `begin` returns, a frame starting on the bus is received.
@@ -41,11 +44,12 @@ use crate::begin_error::{BeginError, ConfigErrors};
 use crate::can_clock::CanClock;
 use crate::configuration::{Configuration, DATA_MAILBOX, MESSAGE_BUFFERS};
 use crate::controller::FlexCan;
-use crate::filters::FilterTable;
+use crate::filters::OwnedTable;
 use crate::handshake;
 use crate::imxrt::ImxrtPlan;
 use crate::installed::PlannedTable;
 use crate::instance::Target;
+use crate::layout::{accepted_rffn, Kinetis, Layout};
 use crate::options::Options;
 use crate::regs::{
     self, code, cs, ctrl1, ctrl2, iflag1, mcr, CTRL1, CTRL2, IFLAG1, IFLAG2, IMASK1, IMASK2, MCR,
@@ -67,14 +71,26 @@ struct Plan {
     message_buffers: usize,
 }
 
-/// The checks of ACAN table 5, all of them, then the register values.
-const fn plan(
+/// The timing rule for a table of `configuration` with the layout `L`: the 16-buffer
+/// rule ([`Settings::timing_rule`]) unless the layout has more buffers.
+const fn rule_of<L: Layout>(settings: &Settings, configuration: Configuration) -> TimingRule {
+    if L::IFLAG2 {
+        settings.timing_rule_with(configuration)
+    } else {
+        settings.timing_rule()
+    }
+}
+
+/// The checks of ACAN table 5, all of them, then the register values; the
+/// configuration against the layout `L` and the chip ([`accepted_rffn`]:
+/// [`ConfigErrors::CONFIGURATION_NOT_ON_CHIP`]).
+const fn plan<L: Layout>(
     target: Target,
     settings: &Settings,
     configuration: Configuration,
     filter_errors: ConfigErrors,
 ) -> Result<Plan, ConfigErrors> {
-    let mut errors = timing_errors(&settings.timing_rule(), settings);
+    let mut errors = timing_errors(&rule_of::<L>(settings, configuration), settings);
     let timing_bits = settings.timing.flexcan_ctrl1();
     if timing_bits.is_err() {
         errors = errors.union(ConfigErrors::BIT_TIMING_INCONSISTENT);
@@ -83,6 +99,15 @@ const fn plan(
     errors = errors.union(filter_errors);
 
     let chip = target.board.chip();
+    // Every chip has the 16 buffers of the layout without `IFLAG2` (a constant).
+    let max_rffn = if L::IFLAG2 {
+        accepted_rffn(L::MAX_RFFN, chip)
+    } else {
+        L::MAX_RFFN
+    };
+    if configuration.rffn() > max_rffn {
+        errors = errors.union(ConfigErrors::CONFIGURATION_NOT_ON_CHIP);
+    }
     if !settings.can_clock.fits(chip) {
         errors = errors.union(ConfigErrors::CLOCK_NOT_ON_CHIP);
     }
@@ -103,7 +128,7 @@ const fn plan(
                 | mcr::IRMQ
                 | mcr::AEN
                 | mcr::IDAM.val(mcr::IDAM_FORMAT_A)
-                | mcr::MAXMB.val(MESSAGE_BUFFERS as u32 - 1);
+                | mcr::MAXMB.val(last_mailbox::<L>(configuration) as u32);
             if !settings.self_reception {
                 mcr |= mcr::SRXDIS;
             }
@@ -130,6 +155,18 @@ const fn plan(
             })
         }
         _ => Err(errors),
+    }
+}
+
+/// The last message buffer the driver enables (`MCR[MAXMB]`) and its data mailbox:
+/// MB15 with [`Kinetis`] (a constant), [`Configuration::data_mailbox`] with a layout of
+/// more buffers (IMXRT1060RM, MCR field MAXMB).
+#[inline(always)]
+pub(crate) const fn last_mailbox<L: Layout>(configuration: Configuration) -> usize {
+    if L::IFLAG2 {
+        configuration.data_mailbox() as usize
+    } else {
+        DATA_MAILBOX as usize
     }
 }
 
@@ -232,11 +269,11 @@ const fn timing_errors(rule: &TimingRule, settings: &Settings) -> ConfigErrors {
 /// The error `begin` gives before any other check: the wished rate outside the range of
 /// the driver's rule ([`TimingRule::check_bitrate`]; a rule that accepts nothing is left
 /// to the flags, [`ConfigErrors::BIT_TIMING_FORBIDDEN`]).
-const fn bitrate_error(settings: &Settings) -> Option<TimingError> {
-    match settings
-        .timing_rule()
-        .check_bitrate(settings.wished_bit_rate())
-    {
+const fn bitrate_error<L: Layout>(
+    settings: &Settings,
+    configuration: Configuration,
+) -> Option<TimingError> {
+    match rule_of::<L>(settings, configuration).check_bitrate(settings.wished_bit_rate()) {
         Ok(()) | Err(TimingError::ForbiddenByManual) => None,
         Err(e) => Some(e),
     }
@@ -244,7 +281,7 @@ const fn bitrate_error(settings: &Settings) -> Option<TimingError> {
 
 /// Writes the plan, and the filter table with `write_table` (steps 2–5 of the module
 /// docs).
-fn configure<R: Registers>(
+fn configure<R: Registers, L: Layout>(
     regs: &mut R,
     plan: &Plan,
     write_table: impl FnOnce(&R),
@@ -266,25 +303,60 @@ fn configure<R: Registers>(
     write_table(regs);
     // Masks of the transmit mailboxes: a remote-frame mailbox briefly receives after
     // its transmission; exact matching keeps it to its own identifier.
-    for n in plan.configuration.primary_filter_capacity()..MESSAGE_BUFFERS as usize {
+    let data = last_mailbox::<L>(plan.configuration);
+    let last = if L::IFLAG2 {
+        data
+    } else {
+        MESSAGE_BUFFERS as usize - 1
+    };
+    let first = plan.configuration.first_remote_mailbox() as usize;
+    let primary = if L::IFLAG2 {
+        plan.configuration.primary_filter_capacity()
+    } else {
+        // Below RFFN 4 the individual masks are the FIFO's message buffers.
+        first
+    };
+    for n in primary..last + 1 {
         regs.write32(regs::rximr(n), u32::MAX);
     }
+    // The transmit mailboxes' flags: IFLAG1 bit n for MBn, or (above MB31, where every
+    // transmit mailbox of the configuration lies: `Configuration::data_mailbox`) IFLAG2
+    // bit n - 32 (IMXRT1060RM, IMASK2/IFLAG2).
+    let base = tx_flag_base::<L>(data);
     let mut tx_flags = 0;
-    for mb in plan.configuration.first_remote_mailbox() as usize..=DATA_MAILBOX as usize {
+    for mb in first..=data {
         regs.write32(regs::mb_cs(mb), cs::CODE.val(code::TX_INACTIVE));
         regs.write32(regs::mb_id(mb), 0);
         regs.write32(regs::mb_word0(mb), 0);
         regs.write32(regs::mb_word1(mb), 0);
-        tx_flags |= iflag1::buf(mb);
+        tx_flags |= iflag1::buf(mb - base);
     }
     regs.write32(IFLAG1, u32::MAX);
-    regs.write32(IMASK1, iflag1::BUF5I | iflag1::BUF7I | tx_flags);
+    let (low, high) = if base == 0 {
+        (tx_flags, 0)
+    } else {
+        (0, tx_flags)
+    };
+    regs.write32(IMASK1, iflag1::BUF5I | iflag1::BUF7I | low);
     if plan.message_buffers > 32 {
-        // MB32 and above lie beyond `MAXMB` (15): never flagged, masked anyway.
+        // MB32 and above: the transmit mailboxes of the RT1062's larger tables, or
+        // beyond `MAXMB` (never flagged, masked anyway).
         regs.write32(IFLAG2, u32::MAX);
-        regs.write32(IMASK2, 0);
+        regs.write32(IMASK2, high);
     }
     handshake::unfreeze(regs, polls)
+}
+
+/// The first message buffer of the flag register that holds the transmit mailboxes'
+/// flags, the data mailbox being `data`: 0 (`IFLAG1`), or 32 (`IFLAG2`) for a data
+/// mailbox above MB31 with a layout that has `IFLAG2` (a constant 0 otherwise).
+#[inline(always)]
+pub(crate) const fn tx_flag_base<L: Layout>(data: usize) -> usize {
+    if L::IFLAG2 && data >= 32 {
+        32
+    } else {
+        0
+    }
 }
 
 /// Every error `begin` would report for these arguments (ACAN table 5), found
@@ -313,8 +385,35 @@ pub fn check(
     primary: &[Filter],
     secondary: &[Filter],
 ) -> ConfigErrors {
-    let filters = FilterTable::check(settings.configuration, primary, secondary);
-    match plan(target, settings, settings.configuration, filters) {
+    check_with_layout::<Kinetis>(target, settings, primary, secondary)
+}
+
+/// [`check`] for a controller of the layout `L` ([`crate::layout`]): what
+/// [`FlexCan::begin_with_layout`] would report.
+///
+/// ```
+/// use twocan_core::Filter;
+/// use twocan_flexcan::begin::check_with_layout;
+/// use twocan_flexcan::layout::{Imxrt1062, Kinetis};
+/// use twocan_flexcan::{check, Board, CanClock, ConfigErrors, Configuration, Instance};
+/// use twocan_flexcan::{Settings, Target};
+///
+/// let t41 = Target::new(Board::Teensy41, Instance::Can1);
+/// let mut s = Settings::with_clock(500_000, CanClock::IMXRT_24MHZ);
+/// s.configuration = Configuration::Filters32_96;
+/// let secondary: Vec<Filter> = (0..96).map(|i| Filter::standard(0x100 + i)).collect();
+/// assert_eq!(check_with_layout::<Imxrt1062>(t41, &s, &[], &secondary), ConfigErrors::NONE);
+/// // ACAN's layout (MB0–MB15) takes RFFN 0–3 only: a typed error, nothing written.
+/// assert!(check(t41, &s, &[], &secondary).contains(ConfigErrors::CONFIGURATION_NOT_ON_CHIP));
+/// ```
+pub fn check_with_layout<L: Layout>(
+    target: Target,
+    settings: &Settings,
+    primary: &[Filter],
+    secondary: &[Filter],
+) -> ConfigErrors {
+    let filters = L::Table::check_lists(settings.configuration, primary, secondary);
+    match plan::<L>(target, settings, settings.configuration, filters) {
         Ok(_) => ConfigErrors::NONE,
         Err(e) => e,
     }
@@ -341,35 +440,7 @@ impl<R: Registers> FlexCan<R> {
         primary: &[Filter],
         secondary: &[Filter],
     ) -> Result<Self, BeginError> {
-        if let Some(e) = bitrate_error(settings) {
-            return Err(BeginError::Timing(e));
-        }
-        let filters = FilterTable::check(settings.configuration, primary, secondary);
-        let plan =
-            plan(target, settings, settings.configuration, filters).map_err(BeginError::Config)?;
-        plan.system.apply(sys);
-        let polls = settings.handshake_bound();
-        let bus_mode = bus_mode_of(settings);
-        // The table is built once, in the controller, and written from there.
-        let mut controller = FlexCan::configured(
-            regs,
-            target,
-            FilterTable::build(plan.configuration, primary, secondary),
-            bus_mode,
-            settings.bus_off_recovery,
-            polls,
-            settings.message_irq_priority,
-            plan.system,
-            settings.bus_clock_hz.unwrap_or(settings.can_clock.hz()),
-        );
-        let table = &controller.table;
-        configure(
-            &mut controller.regs,
-            &plan,
-            |r| FlexCan::write_filters(r, table),
-            polls,
-        )?;
-        Ok(controller)
+        Self::begin_with_layout(regs, sys, target, settings, primary, secondary)
     }
 
     /// [`FlexCan::begin`] compiling the lists straight into `slot`, a table in a
@@ -403,17 +474,21 @@ impl<R: Registers> FlexCan<R> {
     /// # Ok::<(), String>(())
     /// ```
     #[allow(clippy::type_complexity)]
-    pub fn begin_in<S: Registers, O: Options<Table = &'static mut FilterTable>>(
+    pub fn begin_in<S: Registers, O, L>(
         regs: R,
         sys: &mut S,
         target: Target,
         settings: &Settings,
         primary: &[Filter],
         secondary: &[Filter],
-        slot: &'static mut FilterTable,
-    ) -> Result<FlexCanHw<R, O>, (BeginError, &'static mut FilterTable)> {
+        slot: &'static mut L::Table,
+    ) -> Result<FlexCanHw<R, O>, (BeginError, &'static mut L::Table)>
+    where
+        L: Layout,
+        O: Options<Layout = L, Table = &'static mut L::Table>,
+    {
         let (regs, table, parts) =
-            Self::begin_in_parts(regs, sys, target, settings, primary, secondary, slot)?;
+            Self::begin_in_parts::<S, L>(regs, sys, target, settings, primary, secondary, slot)?;
         Ok(FlexCanHw::from_parts(regs, target, table, parts))
     }
 
@@ -428,27 +503,31 @@ impl<R: Registers> FlexCan<R> {
     /// written and the table's slot comes back.
     #[allow(clippy::type_complexity)]
     #[inline(always)]
-    pub fn begin_in_place<'h, S: Registers, O: Options<Table = &'static mut FilterTable>>(
+    pub fn begin_in_place<'h, S: Registers, O, L>(
         hw: &'h mut MaybeUninit<FlexCanHw<R, O>>,
         mut regs: R,
         sys: &mut S,
-        checked: &BeginPlan,
+        checked: &BeginPlan<L>,
         primary: &[Filter],
         secondary: &[Filter],
-        slot: &'static mut FilterTable,
-    ) -> Result<&'h mut FlexCanHw<R, O>, (BeginError, &'static mut FilterTable)> {
+        slot: &'static mut L::Table,
+    ) -> Result<&'h mut FlexCanHw<R, O>, (BeginError, &'static mut L::Table)>
+    where
+        L: Layout,
+        O: Options<Layout = L, Table = &'static mut L::Table>,
+    {
         let plan = &checked.plan;
-        let filters = FilterTable::check(plan.configuration, primary, secondary);
+        let filters = L::Table::check_lists(plan.configuration, primary, secondary);
         if filters != ConfigErrors::NONE {
             return Err((BeginError::Config(filters), slot));
         }
         plan.system.apply(sys);
-        slot.fill(plan.configuration, primary, secondary);
-        let table: &FilterTable = slot;
-        if let Err(e) = configure(
+        slot.fill_lists(plan.configuration, primary, secondary);
+        let table: &L::Table = slot;
+        if let Err(e) = configure::<R, L>(
             &mut regs,
             plan,
-            |r| FlexCan::write_filters(r, table),
+            |r| FlexCan::<R, L>::write_filters(r, table),
             checked.polls,
         ) {
             return Err((BeginError::Hardware(e), slot));
@@ -464,31 +543,31 @@ impl<R: Registers> FlexCan<R> {
     /// [`FlexCan::begin_in`] but the controller: the checks, the lists compiled into
     /// `slot`, the module configured; the split controller's small values.
     #[allow(clippy::type_complexity)]
-    fn begin_in_parts<S: Registers>(
+    fn begin_in_parts<S: Registers, L: Layout>(
         mut regs: R,
         sys: &mut S,
         target: Target,
         settings: &Settings,
         primary: &[Filter],
         secondary: &[Filter],
-        slot: &'static mut FilterTable,
-    ) -> Result<(R, &'static mut FilterTable, Parts), (BeginError, &'static mut FilterTable)> {
-        if let Some(e) = bitrate_error(settings) {
+        slot: &'static mut L::Table,
+    ) -> Result<(R, &'static mut L::Table, Parts), (BeginError, &'static mut L::Table)> {
+        if let Some(e) = bitrate_error::<L>(settings, settings.configuration) {
             return Err((BeginError::Timing(e), slot));
         }
-        let filters = FilterTable::check(settings.configuration, primary, secondary);
-        let plan = match plan(target, settings, settings.configuration, filters) {
+        let filters = L::Table::check_lists(settings.configuration, primary, secondary);
+        let plan = match plan::<L>(target, settings, settings.configuration, filters) {
             Ok(p) => p,
             Err(e) => return Err((BeginError::Config(e), slot)),
         };
         plan.system.apply(sys);
         let polls = settings.handshake_bound();
-        slot.fill(plan.configuration, primary, secondary);
-        let table: &FilterTable = slot;
-        if let Err(e) = configure(
+        slot.fill_lists(plan.configuration, primary, secondary);
+        let table: &L::Table = slot;
+        if let Err(e) = configure::<R, L>(
             &mut regs,
             &plan,
-            |r| FlexCan::write_filters(r, table),
+            |r| FlexCan::<R, L>::write_filters(r, table),
             polls,
         ) {
             return Err((BeginError::Hardware(e), slot));
@@ -543,7 +622,8 @@ impl<R: Registers> FlexCan<R> {
         settings: &Settings,
         table: PlannedTable,
     ) -> Result<FlexCanHw<R, O>, BeginError> {
-        let checked = BeginPlan::new(target, settings, table.configuration())?;
+        let checked =
+            BeginPlan::<O::Layout>::new_with_layout(target, settings, table.configuration())?;
         Self::begin_checked(regs, sys, &checked, table)
     }
 
@@ -555,7 +635,7 @@ impl<R: Registers> FlexCan<R> {
     pub fn begin_checked<S: Registers, O: Options<Table = PlannedTable>>(
         regs: R,
         sys: &mut S,
-        checked: &BeginPlan,
+        checked: &BeginPlan<O::Layout>,
         table: PlannedTable,
     ) -> Result<FlexCanHw<R, O>, BeginError> {
         let (regs, parts) = Self::begin_checked_parts(regs, sys, checked, table)?;
@@ -569,7 +649,7 @@ impl<R: Registers> FlexCan<R> {
         hw: &'h mut MaybeUninit<FlexCanHw<R, O>>,
         regs: R,
         sys: &mut S,
-        checked: &BeginPlan,
+        checked: &BeginPlan<O::Layout>,
         table: PlannedTable,
     ) -> Result<&'h mut FlexCanHw<R, O>, BeginError> {
         let (regs, parts) = Self::begin_checked_parts(regs, sys, checked, table)?;
@@ -578,10 +658,10 @@ impl<R: Registers> FlexCan<R> {
 
     /// What [`FlexCan::begin_checked`] and [`FlexCan::begin_checked_in_place`] share.
     #[inline(always)]
-    fn begin_checked_parts<S: Registers>(
+    fn begin_checked_parts<S: Registers, L: Layout>(
         mut regs: R,
         sys: &mut S,
-        checked: &BeginPlan,
+        checked: &BeginPlan<L>,
         table: PlannedTable,
     ) -> Result<(R, Parts), BeginError> {
         let plan = &checked.plan;
@@ -589,11 +669,11 @@ impl<R: Registers> FlexCan<R> {
             return Err(BeginError::Hardware(Error::InvalidArgument));
         }
         plan.system.apply(sys);
-        configure(
+        configure::<R, L>(
             &mut regs,
             plan,
             |r| {
-                FlexCan::write_table(
+                FlexCan::<R, L>::write_table(
                     r,
                     table.rejects_all(),
                     table.elements(),
@@ -604,6 +684,73 @@ impl<R: Registers> FlexCan<R> {
             checked.polls,
         )?;
         Ok((regs, checked.parts()))
+    }
+}
+
+impl<R: Registers, L: Layout> FlexCan<R, L> {
+    /// [`FlexCan::begin`] for the message-buffer layout `L` ([`crate::layout`]): with
+    /// [`crate::layout::Imxrt1062`] on an RT1062, `settings.configuration` may be any
+    /// RFFN up to 0xF (a table of up to 128 elements, 32 primary and 96 secondary
+    /// filters; the transmit mailboxes after it, [`Configuration::data_mailbox`]); a
+    /// configuration the layout or the chip does not take is
+    /// [`ConfigErrors::CONFIGURATION_NOT_ON_CHIP`], nothing written.
+    ///
+    /// ```
+    /// use twocan_core::Filter;
+    /// use twocan_flexcan::layout::Imxrt1062;
+    /// use twocan_flexcan::{model::FlexCanModel, Board, CanClock, Configuration, FlexCan};
+    /// use twocan_flexcan::{HostSystem, IdleClocked, Instance, Settings, Target};
+    ///
+    /// let target = Target::new(Board::Teensy41, Instance::Can1);
+    /// let mut settings = Settings::with_clock(500_000, CanClock::IMXRT_24MHZ);
+    /// settings.configuration = Configuration::Filters32_96;
+    /// settings.loop_back = true;
+    /// let secondary: Vec<Filter> = (0..96).map(|i| Filter::extended(0x1000 + i)).collect();
+    /// let model = IdleClocked::new(FlexCanModel::new(target.model_chip()));
+    /// let can = FlexCan::<_, Imxrt1062>::begin_with_layout(
+    ///     model, &mut HostSystem::new(), target, &settings, &[], &secondary,
+    /// )
+    /// .map_err(|e| format!("{e:?}"))?;
+    /// assert_eq!(can.filters().elements().len(), 128);
+    /// # Ok::<(), String>(())
+    /// ```
+    pub fn begin_with_layout<S: Registers>(
+        regs: R,
+        sys: &mut S,
+        target: Target,
+        settings: &Settings,
+        primary: &[Filter],
+        secondary: &[Filter],
+    ) -> Result<Self, BeginError> {
+        if let Some(e) = bitrate_error::<L>(settings, settings.configuration) {
+            return Err(BeginError::Timing(e));
+        }
+        let filters = L::Table::check_lists(settings.configuration, primary, secondary);
+        let plan = plan::<L>(target, settings, settings.configuration, filters)
+            .map_err(BeginError::Config)?;
+        plan.system.apply(sys);
+        let polls = settings.handshake_bound();
+        let bus_mode = bus_mode_of(settings);
+        // The table is built once, in the controller, and written from there.
+        let mut controller = FlexCan::configured(
+            regs,
+            target,
+            L::Table::build_lists(plan.configuration, primary, secondary),
+            bus_mode,
+            settings.bus_off_recovery,
+            polls,
+            settings.message_irq_priority,
+            plan.system,
+            settings.bus_clock_hz.unwrap_or(settings.can_clock.hz()),
+        );
+        let table = &controller.table;
+        configure::<R, L>(
+            &mut controller.regs,
+            &plan,
+            |r| FlexCan::<R, L>::write_filters(r, table),
+            polls,
+        )?;
+        Ok(controller)
     }
 }
 
@@ -622,8 +769,13 @@ impl<R: Registers> FlexCan<R> {
 /// assert!(BeginPlan::new(T36, &Settings::new(2_000_000), Configuration::Filters8_0).is_err());
 /// # let _ = CHECKED;
 /// ```
+///
+/// The plan is made for a message-buffer layout `L` ([`crate::layout`], [`Kinetis`] by
+/// default: [`BeginPlan::new`]; [`BeginPlan::new_with_layout`] for another), the layout
+/// of the options of the controller it configures.
 #[derive(Debug, Clone)]
-pub struct BeginPlan {
+pub struct BeginPlan<L: Layout = Kinetis> {
+    layout: core::marker::PhantomData<L>,
     target: Target,
     plan: Plan,
     polls: u32,
@@ -642,11 +794,34 @@ impl BeginPlan {
         settings: &Settings,
         configuration: Configuration,
     ) -> Result<Self, BeginError> {
-        if let Some(e) = bitrate_error(settings) {
+        Self::new_with_layout(target, settings, configuration)
+    }
+
+    /// [`BeginPlan::new`], panicking on an error: in a `const` item, settings that
+    /// `begin` would refuse are a compile-time error.
+    pub const fn new_or_panic(
+        target: Target,
+        settings: &Settings,
+        configuration: Configuration,
+    ) -> Self {
+        Self::new_with_layout_or_panic(target, settings, configuration)
+    }
+}
+
+impl<L: Layout> BeginPlan<L> {
+    /// [`BeginPlan::new`] for the layout `L` (a configuration the layout or the chip does
+    /// not take: [`ConfigErrors::CONFIGURATION_NOT_ON_CHIP`]).
+    pub const fn new_with_layout(
+        target: Target,
+        settings: &Settings,
+        configuration: Configuration,
+    ) -> Result<Self, BeginError> {
+        if let Some(e) = bitrate_error::<L>(settings, configuration) {
             return Err(BeginError::Timing(e));
         }
-        match plan(target, settings, configuration, ConfigErrors::NONE) {
+        match plan::<L>(target, settings, configuration, ConfigErrors::NONE) {
             Ok(plan) => Ok(BeginPlan {
+                layout: core::marker::PhantomData,
                 target,
                 plan,
                 polls: settings.handshake_bound(),
@@ -662,14 +837,14 @@ impl BeginPlan {
         }
     }
 
-    /// [`BeginPlan::new`], panicking on an error: in a `const` item, settings that
-    /// `begin` would refuse are a compile-time error.
-    pub const fn new_or_panic(
+    /// [`BeginPlan::new_with_layout`], panicking on an error (in a `const` item: a
+    /// compile-time error).
+    pub const fn new_with_layout_or_panic(
         target: Target,
         settings: &Settings,
         configuration: Configuration,
     ) -> Self {
-        match Self::new(target, settings, configuration) {
+        match Self::new_with_layout(target, settings, configuration) {
             Ok(p) => p,
             Err(BeginError::Timing(_)) => {
                 panic!("twocan_flexcan::BeginPlan: bit rate outside the driver's range")

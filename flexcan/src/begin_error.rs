@@ -68,6 +68,13 @@ bitflags::bitflags! {
         /// oscillator on a Teensy 3.x, a CCM clock root (divider 1–64, at most 80 MHz,
         /// IMXRT1060RM "CCM_CSCMR2") on a Teensy 4.x.
         const CLOCK_NOT_ON_CHIP = 1 << 11;
+        /// Bit 12 (not in ACAN): the configuration's Rx FIFO filter table
+        /// (`CTRL2[RFFN]`, [`crate::Configuration`]) is larger than the controller
+        /// accepts: RFFN 0–3 (ACAN's four configurations, MB0–MB15) with the default
+        /// layout ([`crate::layout::Kinetis`]) and on the Teensy 3.x; up to 0xF with
+        /// [`crate::layout::Imxrt1062`] on the i.MX RT1062
+        /// ([`crate::Chip::accepted_max_rffn`]). Nothing is written.
+        const CONFIGURATION_NOT_ON_CHIP = 1 << 12;
     }
 }
 
@@ -201,7 +208,8 @@ mod tests {
         assert_eq!(ConfigErrors::BIT_TIMING_FORBIDDEN.bits(), 0x200);
         assert_eq!(ConfigErrors::BIT_RATE_OUT_OF_RANGE.bits(), 0x400);
         assert_eq!(ConfigErrors::CLOCK_NOT_ON_CHIP.bits(), 0x800);
-        assert_eq!(ConfigErrors::ALL.count(), 12);
+        assert_eq!(ConfigErrors::CONFIGURATION_NOT_ON_CHIP.bits(), 0x1000);
+        assert_eq!(ConfigErrors::ALL.count(), 13);
         assert_eq!(BeginError::Config(e).flags(), e);
         assert_eq!(
             BeginError::from(twocan_core::Error::Timeout).flags(),

@@ -66,7 +66,9 @@ impl Chip {
     /// MB`5 + 2 × (RFFN + 1)`, reference manuals' table "Rx FIFO filter: possible
     /// structures") leave the chip's message buffers room for a data mailbox and a
     /// remote-frame mailbox: 3 on the Kinetis parts (ACAN's 14/18: MB14 remote, MB15
-    /// data), 0xF on the RT1062 (the table up to MB37, MB38–MB63 left).
+    /// data), 0xF on the RT1062 (IMXRT1060RM, FlexCAN chapter, CTRL2 field RFFN: the
+    /// table up to MB37, MB38–MB63 left; the driver's transmit mailboxes are MB38–MB45,
+    /// [`crate::Configuration::data_mailbox`]).
     pub const fn max_rffn(self) -> u8 {
         let mut r: u8 = 15;
         while r > 0 && crate::regs::rx_fifo_occupied_mbs(r as u32) + 2 > self.message_buffers() {
@@ -98,13 +100,17 @@ impl Chip {
         self.max_table_elements() - self.max_primary_filters()
     }
 
-    /// The largest `CTRL2[RFFN]` the driver accepts today: ACAN's four configurations
-    /// ([`crate::Configuration::ALL`], RFFN 0–3, in MB0–MB15) on every chip. On the
-    /// RT1062 this is below [`Chip::max_rffn`]: the larger tables need transmit
-    /// mailboxes above MB31 (`IMASK2`/`IFLAG2`), not served yet; the capabilities and
-    /// the planner report this limit.
+    /// The largest `CTRL2[RFFN]` the driver accepts on this chip: [`Chip::max_rffn`],
+    /// 3 on the Kinetis parts (ACAN's four configurations, [`crate::Configuration::ALL`],
+    /// in MB0–MB15) and 0xF on the RT1062 (IMXRT1060RM, FlexCAN chapter, CTRL2 field
+    /// RFFN, table "Rx FIFO filter: possible structures": the table up to MB37, the
+    /// transmit mailboxes after it up to MB45, served through `IMASK2`/`IFLAG2` above
+    /// MB31, `MCR[MAXMB]` = the data mailbox). A controller accepts the smaller of this
+    /// and its layout's limit ([`crate::layout::Layout::max_rffn`]: 3 with the default
+    /// [`crate::layout::Kinetis`], 0xF with [`crate::layout::Imxrt1062`]); `begin`,
+    /// `check`, the planner and the capabilities apply that one rule.
     pub const fn accepted_max_rffn(self) -> u8 {
-        crate::configuration::Configuration::Filters14_18.rffn()
+        self.max_rffn()
     }
 }
 
@@ -315,7 +321,7 @@ mod tests {
                 Chip::Imxrt1062.max_secondary_filters(),
                 Chip::Imxrt1062.accepted_max_rffn()
             ),
-            (15, 128, 32, 96, 3)
+            (15, 128, 32, 96, 15)
         );
         for chip in [
             Chip::Mk20dx256,
@@ -323,11 +329,13 @@ mod tests {
             Chip::Mk66fx1m0,
             Chip::Imxrt1062,
         ] {
-            // The largest ACAN configuration is what every chip's sizes allow today.
-            let c = crate::Configuration::Filters14_18;
-            assert!(c.rffn() <= chip.max_rffn());
-            assert_eq!(chip.accepted_max_rffn(), c.rffn());
-            assert!(c.primary_filter_capacity() <= chip.max_primary_filters());
+            // What is accepted is what the chip's message buffers allow, and the
+            // largest configuration accepted has the chip's largest table.
+            assert_eq!(chip.accepted_max_rffn(), chip.max_rffn());
+            let c = crate::Configuration::from_rffn(chip.accepted_max_rffn()).unwrap();
+            assert_eq!(c.table_elements(), chip.max_table_elements());
+            assert_eq!(c.primary_filter_capacity(), chip.max_primary_filters());
+            assert!(c.message_buffers_used() <= chip.message_buffers());
         }
     }
 }

@@ -25,7 +25,7 @@
 //! The receive handler reads the Rx FIFO output (MB0) and the `RXFIR.IDHIT` of the
 //! element that accepted it, then pops the FIFO by writing 1 to `IFLAG1.BUF5I` (the
 //! reading order of the reference manual). On the thread side `IDHIT` becomes the
-//! user's filter index through [`FilterTable::filter_index`] (an `IDHIT` that maps to
+//! user's filter index through [`crate::FilterTable::filter_index`] (an `IDHIT` that maps to
 //! no filter gives [`crate::UNKNOWN_FILTER`]); the TIME STAMP field becomes the
 //! frame's time stamp. A FIFO overflow (`IFLAG1.BUF7I`: at least one frame lost, the
 //! hardware does not count them) is counted as one overrun occurrence.
@@ -35,18 +35,21 @@ use core::cell::Cell;
 use twocan_core::{BusMode, BusOffRecovery, LastErrorCode, Mode, Registers};
 
 use crate::configuration::Configuration;
-use crate::filters::FilterTable;
+use crate::filters::OwnedTable;
 use crate::instance::Target;
+use crate::layout::{Kinetis, Layout};
 use crate::regs::{self, TIMER};
 use crate::system::SystemPlan;
 
 /// A FlexCAN instance configured by `begin` (see [`crate::instance`]), over its
-/// registers `R`. Give it to the portable driver with [`FlexCan::into_split`].
+/// registers `R`, in the message-buffer layout `L` ([`crate::layout`]: [`Kinetis`],
+/// MB0–MB15, by default; [`crate::layout::Imxrt1062`] for the RT1062's larger Rx FIFO
+/// tables). Give it to the portable driver with [`FlexCan::into_split`].
 #[derive(Debug)]
-pub struct FlexCan<R: Registers> {
+pub struct FlexCan<R: Registers, L: Layout = Kinetis> {
     pub(crate) regs: R,
     pub(crate) target: Target,
-    pub(crate) table: FilterTable,
+    pub(crate) table: L::Table,
     pub(crate) bus_mode: BusMode,
     pub(crate) recovery: BusOffRecovery,
     pub(crate) polls: u32,
@@ -62,12 +65,12 @@ pub struct FlexCan<R: Registers> {
     pub(crate) bus_clock_hz: u32,
 }
 
-impl<R: Registers> FlexCan<R> {
+impl<R: Registers, L: Layout> FlexCan<R, L> {
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn configured(
         regs: R,
         target: Target,
-        table: FilterTable,
+        table: L::Table,
         bus_mode: BusMode,
         recovery: BusOffRecovery,
         polls: u32,
@@ -96,12 +99,12 @@ impl<R: Registers> FlexCan<R> {
     }
 
     /// The message-buffer partition (ACAN §11).
-    pub const fn configuration(&self) -> Configuration {
-        self.table.configuration()
+    pub fn configuration(&self) -> Configuration {
+        self.table.table_configuration()
     }
 
     /// The installed filters (ACAN §12–§13), with the filter numbering.
-    pub const fn filters(&self) -> &FilterTable {
+    pub const fn filters(&self) -> &L::Table {
         &self.table
     }
 
@@ -145,17 +148,17 @@ impl<R: Registers> FlexCan<R> {
     /// Writes the ID table, the masks and `MCR.IDAM` (format A, or format D "all frames
     /// rejected" for an empty list): Freeze mode only (Kinetis RM, MCR: IDAM is
     /// writable in Freeze mode only).
-    pub(crate) fn write_filters(regs: &R, table: &FilterTable) {
+    pub(crate) fn write_filters<T: OwnedTable>(regs: &R, table: &T) {
         Self::write_table(
             regs,
-            table.rejects_all(),
-            table.elements(),
-            table.individual_masks(),
-            table.global_mask(),
+            table.table_rejects_all(),
+            table.table_elements(),
+            table.table_individual_masks(),
+            table.table_global_mask(),
         );
     }
 
-    /// [`FlexCan::write_filters`] from the table's parts (a [`FilterTable`] or a
+    /// [`FlexCan::write_filters`] from the table's parts (a [`crate::FilterTable`] or a
     /// [`crate::installed::PlannedTable`]).
     pub(crate) fn write_table(
         regs: &R,

@@ -35,8 +35,10 @@ use twocan_core::{Error, Registers};
 
 use crate::controller::FlexCan;
 use crate::handshake;
+use crate::instance::Target;
+use crate::layout::Layout;
 use crate::options::Options;
-use crate::regs::{ctrl1, esr1, mcr, CTRL1, ESR1, IFLAG1, IMASK1, MCR};
+use crate::regs::{ctrl1, esr1, mcr, CTRL1, ESR1, IFLAG1, IFLAG2, IMASK1, IMASK2, MCR};
 use crate::split::FlexCanHw;
 
 /// `CTRL1`'s interrupt masks `begin` may set.
@@ -45,7 +47,7 @@ const CTRL1_IRQ_MASKS: u32 = ctrl1::ERRMSK | ctrl1::BOFFMSK | ctrl1::TWRNMSK | c
 const ESR1_IRQ_FLAGS: u32 =
     esr1::WAKINT | esr1::ERRINT | esr1::BOFFINT | esr1::RWRNINT | esr1::TWRNINT;
 
-impl<R: Registers> FlexCan<R> {
+impl<R: Registers, L: Layout> FlexCan<R, L> {
     /// Stops the module and releases its pins and clock gate (see the [module
     /// documentation](crate::end)); gives the registers back, so that
     /// [`FlexCan::begin`] can run again. `sys` reaches the SIM and PORT registers as
@@ -67,7 +69,7 @@ impl<R: Registers> FlexCan<R> {
 
     /// Steps 1–3 of the module documentation ([`crate::system::SystemPlan::release`] is step 4).
     fn stop(&self) -> Result<(), Error> {
-        stop(&self.regs, self.polls)
+        stop(&self.regs, self.polls, upper_flags::<L>(self.target))
     }
 }
 
@@ -80,7 +82,8 @@ impl<R: Registers, O: Options> FlexCanHw<R, O> {
     /// comes back with [`Error::Timeout`], nothing of the chip level released.
     #[allow(clippy::result_large_err)]
     pub fn end<S: Registers>(self, sys: &mut S) -> Result<(R, O::Table), (Self, Error)> {
-        if let Err(e) = stop(self.registers(), self.handshake_polls()) {
+        let upper = upper_flags::<O::Layout>(self.target());
+        if let Err(e) = stop(self.registers(), self.handshake_polls(), upper) {
             return Err((self, e));
         }
         self.system_plan().release(sys);
@@ -88,8 +91,17 @@ impl<R: Registers, O: Options> FlexCanHw<R, O> {
     }
 }
 
-/// Steps 1–3 of the module documentation on `regs`, each wait bounded by `polls`.
-fn stop<R: Registers>(regs: &R, polls: u32) -> Result<(), Error> {
+/// Whether `begin` may have enabled interrupts in `IMASK2` (the transmit mailboxes above
+/// MB31 of the RT1062 layout): a layout with `IFLAG2` on a module of more than 32
+/// message buffers (a constant `false` with [`crate::layout::Kinetis`]).
+#[inline(always)]
+fn upper_flags<L: Layout>(target: Target) -> bool {
+    L::IFLAG2 && target.board.chip().message_buffers() > 32
+}
+
+/// Steps 1–3 of the module documentation on `regs`, each wait bounded by `polls`; with
+/// `upper`, `IMASK2` and `IFLAG2` too (IMXRT1060RM "Interrupt Masks 2 register").
+fn stop<R: Registers>(regs: &R, polls: u32, upper: bool) -> Result<(), Error> {
     // A module put to sleep (disabled) is enabled first: freeze is requested and
     // acknowledged only while the module is enabled ("Freeze mode"), and the
     // interrupt registers are written in freeze.
@@ -100,6 +112,10 @@ fn stop<R: Registers>(regs: &R, polls: u32) -> Result<(), Error> {
     regs.write32(IMASK1, 0);
     regs.modify32(CTRL1, |v| v & !CTRL1_IRQ_MASKS);
     regs.write32(IFLAG1, u32::MAX);
+    if upper {
+        regs.write32(IMASK2, 0);
+        regs.write32(IFLAG2, u32::MAX);
+    }
     regs.write32(ESR1, ESR1_IRQ_FLAGS);
     handshake::disable(regs, polls)
 }

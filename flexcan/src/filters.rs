@@ -94,13 +94,18 @@ pub enum Hit {
 ///
 /// This is the FlexCAN [`twocan_core::Hardware::Filters`] type (with the default `K`).
 #[derive(Debug, Clone, PartialEq, Eq)]
-pub struct FilterTable<const K: usize = LOOKUP_KEYS> {
+pub struct FilterTable<
+    const K: usize = LOOKUP_KEYS,
+    const ELEMS: usize = MAX_TABLE_ELEMENTS,
+    const PRIM: usize = MAX_PRIMARY_FILTERS,
+    const SEC: usize = MAX_SECONDARY_FILTERS,
+> {
     configuration: Configuration,
-    elements: [u32; MAX_TABLE_ELEMENTS],
-    individual_masks: [u32; MAX_PRIMARY_FILTERS],
+    elements: [u32; ELEMS],
+    individual_masks: [u32; PRIM],
     global_mask: u32,
-    hits: [Hit; MAX_TABLE_ELEMENTS],
-    secondary: [Filter; MAX_SECONDARY_FILTERS],
+    hits: [Hit; ELEMS],
+    secondary: [Filter; SEC],
     primary_count: u8,
     secondary_count: u8,
     keys: KeyTable<K>,
@@ -164,35 +169,122 @@ pub const fn mask_of(f: &Filter) -> u32 {
 }
 
 impl FilterTable {
-    /// Checks and compiles the lists (ACAN §12–§13). Every problem is reported at once
-    /// (ACAN table 5 bits 2–5).
+    /// Checks and compiles the lists (ACAN §12–§13) into a table of ACAN's sizes (at
+    /// most 32 elements: RFFN 0–3). Every problem is reported at once (ACAN table 5
+    /// bits 2–5). [`FilterTable::compile_for`] compiles into a table of any size (the
+    /// RT1062's [`crate::LargeFilterTable`]).
     pub fn compile(
         configuration: Configuration,
         primary: &[Filter],
         secondary: &[Filter],
     ) -> Result<Self, ConfigErrors> {
-        let errors = Self::check(configuration, primary, secondary);
+        Self::compile_for(configuration, primary, secondary)
+    }
+}
+
+impl<const K: usize, const ELEMS: usize, const PRIM: usize, const SEC: usize>
+    FilterTable<K, ELEMS, PRIM, SEC>
+{
+    /// Checks and compiles the lists (ACAN §12–§13) into a table of this type's
+    /// capacity. Every problem is reported at once (ACAN table 5 bits 2–5); a
+    /// configuration whose table does not fit the type is
+    /// [`ConfigErrors::CONFIGURATION_NOT_ON_CHIP`].
+    pub fn compile_for(
+        configuration: Configuration,
+        primary: &[Filter],
+        secondary: &[Filter],
+    ) -> Result<Self, ConfigErrors> {
+        let errors = Self::check_for(configuration, primary, secondary);
         if !errors.is_empty() {
             return Err(errors);
         }
         Ok(Self::build(configuration, primary, secondary))
     }
 
-    /// The errors [`FilterTable::compile`] reports for these lists (none: it compiles),
-    /// without building the table.
-    pub(crate) fn check(
+    /// The largest `CTRL2[RFFN]` whose table fits this type (its elements, individual
+    /// masks and secondary elements; each grows with RFFN): 3 for ACAN's sizes, 0xF for
+    /// [`crate::LargeFilterTable`].
+    pub const MAX_RFFN: u8 = {
+        let mut r = 15;
+        while r > 0 {
+            let c = Configuration::EVERY[r];
+            if c.table_elements() <= ELEMS
+                && c.primary_filter_capacity() <= PRIM
+                && c.secondary_filter_capacity() <= SEC
+            {
+                break;
+            }
+            r -= 1;
+        }
+        r as u8
+    };
+
+    /// Whether a table of `configuration` fits this type ([`FilterTable::MAX_RFFN`]).
+    pub const fn holds(configuration: Configuration) -> bool {
+        configuration.rffn() <= Self::MAX_RFFN
+    }
+
+    /// The RFFN of a configuration this type holds (every table's: checked on the way
+    /// in), in a form the compiler sees is at most [`FilterTable::MAX_RFFN`], so that
+    /// the arrays sized to it need no bounds check ([`Configuration::rffn_at_most`]).
+    #[inline(always)]
+    const fn rffn_of(configuration: Configuration) -> usize {
+        configuration.rffn_at_most(Self::MAX_RFFN) as usize
+    }
+
+    /// [`Configuration::table_elements`] for a configuration this type holds.
+    #[inline(always)]
+    pub(crate) const fn elements_of(configuration: Configuration) -> usize {
+        8 * (Self::rffn_of(configuration) + 1)
+    }
+
+    /// [`Configuration::primary_filter_capacity`] for a configuration this type holds:
+    /// below 32 individual masks, the FIFO's message buffers (no cap to apply).
+    #[inline(always)]
+    pub(crate) const fn primary_of(configuration: Configuration) -> usize {
+        let occupied = 8 + 2 * Self::rffn_of(configuration);
+        if PRIM >= 32 && occupied > 32 {
+            32
+        } else {
+            occupied
+        }
+    }
+
+    /// [`Configuration::secondary_filter_capacity`] for a configuration this type holds.
+    #[inline(always)]
+    pub(crate) const fn secondary_of(configuration: Configuration) -> usize {
+        Self::elements_of(configuration) - Self::primary_of(configuration)
+    }
+
+    /// The errors [`FilterTable::compile_for`] reports for these lists (none: it
+    /// compiles), without building the table.
+    pub(crate) fn check_for(
         configuration: Configuration,
         primary: &[Filter],
         secondary: &[Filter],
     ) -> ConfigErrors {
         let mut errors = ConfigErrors::NONE;
-        if primary.len() > configuration.primary_filter_capacity() {
+        // The counts against the configuration's own capacities (ACAN table 5), also
+        // for a configuration this table cannot hold.
+        let (capacity_p, capacity_s) = if Self::holds(configuration) {
+            (
+                Self::primary_of(configuration),
+                Self::secondary_of(configuration),
+            )
+        } else {
+            errors |= ConfigErrors::CONFIGURATION_NOT_ON_CHIP;
+            (
+                configuration.primary_filter_capacity(),
+                configuration.secondary_filter_capacity(),
+            )
+        };
+        if primary.len() > capacity_p {
             errors |= ConfigErrors::TOO_MANY_PRIMARY_FILTERS;
         }
         if primary.iter().any(|f| f.check().is_err()) {
             errors |= ConfigErrors::PRIMARY_FILTER_NOT_CONFORM;
         }
-        if secondary.len() > configuration.secondary_filter_capacity() {
+        if secondary.len() > capacity_s {
             errors |= ConfigErrors::TOO_MANY_SECONDARY_FILTERS;
         }
         if !secondary.iter().all(secondary_conforms) {
@@ -201,7 +293,7 @@ impl FilterTable {
         errors
     }
 
-    /// Builds a table from lists already checked ([`FilterTable::check`]).
+    /// Builds a table from lists already checked ([`FilterTable::check_for`]).
     pub(crate) fn build(
         configuration: Configuration,
         primary: &[Filter],
@@ -223,8 +315,8 @@ impl FilterTable {
         let t = self;
         let p = primary.len();
         let s = secondary.len();
-        let capacity_p = configuration.primary_filter_capacity();
-        let capacity_s = configuration.secondary_filter_capacity();
+        let capacity_p = Self::primary_of(configuration);
+        let capacity_s = Self::secondary_of(configuration);
         let scan = secondary.iter().any(Filter::is_pass_all);
         let global_mask = if scan {
             0
@@ -247,11 +339,11 @@ impl FilterTable {
         };
 
         t.configuration = configuration;
-        t.elements = [0; MAX_TABLE_ELEMENTS];
-        t.individual_masks = [FULL_MASK; MAX_PRIMARY_FILTERS];
+        t.elements = [0; ELEMS];
+        t.individual_masks = [FULL_MASK; PRIM];
         t.global_mask = global_mask;
-        t.hits = [Hit::Filter(0); MAX_TABLE_ELEMENTS];
-        t.secondary = [Filter::pass_all(); MAX_SECONDARY_FILTERS];
+        t.hits = [Hit::Filter(0); ELEMS];
+        t.secondary = [Filter::pass_all(); SEC];
         t.primary_count = p as u8;
         t.secondary_count = s as u8;
         t.keys.clear();
@@ -287,11 +379,101 @@ impl FilterTable {
     }
 }
 
+/// A filter table the driver compiles and keeps (a [`FilterTable`] of any size): what
+/// `begin`, the split controller and `set_filters` need of the table of a layout
+/// ([`crate::layout::Layout::Table`]).
+pub trait OwnedTable: Clone + Send + Sync + 'static {
+    /// Whether a table of `configuration` fits ([`FilterTable::holds`]).
+    fn holds(configuration: Configuration) -> bool;
+    /// The errors compiling the lists gives ([`FilterTable::compile_for`]).
+    fn check_lists(
+        configuration: Configuration,
+        primary: &[Filter],
+        secondary: &[Filter],
+    ) -> ConfigErrors;
+    /// Lists already checked, compiled in place.
+    fn fill_lists(
+        &mut self,
+        configuration: Configuration,
+        primary: &[Filter],
+        secondary: &[Filter],
+    );
+    /// Lists already checked, compiled.
+    fn build_lists(configuration: Configuration, primary: &[Filter], secondary: &[Filter]) -> Self;
+    /// The configuration the table was compiled for.
+    fn table_configuration(&self) -> Configuration;
+    /// Whether the table accepts no frame (format D).
+    fn table_rejects_all(&self) -> bool;
+    /// The ID table elements.
+    fn table_elements(&self) -> &[u32];
+    /// The individual masks.
+    fn table_individual_masks(&self) -> &[u32];
+    /// `RXFGMASK`.
+    fn table_global_mask(&self) -> u32;
+    /// What a hit on `element` means.
+    fn table_hit(&self, element: usize) -> Option<Hit>;
+    /// The user's filter for a hit ([`FilterTable::filter_index`]).
+    fn table_filter_index(&self, element: usize, frame: &Frame) -> Option<u16>;
+}
+
+impl<const K: usize, const ELEMS: usize, const PRIM: usize, const SEC: usize> OwnedTable
+    for FilterTable<K, ELEMS, PRIM, SEC>
+{
+    #[inline(always)]
+    fn holds(configuration: Configuration) -> bool {
+        Self::holds(configuration)
+    }
+    fn check_lists(
+        configuration: Configuration,
+        primary: &[Filter],
+        secondary: &[Filter],
+    ) -> ConfigErrors {
+        Self::check_for(configuration, primary, secondary)
+    }
+    fn fill_lists(
+        &mut self,
+        configuration: Configuration,
+        primary: &[Filter],
+        secondary: &[Filter],
+    ) {
+        self.fill(configuration, primary, secondary)
+    }
+    fn build_lists(configuration: Configuration, primary: &[Filter], secondary: &[Filter]) -> Self {
+        Self::build(configuration, primary, secondary)
+    }
+    #[inline(always)]
+    fn table_configuration(&self) -> Configuration {
+        self.configuration
+    }
+    fn table_rejects_all(&self) -> bool {
+        self.reject_all
+    }
+    fn table_elements(&self) -> &[u32] {
+        self.elements()
+    }
+    fn table_individual_masks(&self) -> &[u32] {
+        self.individual_masks()
+    }
+    fn table_global_mask(&self) -> u32 {
+        self.global_mask
+    }
+    #[inline]
+    fn table_hit(&self, element: usize) -> Option<Hit> {
+        self.hit(element)
+    }
+    #[inline]
+    fn table_filter_index(&self, element: usize, frame: &Frame) -> Option<u16> {
+        self.filter_index(element, frame)
+    }
+}
+
 /// Room for one [`FilterTable`] in a `static`, handed out once as `&'static mut`
 /// ([`TableSlot::take`]): `begin` compiles the lists straight into it
 /// ([`crate::FlexCan::begin_in`]) and the split controller keeps the reference
 /// ([`crate::options::FullInSlot`]), so that no table-sized value moves through the
-/// configuration.
+/// configuration. `T` is the table (ACAN's sizes by default; the RT1062's
+/// [`crate::layout::LargeFilterTable`] with [`crate::layout::Imxrt1062`]:
+/// `TableSlot::<LargeFilterTable>::new_sized()`).
 ///
 /// ```
 /// use twocan_flexcan::filters::TableSlot;
@@ -299,14 +481,14 @@ impl FilterTable {
 /// assert!(TABLE.take().is_some());
 /// assert!(TABLE.take().is_none()); // once
 /// ```
-pub struct TableSlot {
-    table: core::cell::UnsafeCell<FilterTable>,
+pub struct TableSlot<T = FilterTable> {
+    table: core::cell::UnsafeCell<T>,
     taken: core::sync::atomic::AtomicBool,
 }
 
 // SAFETY: the table is reached only through the one `&'static mut` that `take` hands
 // out (the atomic flag makes it once), so no two contexts share it through the slot.
-unsafe impl Sync for TableSlot {}
+unsafe impl<T: Send> Sync for TableSlot<T> {}
 
 impl TableSlot {
     /// An empty slot (all zeros: it lives in `.bss`).
@@ -316,11 +498,25 @@ impl TableSlot {
             taken: core::sync::atomic::AtomicBool::new(false),
         }
     }
+}
 
+impl<const K: usize, const ELEMS: usize, const PRIM: usize, const SEC: usize>
+    TableSlot<FilterTable<K, ELEMS, PRIM, SEC>>
+{
+    /// An empty slot for a table of any size (all zeros: it lives in `.bss`).
+    pub const fn new_sized() -> Self {
+        TableSlot {
+            table: core::cell::UnsafeCell::new(FilterTable::zeroed()),
+            taken: core::sync::atomic::AtomicBool::new(false),
+        }
+    }
+}
+
+impl<T> TableSlot<T> {
     /// The table, the first time only.
     // The one `&mut` comes from the cell, handed out once (the flag).
     #[allow(clippy::mut_from_ref)]
-    pub fn take(&'static self) -> Option<&'static mut FilterTable> {
+    pub fn take(&'static self) -> Option<&'static mut T> {
         if self.taken.swap(true, core::sync::atomic::Ordering::AcqRel) {
             return None;
         }
@@ -335,7 +531,9 @@ impl Default for TableSlot {
     }
 }
 
-impl<const K: usize> FilterTable<K> {
+impl<const K: usize, const ELEMS: usize, const PRIM: usize, const SEC: usize>
+    FilterTable<K, ELEMS, PRIM, SEC>
+{
     /// The configuration the table was compiled for.
     pub const fn configuration(&self) -> Configuration {
         self.configuration
@@ -365,20 +563,20 @@ impl<const K: usize> FilterTable<K> {
     /// The table elements, in hardware order (`8 × (RFFN + 1)` of them).
     pub const fn elements(&self) -> &[u32] {
         self.elements
-            .split_at(self.configuration.table_elements())
+            .split_at(Self::elements_of(self.configuration))
             .0
     }
 
     /// The individual masks `RXIMR0…`, one per primary element.
     pub const fn individual_masks(&self) -> &[u32] {
         self.individual_masks
-            .split_at(self.configuration.primary_filter_capacity())
+            .split_at(Self::primary_of(self.configuration))
             .0
     }
 
     /// What each table element's hit means, in hardware order.
     pub const fn hits(&self) -> &[Hit] {
-        self.hits.split_at(self.configuration.table_elements()).0
+        self.hits.split_at(Self::elements_of(self.configuration)).0
     }
 
     /// The keys (identifier, format, kind) the hardware routes to a merged or
@@ -437,16 +635,18 @@ pub const fn frame_word(raw_id: u32, extended: bool, remote: bool) -> u32 {
 /// One planned primary element: (element, individual mask, hit).
 pub(crate) type PlannedPrimary = (u32, u32, Hit);
 
-impl<const K: usize> FilterTable<K> {
+impl<const K: usize, const ELEMS: usize, const PRIM: usize, const SEC: usize>
+    FilterTable<K, ELEMS, PRIM, SEC>
+{
     /// All zeros: a planner scratch's table before its first plan.
     pub(crate) const fn zeroed() -> Self {
         FilterTable {
             configuration: Configuration::Filters8_0,
-            elements: [0; MAX_TABLE_ELEMENTS],
-            individual_masks: [0; MAX_PRIMARY_FILTERS],
+            elements: [0; ELEMS],
+            individual_masks: [0; PRIM],
             global_mask: 0,
-            hits: [Hit::Filter(0); MAX_TABLE_ELEMENTS],
-            secondary: [ZERO_FILTER; MAX_SECONDARY_FILTERS],
+            hits: [Hit::Filter(0); ELEMS],
+            secondary: [ZERO_FILTER; SEC],
             primary_count: 0,
             secondary_count: 0,
             keys: KeyTable::new(),
@@ -475,8 +675,8 @@ impl<const K: usize> FilterTable<K> {
         keys: &KeyTable<N>,
         extra: u64,
     ) -> Result<(), PlanError> {
-        let capacity_p = configuration.primary_filter_capacity();
-        let capacity_s = configuration.secondary_filter_capacity();
+        let capacity_p = Self::primary_of(configuration);
+        let capacity_s = Self::secondary_of(configuration);
         let (np, ns) = (primary.len(), secondary.len());
         let global_mask = if ns == 0 { FULL_MASK } else { global_mask };
         // Field by field: no table-sized value on the stack.
@@ -488,18 +688,18 @@ impl<const K: usize> FilterTable<K> {
         self.extra = extra;
         self.reject_all = np == 0 && ns == 0;
         let mut i = 0;
-        while i < MAX_TABLE_ELEMENTS {
+        while i < ELEMS {
             self.elements[i] = 0;
             self.hits[i] = Hit::Filter(0);
             i += 1;
         }
         let mut i = 0;
-        while i < MAX_PRIMARY_FILTERS {
+        while i < PRIM {
             self.individual_masks[i] = FULL_MASK;
             i += 1;
         }
         let mut i = 0;
-        while i < MAX_SECONDARY_FILTERS {
+        while i < SEC {
             self.secondary[i] = Filter::pass_all();
             i += 1;
         }
@@ -577,8 +777,8 @@ impl<const K: usize> FilterTable<K> {
         if self.reject_all {
             return None;
         }
-        let p = self.configuration.primary_filter_capacity();
-        let n = self.configuration.table_elements();
+        let p = Self::primary_of(self.configuration);
+        let n = Self::elements_of(self.configuration);
         let mut i = 0;
         while i < n {
             let m = if i < p {
@@ -635,8 +835,8 @@ impl<const K: usize> FilterTable<K> {
     /// [`SizedTable`].
     pub const fn sizes(&self) -> TableSizes {
         TableSizes {
-            elements: self.configuration.table_elements(),
-            primary: self.configuration.primary_filter_capacity(),
+            elements: Self::elements_of(self.configuration),
+            primary: Self::primary_of(self.configuration),
             keys: self.keys.len(),
         }
     }
@@ -690,14 +890,21 @@ impl<const K: usize> FilterTable<K> {
     /// The driver's table for a `const` [`SizedTable`] (for the split driver's
     /// `set_filters`; about 1 KB by value).
     ///
-    /// Errors: [`PlanError::TooManyLookupKeys`] when it needs more lookup keys than `K`.
+    /// Errors: [`PlanError::TooManyLookupKeys`] when it needs more lookup keys than `K`,
+    /// [`PlanError::ConfigurationTooLarge`] when its table is larger than this type holds.
     pub const fn from_sized<const E: usize, const P: usize, const K2: usize>(
         t: &SizedTable<E, P, K2>,
     ) -> Result<Self, PlanError> {
+        if !Self::holds(t.configuration) {
+            return Err(PlanError::ConfigurationTooLarge {
+                rffn: t.configuration.rffn(),
+                max_rffn: Self::MAX_RFFN,
+            });
+        }
         let mut out = Self::zeroed();
         out.configuration = t.configuration;
-        out.individual_masks = [FULL_MASK; MAX_PRIMARY_FILTERS];
-        out.secondary = [Filter::pass_all(); MAX_SECONDARY_FILTERS];
+        out.individual_masks = [FULL_MASK; PRIM];
+        out.secondary = [Filter::pass_all(); SEC];
         out.global_mask = t.global_mask;
         out.extra = t.extra;
         out.reject_all = t.reject_all;

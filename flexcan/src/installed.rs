@@ -12,7 +12,7 @@ use twocan_core::filter_set::{key, lower_bound, Key};
 use twocan_core::{Error, Frame};
 
 use crate::configuration::Configuration;
-use crate::filters::{FilterTable, Hit, SizedTable};
+use crate::filters::{FilterTable, Hit, OwnedTable, SizedTable};
 
 /// Why a hit gives no user filter ([`InstalledTable::resolve`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -25,8 +25,9 @@ pub enum Unresolved {
     Unknown,
 }
 
-/// What the split controller needs of its filter table.
-pub trait InstalledTable: Send + 'static {
+/// What the split controller needs of its filter table; `T` is the table
+/// `set_filters` takes (the layout's, [`crate::layout::Layout::Table`]).
+pub trait InstalledTable<T = FilterTable>: Send + 'static {
     /// Whether [`InstalledTable::replace`] can take a new table (checked before any
     /// register is written).
     const REPLACEABLE: bool;
@@ -39,44 +40,46 @@ pub trait InstalledTable: Send + 'static {
 
     /// Replaces the table with `table` (the receive half's `set_filters`, after the
     /// registers were written). [`Error::Unsupported`] for a table that cannot change.
-    fn replace(&mut self, table: &FilterTable) -> Result<(), Error>;
+    fn replace(&mut self, table: &T) -> Result<(), Error>;
 }
 
-impl InstalledTable for FilterTable {
+impl<T: OwnedTable> InstalledTable<T> for T {
     const REPLACEABLE: bool = true;
 
+    #[inline(always)]
     fn configuration(&self) -> Configuration {
-        FilterTable::configuration(self)
+        self.table_configuration()
     }
 
     #[inline]
     fn resolve(&self, hit: usize, frame: &Frame) -> Result<u16, Unresolved> {
-        match self.filter_index(hit, frame) {
+        match self.table_filter_index(hit, frame) {
             Some(i) => Ok(i),
-            None if self.hit(hit) == Some(Hit::Lookup) => Err(Unresolved::Superset),
+            None if self.table_hit(hit) == Some(Hit::Lookup) => Err(Unresolved::Superset),
             None => Err(Unresolved::Unknown),
         }
     }
 
-    fn replace(&mut self, table: &FilterTable) -> Result<(), Error> {
+    fn replace(&mut self, table: &T) -> Result<(), Error> {
         self.clone_from(table);
         Ok(())
     }
 }
 
-impl InstalledTable for &'static mut FilterTable {
+impl<T: OwnedTable> InstalledTable<T> for &'static mut T {
     const REPLACEABLE: bool = true;
 
+    #[inline(always)]
     fn configuration(&self) -> Configuration {
-        FilterTable::configuration(self)
+        self.table_configuration()
     }
 
     #[inline]
     fn resolve(&self, hit: usize, frame: &Frame) -> Result<u16, Unresolved> {
-        <FilterTable as InstalledTable>::resolve(self, hit, frame)
+        <T as InstalledTable<T>>::resolve(self, hit, frame)
     }
 
-    fn replace(&mut self, table: &FilterTable) -> Result<(), Error> {
+    fn replace(&mut self, table: &T) -> Result<(), Error> {
         self.clone_from(table);
         Ok(())
     }
@@ -144,7 +147,7 @@ impl PlannedTable {
     }
 }
 
-impl InstalledTable for PlannedTable {
+impl<T> InstalledTable<T> for PlannedTable {
     const REPLACEABLE: bool = false;
 
     fn configuration(&self) -> Configuration {
@@ -168,7 +171,7 @@ impl InstalledTable for PlannedTable {
         }
     }
 
-    fn replace(&mut self, _: &FilterTable) -> Result<(), Error> {
+    fn replace(&mut self, _: &T) -> Result<(), Error> {
         Err(Error::Unsupported)
     }
 }

@@ -75,7 +75,12 @@
 //! On a Teensy 4.x (i.MX RT1062, [`imxrt`]) the tokens are `Can1`, `Can2`, `Can3` (CAN1 on
 //! pins 22/23, CAN2 on 1/0, CAN3 on 31/30), the settings name the CCM clock root
 //! (`Settings::with_clock(rate, CanClock::IMXRT_24MHZ)`), and with `rt` the entry points
-//! are `CAN1`, `CAN2`, `CAN3` (`rt_imxrt`), one line per module.
+//! are `CAN1`, `CAN2`, `CAN3` (`rt_imxrt`), one line per module. The message-buffer
+//! layout is a type parameter ([`layout`]): the default, [`layout::Kinetis`], keeps ACAN's
+//! four configurations in MB0–MB15 on both families; [`layout::Imxrt1062`] takes the
+//! RT1062's Rx FIFO tables up to 128 elements (32 primary and 96 secondary filters,
+//! [`FlexCan::begin_with_layout`], [`LargeFilterTable`]), at no cost to a Teensy 3.x
+//! firmware.
 //!
 //! So `teensy32` + `teensy36` builds for a Teensy 3.6: firmware for a Teensy 3.2 linked
 //! that way would drive the wrong pins. Check `Board::DEFAULT` (or `cargo tree -e
@@ -138,6 +143,7 @@ mod handshake;
 pub mod imxrt;
 pub mod installed;
 pub mod instance;
+pub mod layout;
 mod message_buffer;
 pub mod options;
 #[cfg(all(
@@ -194,6 +200,7 @@ pub use instance::Can1;
 #[cfg(any(feature = "teensy40", feature = "teensy41"))]
 pub use instance::{Can2, Can3};
 pub use instance::{Instance, Irqs, Target};
+pub use layout::LargeFilterTable;
 pub use settings::{Settings, CAN_CLOCK_HZ, RECEIVE_BUFFER_SIZE, TRANSMIT_BUFFER_SIZE};
 pub use split::{FlexCanHw, InstalledFilters};
 pub use system::HostSystem;

@@ -158,6 +158,15 @@ pub enum PlanError {
         /// The lookup capacity.
         max: u16,
     },
+    /// The configuration asked for has a larger ID filter table than the table type
+    /// holds ([`FilterTable::MAX_RFFN`]: RFFN 3 for ACAN's sizes, 0xF for
+    /// [`crate::LargeFilterTable`], the RT1062 layout's).
+    ConfigurationTooLarge {
+        /// `CTRL2[RFFN]` of the configuration asked for.
+        rffn: u8,
+        /// The largest the table holds.
+        max_rffn: u8,
+    },
 }
 
 impl core::fmt::Display for PlanError {
@@ -179,6 +188,11 @@ impl core::fmt::Display for PlanError {
             PlanError::TooManyLookupKeys { needed, max } => write!(
                 f,
                 "the table needs {needed} lookup keys for its merged elements, it keeps {max}"
+            ),
+            PlanError::ConfigurationTooLarge { rffn, max_rffn } => write!(
+                f,
+                "the configuration's table (RFFN {rffn}) is larger than the table holds \
+                 (RFFN {max_rffn} at most)"
             ),
         }
     }
@@ -213,6 +227,7 @@ impl From<PlanError> for twocan_core::Error {
                 needed,
                 available: max,
             },
+            PlanError::ConfigurationTooLarge { .. } => twocan_core::Error::InvalidArgument,
         }
     }
 }
@@ -309,6 +324,12 @@ impl PlanError {
                 .number(needed as u32)
                 .text(" lookup keys, the capacity is ")
                 .number(max as u32),
+            PlanError::ConfigurationTooLarge { rffn, max_rffn } => m
+                .text("the configuration's table (RFFN ")
+                .number(rffn as u32)
+                .text(") is larger than the table holds (RFFN ")
+                .number(max_rffn as u32)
+                .text(" at most)"),
         };
         panic!("{}", m.as_str())
     }
@@ -433,31 +454,32 @@ const fn need(prep: &Prepared, cubes: &CubeList, capacity_s: usize) -> usize {
 /// One primary element while placing: (position in user order, element, mask, hit).
 type Primary = (u16, u32, u32, Hit);
 
-/// Working memory of [`place`].
-struct PlaceScratch {
-    primary: [Primary; MAX_PRIMARY_FILTERS],
-    planned: [PlannedPrimary; MAX_PRIMARY_FILTERS],
-    secondary: [(u32, Hit); MAX_SECONDARY_FILTERS],
+/// Working memory of [`place`], for a table of `PRIM` primary and `SEC` secondary
+/// elements at most.
+struct PlaceScratch<const PRIM: usize, const SEC: usize> {
+    primary: [Primary; PRIM],
+    planned: [PlannedPrimary; PRIM],
+    secondary: [(u32, Hit); SEC],
 }
 
-impl PlaceScratch {
-    const ZERO: PlaceScratch = PlaceScratch {
-        primary: [(0, 0, 0, Hit::Filter(0)); MAX_PRIMARY_FILTERS],
-        planned: [(0, 0, Hit::Filter(0)); MAX_PRIMARY_FILTERS],
-        secondary: [(0, Hit::Filter(0)); MAX_SECONDARY_FILTERS],
+impl<const PRIM: usize, const SEC: usize> PlaceScratch<PRIM, SEC> {
+    const ZERO: Self = PlaceScratch {
+        primary: [(0, 0, 0, Hit::Filter(0)); PRIM],
+        planned: [(0, 0, Hit::Filter(0)); PRIM],
+        secondary: [(0, Hit::Filter(0)); SEC],
     };
 }
 
 /// Step 3: the table of a cover that fits `configuration`, into `out`.
-const fn place<const K: usize>(
+const fn place<const K: usize, const ELEMS: usize, const PRIM: usize, const SEC: usize>(
     prep: &Prepared,
     cubes: &CubeList,
     configuration: Configuration,
     extra: u64,
-    ps: &mut PlaceScratch,
-    out: &mut FilterTable<K>,
+    ps: &mut PlaceScratch<PRIM, SEC>,
+    out: &mut FilterTable<K, ELEMS, PRIM, SEC>,
 ) -> Result<(), PlanError> {
-    let capacity_s = configuration.secondary_filter_capacity();
+    let capacity_s = FilterTable::<K, ELEMS, PRIM, SEC>::secondary_of(configuration);
     let mut np = 0;
     let mut ns = 0;
     let mut all_std = true;
@@ -616,7 +638,15 @@ const fn tune(prep: &Prepared, cubes: &mut CubeList, capacity_s: usize) {
 /// A firmware that plans at run time keeps it in a `static` place it owns (an RTIC
 /// `#[local]` resource, a `cortex_m::singleton!`, any static cell lending `&mut` to one
 /// context at a time); the planning call then needs a small stack frame.
-pub struct Scratch<const K: usize = LOOKUP_KEYS> {
+///
+/// The table's sizes are those of [`FilterTable`]'s parameters (ACAN's by default;
+/// `Scratch<K, 128, 32, 96>` plans for the RT1062 layout's [`crate::LargeFilterTable`]).
+pub struct Scratch<
+    const K: usize = LOOKUP_KEYS,
+    const ELEMS: usize = { crate::configuration::MAX_TABLE_ELEMENTS },
+    const PRIM: usize = MAX_PRIMARY_FILTERS,
+    const SEC: usize = MAX_SECONDARY_FILTERS,
+> {
     prep: Prepared,
     /// The merged covers: greedy with blocks of two or more, greedy with blocks of
     /// three or more, and the fewest cubes (the list of singles is made on demand).
@@ -627,19 +657,23 @@ pub struct Scratch<const K: usize = LOOKUP_KEYS> {
     best: CubeList,
     cand: CubeList,
     cover: CoverScratch,
-    place: PlaceScratch,
-    tables: [FilterTable<K>; 2],
+    place: PlaceScratch<PRIM, SEC>,
+    tables: [FilterTable<K, ELEMS, PRIM, SEC>; 2],
     /// The table of the last successful plan.
     result: usize,
 }
 
-impl<const K: usize> Default for Scratch<K> {
+impl<const K: usize, const ELEMS: usize, const PRIM: usize, const SEC: usize> Default
+    for Scratch<K, ELEMS, PRIM, SEC>
+{
     fn default() -> Self {
         Self::new()
     }
 }
 
-impl<const K: usize> Scratch<K> {
+impl<const K: usize, const ELEMS: usize, const PRIM: usize, const SEC: usize>
+    Scratch<K, ELEMS, PRIM, SEC>
+{
     /// Fresh working memory (all zeros).
     pub const fn new() -> Self {
         Scratch {
@@ -656,7 +690,7 @@ impl<const K: usize> Scratch<K> {
     }
 
     /// The table of the last successful [`plan_in`] call.
-    pub const fn table(&self) -> &FilterTable<K> {
+    pub const fn table(&self) -> &FilterTable<K, ELEMS, PRIM, SEC> {
         &self.tables[self.result]
     }
 }
@@ -709,9 +743,14 @@ const fn best_cover(
     best_need
 }
 
-/// Plans one configuration into `tables[t]`.
-const fn plan_for_configuration<const K: usize>(
-    s: &mut Scratch<K>,
+/// Plans one configuration into `tables[t]` (a configuration the table holds).
+const fn plan_for_configuration<
+    const K: usize,
+    const ELEMS: usize,
+    const PRIM: usize,
+    const SEC: usize,
+>(
+    s: &mut Scratch<K, ELEMS, PRIM, SEC>,
     configuration: Configuration,
     superset: bool,
     t: usize,
@@ -727,8 +766,8 @@ const fn plan_for_configuration<const K: usize>(
         tables,
         ..
     } = s;
-    let capacity_p = configuration.primary_filter_capacity();
-    let capacity_s = configuration.secondary_filter_capacity();
+    let capacity_p = FilterTable::<K, ELEMS, PRIM, SEC>::primary_of(configuration);
+    let capacity_s = FilterTable::<K, ELEMS, PRIM, SEC>::secondary_of(configuration);
     let n = best_cover(prep, covers, *n_covers, capacity_s, None, best, cand);
     if n <= capacity_p {
         let keys = match place(prep, best, configuration, 0, ps, &mut tables[t]) {
@@ -771,11 +810,21 @@ const fn plan_for_configuration<const K: usize>(
 }
 
 /// The steps of the module documentation, into `s`.
-const fn plan_into<const K: usize>(
+const fn plan_into<const K: usize, const ELEMS: usize, const PRIM: usize, const SEC: usize>(
     filters: &[Filter],
     options: PlanOptions,
-    s: &mut Scratch<K>,
+    s: &mut Scratch<K, ELEMS, PRIM, SEC>,
 ) -> Result<(), PlanError> {
+    // The configurations the table holds: RFFN 0 to `max` (ACAN's four by default).
+    let max = FilterTable::<K, ELEMS, PRIM, SEC>::MAX_RFFN as usize;
+    if let Some(c) = options.configuration {
+        if !FilterTable::<K, ELEMS, PRIM, SEC>::holds(c) {
+            return Err(PlanError::ConfigurationTooLarge {
+                rffn: c.rffn(),
+                max_rffn: max as u8,
+            });
+        }
+    }
     if let Err(e) = s.prep.fill(filters) {
         return Err(e);
     }
@@ -799,13 +848,13 @@ const fn plan_into<const K: usize>(
         return plan_for_configuration(s, c, options.superset, 0);
     }
     let mut i = 0;
-    while i < Configuration::ALL.len() {
-        if plan_for_configuration(s, Configuration::ALL[i], false, 0).is_ok() {
+    while i <= max {
+        if plan_for_configuration(s, Configuration::EVERY[i], false, 0).is_ok() {
             return Ok(());
         }
         i += 1;
     }
-    let largest = Configuration::Filters14_18;
+    let largest = Configuration::EVERY[max];
     if !options.superset {
         return plan_for_configuration(s, largest, false, 0);
     }
@@ -813,12 +862,12 @@ const fn plan_into<const K: usize>(
     let mut best: Option<usize> = None;
     let mut keys_refused: Option<PlanError> = None;
     let mut i = 0;
-    while i < Configuration::ALL.len() {
+    while i <= max {
         let t = match best {
             Some(b) => 1 - b,
             None => 0,
         };
-        match plan_for_configuration(s, Configuration::ALL[i], true, t) {
+        match plan_for_configuration(s, Configuration::EVERY[i], true, t) {
             Ok(()) => {
                 let fewer = match best {
                     None => true,
@@ -849,11 +898,21 @@ const fn plan_into<const K: usize>(
 /// `static` (see [`Scratch`]). The table needs at most `K` lookup keys.
 ///
 /// The same `const fn` as [`plan`] and [`crate::const_plan!`]. Errors: as [`plan`].
-pub const fn plan_in<'s, const K: usize>(
+///
+/// The scratch's sizes choose the table's: `Scratch<K, 128, 32, 96>` plans a
+/// [`crate::LargeFilterTable`] (RFFN up to 0xF, the RT1062 layout's), choosing among
+/// all sixteen configurations.
+pub const fn plan_in<
+    's,
+    const K: usize,
+    const ELEMS: usize,
+    const PRIM: usize,
+    const SEC: usize,
+>(
     filters: &[Filter],
     options: PlanOptions,
-    scratch: &'s mut Scratch<K>,
-) -> Result<&'s FilterTable<K>, PlanError> {
+    scratch: &'s mut Scratch<K, ELEMS, PRIM, SEC>,
+) -> Result<&'s FilterTable<K, ELEMS, PRIM, SEC>, PlanError> {
     match plan_into(filters, options, scratch) {
         Ok(()) => Ok(&scratch.tables[scratch.result]),
         Err(e) => Err(e),
@@ -866,7 +925,22 @@ pub const fn plan_for<const K: usize>(
     filters: &[Filter],
     options: PlanOptions,
 ) -> Result<FilterTable<K>, PlanError> {
-    let mut s = Scratch::<K>::new();
+    plan_sized::<
+        K,
+        { crate::configuration::MAX_TABLE_ELEMENTS },
+        MAX_PRIMARY_FILTERS,
+        MAX_SECONDARY_FILTERS,
+    >(filters, options)
+}
+
+/// [`plan_for`] into a table of any size (its [`Scratch`] on the stack): with
+/// `FilterTable<K, 128, 32, 96>` the RT1062 layout's tables, RFFN up to 0xF
+/// ([`plan_large`]).
+pub const fn plan_sized<const K: usize, const ELEMS: usize, const PRIM: usize, const SEC: usize>(
+    filters: &[Filter],
+    options: PlanOptions,
+) -> Result<FilterTable<K, ELEMS, PRIM, SEC>, PlanError> {
+    let mut s = Scratch::<K, ELEMS, PRIM, SEC>::new();
     match plan_into(filters, options, &mut s) {
         Ok(()) => {
             let [a, b] = s.tables;
@@ -926,6 +1000,37 @@ pub const fn plan_for<const K: usize>(
 /// ```
 pub const fn plan(filters: &[Filter], options: PlanOptions) -> Result<FilterTable, PlanError> {
     plan_for::<LOOKUP_KEYS>(filters, options)
+}
+
+/// [`plan`] for the RT1062 layout ([`crate::layout::Imxrt1062`]): a
+/// [`crate::LargeFilterTable`], the configuration chosen among RFFN 0 to 0xF (up to 128
+/// elements: 32 primary, 96 secondary) or given. A configuration whose table is larger
+/// than the chip takes is refused by `begin` ([`crate::Chip::accepted_max_rffn`]).
+///
+/// ```
+/// use twocan_core::Filter;
+/// use twocan_flexcan::planner::{plan, plan_large, PlanError, PlanOptions};
+/// use twocan_flexcan::Configuration;
+///
+/// // 120 single identifiers: more than ACAN's 14/18 table holds; the smallest large
+/// // table that does has 120 elements (RFFN 0xE).
+/// let ids: Vec<Filter> = (0..120u32).map(|i| Filter::extended(0x1000 + 7 * i)).collect();
+/// let options = PlanOptions::default().merge(false);
+/// assert!(matches!(plan(&ids, options), Err(PlanError::TooManyPrimary { .. })));
+/// let table = plan_large(&ids, options)?;
+/// assert_eq!(table.configuration(), Configuration::Filters32_88);
+/// // ACAN's table type does not hold RFFN 0xF: a typed error.
+/// assert_eq!(
+///     plan(&ids, PlanOptions::new(Configuration::Filters32_96)).unwrap_err(),
+///     PlanError::ConfigurationTooLarge { rffn: 15, max_rffn: 3 }
+/// );
+/// # Ok::<(), PlanError>(())
+/// ```
+pub fn plan_large(
+    filters: &[Filter],
+    options: PlanOptions,
+) -> Result<crate::LargeFilterTable, PlanError> {
+    plan_sized(filters, options)
 }
 
 /// [`plan_for`] with room for every key ([`MAX_LOOKUP_KEYS`]), or a compile-time error
@@ -1012,10 +1117,65 @@ macro_rules! const_plan {
     }};
 }
 
+/// [`plan_large`] with room for every key, or a compile-time error with a readable
+/// message: the first step of [`crate::const_plan_large!`].
+#[doc(hidden)]
+pub const fn plan_large_or_panic(
+    filters: &[Filter],
+    options: PlanOptions,
+) -> crate::filters::FilterTable<MAX_LOOKUP_KEYS, 128, 32, 96> {
+    match plan_sized::<MAX_LOOKUP_KEYS, 128, 32, 96>(filters, options) {
+        Ok(t) => t,
+        Err(e) => e.panic(),
+    }
+}
+
+/// [`crate::const_plan!`] for the RT1062 layout ([`crate::layout::Imxrt1062`]): the
+/// configuration chosen among RFFN 0 to 0xF (tables up to 128 elements, 32 primary and
+/// 96 secondary) or given, planned at compile time into a `&'static`
+/// [`SizedTable`](crate::filters::SizedTable) for `begin_planned` with
+/// [`crate::options::Lean`]`<Imxrt1062>` (its [`crate::BeginPlan`] made with
+/// `BeginPlan::<Imxrt1062>::new_with_layout`).
+///
+/// ```
+/// use twocan_core::{Filter, Frame};
+/// use twocan_flexcan::planner::PlanOptions;
+/// use twocan_flexcan::{const_plan_large, Configuration};
+///
+/// const IDS: [Filter; 100] = {
+///     let mut f = [Filter::pass_all(); 100];
+///     let mut i = 0;
+///     while i < 100 {
+///         f[i] = Filter::extended(0x1000 + 7 * i as u32);
+///         i += 1;
+///     }
+///     f
+/// };
+/// let table = const_plan_large!(IDS, PlanOptions::choose().merge(false));
+/// assert_eq!(table.configuration(), Configuration::Filters32_72);
+/// let (_, user) = table.evaluate(&Frame::extended(0x1000 + 7 * 99, &[]).unwrap()).unwrap();
+/// assert_eq!(user, Some(99));
+/// ```
+#[macro_export]
+macro_rules! const_plan_large {
+    ($filters:expr, $options:expr $(,)?) => {{
+        #[allow(long_running_const_eval)]
+        const FULL: $crate::FilterTable<{ $crate::filters::MAX_LOOKUP_KEYS }, 128, 32, 96> =
+            $crate::planner::plan_large_or_panic(&$filters, $options);
+        const SIZES: $crate::filters::TableSizes = FULL.sizes();
+        const TABLE: $crate::filters::SizedTable<
+            { SIZES.elements },
+            { SIZES.primary },
+            { SIZES.keys },
+        > = FULL.sized();
+        &TABLE
+    }};
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use twocan_core::{Frame, FrameKind};
+    use twocan_core::{Format, Frame, FrameKind};
 
     fn first(filters: &[Filter], f: &Frame) -> Option<u16> {
         filters.iter().position(|x| x.matches(f)).map(|i| i as u16)
@@ -1030,6 +1190,83 @@ mod tests {
                 let got = t.evaluate(&f).and_then(|(_, i)| i);
                 assert_eq!(got, first(filters, &f), "{f:?}");
             }
+        }
+    }
+
+    /// `n` general filters (masked extended ranges, one primary element each) and `m`
+    /// single extended identifiers, none mergeable with another, and a frame each accepts.
+    fn mixed(n: u32, m: u32) -> (Vec<Filter>, Vec<Frame>) {
+        let mut filters = Vec::new();
+        let mut frames = Vec::new();
+        for i in 0..n {
+            filters.push(Filter::masked(
+                FrameKind::Data,
+                Format::Extended,
+                0x1FFF_FF00,
+                0x0100_0000 + (i << 8),
+            ));
+            frames.push(Frame::extended(0x0100_0000 + (i << 8) + 0x33, &[]).unwrap());
+        }
+        for j in 0..m {
+            filters.push(Filter::extended(0x0002_0000 + 5 * j));
+            frames.push(Frame::extended(0x0002_0000 + 5 * j, &[]).unwrap());
+        }
+        (filters, frames)
+    }
+
+    #[test]
+    fn rt1062_tables_of_32_64_96_and_128_elements() {
+        for (n, m, c) in [
+            (14, 18, Configuration::Filters14_18),
+            (22, 42, Configuration::Filters22_42),
+            (30, 66, Configuration::Filters30_66),
+            (32, 96, Configuration::Filters32_96),
+        ] {
+            let (filters, frames) = mixed(n, m);
+            // "Choose for me" gives the smallest table that holds the list.
+            let t = plan_large(&filters, PlanOptions::choose()).unwrap();
+            assert_eq!(t.configuration(), c);
+            assert_eq!(t.elements().len(), c.table_elements());
+            for f in &frames {
+                let got = t.evaluate(f).and_then(|(_, i)| i);
+                assert_eq!(got, first(&filters, f), "{c:?} {f:?}");
+                assert!(got.is_some());
+            }
+            assert_eq!(t.evaluate(&Frame::standard(0x7FF, &[]).unwrap()), None);
+            // ACAN's table type holds the first only.
+            let acan = plan(&filters, PlanOptions::choose());
+            assert_eq!(acan.is_ok(), c == Configuration::Filters14_18, "{c:?}");
+        }
+        // One general filter more than the 32 individual masks: refused with the counts.
+        let (filters, _) = mixed(33, 0);
+        assert_eq!(
+            plan_large(&filters, PlanOptions::choose()).unwrap_err(),
+            PlanError::TooManyPrimary {
+                needed: 33,
+                available: 32,
+                secondary: 96
+            }
+        );
+        // A configuration the table type cannot hold: typed, never a panic.
+        assert_eq!(
+            plan(&[], PlanOptions::new(Configuration::Filters16_24)).unwrap_err(),
+            PlanError::ConfigurationTooLarge {
+                rffn: 4,
+                max_rffn: 3
+            }
+        );
+        // The run-time planner with the large scratch, a configuration given.
+        let (filters, frames) = mixed(20, 30);
+        let mut scratch: Box<Scratch<LOOKUP_KEYS, 128, 32, 96>> = Box::default();
+        let t = plan_in(
+            &filters,
+            PlanOptions::new(Configuration::Filters32_72),
+            &mut scratch,
+        )
+        .unwrap();
+        assert_eq!(t.configuration(), Configuration::Filters32_72);
+        for f in &frames {
+            assert_eq!(t.evaluate(f).and_then(|(_, i)| i), first(&filters, f));
         }
     }
 

@@ -54,6 +54,28 @@ pub const fn timing_rule_for(can_clock_hz: u32, bus_clock_hz: Option<u32>) -> Ti
     flexcan_rules::rule(can_clock_hz, bus, MESSAGE_BUFFERS, true)
 }
 
+/// [`timing_rule_for`] for a module whose first `message_buffers` message buffers take
+/// part in matching and arbitration (`MCR[MAXMB]` + 1, [`Configuration::message_buffers_used`]):
+/// 16 bus clocks per CAN bit up to 16 buffers, 17 up to 32 with the Rx FIFO, 30 above
+/// (IMXRT1060RM, FlexCAN "Arbitration and matching timing", table "Minimum ratio between
+/// peripheral clock frequency and CAN bit rate").
+pub const fn timing_rule_for_buffers(
+    can_clock_hz: u32,
+    bus_clock_hz: Option<u32>,
+    message_buffers: usize,
+) -> TimingRule {
+    let bus = match bus_clock_hz {
+        Some(hz) => hz,
+        None => can_clock_hz,
+    };
+    let mbs = if message_buffers > 64 {
+        64
+    } else {
+        message_buffers as u8
+    };
+    flexcan_rules::rule(can_clock_hz, bus, mbs, true)
+}
+
 /// The bit rate of the default settings (ACAN table 7: `mWhishedBitRate` 250,000).
 pub const DEFAULT_BIT_RATE: u32 = 250_000;
 
@@ -273,6 +295,18 @@ impl Settings {
     /// [`Settings::bus_clock_hz`].
     pub const fn timing_rule(&self) -> TimingRule {
         timing_rule_for(self.can_clock.hz(), self.bus_clock_hz)
+    }
+
+    /// The bit timing rule `begin` applies to these settings with a table of
+    /// `configuration`: [`Settings::timing_rule`] for ACAN's configurations (16 message
+    /// buffers), [`timing_rule_for_buffers`] with the buffers of the RT1062's larger
+    /// ones ([`Configuration::message_buffers_used`]).
+    pub const fn timing_rule_with(&self, configuration: Configuration) -> TimingRule {
+        timing_rule_for_buffers(
+            self.can_clock.hz(),
+            self.bus_clock_hz,
+            configuration.message_buffers_used(),
+        )
     }
 
     /// Whether the actual bit rate is exactly the wished one (ACAN §16.4).

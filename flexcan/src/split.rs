@@ -11,6 +11,11 @@
 //! - transmit half and transmit handler: `IFLAG1` read, the words of one transmit
 //!   mailbox that is inactive and settled (code `INACTIVE`, its `IFLAG1` bit clear);
 //! - transmit handler: `IFLAG1` write-1-to-clear of the transmit mailboxes' bits;
+//!
+//! (With the RT1062 layout, [`crate::layout::Imxrt1062`], the transmit mailboxes of the
+//! tables from RFFN 0xC on are MB32–MB45: what is said here of their `IFLAG1` bits holds
+//! of their `IFLAG2` bits, IMXRT1060RM "Interrupt Flags 2 register (IFLAG2)"; the Rx
+//! FIFO's flags stay in `IFLAG1`.)
 //! - transmit half (`abort`) and transmit handler (`settle`), inside the driver's critical
 //!   section: `ESR1` read for `TX` before an ABORT write (its clear-on-read error bits
 //!   are kept for the status handler, as every state read does), ABORT into the control
@@ -30,7 +35,7 @@
 //!
 //! A raw received frame is the Rx FIFO output's four words (control/status,
 //! identifier, data) and `RXFIR.IDHIT`; the thread side decodes it and maps the hit
-//! to the user's filter ([`FilterTable::filter_index`]).
+//! to the user's filter ([`crate::FilterTable::filter_index`]).
 
 use core::marker::PhantomData;
 use core::sync::atomic::{AtomicBool, AtomicU32, AtomicU8, Ordering};
@@ -46,15 +51,17 @@ use twocan_core::{
 };
 use twocan_core::{MailboxId, MailboxState};
 
-use crate::configuration::{Configuration, DATA_MAILBOX};
+use crate::begin::{last_mailbox, tx_flag_base};
+use crate::configuration::Configuration;
 use crate::controller::FlexCan;
-use crate::filters::{FilterTable, UNKNOWN_FILTER};
+use crate::filters::{OwnedTable, UNKNOWN_FILTER};
 use crate::handshake;
 use crate::installed::{InstalledTable, Unresolved};
 use crate::instance::Target;
+use crate::layout::Layout;
 use crate::message_buffer::MbWords;
 use crate::options::{Full, Options};
-use crate::regs::{self, code, cs, ctrl1, esr1, iflag1, rxfir, ECR, ESR1, IFLAG1, RXFIR};
+use crate::regs::{self, code, cs, ctrl1, esr1, iflag1, rxfir, ECR, ESR1, IFLAG1, IFLAG2, RXFIR};
 use crate::status;
 use crate::system::SystemPlan;
 
@@ -65,7 +72,8 @@ pub type RawFrame = [u32; 5];
 /// Frames the Rx FIFO holds (Kinetis RM, "Rx FIFO": six deep).
 const RX_FIFO_DEPTH: usize = 6;
 
-/// Transmit mailboxes at most (MB15 and up to seven remote-frame mailboxes).
+/// Transmit mailboxes at most (the data mailbox, MB15 in ACAN's configurations, and up
+/// to seven remote-frame mailboxes: [`Configuration::data_mailbox`]).
 const MAX_TX: usize = 8;
 
 const MODE_NORMAL: u8 = 0;
@@ -105,7 +113,8 @@ fn mode_code(m: Mode) -> u8 {
 pub struct FlexCanHw<R: Registers, O: Options = Full> {
     regs: R,
     target: Target,
-    /// The transmit mailboxes' bits in `IFLAG1` (remote-frame mailboxes and MB15),
+    /// The transmit mailboxes' bits in their flag register (remote-frame mailboxes and
+    /// the data mailbox; `IFLAG1`, or `IFLAG2` above MB31: [`FlexCanHw::tx_flags`]),
     /// from the configuration.
     tx_mask: u32,
     /// The installed filter table (ID table, masks, map from `IDHIT` to the user's
@@ -131,7 +140,7 @@ pub struct FlexCanHw<R: Registers, O: Options = Full> {
     /// and compared by `decode`: frames read before the last `install_filters` are
     /// dropped. Written by `install_filters` only.
     generation: AtomicU32,
-    /// Token of the frame in each transmit mailbox, indexed by `15 - MB`.
+    /// Token of the frame in each transmit mailbox, indexed by `data mailbox - MB`.
     tokens: [AtomicU32; MAX_TX],
     last_error: AtomicLastError,
     /// Written by the receive half's `decode` only.
@@ -163,17 +172,17 @@ pub struct FlexCanHw<R: Registers, O: Options = Full> {
     options: PhantomData<O>,
 }
 
-impl<R: Registers> FlexCan<R> {
+impl<R: Registers, L: Layout> FlexCan<R, L> {
     /// The controller for the split driver (`twocan_core::split::State::split`); the
     /// installed filter table comes along. Every feature ([`Full`]); see
     /// [`FlexCan::into_split_with`] for a leaner choice.
-    pub fn into_split(self) -> FlexCanHw<R> {
-        self.into_split_with::<Full>()
+    pub fn into_split(self) -> FlexCanHw<R, Full<L>> {
+        self.into_split_with::<Full<L>>()
     }
 
     /// The controller for the split driver with the compile-time choices `O`
-    /// ([`crate::options`]: [`Full`], [`crate::options::Lean`]).
-    pub fn into_split_with<O: Options<Table = FilterTable>>(self) -> FlexCanHw<R, O> {
+    /// ([`crate::options`]: [`Full`], [`crate::options::Lean`]) of the same layout.
+    pub fn into_split_with<O: Options<Layout = L, Table = L::Table>>(self) -> FlexCanHw<R, O> {
         let last_error = self.last_error.get();
         FlexCanHw::from_parts(
             self.regs,
@@ -212,12 +221,20 @@ impl<R: Registers, O: Options> FlexCanHw<R, O> {
     pub(crate) fn from_parts(regs: R, target: Target, table: O::Table, p: Parts) -> Self {
         let configuration = table.configuration();
         let first = configuration.first_remote_mailbox() as u32;
+        let tx_mask = if O::Layout::IFLAG2 {
+            // The transmit mailboxes `first..=data` as bits of their flag register.
+            let data = last_mailbox::<O::Layout>(configuration) as u32;
+            let base = tx_flag_base::<O::Layout>(data as usize) as u32;
+            (u32::MAX >> (31 - (data - base))) >> (first - base) << (first - base)
+        } else {
+            (0xFFFF_u32 >> first << first) & 0xFFFF
+        };
         let srxdis =
             p.bus_mode != BusMode::LoopBack && regs.read32(regs::MCR) & regs::mcr::SRXDIS != 0;
         FlexCanHw {
             regs,
             target,
-            tx_mask: (0xFFFF_u32 >> first << first) & 0xFFFF,
+            tx_mask,
             configuration,
             table: core::cell::UnsafeCell::new(table),
             bus_mode: AtomicU8::new(bus_mode_code(p.bus_mode)),
@@ -256,6 +273,9 @@ impl<R: Registers, O: Options> FlexCanHw<R, O> {
 /// }
 /// ```
 ///
+/// The table is the layout's ([`crate::layout::Layout::Table`]): a
+/// [`crate::LargeFilterTable`] with [`crate::layout::Imxrt1062`].
+///
 /// Any other context has only `&FlexCanHw` (`State::hardware`, `Tx::hardware`), which
 /// does not offer the table, so a copy is never torn by a concurrent `set_filters`:
 ///
@@ -267,14 +287,17 @@ impl<R: Registers, O: Options> FlexCanHw<R, O> {
 /// # }
 /// ```
 pub trait InstalledFilters {
+    /// The table's type ([`crate::FilterTable`] with the default layout).
+    type Table;
     /// A copy of the filter table in force.
-    fn filters(&self) -> FilterTable;
+    fn filters(&self) -> Self::Table;
 }
 
-impl<R: Registers, O: Options<Table = FilterTable>> InstalledFilters
+impl<R: Registers, L: Layout, O: Options<Layout = L, Table = L::Table>> InstalledFilters
     for ReceiveContext<'_, FlexCanHw<R, O>>
 {
-    fn filters(&self) -> FilterTable {
+    type Table = L::Table;
+    fn filters(&self) -> L::Table {
         // SAFETY: the table is written only by `install_filters`, which the receive
         // half calls with `&mut self`; a `ReceiveContext` borrows that half (or the
         // one-struct driver) exclusively for its lifetime, so no write overlaps.
@@ -353,11 +376,11 @@ impl<R: Registers, O: Options> FlexCanHw<R, O> {
     }
 }
 
-impl<R: Registers, O: Options<Table = FilterTable>> FlexCanHw<R, O> {
+impl<R: Registers, L: Layout, O: Options<Layout = L, Table = L::Table>> FlexCanHw<R, O> {
     /// The controller back, as `begin` gave it (the reverse of
     /// [`FlexCan::into_split`]): for [`FlexCan::end`] after
     /// [`twocan_core::Driver::release`].
-    pub fn into_controller(self) -> FlexCan<R> {
+    pub fn into_controller(self) -> FlexCan<R, L> {
         let mode = match self.mode() {
             MODE_STOPPED => Mode::Stopped,
             MODE_SLEEP => Mode::Sleep,
@@ -387,6 +410,38 @@ impl<R: Registers, O: Options> FlexCanHw<R, O> {
         self.mode.load(Ordering::Relaxed)
     }
 
+    /// The data mailbox: MB15 (a constant) with a layout of 16 buffers, else the
+    /// configuration's ([`Configuration::data_mailbox`]).
+    #[inline(always)]
+    fn data_mb(&self) -> usize {
+        last_mailbox::<O::Layout>(self.configuration)
+    }
+
+    /// The first MB of the flag register holding the transmit mailboxes' flags: 0, or
+    /// 32 when they lie above MB31 (a constant 0 with a layout of 16 buffers).
+    #[inline(always)]
+    fn tx_base(&self) -> usize {
+        tx_flag_base::<O::Layout>(self.data_mb())
+    }
+
+    /// The flag register of the transmit mailboxes: `IFLAG1`, or `IFLAG2` for MB32–MB63
+    /// (IMXRT1060RM, "Interrupt Flags 2 register (IFLAG2)").
+    #[inline(always)]
+    fn tx_flags(&self) -> usize {
+        if self.tx_base() == 0 {
+            IFLAG1
+        } else {
+            IFLAG2
+        }
+    }
+
+    /// Transmit mailbox `mb`'s bit in [`FlexCanHw::tx_flags`] (and in `loaded`,
+    /// `abort_wanted`, `tx_mask`).
+    #[inline(always)]
+    fn tx_bit(&self, mb: usize) -> u32 {
+        iflag1::buf(mb - self.tx_base())
+    }
+
     /// Refused with [`Error::WrongMode`] in listen-only mode and while disabled (sleep).
     #[inline(always)]
     fn check_can_send(&self) -> Result<(), Error> {
@@ -406,7 +461,8 @@ impl<R: Registers, O: Options> FlexCanHw<R, O> {
         self.tx_refused.store(refused, Ordering::Relaxed);
     }
 
-    /// MB15 for a data frame, the first free remote-frame mailbox for a remote frame.
+    /// The data mailbox (MB15 in ACAN's configurations) for a data frame, the first free
+    /// remote-frame mailbox for a remote frame.
     #[inline(always)]
     fn free_now(&self, frame: &Frame) -> Result<Option<u8>, Error> {
         // The control word first, then the flag: a mailbox reading INACTIVE stays so
@@ -415,16 +471,14 @@ impl<R: Registers, O: Options> FlexCanHw<R, O> {
         // with its completion unsettled, and the load would overwrite its token.)
         let free = |mb: usize| {
             cs::CODE.get(self.regs.read32(regs::mb_cs(mb))) == code::TX_INACTIVE
-                && self.regs.read32(IFLAG1) & iflag1::buf(mb) == 0
+                && self.regs.read32(self.tx_flags()) & self.tx_bit(mb) == 0
         };
+        let data = self.data_mb();
         if !frame.is_remote() {
-            let mb = DATA_MAILBOX as usize;
-            return Ok(free(mb).then_some(DATA_MAILBOX));
+            return Ok(free(data).then_some(data as u8));
         }
-        let first = self.configuration().first_remote_mailbox() as usize;
-        Ok((first..DATA_MAILBOX as usize)
-            .find(|&mb| free(mb))
-            .map(|mb| mb as u8))
+        let first = self.configuration.first_remote_mailbox() as usize;
+        Ok((first..data).find(|&mb| free(mb)).map(|mb| mb as u8))
     }
 
     /// Requests the abort of the pending mailboxes among `mask` (transmit half or
@@ -452,17 +506,17 @@ impl<R: Registers, O: Options> FlexCanHw<R, O> {
         // ESR1's error bits clear on read: kept for the status handler.
         self.keep_unreported(esr);
         let transmitting = esr & esr1::TX != 0;
-        let flags = self.regs.read32(IFLAG1);
+        let flags = self.regs.read32(self.tx_flags());
         let mut pending = 0;
-        for mb in (0..=DATA_MAILBOX as usize).filter(|&mb| mask & (1 << mb) != 0) {
-            if flags & iflag1::buf(mb) != 0 {
+        for mb in (self.tx_base()..=self.data_mb()).filter(|&mb| mask & self.tx_bit(mb) != 0) {
+            if flags & self.tx_bit(mb) != 0 {
                 continue;
             }
             let control = self.regs.read32(regs::mb_cs(mb));
             if cs::CODE.get(control) != code::TX_DATA {
                 continue;
             }
-            pending |= 1 << mb;
+            pending |= self.tx_bit(mb);
             if !transmitting {
                 self.regs
                     .write32(regs::mb_cs(mb), cs::CODE.replace(control, code::TX_ABORT));
@@ -501,28 +555,32 @@ impl<R: Registers, O: Options> FlexCanHw<R, O> {
     /// became a receive mailbox for the answer; an aborted one shows `ABORT`).
     #[inline(always)]
     fn settle_one(&self, mb: usize) -> Option<Completion> {
-        // Every configuration's transmit mailboxes fit the token slots (`15 - mb` < 8).
+        // Every configuration's transmit mailboxes fit the token slots (`data - mb` < 8).
         const {
-            let first = Configuration::Filters8_0.first_remote_mailbox();
-            assert!(((DATA_MAILBOX - first) as usize) < MAX_TX)
+            let mut i = 0;
+            while i < Configuration::EVERY.len() {
+                let c = Configuration::EVERY[i];
+                assert!(((c.data_mailbox() - c.first_remote_mailbox()) as usize) < MAX_TX);
+                i += 1;
+            }
         };
         let control = self.regs.read32(regs::mb_cs(mb));
         let c = cs::CODE.get(control);
-        let bit = 1 << mb;
+        let bit = self.tx_bit(mb);
         let was_loaded = self.loaded.fetch_and(!bit, Ordering::Relaxed) & bit != 0;
         if c == code::RX_FULL || c == code::RX_OVERRUN {
             self.count_caught(c);
         }
         // The token before the flag is acknowledged: once it is, the transmit half may
-        // load the mailbox with the next frame and its token. Transmit mailboxes are
-        // MB8..=MB15 in every configuration, so `15 - mb` is below 8.
+        // load the mailbox with the next frame and its token. Transmit mailboxes are the
+        // data mailbox and at most seven before it in every configuration, so
+        // `data - mb` is below 8.
         let token = was_loaded.then(|| {
             Token(
-                self.tokens[(DATA_MAILBOX as usize).wrapping_sub(mb) & (MAX_TX - 1)]
-                    .load(Ordering::Acquire),
+                self.tokens[self.data_mb().wrapping_sub(mb) & (MAX_TX - 1)].load(Ordering::Acquire),
             )
         });
-        self.regs.write32(IFLAG1, iflag1::buf(mb));
+        self.regs.write32(self.tx_flags(), self.tx_bit(mb));
         if c != code::TX_INACTIVE {
             self.regs
                 .write32(regs::mb_cs(mb), cs::CODE.val(code::TX_INACTIVE));
@@ -576,7 +634,7 @@ impl<R: Registers, O: Options> FlexCanHw<R, O> {
             },
         ); MAX_TX];
         let mut n = 0;
-        for mb in (0..=DATA_MAILBOX as usize).filter(|&mb| ended & iflag1::buf(mb) != 0) {
+        for mb in (self.tx_base()..=self.data_mb()).filter(|&mb| ended & self.tx_bit(mb) != 0) {
             if let Some(c) = self.settle_one(mb) {
                 if let Some(slot) = out.get_mut(n) {
                     *slot = (c.token.0, c);
@@ -718,9 +776,10 @@ unsafe impl<R: Registers + Sync, O: Options> Sync for FlexCanHw<R, O> {}
 unsafe impl<R: Registers, O: Options> Hardware for FlexCanHw<R, O> {
     type Raw = RawFrame;
     type FilterMap = ();
-    type Filters = FilterTable;
+    type Filters = <O::Layout as Layout>::Table;
 
-    /// MB15 is the one data mailbox: request order (ACAN §3 "sequentiality").
+    /// One data mailbox (MB15 in ACAN's configurations): request order (ACAN §3
+    /// "sequentiality").
     fn tx_policy(&self) -> TxPolicy {
         TxPolicy::Fifo
     }
@@ -741,7 +800,7 @@ unsafe impl<R: Registers, O: Options> Hardware for FlexCanHw<R, O> {
         self.free_now(frame)
     }
 
-    /// Data frames: MB15; remote frames: the first free remote-frame mailbox (ACAN §9),
+    /// Data frames: the data mailbox (MB15 in ACAN's configurations); remote frames: the first free remote-frame mailbox (ACAN §9),
     /// whatever else is loaded. Free means code `INACTIVE` and its `IFLAG1` bit clear
     /// (settled). Refused with [`Error::WrongMode`] in listen-only mode and while
     /// disabled (sleep).
@@ -754,8 +813,8 @@ unsafe impl<R: Registers, O: Options> Hardware for FlexCanHw<R, O> {
     #[inline(always)]
     unsafe fn load(&self, mailbox: u8, frame: &Frame, token: Token) {
         let mb = mailbox as usize;
-        self.tokens[DATA_MAILBOX as usize - mb].store(token.0, Ordering::Release);
-        self.loaded.fetch_or(1 << mb, Ordering::Relaxed);
+        self.tokens[self.data_mb() - mb].store(token.0, Ordering::Release);
+        self.loaded.fetch_or(self.tx_bit(mb), Ordering::Relaxed);
         MbWords::transmit(frame).write(&self.regs, mb);
     }
 
@@ -767,38 +826,40 @@ unsafe impl<R: Registers, O: Options> Hardware for FlexCanHw<R, O> {
         if self.mode() == MODE_SLEEP {
             return;
         }
-        let ended = self.regs.read32(IFLAG1) & self.tx_mask;
+        let ended = self.regs.read32(self.tx_flags()) & self.tx_mask;
         if ended & ended.wrapping_sub(1) != 0 {
             // Several mailboxes ended (remote frames beside MB15): out of line.
             self.settle_many(ended, &mut f);
         } else if ended != 0 {
             // One mailbox: no sorting, no list.
-            if let Some(c) = self.settle_one(ended.trailing_zeros() as usize) {
+            if let Some(c) = self.settle_one(self.tx_base() + ended.trailing_zeros() as usize) {
                 f(Settled::Done(c));
             }
         }
         self.retry_aborts();
     }
 
-    /// MB15 (data) and the remote-frame mailboxes.
+    /// The data mailbox and the remote-frame mailboxes.
     fn mailbox_count(&self) -> u8 {
-        1 + self.configuration().remote_mailbox_count()
+        (1 + self.data_mb() - (self.configuration.first_remote_mailbox() as usize)) as u8
     }
 
-    /// `MailboxId(0)` is MB15 (data), `MailboxId(1..=n)` the remote-frame mailboxes in
+    /// `MailboxId(0)` is the data mailbox (MB15 in ACAN's configurations), `MailboxId(1..=n)` the remote-frame mailboxes in
     /// increasing MB order: `Pending` while loaded (code `DATA`, flag clear), else
     /// `Empty` (FlexCAN shows no scheduled or transmitting state per mailbox).
     fn mailbox_state(&self, mailbox: MailboxId) -> MailboxState {
         let c = self.configuration();
         let mb = match mailbox.0 {
-            0 => DATA_MAILBOX as usize,
-            k if k <= c.remote_mailbox_count() => (c.first_remote_mailbox() + k - 1) as usize,
+            0 => self.data_mb(),
+            k if (k as usize) < 1 + self.data_mb() - (c.first_remote_mailbox() as usize) => {
+                (c.first_remote_mailbox() as usize) + k as usize - 1
+            }
             _ => return MailboxState::Empty,
         };
         if self.mode() == MODE_SLEEP {
             return MailboxState::Empty;
         }
-        let done = self.regs.read32(IFLAG1) & iflag1::buf(mb) != 0;
+        let done = self.regs.read32(self.tx_flags()) & self.tx_bit(mb) != 0;
         let code = cs::CODE.get(self.regs.read32(regs::mb_cs(mb)));
         if !done && code == code::TX_DATA {
             MailboxState::Pending
@@ -818,13 +879,14 @@ unsafe impl<R: Registers, O: Options> Hardware for FlexCanHw<R, O> {
             return false;
         }
         let loaded = self.loaded.load(Ordering::Relaxed);
-        let first = self.configuration().first_remote_mailbox() as usize;
-        let holder = (first..=DATA_MAILBOX as usize).find(|&mb| {
-            loaded & (1 << mb) != 0
-                && self.tokens[DATA_MAILBOX as usize - mb].load(Ordering::Acquire) == token.0
+        let first = self.configuration.first_remote_mailbox() as usize;
+        let data = self.data_mb();
+        let holder = (first..=data).find(|&mb| {
+            loaded & self.tx_bit(mb) != 0
+                && self.tokens[data - mb].load(Ordering::Acquire) == token.0
         });
         match holder {
-            Some(mb) => self.abort_mailboxes(1 << mb) != 0,
+            Some(mb) => self.abort_mailboxes(self.tx_bit(mb)) != 0,
             None => false,
         }
     }
@@ -841,9 +903,9 @@ unsafe impl<R: Registers, O: Options> Hardware for FlexCanHw<R, O> {
         let loaded = self.loaded.load(Ordering::Relaxed);
         let ours = match token {
             None => loaded != 0,
-            Some(t) => (0..=DATA_MAILBOX as usize).any(|mb| {
-                loaded & (1 << mb) != 0
-                    && self.tokens[DATA_MAILBOX as usize - mb].load(Ordering::Acquire) == t.0
+            Some(t) => (self.tx_base()..=self.data_mb()).any(|mb| {
+                loaded & self.tx_bit(mb) != 0
+                    && self.tokens[self.data_mb() - mb].load(Ordering::Acquire) == t.0
             }),
         };
         if !ours {
@@ -903,7 +965,7 @@ unsafe impl<R: Registers, O: Options> Hardware for FlexCanHw<R, O> {
         Some(raw)
     }
 
-    /// The frame and the user's filter for `IDHIT` ([`FilterTable::filter_index`];
+    /// The frame and the user's filter for `IDHIT` ([`crate::FilterTable::filter_index`];
     /// [`UNKNOWN_FILTER`] when it maps to none). The driver adds the time stamp, widened
     /// from [`Hardware::raw_timestamp`] on the interrupt side.
     #[inline]
@@ -976,16 +1038,18 @@ unsafe impl<R: Registers, O: Options> Hardware for FlexCanHw<R, O> {
     ///
     /// Refused with [`Error::Unsupported`] without [`Options::FILTER_SWITCH`]
     /// ([`crate::options::Lean`]).
-    unsafe fn install_filters(&self, filters: &FilterTable) -> Result<(), Error> {
-        if !O::FILTER_SWITCH || !<O::Table as InstalledTable>::REPLACEABLE {
+    unsafe fn install_filters(&self, filters: &Self::Filters) -> Result<(), Error> {
+        if !O::FILTER_SWITCH
+            || !<O::Table as InstalledTable<<O::Layout as Layout>::Table>>::REPLACEABLE
+        {
             return Err(Error::Unsupported);
         }
-        if filters.configuration() != self.configuration() {
+        if filters.table_configuration() != self.configuration() {
             return Err(Error::InvalidArgument);
         }
         let mode = self.mode();
         self.freeze_for_switch(mode)?;
-        FlexCan::write_filters(&self.regs, filters);
+        FlexCan::<R, O::Layout>::write_filters(&self.regs, filters);
         // The FIFO holds at most its depth; the receive interrupt may pop some too.
         // Each frame popped here is counted (`take_filter_switch_discards`). The test
         // of BUF5I and its acknowledgement run in one critical section: a receive
@@ -1101,9 +1165,12 @@ unsafe impl<R: Registers, O: Options> Hardware for FlexCanHw<R, O> {
     /// clock `begin` was given): the 16 MHz oscillator, [`Limits::FLEXCAN_KINETIS`]
     /// (8..=25 quanta per bit) and 16 bus clocks per CAN bit (Kinetis RM, FlexCAN
     /// chapter, "Arbitration and matching timing"; 1 Mbit/s from a 16 MHz bus clock,
-    /// 2 Mbit/s from 32 MHz and above); one ID table element per exact
+    /// 2 Mbit/s from 32 MHz and above; with the RT1062 layout's larger tables 17 or 30
+    /// for `MCR[MAXMB]` + 1 buffers, IMXRT1060RM same section,
+    /// [`crate::settings::timing_rule_for_buffers`]); one ID table element per exact
     /// filter of either format (format A), as many as the configuration's primary and
-    /// secondary elements (ACAN §11, table 4); MB15 and the remote-frame mailboxes;
+    /// secondary elements (ACAN §11, table 4; up to 128 with the RT1062 layout); the data
+    /// mailbox and the remote-frame mailboxes;
     /// the 6-frame Rx FIFO; the 16-bit free-running timer (Kinetis RM, TIMER).
     /// No one-shot mode on these modules. No wake-up events as configured: `MCR.WAKMSK`
     /// and `MCR.SLFWAK` are never set (Kinetis RM, MCR field descriptions), so the module
@@ -1129,10 +1196,15 @@ unsafe impl<R: Registers, O: Options> Hardware for FlexCanHw<R, O> {
             RX_FIFO_DEPTH as u8,
             Some(16),
         )
-        .with_timing_rule(crate::settings::timing_rule_for(
-            self.system.can_clock_hz(),
-            Some(self.bus_clock_hz),
-        ))
+        .with_timing_rule(if O::Layout::IFLAG2 {
+            crate::settings::timing_rule_for_buffers(
+                self.system.can_clock_hz(),
+                Some(self.bus_clock_hz),
+                c.message_buffers_used(),
+            )
+        } else {
+            crate::settings::timing_rule_for(self.system.can_clock_hz(), Some(self.bus_clock_hz))
+        })
     }
 
     fn bus_mode(&self) -> BusMode {

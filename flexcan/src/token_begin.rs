@@ -19,18 +19,19 @@ macro_rules! token_begin {
             /// ([`crate::FlexCan::begin_in`]). On error the token and the slot come back
             /// with the reason.
             #[allow(clippy::type_complexity)]
-            pub fn begin_in<O>(
+            pub fn begin_in<O, L>(
                 self,
                 settings: &$crate::Settings,
                 primary: &[twocan_core::Filter],
                 secondary: &[twocan_core::Filter],
-                slot: &'static mut $crate::FilterTable,
+                slot: &'static mut L::Table,
             ) -> Result<
                 $crate::FlexCanHw<$crate::regs::FlexCanRegs, O>,
-                (Self, $crate::BeginError, &'static mut $crate::FilterTable),
+                (Self, $crate::BeginError, &'static mut L::Table),
             >
             where
-                O: $crate::options::Options<Table = &'static mut $crate::FilterTable>,
+                L: $crate::layout::Layout,
+                O: $crate::options::Options<Layout = L, Table = &'static mut L::Table>,
             {
                 let target = self.target();
                 let Some(base) = target.base() else {
@@ -58,9 +59,9 @@ macro_rules! token_begin {
 
             /// The module's registers for a begin with `checked`: `None` when the plan
             /// was made for another module (or the board has no such module).
-            fn checked_regs(
+            fn checked_regs<L: $crate::layout::Layout>(
                 &self,
-                checked: &$crate::BeginPlan,
+                checked: &$crate::BeginPlan<L>,
             ) -> Option<$crate::regs::FlexCanRegs> {
                 let target = self.target();
                 let base = target.base().filter(|_| checked.target() == target)?;
@@ -78,19 +79,20 @@ macro_rules! token_begin {
             /// [`twocan_core::Error::InvalidArgument`]. On error nothing is written, and
             /// the token and the slot come back.
             #[allow(clippy::type_complexity)]
-            pub fn begin_in_place<'h, O>(
+            pub fn begin_in_place<'h, O, L>(
                 self,
                 hw: &'h mut core::mem::MaybeUninit<$crate::FlexCanHw<$crate::regs::FlexCanRegs, O>>,
-                checked: &$crate::BeginPlan,
+                checked: &$crate::BeginPlan<L>,
                 primary: &[twocan_core::Filter],
                 secondary: &[twocan_core::Filter],
-                slot: &'static mut $crate::FilterTable,
+                slot: &'static mut L::Table,
             ) -> Result<
                 &'h mut $crate::FlexCanHw<$crate::regs::FlexCanRegs, O>,
-                (Self, $crate::BeginError, &'static mut $crate::FilterTable),
+                (Self, $crate::BeginError, &'static mut L::Table),
             >
             where
-                O: $crate::options::Options<Table = &'static mut $crate::FilterTable>,
+                L: $crate::layout::Layout,
+                O: $crate::options::Options<Layout = L, Table = &'static mut L::Table>,
             {
                 let Some(regs) = self.checked_regs(checked) else {
                     return Err((
@@ -117,7 +119,7 @@ macro_rules! token_begin {
             pub fn begin_planned_in_place<'h, O>(
                 self,
                 hw: &'h mut core::mem::MaybeUninit<$crate::FlexCanHw<$crate::regs::FlexCanRegs, O>>,
-                checked: &$crate::BeginPlan,
+                checked: &$crate::BeginPlan<O::Layout>,
                 table: $crate::installed::PlannedTable,
             ) -> Result<
                 &'h mut $crate::FlexCanHw<$crate::regs::FlexCanRegs, O>,
@@ -145,7 +147,7 @@ macro_rules! token_begin {
             /// on error the token comes back with the reason.
             pub fn begin_planned<O>(
                 self,
-                checked: &$crate::BeginPlan,
+                checked: &$crate::BeginPlan<O::Layout>,
                 table: $crate::installed::PlannedTable,
             ) -> Result<$crate::FlexCanHw<$crate::regs::FlexCanRegs, O>, (Self, $crate::BeginError)>
             where

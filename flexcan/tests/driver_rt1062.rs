@@ -299,8 +299,10 @@ fn typed_pins_are_the_pads_begin_muxes() {
 /// The Rx FIFO sizes per chip ([`twocan_flexcan::Chip`]) against the RT1062 model
 /// (written from the reference manual's table "Rx FIFO filter: possible structures"):
 /// the largest table fits the module with room left for transmit mailboxes, its
-/// individually masked elements are the model's; and what the driver accepts today is
-/// what the running controller reports: ACAN's 14/18 at most, MB0–MB15, `IMASK2` = 0.
+/// individually masked elements are the model's; the chip accepts RFFN 0xF
+/// (`driver_rt1062_large.rs` runs those tables), and the default layout (ACAN's,
+/// MB0–MB15) is what the running controller reports: 14/18 at most, `IMASK2` = 0, a
+/// larger table refused with a typed error.
 #[test]
 fn rx_fifo_sizes_are_data_per_chip_and_the_accepted_limit_is_reported() {
     use twocan_flexcan::{Chip, Configuration};
@@ -326,8 +328,10 @@ fn rx_fifo_sizes_are_data_per_chip_and_the_accepted_limit_is_reported() {
             (32, 96)
         );
 
-        // Accepted today: the largest ACAN configuration; the capabilities say so.
-        assert_eq!(chip.accepted_max_rffn(), Configuration::Filters14_18.rffn());
+        // The chip accepts its largest table; the default layout ACAN's 14/18, and the
+        // capabilities say so.
+        assert_eq!(chip.accepted_max_rffn(), chip.max_rffn());
+        assert_eq!(chip.accepted_max_rffn(), 0xF);
         let mut settings = Settings::with_clock(500_000, CanClock::IMXRT_24MHZ);
         settings.configuration = Configuration::Filters14_18;
         let primary: Vec<Filter> = (0..14u32)
@@ -358,5 +362,14 @@ fn rx_fifo_sizes_are_data_per_chip_and_the_accepted_limit_is_reported() {
             matches!(e, BeginError::Config(c) if c.contains(ConfigErrors::TOO_MANY_SECONDARY_FILTERS)),
             "{e:?}"
         );
+        // A table above RFFN 3 with the default layout: a typed error, from `check`
+        // and from `begin` alike, nothing written.
+        settings.configuration = Configuration::Filters16_24;
+        let expected = ConfigErrors::CONFIGURATION_NOT_ON_CHIP;
+        assert_eq!(check(target, &settings, &primary, &secondary), expected);
+        let e = begin_on_exact::<32, 16>(target, &settings, &primary, &secondary)
+            .map(|_| ())
+            .unwrap_err();
+        assert_eq!(e, BeginError::Config(expected), "{target:?}");
     }
 }

@@ -1,0 +1,130 @@
+//! The i.MX RT1062's interrupt wiring with the RT1062 layout
+//! ([`twocan_flexcan::layout::Imxrt1062`], features `rt` and `teensy40` or `teensy41`):
+//! the exported entry point (`CAN3` here) settles a transmit mailbox above MB31 from its
+//! `IFLAG2` flag (IMXRT1060RM "Interrupt Flags 2 register") and takes a frame from the Rx
+//! FIFO, whose flags stay in `IFLAG1`. A test binary of its own: the entry points'
+//! state is per process.
+//!
+//! As in `rt_imxrt.rs`, the registers are a small `Sync` register file that
+//! acknowledges the mode handshakes at once and clears `IFLAG1`/`IFLAG2`/`ESR1` bits
+//! written 1.
+#![cfg(all(feature = "rt", any(feature = "teensy40", feature = "teensy41")))]
+
+use std::sync::atomic::{AtomicU32, Ordering};
+
+use twocan_core::{Frame, Registers};
+use twocan_flexcan::layout::Imxrt1062;
+use twocan_flexcan::options::Full;
+use twocan_flexcan::regs::{self, code, cs, esr1, iflag1, mcr, ESR1, IFLAG1, IFLAG2, IMASK2, MCR};
+use twocan_flexcan::rt::{self, IrqNumber, IrqState, Nvic};
+use twocan_flexcan::{
+    rt_imxrt, Board, CanClock, Configuration, FlexCan, HostSystem, Instance, Settings, Target,
+};
+
+struct SyncRegs {
+    words: Vec<AtomicU32>,
+}
+
+impl Registers for SyncRegs {
+    fn read32(&self, offset: usize) -> u32 {
+        let v = self.words[offset / 4].load(Ordering::SeqCst);
+        match offset {
+            MCR if v & mcr::MDIS != 0 => v | mcr::LPMACK | mcr::NOTRDY,
+            MCR if v & mcr::FRZ != 0 && v & mcr::HALT != 0 => v | mcr::FRZACK | mcr::NOTRDY,
+            ESR1 => v | esr1::SYNCH,
+            _ => v,
+        }
+    }
+
+    fn write32(&self, offset: usize, value: u32) {
+        let w = &self.words[offset / 4];
+        match offset {
+            MCR => w.store(
+                value & !(mcr::FRZACK | mcr::LPMACK | mcr::NOTRDY | mcr::SOFTRST),
+                Ordering::SeqCst,
+            ),
+            IFLAG1 | IFLAG2 | ESR1 => {
+                w.fetch_and(!value, Ordering::SeqCst);
+            }
+            _ => w.store(value, Ordering::SeqCst),
+        }
+    }
+}
+
+#[derive(Default)]
+struct Recorder {
+    calls: Vec<(&'static str, u16, u8)>,
+}
+
+impl Nvic for Recorder {
+    fn set_priority(&mut self, irq: IrqNumber, priority: u8) {
+        self.calls.push(("priority", irq.number(), priority));
+    }
+
+    fn unmask(&mut self, irq: IrqNumber) {
+        self.calls.push(("unmask", irq.number(), 0));
+    }
+
+    fn mask(&mut self, irq: IrqNumber) {
+        self.calls.push(("mask", irq.number(), 0));
+    }
+}
+
+#[test]
+fn can3_settles_a_mailbox_above_mb31_from_iflag2() {
+    let regs: &'static SyncRegs = Box::leak(Box::new(SyncRegs {
+        // The RT1062 block: 64 message buffers, RXIMR0–63 (up to 0x97C).
+        words: (0..0xA00 / 4).map(|_| AtomicU32::new(0)).collect(),
+    }));
+    let mut settings = Settings::with_clock(500_000, CanClock::IMXRT_24MHZ);
+    settings.configuration = Configuration::Filters32_96;
+    let target = Target::new(Board::Teensy41, Instance::Can3);
+    let hw = FlexCan::<_, Imxrt1062>::begin_with_layout(
+        regs,
+        &mut HostSystem::new(),
+        target,
+        &settings,
+        &[twocan_core::Filter::pass_all()],
+        &[],
+    )
+    .expect("begin")
+    .into_split();
+    let data = usize::from(Configuration::Filters32_96.data_mailbox());
+    assert_eq!(data, 45);
+    assert_ne!(
+        regs.read32(IMASK2) & 1 << (data - 32),
+        0,
+        "MB45's interrupt on"
+    );
+    type Wired = IrqState<&'static SyncRegs, 32, twocan_core::FifoQueue<16>, 8, Full<Imxrt1062>>;
+    let state: &'static Wired = Box::leak(Box::new(Wired::new()));
+    let mut nvic = Recorder::default();
+    let (mut tx, mut rx) = state.start(hw, &mut nvic).map_err(|(e, _)| e).unwrap();
+    assert!(rt::is_wired(Instance::Can3));
+
+    // A data frame goes to MB45; the module "sends" it: INACTIVE, IFLAG2 bit 13.
+    let frame = Frame::standard(0x123, &[7]).unwrap();
+    let token = tx.try_send(&frame).unwrap();
+    assert_eq!(cs::CODE.get(regs.read32(regs::mb_cs(data))), code::TX_DATA);
+    regs.write32(regs::mb_cs(data), cs::CODE.val(code::TX_INACTIVE));
+    regs.words[IFLAG2 / 4].fetch_or(1 << (data - 32), Ordering::SeqCst);
+    // And a frame at the Rx FIFO output (IFLAG1) in the same interrupt.
+    regs.write32(regs::mb_cs(0), cs::DLC.val(1));
+    regs.write32(regs::mb_id(0), regs::id::STD.val(0x2A));
+    regs.write32(regs::mb_word0(0), 0x0900_0000);
+    regs.words[IFLAG1 / 4].fetch_or(iflag1::BUF5I, Ordering::SeqCst);
+    rt_imxrt::can3();
+    assert_eq!(regs.read32(IFLAG2), 0, "MB45's flag acknowledged in IFLAG2");
+    assert_eq!(regs.read32(IFLAG1) & iflag1::BUF5I, 0, "FIFO popped");
+    let done = tx.take_completion().expect("one completion");
+    assert_eq!(
+        (done.token, done.outcome),
+        (token, twocan_core::TxOutcome::Sent)
+    );
+    assert!(tx.take_completion().is_none(), "exactly one");
+    let got = rx.receive().expect("a frame");
+    assert_eq!(got.frame, Frame::standard(0x2A, &[9]).unwrap());
+    // The data mailbox is free again.
+    tx.try_send(&frame).unwrap();
+    assert_eq!(cs::CODE.get(regs.read32(regs::mb_cs(data))), code::TX_DATA);
+}
