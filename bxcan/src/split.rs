@@ -546,9 +546,8 @@ unsafe impl<R: Registers, F: Registers, const K: usize, const M: usize, const SW
     /// [`Hardware::free_mailbox`] is.
     #[inline(always)]
     fn free_mailbox_quiet(&self, frame: &Frame) -> Result<Option<u8>, Error> {
-        // The quiet mode's queue is adopted only by a request-order controller, whose
-        // order (`config`) never changes while split.
-        debug_assert!(self.config.get_tx_policy() == TxPolicy::Fifo);
+        // The quiet mode's state is split only with a request-order controller, whose
+        // order (`config`) never changes while split (`State::split` refuses others).
         let _ = frame;
         if self.listen_only.load(Ordering::Relaxed) {
             return Err(Error::WrongMode);
@@ -564,12 +563,20 @@ unsafe impl<R: Registers, F: Registers, const K: usize, const M: usize, const SW
 
     /// Writes back the `RQCPx` bits `CAN_TSR` shows (write 1 to clear; RM0410 §40.9.2),
     /// which lowers the transmit line; nothing is reported. The `aborting` marks of
-    /// these mailboxes are left as they are: the quiet mode never reads them (no
-    /// outcome is reported), and a reload writes new tokens.
+    /// these mailboxes are cleared too (their aborts ended), so that a driver split
+    /// later with completions does not take a later frame of theirs for aborted.
     unsafe fn acknowledge_ended(&self) {
         let rq = self.regs.read32(TSR) & RQCP_ALL;
         if rq != 0 {
             self.regs.write32(TSR, rq);
+            // Bit x of the mailboxes from `RQCPx` (bits 0, 8, 16). The marks change only
+            // inside the driver's critical section (this context and `request_abort`).
+            let ended = (rq & tsr::RQCP0) | (rq & tsr::RQCP1) >> 7 | (rq & tsr::RQCP2) >> 14;
+            let marks = self.aborting.load(Ordering::Relaxed);
+            if marks & ended as u8 != 0 {
+                self.aborting
+                    .store(marks & !(ended as u8), Ordering::Relaxed);
+            }
         }
     }
 

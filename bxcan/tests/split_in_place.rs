@@ -265,3 +265,46 @@ fn fixed_filters_refuse_a_switch_and_keep_receiving() {
             .unwrap();
     assert_eq!(q.rx.set_filters(&same_full), Err(Error::Unsupported));
 }
+
+/// The quiet transmit mode (no completion ring, `Lean`, request order): `CAN_IER.TMEIE`
+/// off while nothing is queued, an end left unacknowledged by the direct path, and the
+/// way back (`unsplit`) acknowledging it and giving the interrupt back as configured, so
+/// that a driver split next with completions reports nothing of this one's frames.
+#[test]
+fn the_quiet_mode_gives_the_controller_back_acknowledged_with_its_interrupt() {
+    use twocan_bxcan::regs::{ier, tsr, TSR};
+    use twocan_core::Lean;
+    const OPTIONS: PlanOptions = PlanOptions::new(14);
+    type Quiet = State<BxCan<Clocked, Clocked, 0>, 8, FifoQueue<4>, 0, 0, Lean>;
+    assert!(Quiet::QUIET_TX);
+    let config = loopback_config(TxPolicy::Fifo);
+    let (regs, bus) = attached();
+    let state: Quiet = State::new();
+    let p = state
+        .split_with(|slot| {
+            BxCan::can1_in(slot, regs.clone(), &config, const_plan!(FILTERS, OPTIONS))
+                .map_err(|f| f.error)
+        })
+        .ok()
+        .unwrap();
+    assert_eq!(regs.model.read32(IER) & ier::TMEIE, 0, "off at split");
+    let mut p = p;
+    p.tx.try_send(&Frame::standard(0x100, &[1]).unwrap())
+        .unwrap();
+    run(&bus, 300);
+    let tsr_now = regs.model.read32(TSR);
+    assert_ne!(tsr_now & tsr::RQCP0, 0, "the end is left unacknowledged");
+    assert_eq!(regs.model.read32(IER) & ier::TMEIE, 0, "and raises nothing");
+    // A second frame reuses the mailbox without an acknowledgement.
+    p.tx.try_send(&Frame::standard(0x100, &[2]).unwrap())
+        .unwrap();
+    run(&bus, 300);
+    let (hw, _) = state.unsplit(p).map_err(|(e, _)| e).unwrap();
+    let tsr_back = hw.registers().model.read32(TSR);
+    assert_eq!(
+        tsr_back & (tsr::RQCP0 | tsr::RQCP1 | tsr::RQCP2),
+        0,
+        "acknowledged on the way back"
+    );
+    assert_ne!(hw.registers().model.read32(IER) & ier::TMEIE, 0, "on again");
+}

@@ -123,8 +123,16 @@ impl<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE:
 
     /// Waits for the next completion, in the order the controller reported them.
     ///
-    /// Cancel-safe: a completion is taken only by the poll that returns it.
+    /// Cancel-safe: a completion is taken only by the poll that returns it. A call on
+    /// a state without a completion ring (`DONE` = 0) does not compile: nothing would
+    /// ever come.
     pub async fn completion(&mut self) -> Completion {
+        const {
+            assert!(
+                DONE != 0,
+                "completions are off (DONE = 0): none to wait for"
+            );
+        }
         let s = self.s;
         take_or_wait(&s.wakers.tx_done, || self.take_completion()).await
     }
@@ -134,8 +142,7 @@ impl<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE:
     /// use [`Tx::completion`] to see every one.
     ///
     /// Fails at once with [`Error::InvalidArgument`] for a token this half has not handed
-    /// out (at or after [`Tx::next_token`], within half the token space), with
-    /// [`Error::WrongMode`] when completions are off (`DONE` = 0), and with
+    /// out (at or after [`Tx::next_token`], within half the token space), and with
     /// [`Error::Overrun`] when the completion ring overflowed during the wait and holds
     /// no more completions: the one of `token` may have been lost. A completion lost
     /// before the call is not detected (the wait would not end): a ring of `DONE`
@@ -143,14 +150,17 @@ impl<'a, H: Hardware, const RX: usize, Q: TxQueue, const RX1: usize, const DONE:
     /// overflows; [`crate::TrafficStats::completion_overflows`] counts the losses.
     ///
     /// Cancel-safe as [`Tx::completion`]: completions taken before the drop are gone,
-    /// the one of `token` is still in the ring if it had not come.
+    /// the one of `token` is still in the ring if it had not come. As for
+    /// [`Tx::completion`], a call without a completion ring does not compile.
     pub async fn completed(&mut self, token: Token) -> Result<Completion, Error> {
         if token.0.wrapping_sub(self.next) < 0x8000_0000 {
             return Err(Error::InvalidArgument);
         }
-        if DONE == 0 {
-            // Completions are off (no ring): none will come.
-            return Err(Error::WrongMode);
+        const {
+            assert!(
+                DONE != 0,
+                "completions are off (DONE = 0): none to wait for"
+            );
         }
         let s = self.s;
         let overflows = s.traffic().completion_overflows;

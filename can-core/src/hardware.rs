@@ -232,7 +232,9 @@ pub unsafe trait Hardware {
 
     /// Quiet mode ([`Hardware::QUIET_TX`], request order): an empty mailbox for
     /// `frame`, whether or not its last end was acknowledged (the outcome is not
-    /// reported). The default is [`Hardware::free_mailbox`].
+    /// reported). In the quiet mode it replaces both [`Hardware::free_mailbox`] and
+    /// [`Hardware::free_mailbox_now`] (a backend whose `free_mailbox_now` differs must
+    /// keep that difference here). The default is [`Hardware::free_mailbox`].
     fn free_mailbox_quiet(&self, frame: &Frame) -> Result<Option<u8>, Error> {
         self.free_mailbox(frame)
     }
@@ -257,7 +259,9 @@ pub unsafe trait Hardware {
         let _ = on;
     }
 
-    /// Loads `frame` into `mailbox` (returned by [`Hardware::free_mailbox`]), remembers
+    /// Loads `frame` into `mailbox` (returned by [`Hardware::free_mailbox`],
+    /// [`Hardware::free_mailbox_now`] or, in the quiet mode,
+    /// [`Hardware::free_mailbox_quiet`]), remembers
     /// `token` for its completion, and requests transmission.
     ///
     /// # Safety

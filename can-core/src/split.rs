@@ -321,9 +321,9 @@ impl<
     /// completion ring (`DONE` = 0), no statistics or time stamps to record, a queue
     /// in request order (nothing is ever displaced), on a controller that offers it.
     /// The transmit interrupt then runs only while frames wait in the queue, and
-    /// acknowledges ended mailboxes without reporting them (with the `async` feature,
-    /// a frame it moves from the queue to a mailbox wakes the senders waiting for
-    /// room).
+    /// acknowledges ended mailboxes without reporting them. (The async halves exist for
+    /// [`crate::Full`] only, so no async waiter depends on it.) `split` refuses a
+    /// controller whose transmit order is not the request order in this mode.
     pub const QUIET_TX: bool =
         H::QUIET_TX && DONE == 0 && !Fe::COUNTS && !Fe::TIMESTAMPS && Q::ALWAYS_FIFO;
 
@@ -423,6 +423,11 @@ impl<
     /// Makes the queue take the controller's transmit order (the claimer only);
     /// whether the orders agree.
     fn adopt_order(&self, hw: &H) -> bool {
+        if Self::QUIET_TX && hw.tx_policy() != TxPolicy::Fifo {
+            // The quiet mode loads any empty mailbox: only request order keeps the
+            // order then (a user queue claiming `ALWAYS_FIFO` may adopt another).
+            return false;
+        }
         critical_section::with(|cs| {
             // SAFETY: the queue is only touched inside a critical section.
             unsafe { &mut *self.queue.borrow(cs).get() }.adopt(hw.tx_policy())
@@ -769,11 +774,6 @@ impl<
                     // must not pick the mailbox being loaded here (release: the load's
                     // register writes come first).
                     self.queue_len_step(false, Ordering::Release);
-                    // Queue room freed: in the quiet mode no completion says so.
-                    #[cfg(feature = "async")]
-                    if Self::QUIET_TX {
-                        self.tx_event.store(true, Ordering::Relaxed);
-                    }
                 }
                 Ok(None) => {
                     // The displaced frame comes back through `settle` while `next` still
@@ -798,9 +798,16 @@ impl<
                 Err(_) => break,
             }
         }
+        self.quiet_if_empty(q);
+    }
+
+    /// The quiet mode: with nothing left to refill, no transmit interrupt until a frame
+    /// is queued again. Called inside the critical section (`q` is borrowed from it).
+    #[inline(always)]
+    fn quiet_if_empty(&self, q: &Q) {
         if Self::QUIET_TX && q.is_empty() {
-            // Nothing left to refill: no interrupt until a frame is queued again.
-            unsafe { hw.set_tx_interrupt(false) };
+            // SAFETY: inside the critical section, the transmit interrupt's context.
+            unsafe { self.hw().set_tx_interrupt(false) };
         }
     }
 
@@ -970,10 +977,10 @@ pub struct Tx<
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum AbortRequest {
     /// The frame was still queued: it was removed; its `Aborted` completion is in the
-    /// completion ring already.
+    /// completion ring already (with one: `DONE` > 0).
     Dequeued,
     /// The frame is in a mailbox: its abort was requested; the completion (aborted, or
-    /// sent if the abort came too late) follows.
+    /// sent if the abort came too late) follows (with a completion ring).
     Requested,
     /// Nothing was aborted: no frame with this token is queued or waiting in a mailbox
     /// now. That does not mean its completion was delivered: a frame whose mailbox
@@ -993,8 +1000,9 @@ impl<
         Fe: Features,
     > Tx<'a, H, RX, Q, RX1, DONE, Fe>
 {
-    /// Accepts `frame` for transmission and returns its token; exactly one
-    /// [`Completion`] with that token follows.
+    /// Accepts `frame` for transmission and returns its token; with a completion ring
+    /// (`DONE` > 0) exactly one [`Completion`] with that token follows (with `DONE` = 0
+    /// none: fire and forget).
     ///
     /// When nothing is queued and a mailbox is free, the frame goes straight into it
     /// (no lock). Otherwise it joins the queue (a short critical section, in which the
@@ -1022,7 +1030,8 @@ impl<
                 Ok(Some(m)) => {
                     // SAFETY: the transmit half's direct path: the queue is empty and only
                     // this half fills it, so the interrupt's refill loads nothing and
-                    // `m` (empty and settled) is this call's alone.
+                    // `m` (empty, and settled unless in the quiet mode, where the end of
+                    // its last frame is not reported) is this call's alone.
                     unsafe { hw.load(m, frame, token) };
                     return Ok(self.accept(token));
                 }
@@ -1154,6 +1163,7 @@ impl<
                     cause: None,
                     timestamp: None,
                 });
+                s.quiet_if_empty(q);
                 AbortRequest::Dequeued
             } else {
                 // SAFETY: inside the critical section, exclusive with the interrupt's
@@ -1187,6 +1197,7 @@ impl<
                 });
                 dropped += 1;
             }
+            s.quiet_if_empty(q);
             // SAFETY: inside the critical section, as `abort_all_mailboxes` needs.
             unsafe { s.hw().abort_all_mailboxes() };
             dropped
@@ -1433,7 +1444,9 @@ impl<
     > TxIrq<'_, H, RX, Q, RX1, DONE, Fe>
 {
     /// Settles ended mailboxes (completions in order, with their tokens) and refills
-    /// free mailboxes from the queue, in one critical section.
+    /// free mailboxes from the queue, in one critical section. In the quiet transmit
+    /// mode ([`State::QUIET_TX`]) it acknowledges the ended mailboxes without a report,
+    /// refills, and turns itself off once the queue is empty.
     pub fn on_interrupt(&mut self) {
         let s = self.s;
         let completed = critical_section::with(|cs| {
@@ -1836,10 +1849,15 @@ impl<
             Err(true) => return Err((UnsplitError::Leased, parts)),
         };
         if Self::QUIET_TX {
-            // The transmit interrupt back as configured for whoever takes the
-            // controller. SAFETY: every handle is here, so no other context runs the
-            // driver; the critical section keeps the interrupt's own handler out.
-            critical_section::with(|_| unsafe { hw.set_tx_interrupt(true) });
+            // Ends never acknowledged are acknowledged now (a driver split next with
+            // completions must not report this one's frames), then the transmit
+            // interrupt goes back as configured. SAFETY: every handle is here, so no
+            // other context runs the driver; the critical section keeps the interrupt's
+            // own handler out.
+            critical_section::with(|_| unsafe {
+                hw.acknowledge_ended();
+                hw.set_tx_interrupt(true);
+            });
         }
         let mut left = Leftovers::default();
         // SAFETY: the consumer handles of the rings (`Rx`, `Tx`) and the producer

@@ -67,6 +67,27 @@ fn sends(frames: &[Frame]) -> Vec<Step> {
     steps
 }
 
+/// Submissions mixing `try_send` and `try_send_now`, a `poll` from the thread, then
+/// `abort_all` with frames queued and loaded.
+fn sends_now_poll_abort_all(frames: &[Frame]) -> Vec<Step> {
+    let mut steps = vec![Step::Peer(peer_frame(0))];
+    for (i, f) in frames.iter().enumerate() {
+        steps.push(if i % 4 == 1 {
+            Step::SendNow(*f)
+        } else {
+            Step::Send(*f)
+        });
+        if i == 3 {
+            steps.push(Step::Poll);
+        }
+        if i % 5 == 4 {
+            steps.push(Step::Bus(31));
+        }
+    }
+    steps.extend([Step::Poll, Step::AbortAll]);
+    steps
+}
+
 /// Submissions, then aborts of queued, loaded and finished frames in between bus runs.
 fn sends_and_aborts(frames: &[Frame]) -> Vec<Step> {
     let n = frames.len();
@@ -160,6 +181,8 @@ sweeps! {
     bxcan_quiet_one_identifier_abort: bx_quiet, Fifo, one_identifier(N), sends_and_aborts;
     bxcan_quiet_mixed_send: bx_quiet, Fifo, mixed(N), sends;
     bxcan_quiet_mixed_abort_on_the_wire: bx_quiet, Fifo, mixed(N), aborts_on_the_wire;
+    bxcan_quiet_send_now_poll_abort_all: bx_quiet, Fifo, mixed(N), sends_now_poll_abort_all;
+    bxcan_request_order_send_now_poll_abort_all: bx_fifo, Fifo, mixed(N), sends_now_poll_abort_all;
     bxcan_priority_one_identifier_send: bx_priority, Priority, one_identifier(N), sends;
     bxcan_priority_one_identifier_abort: bx_priority, Priority, one_identifier(N), sends_and_aborts;
     bxcan_priority_one_identifier_abort_on_the_wire: bx_priority, Priority, one_identifier(N), aborts_on_the_wire;
