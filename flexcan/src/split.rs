@@ -577,7 +577,9 @@ impl<R: Registers, O: Options> FlexCanHw<R, O> {
             while i < Configuration::EVERY.len() {
                 let c = Configuration::EVERY[i];
                 assert!(((c.data_mailbox() - c.first_remote_mailbox()) as usize) < MAX_TX);
-                assert!(((c.data_mailbox_in(true) - c.first_remote_mailbox_in(true)) as usize) < MAX_TX);
+                assert!(
+                    ((c.data_mailbox_in(true) - c.first_remote_mailbox_in(true)) as usize) < MAX_TX
+                );
                 i += 1;
             }
         };

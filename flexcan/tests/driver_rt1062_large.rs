@@ -175,7 +175,8 @@ fn tables_of_32_64_96_and_128_elements_give_every_user_index() {
             u32::from(Imxrt1062::data_mailbox(c))
         );
         // The transmit mailboxes' interrupts: IMASK1 below MB32, IMASK2 above.
-        let tx: u64 = (Imxrt1062::first_remote_mailbox(c)..=Imxrt1062::data_mailbox(c)).fold(0, |m, mb| m | 1 << mb);
+        let tx: u64 = (Imxrt1062::first_remote_mailbox(c)..=Imxrt1062::data_mailbox(c))
+            .fold(0, |m, mb| m | 1 << mb);
         let fifo = u64::from(iflag1::BUF5I | iflag1::BUF7I);
         let imask = u64::from(r.read32(regs::IMASK1)) | u64::from(r.read32(regs::IMASK2)) << 32;
         assert_eq!(imask, fifo | tx, "{c:?}");
@@ -393,7 +394,8 @@ fn end_masks_the_mailboxes_above_mb31_and_begin_runs_again() {
     let c = Configuration::Filters32_96;
     let (_model, can) =
         begin_large::<8, 8>(T41[0], &settings(c, true), &[Filter::pass_all()], &[]).unwrap();
-    let tx = (Imxrt1062::first_remote_mailbox(c)..=Imxrt1062::data_mailbox(c)).fold(0u32, |m, mb| m | 1 << (mb - 32));
+    let tx = (Imxrt1062::first_remote_mailbox(c)..=Imxrt1062::data_mailbox(c))
+        .fold(0u32, |m, mb| m | 1 << (mb - 32));
     assert_eq!(can.hardware().registers().read32(regs::IMASK2), tx);
     let hw = can.release();
     let (regs, _table) = hw.end(&mut HostSystem::new()).map_err(|(_, e)| e).unwrap();
