@@ -33,7 +33,7 @@ use twocan_flexcan::{
 /// The model's registers with every write recorded (offset, value), in order.
 struct Traced {
     inner: Ticking,
-    log: Rc<RefCell<Vec<(usize, u32)>>>,
+    log: Log,
 }
 
 impl core::fmt::Debug for Traced {
@@ -83,18 +83,17 @@ fn settings(c: Configuration, loop_back: bool) -> Settings {
     s
 }
 
+/// The register writes, in order.
+type Log = Rc<RefCell<Vec<(usize, u32)>>>;
+
 /// `begin` with layout `L` over a fresh model of CAN1 whose message-buffer RAM holds
 /// garbage, every write traced.
 fn begin_traced<L: Layout>(
     c: Configuration,
     loop_back: bool,
-) -> (
-    twocan_flexcan::model::FlexCanModel,
-    Rc<RefCell<Vec<(usize, u32)>>>,
-    Rt<L>,
-) {
+) -> (twocan_flexcan::model::FlexCanModel, Log, Rt<L>) {
     let model = model_of(T41);
-    model.scramble_ram(0xE582_9);
+    model.scramble_ram(0x000E_5829);
     let log = Rc::new(RefCell::new(Vec::new()));
     let regs = Traced {
         inner: Ticking::new(model.clone()),
