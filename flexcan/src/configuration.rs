@@ -55,6 +55,15 @@ pub const MAX_SECONDARY_FILTERS: usize = 18;
 /// [`Configuration::data_mailbox`]. Those configurations need 64 message buffers: the
 /// controller's layout ([`crate::layout::Imxrt1062`]) and the chip
 /// ([`crate::Chip::accepted_max_rffn`]) decide which are accepted.
+///
+/// The MB columns above are the positions without the ERR005829 reservation (the
+/// [`crate::layout::Kinetis`] layout, and the RT1062 tables as the manual numbers
+/// them). The [`crate::layout::Imxrt1062`] layout keeps the first valid mailbox
+/// after the table INACTIVE (i.MX RT1060 chip errata, ERR005829:
+/// [`Configuration::reserved_mailbox`]) and puts the same number of transmit
+/// mailboxes after it ([`Configuration::first_remote_mailbox_in`],
+/// [`Configuration::data_mailbox_in`]): data mailbox MB16 for ACAN's four, MB39 at
+/// RFFN 8, MB40 at 0xC, MB46 at 0xF (table in [`crate::layout`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[allow(non_camel_case_types)]

@@ -13,9 +13,11 @@
 //! - transmit handler: `IFLAG1` write-1-to-clear of the transmit mailboxes' bits;
 //!
 //! (With the RT1062 layout, [`crate::layout::Imxrt1062`], the transmit mailboxes of the
-//! tables from RFFN 0xC on are MB32–MB45: what is said here of their `IFLAG1` bits holds
+//! tables from RFFN 8 on are MB32–MB46: what is said here of their `IFLAG1` bits holds
 //! of their `IFLAG2` bits, IMXRT1060RM "Interrupt Flags 2 register (IFLAG2)"; the Rx
-//! FIFO's flags stay in `IFLAG1`.)
+//! FIFO's flags stay in `IFLAG1`. That layout also writes the control/status word of
+//! the ERR005829 reserved mailbox, INACTIVE twice, after each activation: transmit
+//! half and transmit handler alike, the same value, [`Hardware::load`].)
 //! - transmit half (`abort`) and transmit handler (`settle`), inside the driver's critical
 //!   section: `ESR1` read for `TX` before an ABORT write (its clear-on-read error bits
 //!   are kept for the status handler, as every state read does), ABORT into the control
