@@ -464,6 +464,7 @@ fn a_const_plan_of_128_elements_on_the_lean_path() {
     let checked = BeginPlan::<Imxrt1062>::new_with_layout(T41[2], &s, plan.configuration())
         .expect("the RT1062 layout takes RFFN 0xF");
     let model = model_of(T41[2]);
+    model.scramble_ram(0x1EA7);
     let hw: FlexCanHw<_, Lean<Imxrt1062>> = FlexCan::begin_checked(
         Ticking::new(model.clone()),
         &mut HostSystem::new(),
@@ -484,6 +485,13 @@ fn a_const_plan_of_128_elements_on_the_lean_path() {
     }
     assert_eq!(can.traffic().sent, 5);
     assert_eq!(model.read32(regs::IFLAG2), 0, "every flag acknowledged");
+    // The lean path reserves the ERR005829 mailbox as well (MB38, over scrambled RAM
+    // at `begin`: INACTIVE, masked).
+    assert_eq!(
+        regs::cs::CODE.get(model.read32(regs::mb_cs(38))),
+        regs::code::TX_INACTIVE
+    );
+    assert_eq!(model.read32(regs::IMASK2) & 1 << (38 - 32), 0);
 }
 
 /// The lean driver with the RT1062 layout.
