@@ -49,7 +49,7 @@ use crate::handshake;
 use crate::imxrt::ImxrtPlan;
 use crate::installed::PlannedTable;
 use crate::instance::Target;
-use crate::layout::{accepted_rffn, Kinetis, Layout};
+use crate::layout::{layout_accepts, Kinetis, Layout};
 use crate::options::Options;
 use crate::regs::{
     self, code, cs, ctrl1, ctrl2, iflag1, mcr, CTRL1, CTRL2, IFLAG1, IFLAG2, IMASK1, IMASK2, MCR,
@@ -75,14 +75,14 @@ struct Plan {
 /// rule ([`Settings::timing_rule`]) unless the layout has more buffers.
 const fn rule_of<L: Layout>(settings: &Settings, configuration: Configuration) -> TimingRule {
     if L::IFLAG2 {
-        settings.timing_rule_with(configuration)
+        settings.timing_rule_for_mailboxes(configuration.message_buffers_used_in(L::E5829))
     } else {
         settings.timing_rule()
     }
 }
 
 /// The checks of ACAN table 5, all of them, then the register values; the
-/// configuration against the layout `L` and the chip ([`accepted_rffn`]:
+/// configuration against the layout `L` and the chip ([`layout_accepts`]:
 /// [`ConfigErrors::CONFIGURATION_NOT_ON_CHIP`]).
 const fn plan<L: Layout>(
     target: Target,
@@ -99,13 +99,15 @@ const fn plan<L: Layout>(
     errors = errors.union(filter_errors);
 
     let chip = target.board.chip();
-    // Every chip has the 16 buffers of the layout without `IFLAG2` (a constant).
-    let max_rffn = if L::IFLAG2 {
-        accepted_rffn(L::MAX_RFFN, chip)
+    // Every chip has the 16 buffers of the layout without `IFLAG2` (a constant); a
+    // layout of more buffers needs the chip to have every one it uses
+    // (`Layout::accepts`, the same rule).
+    let accepted = if L::IFLAG2 {
+        layout_accepts(L::MAX_RFFN, L::IFLAG2, L::E5829, chip, configuration)
     } else {
-        L::MAX_RFFN
+        configuration.rffn() <= L::MAX_RFFN
     };
-    if configuration.rffn() > max_rffn {
+    if !accepted {
         errors = errors.union(ConfigErrors::CONFIGURATION_NOT_ON_CHIP);
     }
     if !settings.can_clock.fits(chip) {
@@ -159,12 +161,13 @@ const fn plan<L: Layout>(
 }
 
 /// The last message buffer the driver enables (`MCR[MAXMB]`) and its data mailbox:
-/// MB15 with [`Kinetis`] (a constant), [`Configuration::data_mailbox`] with a layout of
-/// more buffers (IMXRT1060RM, MCR field MAXMB).
+/// MB15 with [`Kinetis`] (a constant), [`Configuration::data_mailbox_in`] with a layout
+/// of more buffers (IMXRT1060RM, MCR field MAXMB; after the ERR005829 reserved mailbox
+/// with [`Layout::E5829`]).
 #[inline(always)]
 pub(crate) const fn last_mailbox<L: Layout>(configuration: Configuration) -> usize {
     if L::IFLAG2 {
-        configuration.data_mailbox() as usize
+        configuration.data_mailbox_in(L::E5829) as usize
     } else {
         DATA_MAILBOX as usize
     }
@@ -309,7 +312,11 @@ fn configure<R: Registers, L: Layout>(
     } else {
         MESSAGE_BUFFERS as usize - 1
     };
-    let first = plan.configuration.first_remote_mailbox() as usize;
+    let first = if L::E5829 {
+        plan.configuration.first_remote_mailbox_in(true)
+    } else {
+        plan.configuration.first_remote_mailbox()
+    } as usize;
     let primary = if L::IFLAG2 {
         plan.configuration.primary_filter_capacity()
     } else {
@@ -323,6 +330,16 @@ fn configure<R: Registers, L: Layout>(
     // transmit mailbox of the configuration lies: `Configuration::data_mailbox`) IFLAG2
     // bit n - 32 (IMXRT1060RM, IMASK2/IFLAG2).
     let base = tx_flag_base::<L>(data);
+    if L::E5829 {
+        // ERR005829 (i.MX RT1060 chip errata): the first valid mailbox after the Rx
+        // FIFO area is a transmit mailbox kept INACTIVE, inside `MAXMB`, its interrupt
+        // masked (no bit in `IMASK1`/`IMASK2`); so are the buffers between it and the
+        // transmit mailboxes when these start at MB32 (`first_remote_mailbox_in`).
+        // Message buffer RAM is not reset by a soft reset: each gets its code here.
+        for mb in plan.configuration.reserved_mailbox() as usize..first {
+            regs.write32(regs::mb_cs(mb), cs::CODE.val(code::TX_INACTIVE));
+        }
+    }
     let mut tx_flags = 0;
     for mb in first..=data {
         regs.write32(regs::mb_cs(mb), cs::CODE.val(code::TX_INACTIVE));
@@ -691,7 +708,8 @@ impl<R: Registers, L: Layout> FlexCan<R, L> {
     /// [`FlexCan::begin`] for the message-buffer layout `L` ([`crate::layout`]): with
     /// [`crate::layout::Imxrt1062`] on an RT1062, `settings.configuration` may be any
     /// RFFN up to 0xF (a table of up to 128 elements, 32 primary and 96 secondary
-    /// filters; the transmit mailboxes after it, [`Configuration::data_mailbox`]); a
+    /// filters; the ERR005829 reserved mailbox and the transmit mailboxes after it,
+    /// [`Configuration::data_mailbox_in`]); a
     /// configuration the layout or the chip does not take is
     /// [`ConfigErrors::CONFIGURATION_NOT_ON_CHIP`], nothing written.
     ///

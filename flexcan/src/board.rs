@@ -67,8 +67,8 @@ impl Chip {
     /// structures") leave the chip's message buffers room for a data mailbox and a
     /// remote-frame mailbox: 3 on the Kinetis parts (ACAN's 14/18: MB14 remote, MB15
     /// data), 0xF on the RT1062 (IMXRT1060RM, FlexCAN chapter, CTRL2 field RFFN: the
-    /// table up to MB37, MB38–MB63 left; the driver's transmit mailboxes are MB38–MB45,
-    /// [`crate::Configuration::data_mailbox`]).
+    /// table up to MB37, MB38–MB63 left; the RT1062 layout's ERR005829 reserved mailbox is
+    /// MB38 and its transmit mailboxes MB39–MB46, [`crate::Configuration::data_mailbox_in`]).
     pub const fn max_rffn(self) -> u8 {
         let mut r: u8 = 15;
         while r > 0 && crate::regs::rx_fifo_occupied_mbs(r as u32) + 2 > self.message_buffers() {
@@ -104,7 +104,7 @@ impl Chip {
     /// 3 on the Kinetis parts (ACAN's four configurations, [`crate::Configuration::ALL`],
     /// in MB0–MB15) and 0xF on the RT1062 (IMXRT1060RM, FlexCAN chapter, CTRL2 field
     /// RFFN, table "Rx FIFO filter: possible structures": the table up to MB37, the
-    /// transmit mailboxes after it up to MB45, served through `IMASK2`/`IFLAG2` above
+    /// transmit mailboxes after it up to MB46, served through `IMASK2`/`IFLAG2` above
     /// MB31, `MCR[MAXMB]` = the data mailbox). A controller accepts the smaller of this
     /// and its layout's limit ([`crate::layout::Layout::max_rffn`]: 3 with the default
     /// [`crate::layout::Kinetis`], 0xF with [`crate::layout::Imxrt1062`]); `begin`,

@@ -55,6 +55,15 @@ pub const MAX_SECONDARY_FILTERS: usize = 18;
 /// [`Configuration::data_mailbox`]. Those configurations need 64 message buffers: the
 /// controller's layout ([`crate::layout::Imxrt1062`]) and the chip
 /// ([`crate::Chip::accepted_max_rffn`]) decide which are accepted.
+///
+/// The MB columns above are the positions without the ERR005829 reservation (the
+/// [`crate::layout::Kinetis`] layout, and the RT1062 tables as the manual numbers
+/// them). The [`crate::layout::Imxrt1062`] layout keeps the first valid mailbox
+/// after the table INACTIVE (i.MX RT1060 chip errata, ERR005829:
+/// [`Configuration::reserved_mailbox`]) and puts the same number of transmit
+/// mailboxes after it ([`Configuration::first_remote_mailbox_in`],
+/// [`Configuration::data_mailbox_in`]): data mailbox MB16 for ACAN's four, MB39 at
+/// RFFN 8, MB40 at 0xC, MB46 at 0xF (table in [`crate::layout`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[allow(non_camel_case_types)]
@@ -190,15 +199,66 @@ impl Configuration {
         self.table_elements() - self.primary_filter_capacity()
     }
 
-    /// The first remote-frame mailbox.
+    /// The first remote-frame mailbox without the ERR005829 reservation (the
+    /// [`crate::layout::Kinetis`] layout): the first message buffer after the Rx FIFO
+    /// and its table. With the [`crate::layout::Imxrt1062`] layout:
+    /// [`Configuration::first_remote_mailbox_in`]`(true)`.
     pub const fn first_remote_mailbox(self) -> u8 {
         self.fifo_mailboxes()
     }
 
-    /// The message buffer that sends data frames: MB15 in ACAN's configurations (§3
+    /// The message buffer the ERR005829 workaround keeps INACTIVE (i.MX RT1060 chip
+    /// errata, ERR005829: "the first valid mailbox", the first message buffer after the
+    /// area the Rx FIFO and its ID filter table occupy): MB`6 + 2 × (RFFN + 1)`, MB8 at
+    /// RFFN 0, MB38 at RFFN 0xF. Reserved only by a layout with
+    /// [`crate::layout::Layout::E5829`]; never loaded with a frame.
+    pub const fn reserved_mailbox(self) -> u8 {
+        self.fifo_mailboxes()
+    }
+
+    /// The first remote-frame mailbox; with `e5829` (the layout's
+    /// [`crate::layout::Layout::E5829`]) the transmit mailboxes leave room for the
+    /// reserved mailbox ([`Configuration::reserved_mailbox`]): they move up by one, as
+    /// many as without it ([`Configuration::remote_mailbox_count`]), or start at MB32
+    /// when one up would put them across MB31/MB32 (RFFN 8 to 0xB: the table ends in
+    /// MB23 … MB29, the reserved mailbox MB24 … MB30; the buffers between it and MB32
+    /// stay INACTIVE). Without `e5829`: [`Configuration::first_remote_mailbox`].
+    pub const fn first_remote_mailbox_in(self, e5829: bool) -> u8 {
+        if e5829 {
+            let first = self.reserved_mailbox() + 1;
+            if first / 32 == (first + self.remote_mailbox_count()) / 32 {
+                first
+            } else {
+                (first | 31) + 1
+            }
+        } else {
+            self.first_remote_mailbox()
+        }
+    }
+
+    /// The data mailbox with or without the ERR005829 reservation (`e5829`, see
+    /// [`Configuration::first_remote_mailbox_in`]): the remote-frame mailboxes and
+    /// then the data mailbox, `MCR[MAXMB]`. Without `e5829`: [`Configuration::data_mailbox`].
+    pub const fn data_mailbox_in(self, e5829: bool) -> u8 {
+        if e5829 {
+            self.first_remote_mailbox_in(true) + self.remote_mailbox_count()
+        } else {
+            self.data_mailbox()
+        }
+    }
+
+    /// The message buffers taken into matching and arbitration with or without the
+    /// ERR005829 reservation: MB0 to [`Configuration::data_mailbox_in`] (`MCR[MAXMB]` + 1).
+    pub const fn message_buffers_used_in(self, e5829: bool) -> usize {
+        self.data_mailbox_in(e5829) as usize + 1
+    }
+
+    /// The message buffer that sends data frames without the ERR005829 reservation
+    /// (the [`crate::layout::Kinetis`] layout): MB15 in ACAN's configurations (§3
     /// table 1); beyond them the seventh after the table, or MB31 when the table ends
     /// within seven of it (the transmit mailboxes stay within one of `IFLAG1` and
-    /// `IFLAG2`). Also the last message buffer the driver enables (`MCR[MAXMB]`).
+    /// `IFLAG2`). Also the last message buffer the driver enables (`MCR[MAXMB]`). With
+    /// the [`crate::layout::Imxrt1062`] layout: [`Configuration::data_mailbox_in`]`(true)`.
     pub const fn data_mailbox(self) -> u8 {
         let first = self.first_remote_mailbox();
         if first <= DATA_MAILBOX {
@@ -215,8 +275,10 @@ impl Configuration {
         self.data_mailbox() - self.first_remote_mailbox()
     }
 
-    /// The message buffers the configuration uses, MB0 to [`Configuration::data_mailbox`]
-    /// (`MCR[MAXMB]` + 1): 16 for ACAN's four.
+    /// The message buffers the configuration uses without the ERR005829 reservation,
+    /// MB0 to [`Configuration::data_mailbox`] (`MCR[MAXMB]` + 1): 16 for ACAN's four.
+    /// With the [`crate::layout::Imxrt1062`] layout:
+    /// [`Configuration::message_buffers_used_in`]`(true)`.
     pub const fn message_buffers_used(self) -> usize {
         self.data_mailbox() as usize + 1
     }
@@ -289,5 +351,53 @@ mod tests {
             assert!(c.message_buffers_used() <= 64);
         }
         assert_eq!(Configuration::from_rffn(16), None);
+    }
+
+    /// The ERR005829 reservation (i.MX RT1060 chip errata, ERR005829): the first valid
+    /// mailbox after the FIFO area reserved, the transmit mailboxes after it as many as
+    /// without it, never across MB31/MB32, all within the RT1062's 64 buffers.
+    #[test]
+    fn the_e5829_reservation_keeps_every_remote_mailbox() {
+        // (RFFN, reserved MB, first remote MB, data MB)
+        let rows = [
+            (0, 8, 9, 16),
+            (1, 10, 11, 16),
+            (3, 14, 15, 16),
+            (4, 16, 17, 24),
+            (7, 22, 23, 30),
+            (8, 24, 32, 39),
+            (9, 26, 32, 37),
+            (0xB, 30, 32, 33),
+            (0xC, 32, 33, 40),
+            (0xF, 38, 39, 46),
+        ];
+        for (r, reserved, first, data) in rows {
+            let c = Configuration::from_rffn(r).unwrap();
+            assert_eq!(
+                (
+                    c.reserved_mailbox(),
+                    c.first_remote_mailbox_in(true),
+                    c.data_mailbox_in(true)
+                ),
+                (reserved, first, data),
+                "RFFN {r}"
+            );
+        }
+        for c in Configuration::EVERY {
+            let (first, data) = (c.first_remote_mailbox_in(true), c.data_mailbox_in(true));
+            // The first valid mailbox: right after the FIFO and its table.
+            assert_eq!(
+                usize::from(c.reserved_mailbox()),
+                crate::regs::rx_fifo_occupied_mbs(u32::from(c.rffn()))
+            );
+            assert!(c.reserved_mailbox() < first && data < 64, "{c:?}");
+            assert_eq!(first / 32, data / 32, "{c:?}");
+            assert_eq!(data - first, c.remote_mailbox_count(), "{c:?}");
+            assert_eq!(c.message_buffers_used_in(true), usize::from(data) + 1);
+            // Without the reservation: the plain rule.
+            assert_eq!(c.first_remote_mailbox_in(false), c.first_remote_mailbox());
+            assert_eq!(c.data_mailbox_in(false), c.data_mailbox());
+            assert_eq!(c.message_buffers_used_in(false), c.message_buffers_used());
+        }
     }
 }

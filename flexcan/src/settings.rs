@@ -297,16 +297,22 @@ impl Settings {
         timing_rule_for(self.can_clock.hz(), self.bus_clock_hz)
     }
 
-    /// The bit timing rule `begin` applies to these settings with a table of
-    /// `configuration`: [`Settings::timing_rule`] for ACAN's configurations (16 message
+    /// The bit timing rule for a table of `configuration` without the ERR005829
+    /// reservation: [`Settings::timing_rule`] for ACAN's configurations (16 message
     /// buffers), [`timing_rule_for_buffers`] with the buffers of the RT1062's larger
-    /// ones ([`Configuration::message_buffers_used`]).
+    /// ones ([`Configuration::message_buffers_used`]). `begin` with the RT1062 layout
+    /// counts the reserved mailbox too ([`Settings::timing_rule_for_mailboxes`]).
     pub const fn timing_rule_with(&self, configuration: Configuration) -> TimingRule {
-        timing_rule_for_buffers(
-            self.can_clock.hz(),
-            self.bus_clock_hz,
-            configuration.message_buffers_used(),
-        )
+        self.timing_rule_for_mailboxes(configuration.message_buffers_used())
+    }
+
+    /// The bit timing rule `begin` applies to these settings with `message_buffers`
+    /// buffers in matching and arbitration (`MCR[MAXMB]` + 1): [`timing_rule_for_buffers`].
+    /// With the RT1062 layout `begin` gives it
+    /// [`crate::layout::Layout::message_buffers_used`] (the ERR005829 reserved mailbox
+    /// counted).
+    pub const fn timing_rule_for_mailboxes(&self, message_buffers: usize) -> TimingRule {
+        timing_rule_for_buffers(self.can_clock.hz(), self.bus_clock_hz, message_buffers)
     }
 
     /// Whether the actual bit rate is exactly the wished one (ACAN §16.4).

@@ -13,9 +13,11 @@
 //! - transmit handler: `IFLAG1` write-1-to-clear of the transmit mailboxes' bits;
 //!
 //! (With the RT1062 layout, [`crate::layout::Imxrt1062`], the transmit mailboxes of the
-//! tables from RFFN 0xC on are MB32–MB45: what is said here of their `IFLAG1` bits holds
+//! tables from RFFN 8 on are MB32–MB46: what is said here of their `IFLAG1` bits holds
 //! of their `IFLAG2` bits, IMXRT1060RM "Interrupt Flags 2 register (IFLAG2)"; the Rx
-//! FIFO's flags stay in `IFLAG1`.)
+//! FIFO's flags stay in `IFLAG1`. That layout also writes the control/status word of
+//! the ERR005829 reserved mailbox, INACTIVE twice, after each activation: transmit
+//! half and transmit handler alike, the same value, [`Hardware::load`].)
 //! - transmit half (`abort`) and transmit handler (`settle`), inside the driver's critical
 //!   section: `ESR1` read for `TX` before an ABORT write (its clear-on-read error bits
 //!   are kept for the status handler, as every state read does), ABORT into the control
@@ -220,7 +222,11 @@ impl<R: Registers, O: Options> FlexCanHw<R, O> {
     #[inline(always)]
     pub(crate) fn from_parts(regs: R, target: Target, table: O::Table, p: Parts) -> Self {
         let configuration = table.configuration();
-        let first = configuration.first_remote_mailbox() as u32;
+        let first = if O::Layout::E5829 {
+            configuration.first_remote_mailbox_in(true)
+        } else {
+            configuration.first_remote_mailbox()
+        } as u32;
         let tx_mask = if O::Layout::IFLAG2 {
             // The transmit mailboxes `first..=data` as bits of their flag register.
             let data = last_mailbox::<O::Layout>(configuration) as u32;
@@ -417,6 +423,18 @@ impl<R: Registers, O: Options> FlexCanHw<R, O> {
         last_mailbox::<O::Layout>(self.configuration)
     }
 
+    /// The first remote-frame mailbox: after the Rx FIFO area, and with
+    /// [`Layout::E5829`] after the reserved mailbox too
+    /// ([`Configuration::first_remote_mailbox_in`]).
+    #[inline(always)]
+    fn first_remote(&self) -> usize {
+        if O::Layout::E5829 {
+            self.configuration.first_remote_mailbox_in(true) as usize
+        } else {
+            self.configuration.first_remote_mailbox() as usize
+        }
+    }
+
     /// The first MB of the flag register holding the transmit mailboxes' flags: 0, or
     /// 32 when they lie above MB31 (a constant 0 with a layout of 16 buffers).
     #[inline(always)]
@@ -477,7 +495,7 @@ impl<R: Registers, O: Options> FlexCanHw<R, O> {
         if !frame.is_remote() {
             return Ok(free(data).then_some(data as u8));
         }
-        let first = self.configuration.first_remote_mailbox() as usize;
+        let first = self.first_remote();
         Ok((first..data).find(|&mb| free(mb)).map(|mb| mb as u8))
     }
 
@@ -561,6 +579,9 @@ impl<R: Registers, O: Options> FlexCanHw<R, O> {
             while i < Configuration::EVERY.len() {
                 let c = Configuration::EVERY[i];
                 assert!(((c.data_mailbox() - c.first_remote_mailbox()) as usize) < MAX_TX);
+                assert!(
+                    ((c.data_mailbox_in(true) - c.first_remote_mailbox_in(true)) as usize) < MAX_TX
+                );
                 i += 1;
             }
         };
@@ -809,13 +830,25 @@ unsafe impl<R: Registers, O: Options> Hardware for FlexCanHw<R, O> {
         self.free_now(frame)
     }
     /// Identifier and data first, the control word (CODE `DATA`) last (Kinetis RM,
-    /// "Transmit process").
+    /// "Transmit process"). With [`Layout::E5829`] (the RT1062 layout), the workaround
+    /// of i.MX RT1060 chip errata, ERR005829 (a mailbox activated at a specific moment
+    /// of the arbitration process is not transmitted in it): after the control word,
+    /// INACTIVE is written twice into the control/status word of the reserved mailbox
+    /// ([`Configuration::reserved_mailbox`], the first valid mailbox after the Rx FIFO
+    /// area, INACTIVE since `begin`). Two contexts may do it at once (the transmit half
+    /// and the transmit interrupt's refill); both write the same value.
     #[inline(always)]
     unsafe fn load(&self, mailbox: u8, frame: &Frame, token: Token) {
         let mb = mailbox as usize;
         self.tokens[self.data_mb() - mb].store(token.0, Ordering::Release);
         self.loaded.fetch_or(self.tx_bit(mb), Ordering::Relaxed);
         MbWords::transmit(frame).write(&self.regs, mb);
+        if O::Layout::E5829 {
+            let reserved = regs::mb_cs(self.configuration.reserved_mailbox() as usize);
+            let inactive = cs::CODE.val(code::TX_INACTIVE);
+            self.regs.write32(reserved, inactive);
+            self.regs.write32(reserved, inactive);
+        }
     }
 
     /// Each transmit mailbox with its `IFLAG1` bit set ended: code `ABORT` means
@@ -839,20 +872,20 @@ unsafe impl<R: Registers, O: Options> Hardware for FlexCanHw<R, O> {
         self.retry_aborts();
     }
 
-    /// The data mailbox and the remote-frame mailboxes.
+    /// The data mailbox and the remote-frame mailboxes (the ERR005829 reserved mailbox
+    /// of the RT1062 layout is not one: it is never loaded).
     fn mailbox_count(&self) -> u8 {
-        (1 + self.data_mb() - (self.configuration.first_remote_mailbox() as usize)) as u8
+        (1 + self.data_mb() - self.first_remote()) as u8
     }
 
     /// `MailboxId(0)` is the data mailbox (MB15 in ACAN's configurations), `MailboxId(1..=n)` the remote-frame mailboxes in
     /// increasing MB order: `Pending` while loaded (code `DATA`, flag clear), else
     /// `Empty` (FlexCAN shows no scheduled or transmitting state per mailbox).
     fn mailbox_state(&self, mailbox: MailboxId) -> MailboxState {
-        let c = self.configuration();
         let mb = match mailbox.0 {
             0 => self.data_mb(),
-            k if (k as usize) < 1 + self.data_mb() - (c.first_remote_mailbox() as usize) => {
-                (c.first_remote_mailbox() as usize) + k as usize - 1
+            k if (k as usize) < 1 + self.data_mb() - self.first_remote() => {
+                self.first_remote() + k as usize - 1
             }
             _ => return MailboxState::Empty,
         };
@@ -879,7 +912,7 @@ unsafe impl<R: Registers, O: Options> Hardware for FlexCanHw<R, O> {
             return false;
         }
         let loaded = self.loaded.load(Ordering::Relaxed);
-        let first = self.configuration.first_remote_mailbox() as usize;
+        let first = self.first_remote();
         let data = self.data_mb();
         let holder = (first..=data).find(|&mb| {
             loaded & self.tx_bit(mb) != 0
@@ -1200,7 +1233,7 @@ unsafe impl<R: Registers, O: Options> Hardware for FlexCanHw<R, O> {
             crate::settings::timing_rule_for_buffers(
                 self.system.can_clock_hz(),
                 Some(self.bus_clock_hz),
-                c.message_buffers_used(),
+                c.message_buffers_used_in(O::Layout::E5829),
             )
         } else {
             crate::settings::timing_rule_for(self.system.can_clock_hz(), Some(self.bus_clock_hz))

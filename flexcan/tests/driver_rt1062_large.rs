@@ -172,10 +172,11 @@ fn tables_of_32_64_96_and_128_elements_give_every_user_index() {
         assert_eq!(ctrl2::RFFN.get(r.read32(regs::CTRL2)), u32::from(c.rffn()));
         assert_eq!(
             mcr::MAXMB.get(r.read32(regs::MCR)),
-            u32::from(c.data_mailbox())
+            u32::from(Imxrt1062::data_mailbox(c))
         );
         // The transmit mailboxes' interrupts: IMASK1 below MB32, IMASK2 above.
-        let tx: u64 = (c.first_remote_mailbox()..=c.data_mailbox()).fold(0, |m, mb| m | 1 << mb);
+        let tx: u64 = (Imxrt1062::first_remote_mailbox(c)..=Imxrt1062::data_mailbox(c))
+            .fold(0, |m, mb| m | 1 << mb);
         let fifo = u64::from(iflag1::BUF5I | iflag1::BUF7I);
         let imask = u64::from(r.read32(regs::IMASK1)) | u64::from(r.read32(regs::IMASK2)) << 32;
         assert_eq!(imask, fifo | tx, "{c:?}");
@@ -226,7 +227,7 @@ fn every_rffn_of_the_chip_begins_and_sends_from_its_mailboxes() {
 #[test]
 fn remote_frames_from_mailboxes_above_mb31_complete_once_in_order() {
     let c = Configuration::Filters32_96;
-    assert!(c.first_remote_mailbox() >= 32 && c.remote_mailbox_count() == 7);
+    assert!(Imxrt1062::first_remote_mailbox(c) >= 32 && c.remote_mailbox_count() == 7);
     let (model, mut can) =
         begin_large::<32, 16>(T41[2], &settings(c, true), &[Filter::pass_all()], &[]).unwrap();
     let mut bus = bus_with(500_000, &[&model]);
@@ -300,7 +301,7 @@ fn abort_in_a_mailbox_above_mb31() {
     for m in 0..can.hardware().mailbox_count() {
         assert_eq!(can.mailbox_state(MailboxId(m)), MailboxState::Empty);
     }
-    // The data mailbox (MB41) is usable again.
+    // The data mailbox (MB42) is usable again.
     can.try_send(&std_data(0x124, &[])).unwrap();
     assert_eq!(can.mailbox_state(MailboxId(0)), MailboxState::Pending);
 }
@@ -361,17 +362,26 @@ fn too_large_a_table_is_a_typed_error() {
         e,
         BeginError::Config(ConfigErrors::CONFIGURATION_NOT_ON_CHIP)
     );
-    // ... where ACAN's configurations run as with the default layout.
-    k.configuration = Configuration::Filters14_18;
-    k.loop_back = true;
-    k.self_reception = true;
-    let (model, mut can) = begin_large::<8, 8>(t36, &k, &[Filter::pass_all()], &[]).unwrap();
-    let mut bus = bus_with(500_000, &[&model]);
-    send_and_check(
-        &mut bus,
-        &mut can,
-        &[(std_data(1, &[]), 0), (remote(2, true), 0)],
-    );
+    // ... and none of ACAN's either: the ERR005829 reserved mailbox puts their data
+    // mailbox at MB16, beyond a Kinetis module's 16 buffers (the default layout runs
+    // them there).
+    for c in Configuration::ALL {
+        k.configuration = c;
+        assert_eq!(Imxrt1062::data_mailbox(c), 16);
+        assert_eq!(
+            check_with_layout::<Imxrt1062>(t36, &k, &[], &[]),
+            ConfigErrors::CONFIGURATION_NOT_ON_CHIP,
+            "{c:?}"
+        );
+        let e = begin_large::<8, 8>(t36, &k, &[Filter::pass_all()], &[])
+            .map(|_| ())
+            .unwrap_err();
+        assert_eq!(
+            e,
+            BeginError::Config(ConfigErrors::CONFIGURATION_NOT_ON_CHIP)
+        );
+        assert!(check_with_layout::<twocan_flexcan::layout::Kinetis>(t36, &k, &[], &[]).is_empty());
+    }
     // A table too large for the table type is refused by the compiler of lists too.
     assert_eq!(
         twocan_flexcan::FilterTable::compile(Configuration::Filters16_24, &[], &[]).unwrap_err(),
@@ -384,15 +394,21 @@ fn end_masks_the_mailboxes_above_mb31_and_begin_runs_again() {
     let c = Configuration::Filters32_96;
     let (_model, can) =
         begin_large::<8, 8>(T41[0], &settings(c, true), &[Filter::pass_all()], &[]).unwrap();
-    let tx = (c.first_remote_mailbox()..=c.data_mailbox()).fold(0u32, |m, mb| m | 1 << (mb - 32));
+    let tx = (Imxrt1062::first_remote_mailbox(c)..=Imxrt1062::data_mailbox(c))
+        .fold(0u32, |m, mb| m | 1 << (mb - 32));
     assert_eq!(can.hardware().registers().read32(regs::IMASK2), tx);
     let hw = can.release();
     let (regs, _table) = hw.end(&mut HostSystem::new()).map_err(|(_, e)| e).unwrap();
     assert_eq!(regs.read32(regs::IMASK2), 0);
     assert_eq!(regs.read32(regs::IMASK1), 0);
     assert_eq!(regs.read32(regs::IFLAG2), 0);
+    // The reserved mailbox (MB38) is left INACTIVE by the driver and by `end`.
+    assert_eq!(
+        regs::cs::CODE.get(regs.read32(regs::mb_cs(38))),
+        regs::code::TX_INACTIVE
+    );
     // The same registers begin again, with a table of another size.
-    let c = Configuration::Filters26_54;
+    let c = Configuration::Filters22_42;
     let can = FlexCan::<_, Imxrt1062>::begin_with_layout(
         regs,
         &mut HostSystem::new(),
@@ -405,16 +421,25 @@ fn end_masks_the_mailboxes_above_mb31_and_begin_runs_again() {
     let r = can.registers();
     assert_eq!(
         mcr::MAXMB.get(r.read32(regs::MCR)),
-        u32::from(c.data_mailbox())
+        u32::from(Imxrt1062::data_mailbox(c))
     );
-    assert_eq!(r.read32(regs::IMASK2), 0, "MB26–MB31: IMASK1");
+    assert_eq!(r.read32(regs::IMASK2), 0, "MB23–MB30: IMASK1");
+    assert_eq!(
+        r.read32(regs::IMASK1),
+        iflag1::BUF5I | iflag1::BUF7I | 0xFF << 23,
+        "the reserved MB22 masked"
+    );
+    assert_eq!(
+        regs::cs::CODE.get(r.read32(regs::mb_cs(22))),
+        regs::code::TX_INACTIVE
+    );
     let mut can: Large<8, 8> = Driver::new(can.into_split());
     can.try_send(&std_data(0x42, &[])).unwrap();
 }
 
 /// The lean path with the RT1062 layout: a table of 128 elements planned at compile
 /// time, the settings checked for the layout beforehand, the controller read from flash
-/// ([`twocan_flexcan::options::Lean`]`<Imxrt1062>`), frames sent from MB38–MB45.
+/// ([`twocan_flexcan::options::Lean`]`<Imxrt1062>`), frames sent from MB39–MB46 (MB38 the ERR005829 reserved mailbox).
 #[test]
 fn a_const_plan_of_128_elements_on_the_lean_path() {
     use twocan_flexcan::begin::BeginPlan;
@@ -439,6 +464,7 @@ fn a_const_plan_of_128_elements_on_the_lean_path() {
     let checked = BeginPlan::<Imxrt1062>::new_with_layout(T41[2], &s, plan.configuration())
         .expect("the RT1062 layout takes RFFN 0xF");
     let model = model_of(T41[2]);
+    model.scramble_ram(0x1EA7);
     let hw: FlexCanHw<_, Lean<Imxrt1062>> = FlexCan::begin_checked(
         Ticking::new(model.clone()),
         &mut HostSystem::new(),
@@ -459,6 +485,13 @@ fn a_const_plan_of_128_elements_on_the_lean_path() {
     }
     assert_eq!(can.traffic().sent, 5);
     assert_eq!(model.read32(regs::IFLAG2), 0, "every flag acknowledged");
+    // The lean path reserves the ERR005829 mailbox as well (MB38, over scrambled RAM
+    // at `begin`: INACTIVE, masked).
+    assert_eq!(
+        regs::cs::CODE.get(model.read32(regs::mb_cs(38))),
+        regs::code::TX_INACTIVE
+    );
+    assert_eq!(model.read32(regs::IMASK2) & 1 << (38 - 32), 0);
 }
 
 /// The lean driver with the RT1062 layout.
@@ -475,7 +508,7 @@ impl Service for LeanLarge {
 /// The bit-timing rule follows the buffers the configuration enables (IMXRT1060RM,
 /// "Arbitration and matching timing": 16 peripheral clocks per CAN bit up to 16
 /// buffers, 30 above 32): at 1 Mbit/s with the peripheral clock the 24 MHz CAN clock
-/// (no bus clock given), 14/18 is taken and 32/96 (MB0–MB45) refused, by `check`,
+/// (no bus clock given), 14/18 is taken and 32/96 (MB0–MB46) refused, by `check`,
 /// `begin` and the running controller's `set_bitrate` alike; with the RT1062's 150 MHz
 /// IPG clock given, both are taken.
 #[test]

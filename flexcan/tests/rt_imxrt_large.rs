@@ -13,7 +13,7 @@
 use std::sync::atomic::{AtomicU32, Ordering};
 
 use twocan_core::{Frame, Registers};
-use twocan_flexcan::layout::Imxrt1062;
+use twocan_flexcan::layout::{Imxrt1062, Layout};
 use twocan_flexcan::options::Full;
 use twocan_flexcan::regs::{self, code, cs, esr1, iflag1, mcr, ESR1, IFLAG1, IFLAG2, IMASK2, MCR};
 use twocan_flexcan::rt::{self, IrqNumber, IrqState, Nvic};
@@ -89,12 +89,13 @@ fn can3_settles_a_mailbox_above_mb31_from_iflag2() {
     )
     .expect("begin")
     .into_split();
-    let data = usize::from(Configuration::Filters32_96.data_mailbox());
-    assert_eq!(data, 45);
+    // After the ERR005829 reserved mailbox (MB38): MB39–MB45 remote, MB46 data.
+    let data = usize::from(Imxrt1062::data_mailbox(Configuration::Filters32_96));
+    assert_eq!(data, 46);
     assert_ne!(
         regs.read32(IMASK2) & 1 << (data - 32),
         0,
-        "MB45's interrupt on"
+        "MB46's interrupt on"
     );
     type Wired = IrqState<&'static SyncRegs, 32, twocan_core::FifoQueue<16>, 8, Full<Imxrt1062>>;
     let state: &'static Wired = Box::leak(Box::new(Wired::new()));
@@ -102,10 +103,16 @@ fn can3_settles_a_mailbox_above_mb31_from_iflag2() {
     let (mut tx, mut rx) = state.start(hw, &mut nvic).map_err(|(e, _)| e).unwrap();
     assert!(rt::is_wired(Instance::Can3));
 
-    // A data frame goes to MB45; the module "sends" it: INACTIVE, IFLAG2 bit 13.
+    // A data frame goes to MB46; the module "sends" it: INACTIVE, IFLAG2 bit 14.
     let frame = Frame::standard(0x123, &[7]).unwrap();
     let token = tx.try_send(&frame).unwrap();
     assert_eq!(cs::CODE.get(regs.read32(regs::mb_cs(data))), code::TX_DATA);
+    // The ERR005829 reserved mailbox (MB38): INACTIVE after the activation, masked.
+    assert_eq!(
+        cs::CODE.get(regs.read32(regs::mb_cs(38))),
+        code::TX_INACTIVE
+    );
+    assert_eq!(regs.read32(IMASK2) & 1 << (38 - 32), 0);
     regs.write32(regs::mb_cs(data), cs::CODE.val(code::TX_INACTIVE));
     regs.words[IFLAG2 / 4].fetch_or(1 << (data - 32), Ordering::SeqCst);
     // And a frame at the Rx FIFO output (IFLAG1) in the same interrupt.
@@ -114,7 +121,7 @@ fn can3_settles_a_mailbox_above_mb31_from_iflag2() {
     regs.write32(regs::mb_word0(0), 0x0900_0000);
     regs.words[IFLAG1 / 4].fetch_or(iflag1::BUF5I, Ordering::SeqCst);
     rt_imxrt::can3();
-    assert_eq!(regs.read32(IFLAG2), 0, "MB45's flag acknowledged in IFLAG2");
+    assert_eq!(regs.read32(IFLAG2), 0, "MB46's flag acknowledged in IFLAG2");
     assert_eq!(regs.read32(IFLAG1) & iflag1::BUF5I, 0, "FIFO popped");
     let done = tx.take_completion().expect("one completion");
     assert_eq!(

@@ -20,7 +20,9 @@
 pub enum Erratum {
     /// e5829: "FlexCAN does not transmit a message that is enabled to be transmitted in a
     /// specific moment during the arbitration process". Work-around: keep the first
-    /// mailbox after the Rx FIFO area inactive (reserved) and never use it.
+    /// mailbox after the Rx FIFO area inactive (reserved) and never use it, and write
+    /// INACTIVE into it twice after each transmit activation (the driver's RT1062 layout
+    /// does, `Layout::E5829`). The model does not reproduce the erratum.
     E5829,
     /// e6032: "A frame with wrong ID or payload is transmitted into the CAN bus when the
     /// Message Buffer under transmission is either aborted or deactivated while the CAN
