@@ -276,7 +276,7 @@ fn the_quiet_mode_gives_the_controller_back_acknowledged_with_its_interrupt() {
     use twocan_core::Lean;
     const OPTIONS: PlanOptions = PlanOptions::new(14);
     type Quiet = State<BxCan<Clocked, Clocked, 0>, 8, FifoQueue<4>, 0, 0, Lean>;
-    assert!(Quiet::QUIET_TX);
+    const { assert!(Quiet::QUIET_TX) };
     let config = loopback_config(TxPolicy::Fifo);
     let (regs, bus) = attached();
     let state: Quiet = State::new();

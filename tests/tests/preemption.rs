@@ -238,10 +238,13 @@ fn flexcan_abort_during_a_retry_loop_takes_effect() {
 /// any transmit interrupt (the line never rises).
 #[test]
 fn bxcan_quiet_mode_enables_the_transmit_interrupt_only_while_frames_wait() {
-    assert!(State::<BxHw, RX, FifoQueue<4>, RX, 0, Lean>::QUIET_TX);
-    assert!(!State::<BxHw, RX, FifoQueue<4>, RX, 0, twocan_core::Full>::QUIET_TX);
-    assert!(!State::<BxHw, RX, FifoQueue<4>, RX, 8, Lean>::QUIET_TX);
-    assert!(!State::<BxHw, RX, PriorityQueue<4>, RX, 0, Lean>::QUIET_TX);
+    // Settled at compile time: checked by the compiler.
+    const {
+        assert!(State::<BxHw, RX, FifoQueue<4>, RX, 0, Lean>::QUIET_TX);
+        assert!(!State::<BxHw, RX, FifoQueue<4>, RX, 0, twocan_core::Full>::QUIET_TX);
+        assert!(!State::<BxHw, RX, FifoQueue<4>, RX, 8, Lean>::QUIET_TX);
+        assert!(!State::<BxHw, RX, PriorityQueue<4>, RX, 0, Lean>::QUIET_TX);
+    }
     let ier = |rig: &twocan_tests::preempt::Rig<BxHw, FifoQueue<4>, 0, Lean>| {
         rig.state
             .hardware()
