@@ -258,11 +258,12 @@ mod tests {
             .unwrap_or_else(|(_, e)| panic!("{e:?}"));
         assert_eq!(controller.target().instance, Instance::Can1);
         assert_eq!(model.read32(regs::MCR) & mcr::MDIS, 0, "running");
-        // The RT1062 layout: the ERR005829 reserved mailbox (MB8, the first after the
-        // RFFN 0 table) INACTIVE and masked, the data mailbox MB16 = MAXMB (the
-        // Kinetis layout's MB8 is a remote-frame mailbox, unmasked, and MAXMB 15).
+        // The RT1062 layout: the ERR005829 reserved mailbox (MB12, the first after the
+        // table of the default configuration, RFFN 2) INACTIVE and masked, the data
+        // mailbox MB16 = MAXMB (the Kinetis layout's MB12 is a remote-frame mailbox,
+        // unmasked, and MAXMB 15).
         let reserved = usize::from(controller.configuration().reserved_mailbox());
-        assert_eq!(reserved, 8);
+        assert_eq!(reserved, 12);
         assert_eq!(
             regs::cs::CODE.get(model.read32(regs::mb_cs(reserved))),
             regs::code::TX_INACTIVE
