@@ -223,6 +223,19 @@ mod tests {
     use super::*;
 
     #[test]
+    fn the_board_layout_and_window_follow_the_board_feature() {
+        let teensy4 = cfg!(any(feature = "teensy40", feature = "teensy41"));
+        // The RT1062 layout (ERR005829 workaround, RFFN up to 0xF) on a Teensy 4 only.
+        assert_eq!(BoardLayout::E5829, teensy4);
+        assert_eq!(BoardLayout::MAX_RFFN, if teensy4 { 0xF } else { 3 });
+        // Its window reaches the individual masks beyond the Kinetis block.
+        let (imxrt, kinetis) = (crate::regs::IMXRT_BLOCK_END, crate::regs::BLOCK_END);
+        let expected = if teensy4 { imxrt } else { kinetis };
+        assert_eq!(crate::regs::BOARD_BLOCK_END, expected);
+        assert_eq!(crate::regs::rximr(64), imxrt);
+    }
+
+    #[test]
     fn layouts_hold_their_largest_table() {
         let largest = |max: u8| Configuration::from_rffn(max).unwrap();
         assert!(FilterTable::<LOOKUP_KEYS>::holds(largest(
