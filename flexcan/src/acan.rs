@@ -10,10 +10,10 @@
 //! the settings checked beforehand (a `const` [`BeginPlan`]). Its `end_*` is ACAN's `end`: the way back, after which the one call runs
 //! again.
 //!
-//! | board | one call | way back | default settings |
-//! |---|---|---|---|
-//! | Teensy 3.x | `can0`, and `can1` on the Teensy 3.6 | `end_can0`, `end_can1` | [`Settings::new`] (ACAN table 7: the 16 MHz oscillator), pins of [`crate::Board::pins`] |
-//! | Teensy 4.0 / 4.1 | `can1`, `can2`, `can3` | `end_can1`, `end_can2`, `end_can3` | [`Settings::with_clock`] at [`CanClock::default_for`] the RT1062 (the 24 MHz oscillator root; ACAN_T4's is 60 MHz from PLL3, see `docs/differences.md`), pins 22/23, 0/1 (CAN2: TX 1, RX 0), 30/31 (CAN3: TX 31, RX 30) |
+//! | board | one call | way back | default settings | layout ([`crate::layout`]) |
+//! |---|---|---|---|---|
+//! | Teensy 3.x | `can0`, and `can1` on the Teensy 3.6 | `end_can0`, `end_can1` | [`Settings::new`] (ACAN table 7: the 16 MHz oscillator), pins of [`crate::Board::pins`] | [`Kinetis`]: MB0–MB15, ACAN's |
+//! | Teensy 4.0 / 4.1 | `can1`, `can2`, `can3` | `end_can1`, `end_can2`, `end_can3` | [`Settings::with_clock`] at [`CanClock::default_for`] the RT1062 (the 24 MHz oscillator root; ACAN_T4's is 60 MHz from PLL3, see `docs/differences.md`), pins 22/23, 0/1 (CAN2: TX 1, RX 0), 30/31 (CAN3: TX 31, RX 30) | [`Imxrt1062`]: the ERR005829 workaround ([`Layout::E5829`]: the first mailbox after the Rx FIFO area kept INACTIVE, two INACTIVE writes after each transmit activation; i.MX RT1060 chip errata) and tables up to RFFN 0xF (a `*_with` or `*_checked` call may give `Filters16_24` … `Filters32_96`); the filter table is the 128-element [`crate::layout::LargeFilterTable`] |
 //!
 //! The five steps stay available for programs that want control (their own state sizes,
 //! filters, pins, priorities, or their own vectors): `Can0::take` (`Can1::take` ...),
@@ -44,7 +44,9 @@ use twocan_core::{Error, FifoQueue, Filter, Leftovers, Registers};
 use crate::begin_error::BeginError;
 #[allow(unused_imports)] // doc links
 use crate::can_clock::CanClock;
-use crate::filters::{FilterTable, TableSlot};
+use crate::filters::TableSlot;
+#[allow(unused_imports)] // used by the board's one calls
+use crate::layout::{BoardLayout, Imxrt1062, Kinetis, Layout};
 use crate::options::FullInSlot;
 use crate::regs::FlexCanRegs;
 use crate::rt::{Halves, InPlaceError, IrqState, Nvic, StartError, StopError};
@@ -55,13 +57,20 @@ use crate::{BeginPlan, FlexCanHw, Target};
 /// transmit 16, table 7), 8 completions, every feature, the filter table compiled by
 /// `begin` straight into the module's `static` [`TableSlot`] ([`FullInSlot`]: no
 /// table-sized value moves through the one call, so it configures within a few hundred
-/// bytes of stack, issue 21).
-pub type OneCallState<R = FlexCanRegs> =
-    IrqState<R, RECEIVE_BUFFER_SIZE, FifoQueue<TRANSMIT_BUFFER_SIZE>, 8, FullInSlot>;
+/// bytes of stack, issue 21), in the message-buffer layout `L` ([`crate::layout`]: the
+/// board's, [`BoardLayout`], by default — [`Imxrt1062`] on a Teensy 4, with the
+/// ERR005829 workaround; [`Kinetis`] on a Teensy 3.x).
+pub type OneCallState<R = FlexCanRegs, L = BoardLayout> =
+    IrqState<R, RECEIVE_BUFFER_SIZE, FifoQueue<TRANSMIT_BUFFER_SIZE>, 8, FullInSlot<L>>;
 
-/// The transmit and receive halves of a module started by the one call.
-pub type AcanHalves<R = FlexCanRegs> =
-    Halves<R, RECEIVE_BUFFER_SIZE, FifoQueue<TRANSMIT_BUFFER_SIZE>, 8, FullInSlot>;
+/// The transmit and receive halves of a module started by the one call (layout `L` as
+/// [`OneCallState`]).
+pub type AcanHalves<R = FlexCanRegs, L = BoardLayout> =
+    Halves<R, RECEIVE_BUFFER_SIZE, FifoQueue<TRANSMIT_BUFFER_SIZE>, 8, FullInSlot<L>>;
+
+/// The filter table of a one call's module in the layout `L` (ACAN's 32 elements with
+/// [`Kinetis`], 128 with [`Imxrt1062`]).
+pub type OneCallTable<L = BoardLayout> = <L as Layout>::Table;
 
 /// A module's ownership token as the one call uses it: taken once, begun in place, and
 /// ended back into a token (`Can0`..`Can3` on the target; a host test's own over the
@@ -69,6 +78,11 @@ pub type AcanHalves<R = FlexCanRegs> =
 pub trait Module: Sized {
     /// The module's registers.
     type Regs: Registers + 'static;
+
+    /// The message-buffer layout the one call begins the module in ([`crate::layout`]):
+    /// [`Imxrt1062`] for the Teensy 4 modules (the RT1062's tables and the ERR005829
+    /// workaround), [`Kinetis`] for the Teensy 3.x ones.
+    type Layout: Layout;
 
     /// The module this token owns (what a [`BeginPlan`] for it names).
     const TARGET: Target;
@@ -82,40 +96,46 @@ pub trait Module: Sized {
     #[allow(clippy::type_complexity)]
     fn begin_in_place<'h>(
         self,
-        hw: &'h mut MaybeUninit<FlexCanHw<Self::Regs, FullInSlot>>,
-        checked: &BeginPlan,
+        hw: &'h mut MaybeUninit<FlexCanHw<Self::Regs, FullInSlot<Self::Layout>>>,
+        checked: &BeginPlan<Self::Layout>,
         primary: &[Filter],
         secondary: &[Filter],
-        slot: &'static mut FilterTable,
+        slot: &'static mut OneCallTable<Self::Layout>,
     ) -> Result<
-        &'h mut FlexCanHw<Self::Regs, FullInSlot>,
-        (Self, BeginError, &'static mut FilterTable),
+        &'h mut FlexCanHw<Self::Regs, FullInSlot<Self::Layout>>,
+        (Self, BeginError, &'static mut OneCallTable<Self::Layout>),
     >;
 
     /// ACAN's `end`: the module stopped, its pins and clock gates released, the token
     /// and the table back (the controller comes back with the error).
     #[allow(clippy::result_large_err, clippy::type_complexity)]
     fn end_split(
-        hw: FlexCanHw<Self::Regs, FullInSlot>,
-    ) -> Result<(Self, &'static mut FilterTable), (FlexCanHw<Self::Regs, FullInSlot>, Error)>;
+        hw: FlexCanHw<Self::Regs, FullInSlot<Self::Layout>>,
+    ) -> Result<
+        (Self, &'static mut OneCallTable<Self::Layout>),
+        (FlexCanHw<Self::Regs, FullInSlot<Self::Layout>>, Error),
+    >;
 }
+
+/// What a [`Spare`] keeps: the token and its module's filter table.
+type Kept<M> = (M, &'static mut OneCallTable<<M as Module>::Layout>);
 
 /// Where a module's token and filter table wait between one calls: given back by the
 /// way back or by a failed one call (both are taken once: [`Module::take`],
 /// [`TableSlot::take`]).
-pub struct Spare<M>(Mutex<Cell<Option<(M, &'static mut FilterTable)>>>);
+pub struct Spare<M: Module>(Mutex<Cell<Option<Kept<M>>>>);
 
-impl<M> Spare<M> {
+impl<M: Module> Spare<M> {
     /// Empty.
     pub const fn new() -> Self {
         Spare(Mutex::new(Cell::new(None)))
     }
 
-    fn put(&self, kept: (M, &'static mut FilterTable)) {
+    fn put(&self, kept: Kept<M>) {
         critical_section::with(|cs| self.0.borrow(cs).set(Some(kept)));
     }
 
-    fn take(&self) -> Option<(M, &'static mut FilterTable)> {
+    fn take(&self) -> Option<Kept<M>> {
         critical_section::with(|cs| self.0.borrow(cs).take())
     }
 
@@ -131,7 +151,7 @@ impl<M> Spare<M> {
     }
 }
 
-impl<M> Default for Spare<M> {
+impl<M: Module> Default for Spare<M> {
     fn default() -> Self {
         Self::new()
     }
@@ -147,15 +167,15 @@ impl<M> Default for Spare<M> {
 #[inline]
 pub fn start<M: Module>(
     spare: &Spare<M>,
-    table: &'static TableSlot,
-    state: &'static OneCallState<M::Regs>,
-    checked: &BeginPlan,
+    table: &'static TableSlot<OneCallTable<M::Layout>>,
+    state: &'static OneCallState<M::Regs, M::Layout>,
+    checked: &BeginPlan<M::Layout>,
     primary: &[Filter],
     secondary: &[Filter],
     nvic: &mut impl Nvic,
-) -> Result<AcanHalves<M::Regs>, OneCallError>
+) -> Result<AcanHalves<M::Regs, M::Layout>, OneCallError>
 where
-    OneCallState<M::Regs>: Sync,
+    OneCallState<M::Regs, M::Layout>: Sync,
 {
     let mut kept = spare.take().or_else(|| Some((M::take()?, table.take()?)));
     if kept.is_none() {
@@ -194,12 +214,12 @@ where
 #[allow(clippy::result_large_err, clippy::type_complexity)]
 pub fn end<M: Module>(
     spare: &Spare<M>,
-    state: &'static OneCallState<M::Regs>,
-    halves: AcanHalves<M::Regs>,
+    state: &'static OneCallState<M::Regs, M::Layout>,
+    halves: AcanHalves<M::Regs, M::Layout>,
     nvic: &mut impl Nvic,
-) -> Result<Leftovers, (OneCallError, Option<AcanHalves<M::Regs>>)>
+) -> Result<Leftovers, (OneCallError, Option<AcanHalves<M::Regs, M::Layout>>)>
 where
-    OneCallState<M::Regs>: Sync,
+    OneCallState<M::Regs, M::Layout>: Sync,
 {
     let (hw, left) = state
         .stop(halves.0, halves.1, nvic)
@@ -265,9 +285,10 @@ pub const fn default_settings(bit_rate: u32) -> Settings {
 /// base address.
 #[cfg(target_os = "none")]
 macro_rules! module {
-    ($token:ty) => {
+    ($token:ty, $layout:ty) => {
         impl Module for $token {
             type Regs = FlexCanRegs;
+            type Layout = $layout;
             const TARGET: Target = <$token>::TARGET;
 
             fn take() -> Option<Self> {
@@ -276,23 +297,23 @@ macro_rules! module {
 
             fn begin_in_place<'h>(
                 self,
-                hw: &'h mut MaybeUninit<FlexCanHw<FlexCanRegs, FullInSlot>>,
-                checked: &BeginPlan,
+                hw: &'h mut MaybeUninit<FlexCanHw<FlexCanRegs, FullInSlot<$layout>>>,
+                checked: &BeginPlan<$layout>,
                 primary: &[Filter],
                 secondary: &[Filter],
-                slot: &'static mut FilterTable,
+                slot: &'static mut OneCallTable<$layout>,
             ) -> Result<
-                &'h mut FlexCanHw<FlexCanRegs, FullInSlot>,
-                (Self, BeginError, &'static mut FilterTable),
+                &'h mut FlexCanHw<FlexCanRegs, FullInSlot<$layout>>,
+                (Self, BeginError, &'static mut OneCallTable<$layout>),
             > {
                 <$token>::begin_in_place(self, hw, checked, primary, secondary, slot)
             }
 
             fn end_split(
-                hw: FlexCanHw<FlexCanRegs, FullInSlot>,
+                hw: FlexCanHw<FlexCanRegs, FullInSlot<$layout>>,
             ) -> Result<
-                (Self, &'static mut FilterTable),
-                (FlexCanHw<FlexCanRegs, FullInSlot>, Error),
+                (Self, &'static mut OneCallTable<$layout>),
+                (FlexCanHw<FlexCanRegs, FullInSlot<$layout>>, Error),
             > {
                 <$token>::end_split(hw)
             }
@@ -304,27 +325,31 @@ macro_rules! module {
     target_os = "none",
     not(any(feature = "teensy40", feature = "teensy41"))
 ))]
-module!(crate::Can0);
+module!(crate::Can0, Kinetis);
 #[cfg(all(
     target_os = "none",
-    any(feature = "teensy36", feature = "teensy40", feature = "teensy41")
+    feature = "teensy36",
+    not(any(feature = "teensy40", feature = "teensy41"))
 ))]
-module!(crate::Can1);
+module!(crate::Can1, Kinetis);
+// The RT1062's modules: the RT1062 layout (its tables, the ERR005829 workaround).
 #[cfg(all(target_os = "none", any(feature = "teensy40", feature = "teensy41")))]
-module!(crate::Can2);
+module!(crate::Can1, Imxrt1062);
 #[cfg(all(target_os = "none", any(feature = "teensy40", feature = "teensy41")))]
-module!(crate::Can3);
+module!(crate::Can2, Imxrt1062);
+#[cfg(all(target_os = "none", any(feature = "teensy40", feature = "teensy41")))]
+module!(crate::Can3, Imxrt1062);
 
 /// Defines the one call and its way back for one module.
 macro_rules! one_call {
-    ($(#[$m:meta])* $token:ident, $state:ident, $table:ident, $spare:ident, $start:ident, $start_with:ident, $start_checked:ident, $end:ident, $name:literal) => {
+    ($(#[$m:meta])* $token:ident, $layout:ty, $state:ident, $table:ident, $spare:ident, $start:ident, $start_with:ident, $start_checked:ident, $end:ident, $name:literal) => {
         $(#[$m])*
-        #[doc = concat!("The module's state and interrupt handlers (ACAN's buffer sizes), used by [`", stringify!($start), "`].")]
-        pub static $state: OneCallState = OneCallState::new();
+        #[doc = concat!("The module's state and interrupt handlers (ACAN's buffer sizes, the layout `", stringify!($layout), "`), used by [`", stringify!($start), "`].")]
+        pub static $state: OneCallState<FlexCanRegs, $layout> = OneCallState::new();
 
         $(#[$m])*
         #[cfg(target_os = "none")]
-        static $table: TableSlot = TableSlot::new();
+        static $table: TableSlot<OneCallTable<$layout>> = TableSlot::new_sized();
 
         $(#[$m])*
         #[cfg(target_os = "none")]
@@ -339,7 +364,7 @@ macro_rules! one_call {
         pub fn $start(
             bit_rate: u32,
             nvic: &mut impl Nvic,
-        ) -> Result<AcanHalves, OneCallError> {
+        ) -> Result<AcanHalves<FlexCanRegs, $layout>, OneCallError> {
             $start_with(&default_settings(bit_rate), &[Filter::pass_all()], &[], nvic)
         }
 
@@ -350,7 +375,7 @@ macro_rules! one_call {
             primary: &[Filter],
             secondary: &[Filter],
             nvic: &mut impl Nvic,
-        ) -> Result<AcanHalves, OneCallError> {
+        ) -> Result<AcanHalves<FlexCanRegs, $layout>, OneCallError> {
             #[cfg(not(target_os = "none"))]
             {
                 let _ = (settings, primary, secondary, nvic);
@@ -360,21 +385,24 @@ macro_rules! one_call {
             {
                 // The settings checked first (ACAN table 5), before the state lends its
                 // storage.
-                let checked =
-                    BeginPlan::new(crate::$token::TARGET, settings, settings.configuration)
-                        .map_err(OneCallError::Begin)?;
+                let checked = BeginPlan::<$layout>::new_with_layout(
+                    crate::$token::TARGET,
+                    settings,
+                    settings.configuration,
+                )
+                .map_err(OneCallError::Begin)?;
                 $start_checked(&checked, primary, secondary, nvic)
             }
         }
 
         $(#[$m])*
-        #[doc = concat!("[`", stringify!($start_with), "`] with the settings checked beforehand: a `BeginPlan` for `", stringify!($token), "::TARGET`, `const` for `const` settings (no check of the settings runs then, and the configuration's stack is the smallest). A plan for another module is `Begin(Hardware(InvalidArgument))`.")]
+        #[doc = concat!("[`", stringify!($start_with), "`] with the settings checked beforehand: a `BeginPlan<", stringify!($layout), ">` for `", stringify!($token), "::TARGET` (`BeginPlan::new_with_layout`), `const` for `const` settings (no check of the settings runs then, and the configuration's stack is the smallest). A plan for another module is `Begin(Hardware(InvalidArgument))`.")]
         pub fn $start_checked(
-            checked: &BeginPlan,
+            checked: &BeginPlan<$layout>,
             primary: &[Filter],
             secondary: &[Filter],
             nvic: &mut impl Nvic,
-        ) -> Result<AcanHalves, OneCallError> {
+        ) -> Result<AcanHalves<FlexCanRegs, $layout>, OneCallError> {
             #[cfg(not(target_os = "none"))]
             {
                 let _ = (checked, primary, secondary, nvic);
@@ -394,9 +422,9 @@ macro_rules! one_call {
         /// error the halves come back when the driver still runs.
         #[allow(clippy::result_large_err)]
         pub fn $end(
-            halves: AcanHalves,
+            halves: AcanHalves<FlexCanRegs, $layout>,
             nvic: &mut impl Nvic,
-        ) -> Result<Leftovers, (OneCallError, Option<AcanHalves>)> {
+        ) -> Result<Leftovers, (OneCallError, Option<AcanHalves<FlexCanRegs, $layout>>)> {
             #[cfg(not(target_os = "none"))]
             {
                 let _ = nvic;
@@ -413,6 +441,7 @@ macro_rules! one_call {
 one_call!(
     #[cfg(not(any(feature = "teensy40", feature = "teensy41")))]
     Can0,
+    Kinetis,
     CAN0,
     TABLE0,
     SPARE0,
@@ -423,8 +452,25 @@ one_call!(
     "can0"
 );
 one_call!(
-    #[cfg(any(feature = "teensy36", feature = "teensy40", feature = "teensy41"))]
+    #[cfg(all(
+        feature = "teensy36",
+        not(any(feature = "teensy40", feature = "teensy41"))
+    ))]
     Can1,
+    Kinetis,
+    CAN1,
+    TABLE1,
+    SPARE1,
+    can1,
+    can1_with,
+    can1_checked,
+    end_can1,
+    "can1"
+);
+one_call!(
+    #[cfg(any(feature = "teensy40", feature = "teensy41"))]
+    Can1,
+    Imxrt1062,
     CAN1,
     TABLE1,
     SPARE1,
@@ -437,6 +483,7 @@ one_call!(
 one_call!(
     #[cfg(any(feature = "teensy40", feature = "teensy41"))]
     Can2,
+    Imxrt1062,
     CAN2,
     TABLE2,
     SPARE2,
@@ -449,6 +496,7 @@ one_call!(
 one_call!(
     #[cfg(any(feature = "teensy40", feature = "teensy41"))]
     Can3,
+    Imxrt1062,
     CAN3,
     TABLE3,
     SPARE3,

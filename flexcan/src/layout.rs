@@ -174,6 +174,25 @@ pub const fn accepted_rffn(layout_max: u8, chip: Chip) -> u8 {
     }
 }
 
+/// The layout of the board the crate is built for: [`Imxrt1062`] with the feature
+/// `teensy40` or `teensy41` (so that a Teensy 4 firmware gets the RT1062's tables and
+/// the ERR005829 workaround, [`Layout::E5829`], without naming a layout), [`Kinetis`]
+/// otherwise (the Teensy 3.x, and the host without a board feature). The precedence of
+/// the board features is the crate's ("Board features"): a Teensy 4 feature wins. What
+/// the one calls ([`crate::acan`]), `rt::AcanState` and the Teensy 4 tokens' `begin`
+/// use; `Full`, `FullInSlot`, `Lean` and `FlexCan` keep [`Kinetis`] as their default.
+#[cfg(any(feature = "teensy40", feature = "teensy41"))]
+pub type BoardLayout = Imxrt1062;
+/// The layout of the board the crate is built for: [`Imxrt1062`] with the feature
+/// `teensy40` or `teensy41` (so that a Teensy 4 firmware gets the RT1062's tables and
+/// the ERR005829 workaround, [`Layout::E5829`], without naming a layout), [`Kinetis`]
+/// otherwise (the Teensy 3.x, and the host without a board feature). The precedence of
+/// the board features is the crate's ("Board features"): a Teensy 4 feature wins. What
+/// the one calls ([`crate::acan`]), `rt::AcanState` and the Teensy 4 tokens' `begin`
+/// use; `Full`, `FullInSlot`, `Lean` and `FlexCan` keep [`Kinetis`] as their default.
+#[cfg(not(any(feature = "teensy40", feature = "teensy41")))]
+pub type BoardLayout = Kinetis;
+
 /// ACAN's layout, MB0–MB15 (the default): every chip.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Kinetis {}
@@ -202,6 +221,19 @@ impl Layout for Imxrt1062 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_board_layout_and_window_follow_the_board_feature() {
+        let teensy4 = cfg!(any(feature = "teensy40", feature = "teensy41"));
+        // The RT1062 layout (ERR005829 workaround, RFFN up to 0xF) on a Teensy 4 only.
+        assert_eq!(BoardLayout::E5829, teensy4);
+        assert_eq!(BoardLayout::MAX_RFFN, if teensy4 { 0xF } else { 3 });
+        // Its window reaches the individual masks beyond the Kinetis block.
+        let (imxrt, kinetis) = (crate::regs::IMXRT_BLOCK_END, crate::regs::BLOCK_END);
+        let expected = if teensy4 { imxrt } else { kinetis };
+        assert_eq!(crate::regs::BOARD_BLOCK_END, expected);
+        assert_eq!(crate::regs::rximr(64), imxrt);
+    }
 
     #[test]
     fn layouts_hold_their_largest_table() {

@@ -76,11 +76,17 @@
 //! pins 22/23, CAN2 on 1/0, CAN3 on 31/30), the settings name the CCM clock root
 //! (`Settings::with_clock(rate, CanClock::IMXRT_24MHZ)`), and with `rt` the entry points
 //! are `CAN1`, `CAN2`, `CAN3` (`rt_imxrt`), one line per module. The message-buffer
-//! layout is a type parameter ([`layout`]): the default, [`layout::Kinetis`], keeps ACAN's
-//! four configurations in MB0–MB15 on both families; [`layout::Imxrt1062`] takes the
-//! RT1062's Rx FIFO tables up to 128 elements (32 primary and 96 secondary filters,
-//! [`FlexCan::begin_with_layout`], [`LargeFilterTable`]), at no cost to a Teensy 3.x
-//! firmware.
+//! layout is a type parameter ([`layout`]): [`layout::Kinetis`], the generic default,
+//! keeps ACAN's four configurations in MB0–MB15 on both families; [`layout::Imxrt1062`]
+//! takes the RT1062's Rx FIFO tables up to 128 elements (32 primary and 96 secondary
+//! filters, [`FlexCan::begin_with_layout`], [`LargeFilterTable`]) and works around the
+//! chip's erratum ERR005829 ([`layout::Layout::E5829`]), at no cost to a Teensy 3.x
+//! firmware. The Teensy 4 paths use [`layout::Imxrt1062`] without being asked
+//! ([`layout::BoardLayout`]): the one calls `acan::can1`..`can3`, `Can1::begin` (a
+//! `FlexCan<FlexCanRegs, Imxrt1062>`), `begin_on`, the `imxrt-ral` hand-over and
+//! `rt::AcanState`; a state for the in-place forms names it, e.g.
+//! `rt::IrqState<FlexCanRegs, 32, FifoQueue<16>, 8, options::FullInSlot<Imxrt1062>>` with a
+//! `TableSlot::<LargeFilterTable>::new_sized()` and a `BeginPlan::<Imxrt1062>`.
 //!
 //! So `teensy32` + `teensy36` builds for a Teensy 3.6: firmware for a Teensy 3.2 linked
 //! that way would drive the wrong pins. Check `Board::DEFAULT` (or `cargo tree -e

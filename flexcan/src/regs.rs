@@ -76,11 +76,38 @@ pub const CAN0_BASE: usize = 0x4002_4000;
 /// End of the module's registers (the last is `RXIMR15` at 0x8BC).
 pub const BLOCK_END: usize = 0x8C0;
 
-/// Volatile access to one FlexCAN module's registers (offsets `0..BLOCK_END`).
-pub type FlexCanRegs = twocan_core::Mmio<BLOCK_END>;
+/// End of an i.MX RT1062 module's registers as the driver uses them: `RXIMR0`–`RXIMR63`
+/// at 0x880–0x97C (IMXRT1060RM, FlexCAN memory map; 64 message buffers, so 64 individual
+/// masks, of which the RT1062 layout writes those of its up to 32 primary filters and
+/// of its transmit mailboxes, up to MB46). The glitch filter register beyond
+/// (`GFWR`, 0x9E0) is not used.
+pub const IMXRT_BLOCK_END: usize = 0x980;
 
-/// Volatile access to the FlexCAN module whose registers start at `BASE`, an address
-/// known at compile time (offsets `0..BLOCK_END`, as [`FlexCanRegs`]): the value is
+/// The register window of the board's modules ([`FlexCanRegs`]): [`IMXRT_BLOCK_END`]
+/// with the feature `teensy40` or `teensy41` (the RT1062's `Can1`–`Can3`, whose
+/// layout, [`crate::layout::Imxrt1062`], writes `RXIMR16` and above), [`BLOCK_END`]
+/// otherwise (the Kinetis modules).
+#[cfg(any(feature = "teensy40", feature = "teensy41"))]
+pub const BOARD_BLOCK_END: usize = IMXRT_BLOCK_END;
+/// The register window of the board's modules ([`FlexCanRegs`]): [`IMXRT_BLOCK_END`]
+/// with the feature `teensy40` or `teensy41`, [`BLOCK_END`] otherwise (the Kinetis
+/// modules).
+#[cfg(not(any(feature = "teensy40", feature = "teensy41")))]
+pub const BOARD_BLOCK_END: usize = BLOCK_END;
+
+/// Volatile access to one FlexCAN module's registers (offsets `0..BOARD_BLOCK_END`: the
+/// Kinetis block, or with a Teensy 4 feature the RT1062's, whose `RXIMR16`–`RXIMR63`
+/// lie beyond the Kinetis one). An access outside the window is dropped (a read gives
+/// 0; debug builds assert), so the window must cover every register the board's
+/// layout writes.
+pub type FlexCanRegs = twocan_core::Mmio<BOARD_BLOCK_END>;
+
+/// The Kinetis module's window (`0..BLOCK_END`), whatever the board feature.
+type KinetisRegs = twocan_core::Mmio<BLOCK_END>;
+
+/// Volatile access to the Kinetis FlexCAN module whose registers start at `BASE`, an
+/// address known at compile time (offsets `0..BLOCK_END`, as [`FlexCanRegs`] on a
+/// Teensy 3.x): the value is
 /// empty and every access is one load or store at `BASE + offset`, without reading a
 /// base address first. The window check of [`twocan_core::Mmio`] stays: an offset
 /// outside the module's registers reads 0 and writes nothing (a `debug_assert` in
@@ -116,7 +143,7 @@ impl<const BASE: usize> FlexCanAt<BASE> {
 impl<const BASE: usize> twocan_core::Registers for FlexCanAt<BASE> {
     #[inline(always)]
     fn read32(&self, offset: usize) -> u32 {
-        if !FlexCanRegs::owns(offset) {
+        if !KinetisRegs::owns(offset) {
             debug_assert!(
                 false,
                 "register offset {offset:#x} outside 0..{BLOCK_END:#x}"
@@ -130,7 +157,7 @@ impl<const BASE: usize> twocan_core::Registers for FlexCanAt<BASE> {
 
     #[inline(always)]
     fn write32(&self, offset: usize, value: u32) {
-        if !FlexCanRegs::owns(offset) {
+        if !KinetisRegs::owns(offset) {
             debug_assert!(
                 false,
                 "register offset {offset:#x} outside 0..{BLOCK_END:#x}"

@@ -269,8 +269,16 @@ pub struct IrqState<
 }
 
 /// ACAN's buffer sizes (receive 32, transmit 16, table 7) on the target registers, with
-/// 8 completions.
-pub type AcanState = IrqState<FlexCanRegs, RECEIVE_BUFFER_SIZE, FifoQueue<TRANSMIT_BUFFER_SIZE>, 8>;
+/// 8 completions, for the controller of the board's token (`begin(...).into_split()`):
+/// its layout is the board's ([`crate::layout::BoardLayout`]: the RT1062 layout, with
+/// the ERR005829 workaround, on a Teensy 4; ACAN's MB0–MB15 on a Teensy 3.x).
+pub type AcanState = IrqState<
+    FlexCanRegs,
+    RECEIVE_BUFFER_SIZE,
+    FifoQueue<TRANSMIT_BUFFER_SIZE>,
+    8,
+    Full<crate::layout::BoardLayout>,
+>;
 
 /// Why [`IrqState::start`] did not start; the controller comes back with it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -5,9 +5,15 @@
 //! registers.
 //!
 //! The token here is the test's own [`acan::Module`]: taken once, it begins CAN1 of a
-//! Teensy 4.1 over the RT1062 model (64 message buffers) and ends back into a token. The
-//! NVIC records its calls; the "interrupt" is the exported `CAN1` entry point, run
-//! whenever the model raises its line.
+//! Teensy 4.1 over the RT1062 model (64 message buffers) in the RT1062 layout, as the
+//! board's `Can1` does, and ends back into a token. The NVIC records its calls; the
+//! "interrupt" is the exported `CAN1` entry point, run whenever the model raises its
+//! line. The registers record every write, so that the ERR005829 workaround of the
+//! RT1062 layout shows (`driver_rt1062_e5829.rs` tests it for every configuration): the
+//! reserved mailbox after the Rx FIFO area reads INACTIVE and is masked, and each
+//! transmit activation is followed by two INACTIVE writes into it. The board's one
+//! calls are checked to be typed in that layout (a one call back on the Kinetis layout
+//! does not compile here).
 //!
 //! One test function: the entry points' slots are process-wide, and the model (`Rc`, one
 //! thread) is shared with the "interrupt" side only on this thread.
@@ -19,19 +25,20 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 use twocan_core::{Error, Filter, Frame, Registers, TxOutcome};
 use twocan_flexcan::acan::{self, Module, OneCallError, Spare};
-use twocan_flexcan::filters::{FilterTable, TableSlot};
+use twocan_flexcan::filters::TableSlot;
+use twocan_flexcan::layout::{BoardLayout, Imxrt1062, LargeFilterTable, Layout};
 use twocan_flexcan::model::FlexCanModel;
-use twocan_flexcan::options::FullInSlot;
-use twocan_flexcan::regs::{self, mcr};
+use twocan_flexcan::options::{Full, FullInSlot};
+use twocan_flexcan::regs::{self, code, cs, mcr, FlexCanRegs};
 use twocan_flexcan::rt::{self, IrqNumber, Nvic, StartError};
 use twocan_flexcan::{
-    rt_imxrt, BeginError, BeginPlan, Board, ConfigErrors, FlexCan, FlexCanHw, HostSystem,
-    IdleClocked, Instance, Settings, Target,
+    rt_imxrt, BeginError, BeginPlan, Board, ConfigErrors, Configuration, FlexCan, FlexCanHw,
+    HostSystem, IdleClocked, Instance, Settings, Target,
 };
 use twocan_sim::Bus;
 
 /// The model's registers, declared shareable between "contexts" that are all this
-/// test's one thread.
+/// test's one thread; every write is recorded in [`WRITES`].
 struct OneThread(IdleClocked);
 
 // SAFETY: the registers (an `Rc` model) are reached only from the thread that runs the
@@ -45,6 +52,7 @@ impl Registers for OneThread {
         self.0.read32(offset)
     }
     fn write32(&self, offset: usize, value: u32) {
+        WRITES.with(|w| w.borrow_mut().push((offset, value)));
         self.0.write32(offset, value)
     }
 }
@@ -54,6 +62,8 @@ const TARGET: Target = Target::new(Board::Teensy41, Instance::Can1);
 thread_local! {
     /// The module the test's token owns.
     static MODEL: RefCell<Option<FlexCanModel>> = const { RefCell::new(None) };
+    /// The register writes of the module, in order (offset, value).
+    static WRITES: RefCell<Vec<(usize, u32)>> = const { RefCell::new(Vec::new()) };
 }
 static TAKEN: AtomicBool = AtomicBool::new(false);
 
@@ -62,6 +72,8 @@ struct HostCan1(FlexCanModel);
 
 impl Module for HostCan1 {
     type Regs = OneThread;
+    // As the board's `Can1`.
+    type Layout = Imxrt1062;
     const TARGET: Target = TARGET;
 
     fn take() -> Option<Self> {
@@ -73,14 +85,14 @@ impl Module for HostCan1 {
 
     fn begin_in_place<'h>(
         self,
-        hw: &'h mut MaybeUninit<FlexCanHw<OneThread, FullInSlot>>,
-        checked: &BeginPlan,
+        hw: &'h mut MaybeUninit<FlexCanHw<OneThread, FullInSlot<Imxrt1062>>>,
+        checked: &BeginPlan<Imxrt1062>,
         primary: &[Filter],
         secondary: &[Filter],
-        slot: &'static mut FilterTable,
+        slot: &'static mut LargeFilterTable,
     ) -> Result<
-        &'h mut FlexCanHw<OneThread, FullInSlot>,
-        (Self, BeginError, &'static mut FilterTable),
+        &'h mut FlexCanHw<OneThread, FullInSlot<Imxrt1062>>,
+        (Self, BeginError, &'static mut LargeFilterTable),
     > {
         let regs = OneThread(IdleClocked::new(self.0.clone()));
         FlexCan::begin_in_place(
@@ -95,9 +107,13 @@ impl Module for HostCan1 {
         .map_err(|(e, slot)| (self, e, slot))
     }
 
+    #[allow(clippy::type_complexity)]
     fn end_split(
-        hw: FlexCanHw<OneThread, FullInSlot>,
-    ) -> Result<(Self, &'static mut FilterTable), (FlexCanHw<OneThread, FullInSlot>, Error)> {
+        hw: FlexCanHw<OneThread, FullInSlot<Imxrt1062>>,
+    ) -> Result<
+        (Self, &'static mut LargeFilterTable),
+        (FlexCanHw<OneThread, FullInSlot<Imxrt1062>>, Error),
+    > {
         if hw.target() != TARGET {
             return Err((hw, Error::InvalidArgument));
         }
@@ -106,8 +122,9 @@ impl Module for HostCan1 {
     }
 }
 
-/// CAN1's filter table, which the one call's `begin` compiles into.
-static TABLE: TableSlot = TableSlot::new();
+/// CAN1's filter table, which the one call's `begin` compiles into (the RT1062
+/// layout's, 128 elements).
+static TABLE: TableSlot<LargeFilterTable> = TableSlot::new_sized();
 
 /// The one call with `settings` checked first, as the board's `can1_with` does.
 fn start(
@@ -118,8 +135,8 @@ fn start(
     secondary: &[Filter],
     nvic: &mut Recorder,
 ) -> Result<acan::AcanHalves<OneThread>, OneCallError> {
-    let checked =
-        BeginPlan::new(TARGET, settings, settings.configuration).map_err(OneCallError::Begin)?;
+    let checked = BeginPlan::<Imxrt1062>::new_with_layout(TARGET, settings, settings.configuration)
+        .map_err(OneCallError::Begin)?;
     acan::start(spare, &TABLE, state, &checked, primary, secondary, nvic)
 }
 
@@ -145,6 +162,8 @@ impl Nvic for Recorder {
     }
 }
 
+/// The one call's state over the test's registers, in the board's layout (the
+/// default of `OneCallState`), which the first test checks is the RT1062's.
 type State = acan::OneCallState<OneThread>;
 
 /// Runs the bus for `bits`, entering `CAN1` whenever the model raises its line.
@@ -176,9 +195,114 @@ fn disabled(model: &FlexCanModel) -> bool {
     model.read32(regs::MCR) & mcr::MDIS != 0
 }
 
+/// The message buffer and word (0 = C/S) a register offset belongs to.
+fn mb_word(offset: usize) -> Option<(usize, usize)> {
+    let first = regs::mb_cs(0);
+    (first..regs::mb_cs(64))
+        .contains(&offset)
+        .then(|| ((offset - first) / 16, (offset - first) % 16 / 4))
+}
+
+/// ERR005829 with the RT1062 layout, right after the one call's `begin`: the first
+/// mailbox after the Rx FIFO area of the settings' configuration reads INACTIVE (over
+/// the garbage the RAM held), has no interrupt mask bit, and lies inside `MCR[MAXMB]`,
+/// whose value is the data mailbox after it (the Kinetis layout: that mailbox is a
+/// remote-frame one, unmasked, and `MAXMB` 15).
+fn assert_reserved_mailbox(model: &FlexCanModel, settings: &Settings) -> usize {
+    let c = settings.configuration;
+    let reserved = usize::from(c.reserved_mailbox());
+    assert_eq!(reserved, regs::rx_fifo_occupied_mbs(u32::from(c.rffn())));
+    assert_eq!(Imxrt1062::reserved_mailbox(c), Some(c.reserved_mailbox()));
+    assert_eq!(
+        cs::CODE.get(model.read32(regs::mb_cs(reserved))),
+        code::TX_INACTIVE,
+        "MB{reserved} INACTIVE"
+    );
+    assert_eq!(
+        model.read32(regs::IMASK1) & 1 << reserved,
+        0,
+        "MB{reserved} masked"
+    );
+    let data = usize::from(Imxrt1062::data_mailbox(c));
+    assert_eq!(mcr::MAXMB.get(model.read32(regs::MCR)) as usize, data);
+    assert!(reserved < data);
+    reserved
+}
+
+/// ERR005829 with the RT1062 layout, over the writes since `WRITES` was cleared: each
+/// write of code DATA into a transmit mailbox's C/S word (`tx`) is followed at once by
+/// exactly two INACTIVE writes into the reserved mailbox's C/S word, and nothing else
+/// reaches the reserved mailbox. Returns the number of activations.
+fn assert_two_inactive_writes(reserved: usize, tx: core::ops::RangeInclusive<usize>) -> usize {
+    let log = WRITES.with(|w| w.borrow().clone());
+    let inactive = (regs::mb_cs(reserved), cs::CODE.val(code::TX_INACTIVE));
+    let mut activations = 0;
+    for (i, &(offset, value)) in log.iter().enumerate() {
+        if matches!(mb_word(offset), Some((mb, 0)) if tx.contains(&mb))
+            && cs::CODE.get(value) == code::TX_DATA
+        {
+            activations += 1;
+            assert_eq!(
+                log.get(i + 1..i + 3),
+                Some(&[inactive, inactive][..]),
+                "two INACTIVE writes after write {i}"
+            );
+            assert_ne!(log.get(i + 3).map(|w| w.0), Some(inactive.0), "exactly two");
+        }
+    }
+    let to_reserved = log
+        .iter()
+        .filter(|(o, _)| mb_word(*o).map(|w| w.0) == Some(reserved))
+        .inspect(|w| assert_eq!(**w, inactive, "only INACTIVE reaches MB{reserved}"))
+        .count();
+    assert_eq!(to_reserved, 2 * activations);
+    activations
+}
+
+/// The board's one calls, their states and `rt::AcanState` are typed in the RT1062
+/// layout: these bindings do not compile if any of them is back on `Kinetis`. On the
+/// host the calls touch nothing.
+#[test]
+fn the_board_s_one_calls_are_in_the_rt1062_layout() {
+    let _: &'static acan::OneCallState<FlexCanRegs, Imxrt1062> = &acan::CAN1;
+    let _: &'static acan::OneCallState<FlexCanRegs, Imxrt1062> = &acan::CAN2;
+    let _: &'static acan::OneCallState<FlexCanRegs, Imxrt1062> = &acan::CAN3;
+    type Checked = fn(
+        &BeginPlan<Imxrt1062>,
+        &[Filter],
+        &[Filter],
+        &mut Recorder,
+    ) -> Result<acan::AcanHalves<FlexCanRegs, Imxrt1062>, OneCallError>;
+    let checked: [Checked; 3] = [acan::can1_checked, acan::can2_checked, acan::can3_checked];
+    let state = rt::AcanState::new();
+    let _: &rt::IrqState<FlexCanRegs, 32, twocan_core::FifoQueue<16>, 8, Full<Imxrt1062>> = &state;
+    // The board's layout is the RT1062's: the workaround and the larger tables.
+    let (e5829, max_rffn) = (BoardLayout::E5829, BoardLayout::MAX_RFFN);
+    assert_eq!((e5829, max_rffn), (true, 0xF));
+    // A configuration only the RT1062 layout takes: the plan the `*_checked` calls
+    // take is made, and on the host the call returns before touching anything.
+    let mut large = loop_back();
+    large.configuration = Configuration::Filters32_96;
+    for (call, instance) in
+        checked
+            .into_iter()
+            .zip([Instance::Can1, Instance::Can2, Instance::Can3])
+    {
+        let target = Target::new(Board::DEFAULT, instance);
+        let plan = BeginPlan::<Imxrt1062>::new_with_layout(target, &large, large.configuration)
+            .unwrap_or_else(|e| panic!("{e:?}"));
+        assert_eq!(
+            call(&plan, &[], &[], &mut Recorder::default()).map(|_| ()),
+            Err(OneCallError::NotOnTarget)
+        );
+    }
+}
+
 #[test]
 fn the_one_call_starts_runs_ends_and_starts_again() {
     let model = FlexCanModel::new(TARGET.model_chip());
+    // Garbage in the message-buffer RAM: what reads INACTIVE below, `begin` wrote.
+    model.scramble_ram(0x000E_5829);
     MODEL.with(|m| *m.borrow_mut() = Some(model.clone()));
     let mut bus = Bus::new(500_000).unwrap();
     bus.attach("can1", model.clone());
@@ -207,14 +331,33 @@ fn the_one_call_starts_runs_ends_and_starts_again() {
     assert_eq!(state.installed(), [true, true]);
     assert!(!spare.holds());
 
+    // The RT1062 layout's ERR005829 reservation (RFFN 2 of the default settings:
+    // MB12 reserved, MB13–MB15 for remote frames, data MB16).
+    let c = loop_back().configuration;
+    let reserved = assert_reserved_mailbox(&model, &loop_back());
+    assert_eq!((reserved, Imxrt1062::data_mailbox(c)), (12, 16));
+    let tx_mailboxes =
+        usize::from(Imxrt1062::first_remote_mailbox(c))..=usize::from(Imxrt1062::data_mailbox(c));
+
     // Frames go round through the model and come back, in order, with their
     // completions in order.
+    WRITES.with(|w| w.borrow_mut().clear());
     let frames: Vec<Frame> = (0..5u8)
         .map(|i| Frame::standard(0x100 + u16::from(i), &[i; 3]).unwrap())
         .collect();
     let tokens: Vec<_> = frames.iter().map(|f| tx.try_send(f).unwrap()).collect();
     let entered = run(&mut bus, &model, 2_000);
     assert!(entered >= 5, "{entered} entries of CAN1");
+    // Each of the five frames activated a transmit mailbox once, each activation
+    // followed by the workaround's two INACTIVE writes.
+    assert_eq!(
+        assert_two_inactive_writes(reserved, tx_mailboxes.clone()),
+        5
+    );
+    assert_eq!(
+        cs::CODE.get(model.read32(regs::mb_cs(reserved))),
+        code::TX_INACTIVE
+    );
     let got: Vec<Frame> = std::iter::from_fn(|| rx.receive().ok())
         .map(|r| r.frame)
         .collect();
@@ -257,9 +400,13 @@ fn the_one_call_starts_runs_ends_and_starts_again() {
     .unwrap();
     assert_eq!(nvic.0, [Call::Priority(36, 64), Call::Unmask(36)]);
     assert!(!disabled(&model));
+    // Begun again: the reservation again, the two writes again.
+    assert_eq!(assert_reserved_mailbox(&model, &loop_back()), reserved);
+    WRITES.with(|w| w.borrow_mut().clear());
     tx.try_send(&frames[0]).unwrap();
     run(&mut bus, &model, 500);
     assert_eq!(rx.receive().unwrap().frame, frames[0]);
+    assert_eq!(assert_two_inactive_writes(reserved, tx_mailboxes), 1);
     acan::end(&spare, state, (tx, rx), &mut nvic)
         .map_err(|(e, _)| e)
         .unwrap();

@@ -5,11 +5,15 @@
 //!
 //! As in `rt_start.rs`, the registers are a small `Sync` register file that
 //! acknowledges the mode handshakes at once and clears `IFLAG1`/`ESR1` bits written 1.
+//! The controller is in the RT1062 layout, as the board's `Can2::begin` gives it and
+//! `rt::AcanState` holds it on a Teensy 4.
 #![cfg(all(feature = "rt", any(feature = "teensy40", feature = "teensy41")))]
 
 use std::sync::atomic::{AtomicU32, Ordering};
 
 use twocan_core::{Frame, Registers};
+use twocan_flexcan::layout::{BoardLayout, Imxrt1062};
+use twocan_flexcan::options::Full;
 use twocan_flexcan::regs::{self, cs, esr1, iflag1, mcr, ESR1, IFLAG1, MCR};
 use twocan_flexcan::rt::{self, IrqNumber, IrqState, Nvic};
 use twocan_flexcan::{rt_imxrt, Board, CanClock, FlexCan, HostSystem, Instance, Settings, Target};
@@ -66,17 +70,25 @@ impl Nvic for Recorder {
 #[test]
 fn can2_one_line_runs_every_handler() {
     let regs: &'static SyncRegs = Box::leak(Box::new(SyncRegs {
-        words: (0..regs::BLOCK_END / 4)
+        words: (0..regs::IMXRT_BLOCK_END / 4)
             .map(|_| AtomicU32::new(0))
             .collect(),
     }));
     let mut settings = Settings::with_clock(500_000, CanClock::IMXRT_24MHZ);
     settings.message_irq_priority = 0x40;
     let target = Target::new(Board::Teensy41, Instance::Can2);
-    let hw = FlexCan::begin(regs, &mut HostSystem::new(), target, &settings, &[], &[])
-        .expect("begin")
-        .into_split();
-    type Wired = IrqState<&'static SyncRegs, 32, twocan_core::FifoQueue<16>, 8>;
+    let hw = FlexCan::<_, Imxrt1062>::begin_with_layout(
+        regs,
+        &mut HostSystem::new(),
+        target,
+        &settings,
+        &[],
+        &[],
+    )
+    .expect("begin")
+    .into_split();
+    // `rt::AcanState`'s shape, over these registers: the board's layout is the RT1062's.
+    type Wired = IrqState<&'static SyncRegs, 32, twocan_core::FifoQueue<16>, 8, Full<BoardLayout>>;
     let state: &'static Wired = Box::leak(Box::new(Wired::new()));
     let mut nvic = Recorder::default();
     let (_tx, mut rx) = state.start(hw, &mut nvic).map_err(|(e, _)| e).unwrap();
@@ -86,6 +98,11 @@ fn can2_one_line_runs_every_handler() {
         "CAN2's one line, once"
     );
     assert!(rt::is_wired(Instance::Can2));
+    // The ERR005829 reserved mailbox (MB12 at the default RFFN 2) has no mask bit; the
+    // transmit mailboxes after it (MB13–MB16) have theirs.
+    assert_eq!(regs.read32(regs::IMASK1) & 1 << 12, 0);
+    assert_eq!(regs.read32(regs::IMASK1) & 0xF << 13, 0xF << 13);
+    assert_eq!(mcr::MAXMB.get(regs.read32(MCR)), 16);
 
     // A frame at the Rx FIFO output and a bus error at once: the one entry point
     // takes both.

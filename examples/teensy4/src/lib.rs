@@ -10,8 +10,10 @@
 //!   `set-vtor`) moves VTOR to this image's table.
 //!
 //! The clocks stay as the boot ROM leaves them (core on PLL2 PFD2); the CAN clock root is
-//! set by `begin` (the 24 MHz oscillator, [`configs`]). The portable application, the
-//! time base and the log are the Teensy 3 examples' modules, included, not copied.
+//! set by `begin` (the 24 MHz oscillator, [`configs`]). Every example runs its modules in
+//! the RT1062 message-buffer layout (`twocan_flexcan::layout::Imxrt1062`: the ERR005829
+//! workaround; [`can`]). The portable application, the filter example's lists, the time
+//! base and the log are the Teensy 3 examples' modules, included, not copied.
 #![cfg_attr(not(test), no_std)]
 #![deny(missing_docs)]
 
@@ -28,7 +30,6 @@ compile_error!("choose one board feature only");
 use defmt_rtt as _;
 
 pub mod boot;
-#[path = "../../teensy/src/can.rs"]
 pub mod can;
 pub mod configs;
 #[path = "../../teensy/src/filters_example.rs"]

@@ -1,13 +1,21 @@
 //! Every Teensy 4 example's configuration passes `check` and the model's `begin` on the
-//! module it uses, on both boards: a configuration the driver refuses would otherwise
-//! only show on the board as `rt::HALT` = 5.
+//! module it uses, on both boards, in the layout the examples use (the RT1062's,
+//! `Imxrt1062`): a configuration the driver refuses would otherwise only show on the
+//! board as `rt::HALT` = 5.
 
 use twocan_app::App;
-use twocan_core::Filter;
+use twocan_core::{Filter, Registers};
+use twocan_flexcan::begin::check_with_layout;
+use twocan_flexcan::layout::{Imxrt1062, LargeFilterTable, Layout};
 use twocan_flexcan::model::FlexCanModel;
+use twocan_flexcan::options::FullInSlot;
+use twocan_flexcan::regs::{self, FlexCanRegs};
+use twocan_flexcan::rt::IrqState;
 use twocan_flexcan::{
-    check, Board, ConfigErrors, FlexCan, HostSystem, IdleClocked, Instance, Settings, Target,
+    check, BeginPlan, Board, ConfigErrors, FlexCan, HostSystem, IdleClocked, Instance, Settings,
+    Target,
 };
+use twocan_teensy4::can::{self, CanState};
 use twocan_teensy4::configs::{self, APP_NODES, CAN1_CAN2_NODES};
 use twocan_teensy4::filters_example;
 
@@ -70,13 +78,18 @@ fn every_example_configuration_passes_check_and_begin_on_both_boards() {
         for (name, instance, settings, primary, secondary) in examples() {
             let target = Target::new(board, instance);
             assert_eq!(
-                check(target, &settings, &primary, &secondary),
+                check_with_layout::<Imxrt1062>(target, &settings, &primary, &secondary),
                 ConfigErrors::NONE,
                 "{name} on {board:?}"
             );
+            assert!(
+                BeginPlan::<Imxrt1062>::new_with_layout(target, &settings, settings.configuration)
+                    .is_ok(),
+                "{name} on {board:?}"
+            );
             let model = FlexCanModel::new(target.model_chip());
-            let began = FlexCan::begin(
-                IdleClocked::new(model),
+            let began = FlexCan::<_, Imxrt1062>::begin_with_layout(
+                IdleClocked::new(model.clone()),
                 &mut HostSystem::new(),
                 target,
                 &settings,
@@ -84,6 +97,19 @@ fn every_example_configuration_passes_check_and_begin_on_both_boards() {
                 &secondary,
             );
             assert!(began.is_ok(), "{name} on {board:?}: {:?}", began.err());
+            // The RT1062 layout: the ERR005829 reserved mailbox, the data mailbox after
+            // it is `MCR[MAXMB]`.
+            let c = settings.configuration;
+            assert_eq!(
+                regs::mcr::MAXMB.get(model.read32(regs::MCR)),
+                u32::from(Imxrt1062::data_mailbox(c)),
+                "{name}"
+            );
+            assert_eq!(
+                model.read32(regs::IMASK1) & 1 << c.reserved_mailbox(),
+                0,
+                "{name}"
+            );
             assert_eq!(
                 settings.actual_bit_rate(),
                 settings.wished_bit_rate(),
@@ -93,6 +119,22 @@ fn every_example_configuration_passes_check_and_begin_on_both_boards() {
         }
     }
     assert_eq!(ran, 2 * 7);
+}
+
+/// The examples' state and table are the RT1062 layout's: these bindings do not compile
+/// if `twocan_teensy4::can` goes back to ACAN's layout.
+#[test]
+fn the_examples_types_are_in_the_rt1062_layout() {
+    let state = CanState::new();
+    let _: &IrqState<
+        FlexCanRegs,
+        { twocan_flexcan::RECEIVE_BUFFER_SIZE },
+        can::Queue,
+        { can::COMPLETIONS },
+        FullInSlot<Imxrt1062>,
+    > = &state;
+    let slot = can::TableSlot::new_sized();
+    let _: &twocan_flexcan::filters::TableSlot<LargeFilterTable> = &slot;
 }
 
 #[test]

@@ -1,11 +1,15 @@
 //! `begin` and `end` of the Teensy 4.x tokens on the target (`Can1`, `Can2`, `Can3`):
-//! the module at its base address, the CCM and IOMUXC by absolute address.
+//! the module at its base address, the CCM and IOMUXC by absolute address. The
+//! controller is in the RT1062 layout ([`Imxrt1062`]: the ERR005829 workaround, tables
+//! up to RFFN 0xF); the in-place and planned forms (`begin_in`, `begin_in_place`,
+//! `begin_planned`) take the layout of the options the caller's state names.
 
 use twocan_core::{Error, Filter};
 
 use crate::begin_error::BeginError;
 use crate::controller::FlexCan;
 use crate::instance::{Can1, Can2, Can3};
+use crate::layout::Imxrt1062;
 use crate::regs::FlexCanRegs;
 use crate::settings::Settings;
 
@@ -26,13 +30,15 @@ macro_rules! begin_end {
     ($token:ident, $name:literal) => {
         impl $token {
             #[doc = concat!("Configures ", $name, " (ACAN `begin`, §15): clock root, gates, pads, then the")]
-            /// module; gives the controller, or the token back with the reason.
+            /// module, in the RT1062 layout ([`Imxrt1062`]: the ERR005829 reserved
+            /// mailbox, `settings.configuration` up to `Filters32_96`); gives the
+            /// controller, or the token back with the reason.
             pub fn begin(
                 self,
                 settings: &Settings,
                 primary: &[Filter],
                 secondary: &[Filter],
-            ) -> Result<FlexCan<FlexCanRegs>, (Self, BeginError)> {
+            ) -> Result<FlexCan<FlexCanRegs, Imxrt1062>, (Self, BeginError)> {
                 let target = self.target();
                 let Some(base) = target.base() else {
                     return Err((self, BeginError::Config(crate::ConfigErrors::NO_SUCH_INSTANCE)));
@@ -40,8 +46,15 @@ macro_rules! begin_end {
                 // SAFETY: the token is unique (taken once) and consumed here, so this
                 // is the only access to the module, at its reference-manual base.
                 let regs = unsafe { FlexCanRegs::new(base) };
-                FlexCan::begin(regs, &mut system(), target, settings, primary, secondary)
-                    .map_err(|e| (self, e))
+                FlexCan::<_, Imxrt1062>::begin_with_layout(
+                    regs,
+                    &mut system(),
+                    target,
+                    settings,
+                    primary,
+                    secondary,
+                )
+                .map_err(|e| (self, e))
             }
 
             #[doc = concat!("Stops ", $name, ", releases its pads and clock gates ([`FlexCan::end`]) and")]
@@ -49,8 +62,8 @@ macro_rules! begin_end {
             /// [`Error::InvalidArgument`]; either error gives the controller back.
             #[allow(clippy::result_large_err)]
             pub fn end(
-                controller: FlexCan<FlexCanRegs>,
-            ) -> Result<$token, (FlexCan<FlexCanRegs>, Error)> {
+                controller: FlexCan<FlexCanRegs, Imxrt1062>,
+            ) -> Result<$token, (FlexCan<FlexCanRegs, Imxrt1062>, Error)> {
                 if controller.target() != $token::returned().target() {
                     return Err((controller, Error::InvalidArgument));
                 }

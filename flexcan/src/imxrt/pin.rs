@@ -122,7 +122,8 @@ mod firmware {
     macro_rules! begin_on {
         ($token:ident) => {
             impl $token {
-                /// `begin` with the typed pins of this module.
+                /// `begin` with the typed pins of this module (the RT1062 layout,
+                /// [`crate::layout::Imxrt1062`], as `begin`).
                 pub fn begin_on<T: TxPin<$token>, X: RxPin<$token>>(
                     self,
                     tx: T,
@@ -130,7 +131,8 @@ mod firmware {
                     settings: &Settings,
                     primary: &[Filter],
                     secondary: &[Filter],
-                ) -> Result<FlexCan<FlexCanRegs>, (Self, BeginError)> {
+                ) -> Result<FlexCan<FlexCanRegs, crate::layout::Imxrt1062>, (Self, BeginError)>
+                {
                     self.begin(&settings_for(settings, tx, rx), primary, secondary)
                 }
             }

@@ -12,8 +12,9 @@
 //! ([`crate::imxrt::pads`]); the program must not give those pads to another function.
 //!
 //! - before `begin`, [`HandOver::free`] gives the instances back;
-//! - `HandOver::begin` configures the module as `Can1::begin` does and returns the
-//!   controller with a [`Parked`] value holding the instances;
+//! - `HandOver::begin` configures the module as `Can1::begin` does — in the RT1062
+//!   layout ([`Imxrt1062`]: the ERR005829 workaround, tables up to RFFN 0xF) — and
+//!   returns the controller with a [`Parked`] value holding the instances;
 //! - when the controller comes back (from [`crate::FlexCanHw::into_controller`] after
 //!   the driver, or unsplit), `Parked::free` ends it ([`crate::FlexCan::end`]: module
 //!   stopped, pads and gates released) and gives the instances back — only in exchange
@@ -34,6 +35,7 @@ use crate::begin_error::BeginError;
 use crate::board::Board;
 use crate::controller::FlexCan;
 use crate::instance::{Instance, Target};
+use crate::layout::Imxrt1062;
 use crate::settings::Settings;
 
 mod sealed {
@@ -70,6 +72,10 @@ ral_can!(ral::can3::CAN3, Can3);
 /// The CCM's RAL instance.
 pub type Ccm = ral::ccm::CCM;
 
+/// The controller a hand-over begins: the module in the RT1062 layout ([`Imxrt1062`]:
+/// the ERR005829 workaround, tables up to RFFN 0xF).
+pub type Controller<R = crate::regs::FlexCanRegs> = FlexCan<R, Imxrt1062>;
+
 /// A module handed over, not begun yet.
 pub struct HandOver<C: RalCan> {
     can: C,
@@ -102,7 +108,7 @@ impl<C: RalCan> HandOver<C> {
         settings: &Settings,
         primary: &[Filter],
         secondary: &[Filter],
-    ) -> Result<(FlexCan<crate::regs::FlexCanRegs>, Parked<C>), (Self, BeginError)> {
+    ) -> Result<(Controller, Parked<C>), (Self, BeginError)> {
         let Some(base) = self.target().base() else {
             return Err((
                 self,
@@ -125,7 +131,8 @@ impl<C: RalCan> HandOver<C> {
 
     /// `HandOver::begin` over `regs` for the module and `sys` for the CCM and
     /// IOMUXC (absolute offsets): on the host, the behavioural model and
-    /// [`crate::HostSystem`].
+    /// [`crate::HostSystem`]. The RT1062 layout, as `HandOver::begin`
+    /// ([`FlexCan::begin_with_layout`]).
     #[allow(clippy::result_large_err)]
     pub fn begin_over<R: Registers, S: Registers>(
         self,
@@ -134,8 +141,15 @@ impl<C: RalCan> HandOver<C> {
         settings: &Settings,
         primary: &[Filter],
         secondary: &[Filter],
-    ) -> Result<(FlexCan<R>, Parked<C>), (Self, BeginError)> {
-        match FlexCan::begin(regs, sys, self.target(), settings, primary, secondary) {
+    ) -> Result<(Controller<R>, Parked<C>), (Self, BeginError)> {
+        match FlexCan::<R, Imxrt1062>::begin_with_layout(
+            regs,
+            sys,
+            self.target(),
+            settings,
+            primary,
+            secondary,
+        ) {
             Ok(controller) => Ok((
                 controller,
                 Parked {
@@ -160,10 +174,7 @@ impl<C: RalCan> Parked<C> {
     /// either error gives both back.
     #[cfg(target_os = "none")]
     #[allow(clippy::result_large_err, clippy::type_complexity)]
-    pub fn free(
-        self,
-        controller: FlexCan<crate::regs::FlexCanRegs>,
-    ) -> Result<(C, Ccm), (Self, FlexCan<crate::regs::FlexCanRegs>, Error)> {
+    pub fn free(self, controller: Controller) -> Result<(C, Ccm), (Self, Controller, Error)> {
         self.free_over(controller, &mut super::firmware::system())
             .map(|(can, ccm, _)| (can, ccm))
     }
@@ -173,9 +184,9 @@ impl<C: RalCan> Parked<C> {
     #[allow(clippy::result_large_err, clippy::type_complexity)]
     pub fn free_over<R: Registers, S: Registers>(
         self,
-        controller: FlexCan<R>,
+        controller: Controller<R>,
         sys: &mut S,
-    ) -> Result<(C, Ccm, R), (Self, FlexCan<R>, Error)> {
+    ) -> Result<(C, Ccm, R), (Self, Controller<R>, Error)> {
         if controller.target() != Target::new(Board::DEFAULT, C::INSTANCE) {
             return Err((self, controller, Error::InvalidArgument));
         }
@@ -247,6 +258,18 @@ mod tests {
             .unwrap_or_else(|(_, e)| panic!("{e:?}"));
         assert_eq!(controller.target().instance, Instance::Can1);
         assert_eq!(model.read32(regs::MCR) & mcr::MDIS, 0, "running");
+        // The RT1062 layout: the ERR005829 reserved mailbox (MB12, the first after the
+        // table of the default configuration, RFFN 2) INACTIVE and masked, the data
+        // mailbox MB16 = MAXMB (the Kinetis layout's MB12 is a remote-frame mailbox,
+        // unmasked, and MAXMB 15).
+        let reserved = usize::from(controller.configuration().reserved_mailbox());
+        assert_eq!(reserved, 12);
+        assert_eq!(
+            regs::cs::CODE.get(model.read32(regs::mb_cs(reserved))),
+            regs::code::TX_INACTIVE
+        );
+        assert_eq!(model.read32(regs::IMASK1) & 1 << reserved, 0, "masked");
+        assert_eq!(mcr::MAXMB.get(model.read32(regs::MCR)), 16);
         // The module's gates are on in the CCM.
         let (gate, bits) = controller.target().clock_gate().unwrap();
         assert_eq!(sys.read32(gate) & bits, bits);

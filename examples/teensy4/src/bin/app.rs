@@ -13,6 +13,7 @@ mod firmware {
     use critical_section::Mutex;
     use twocan_app::firmware::{FirmwareLoop, Published};
     use twocan_app::{App, AppStats};
+    use twocan_flexcan::layout::Imxrt1062;
     use twocan_flexcan::pin::{settings_for, Pin22, Pin23};
     use twocan_flexcan::{BeginPlan, Can1};
     use twocan_teensy4::can::{CanState, TableSlot};
@@ -22,7 +23,7 @@ mod firmware {
 
     static CAN1: CanState = CanState::new();
     /// CAN1's filter table (`begin_in` compiles the list straight into it).
-    static TABLE1: TableSlot = TableSlot::new();
+    static TABLE1: TableSlot = TableSlot::new_sized();
 
     /// The application's counters, copied after each step (`None` before the first).
     pub static STATS: Mutex<RefCell<Option<AppStats>>> = Mutex::new(RefCell::new(None));
@@ -54,7 +55,7 @@ mod firmware {
                     can.begin_in_place(
                         hw,
                         &const {
-                            BeginPlan::new_or_panic(
+                            BeginPlan::<Imxrt1062>::new_with_layout_or_panic(
                                 Can1::TARGET,
                                 &settings_for(&BUS, Pin22, Pin23),
                                 BUS.configuration,

@@ -12,6 +12,7 @@ mod firmware {
     use embassy_executor::Executor;
     use static_cell::StaticCell;
     use twocan_app::asynch::{echo, EchoStats};
+    use twocan_flexcan::layout::Imxrt1062;
     use twocan_flexcan::pin::{settings_for, Pin22, Pin23};
     use twocan_flexcan::{BeginPlan, Can1};
     use twocan_teensy4::can::{CanRxHalf, CanState, CanTxHalf, TableSlot};
@@ -20,7 +21,7 @@ mod firmware {
 
     static CAN1: CanState = CanState::new();
     /// CAN1's filter table (`begin_in` compiles the list straight into it).
-    static TABLE1: TableSlot = TableSlot::new();
+    static TABLE1: TableSlot = TableSlot::new_sized();
     static EXECUTOR: StaticCell<Executor> = StaticCell::new();
 
     /// Echoes sent so far.
@@ -48,7 +49,7 @@ mod firmware {
                     can.begin_in_place(
                         hw,
                         &const {
-                            BeginPlan::new_or_panic(
+                            BeginPlan::<Imxrt1062>::new_with_layout_or_panic(
                                 Can1::TARGET,
                                 &settings_for(&BUS, Pin22, Pin23),
                                 BUS.configuration,

@@ -10,6 +10,7 @@ mod firmware {
 
     use critical_section::Mutex;
     use twocan_app::{App, AppStats};
+    use twocan_flexcan::layout::Imxrt1062;
     use twocan_flexcan::pin::{settings_for, Pin0, Pin1, Pin22, Pin23};
     use twocan_flexcan::{BeginPlan, Can1, Can2};
     use twocan_teensy4::can::{CanState, TableSlot};
@@ -19,10 +20,10 @@ mod firmware {
 
     static CAN1: CanState = CanState::new();
     /// CAN1's filter table (`begin_in` compiles the list straight into it).
-    static TABLE1: TableSlot = TableSlot::new();
+    static TABLE1: TableSlot = TableSlot::new_sized();
     static CAN2: CanState = CanState::new();
     /// CAN2's filter table (`begin_in` compiles the list straight into it).
-    static TABLE2: TableSlot = TableSlot::new();
+    static TABLE2: TableSlot = TableSlot::new_sized();
 
     /// The counters of node 1 (CAN1) and node 2 (CAN2), copied after each step.
     pub static STATS: Mutex<RefCell<Option<[AppStats; 2]>>> = Mutex::new(RefCell::new(None));
@@ -43,7 +44,7 @@ mod firmware {
                     can1.begin_in_place(
                         hw,
                         &const {
-                            BeginPlan::new_or_panic(
+                            BeginPlan::<Imxrt1062>::new_with_layout_or_panic(
                                 Can1::TARGET,
                                 &settings_for(&BUS, Pin22, Pin23),
                                 BUS.configuration,
@@ -64,7 +65,7 @@ mod firmware {
                     can2.begin_in_place(
                         hw,
                         &const {
-                            BeginPlan::new_or_panic(
+                            BeginPlan::<Imxrt1062>::new_with_layout_or_panic(
                                 Can2::TARGET,
                                 &settings_for(&BUS, Pin1, Pin0),
                                 BUS.configuration,

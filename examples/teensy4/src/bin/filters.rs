@@ -10,6 +10,7 @@ mod firmware {
     use core::sync::atomic::{AtomicU32, Ordering};
 
     use twocan_core::{Dispatcher, Frame, RxFrame};
+    use twocan_flexcan::layout::Imxrt1062;
     use twocan_flexcan::pin::{settings_for, Pin22, Pin23};
     use twocan_flexcan::{BeginPlan, Can1};
     use twocan_teensy4::can::{CanState, TableSlot};
@@ -20,7 +21,7 @@ mod firmware {
 
     static CAN1: CanState = CanState::new();
     /// CAN1's filter table (`begin_in` compiles the list straight into it).
-    static TABLE1: TableSlot = TableSlot::new();
+    static TABLE1: TableSlot = TableSlot::new_sized();
 
     /// Frames each filter's call-back received.
     pub static HITS: [AtomicU32; FILTERS] = [const { AtomicU32::new(0) }; FILTERS];
@@ -71,7 +72,7 @@ mod firmware {
                     can.begin_in_place(
                         hw,
                         &const {
-                            BeginPlan::new_or_panic(
+                            BeginPlan::<Imxrt1062>::new_with_layout_or_panic(
                                 Can1::TARGET,
                                 &settings_for(&SETTINGS, Pin22, Pin23),
                                 SETTINGS.configuration,

@@ -4,8 +4,8 @@
 //! `can-fil`; `rt::HALT` says why it stopped, if it did.
 //!
 //! Started with the one call of `twocan_flexcan::acan` (ACAN_T4's `begin`): token, begin
-//! on CAN1's default pins (22 and 23), the library's `static` state, the `CAN1` line
-//! wired.
+//! on CAN1's default pins (22 and 23) in the RT1062 layout (the ERR005829 workaround),
+//! the library's `static` state, the `CAN1` line wired.
 #![cfg_attr(target_os = "none", no_std, no_main)]
 
 #[cfg(target_os = "none")]
@@ -13,6 +13,7 @@ mod firmware {
     use core::sync::atomic::{AtomicU32, Ordering};
 
     use twocan_core::Frame;
+    use twocan_flexcan::layout::Imxrt1062;
     use twocan_flexcan::{acan, BeginPlan, Can1};
     use twocan_teensy4::configs::{LOOPBACK, LOOPBACK_FILTERS};
     use twocan_teensy4::rt::{self, CAN_HALT};
@@ -23,10 +24,11 @@ mod firmware {
     /// Frames received back.
     pub static RECEIVED: AtomicU32 = AtomicU32::new(0);
 
-    /// The settings checked at compile time for CAN1 (`can1_checked`: no check runs on
-    /// the board, and the configuration stays within a few hundred bytes of stack).
-    const CHECKED: BeginPlan =
-        BeginPlan::new_or_panic(Can1::TARGET, &LOOPBACK, LOOPBACK.configuration);
+    /// The settings checked at compile time for CAN1 in the RT1062 layout, the one
+    /// call's (`can1_checked`: no check runs on the board, and the configuration stays
+    /// within a few hundred bytes of stack).
+    const CHECKED: BeginPlan<Imxrt1062> =
+        BeginPlan::new_with_layout_or_panic(Can1::TARGET, &LOOPBACK, LOOPBACK.configuration);
 
     #[cortex_m_rt::entry]
     fn main() -> ! {
