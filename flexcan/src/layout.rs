@@ -179,7 +179,7 @@ pub const fn accepted_rffn(layout_max: u8, chip: Chip) -> u8 {
 /// the ERR005829 workaround, [`Layout::E5829`], without naming a layout), [`Kinetis`]
 /// otherwise (the Teensy 3.x, and the host without a board feature). The precedence of
 /// the board features is the crate's ("Board features"): a Teensy 4 feature wins. What
-/// the one calls ([`crate::acan`]), `rt::AcanState` and the Teensy 4 tokens' `begin`
+/// the one calls (`acan`, feature `rt`), `rt::AcanState` and the Teensy 4 tokens' `begin`
 /// use; `Full`, `FullInSlot`, `Lean` and `FlexCan` keep [`Kinetis`] as their default.
 #[cfg(any(feature = "teensy40", feature = "teensy41"))]
 pub type BoardLayout = Imxrt1062;
@@ -188,7 +188,7 @@ pub type BoardLayout = Imxrt1062;
 /// the ERR005829 workaround, [`Layout::E5829`], without naming a layout), [`Kinetis`]
 /// otherwise (the Teensy 3.x, and the host without a board feature). The precedence of
 /// the board features is the crate's ("Board features"): a Teensy 4 feature wins. What
-/// the one calls ([`crate::acan`]), `rt::AcanState` and the Teensy 4 tokens' `begin`
+/// the one calls (`acan`, feature `rt`), `rt::AcanState` and the Teensy 4 tokens' `begin`
 /// use; `Full`, `FullInSlot`, `Lean` and `FlexCan` keep [`Kinetis`] as their default.
 #[cfg(not(any(feature = "teensy40", feature = "teensy41")))]
 pub type BoardLayout = Kinetis;
