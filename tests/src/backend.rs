@@ -13,19 +13,22 @@
 use twocan_bxcan::model::BxCanModel;
 use twocan_bxcan::{Config as BxConfig, ConfigError, FifoPolicy, PlanError};
 use twocan_core::timing::{
-    cia_sample_point, solve, Limits, PeripheralClockRule, Timing, TimingError,
+    cia_sample_point, solve, Limits, PeripheralClockRule, Timing, TimingError, TimingRule,
     DEFAULT_TOLERANCE_PPM,
 };
 use twocan_core::{
     BusOffRecovery, Driver, Filter, Hardware, Mode, ModeSupport, Registers, TxPolicy,
 };
+use twocan_flexcan::filters::OwnedTable;
+use twocan_flexcan::layout::{Imxrt1062, Kinetis, Layout};
 use twocan_flexcan::model::FlexCanModel;
+use twocan_flexcan::options::Full;
 use twocan_flexcan::{
     BeginError, Board, CanClock, ConfigErrors, Configuration, FlexCanHw, Instance, Settings, Target,
 };
 use twocan_host::{
-    attach_plain, BxNode, FlexNode, Harness, Serviced, SetupError, RX_RING, STM32F767_APB1_HZ,
-    TX_RING,
+    attach_plain, BxNode, FlexNode, FlexNodeOf, Harness, Rt1062Node, Serviced, SetupError, RX_RING,
+    STM32F767_APB1_HZ, TX_RING,
 };
 use twocan_sim::{Bus, BusNode, NodeId};
 
@@ -210,7 +213,8 @@ pub trait Backend {
     /// The manual's minimum ratio between the peripheral clock and the bit rate, with
     /// the peripheral clock of the node [`Backend::attach`] brings up (FlexCAN: 16 bus
     /// clocks per bit with 16 message buffers and the Rx FIFO, from the least bus clock
-    /// the manual allows, 16 MHz; bxCAN: none).
+    /// the manual allows, 16 MHz; the RT1062 in its layout: 17 with `MAXMB` 16, from
+    /// the driver's rule for that layout, [`layout_rule`]; bxCAN: none).
     const PERIPHERAL_CLOCK: Option<PeripheralClockRule>;
     /// The fastest bit rate the backend accepts: `CLOCK_HZ / LIMITS.min_quanta()`
     /// unless a rule beyond the register ranges forbids it (FlexCAN: 1 Mbit/s, 16 bus
@@ -278,9 +282,9 @@ fn timing_refused(e: TimingError) -> TimingRefused {
 // FlexCAN: can0 of a Teensy 3.6.
 
 /// Which FlexCAN module a [`FlexCanBackendOf`] drives, and the facts that differ between
-/// the parts: the module, its CAN clock and the bit-rate range that clock gives under the
-/// reference manuals' rule (8 to 25 quanta, `PRESDIV` up to 256, 16 bus clocks per bit
-/// with 16 message buffers, the bus clock taken equal to the CAN clock).
+/// the parts: the module, its CAN clock, the message-buffer layout its programs begin it
+/// in, and how the node is begun in that layout. The bit-rate range is not a figure of
+/// the part: it is the driver's rule for that layout and clock ([`layout_rule`]).
 pub trait FlexPart: 'static {
     /// Name in messages.
     const NAME: &'static str;
@@ -288,10 +292,42 @@ pub trait FlexPart: 'static {
     const TARGET: Target;
     /// The protocol engine clock.
     const CLOCK: CanClock;
-    /// The slowest rate: clock / (256 × 25).
-    const SLOWEST_BITRATE: u32;
-    /// The fastest rate: clock / 16 (16 bus clocks per bit), capped by 8 quanta.
-    const FASTEST_BITRATE: u32;
+    /// The message-buffer layout a program for that board begins the module in
+    /// (Teensy 3.x: [`Kinetis`]; Teensy 4.x: [`Imxrt1062`]).
+    type Layout: Layout;
+    /// Begins the node in [`FlexPart::Layout`] as a program for that board does.
+    fn begin_via(
+        h: &mut Harness,
+        settings: &Settings,
+        primary: &[Filter],
+        secondary: &[Filter],
+        attach: impl FnOnce(&mut Bus, &str, Box<dyn BusNode>) -> NodeId,
+    ) -> Result<FlexNodeOf<Self::Layout>, SetupError>;
+}
+
+/// The configuration the suite's FlexCAN nodes are begun with when they hold few
+/// filters: ACAN's default ([`flexcan_lists_on`]).
+const ACAN_DEFAULT: Configuration = Configuration::Filters12_12;
+
+/// The bit-timing rule `begin` applies in the layout `L` from the CAN clock `clock` (no
+/// bus clock given: the CAN clock, the least the manuals allow) to a table of
+/// `configuration`: the driver's own rule functions — the 16-buffer rule
+/// ([`twocan_flexcan::settings::timing_rule_for`]) in ACAN's layout, the rule of the
+/// message buffers the configuration takes into matching and arbitration
+/// ([`twocan_flexcan::settings::timing_rule_for_buffers`] with
+/// [`Configuration::message_buffers_used_in`], the ERR005829 reserved mailbox counted)
+/// in a layout of more buffers (IMXRT1060RM, FlexCAN "Arbitration and matching timing",
+/// table "Minimum ratio between peripheral clock frequency and CAN bit rate").
+pub const fn layout_rule<L: Layout>(clock: CanClock, configuration: Configuration) -> TimingRule {
+    if L::IFLAG2 {
+        twocan_flexcan::settings::timing_rule_for_buffers(
+            clock.hz(),
+            None,
+            configuration.message_buffers_used_in(L::E5829),
+        )
+    } else {
+        twocan_flexcan::settings::timing_rule_for(clock.hz(), None)
+    }
 }
 
 /// FlexCAN0 of a Teensy 3.6 (MK66FX1M0, 16 message buffers), 16 MHz oscillator.
@@ -301,20 +337,38 @@ impl FlexPart for Teensy36Can0 {
     const NAME: &'static str = "FlexCAN (Teensy 3.6 can0)";
     const TARGET: Target = Target::new(Board::Teensy36, Instance::Can0);
     const CLOCK: CanClock = CanClock::Oscillator16MHz;
-    const SLOWEST_BITRATE: u32 = 2_500;
-    const FASTEST_BITRATE: u32 = 1_000_000;
+    type Layout = Kinetis;
+    fn begin_via(
+        h: &mut Harness,
+        settings: &Settings,
+        primary: &[Filter],
+        secondary: &[Filter],
+        attach: impl FnOnce(&mut Bus, &str, Box<dyn BusNode>) -> NodeId,
+    ) -> Result<FlexNode, SetupError> {
+        FlexNode::begin_via(h, Self::TARGET, settings, primary, secondary, attach)
+    }
 }
 
 /// CAN3 of a Teensy 4.1 (i.MX RT1062, 64 message buffers, the CAN FD capable module in
-/// classic CAN), the 24 MHz oscillator as CAN clock root.
+/// classic CAN), the 24 MHz oscillator as CAN clock root, begun in the RT1062 layout
+/// ([`Imxrt1062`]) as every Teensy 4 program begins it: the ERR005829 reserved mailbox
+/// after the Rx FIFO area, the transmit mailboxes after it.
 pub struct Teensy41Can3;
 
 impl FlexPart for Teensy41Can3 {
     const NAME: &'static str = "FlexCAN (Teensy 4.1 CAN3)";
     const TARGET: Target = Target::new(Board::Teensy41, Instance::Can3);
     const CLOCK: CanClock = CanClock::IMXRT_24MHZ;
-    const SLOWEST_BITRATE: u32 = 3_750;
-    const FASTEST_BITRATE: u32 = 1_500_000;
+    type Layout = Imxrt1062;
+    fn begin_via(
+        h: &mut Harness,
+        settings: &Settings,
+        primary: &[Filter],
+        secondary: &[Filter],
+        attach: impl FnOnce(&mut Bus, &str, Box<dyn BusNode>) -> NodeId,
+    ) -> Result<Rt1062Node, SetupError> {
+        Rt1062Node::begin_via(h, Self::TARGET, settings, primary, secondary, attach)
+    }
 }
 
 /// A FlexCAN module through ACAN's `begin`: the driver is the same for every part, the
@@ -327,9 +381,6 @@ pub type FlexCanBackend = FlexCanBackendOf<Teensy36Can0>;
 /// CAN3 of a Teensy 4.1 (i.MX RT1062) through the same `begin`: the third configuration
 /// of the conformance suite.
 pub type Rt1062Backend = FlexCanBackendOf<Teensy41Can3>;
-
-/// The limits the FlexCAN driver accepts (the fields and 8 quanta per bit).
-const LIMITS_FLEX: Limits = Limits::FLEXCAN_KINETIS;
 
 /// The Teensy 3.6 can0 target.
 pub fn teensy36_can0() -> Target {
@@ -399,8 +450,8 @@ pub fn bxcan_btr_bitrate(btr: u32, clock_hz: u32) -> u32 {
     clock_hz / ((brp + 1) * (3 + ts1 + ts2))
 }
 
-impl Dut for FlexNode {
-    type C = FlexCanHw<twocan_host::Clocked<FlexCanModel>>;
+impl<L: Layout> Dut for FlexNodeOf<L> {
+    type C = FlexCanHw<twocan_host::Clocked<FlexCanModel>, Full<L>>;
     fn driver(&mut self) -> &mut Driver<Self::C, RX_RING, TX_RING, RX_RING> {
         &mut self.driver
     }
@@ -425,8 +476,14 @@ impl Dut for FlexNode {
     }
 }
 
+impl<P: FlexPart> FlexCanBackendOf<P> {
+    /// The rule `begin` applies to the node [`Backend::attach`] brings up (ACAN's
+    /// default configuration in the part's layout, [`layout_rule`]).
+    pub const RULE: TimingRule = layout_rule::<P::Layout>(P::CLOCK, ACAN_DEFAULT);
+}
+
 impl<P: FlexPart> Backend for FlexCanBackendOf<P> {
-    type Node = FlexNode;
+    type Node = FlexNodeOf<P::Layout>;
     const NAME: &'static str = P::NAME;
     const RX_FIFO_DEPTH: usize = 6;
     const OVERRUN: OverrunPolicy = OverrunPolicy::DiscardNew;
@@ -446,13 +503,10 @@ impl<P: FlexPart> Backend for FlexCanBackendOf<P> {
     const RX_QUEUES: u8 = 1;
     const TIMESTAMP_BITS: Option<u8> = Some(16);
     const CLOCK_HZ: u32 = P::CLOCK.hz();
-    const LIMITS: Limits = Limits::FLEXCAN_KINETIS;
-    const PERIPHERAL_CLOCK: Option<PeripheralClockRule> = Some(PeripheralClockRule {
-        peripheral_hz: P::CLOCK.hz(),
-        min_clocks_per_bit: 16,
-    });
-    const FASTEST_BITRATE: u32 = P::FASTEST_BITRATE;
-    const SLOWEST_BITRATE: u32 = P::SLOWEST_BITRATE;
+    const LIMITS: Limits = Self::RULE.limits;
+    const PERIPHERAL_CLOCK: Option<PeripheralClockRule> = Self::RULE.peripheral_clock;
+    const FASTEST_BITRATE: u32 = Self::RULE.max_bitrate();
+    const SLOWEST_BITRATE: u32 = Self::RULE.min_bitrate();
     const WAKEUP_EVENTS: bool = false;
     const TIMESTAMP_COUNTER_READABLE: bool = true;
 
@@ -460,18 +514,23 @@ impl<P: FlexPart> Backend for FlexCanBackendOf<P> {
         h: &mut Harness,
         opts: &NodeOptions,
         attach: impl FnOnce(&mut Bus, &str, Box<dyn BusNode>) -> NodeId,
-    ) -> Result<FlexNode, Refused> {
+    ) -> Result<Self::Node, Refused> {
         let rate = h.bus().borrow().bit_rate();
         let (mut s, primary, secondary) = flexcan_lists_on(P::CLOCK, rate, &opts.filters);
         s.bus_off_recovery = portable_recovery(opts.recovery);
-        FlexNode::begin_via(h, P::TARGET, &s, &primary, &secondary, attach).map_err(flexcan_refused)
+        P::begin_via(h, &s, &primary, &secondary, attach).map_err(flexcan_refused)
     }
 
     fn check_timing(bitrate: u32, sample_point_permille: u16) -> Result<u32, TimingRefused> {
         // An application's settings for that rate and sample point (the solver within
         // the limits the driver accepts), given to `begin`.
-        let t = solve(P::CLOCK.hz(), bitrate, &LIMITS_FLEX, sample_point_permille)
-            .map_err(timing_refused)?;
+        let t = solve(
+            P::CLOCK.hz(),
+            bitrate,
+            &Self::RULE.limits,
+            sample_point_permille,
+        )
+        .map_err(timing_refused)?;
         Self::check_given_timing(&t)
     }
 
@@ -479,7 +538,7 @@ impl<P: FlexPart> Backend for FlexCanBackendOf<P> {
         let mut s = Settings::with_clock(timing.bitrate, P::CLOCK);
         s.timing = *timing;
         let model = FlexCanModel::new(P::TARGET.model_chip());
-        let r = twocan_flexcan::FlexCan::begin(
+        let r = twocan_flexcan::FlexCan::<_, P::Layout>::begin_with_layout(
             twocan_flexcan::IdleClocked::new(model),
             &mut twocan_flexcan::HostSystem::new(),
             P::TARGET,
@@ -487,7 +546,12 @@ impl<P: FlexPart> Backend for FlexCanBackendOf<P> {
             &[Filter::pass_all()],
             &[],
         );
-        let flags = twocan_flexcan::check(P::TARGET, &s, &[Filter::pass_all()], &[]);
+        let flags = twocan_flexcan::begin::check_with_layout::<P::Layout>(
+            P::TARGET,
+            &s,
+            &[Filter::pass_all()],
+            &[],
+        );
         match r {
             Ok(_) => {
                 assert_eq!(flags, ConfigErrors::NONE, "check() and begin() agree");
@@ -511,22 +575,29 @@ impl<P: FlexPart> Backend for FlexCanBackendOf<P> {
         }
     }
 
-    fn set_filters(node: &mut FlexNode, filters: &[Filter]) -> Result<(), Refused> {
+    fn set_filters(node: &mut Self::Node, filters: &[Filter]) -> Result<(), Refused> {
         let c = node.driver.hardware().configuration();
         let n = filters.len().min(c.primary_filter_capacity());
-        let table = twocan_flexcan::FilterTable::compile(c, &filters[..n], &filters[n..])
-            .map_err(|e| flexcan_refused(SetupError::FlexCan(BeginError::Config(e))))?;
+        // The table of the node's layout, compiled as `begin` compiles it.
+        let (primary, secondary) = (&filters[..n], &filters[n..]);
+        let flags = <P::Layout as Layout>::Table::check_lists(c, primary, secondary);
+        if flags != ConfigErrors::NONE {
+            return Err(flexcan_refused(SetupError::FlexCan(BeginError::Config(
+                flags,
+            ))));
+        }
+        let table = <P::Layout as Layout>::Table::build_lists(c, primary, secondary);
         node.driver
             .set_filters(&table)
             .map_err(|e| Refused::Other(format!("{e:?}")))
     }
 
     fn change_bitrate(
-        node: FlexNode,
+        node: Self::Node,
         _opts: &NodeOptions,
         h: &mut Harness,
-    ) -> Result<(FlexNode, BitrateChange), Refused> {
-        let FlexNode { model, driver, .. } = node;
+    ) -> Result<(Self::Node, BitrateChange), Refused> {
+        let FlexNodeOf { model, driver, .. } = node;
         let rate = h.bus().borrow().bit_rate();
         let (driver, id) = portable_bitrate_change(driver, rate, h, |hw, h| {
             hw.registers_mut().set_bus(h.bus());
@@ -534,7 +605,7 @@ impl<P: FlexPart> Backend for FlexCanBackendOf<P> {
                 .borrow_mut()
                 .attach(&format!("{}-moved", P::NAME), model.clone())
         })?;
-        Ok((FlexNode { model, driver, id }, BitrateChange::FiltersKept))
+        Ok((FlexNodeOf { model, driver, id }, BitrateChange::FiltersKept))
     }
 }
 

@@ -547,20 +547,32 @@ fn capabilities_are_the_hardware_facts<B: Backend>() {
     );
     // Slowest: largest prescaler × most quanta (25 for both), rounded down (bxCAN:
     // 2,109.375 bit/s); fastest: bxCAN prescaler 1 and the fewest quanta (1 + 1 + 1);
-    // FlexCAN the Kinetis manual's rule with the default bus clock of 16 MHz
-    // ("Arbitration and matching timing": at least 8 quanta, 16 MHz / 8 = 2 Mbit/s, and
-    // 16 bus clocks per bit, 16 MHz / 16 = 1 Mbit/s), below the register ranges'
-    // 3.2 Mbit/s (5 quanta, ACAN §16.1).
+    // FlexCAN the manuals' rule with the bus clock taken equal to the CAN clock
+    // ("Arbitration and matching timing": at least 8 quanta, and a least number of bus
+    // clocks per bit set by the message buffers in matching and arbitration), below
+    // the register ranges' 5 quanta (ACAN §16.1).
     let (slowest, fastest) = match B::CLOCK_HZ {
+        // Kinetis, ACAN's layout (16 buffers): 16 MHz / 16 bus clocks = 1 Mbit/s.
         16_000_000 => (16_000_000 / (256 * 25), 1_000_000),
-        // The RT1062 (IMXRT1060RM, the same rule): 24 MHz / 16 bus clocks = 1.5 Mbit/s.
-        24_000_000 => (24_000_000 / (256 * 25), 24_000_000 / 16),
+        // The RT1062 in its layout (IMXRT1060RM, table "Minimum ratio between
+        // peripheral clock frequency and CAN bit rate"): MAXMB 16 (the ERR005829
+        // reserved mailbox moves the transmit mailboxes up by one), 17 buffers with the
+        // Rx FIFO, 17 bus clocks per bit: 24 MHz / 17, rounded down.
+        24_000_000 => (24_000_000 / (256 * 25), 24_000_000 / 17),
         54_000_000 => (54_000_000 / (1024 * 25), 18_000_000),
         c => panic!("unexpected clock {c}"),
     };
     assert_eq!(
         (caps.min_bitrate, caps.max_bitrate),
         (slowest, fastest),
+        "{}",
+        B::NAME
+    );
+    // What the backend asserts elsewhere as accepted (its limits, from the driver's rule
+    // for its layout) is what the driver reports.
+    assert_eq!(
+        (caps.min_bitrate, caps.max_bitrate),
+        (B::SLOWEST_BITRATE, B::FASTEST_BITRATE),
         "{}",
         B::NAME
     );
@@ -1289,6 +1301,91 @@ fn capabilities_follow_the_current_configuration() {
     );
     assert_eq!(caps.timestamp_bits, Some(16));
     assert_eq!(caps.clock_hz, 54_000_000);
+}
+
+/// Issue 24 review: the RT1062 backend is begun in the RT1062 layout, as every Teensy 4
+/// program begins it, in both configurations the backend uses (ACAN's 12/12 and, with
+/// more than 12 filters, 14/18): `MCR[MAXMB]` is the layout's data mailbox, one above
+/// ACAN's; the reserved ERR005829 mailbox (i.MX RT1060 chip errata, ERR005829; the
+/// first valid mailbox after the Rx FIFO area) reads INACTIVE after data and remote
+/// frames both ways, its interrupt flag never raised, its identifier none the node sent;
+/// the peripheral-clock rule the node reports is that of `MAXMB` + 1 buffers, and the
+/// backend's limits are the ones the node reports. In ACAN's layout the mailbox after
+/// the Rx FIFO area is a transmit mailbox and `MAXMB` is 15: the test fails.
+#[test]
+fn flexcan_rt1062_is_begun_in_the_rt1062_layout() {
+    use twocan_flexcan::layout::{Imxrt1062, Kinetis, Layout};
+    use twocan_flexcan::regs::{self, code, cs, mcr};
+    use twocan_flexcan::Configuration;
+
+    let many: Vec<Filter> = (0..20).map(|i| Filter::standard(0x100 + 3 * i)).collect();
+    let lists = [
+        (vec![Filter::pass_all()], Configuration::Filters12_12),
+        (many, Configuration::Filters14_18),
+    ];
+    for (filters, configuration) in lists {
+        let (mut h, mut dut, peer) = setup::<Rt1062Backend>(&NodeOptions::filters(&filters));
+        let c = dut.driver_ref().hardware().configuration();
+        assert_eq!(c, configuration);
+        let reserved = Imxrt1062::reserved_mailbox(c).expect("the RT1062 layout reserves one");
+        assert_eq!(reserved, c.reserved_mailbox());
+        let maxmb = mcr::MAXMB.get(dut.model.peek32(regs::MCR));
+        assert_eq!(maxmb, u32::from(Imxrt1062::data_mailbox(c)), "{c:?}");
+        assert_eq!(maxmb, u32::from(Kinetis::data_mailbox(c)) + 1, "{c:?}");
+        // The rule of MAXMB + 1 buffers with the Rx FIFO: 17 bus clocks per bit.
+        let caps = dut.driver_ref().capabilities();
+        let rule = caps
+            .peripheral_clock
+            .expect("FlexCAN has a peripheral-clock rule");
+        assert_eq!(
+            Imxrt1062::message_buffers_used(c),
+            usize::from(Imxrt1062::data_mailbox(c)) + 1
+        );
+        assert_eq!(rule.min_clocks_per_bit, 17, "{c:?}");
+        assert_eq!(Some(rule), Rt1062Backend::PERIPHERAL_CLOCK, "{c:?}");
+        assert_eq!(caps.max_bitrate, Rt1062Backend::FASTEST_BITRATE, "{c:?}");
+        assert_eq!(caps.max_bitrate, rule.peripheral_hz / 17, "{c:?}");
+
+        // Traffic both ways, every transmit mailbox busy: data and remote frames out,
+        // data frames in (identifiers the filters pass).
+        // Identifiers both lists pass (the 14/18 list holds 0x100 + 3 i, i < 20).
+        let ids: Vec<u16> = (0..8).map(|i| 0x100 + 3 * i).collect();
+        let sent: Vec<Frame> = (0..24u16)
+            .map(|i| {
+                let id = 0x7A0 + i;
+                if i % 3 == 2 {
+                    remote_frame(u32::from(id), false, 4)
+                } else {
+                    std_frame(id, &[i as u8; 8])
+                }
+            })
+            .collect();
+        for f in &sent {
+            dut.driver().try_send(f).unwrap();
+        }
+        for &id in &ids {
+            peer.borrow_mut().send(std_frame(id, &[0xA5]));
+        }
+        settle(&mut h, &mut dut, &[&peer], 100_000);
+        assert_eq!(peer.borrow().received_frames(), sent, "{c:?}");
+        assert_eq!(drain(&mut dut).len(), ids.len(), "{c:?}");
+
+        let mb = usize::from(reserved);
+        let code_of = |m: usize| cs::CODE.get(dut.model.peek32(regs::mb_cs(m)));
+        assert_eq!(code_of(mb), code::TX_INACTIVE, "{c:?} MB{mb}");
+        assert_eq!(
+            dut.model.peek32(regs::IFLAG1) & (1 << mb),
+            0,
+            "{c:?} MB{mb}"
+        );
+        let id_word = dut.model.peek32(regs::mb_id(mb));
+        assert!(
+            sent.iter().all(|f| (id_word >> 18) & 0x7FF != f.raw_id()),
+            "{c:?}: MB{mb} was loaded ({id_word:#x})"
+        );
+        // The transmit mailboxes lie above it.
+        assert_eq!(Imxrt1062::first_remote_mailbox(c), reserved + 1, "{c:?}");
+    }
 }
 
 #[test]

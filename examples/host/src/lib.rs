@@ -27,7 +27,9 @@ use std::rc::Rc;
 use twocan_bxcan::model::BxCanModel;
 use twocan_bxcan::{BxCan, Can, Config as BxConfig, FifoPolicy};
 use twocan_core::{Driver, ErrorState, Filter};
+use twocan_flexcan::layout::{Imxrt1062, Kinetis, Layout};
 use twocan_flexcan::model::FlexCanModel;
+use twocan_flexcan::options::Full;
 use twocan_flexcan::{Board, FlexCan, FlexCanHw, HostSystem, Instance, Settings, Target};
 use twocan_sim::{Bus, BusNode, NodeId, SimError};
 
@@ -121,20 +123,55 @@ pub fn attach_plain(bus: &mut Bus, name: &str, node: Box<dyn BusNode>) -> NodeId
     bus.attach_boxed(name, node)
 }
 
-/// The FlexCAN driver over its model, as used by the host nodes.
-pub type FlexDriver = Driver<FlexCanHw<Clocked<FlexCanModel>>, RX_RING, TX_RING, RX_RING>;
+/// The FlexCAN driver over its model with the message-buffer layout `L`
+/// ([`twocan_flexcan::layout`]).
+pub type FlexDriverOf<L> =
+    Driver<FlexCanHw<Clocked<FlexCanModel>, Full<L>>, RX_RING, TX_RING, RX_RING>;
+/// The FlexCAN driver over its model, as used by the host nodes (ACAN's layout,
+/// [`Kinetis`], the default options: the Teensy 3.x).
+pub type FlexDriver = FlexDriverOf<Kinetis>;
+/// The FlexCAN driver over its model with the RT1062 layout ([`Imxrt1062`]: the
+/// ERR005829 reserved mailbox after the Rx FIFO area, the transmit mailboxes after it),
+/// the layout every Teensy 4 program uses.
+pub type Rt1062Driver = FlexDriverOf<Imxrt1062>;
 /// The bxCAN driver over its model, as used by the host nodes (a receive ring per
 /// FIFO; the FlexCAN one has the same shape, its second ring stays unused).
 pub type BxDriver = Driver<BxCan<Clocked<BxCanModel>>, RX_RING, TX_RING, RX_RING>;
 
-/// A Teensy 3.x FlexCAN node on the bus.
-pub struct FlexNode {
+/// A FlexCAN node on the bus whose controller uses the message-buffer layout `L`.
+pub struct FlexNodeOf<L: Layout = Kinetis> {
     /// The peripheral model (for inspection and fault injection).
     pub model: FlexCanModel,
     /// The portable driver over the real FlexCAN backend.
-    pub driver: FlexDriver,
+    pub driver: FlexDriverOf<L>,
     /// Its place on the bus.
     pub id: NodeId,
+}
+
+/// A Teensy 3.x FlexCAN node on the bus (ACAN's layout, [`Kinetis`]).
+pub type FlexNode = FlexNodeOf<Kinetis>;
+
+/// A Teensy 4.x FlexCAN node on the bus, begun in the RT1062 layout ([`Imxrt1062`])
+/// as a Teensy 4 program begins it.
+pub type Rt1062Node = FlexNodeOf<Imxrt1062>;
+
+/// The model of `target` attached by `attach`, and its registers with the bus time
+/// passing while the driver polls MCR (mode acknowledges) and ESR1 (synchronisation
+/// after freeze).
+fn flex_model_via(
+    h: &mut Harness,
+    target: Target,
+    attach: impl FnOnce(&mut Bus, &str, Box<dyn BusNode>) -> NodeId,
+) -> (FlexCanModel, Clocked<FlexCanModel>, NodeId) {
+    let model = FlexCanModel::new(target.model_chip());
+    let name = format!("{:?}-{:?}", target.board, target.instance).to_lowercase();
+    let id = attach(&mut h.bus.borrow_mut(), &name, Box::new(model.clone()));
+    let regs = Clocked::with_poll_registers(
+        model.clone(),
+        &h.bus,
+        &[twocan_flexcan::regs::MCR, twocan_flexcan::regs::ESR1],
+    );
+    (model, regs, id)
 }
 
 impl FlexNode {
@@ -173,15 +210,7 @@ impl FlexNode {
         secondary: &[Filter],
         attach: impl FnOnce(&mut Bus, &str, Box<dyn BusNode>) -> NodeId,
     ) -> Result<Self, SetupError> {
-        let model = FlexCanModel::new(target.model_chip());
-        let name = format!("{:?}-{:?}", target.board, target.instance).to_lowercase();
-        let id = attach(&mut h.bus.borrow_mut(), &name, Box::new(model.clone()));
-        // MCR for the mode acknowledges, ESR1 for the synchronisation after freeze.
-        let regs = Clocked::with_poll_registers(
-            model.clone(),
-            &h.bus,
-            &[twocan_flexcan::regs::MCR, twocan_flexcan::regs::ESR1],
-        );
+        let (model, regs, id) = flex_model_via(h, target, attach);
         let controller = FlexCan::begin(
             regs,
             &mut HostSystem::new(),
@@ -197,7 +226,51 @@ impl FlexNode {
             id,
         })
     }
+}
 
+impl Rt1062Node {
+    /// A Teensy 4.x module (`target`) in the RT1062 layout with explicit settings and
+    /// primary / secondary filters: `FlexCan::<_, Imxrt1062>::begin_with_layout`, as a
+    /// Teensy 4 program begins it.
+    pub fn begin(
+        h: &mut Harness,
+        target: Target,
+        settings: &Settings,
+        primary: &[Filter],
+        secondary: &[Filter],
+    ) -> Result<Self, SetupError> {
+        Self::begin_via(h, target, settings, primary, secondary, attach_plain)
+    }
+
+    /// Like [`Rt1062Node::begin`], but `attach` puts the model on the bus (see
+    /// [`FlexNode::begin_via`]).
+    pub fn begin_via(
+        h: &mut Harness,
+        target: Target,
+        settings: &Settings,
+        primary: &[Filter],
+        secondary: &[Filter],
+        attach: impl FnOnce(&mut Bus, &str, Box<dyn BusNode>) -> NodeId,
+    ) -> Result<Self, SetupError> {
+        let (model, regs, id) = flex_model_via(h, target, attach);
+        let controller = FlexCan::<_, Imxrt1062>::begin_with_layout(
+            regs,
+            &mut HostSystem::new(),
+            target,
+            settings,
+            primary,
+            secondary,
+        )
+        .map_err(SetupError::FlexCan)?;
+        Ok(FlexNodeOf {
+            model,
+            driver: Driver::new(controller.into_split()),
+            id,
+        })
+    }
+}
+
+impl<L: Layout> FlexNodeOf<L> {
     /// Frames the hardware received but no filter accepted.
     pub fn filtered_out(&self) -> u64 {
         self.model.frames_discarded()
@@ -209,7 +282,7 @@ impl FlexNode {
     }
 }
 
-impl Serviced for FlexNode {
+impl<L: Layout> Serviced for FlexNodeOf<L> {
     fn service(&mut self) -> bool {
         if self.model.irq_pending() {
             self.driver.on_interrupt();
