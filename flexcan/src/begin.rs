@@ -71,8 +71,20 @@ struct Plan {
     message_buffers: usize,
 }
 
-/// The timing rule for a table of `configuration` with the layout `L`: the 16-buffer
-/// rule ([`Settings::timing_rule`]) unless the layout has more buffers.
+/// The timing rule `begin` applies to `settings` for a table of `configuration` in the
+/// layout `L` — the one rule of every entry point (`begin`, `check`, `BeginPlan`, the
+/// capabilities): the 16-buffer rule ([`Settings::timing_rule`]) in the Kinetis layout,
+/// else the rule of the message buffers the configuration takes into matching and
+/// arbitration ([`Settings::timing_rule_for_mailboxes`], the ERR005829 reserved mailbox
+/// counted).
+pub const fn timing_rule_in<L: Layout>(
+    settings: &Settings,
+    configuration: Configuration,
+) -> TimingRule {
+    rule_of::<L>(settings, configuration)
+}
+
+/// See [`timing_rule_in`].
 const fn rule_of<L: Layout>(settings: &Settings, configuration: Configuration) -> TimingRule {
     if L::IFLAG2 {
         settings.timing_rule_for_mailboxes(configuration.message_buffers_used_in(L::E5829))

@@ -291,8 +291,9 @@ impl Settings {
         }
     }
 
-    /// The bit timing rule `begin` applies to these settings: [`timing_rule`] with
-    /// [`Settings::bus_clock_hz`].
+    /// The bit timing rule `begin` applies to these settings in the Kinetis layout
+    /// (16 message buffers): [`timing_rule`] with [`Settings::bus_clock_hz`]. The rule of
+    /// any layout and configuration: [`crate::begin::timing_rule_in`].
     pub const fn timing_rule(&self) -> TimingRule {
         timing_rule_for(self.can_clock.hz(), self.bus_clock_hz)
     }

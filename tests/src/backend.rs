@@ -311,23 +311,19 @@ const ACAN_DEFAULT: Configuration = Configuration::Filters12_12;
 
 /// The bit-timing rule `begin` applies in the layout `L` from the CAN clock `clock` (no
 /// bus clock given: the CAN clock, the least the manuals allow) to a table of
-/// `configuration`: the driver's own rule functions — the 16-buffer rule
-/// ([`twocan_flexcan::settings::timing_rule_for`]) in ACAN's layout, the rule of the
-/// message buffers the configuration takes into matching and arbitration
-/// ([`twocan_flexcan::settings::timing_rule_for_buffers`] with
-/// [`Configuration::message_buffers_used_in`], the ERR005829 reserved mailbox counted)
-/// in a layout of more buffers (IMXRT1060RM, FlexCAN "Arbitration and matching timing",
-/// table "Minimum ratio between peripheral clock frequency and CAN bit rate").
+/// `configuration`: the driver's own rule, [`twocan_flexcan::begin::timing_rule_in`] —
+/// the 16-buffer rule in ACAN's layout, the rule of the message buffers the
+/// configuration takes into matching and arbitration in a layout of more buffers (the
+/// ERR005829 reserved mailbox counted; IMXRT1060RM, FlexCAN "Arbitration and matching
+/// timing", table "Minimum ratio between peripheral clock frequency and CAN bit
+/// rate").
 pub const fn layout_rule<L: Layout>(clock: CanClock, configuration: Configuration) -> TimingRule {
-    if L::IFLAG2 {
-        twocan_flexcan::settings::timing_rule_for_buffers(
-            clock.hz(),
-            None,
-            configuration.message_buffers_used_in(L::E5829),
-        )
-    } else {
-        twocan_flexcan::settings::timing_rule_for(clock.hz(), None)
-    }
+    // The driver's own rule (one rule for every entry point), for settings from `clock`
+    // with no bus clock given (the bit rate does not enter the rule).
+    twocan_flexcan::begin::timing_rule_in::<L>(
+        &twocan_flexcan::Settings::with_clock(500_000, clock),
+        configuration,
+    )
 }
 
 /// FlexCAN0 of a Teensy 3.6 (MK66FX1M0, 16 message buffers), 16 MHz oscillator.
