@@ -122,6 +122,12 @@ const fn plan<L: Layout>(
     if !accepted {
         errors = errors.union(ConfigErrors::CONFIGURATION_NOT_ON_CHIP);
     }
+    // One layout per chip: the RT1062 is begun in its own layout only (the ERR005829
+    // workaround, `Layout::E5829`), the Kinetis parts in theirs (the RT1062 layout needs
+    // more buffers than they have: `CONFIGURATION_NOT_ON_CHIP` above).
+    if chip.is_imxrt() && !L::E5829 {
+        errors = errors.union(ConfigErrors::LAYOUT_NOT_FOR_CHIP);
+    }
     if !settings.can_clock.fits(chip) {
         errors = errors.union(ConfigErrors::CLOCK_NOT_ON_CHIP);
     }
@@ -389,7 +395,10 @@ pub(crate) const fn tx_flag_base<L: Layout>(data: usize) -> usize {
 }
 
 /// Every error `begin` would report for these arguments (ACAN table 5), found
-/// without touching any register. [`ConfigErrors::NONE`] when `begin` would proceed.
+/// without touching any register, in the layout of the target's chip (the only one
+/// `begin` takes there: [`crate::layout::Kinetis`] on a Teensy 3.x,
+/// [`crate::layout::Imxrt1062`] on a Teensy 4.x, [`ConfigErrors::LAYOUT_NOT_FOR_CHIP`]).
+/// [`ConfigErrors::NONE`] when `begin` would proceed.
 ///
 /// A wished bit rate outside the range of the driver's rule ([`Settings::timing_rule`]:
 /// 2,500 bit/s to 1 Mbit/s with the default bus clock), which `begin` refuses with
@@ -414,7 +423,12 @@ pub fn check(
     primary: &[Filter],
     secondary: &[Filter],
 ) -> ConfigErrors {
-    check_with_layout::<Kinetis>(target, settings, primary, secondary)
+    // The layout of the target's chip (the only one `begin` takes there).
+    if target.board.chip().is_imxrt() {
+        check_with_layout::<crate::layout::Imxrt1062>(target, settings, primary, secondary)
+    } else {
+        check_with_layout::<Kinetis>(target, settings, primary, secondary)
+    }
 }
 
 /// [`check`] for a controller of the layout `L` ([`crate::layout`]): what
@@ -432,8 +446,11 @@ pub fn check(
 /// s.configuration = Configuration::Filters32_96;
 /// let secondary: Vec<Filter> = (0..96).map(|i| Filter::standard(0x100 + i)).collect();
 /// assert_eq!(check_with_layout::<Imxrt1062>(t41, &s, &[], &secondary), ConfigErrors::NONE);
-/// // ACAN's layout (MB0–MB15) takes RFFN 0–3 only: a typed error, nothing written.
-/// assert!(check(t41, &s, &[], &secondary).contains(ConfigErrors::CONFIGURATION_NOT_ON_CHIP));
+/// // `check` takes the target chip's layout: the same answer.
+/// assert_eq!(check(t41, &s, &[], &secondary), ConfigErrors::NONE);
+/// // The Kinetis layout is not the RT1062's: a typed error, nothing written.
+/// let kinetis = check_with_layout::<Kinetis>(t41, &s, &[], &secondary);
+/// assert!(kinetis.contains(ConfigErrors::LAYOUT_NOT_FOR_CHIP));
 /// ```
 pub fn check_with_layout<L: Layout>(
     target: Target,

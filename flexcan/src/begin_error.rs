@@ -75,6 +75,13 @@ bitflags::bitflags! {
         /// [`crate::layout::Imxrt1062`] on the i.MX RT1062
         /// ([`crate::Chip::accepted_max_rffn`]). Nothing is written.
         const CONFIGURATION_NOT_ON_CHIP = 1 << 12;
+        /// Bit 13 (not in ACAN): the controller's message-buffer layout is not the
+        /// target chip's: the Kinetis layout ([`crate::layout::Kinetis`], the default
+        /// type parameter) on an i.MX RT1062 module, which would run without the
+        /// ERR005829 workaround; begin a Teensy 4 module in
+        /// [`crate::layout::Imxrt1062`] (`FlexCan::<_, Imxrt1062>::begin_with_layout`,
+        /// the tokens, the one calls and the hand-over do). Nothing is written.
+        const LAYOUT_NOT_FOR_CHIP = 1 << 13;
     }
 }
 
@@ -209,7 +216,7 @@ mod tests {
         assert_eq!(ConfigErrors::BIT_RATE_OUT_OF_RANGE.bits(), 0x400);
         assert_eq!(ConfigErrors::CLOCK_NOT_ON_CHIP.bits(), 0x800);
         assert_eq!(ConfigErrors::CONFIGURATION_NOT_ON_CHIP.bits(), 0x1000);
-        assert_eq!(ConfigErrors::ALL.count(), 13);
+        assert_eq!(ConfigErrors::ALL.count(), 14);
         assert_eq!(BeginError::Config(e).flags(), e);
         assert_eq!(
             BeginError::from(twocan_core::Error::Timeout).flags(),

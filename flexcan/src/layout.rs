@@ -9,8 +9,9 @@
 //! | [`Kinetis`] (the default) | MB0–MB15 (`MCR[MAXMB]` = 15) | 0–3 (ACAN's four [`Configuration`]s) | up to 32 elements: 14 primary, 18 secondary | MB8–MB15, flags in `IFLAG1` | [`FilterTable`] |
 //! | [`Imxrt1062`] | up to MB46 (`MCR[MAXMB]` = the data mailbox) | 0–0xF | up to 128 elements: 32 primary, 96 secondary | after the table and the ERR005829 reserved mailbox, up to MB46, flags in `IFLAG1` or `IFLAG2` | [`LargeFilterTable`] |
 //!
-//! The [`Kinetis`] layout runs on every chip (the RT1062's modules too, in their first
-//! 16 message buffers); [`Imxrt1062`] needs the RT1062's 64 message buffers
+//! One layout per chip: [`Kinetis`] on the Kinetis parts only (on an RT1062 module
+//! `begin` refuses it with `ConfigErrors::LAYOUT_NOT_FOR_CHIP`: it would run without the
+//! ERR005829 workaround); [`Imxrt1062`] needs the RT1062's 64 message buffers
 //! (IMXRT1060RM, FlexCAN chapter: CTRL2 field RFFN, table "Rx FIFO filter: possible
 //! structures", `IMASK2`/`IFLAG2` for MB32–MB63, `MCR[MAXMB]`): on a 16-buffer Kinetis
 //! part it takes no configuration ([`Layout::accepts`], `CONFIGURATION_NOT_ON_CHIP`),
@@ -31,7 +32,7 @@
 //! up by one and keep their number ([`Configuration::first_remote_mailbox_in`]: ACAN's
 //! four configurations send data from MB16, 14/18 from RFFN 0xB … 8 from MB32 on, so
 //! that they never straddle MB31/MB32). [`Kinetis`] is unchanged (the constant is
-//! false: no reserved mailbox, no extra write), also when it runs on the RT1062.
+//! false: no reserved mailbox, no extra write).
 //!
 //! | RFFN | table | reserved | remote-frame mailboxes | data mailbox (`MAXMB`) |
 //! |---|---|---|---|---|

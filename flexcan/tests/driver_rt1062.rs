@@ -11,6 +11,7 @@ use twocan_core::{Filter, Hardware, Registers};
 use twocan_flexcan::imxrt::ccm::{CAN_CLK_PODF, CAN_CLK_SEL, CCM_CCGR0, CCM_CCGR7, CCM_CSCMR2};
 use twocan_flexcan::imxrt::pads::{MUX_RESET, PAD_RESET};
 use twocan_flexcan::imxrt::{CanClockSource, ClockRoot};
+use twocan_flexcan::layout::{Imxrt1062, Layout};
 use twocan_flexcan::regs::{self, mcr};
 use twocan_flexcan::{
     check, BeginError, Board, CanClock, ConfigErrors, FlexCan, HostSystem, Instance, Settings,
@@ -35,7 +36,7 @@ fn loop_back_on_every_module_of_both_boards() {
     for board in Board::IMXRT {
         for instance in [Instance::Can1, Instance::Can2, Instance::Can3] {
             let target = Target::new(board, instance);
-            let (model, mut can) = begin_on::<32, 16>(
+            let (model, mut can) = begin_rt_on::<32, 16>(
                 target,
                 &rt_loop_back(500_000, CanClock::IMXRT_24MHZ),
                 &[],
@@ -52,9 +53,15 @@ fn loop_back_on_every_module_of_both_boards() {
             let got: Vec<_> = drain(&mut can).into_iter().map(|r| r.frame).collect();
             assert_eq!(got.len(), 4, "{target:?}: {got:?}");
             assert!(got.contains(&ext_data(0x1234_5678, &[9; 8])));
-            // The ACAN layout within MB0–MB15: MAXMB = 15, nothing above enabled.
+            // The RT1062 layout with ACAN's default 12/12: MAXMB = the data mailbox
+            // after the ERR005829 reserved one (MB16), nothing above MB31 enabled.
             let r = can.hardware().registers();
-            assert_eq!(mcr::MAXMB.get(r.read32(regs::MCR)), 15);
+            assert_eq!(
+                mcr::MAXMB.get(r.read32(regs::MCR)) as usize,
+                <Imxrt1062 as Layout>::data_mailbox(twocan_flexcan::Configuration::Filters12_12)
+                    as usize
+            );
+            assert_eq!(mcr::MAXMB.get(r.read32(regs::MCR)), 16);
             assert_eq!(r.read32(regs::IMASK2), 0);
             assert_eq!(r.read32(regs::IFLAG2), 0);
         }
@@ -100,8 +107,15 @@ fn begin_sets_the_clock_root_gates_and_pads() {
             sys.write32(CCM_CCGR0, 0b11);
             sys.write32(CCM_CSCMR2, CAN_CLK_SEL.val(3) | 1 << 31);
             let model = model_of(target);
-            let can = FlexCan::begin(Ticking::new(model.clone()), &mut sys, target, &s, &[], &[])
-                .unwrap_or_else(|e| panic!("{target:?} {clock:?}: {e:?}"));
+            let can = FlexCan::<_, Imxrt1062>::begin_with_layout(
+                Ticking::new(model.clone()),
+                &mut sys,
+                target,
+                &s,
+                &[],
+                &[],
+            )
+            .unwrap_or_else(|e| panic!("{target:?} {clock:?}: {e:?}"));
             let cscmr2 = sys.read32(CCM_CSCMR2);
             assert_eq!(CAN_CLK_SEL.get(cscmr2), sel);
             assert_eq!(CAN_CLK_PODF.get(cscmr2), podf);
@@ -144,7 +158,7 @@ fn a_running_root_is_not_switched_again() {
     // gates untouched (no glitch for the running module).
     let mut sys = HostSystem::new();
     let s = rt_loop_back(250_000, CanClock::IMXRT_24MHZ);
-    let _can1 = FlexCan::begin(
+    let _can1 = FlexCan::<_, Imxrt1062>::begin_with_layout(
         Ticking::new(model_of(T41[0])),
         &mut sys,
         T41[0],
@@ -154,7 +168,7 @@ fn a_running_root_is_not_switched_again() {
     )
     .unwrap();
     let before = sys.read32(CCM_CSCMR2);
-    let _can2 = FlexCan::begin(
+    let _can2 = FlexCan::<_, Imxrt1062>::begin_with_layout(
         Ticking::new(model_of(T41[1])),
         &mut sys,
         T41[1],
@@ -170,8 +184,9 @@ fn a_running_root_is_not_switched_again() {
 #[test]
 fn can1_and_can2_of_one_board_exchange_frames() {
     let s = Settings::with_clock(500_000, CanClock::Imxrt(ClockRoot::PLL3_60MHZ));
-    let (m1, mut can1) = begin_on::<32, 16>(T41[0], &s, &[], &[]).unwrap();
-    let (m2, mut can2) = begin_on::<32, 16>(T41[1], &s, &[Filter::standard(0x321)], &[]).unwrap();
+    let (m1, mut can1) = begin_rt_on::<32, 16>(T41[0], &s, &[], &[]).unwrap();
+    let (m2, mut can2) =
+        begin_rt_on::<32, 16>(T41[1], &s, &[Filter::standard(0x321)], &[]).unwrap();
     let mut bus = bus_with(500_000, &[&m1, &m2]);
     for i in 0..7u8 {
         can1.try_send(&std_data(0x321, &[i])).unwrap();
@@ -225,7 +240,7 @@ fn wrong_clock_instance_or_pins_are_refused_before_any_write() {
     // begin refuses without a single write.
     let mut sys = HostSystem::new();
     let model = model_of(t41(Instance::Can1));
-    let e = FlexCan::begin(
+    let e = FlexCan::<_, Imxrt1062>::begin_with_layout(
         Ticking::new(model.clone()),
         &mut sys,
         t41(Instance::Can1),
@@ -275,7 +290,7 @@ fn typed_pins_are_the_pads_begin_muxes() {
         let target = Target::new(Board::DEFAULT, instance);
         let s = pin::settings_for(&rt_loop_back(250_000, CanClock::IMXRT_24MHZ), tx, rx);
         let mut sys = HostSystem::new();
-        let c = FlexCan::begin(
+        let c = FlexCan::<_, Imxrt1062>::begin_with_layout(
             Ticking::new(model_of(target)),
             &mut sys,
             target,
@@ -340,7 +355,7 @@ fn rx_fifo_sizes_are_data_per_chip_and_the_accepted_limit_is_reported() {
         let secondary: Vec<Filter> = (0..18u32)
             .map(|i| Filter::standard(0x200 + i as u16))
             .collect();
-        let (_, can) = begin_on_exact::<32, 16>(target, &settings, &primary, &secondary)
+        let (_, can) = begin_rt_on_exact::<32, 16>(target, &settings, &primary, &secondary)
             .unwrap_or_else(|e| panic!("{target:?}: {e:?}"));
         let caps = can.hardware().capabilities();
         assert_eq!(
@@ -349,27 +364,58 @@ fn rx_fifo_sizes_are_data_per_chip_and_the_accepted_limit_is_reported() {
             "{target:?}"
         );
         let r = can.hardware().registers();
-        assert_eq!(mcr::MAXMB.get(r.read32(regs::MCR)), 15);
+        // The RT1062 layout: 14/18's data mailbox after the ERR005829 reserved one.
+        assert_eq!(
+            mcr::MAXMB.get(r.read32(regs::MCR)) as usize,
+            <Imxrt1062 as Layout>::data_mailbox(Configuration::Filters14_18) as usize
+        );
         assert_eq!(r.read32(regs::IMASK2), 0);
         // One filter more than 14/18 holds is refused, with the ACAN errors.
         let more: Vec<Filter> = (0..19u32)
             .map(|i| Filter::standard(0x200 + i as u16))
             .collect();
-        let e = begin_on_exact::<32, 16>(target, &settings, &primary, &more)
+        let e = begin_rt_on_exact::<32, 16>(target, &settings, &primary, &more)
             .map(|_| ())
             .unwrap_err();
         assert!(
             matches!(e, BeginError::Config(c) if c.contains(ConfigErrors::TOO_MANY_SECONDARY_FILTERS)),
             "{e:?}"
         );
-        // A table above RFFN 3 with the default layout: a typed error, from `check`
-        // and from `begin` alike, nothing written.
-        settings.configuration = Configuration::Filters16_24;
-        let expected = ConfigErrors::CONFIGURATION_NOT_ON_CHIP;
-        assert_eq!(check(target, &settings, &primary, &secondary), expected);
-        let e = begin_on_exact::<32, 16>(target, &settings, &primary, &secondary)
-            .map(|_| ())
-            .unwrap_err();
+        // The Kinetis layout (the default type) is not the RT1062's: a typed error, from
+        // `check_with_layout` and from `begin` alike, nothing written; `check` answers
+        // for the chip's own layout.
+        let expected = ConfigErrors::LAYOUT_NOT_FOR_CHIP;
+        assert_eq!(
+            twocan_flexcan::begin::check_with_layout::<twocan_flexcan::layout::Kinetis>(
+                target, &settings, &primary, &secondary
+            ),
+            expected
+        );
+        assert_eq!(
+            check(target, &settings, &primary, &secondary),
+            ConfigErrors::NONE
+        );
+        let model = model_of(target);
+        let mut sys = HostSystem::new();
+        let e = FlexCan::begin(
+            Ticking::new(model.clone()),
+            &mut sys,
+            target,
+            &settings,
+            &primary,
+            &secondary,
+        )
+        .map(|_| ())
+        .unwrap_err();
         assert_eq!(e, BeginError::Config(expected), "{target:?}");
+        assert!(sys.written().is_empty());
+        // A table above RFFN 3 in the RT1062 layout: accepted.
+        settings.configuration = Configuration::Filters16_24;
+        assert_eq!(
+            check(target, &settings, &primary, &secondary),
+            ConfigErrors::NONE
+        );
+        begin_rt_on_exact::<32, 16>(target, &settings, &primary, &secondary)
+            .unwrap_or_else(|e| panic!("{target:?}: {e:?}"));
     }
 }

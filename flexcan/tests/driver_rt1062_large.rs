@@ -28,14 +28,6 @@ use twocan_flexcan::{
 /// The driver over the model, the RT1062 layout.
 type Large<const RX: usize, const TX: usize> = Driver<FlexCanHw<Ticking, Full<Imxrt1062>>, RX, TX>;
 
-impl<const RX: usize, const TX: usize> Service for Large<RX, TX> {
-    fn service(&mut self) {
-        if self.hardware().registers().irq_pending() {
-            self.on_interrupt();
-        }
-    }
-}
-
 /// Every frame in the receive ring.
 fn drain_large<const RX: usize, const TX: usize>(can: &mut Large<RX, TX>) -> Vec<RxFrame> {
     core::iter::from_fn(|| can.receive().ok()).collect()
@@ -496,14 +488,6 @@ fn a_const_plan_of_128_elements_on_the_lean_path() {
 
 /// The lean driver with the RT1062 layout.
 type LeanLarge = Driver<FlexCanHw<Ticking, twocan_flexcan::options::Lean<Imxrt1062>>, 32, 16>;
-
-impl Service for LeanLarge {
-    fn service(&mut self) {
-        if self.hardware().registers().irq_pending() {
-            self.on_interrupt();
-        }
-    }
-}
 
 /// The bit-timing rule follows the buffers the configuration enables (IMXRT1060RM,
 /// "Arbitration and matching timing": 16 peripheral clocks per CAN bit up to 16

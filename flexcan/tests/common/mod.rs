@@ -64,6 +64,47 @@ pub fn begin_on_exact<const RX: usize, const TX: usize>(
     Ok((model, Driver::new(controller.into_split())))
 }
 
+/// The driver over the model in the RT1062 layout (a Teensy 4 module: the only layout
+/// `begin` takes there, with the ERR005829 workaround).
+pub type CanRt<const RX: usize, const TX: usize> = Driver<
+    FlexCanHw<Ticking, twocan_flexcan::options::Full<twocan_flexcan::layout::Imxrt1062>>,
+    RX,
+    TX,
+>;
+
+/// [`begin_on`] for a Teensy 4 module, in the RT1062 layout.
+pub fn begin_rt_on<const RX: usize, const TX: usize>(
+    target: Target,
+    settings: &Settings,
+    primary: &[Filter],
+    secondary: &[Filter],
+) -> Result<(FlexCanModel, CanRt<RX, TX>), BeginError> {
+    if primary.is_empty() && secondary.is_empty() {
+        return begin_rt_on_exact(target, settings, &[Filter::pass_all()], &[]);
+    }
+    begin_rt_on_exact(target, settings, primary, secondary)
+}
+
+/// [`begin_on_exact`] for a Teensy 4 module, in the RT1062 layout.
+pub fn begin_rt_on_exact<const RX: usize, const TX: usize>(
+    target: Target,
+    settings: &Settings,
+    primary: &[Filter],
+    secondary: &[Filter],
+) -> Result<(FlexCanModel, CanRt<RX, TX>), BeginError> {
+    let model = model_of(target);
+    model.scramble_ram(0x5EED);
+    let controller = FlexCan::<_, twocan_flexcan::layout::Imxrt1062>::begin_with_layout(
+        Ticking::new(model.clone()),
+        &mut HostSystem::new(),
+        target,
+        settings,
+        primary,
+        secondary,
+    )?;
+    Ok((model, Driver::new(controller.into_split())))
+}
+
 /// `begin` on can0 of a Teensy 3.2.
 pub fn begin<const RX: usize, const TX: usize>(
     settings: &Settings,
@@ -92,7 +133,9 @@ pub trait Service {
     fn service(&mut self);
 }
 
-impl<const RX: usize, const TX: usize> Service for Can<RX, TX> {
+impl<O: twocan_flexcan::options::Options, const RX: usize, const TX: usize> Service
+    for Driver<FlexCanHw<Ticking, O>, RX, TX>
+{
     fn service(&mut self) {
         if self.hardware().registers().irq_pending() {
             self.on_interrupt();
@@ -126,12 +169,18 @@ pub fn run(bus: &mut Bus, nodes: &mut [&mut dyn Service], bits: u64) {
 }
 
 /// Runs one driver's bus for `bits` bit times.
-pub fn run1<const RX: usize, const TX: usize>(bus: &mut Bus, can: &mut Can<RX, TX>, bits: u64) {
+pub fn run1<O: twocan_flexcan::options::Options, const RX: usize, const TX: usize>(
+    bus: &mut Bus,
+    can: &mut Driver<FlexCanHw<Ticking, O>, RX, TX>,
+    bits: u64,
+) {
     run(bus, &mut [can], bits);
 }
 
 /// Every frame in the receive ring.
-pub fn drain<const RX: usize, const TX: usize>(can: &mut Can<RX, TX>) -> Vec<RxFrame> {
+pub fn drain<O: twocan_flexcan::options::Options, const RX: usize, const TX: usize>(
+    can: &mut Driver<FlexCanHw<Ticking, O>, RX, TX>,
+) -> Vec<RxFrame> {
     core::iter::from_fn(|| can.receive().ok()).collect()
 }
 
