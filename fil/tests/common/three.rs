@@ -15,7 +15,7 @@ use twocan_core::Frame;
 use twocan_fil::can::Model;
 use twocan_fil::world::World;
 use twocan_flexcan::{Board, CanClock, Instance, Settings, Target};
-use twocan_host::{BxNode, FlexNode, Harness, Serviced};
+use twocan_host::{BxNode, FlexNode, Harness, Rt1062Node, Serviced};
 use twocan_sim::{NodeStats, SimNode};
 
 use super::{app_stats, assert_clean, world, Stats};
@@ -267,6 +267,8 @@ fn stats_of(app: &App) -> Stats {
 /// A board's node on the host demo's code path.
 enum HostNode {
     Flex(FlexNode),
+    /// A Teensy 4 module, in the RT1062 layout as its firmware begins it.
+    Rt(Rt1062Node),
     Bx(BxNode),
 }
 
@@ -297,8 +299,8 @@ impl HostNode {
     fn new(h: &mut Harness, board: &str, app: &App) -> HostNode {
         match board {
             "teensy36" => HostNode::Flex(FlexNode::teensy36_can0(h, &app.filters()).unwrap()),
-            "teensy41" => HostNode::Flex(
-                FlexNode::begin(
+            "teensy41" => HostNode::Rt(
+                Rt1062Node::begin(
                     h,
                     Target::new(Board::Teensy41, Instance::Can1),
                     &Settings::with_clock(BIT_RATE, CanClock::IMXRT_24MHZ),
@@ -321,6 +323,10 @@ impl HostNode {
                 app.handle(&mut n.driver);
                 app.publish(&mut n.driver);
             }
+            HostNode::Rt(n) => {
+                app.handle(&mut n.driver);
+                app.publish(&mut n.driver);
+            }
             HostNode::Bx(n) => {
                 app.handle(&mut n.driver);
                 app.publish(&mut n.driver);
@@ -331,6 +337,7 @@ impl HostNode {
     fn id(&self) -> twocan_sim::NodeId {
         match self {
             HostNode::Flex(n) => n.id,
+            HostNode::Rt(n) => n.id,
             HostNode::Bx(n) => n.id,
         }
     }
@@ -338,6 +345,7 @@ impl HostNode {
     fn filtered_out(&self) -> u64 {
         match self {
             HostNode::Flex(n) => n.filtered_out(),
+            HostNode::Rt(n) => n.filtered_out(),
             HostNode::Bx(n) => n.filtered_out(),
         }
     }
@@ -346,6 +354,7 @@ impl HostNode {
     fn lost(&self) -> u64 {
         match self {
             HostNode::Flex(n) => n.model.frames_lost(),
+            HostNode::Rt(n) => n.model.frames_lost(),
             HostNode::Bx(n) => {
                 let s = n.model.state();
                 s.overruns[0] + s.overruns[1]
@@ -358,6 +367,7 @@ impl Serviced for HostNode {
     fn service(&mut self) -> bool {
         match self {
             HostNode::Flex(n) => n.service(),
+            HostNode::Rt(n) => n.service(),
             HostNode::Bx(n) => n.service(),
         }
     }
