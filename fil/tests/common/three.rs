@@ -268,7 +268,7 @@ fn stats_of(app: &App) -> Stats {
 enum HostNode {
     Flex(FlexNode),
     /// A Teensy 4 module, in the RT1062 layout as its firmware begins it.
-    Rt(Rt1062Node),
+    Rt(Box<Rt1062Node>),
     Bx(BxNode),
 }
 
@@ -299,7 +299,7 @@ impl HostNode {
     fn new(h: &mut Harness, board: &str, app: &App) -> HostNode {
         match board {
             "teensy36" => HostNode::Flex(FlexNode::teensy36_can0(h, &app.filters()).unwrap()),
-            "teensy41" => HostNode::Rt(
+            "teensy41" => HostNode::Rt(Box::new(
                 Rt1062Node::begin(
                     h,
                     Target::new(Board::Teensy41, Instance::Can1),
@@ -308,7 +308,7 @@ impl HostNode {
                     &[],
                 )
                 .unwrap(),
-            ),
+            )),
             "nucleo-f767zi" => bx_node(h, 54_000_000, &chip::STM32F76X_F77X, app),
             "nucleo-f446re" => bx_node(h, 45_000_000, &chip::STM32F446, app),
             "bluepill" => bx_node(h, 36_000_000, &chip::STM32F103, app),
