@@ -14,11 +14,10 @@ mod common;
 use common::*;
 use twocan_core::{
     AbortRequest, Driver, Filter, Format, Frame, FrameKind, Hardware, MailboxId, MailboxState,
-    Registers, RxFrame, Token, TxOutcome,
+    Registers, Token, TxOutcome,
 };
 use twocan_flexcan::begin::check_with_layout;
 use twocan_flexcan::layout::{Imxrt1062, Layout};
-use twocan_flexcan::options::Full;
 use twocan_flexcan::regs::{self, ctrl2, iflag1, mcr};
 use twocan_flexcan::{
     BeginError, Board, CanClock, ConfigErrors, Configuration, FlexCan, FlexCanHw, HostSystem,
@@ -26,12 +25,7 @@ use twocan_flexcan::{
 };
 
 /// The driver over the model, the RT1062 layout.
-type Large<const RX: usize, const TX: usize> = Driver<FlexCanHw<Ticking, Full<Imxrt1062>>, RX, TX>;
-
-/// Every frame in the receive ring.
-fn drain_large<const RX: usize, const TX: usize>(can: &mut Large<RX, TX>) -> Vec<RxFrame> {
-    core::iter::from_fn(|| can.receive().ok()).collect()
-}
+type Large<const RX: usize, const TX: usize> = CanRt<RX, TX>;
 
 const T41: [Target; 3] = [
     Target::new(Board::Teensy41, Instance::Can1),
@@ -53,26 +47,6 @@ fn settings(configuration: Configuration, loop_back: bool) -> Settings {
     s.loop_back = loop_back;
     s.self_reception = loop_back;
     s
-}
-
-/// `begin` with the RT1062 layout on `target` over a fresh model.
-fn begin_large<const RX: usize, const TX: usize>(
-    target: Target,
-    settings: &Settings,
-    primary: &[Filter],
-    secondary: &[Filter],
-) -> Result<(twocan_flexcan::model::FlexCanModel, Large<RX, TX>), BeginError> {
-    let model = model_of(target);
-    model.scramble_ram(0x5EED);
-    let controller = FlexCan::<_, Imxrt1062>::begin_with_layout(
-        Ticking::new(model.clone()),
-        &mut HostSystem::new(),
-        target,
-        settings,
-        primary,
-        secondary,
-    )?;
-    Ok((model, Driver::new(controller.into_split())))
 }
 
 /// A full table for `c`: primary filters of every kind (exact standard data, a masked
@@ -133,10 +107,7 @@ fn send_and_check<const RX: usize, const TX: usize>(
             tokens.push(can.try_send(f).unwrap());
         }
         run(bus, &mut [can], 200 * batch.len() as u64 + 500);
-        let got: Vec<(Frame, u16)> = drain_large(can)
-            .iter()
-            .map(|r| (r.frame, r.filter))
-            .collect();
+        let got: Vec<(Frame, u16)> = drain(can).iter().map(|r| (r.frame, r.filter)).collect();
         assert_eq!(got, batch.to_vec());
         let done: Vec<_> = std::iter::from_fn(|| can.take_completion()).collect();
         assert_eq!(
@@ -154,7 +125,7 @@ fn tables_of_32_64_96_and_128_elements_give_every_user_index() {
         let target = T41[k % 3];
         let (primary, secondary) = lists(c);
         let (model, mut can) =
-            begin_large::<64, 16>(target, &settings(c, true), &primary, &secondary)
+            begin_rt_on_exact::<64, 16>(target, &settings(c, true), &primary, &secondary)
                 .unwrap_or_else(|e| panic!("{c:?}: {e:?}"));
         assert_eq!(
             can.receive_context().filters().elements().len(),
@@ -188,7 +159,7 @@ fn tables_of_32_64_96_and_128_elements_give_every_user_index() {
         // A frame no filter accepts is not received.
         can.try_send(&std_data(0x7FF, &[])).unwrap();
         run(&mut bus, &mut [&mut can], 500);
-        assert!(drain_large(&mut can).is_empty(), "{c:?}");
+        assert!(drain(&mut can).is_empty(), "{c:?}");
         assert_eq!(
             can.take_completion().map(|c| c.outcome),
             Some(TxOutcome::Sent)
@@ -203,7 +174,7 @@ fn every_rffn_of_the_chip_begins_and_sends_from_its_mailboxes() {
     for c in Configuration::EVERY {
         let (primary, secondary) = lists(c);
         let (model, mut can) =
-            begin_large::<32, 8>(T41[0], &settings(c, true), &primary, &secondary)
+            begin_rt_on_exact::<32, 8>(T41[0], &settings(c, true), &primary, &secondary)
                 .unwrap_or_else(|e| panic!("{c:?}: {e:?}"));
         let mut bus = bus_with(500_000, &[&model]);
         // The first and last filters of each kind.
@@ -221,7 +192,8 @@ fn remote_frames_from_mailboxes_above_mb31_complete_once_in_order() {
     let c = Configuration::Filters32_96;
     assert!(Imxrt1062::first_remote_mailbox(c) >= 32 && c.remote_mailbox_count() == 7);
     let (model, mut can) =
-        begin_large::<32, 16>(T41[2], &settings(c, true), &[Filter::pass_all()], &[]).unwrap();
+        begin_rt_on_exact::<32, 16>(T41[2], &settings(c, true), &[Filter::pass_all()], &[])
+            .unwrap();
     let mut bus = bus_with(500_000, &[&model]);
     // Remote frames straight into their mailboxes (several at once: their flags end
     // together in IFLAG2), data frames through the data mailbox.
@@ -240,7 +212,7 @@ fn remote_frames_from_mailboxes_above_mb31_complete_once_in_order() {
         tokens.push(can.try_send(&std_data(0x600 + i, &[i as u8])).unwrap());
     }
     run(&mut bus, &mut [&mut can], 5_000);
-    let got = drain_large(&mut can);
+    let got = drain(&mut can);
     assert_eq!(got.len(), 10);
     assert!(got.iter().all(|r| r.filter == 0));
     // The remote frames win arbitration by identifier (smallest first).
@@ -276,7 +248,8 @@ fn abort_in_a_mailbox_above_mb31() {
     // Normal mode, alone on the bus: nothing leaves the mailboxes before bus time.
     let c = Configuration::Filters32_80;
     let (_model, mut can) =
-        begin_large::<32, 16>(T41[1], &settings(c, false), &[Filter::pass_all()], &[]).unwrap();
+        begin_rt_on_exact::<32, 16>(T41[1], &settings(c, false), &[Filter::pass_all()], &[])
+            .unwrap();
     let data = can.try_send(&std_data(0x123, &[1])).unwrap();
     let rtr = can.try_send_now(&remote(0x42, false)).unwrap();
     assert_eq!(can.mailbox_state(MailboxId(0)), MailboxState::Pending);
@@ -303,7 +276,7 @@ fn a_128_element_table_is_switched_while_running() {
     let c = Configuration::Filters32_96;
     let (primary, secondary) = lists(c);
     let (model, mut can) =
-        begin_large::<64, 16>(T41[0], &settings(c, true), &primary, &secondary).unwrap();
+        begin_rt_on_exact::<64, 16>(T41[0], &settings(c, true), &primary, &secondary).unwrap();
     let mut bus = bus_with(500_000, &[&model]);
     // The lists swapped: the old secondary identifiers are now the first filters.
     let new_primary: Vec<Filter> = secondary[..32].to_vec();
@@ -335,7 +308,7 @@ fn too_large_a_table_is_a_typed_error() {
         check_with_layout::<Imxrt1062>(T41[0], &s, &more, &secondary),
         expected
     );
-    let e = begin_large::<8, 8>(T41[0], &s, &more, &secondary)
+    let e = begin_rt_on_exact::<8, 8>(T41[0], &s, &more, &secondary)
         .map(|_| ())
         .unwrap_err();
     assert_eq!(e, BeginError::Config(expected));
@@ -347,7 +320,7 @@ fn too_large_a_table_is_a_typed_error() {
         check_with_layout::<Imxrt1062>(t36, &k, &[], &[]),
         ConfigErrors::CONFIGURATION_NOT_ON_CHIP
     );
-    let e = begin_large::<8, 8>(t36, &k, &[Filter::pass_all()], &[])
+    let e = begin_rt_on_exact::<8, 8>(t36, &k, &[Filter::pass_all()], &[])
         .map(|_| ())
         .unwrap_err();
     assert_eq!(
@@ -365,7 +338,7 @@ fn too_large_a_table_is_a_typed_error() {
             ConfigErrors::CONFIGURATION_NOT_ON_CHIP,
             "{c:?}"
         );
-        let e = begin_large::<8, 8>(t36, &k, &[Filter::pass_all()], &[])
+        let e = begin_rt_on_exact::<8, 8>(t36, &k, &[Filter::pass_all()], &[])
             .map(|_| ())
             .unwrap_err();
         assert_eq!(
@@ -385,7 +358,7 @@ fn too_large_a_table_is_a_typed_error() {
 fn end_masks_the_mailboxes_above_mb31_and_begin_runs_again() {
     let c = Configuration::Filters32_96;
     let (_model, can) =
-        begin_large::<8, 8>(T41[0], &settings(c, true), &[Filter::pass_all()], &[]).unwrap();
+        begin_rt_on_exact::<8, 8>(T41[0], &settings(c, true), &[Filter::pass_all()], &[]).unwrap();
     let tx = (Imxrt1062::first_remote_mailbox(c)..=Imxrt1062::data_mailbox(c))
         .fold(0u32, |m, mb| m | 1 << (mb - 32));
     assert_eq!(can.hardware().registers().read32(regs::IMASK2), tx);
@@ -511,7 +484,10 @@ fn the_timing_rule_counts_the_enabled_buffers() {
         let s = fast(c, None);
         let e = check_with_layout::<Imxrt1062>(T41[0], &s, &pass, &[]);
         assert_eq!(e.is_empty(), ok, "{c:?}: {e:?}");
-        assert_eq!(begin_large::<8, 8>(T41[0], &s, &pass, &[]).is_ok(), ok);
+        assert_eq!(
+            begin_rt_on_exact::<8, 8>(T41[0], &s, &pass, &[]).is_ok(),
+            ok
+        );
         let s = fast(c, Some(150_000_000));
         assert_eq!(
             check_with_layout::<Imxrt1062>(T41[0], &s, &pass, &[]),
@@ -520,7 +496,7 @@ fn the_timing_rule_counts_the_enabled_buffers() {
     }
     // The running controller applies the same rule: 32/96 at 500 kbit/s, then 1 Mbit/s
     // refused with nothing written; the capabilities report the 30-clock rule.
-    let (_model, mut can) = begin_large::<8, 8>(
+    let (_model, mut can) = begin_rt_on_exact::<8, 8>(
         T41[0],
         &settings(Configuration::Filters32_96, false),
         &pass,

@@ -27,8 +27,8 @@ use twocan_flexcan::{
     BeginError, Board, CanClock, ConfigErrors, Configuration, FlexCanHw, Instance, Settings, Target,
 };
 use twocan_host::{
-    attach_plain, BxNode, FlexNode, FlexNodeOf, Harness, Rt1062Node, Serviced, SetupError, RX_RING,
-    STM32F767_APB1_HZ, TX_RING,
+    attach_plain, BxNode, FlexNodeOf, Harness, Serviced, SetupError, RX_RING, STM32F767_APB1_HZ,
+    TX_RING,
 };
 use twocan_sim::{Bus, BusNode, NodeId};
 
@@ -302,7 +302,9 @@ pub trait FlexPart: 'static {
         primary: &[Filter],
         secondary: &[Filter],
         attach: impl FnOnce(&mut Bus, &str, Box<dyn BusNode>) -> NodeId,
-    ) -> Result<FlexNodeOf<Self::Layout>, SetupError>;
+    ) -> Result<FlexNodeOf<Self::Layout>, SetupError> {
+        FlexNodeOf::<Self::Layout>::begin_via(h, Self::TARGET, settings, primary, secondary, attach)
+    }
 }
 
 /// The configuration the suite's FlexCAN nodes are begun with when they hold few
@@ -334,15 +336,6 @@ impl FlexPart for Teensy36Can0 {
     const TARGET: Target = Target::new(Board::Teensy36, Instance::Can0);
     const CLOCK: CanClock = CanClock::Oscillator16MHz;
     type Layout = Kinetis;
-    fn begin_via(
-        h: &mut Harness,
-        settings: &Settings,
-        primary: &[Filter],
-        secondary: &[Filter],
-        attach: impl FnOnce(&mut Bus, &str, Box<dyn BusNode>) -> NodeId,
-    ) -> Result<FlexNode, SetupError> {
-        FlexNode::begin_via(h, Self::TARGET, settings, primary, secondary, attach)
-    }
 }
 
 /// CAN3 of a Teensy 4.1 (i.MX RT1062, 64 message buffers, the CAN FD capable module in
@@ -356,15 +349,6 @@ impl FlexPart for Teensy41Can3 {
     const TARGET: Target = Target::new(Board::Teensy41, Instance::Can3);
     const CLOCK: CanClock = CanClock::IMXRT_24MHZ;
     type Layout = Imxrt1062;
-    fn begin_via(
-        h: &mut Harness,
-        settings: &Settings,
-        primary: &[Filter],
-        secondary: &[Filter],
-        attach: impl FnOnce(&mut Bus, &str, Box<dyn BusNode>) -> NodeId,
-    ) -> Result<Rt1062Node, SetupError> {
-        Rt1062Node::begin_via(h, Self::TARGET, settings, primary, secondary, attach)
-    }
 }
 
 /// A FlexCAN module through ACAN's `begin`: the driver is the same for every part, the

@@ -462,6 +462,27 @@ pub struct Outcome {
     pub tx_interrupt_on: Option<bool>,
 }
 
+/// Retries `send` while it says `WouldBlock`, running `wait` in between (the 100th
+/// `WouldBlock` fails the test: "no `what` comes"); the token it gives.
+fn until_accepted(
+    name: &str,
+    what: &str,
+    mut send: impl FnMut() -> nb::Result<Token, twocan_core::Error>,
+    mut wait: impl FnMut(),
+) -> Token {
+    for tries in 1.. {
+        match send() {
+            Ok(token) => return token,
+            Err(nb::Error::WouldBlock) => {
+                assert!(tries < 100, "{name}: no {what} comes");
+                wait();
+            }
+            Err(nb::Error::Other(e)) => panic!("{name}: {e:?}"),
+        }
+    }
+    unreachable!("the loop returns or panics")
+}
+
 /// Plays `steps` on a fresh `rig`, preempting at `at`, then runs the bus with the
 /// handlers serviced until nothing is left to do.
 pub fn run_script<H: Hardware + 'static, Q: TxQueue + 'static, const D: usize, Fe: Features>(
@@ -479,21 +500,15 @@ pub fn run_script<H: Hardware + 'static, Q: TxQueue + 'static, const D: usize, F
     for step in steps {
         match *step {
             Step::Send(frame) => {
-                let mut tries = 0;
-                loop {
-                    match rig.tx.try_send(&frame) {
-                        Ok(token) => {
-                            accepted.push((token, frame));
-                            break;
-                        }
-                        Err(nb::Error::WouldBlock) => {
-                            tries += 1;
-                            assert!(tries < 100, "{}: no room comes", rig.name);
-                            p.paused(|| bus.borrow_mut().step());
-                        }
-                        Err(nb::Error::Other(e)) => panic!("{}: {e:?}", rig.name),
-                    }
-                }
+                let token = until_accepted(
+                    rig.name,
+                    "room",
+                    || rig.tx.try_send(&frame),
+                    || {
+                        p.paused(|| bus.borrow_mut().step());
+                    },
+                );
+                accepted.push((token, frame));
             }
             Step::Abort(n) => aborts.push(rig.tx.abort(accepted[n].0)),
             Step::AbortAll => {
@@ -501,25 +516,19 @@ pub fn run_script<H: Hardware + 'static, Q: TxQueue + 'static, const D: usize, F
                 aborted_all = true;
             }
             Step::SendNow(frame) => {
-                let mut tries = 0;
-                loop {
-                    match rig.tx.try_send_now(&frame) {
-                        Ok(token) => {
-                            accepted.push((token, frame));
-                            overtaking.push(accepted.len() - 1);
-                            break;
-                        }
-                        Err(nb::Error::WouldBlock) => {
-                            // No mailbox free and settled: the bus moves on and the
-                            // handlers settle what ended.
-                            tries += 1;
-                            assert!(tries < 100, "{}: no mailbox comes", rig.name);
-                            p.paused(|| bus.borrow_mut().step());
-                            p.run_handlers();
-                        }
-                        Err(nb::Error::Other(e)) => panic!("{}: {e:?}", rig.name),
-                    }
-                }
+                // No mailbox free and settled: the bus moves on and the handlers settle
+                // what ended.
+                let token = until_accepted(
+                    rig.name,
+                    "mailbox",
+                    || rig.tx.try_send_now(&frame),
+                    || {
+                        p.paused(|| bus.borrow_mut().step());
+                        p.run_handlers();
+                    },
+                );
+                accepted.push((token, frame));
+                overtaking.push(accepted.len() - 1);
             }
             Step::Poll => rig.tx.poll(),
             Step::Bus(bits) => {
@@ -586,18 +595,7 @@ impl Outcome {
         }
         // Each of our frames on the wire once if sent, never if aborted; the wire shows
         // them in an order the transmit order allows.
-        let mut index = HashMap::new();
-        for (i, (_, f)) in self.accepted.iter().enumerate() {
-            assert!(
-                index.insert(*f, i).is_none(),
-                "{what}: frames must be distinct"
-            );
-        }
-        let ours: Vec<usize> = self
-            .wire
-            .iter()
-            .filter_map(|f| index.get(f).copied())
-            .collect();
+        let ours = self.ours_on_the_wire(what);
         for (i, (token, frame)) in self.accepted.iter().enumerate() {
             let times = ours.iter().filter(|&&k| k == i).count();
             let Some(o) = outcome.get(token) else {
@@ -616,9 +614,9 @@ impl Outcome {
         self.check_order(&ours, policy, what);
     }
 
-    /// The checks without completions (fire and forget): the queue count back to 0,
-    /// no completion, each frame on the wire exactly once (at most once when the
-    /// scenario aborts), in an order the transmit order allows.
+    /// The checks without completions (fire and forget): the queue count back to 0, the
+    /// quiet mode's transmit interrupt off, each frame on the wire exactly once (at
+    /// most once when the scenario aborts), in an order the transmit order allows.
     fn check_quiet(&self, policy: TxPolicy, what: &str) {
         assert_eq!(self.queue_count, 0, "{what}: queue count at the end");
         if self.quiet {
@@ -629,18 +627,7 @@ impl Outcome {
                 "{what}: transmit interrupt on with an empty queue"
             );
         }
-        let mut index = HashMap::new();
-        for (i, (_, f)) in self.accepted.iter().enumerate() {
-            assert!(
-                index.insert(*f, i).is_none(),
-                "{what}: frames must be distinct"
-            );
-        }
-        let ours: Vec<usize> = self
-            .wire
-            .iter()
-            .filter_map(|f| index.get(f).copied())
-            .collect();
+        let ours = self.ours_on_the_wire(what);
         for (i, (_, frame)) in self.accepted.iter().enumerate() {
             let times = ours.iter().filter(|&&k| k == i).count();
             if self.aborts.is_empty() && !self.aborted_all {
@@ -654,6 +641,22 @@ impl Outcome {
             }
         }
         self.check_order(&ours, policy, what);
+    }
+
+    /// Our frames on the wire, as indices into `accepted` in wire order (the frames
+    /// must be distinct).
+    fn ours_on_the_wire(&self, what: &str) -> Vec<usize> {
+        let mut index = HashMap::new();
+        for (i, (_, f)) in self.accepted.iter().enumerate() {
+            assert!(
+                index.insert(*f, i).is_none(),
+                "{what}: frames must be distinct"
+            );
+        }
+        self.wire
+            .iter()
+            .filter_map(|f| index.get(f).copied())
+            .collect()
     }
 
     /// Our frames (indices into `accepted`, in wire order) left in an order `policy`

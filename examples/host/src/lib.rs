@@ -187,51 +187,12 @@ impl FlexNode {
             &[],
         )
     }
-
-    /// Any instance with explicit settings and primary / secondary filters.
-    pub fn begin(
-        h: &mut Harness,
-        target: Target,
-        settings: &Settings,
-        primary: &[Filter],
-        secondary: &[Filter],
-    ) -> Result<Self, SetupError> {
-        Self::begin_via(h, target, settings, primary, secondary, attach_plain)
-    }
-
-    /// Like [`FlexNode::begin`], but `attach` puts the model on the bus: a test can wrap
-    /// the model in its own [`BusNode`] (to watch or act on every bus event) before it
-    /// attaches it. `attach` gets the bus, the node's name and the model handle.
-    pub fn begin_via(
-        h: &mut Harness,
-        target: Target,
-        settings: &Settings,
-        primary: &[Filter],
-        secondary: &[Filter],
-        attach: impl FnOnce(&mut Bus, &str, Box<dyn BusNode>) -> NodeId,
-    ) -> Result<Self, SetupError> {
-        let (model, regs, id) = flex_model_via(h, target, attach);
-        let controller = FlexCan::begin(
-            regs,
-            &mut HostSystem::new(),
-            target,
-            settings,
-            primary,
-            secondary,
-        )
-        .map_err(SetupError::FlexCan)?;
-        Ok(FlexNode {
-            model,
-            driver: Driver::new(controller.into_split()),
-            id,
-        })
-    }
 }
 
-impl Rt1062Node {
-    /// A Teensy 4.x module (`target`) in the RT1062 layout with explicit settings and
-    /// primary / secondary filters: `FlexCan::<_, Imxrt1062>::begin_with_layout`, as a
-    /// Teensy 4 program begins it.
+impl<L: Layout> FlexNodeOf<L> {
+    /// Any instance with explicit settings and primary / secondary filters, begun in the
+    /// layout `L` (`FlexCan::<_, L>::begin_with_layout`; [`FlexNode`]: ACAN's,
+    /// `FlexCan::begin`; [`Rt1062Node`]: the RT1062's, as a Teensy 4 program begins it).
     pub fn begin(
         h: &mut Harness,
         target: Target,
@@ -242,8 +203,9 @@ impl Rt1062Node {
         Self::begin_via(h, target, settings, primary, secondary, attach_plain)
     }
 
-    /// Like [`Rt1062Node::begin`], but `attach` puts the model on the bus (see
-    /// [`FlexNode::begin_via`]).
+    /// Like [`FlexNodeOf::begin`], but `attach` puts the model on the bus: a test can
+    /// wrap the model in its own [`BusNode`] (to watch or act on every bus event) before
+    /// it attaches it. `attach` gets the bus, the node's name and the model handle.
     pub fn begin_via(
         h: &mut Harness,
         target: Target,
@@ -253,7 +215,7 @@ impl Rt1062Node {
         attach: impl FnOnce(&mut Bus, &str, Box<dyn BusNode>) -> NodeId,
     ) -> Result<Self, SetupError> {
         let (model, regs, id) = flex_model_via(h, target, attach);
-        let controller = FlexCan::<_, Imxrt1062>::begin_with_layout(
+        let controller = FlexCan::<_, L>::begin_with_layout(
             regs,
             &mut HostSystem::new(),
             target,

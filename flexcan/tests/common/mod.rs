@@ -3,6 +3,7 @@
 #![allow(dead_code)]
 
 use twocan_core::{Driver, Filter, Frame, RxFrame};
+use twocan_flexcan::layout::{Imxrt1062, Kinetis, Layout};
 use twocan_flexcan::model::FlexCanModel;
 use twocan_flexcan::{
     BeginError, Board, FlexCan, FlexCanHw, HostSystem, Instance, Settings, Target,
@@ -27,6 +28,15 @@ pub fn model_of(target: Target) -> FlexCanModel {
     FlexCanModel::new(target.model_chip())
 }
 
+/// The driver over the model in the layout `L` with receive ring `RX` and transmit
+/// ring `TX`.
+pub type CanIn<L, const RX: usize, const TX: usize> =
+    Driver<FlexCanHw<Ticking, twocan_flexcan::options::Full<L>>, RX, TX>;
+
+/// The driver over the model in the RT1062 layout (a Teensy 4 module: the only layout
+/// `begin` takes there, with the ERR005829 workaround).
+pub type CanRt<const RX: usize, const TX: usize> = CanIn<Imxrt1062, RX, TX>;
+
 /// `begin` on `target` over a fresh model; gives the model handle and the driver.
 ///
 /// These tests follow ACAN's examples, whose "no filter" form receives everything: with
@@ -38,10 +48,7 @@ pub fn begin_on<const RX: usize, const TX: usize>(
     primary: &[Filter],
     secondary: &[Filter],
 ) -> Result<(FlexCanModel, Can<RX, TX>), BeginError> {
-    if primary.is_empty() && secondary.is_empty() {
-        return begin_on_exact(target, settings, &[Filter::pass_all()], &[]);
-    }
-    begin_on_exact(target, settings, primary, secondary)
+    begin_in_on::<Kinetis, RX, TX>(target, settings, primary, secondary)
 }
 
 /// `begin` with exactly these lists (both empty: nothing is received).
@@ -51,26 +58,8 @@ pub fn begin_on_exact<const RX: usize, const TX: usize>(
     primary: &[Filter],
     secondary: &[Filter],
 ) -> Result<(FlexCanModel, Can<RX, TX>), BeginError> {
-    let model = model_of(target);
-    model.scramble_ram(0x5EED);
-    let controller = FlexCan::begin(
-        Ticking::new(model.clone()),
-        &mut HostSystem::new(),
-        target,
-        settings,
-        primary,
-        secondary,
-    )?;
-    Ok((model, Driver::new(controller.into_split())))
+    begin_in_on_exact::<Kinetis, RX, TX>(target, settings, primary, secondary)
 }
-
-/// The driver over the model in the RT1062 layout (a Teensy 4 module: the only layout
-/// `begin` takes there, with the ERR005829 workaround).
-pub type CanRt<const RX: usize, const TX: usize> = Driver<
-    FlexCanHw<Ticking, twocan_flexcan::options::Full<twocan_flexcan::layout::Imxrt1062>>,
-    RX,
-    TX,
->;
 
 /// [`begin_on`] for a Teensy 4 module, in the RT1062 layout.
 pub fn begin_rt_on<const RX: usize, const TX: usize>(
@@ -79,10 +68,7 @@ pub fn begin_rt_on<const RX: usize, const TX: usize>(
     primary: &[Filter],
     secondary: &[Filter],
 ) -> Result<(FlexCanModel, CanRt<RX, TX>), BeginError> {
-    if primary.is_empty() && secondary.is_empty() {
-        return begin_rt_on_exact(target, settings, &[Filter::pass_all()], &[]);
-    }
-    begin_rt_on_exact(target, settings, primary, secondary)
+    begin_in_on::<Imxrt1062, RX, TX>(target, settings, primary, secondary)
 }
 
 /// [`begin_on_exact`] for a Teensy 4 module, in the RT1062 layout.
@@ -92,9 +78,32 @@ pub fn begin_rt_on_exact<const RX: usize, const TX: usize>(
     primary: &[Filter],
     secondary: &[Filter],
 ) -> Result<(FlexCanModel, CanRt<RX, TX>), BeginError> {
+    begin_in_on_exact::<Imxrt1062, RX, TX>(target, settings, primary, secondary)
+}
+
+/// [`begin_on`] in the layout `L`.
+fn begin_in_on<L: Layout, const RX: usize, const TX: usize>(
+    target: Target,
+    settings: &Settings,
+    primary: &[Filter],
+    secondary: &[Filter],
+) -> Result<(FlexCanModel, CanIn<L, RX, TX>), BeginError> {
+    if primary.is_empty() && secondary.is_empty() {
+        return begin_in_on_exact::<L, RX, TX>(target, settings, &[Filter::pass_all()], &[]);
+    }
+    begin_in_on_exact::<L, RX, TX>(target, settings, primary, secondary)
+}
+
+/// [`begin_on_exact`] in the layout `L` (`FlexCan::begin` is the Kinetis layout's).
+fn begin_in_on_exact<L: Layout, const RX: usize, const TX: usize>(
+    target: Target,
+    settings: &Settings,
+    primary: &[Filter],
+    secondary: &[Filter],
+) -> Result<(FlexCanModel, CanIn<L, RX, TX>), BeginError> {
     let model = model_of(target);
     model.scramble_ram(0x5EED);
-    let controller = FlexCan::<_, twocan_flexcan::layout::Imxrt1062>::begin_with_layout(
+    let controller = FlexCan::<_, L>::begin_with_layout(
         Ticking::new(model.clone()),
         &mut HostSystem::new(),
         target,
