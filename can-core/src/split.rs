@@ -759,12 +759,7 @@ impl<
         }
         let mut displaced = false;
         while let Some(next) = q.peek() {
-            let free = if Self::QUIET_TX {
-                hw.free_mailbox_quiet(&next.frame)
-            } else {
-                hw.free_mailbox(&next.frame)
-            };
-            match free {
+            match self.free_mailbox(&next.frame) {
                 Ok(Some(m)) => {
                     let e = *next;
                     q.pop();
@@ -799,6 +794,18 @@ impl<
             }
         }
         self.quiet_if_empty(q);
+    }
+
+    /// The controller's mailbox for `frame` in the request order this state keeps:
+    /// [`Hardware::free_mailbox_quiet`] in the quiet mode (ends need no acknowledgement),
+    /// else [`Hardware::free_mailbox`] (settled mailboxes only).
+    #[inline(always)]
+    fn free_mailbox(&self, frame: &Frame) -> Result<Option<u8>, Error> {
+        if Self::QUIET_TX {
+            self.hw().free_mailbox_quiet(frame)
+        } else {
+            self.hw().free_mailbox(frame)
+        }
     }
 
     /// The quiet mode: with nothing left to refill, no transmit interrupt until a frame
@@ -1021,12 +1028,7 @@ impl<
         // Relaxed: on the direct path this half reads no memory that the transmit
         // interrupt writes, only the hardware's mailbox status (`free_mailbox`).
         if s.queue_len.load(Ordering::Relaxed) == 0 {
-            let free = if State::<H, RX, Q, RX1, DONE, Fe>::QUIET_TX {
-                hw.free_mailbox_quiet(frame)
-            } else {
-                hw.free_mailbox(frame)
-            };
-            match free {
+            match s.free_mailbox(frame) {
                 Ok(Some(m)) => {
                     // SAFETY: the transmit half's direct path: the queue is empty and only
                     // this half fills it, so the interrupt's refill loads nothing and
@@ -1065,12 +1067,7 @@ impl<
                     return Err(nb::Error::WouldBlock);
                 }
             }
-            let mode = if State::<H, RX, Q, RX1, DONE, Fe>::QUIET_TX {
-                hw.free_mailbox_quiet(frame)
-            } else {
-                hw.free_mailbox(frame)
-            };
-            if let Err(e) = mode {
+            if let Err(e) = s.free_mailbox(frame) {
                 return Err(nb::Error::Other(e));
             }
             if q.push(Queued {
