@@ -82,6 +82,13 @@ bitflags::bitflags! {
         /// [`crate::layout::Imxrt1062`] (`FlexCan::<_, Imxrt1062>::begin_with_layout`,
         /// the tokens, the one calls and the hand-over do). Nothing is written.
         const LAYOUT_NOT_FOR_CHIP = 1 << 13;
+        /// Bit 14 (not in ACAN): on the i.MX RT1062, the settings' clock root
+        /// ([`crate::Settings::can_clock`]) differs from the one `CCM_CSCMR2` selects
+        /// and another FlexCAN module runs on it (its clock gate on, `MCR[NOTRDY]`
+        /// clear: Normal, Listen-Only or Loop-Back mode): switching the shared `CAN_CLK_ROOT` would change that module's bit
+        /// rate (IMXRT1060RM "CCM_CSCMR2"; [`crate::imxrt::ImxrtPlan::apply`]). Found
+        /// by `begin` from the hardware, not by [`crate::check`]; nothing is written.
+        const CLOCK_ROOT_IN_USE = 1 << 14;
     }
 }
 

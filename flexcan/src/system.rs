@@ -13,6 +13,7 @@ use core::cell::{Ref, RefCell};
 
 use twocan_core::Registers;
 
+use crate::begin_error::ConfigErrors;
 use crate::board::InstancePins;
 use crate::imxrt::ImxrtPlan;
 use crate::regs::pins::CanPin;
@@ -124,10 +125,14 @@ impl SystemPlan {
     }
 
     /// Enables the clocks and muxes the pins ([`PortPlan::apply`],
-    /// [`ImxrtPlan::apply`]).
-    pub fn apply<S: Registers>(&self, sys: &mut S) {
+    /// [`ImxrtPlan::apply`]); on the i.MX RT1062, refuses to switch the clock root
+    /// under a running module ([`ConfigErrors::CLOCK_ROOT_IN_USE`], nothing written).
+    pub fn apply<S: Registers>(&self, sys: &mut S) -> Result<(), ConfigErrors> {
         match self {
-            SystemPlan::Kinetis(p) => p.apply(sys),
+            SystemPlan::Kinetis(p) => {
+                p.apply(sys);
+                Ok(())
+            }
             SystemPlan::Imxrt(p) => p.apply(sys),
         }
     }

@@ -34,6 +34,16 @@ pub const fn cg_on(n: u32) -> u32 {
     0b11 << (2 * n)
 }
 
+/// The three modules on the root, for the check that a running module keeps its root
+/// ([`crate::imxrt::ImxrtPlan::apply`]): the `CCGR` register and bits of the module's
+/// register-access gate (`can1_clk` CCGR0 CG7, `can2_clk` CG9, `can3_clk` CCGR7 CG3;
+/// a gated module's registers are not read) and the address of its `MCR` (the base).
+pub const MODULES_ON_ROOT: [(usize, u32, usize); 3] = [
+    (CCM_CCGR0, cg_on(7), super::CAN1_BASE),
+    (CCM_CCGR0, cg_on(9), super::CAN2_BASE),
+    (CCM_CCGR7, cg_on(3), super::CAN3_BASE),
+];
+
 /// Highest `CAN_CLK_ROOT` frequency the data sheet allows.
 pub const MAX_ROOT_HZ: u32 = 80_000_000;
 

@@ -3,6 +3,12 @@
 //!
 //! Order (IMXRT1060RM, CCM "Clock Switching": a clock root's multiplexer and divider are
 //! changed while the clocks it feeds are gated off):
+//! 0. if the root asked for differs from the one `CSCMR2` selects and another module
+//!    runs on it — its register-access gate on and `MCR[NOTRDY]` clear (FlexCAN
+//!    "Module Configuration Register": the module is in Normal, Listen-Only or
+//!    Loop-Back mode; an RT1062 module leaves reset enabled in Freeze mode,
+//!    `MCR` = 0x5980_000F, which does not count) — nothing is written and `begin`
+//!    refuses with [`crate::ConfigErrors::CLOCK_ROOT_IN_USE`];
 //! 1. the module's `CCGR` fields cleared;
 //! 2. `CSCMR2[CAN_CLK_SEL, CAN_CLK_PODF]` written, only if they differ from the root
 //!    asked for (the root is shared: a module already running on the same root is
@@ -11,15 +17,19 @@
 //! 4. each pad muxed (`SW_MUX_CTL_PAD_*[MUX_MODE]`), its pad control written, and the
 //!    Rx signal's daisy-chain input selection pointed at the Rx pad.
 //!
-//! The read-modify-writes of the shared CCM registers run in a critical section.
+//! The check and the read-modify-writes of the shared CCM registers run in one critical
+//! section.
 //!
-//! **The root is shared by CAN1, CAN2 and CAN3.** Beginning one module on another root
-//! than a running one changes the running module's bit rate: give every module of a
-//! firmware the same [`crate::CanClock`].
+//! **The root is shared by CAN1, CAN2 and CAN3.** Switching it would change the bit
+//! rate of a module already running on it, so it is refused (step 0): give every
+//! module of a firmware the same [`crate::CanClock`], or end the running modules
+//! before beginning one on another root.
 
 use twocan_core::Registers;
 
-use super::ccm::{ClockRoot, CCM_CSCMR2};
+use super::ccm::{ClockRoot, CCM_CSCMR2, MODULES_ON_ROOT};
+use crate::begin_error::ConfigErrors;
+use crate::regs::{mcr, MCR};
 use super::pads::{rx_pad, tx_pad, ImxPin, MUX_MODE, MUX_RESET, PAD_RESET};
 
 /// The chip-level writes of one RT1062 FlexCAN module.
@@ -53,18 +63,34 @@ impl ImxrtPlan {
         }
     }
 
-    /// Steps 1–4 of the module documentation.
-    pub fn apply<S: Registers>(&self, sys: &mut S) {
+    /// Whether a module other than this plan's runs on the root: its register-access
+    /// gate on (any `CGn` value but 00) and `MCR[NOTRDY]` clear. A gated module is not
+    /// read (its registers would answer with a bus error).
+    fn another_module_enabled<S: Registers>(&self, sys: &S) -> bool {
+        let (own_gate, own_bits) = self.clock_gate;
+        MODULES_ON_ROOT.iter().any(|&(gate, bits, base)| {
+            let own = gate == own_gate && bits & own_bits != 0;
+            !own && sys.read32(gate) & bits != 0 && sys.read32(base + MCR) & mcr::NOTRDY == 0
+        })
+    }
+
+    /// Steps 0–4 of the module documentation; step 0's refusal is
+    /// [`ConfigErrors::CLOCK_ROOT_IN_USE`], with nothing written.
+    pub fn apply<S: Registers>(&self, sys: &mut S) -> Result<(), ConfigErrors> {
         let (gate, bits) = self.clock_gate;
         critical_section::with(|_| {
             let cscmr2 = sys.read32(CCM_CSCMR2);
             let wanted = self.root.cscmr2(cscmr2);
             if wanted != cscmr2 {
+                if self.another_module_enabled(sys) {
+                    return Err(ConfigErrors::CLOCK_ROOT_IN_USE);
+                }
                 sys.modify32(gate, |v| v & !bits);
                 sys.write32(CCM_CSCMR2, wanted);
             }
             sys.modify32(gate, |v| v | bits);
-        });
+            Ok(())
+        })?;
         for (pin, pad) in [self.tx, self.rx] {
             sys.write32(pin.mux, MUX_MODE.val(pin.alt));
             sys.write32(pin.pad_ctl, pad);
@@ -72,6 +98,7 @@ impl ImxrtPlan {
                 sys.write32(select, value);
             }
         }
+        Ok(())
     }
 
     /// Undoes [`ImxrtPlan::apply`] for the module (`end`): the pads back to their reset
