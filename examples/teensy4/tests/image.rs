@@ -11,7 +11,11 @@
 //! start 0x6000_0000, a size covering every loaded byte); and what cortex-m-rt's reset
 //! needs: the vector table the IVT names, its stack pointer at the top of the DTCM, its
 //! reset vector odd (Thumb) and in the flash, and the CAN1/CAN2/CAN3 device vectors at 36,
-//! 37 and 154 pointing at the library's entry points. Prints flash and RAM use.
+//! 37 and 154 pointing at the library's entry points. The configuration block's
+//! `sflashA1Size` (offset 0x50) is a Teensy 4 flash — 2 MiB (4.0) or 8 MiB (4.1), the one
+//! `$TWOCAN_TEENSY4_BOARD` (`teensy40`/`teensy41`, set by CI) names — and the image
+//! ends inside it (`runner.sh` picks `--mcu` from the same word). Prints flash and RAM
+//! use.
 //!
 //! Where the ELFs are: `$TWOCAN_FIRMWARE_DIR`, else the workspace's
 //! `target/thumbv7em-none-eabihf/release`. Without them the test says so and passes,
@@ -79,6 +83,16 @@ fn boot_header_and_vector_table() {
         // FlexSPI configuration block: tag "FCFB", version 1.4.0.
         assert_eq!(word(&elf, 0x6000_0000), 0x4246_4346, "{bin}: FCB tag");
         assert_eq!(word(&elf, 0x6000_0004), 0x5601_0400, "{bin}: FCB version");
+        // The board's flash: `sflashA1Size`, and the image inside it.
+        let flash_bytes = word(&elf, 0x6000_0050);
+        let board = match flash_bytes {
+            0x0020_0000 => "teensy40",
+            0x0080_0000 => "teensy41",
+            other => panic!("{bin}: sflashA1Size 0x{other:X} is no Teensy 4 flash"),
+        };
+        if let Some(expected) = std::env::var_os("TWOCAN_TEENSY4_BOARD") {
+            assert_eq!(expected.to_str(), Some(board), "{bin}: built for {board}");
+        }
         // Image vector table.
         let ivt = 0x6000_1000;
         assert_eq!(word(&elf, ivt), 0x4020_00D1, "{bin}: IVT header");
@@ -110,6 +124,10 @@ fn boot_header_and_vector_table() {
             0x6000_0000 + size >= end,
             "{bin}: image size 0x{size:X} ends before 0x{end:X}"
         );
+        assert!(
+            size <= u64::from(flash_bytes),
+            "{bin}: image of 0x{size:X} bytes larger than the {board}'s flash"
+        );
         // Vector table: SP at the top of the DTCM, reset in the flash (Thumb).
         let vt = u64::from(entry);
         assert_eq!(word(&elf, vt), 0x2002_0000, "{bin}: initial SP");
@@ -128,7 +146,7 @@ fn boot_header_and_vector_table() {
         }
         let flash = size;
         let ram = symbol(&elf, "__ebss").max(symbol(&elf, "__edata")) - 0x2000_0000;
-        println!("{bin}: image {flash} bytes, static RAM {ram} bytes");
+        println!("{bin} ({board}): image {flash} bytes, static RAM {ram} bytes");
         checked += 1;
     }
     println!("{checked} images checked");
