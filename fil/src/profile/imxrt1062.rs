@@ -11,7 +11,7 @@
 //! (`REG0[STS_DC_OK]`, `REG3[TRG]`), "IOMUXC" (pad mux, pad control, daisy chain); the
 //! i.MX RT1060 data sheet (clock limits); the Teensy 4.1 schematic and pin card (pins
 //! 22/23 = `GPIO_AD_B1_08/09`, 0/1 = `GPIO_AD_B0_03/02`, 30/31 = `GPIO_EMC_37/36`; 8 MB
-//! flash). Reset values: the NXP SVD as `imxrt-ral` 0.4 carries it.
+//! flash). Reset values: the NXP SVD as `imxrt-ral` 0.6 (feature `imxrt1062`) carries it.
 //!
 //! Rules modelled:
 //! - **Boot ROM** (FlexSPI NOR, execute in place): the configuration block's tag and
