@@ -12,10 +12,10 @@ use twocan_flexcan::model::FlexCanModel;
 use twocan_flexcan::regs::{self, mcr};
 use twocan_flexcan::{Board, CanClock, HostSystem, IdleClocked, Instance, Settings, Target};
 
-#[cfg(feature = "teensy41")]
-use teensy4_pins::t41::{from_pads, Pins};
 #[cfg(all(feature = "teensy40", not(feature = "teensy41")))]
 use teensy4_pins::t40::{from_pads, Pins};
+#[cfg(feature = "teensy41")]
+use teensy4_pins::t41::{from_pads, Pins};
 
 fn pins() -> Pins {
     // SAFETY: host test; the pads are taken once per test and never dereferenced (the
@@ -39,7 +39,11 @@ fn begin_and_free<C: RalCan>(can: ral::HandOver<C>, instance: Instance) -> ral::
             &[],
         )
         .unwrap_or_else(|(_, e)| panic!("{instance:?}: {e:?}"));
-    assert_eq!(model.read32(regs::MCR) & mcr::MDIS, 0, "{instance:?} running");
+    assert_eq!(
+        model.read32(regs::MCR) & mcr::MDIS,
+        0,
+        "{instance:?} running"
+    );
     // The two pads the hand-over holds are the ones begin muxed (MUX_MODE = the CAN
     // function's ALTn, not the reset GPIO function ALT5).
     for mux in [
@@ -56,7 +60,11 @@ fn begin_and_free<C: RalCan>(can: ral::HandOver<C>, instance: Instance) -> ral::
         .free_over(controller, &mut sys)
         .map_err(|(_, _, e)| e)
         .unwrap();
-    assert_ne!(model.read32(regs::MCR) & mcr::MDIS, 0, "{instance:?} stopped");
+    assert_ne!(
+        model.read32(regs::MCR) & mcr::MDIS,
+        0,
+        "{instance:?} stopped"
+    );
     owned
 }
 
@@ -80,5 +88,8 @@ fn the_bsp_pins_are_taken_and_given_back() {
     // same instances and pads over again.
     begin_and_free(ral::hand_over(one.can, one.tx, one.rx), Instance::Can1);
     begin_and_free(ral::hand_over(two.can, two.tx, two.rx), Instance::Can2);
-    begin_and_free(ral::hand_over(three.can, three.tx, three.rx), Instance::Can3);
+    begin_and_free(
+        ral::hand_over(three.can, three.tx, three.rx),
+        Instance::Can3,
+    );
 }

@@ -28,9 +28,9 @@
 use twocan_core::Registers;
 
 use super::ccm::{ClockRoot, CCM_CSCMR2, MODULES_ON_ROOT};
+use super::pads::{rx_pad, tx_pad, ImxPin, MUX_MODE, MUX_RESET, PAD_RESET};
 use crate::begin_error::ConfigErrors;
 use crate::regs::{mcr, MCR};
-use super::pads::{rx_pad, tx_pad, ImxPin, MUX_MODE, MUX_RESET, PAD_RESET};
 
 /// The chip-level writes of one RT1062 FlexCAN module.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

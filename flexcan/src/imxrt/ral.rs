@@ -450,9 +450,7 @@ mod tests {
             )
             .map(|_| ())
             .unwrap_err();
-        assert!(
-            matches!(e, BeginError::Config(c) if c.contains(ConfigErrors::CLOCK_NOT_ON_CHIP))
-        );
+        assert!(matches!(e, BeginError::Config(c) if c.contains(ConfigErrors::CLOCK_NOT_ON_CHIP)));
         assert_eq!(back.free().can.address(), crate::imxrt::CAN1_BASE);
     }
 
@@ -477,7 +475,10 @@ mod tests {
         assert_eq!(ClockRoot::from_cscmr2(cscmr2), Some(ClockRoot::OSC_24MHZ));
         // CAN2 running, as its MCR reads through the system window (the host system
         // stands for the CAN2 block's first word here).
-        sys.write32(crate::imxrt::CAN2_BASE + regs::MCR, model2.read32(regs::MCR));
+        sys.write32(
+            crate::imxrt::CAN2_BASE + regs::MCR,
+            model2.read32(regs::MCR),
+        );
         assert_eq!(sys.read32(crate::imxrt::CAN2_BASE) & mcr::NOTRDY, 0);
         let before: std::vec::Vec<_> = sys.written().to_vec();
         let (can1, e) = give(can1)
