@@ -422,17 +422,6 @@ mod tests {
             Some(can1.can.address()),
             Target::new(Board::DEFAULT, Instance::Can1).base()
         );
-        // Handed over again: the same instance and pads begin again.
-        let (controller, parked) = give(can1)
-            .begin_over(
-                IdleClocked::new(model.clone()),
-                &mut sys,
-                &settings,
-                &[Filter::pass_all()],
-                &[],
-            )
-            .unwrap_or_else(|(_, e)| panic!("{e:?}"));
-        assert!(parked.free_over(controller, &mut sys).is_ok());
     }
 
     #[test]
