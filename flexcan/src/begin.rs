@@ -6,7 +6,7 @@
 //! hardware, in the order of the Kinetis reference manuals' "FlexCAN initialization
 //! sequence":
 //!
-//! The bit timing is judged by the driver's one rule ([`Settings::timing_rule`],
+//! The bit timing is judged by the driver's one rule ([`timing_rule_in`],
 //! [`TimingRule::accept`]), the rule the running controller applies to `set_timing` and
 //! `set_bitrate` and reports in its capabilities: a wished rate outside its range is
 //! [`BeginError::Timing`] (`check`: [`ConfigErrors::BIT_RATE_OUT_OF_RANGE`]), a timing
@@ -73,23 +73,34 @@ struct Plan {
 
 /// The timing rule `begin` applies to `settings` for a table of `configuration` in the
 /// layout `L` — the one rule of every entry point (`begin`, `check`, `BeginPlan`, the
-/// capabilities): the 16-buffer rule ([`Settings::timing_rule`]) in the Kinetis layout,
-/// else the rule of the message buffers the configuration takes into matching and
-/// arbitration ([`Settings::timing_rule_for_mailboxes`], the ERR005829 reserved mailbox
-/// counted).
+/// capabilities, `set_timing`, `set_bitrate`): the CTRL1 ranges, at least 8 quanta per
+/// bit, and the bus clocks per CAN bit the message buffers in matching and arbitration
+/// need (`MCR[MAXMB]` + 1: 16 buffers in the Kinetis layout, 16 clocks per bit; in the
+/// RT1062 layout the buffers the configuration uses with the ERR005829 reserved mailbox,
+/// 17 clocks up to 32 buffers and 30 above — Kinetis RM and IMXRT1060RM "Arbitration and
+/// matching timing"), from the settings' CAN clock and bus clock
+/// ([`Settings::bus_clock_hz`]; unset: the CAN clock itself).
 pub const fn timing_rule_in<L: Layout>(
     settings: &Settings,
     configuration: Configuration,
 ) -> TimingRule {
-    rule_of::<L>(settings, configuration)
+    rule_in::<L>(settings.can_clock.hz(), settings.bus_clock_hz, configuration)
 }
 
-/// See [`timing_rule_in`].
-const fn rule_of<L: Layout>(settings: &Settings, configuration: Configuration) -> TimingRule {
+/// [`timing_rule_in`] from the clocks (the running controller keeps no `Settings`).
+pub(crate) const fn rule_in<L: Layout>(
+    can_clock_hz: u32,
+    bus_clock_hz: Option<u32>,
+    configuration: Configuration,
+) -> TimingRule {
     if L::IFLAG2 {
-        settings.timing_rule_for_mailboxes(configuration.message_buffers_used_in(L::E5829))
+        crate::settings::timing_rule_for_buffers(
+            can_clock_hz,
+            bus_clock_hz,
+            configuration.message_buffers_used_in(L::E5829),
+        )
     } else {
-        settings.timing_rule()
+        crate::settings::timing_rule_for(can_clock_hz, bus_clock_hz)
     }
 }
 
@@ -102,7 +113,7 @@ const fn plan<L: Layout>(
     configuration: Configuration,
     filter_errors: ConfigErrors,
 ) -> Result<Plan, ConfigErrors> {
-    let mut errors = timing_errors(&rule_of::<L>(settings, configuration), settings);
+    let mut errors = timing_errors(&timing_rule_in::<L>(settings, configuration), settings);
     let timing_bits = settings.timing.flexcan_ctrl1();
     if timing_bits.is_err() {
         errors = errors.union(ConfigErrors::BIT_TIMING_INCONSISTENT);
@@ -294,7 +305,7 @@ const fn bitrate_error<L: Layout>(
     settings: &Settings,
     configuration: Configuration,
 ) -> Option<TimingError> {
-    match rule_of::<L>(settings, configuration).check_bitrate(settings.wished_bit_rate()) {
+    match timing_rule_in::<L>(settings, configuration).check_bitrate(settings.wished_bit_rate()) {
         Ok(()) | Err(TimingError::ForbiddenByManual) => None,
         Err(e) => Some(e),
     }
@@ -400,8 +411,8 @@ pub(crate) const fn tx_flag_base<L: Layout>(data: usize) -> usize {
 /// [`crate::layout::Imxrt1062`] on a Teensy 4.x, [`ConfigErrors::LAYOUT_NOT_FOR_CHIP`]).
 /// [`ConfigErrors::NONE`] when `begin` would proceed.
 ///
-/// A wished bit rate outside the range of the driver's rule ([`Settings::timing_rule`]:
-/// 2,500 bit/s to 1 Mbit/s with the default bus clock), which `begin` refuses with
+/// A wished bit rate outside the range of the driver's rule ([`timing_rule_in`]:
+/// 2,500 bit/s to 1 Mbit/s with the default bus clock on a Teensy 3.x), which `begin` refuses with
 /// [`BeginError::Timing`] before any other check, is reported here as
 /// [`ConfigErrors::BIT_RATE_OUT_OF_RANGE`], with every other flag that applies.
 ///

@@ -55,7 +55,7 @@ bitflags::bitflags! {
         /// [`crate::Settings::bus_clock_hz`]). ACAN checks only the field ranges.
         const BIT_TIMING_FORBIDDEN = 1 << 9;
         /// Bit 10 (not in ACAN): the wished bit rate is outside the range of the driver's
-        /// bit-timing rule ([`crate::Settings::timing_rule`],
+        /// bit-timing rule ([`crate::begin::timing_rule_in`],
         /// [`twocan_core::timing::TimingRule::check_bitrate`]): from 2,500 bit/s (PRESDIV
         /// 256, 25 quanta, ACAN §16.1) to the fastest timing the Kinetis manual allows
         /// with the bus clock (1 Mbit/s from 16 MHz, 2 Mbit/s from 32 MHz and above) —
@@ -84,10 +84,11 @@ bitflags::bitflags! {
         const LAYOUT_NOT_FOR_CHIP = 1 << 13;
         /// Bit 14 (not in ACAN): on the i.MX RT1062, the settings' clock root
         /// ([`crate::Settings::can_clock`]) differs from the one `CCM_CSCMR2` selects
-        /// and another FlexCAN module runs on it (its clock gate on, `MCR[NOTRDY]`
-        /// clear: Normal, Listen-Only or Loop-Back mode): switching the shared `CAN_CLK_ROOT` would change that module's bit
-        /// rate (IMXRT1060RM "CCM_CSCMR2"; [`crate::imxrt::ImxrtPlan::apply`]). Found
-        /// by `begin` from the hardware, not by [`crate::check`]; nothing is written.
+        /// and another FlexCAN module is in use on it (its clock gate on and its `MCR`
+        /// changed from the reset value: running, frozen or asleep): switching the
+        /// shared `CAN_CLK_ROOT` would change that module's bit rate (IMXRT1060RM
+        /// "CCM_CSCMR2"; [`crate::imxrt::ImxrtPlan::apply`]). Found by `begin` from the
+        /// hardware, not by [`crate::check`]; nothing is written.
         const CLOCK_ROOT_IN_USE = 1 << 14;
     }
 }
@@ -147,7 +148,7 @@ pub enum BeginError {
     /// The wished bit rate is outside the range of the driver's bit-timing rule (the
     /// question every entry point of every backend asks first:
     /// [`twocan_core::timing::TimingRule::check_bitrate`] of
-    /// [`crate::Settings::timing_rule`]); no register was written. ACAN's tolerance
+    /// [`crate::begin::timing_rule_in`]); no register was written. ACAN's tolerance
     /// check ([`ConfigErrors::BIT_RATE_TOO_FAR`]) applies in addition.
     Timing(twocan_core::timing::TimingError),
     /// The settings, filters or pins are invalid (ACAN table 5); no register was
@@ -223,7 +224,9 @@ mod tests {
         assert_eq!(ConfigErrors::BIT_RATE_OUT_OF_RANGE.bits(), 0x400);
         assert_eq!(ConfigErrors::CLOCK_NOT_ON_CHIP.bits(), 0x800);
         assert_eq!(ConfigErrors::CONFIGURATION_NOT_ON_CHIP.bits(), 0x1000);
-        assert_eq!(ConfigErrors::ALL.count(), 14);
+        assert_eq!(ConfigErrors::LAYOUT_NOT_FOR_CHIP.bits(), 0x2000);
+        assert_eq!(ConfigErrors::CLOCK_ROOT_IN_USE.bits(), 0x4000);
+        assert_eq!(ConfigErrors::ALL.count(), 15);
         assert_eq!(BeginError::Config(e).flags(), e);
         assert_eq!(
             BeginError::from(twocan_core::Error::Timeout).flags(),

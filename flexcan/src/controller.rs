@@ -4,11 +4,14 @@
 //!
 //! # Mailboxes and transmit order
 //!
-//! Data frames go through MB15, the one data mailbox (ACAN §3 table 1): the driver's
-//! transmit queue is first-in first-out ([`twocan_core::TxPolicy::Fifo`]) and holds
-//! the next frame until MB15 is free again, so data frames leave strictly in the order
-//! given to `try_send` (ACAN §3 "sequentiality"). Remote frames go to the first free
-//! remote-frame mailbox of the configuration (7, 5, 3 or 1, ACAN §9). The module picks
+//! Data frames go through the one data mailbox — MB15 in the Kinetis layout (ACAN §3
+//! table 1), the layout's [`crate::layout::Layout::data_mailbox`] in the RT1062 layout
+//! (MB16 for ACAN's four configurations, up to MB46 for the larger tables): the
+//! driver's transmit queue is first-in first-out ([`twocan_core::TxPolicy::Fifo`]) and
+//! holds the next frame until the data mailbox is free again, so data frames leave
+//! strictly in the order given to `try_send` (ACAN §3 "sequentiality"). Remote frames
+//! go to the first free remote-frame mailbox of the configuration (7, 5, 3 or 1 of them,
+//! ACAN §9), just below the data mailbox. The module picks
 //! among pending mailboxes by identifier priority, ties lowest mailbox first
 //! (`CTRL1.LBUF` = 0), so `try_send` keeps remote frames in the request order with
 //! data frames by loading one frame at a time, whatever its kind;
@@ -144,7 +147,6 @@ impl<R: Registers, L: Layout> FlexCan<R, L> {
         regs::timer::TIMER.get(self.regs.read32(TIMER)) as u16
     }
 
-    /// The transmit mailboxes: the remote-frame ones, then MB15.
     /// Writes the ID table, the masks and `MCR.IDAM` (format A, or format D "all frames
     /// rejected" for an empty list): Freeze mode only (Kinetis RM, MCR: IDAM is
     /// writable in Freeze mode only).

@@ -6,12 +6,14 @@
 //! what you need, then hand the settings to `begin`, which checks them all before it
 //! touches the hardware.
 //!
-//! **One bit-timing rule.** [`timing_rule`] is what this driver accepts: the CTRL1 field
-//! ranges with at least 8 quanta per bit and 16 bus clocks per CAN bit
-//! ([`twocan_core::timing::flexcan_rules::rule`], Kinetis RM "Arbitration and matching
-//! timing"). [`Settings::new`] solves within its limits, `begin` and [`crate::check`]
-//! judge the settings by it ([`Settings::timing_rule`], with the settings' bus clock),
-//! and the running controller reports it in its capabilities and applies it to
+//! **One bit-timing rule.** [`crate::begin::timing_rule_in`] is what this driver
+//! accepts: the CTRL1 field ranges with at least 8 quanta per bit, and the bus clocks per
+//! CAN bit the message buffers in matching and arbitration need — 16 with the Kinetis
+//! layout's 16 buffers, 17 or 30 with the RT1062 layout's larger tables
+//! ([`twocan_core::timing::flexcan_rules::rule`], Kinetis RM and IMXRT1060RM
+//! "Arbitration and matching timing"). [`Settings::new`] solves within its limits,
+//! `begin` and [`crate::check`] judge the settings by it (with the settings' CAN and bus
+//! clocks), and the running controller reports it in its capabilities and applies it to
 //! `set_timing` and `set_bitrate`: a rate or a timing one entry point takes, they all
 //! take.
 //!
@@ -32,34 +34,21 @@ use crate::configuration::{Configuration, MESSAGE_BUFFERS};
 /// Teensy 3.x, selected by `CTRL1.CLKSRC = 0` (ACAN §16.1 bit-rate formula).
 pub const CAN_CLOCK_HZ: u32 = 16_000_000;
 
-/// The bit timing rule of every FlexCAN entry point (module docs): the 16 MHz CAN clock,
-/// [`twocan_core::timing::Limits::FLEXCAN_KINETIS`], and at least 16 bus clocks per CAN bit with the 16
-/// message buffers and the Rx FIFO this driver configures, from the bus clock
-/// `bus_clock_hz` (`None`: the least the manual allows, the 16 MHz oscillator clock; see
-/// [`Settings::bus_clock_hz`]).
-pub const fn timing_rule(bus_clock_hz: Option<u32>) -> TimingRule {
-    timing_rule_for(CAN_CLOCK_HZ, bus_clock_hz)
+/// The bit-timing formula behind [`crate::begin::timing_rule_in`] for the CAN clock
+/// `can_clock_hz` (16 MHz on a Teensy 3.x, the clock root on the RT1062,
+/// [`CanClock::hz`]) with the 16 message buffers of the Kinetis layout (`MCR.MAXMB` =
+/// 15): the CTRL1 ranges, 16 bus clocks per CAN bit. `None` as bus clock: the CAN clock
+/// itself.
+pub(crate) const fn timing_rule_for(can_clock_hz: u32, bus_clock_hz: Option<u32>) -> TimingRule {
+    timing_rule_for_buffers(can_clock_hz, bus_clock_hz, MESSAGE_BUFFERS as usize)
 }
 
-/// [`timing_rule`] for the CAN clock `can_clock_hz` (the RT1062's clock root,
-/// [`CanClock::hz`]): the same CTRL1 ranges and, with the 16 message buffers the driver
-/// enables (`MCR.MAXMB` = 15 on both families), 16 bus clocks per CAN bit (IMXRT1060RM,
-/// FlexCAN "Arbitration and matching timing", as the Kinetis manuals). `None` as bus
-/// clock: the CAN clock itself.
-pub const fn timing_rule_for(can_clock_hz: u32, bus_clock_hz: Option<u32>) -> TimingRule {
-    let bus = match bus_clock_hz {
-        Some(hz) => hz,
-        None => can_clock_hz,
-    };
-    flexcan_rules::rule(can_clock_hz, bus, MESSAGE_BUFFERS, true)
-}
-
-/// [`timing_rule_for`] for a module whose first `message_buffers` message buffers take
-/// part in matching and arbitration (`MCR[MAXMB]` + 1, [`Configuration::message_buffers_used`]):
-/// 16 bus clocks per CAN bit up to 16 buffers, 17 up to 32 with the Rx FIFO, 30 above
-/// (IMXRT1060RM, FlexCAN "Arbitration and matching timing", table "Minimum ratio between
-/// peripheral clock frequency and CAN bit rate").
-pub const fn timing_rule_for_buffers(
+/// The formula for a module whose first `message_buffers` message buffers take part in
+/// matching and arbitration (`MCR[MAXMB]` + 1): 16 bus clocks per CAN bit up to 16
+/// buffers, 17 up to 32 with the Rx FIFO, 30 above (IMXRT1060RM, FlexCAN "Arbitration and
+/// matching timing", table "Minimum ratio between peripheral clock frequency and CAN bit
+/// rate").
+pub(crate) const fn timing_rule_for_buffers(
     can_clock_hz: u32,
     bus_clock_hz: Option<u32>,
     message_buffers: usize,
@@ -215,8 +204,8 @@ impl Settings {
     /// ranges allow 5). The computation never fails: a wished rate the 16 MHz clock
     /// cannot reach within them (1 bit/s, 0, above 2 Mbit/s) gives the closest
     /// consistent timing, and [`Settings::bit_rate_close_to_wished`] is then `false` —
-    /// `begin` reports it (and refuses a rate outside [`Settings::timing_rule`]'s range
-    /// first).
+    /// `begin` reports it (and refuses a rate outside the range of
+    /// [`crate::begin::timing_rule_in`] first).
     pub const fn new(bit_rate: u32) -> Self {
         Self::with_tolerance(bit_rate, DEFAULT_TOLERANCE_PPM)
     }
@@ -291,31 +280,6 @@ impl Settings {
         }
     }
 
-    /// The bit timing rule `begin` applies to these settings in the Kinetis layout
-    /// (16 message buffers): [`timing_rule`] with [`Settings::bus_clock_hz`]. The rule of
-    /// any layout and configuration: [`crate::begin::timing_rule_in`].
-    pub const fn timing_rule(&self) -> TimingRule {
-        timing_rule_for(self.can_clock.hz(), self.bus_clock_hz)
-    }
-
-    /// The bit timing rule for a table of `configuration` without the ERR005829
-    /// reservation: [`Settings::timing_rule`] for ACAN's configurations (16 message
-    /// buffers), [`timing_rule_for_buffers`] with the buffers of the RT1062's larger
-    /// ones ([`Configuration::message_buffers_used`]). `begin` with the RT1062 layout
-    /// counts the reserved mailbox too ([`Settings::timing_rule_for_mailboxes`]).
-    pub const fn timing_rule_with(&self, configuration: Configuration) -> TimingRule {
-        self.timing_rule_for_mailboxes(configuration.message_buffers_used())
-    }
-
-    /// The bit timing rule `begin` applies to these settings with `message_buffers`
-    /// buffers in matching and arbitration (`MCR[MAXMB]` + 1): [`timing_rule_for_buffers`].
-    /// With the RT1062 layout `begin` gives it
-    /// [`crate::layout::Layout::message_buffers_used`] (the ERR005829 reserved mailbox
-    /// counted).
-    pub const fn timing_rule_for_mailboxes(&self, message_buffers: usize) -> TimingRule {
-        timing_rule_for_buffers(self.can_clock.hz(), self.bus_clock_hz, message_buffers)
-    }
-
     /// Whether the actual bit rate is exactly the wished one (ACAN §16.4).
     pub const fn exact_bit_rate(&self) -> bool {
         self.timing.is_exact()
@@ -342,7 +306,7 @@ impl Settings {
 }
 
 /// The timing ACAN §16.1 describes for `bit_rate`, within the limits the driver accepts
-/// ([`timing_rule`]'s): the closest rate from the 16 MHz clock, always consistent. Rates
+/// ([`timing_rule_for`]'s): the closest rate from the 16 MHz clock, always consistent. Rates
 /// the solver refuses (0, above 2 Mbit/s) get the slowest or fastest timing, still
 /// carrying the wished rate so that the distance shows.
 const fn timing_for(bit_rate: u32, clock_hz: u32) -> Timing {
@@ -455,6 +419,7 @@ mod tests {
         // With a 60 MHz bus clock every one of them is accepted.
         let mut s = Settings::new(15_166);
         s.bus_clock_hz = Some(60_000_000);
-        assert_eq!(s.timing_rule().accept(&s.timing, s.tolerance_ppm), Ok(()));
+        assert_eq!(crate::begin::timing_rule_in::<crate::layout::Kinetis>(&s, s.configuration)
+                .accept(&s.timing, s.tolerance_ppm), Ok(()));
     }
 }

@@ -212,6 +212,11 @@ fn fields_the_driver_uses_have_imxrt_ral_masks() {
         ("CS.IDE", cs::IDE, imxrt_ral::can3::CS0::IDE::mask),
         ("CS.RTR", cs::RTR, imxrt_ral::can3::CS0::RTR::mask),
         ("CS.DLC", f(cs::DLC), imxrt_ral::can3::CS0::DLC::mask),
+        (
+            "CS.TIME_STAMP",
+            f(cs::TIME_STAMP),
+            imxrt_ral::can3::CS0::TIME_STAMP::mask,
+        ),
         ("ID.PRIO", f(id::PRIO), imxrt_ral::can3::ID0::PRIO::mask),
         ("ID.STD", f(id::STD), imxrt_ral::can3::ID0::STD::mask),
         ("ID.EXT", f(id::EXT), imxrt_ral::can3::ID0::EXT::mask),

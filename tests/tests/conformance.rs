@@ -1303,7 +1303,7 @@ fn capabilities_follow_the_current_configuration() {
     assert_eq!(caps.clock_hz, 54_000_000);
 }
 
-/// Issue 24 review: the RT1062 backend is begun in the RT1062 layout, as every Teensy 4
+/// The RT1062 backend is begun in the RT1062 layout, as every Teensy 4
 /// program begins it, in both configurations the backend uses (ACAN's 12/12 and, with
 /// more than 12 filters, 14/18): `MCR[MAXMB]` is the layout's data mailbox, one above
 /// ACAN's; the reserved ERR005829 mailbox (i.MX RT1060 chip errata, ERR005829; the

@@ -4,11 +4,12 @@
 //! Order (IMXRT1060RM, CCM "Clock Switching": a clock root's multiplexer and divider are
 //! changed while the clocks it feeds are gated off):
 //! 0. if the root asked for differs from the one `CSCMR2` selects and another module
-//!    runs on it — its register-access gate on and `MCR[NOTRDY]` clear (FlexCAN
-//!    "Module Configuration Register": the module is in Normal, Listen-Only or
-//!    Loop-Back mode; an RT1062 module leaves reset enabled in Freeze mode,
-//!    `MCR` = 0x5980_000F, which does not count) — nothing is written and `begin`
-//!    refuses with [`crate::ConfigErrors::CLOCK_ROOT_IN_USE`];
+//!    is in use — its register-access gate on and its `MCR` no longer the reset value
+//!    0x5980_000F (IMXRT1060RM, FlexCAN "Module Configuration Register (MCR)": out of
+//!    reset the module is enabled in Freeze mode with `MAXMB` = 0xF and no Rx FIFO; a
+//!    begun module differs whether it runs, is frozen for a filter switch or a bit-rate
+//!    change, or sleeps in Disable mode, and `end` gates it off) — nothing is written
+//!    and `begin` refuses with [`crate::ConfigErrors::CLOCK_ROOT_IN_USE`];
 //! 1. the module's `CCGR` fields cleared;
 //! 2. `CSCMR2[CAN_CLK_SEL, CAN_CLK_PODF]` written, only if they differ from the root
 //!    asked for (the root is shared: a module already running on the same root is
@@ -30,7 +31,12 @@ use twocan_core::Registers;
 use super::ccm::{ClockRoot, CCM_CSCMR2, MODULES_ON_ROOT};
 use super::pads::{rx_pad, tx_pad, ImxPin, MUX_MODE, MUX_RESET, PAD_RESET};
 use crate::begin_error::ConfigErrors;
-use crate::regs::{mcr, MCR};
+use crate::regs::MCR;
+
+/// `MCR` of an RT1062 FlexCAN module out of reset (IMXRT1060RM, FlexCAN "Module
+/// Configuration Register (MCR)"): enabled, Freeze mode requested and acknowledged
+/// (`FRZ`, `HALT`, `FRZACK`, `NOTRDY`), `SUPV`, `MAXMB` = 0xF.
+pub const MCR_RESET: u32 = 0x5980_000F;
 
 /// The chip-level writes of one RT1062 FlexCAN module.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -63,14 +69,15 @@ impl ImxrtPlan {
         }
     }
 
-    /// Whether a module other than this plan's runs on the root: its register-access
-    /// gate on (any `CGn` value but 00) and `MCR[NOTRDY]` clear. A gated module is not
-    /// read (its registers would answer with a bus error).
-    fn another_module_enabled<S: Registers>(&self, sys: &S) -> bool {
+    /// Whether a module other than this plan's is in use on the root: its
+    /// register-access gate on (any `CGn` value but 00) and its `MCR` other than
+    /// [`MCR_RESET`]. A gated module is not read (its registers would answer with a bus
+    /// error).
+    fn another_module_in_use<S: Registers>(&self, sys: &S) -> bool {
         let (own_gate, own_bits) = self.clock_gate;
         MODULES_ON_ROOT.iter().any(|&(gate, bits, base)| {
             let own = gate == own_gate && bits & own_bits != 0;
-            !own && sys.read32(gate) & bits != 0 && sys.read32(base + MCR) & mcr::NOTRDY == 0
+            !own && sys.read32(gate) & bits != 0 && sys.read32(base + MCR) != MCR_RESET
         })
     }
 
@@ -82,7 +89,7 @@ impl ImxrtPlan {
             let cscmr2 = sys.read32(CCM_CSCMR2);
             let wanted = self.root.cscmr2(cscmr2);
             if wanted != cscmr2 {
-                if self.another_module_enabled(sys) {
+                if self.another_module_in_use(sys) {
                     return Err(ConfigErrors::CLOCK_ROOT_IN_USE);
                 }
                 sys.modify32(gate, |v| v & !bits);

@@ -444,16 +444,18 @@ mod tests {
     }
 
     /// One `HostSystem` for the CCM, IOMUXC and the other modules' `MCR`: CAN2 begun
-    /// on the 24 MHz root and running, CAN1 asked on 60 MHz is refused with nothing
-    /// written; on CAN2's root it begins; once CAN2 ended, 60 MHz is taken. A module
-    /// left in Freeze mode out of reset (`MCR` 0x5980_000F, gate on) does not hold the
-    /// root.
+    /// on the 24 MHz root — running, frozen (a filter switch) or asleep (Disable
+    /// mode) — holds the root: CAN1 asked on 60 MHz is refused with nothing written;
+    /// on CAN2's root it begins; once CAN2 ended (gated off), 60 MHz is taken. A
+    /// module left out of reset (`MCR` 0x5980_000F, gate on) does not hold the root.
     #[test]
-    fn the_clock_root_is_not_switched_under_a_running_module() {
+    fn the_clock_root_is_not_switched_under_a_begun_module() {
+        use crate::imxrt::plan::MCR_RESET;
         let (can1, can2, _) = owned();
         let chip = Target::new(Board::DEFAULT, Instance::Can2).model_chip();
         let model2 = FlexCanModel::new(chip);
         let model1 = FlexCanModel::new(chip);
+        assert_eq!(model1.read32(regs::MCR), MCR_RESET, "the model's reset value");
         let mut sys = HostSystem::new();
         let on_24 = Settings::with_clock(500_000, CanClock::IMXRT_24MHZ);
         let on_60 = Settings::with_clock(500_000, CanClock::Imxrt(ClockRoot::PLL3_60MHZ));
@@ -462,26 +464,34 @@ mod tests {
             .unwrap_or_else(|(_, e)| panic!("{e:?}"));
         let cscmr2 = sys.read32(CCM_CSCMR2);
         assert_eq!(ClockRoot::from_cscmr2(cscmr2), Some(ClockRoot::OSC_24MHZ));
-        // CAN2 running, as its MCR reads through the system window (the host system
-        // stands for the CAN2 block's first word here).
-        sys.write32(
-            crate::imxrt::CAN2_BASE + regs::MCR,
-            model2.read32(regs::MCR),
-        );
-        assert_eq!(sys.read32(crate::imxrt::CAN2_BASE) & mcr::NOTRDY, 0);
-        let before: std::vec::Vec<_> = sys.written().to_vec();
-        let (can1, e) = give(can1)
-            .begin_over(IdleClocked::new(model1.clone()), &mut sys, &on_60, &[], &[])
-            .map(|_| ())
-            .unwrap_err();
-        assert!(
-            matches!(e, BeginError::Config(c) if c == ConfigErrors::CLOCK_ROOT_IN_USE),
-            "{e:?}"
-        );
-        assert_eq!(*sys.written(), *before, "nothing written");
-        assert_ne!(model1.read32(regs::MCR) & mcr::NOTRDY, 0, "CAN1 not begun");
+        // CAN2's MCR as it reads through the system window (the host system stands for
+        // the CAN2 block's first word here): running, then frozen, then asleep.
+        let running = model2.read32(regs::MCR);
+        assert_eq!(running & mcr::NOTRDY, 0);
+        let can2_mcr = crate::imxrt::CAN2_BASE + regs::MCR;
+        let mut can1 = Some(can1);
+        for mcr in [
+            running,
+            running | mcr::FRZ | mcr::HALT | mcr::FRZACK | mcr::NOTRDY,
+            running | mcr::MDIS | mcr::LPMACK | mcr::NOTRDY,
+        ] {
+            sys.write32(can2_mcr, mcr);
+            let before: std::vec::Vec<_> = sys.written().to_vec();
+            let (back, e) = give(can1.take().unwrap())
+                .begin_over(IdleClocked::new(model1.clone()), &mut sys, &on_60, &[], &[])
+                .map(|_| ())
+                .unwrap_err();
+            assert!(
+                matches!(e, BeginError::Config(c) if c == ConfigErrors::CLOCK_ROOT_IN_USE),
+                "MCR {mcr:#x}: {e:?}"
+            );
+            assert_eq!(*sys.written(), *before, "MCR {mcr:#x}: nothing written");
+            assert_eq!(model1.read32(regs::MCR), MCR_RESET, "CAN1 untouched");
+            can1 = Some(back.free());
+        }
+        sys.write32(can2_mcr, running);
         // On CAN2's root, CAN1 begins.
-        let (c1, parked1) = can1
+        let (c1, parked1) = give(can1.take().unwrap())
             .begin_over(IdleClocked::new(model1.clone()), &mut sys, &on_24, &[], &[])
             .unwrap_or_else(|(_, e)| panic!("{e:?}"));
         let (can1, _) = parked1
@@ -493,12 +503,12 @@ mod tests {
             .free_over(c2, &mut sys)
             .map_err(|(_, _, e)| e)
             .unwrap();
-        // CAN3 gated on and enabled out of reset, in Freeze mode: not running.
+        // CAN3 gated on, straight out of reset: not in use.
         let (gate3, bits3) = Target::new(Board::DEFAULT, Instance::Can3)
             .clock_gate()
             .unwrap();
         sys.write32(gate3, bits3);
-        sys.write32(crate::imxrt::CAN3_BASE + regs::MCR, 0x5980_000F);
+        sys.write32(crate::imxrt::CAN3_BASE + regs::MCR, MCR_RESET);
         let (c1, _parked1) = give(can1)
             .begin_over(IdleClocked::new(model1), &mut sys, &on_60, &[], &[])
             .unwrap_or_else(|(_, e)| panic!("{e:?}"));
