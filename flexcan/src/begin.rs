@@ -84,7 +84,11 @@ pub const fn timing_rule_in<L: Layout>(
     settings: &Settings,
     configuration: Configuration,
 ) -> TimingRule {
-    rule_in::<L>(settings.can_clock.hz(), settings.bus_clock_hz, configuration)
+    rule_in::<L>(
+        settings.can_clock.hz(),
+        settings.bus_clock_hz,
+        configuration,
+    )
 }
 
 /// [`timing_rule_in`] from the clocks (the running controller keeps no `Settings`).

@@ -419,7 +419,10 @@ mod tests {
         // With a 60 MHz bus clock every one of them is accepted.
         let mut s = Settings::new(15_166);
         s.bus_clock_hz = Some(60_000_000);
-        assert_eq!(crate::begin::timing_rule_in::<crate::layout::Kinetis>(&s, s.configuration)
-                .accept(&s.timing, s.tolerance_ppm), Ok(()));
+        assert_eq!(
+            crate::begin::timing_rule_in::<crate::layout::Kinetis>(&s, s.configuration)
+                .accept(&s.timing, s.tolerance_ppm),
+            Ok(())
+        );
     }
 }

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The examples of the STM32F1/F4 HAL hand-over (`twocan_bxcan::hal::f1` and its
-# connectivity-line part, `hal::f4`),
+# connectivity-line part, `hal::f4`) and of the Teensy 4 hand-over with `teensy4-bsp`
+# (`twocan_flexcan::imxrt::ral`),
 # cross-built: rustdoc cannot run them (their HALs turn on cortex-m's
 # `critical-section-single-core`, which cannot share a host build with the tests'
 # `critical-section/std`), so each example is fenced ```ignore for rustdoc and this
@@ -13,7 +14,9 @@
 # - a block fenced ```ignore,compile_fail,E0277 must fail, every error must carry that
 #   code, and each must name a pin trait of the hand-over (`TxPin`, `RxPin`, `CanPins`):
 #   a wrong pin or a wrong alternate function is refused by the pin traits, not by a
-#   typo in the example.
+#   typo in the example. The Teensy 4 hand-over takes its pads as types
+#   (`RalCan::Tx`/`Rx`): a wrong pad is E0308 and the error must say which types
+#   differ (`expected ... found ...` on a pad, `Pad<`).
 #
 # Only the one-file library is rebuilt per example: the dependencies are those of
 # `cargo build --target ... -p twocan-bxcan --features hal-stm32f4,...` (same target
@@ -28,19 +31,20 @@ work="$target_dir/hal-doctests"
 rm -rf "$work"
 mkdir -p "$work"
 work=$(cd "$work" && pwd)
-pin_traits='TxPin|RxPin|CanPins'
 
-# module file, target, feature of twocan-hal-doctests
+# module file, target, feature of twocan-hal-doctests, what a refusal must name (in its
+# headline, or for E0308 in its `expected`/`found` note)
 specs=(
-    "bxcan/src/hal/f4.rs thumbv7em-none-eabihf f4"
-    "bxcan/src/hal/f1.rs thumbv7m-none-eabi f1"
-    "bxcan/src/hal/f1_connectivity.rs thumbv7m-none-eabi f107"
+    "bxcan/src/hal/f4.rs thumbv7em-none-eabihf f4 TxPin|RxPin|CanPins"
+    "bxcan/src/hal/f1.rs thumbv7m-none-eabi f1 TxPin|RxPin|CanPins"
+    "bxcan/src/hal/f1_connectivity.rs thumbv7m-none-eabi f107 TxPin|RxPin|CanPins"
+    "flexcan/src/imxrt/ral.rs thumbv7em-none-eabihf t4bsp Pad<"
 )
 
 failures=0
 total=0
 for spec in "${specs[@]}"; do
-    read -r module target feature <<<"$spec"
+    read -r module target feature pin_traits <<<"$spec"
     stem=$(basename "$module" .rs)
     # Each block: `$work/<stem>-<n>.rs` (the example in `pub fn doctest`) and a line
     # `<n> <first line> <fence attributes>` in `$work/<stem>.list`.
@@ -118,8 +122,9 @@ for spec in "${specs[@]}"; do
                     problem="an error other than ${codes//$'\n'/ }: $h"
                     break
                 fi
-                if ! grep -qE "$pin_traits" <<<"$h"; then
-                    problem="an error that names no pin trait ($pin_traits): $h"
+                if ! grep -qE "$pin_traits" <<<"$h" &&
+                    { [ "$code" != E0308 ] || ! grep -qE "(expected|found).*($pin_traits)" "$log"; }; then
+                    problem="an error that names no pin trait or pad ($pin_traits): $h"
                     break
                 fi
             done <<<"$headlines"

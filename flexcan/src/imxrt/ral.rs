@@ -33,6 +33,52 @@
 //! addresses (from `imxrt-iomuxc`) are checked at compile time against the driver's pad
 //! table ([`crate::imxrt::pads`]).
 //!
+//! # With `teensy4-bsp`
+//!
+//! `teensy4-bsp`'s `board::t41` takes every RAL instance and keeps the CAN ones, so a
+//! program that uses CAN prepares the board with the BSP's own steps and keeps the
+//! instances it needs (`tools/hal-doctests/run.sh` cross-builds this example with
+//! `teensy4-bsp` 0.6):
+//!
+//! ```ignore
+//! use teensy4_bsp::{board, hal, pins};
+//! use twocan_core::Filter;
+//! use twocan_flexcan::imxrt::ral;
+//! use twocan_flexcan::{CanClock, Settings};
+//!
+//! let mut instances = board::instances();
+//! board::prepare_clocks_and_power(
+//!     &mut instances.CCM,
+//!     &mut instances.CCM_ANALOG,
+//!     &mut instances.DCDC,
+//! );
+//! let pins = pins::t41::from_pads(hal::iomuxc::into_pads(instances.IOMUXC));
+//! let settings = Settings::with_clock(500_000, CanClock::IMXRT_24MHZ);
+//! // CAN1's instance and its pads (pins 22, 23) by value; the CCM only borrowed.
+//! let can = ral::hand_over(instances.CAN1, pins.p22, pins.p23);
+//! let Ok((controller, parked)) =
+//!     can.begin(&mut instances.CCM, &settings, &[Filter::pass_all()], &[])
+//! else {
+//!     return;
+//! };
+//! // ... the driver (`into_split`, `rt::IrqState::start`); when the controller is back:
+//! let Ok(ral::Owned { can, tx, rx }) = parked.free(controller, &mut instances.CCM) else {
+//!     return;
+//! };
+//! // `tx` and `rx` are pins 22 and 23 again, free for another use.
+//! # let _ = (can, tx, rx);
+//! ```
+//!
+//! Another module's pads, or the two pads swapped, do not compile:
+//!
+//! ```ignore,compile_fail,E0308
+//! # use teensy4_bsp::{board, hal, pins};
+//! # use twocan_flexcan::imxrt::ral;
+//! # let instances = board::instances();
+//! # let pins = pins::t41::from_pads(hal::iomuxc::into_pads(instances.IOMUXC));
+//! let can = ral::hand_over(instances.CAN1, pins.p23, pins.p22);
+//! ```
+//!
 //! On the host (no `target_os = "none"`), [`HandOver::begin_over`] and
 //! [`Parked::free_over`] run the same steps over given registers (the behavioural
 //! model), for tests; `begin` and `free` reach the chip's registers and exist on the
@@ -455,7 +501,11 @@ mod tests {
         let chip = Target::new(Board::DEFAULT, Instance::Can2).model_chip();
         let model2 = FlexCanModel::new(chip);
         let model1 = FlexCanModel::new(chip);
-        assert_eq!(model1.read32(regs::MCR), MCR_RESET, "the model's reset value");
+        assert_eq!(
+            model1.read32(regs::MCR),
+            MCR_RESET,
+            "the model's reset value"
+        );
         let mut sys = HostSystem::new();
         let on_24 = Settings::with_clock(500_000, CanClock::IMXRT_24MHZ);
         let on_60 = Settings::with_clock(500_000, CanClock::Imxrt(ClockRoot::PLL3_60MHZ));
