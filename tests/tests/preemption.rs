@@ -8,9 +8,10 @@
 //! priority).
 
 use twocan_core::{FifoQueue, Frame, Lean, PriorityQueue, Registers, State, TxPolicy};
+use twocan_flexcan::Configuration;
 use twocan_tests::preempt::{
-    bxcan_rig, bxcan_rig_with, flexcan_rig, flexcan_rig_with, run_script, sweep, BxHw, FlexHw,
-    Step, Swept, RX,
+    bxcan_rig, bxcan_rig_with, flexcan_rig, flexcan_rig_quiet, flexcan_rig_with, flexcan_rt_rig,
+    run_script, sweep, BxHw, FlexHw, FlexRtHw, Rig, Step, Swept, RX,
 };
 
 /// Frames of one identifier, told apart by their data.
@@ -83,6 +84,30 @@ fn sends_now_poll_abort_all(frames: &[Frame]) -> Vec<Step> {
         if i % 5 == 4 {
             steps.push(Step::Bus(31));
         }
+    }
+    steps.extend([Step::Poll, Step::AbortAll]);
+    steps
+}
+
+/// [`sends_now_poll_abort_all`] with the bus moving after every submission and the peer
+/// sending often: on FlexCAN the receive handler shares the line, and in the quiet mode
+/// a data frame's end raises none, so the peer's frames are what the preempting
+/// handlers find to do at most points.
+fn sends_now_poll_abort_all_busy(frames: &[Frame]) -> Vec<Step> {
+    let mut steps = vec![Step::Peer(peer_frame(0))];
+    for (i, f) in frames.iter().enumerate() {
+        steps.push(if i % 4 == 1 {
+            Step::SendNow(*f)
+        } else {
+            Step::Send(*f)
+        });
+        if i == 3 {
+            steps.push(Step::Poll);
+        }
+        if i % 2 == 1 {
+            steps.push(Step::Peer(peer_frame(i as u8 + 1)));
+        }
+        steps.push(Step::Bus(31 + 7 * (i as u64 % 3)));
     }
     steps.extend([Step::Poll, Step::AbortAll]);
     steps
@@ -168,6 +193,24 @@ fn flex() -> twocan_tests::preempt::Rig<FlexHw, FifoQueue<4>> {
     flexcan_rig()
 }
 
+/// FlexCAN in the quiet transmit mode: no completion ring, `Lean`, request order (the
+/// data mailbox's interrupt on only while frames are queued).
+fn flex_quiet() -> Rig<FlexHw, FifoQueue<4>, 0, Lean> {
+    flexcan_rig_quiet()
+}
+
+/// The same on a Teensy 4.1 in the RT1062 layout, ACAN's first configuration (the
+/// ERR005829 reserved mailbox MB8, remote-frame mailboxes MB9–MB15, data mailbox MB16:
+/// `IFLAG1`/`IMASK1`).
+fn flex_rt_quiet() -> Rig<FlexRtHw, FifoQueue<4>, 0, Lean> {
+    flexcan_rt_rig(Configuration::Filters8_0)
+}
+
+/// The RT1062 layout with the transmit mailboxes above MB31 (RFFN 8: `IFLAG2`/`IMASK2`).
+fn flex_rt_quiet_high() -> Rig<FlexRtHw, FifoQueue<4>, 0, Lean> {
+    flexcan_rt_rig(Configuration::Filters24_48)
+}
+
 use twocan_core::TxPolicy::{Fifo, Priority};
 
 sweeps! {
@@ -198,6 +241,21 @@ sweeps! {
     flexcan_data_and_remote_send: flex, Fifo, data_and_remote(N), sends;
     flexcan_data_and_remote_abort: flex, Fifo, data_and_remote(N), sends_and_aborts;
     flexcan_data_and_remote_abort_on_the_wire: flex, Fifo, data_and_remote(N), aborts_on_the_wire;
+    flexcan_data_and_remote_send_now_poll_abort_all: flex, Fifo, data_and_remote(N), sends_now_poll_abort_all_busy;
+    flexcan_quiet_one_identifier_send: flex_quiet, Fifo, one_identifier(N), sends;
+    flexcan_quiet_one_identifier_abort: flex_quiet, Fifo, one_identifier(N), sends_and_aborts;
+    flexcan_quiet_mixed_send: flex_quiet, Fifo, mixed(N), sends;
+    flexcan_quiet_mixed_abort_on_the_wire: flex_quiet, Fifo, mixed(N), aborts_on_the_wire;
+    flexcan_quiet_send_now_poll_abort_all: flex_quiet, Fifo, mixed(N), sends_now_poll_abort_all_busy;
+    flexcan_quiet_data_and_remote_send: flex_quiet, Fifo, data_and_remote(N), sends;
+    flexcan_quiet_data_and_remote_abort: flex_quiet, Fifo, data_and_remote(N), sends_and_aborts;
+    flexcan_quiet_data_and_remote_send_now_poll_abort_all: flex_quiet, Fifo, data_and_remote(N), sends_now_poll_abort_all_busy;
+    flexcan_rt1062_quiet_mixed_send: flex_rt_quiet, Fifo, mixed(N), sends;
+    flexcan_rt1062_quiet_data_and_remote_abort: flex_rt_quiet, Fifo, data_and_remote(N), sends_and_aborts;
+    flexcan_rt1062_quiet_send_now_poll_abort_all: flex_rt_quiet, Fifo, data_and_remote(N), sends_now_poll_abort_all_busy;
+    flexcan_rt1062_high_quiet_mixed_send: flex_rt_quiet_high, Fifo, mixed(N), sends;
+    flexcan_rt1062_high_quiet_data_and_remote_abort_on_the_wire: flex_rt_quiet_high, Fifo, data_and_remote(N), aborts_on_the_wire;
+    flexcan_rt1062_high_quiet_send_now_poll_abort_all: flex_rt_quiet_high, Fifo, data_and_remote(N), sends_now_poll_abort_all_busy;
 }
 
 #[test]
