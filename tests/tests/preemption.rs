@@ -342,3 +342,142 @@ fn bxcan_quiet_mode_enables_the_transmit_interrupt_only_while_frames_wait() {
     assert_eq!(rig.peer.borrow().received_frames().len(), 6);
     assert_eq!(rig.tx.stats().count, 0);
 }
+
+/// The data mailbox's interrupt enable of a FlexCAN rig (`IMASK1` bit 15 on the
+/// Teensy 3.6), the Rx FIFO's (`BUF5I`, `BUF7I`) and the remote-frame mailboxes'
+/// ([`remote_bits`]), read from the model.
+fn flex_masks(rig: &Rig<FlexHw, FifoQueue<4>, 0, Lean>) -> (bool, u32, u32) {
+    let imask = rig
+        .state
+        .hardware()
+        .unwrap()
+        .registers()
+        .read32(twocan_flexcan::regs::IMASK1);
+    let fifo = twocan_flexcan::regs::iflag1::BUF5I | twocan_flexcan::regs::iflag1::BUF7I;
+    (imask & 1 << 15 != 0, imask & fifo, imask & remote_bits(rig))
+}
+
+/// The remote-frame mailboxes' bits of a FlexCAN rig (MB12–MB14 in ACAN's default
+/// configuration).
+fn remote_bits(rig: &Rig<FlexHw, FifoQueue<4>, 0, Lean>) -> u32 {
+    let first = rig
+        .state
+        .hardware()
+        .unwrap()
+        .configuration()
+        .first_remote_mailbox();
+    0x7FFF >> first << first
+}
+
+/// The quiet mode is what `flex_quiet` runs (settled at compile time), and in it the data
+/// mailbox's interrupt is enabled exactly while frames wait in the queue: frames sent one
+/// at a time with the bus idle in between leave without the message-buffer line ever
+/// rising (nothing received either: the peer is silent); a burst that had to queue
+/// raises it and is refilled from it, and the enable is off again once the queue is
+/// empty. The Rx FIFO's enables and the remote-frame mailboxes' are never touched.
+#[test]
+fn flexcan_quiet_mode_enables_the_data_mailbox_interrupt_only_while_frames_wait() {
+    const {
+        assert!(State::<FlexHw, RX, FifoQueue<4>, RX, 0, Lean>::QUIET_TX);
+        assert!(!State::<FlexHw, RX, FifoQueue<4>, RX, 0, twocan_core::Full>::QUIET_TX);
+        assert!(!State::<FlexHw, RX, FifoQueue<4>, RX, 8, Lean>::QUIET_TX);
+    }
+    let fifo = twocan_flexcan::regs::iflag1::BUF5I | twocan_flexcan::regs::iflag1::BUF7I;
+    let rig = flex_quiet();
+    let remote = remote_bits(&rig);
+    assert_ne!(remote, 0);
+    assert_eq!(flex_masks(&rig), (false, fifo, remote), "split: the data mailbox's off");
+
+    // One at a time, the bus idle in between: the line never rises.
+    let mut rig = flex_quiet();
+    let bus = rig.bus.clone();
+    for k in 0..6u8 {
+        let f = Frame::standard(0x200, &[k]).unwrap();
+        rig.tx.try_send(&f).unwrap();
+        for _ in 0..4 {
+            bus.borrow_mut().step();
+            assert!(
+                !rig.preemption.run_handlers(),
+                "frame {k}: no message-buffer interrupt"
+            );
+            assert_eq!(flex_masks(&rig), (false, fifo, remote), "frame {k}");
+        }
+    }
+    assert_eq!(rig.peer.borrow().received_frames().len(), 6);
+    assert_eq!(rig.tx.stats().count, 0);
+
+    // A burst of five: one goes to the data mailbox, the rest queue (the enable on) and
+    // are refilled from the interrupt; at the end the queue is empty and the enable off.
+    let mut rig = flex_quiet();
+    let bus = rig.bus.clone();
+    let burst = one_identifier(5);
+    for f in &burst {
+        rig.tx.try_send(f).unwrap();
+    }
+    assert_eq!(flex_masks(&rig), (true, fifo, remote), "frames wait");
+    let mut entries = 0;
+    for _ in 0..40 {
+        bus.borrow_mut().step();
+        entries += rig.preemption.run_handlers() as usize;
+    }
+    assert_eq!(entries, 4, "one interrupt per refill");
+    assert_eq!(rig.peer.borrow().received_frames(), burst);
+    assert_eq!(flex_masks(&rig), (false, fifo, remote), "queue empty");
+}
+
+/// The quiet mode keeps FlexCAN's remote-frame path: `try_send_now` puts a remote frame
+/// straight into a remote-frame mailbox beside a pending data frame (and it leaves first
+/// when its identifier wins), while `try_send` keeps one frame of the request order in a
+/// mailbox at a time (the remote frame behind the data frame waits in the queue).
+#[test]
+fn flexcan_quiet_mode_keeps_the_remote_frame_mailboxes() {
+    let mut rig = flex_quiet();
+    let data = Frame::standard(0x400, &[1]).unwrap();
+    let now = Frame::remote(0x100, false, 0).unwrap();
+    let later = Frame::remote(0x101, false, 0).unwrap();
+    rig.tx.try_send(&data).unwrap();
+    rig.tx.try_send_now(&now).expect("a remote-frame mailbox, whatever is loaded");
+    rig.tx.try_send(&later).unwrap();
+    assert_eq!(rig.tx.stats().count, 1, "the request order's remote frame waits");
+    for _ in 0..40 {
+        rig.bus.borrow_mut().step();
+        rig.preemption.run_handlers();
+    }
+    assert_eq!(rig.peer.borrow().received_frames(), vec![now, data, later]);
+    assert_eq!(rig.tx.stats().count, 0);
+    // Every remote-frame mailbox made inactive again (their interrupt stayed on).
+    let first = rig.state.hardware().unwrap().configuration().first_remote_mailbox();
+    let hw = rig.state.hardware().unwrap();
+    for mb in usize::from(first)..15 {
+        let cs = hw.registers().read32(twocan_flexcan::regs::mb_cs(mb));
+        assert_eq!(
+            twocan_flexcan::regs::cs::CODE.get(cs),
+            twocan_flexcan::regs::code::TX_INACTIVE,
+            "MB{mb}"
+        );
+    }
+}
+
+/// Listen-only and stopped refuse the quiet mode's direct path exactly as the other
+/// mode's: a typed error, the frame not accepted.
+#[test]
+fn flexcan_quiet_mode_refuses_to_send_in_listen_only_and_sleep() {
+    use twocan_core::{BusMode, Error, Mode};
+    let mut rig = flex_quiet();
+    let f = Frame::standard(0x10, &[]).unwrap();
+    rig.rx.set_mode(Mode::Stopped).unwrap();
+    rig.rx.set_bus_mode(BusMode::ListenOnly).unwrap();
+    rig.rx.set_mode(Mode::Normal).unwrap();
+    assert_eq!(rig.tx.try_send(&f), Err(nb::Error::Other(Error::WrongMode)));
+    assert_eq!(rig.tx.try_send_now(&f), Err(nb::Error::Other(Error::WrongMode)));
+    let r = Frame::remote(0x10, false, 0).unwrap();
+    assert_eq!(rig.tx.try_send_now(&r), Err(nb::Error::Other(Error::WrongMode)));
+    rig.rx.set_mode(Mode::Stopped).unwrap();
+    rig.rx.set_bus_mode(BusMode::Normal).unwrap();
+    rig.rx.set_mode(Mode::Sleep).unwrap();
+    assert_eq!(rig.tx.try_send(&f), Err(nb::Error::Other(Error::WrongMode)));
+    assert_eq!(rig.tx.try_send_now(&f), Err(nb::Error::Other(Error::WrongMode)));
+    rig.rx.set_mode(Mode::Normal).unwrap();
+    assert!(rig.tx.try_send(&f).is_ok());
+    assert_eq!(rig.state.traffic().queued, 0, "Lean: no counters");
+}
