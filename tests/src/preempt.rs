@@ -369,7 +369,14 @@ pub fn flexcan_rig_with<Q: TxQueue + 'static>(peer: SimNode) -> Rig<FlexHw, Q> {
 /// transmit mode).
 pub fn flexcan_rig_quiet<Q: TxQueue + 'static, const D: usize, Fe: Features>() -> Rig<FlexHw, Q, D, Fe>
 {
-    flexcan_rig_in::<Kinetis, Q, D, Fe>(SimNode::new(), crate::backend::teensy36_can0(), 0)
+    flexcan_rig_quiet_with(SimNode::new())
+}
+
+/// [`flexcan_rig_quiet`] with another peer (a listen-only one acknowledges nothing).
+pub fn flexcan_rig_quiet_with<Q: TxQueue + 'static, const D: usize, Fe: Features>(
+    peer: SimNode,
+) -> Rig<FlexHw, Q, D, Fe> {
+    flexcan_rig_in::<Kinetis, Q, D, Fe>(peer, crate::backend::teensy36_can0(), 0)
 }
 
 /// CAN3 of a Teensy 4.1 in the RT1062 layout (the ERR005829 reserved mailbox after the

@@ -10,7 +10,8 @@
 use twocan_core::{FifoQueue, Frame, Lean, PriorityQueue, Registers, State, TxPolicy};
 use twocan_flexcan::Configuration;
 use twocan_tests::preempt::{
-    bxcan_rig, bxcan_rig_with, flexcan_rig, flexcan_rig_quiet, flexcan_rig_with, flexcan_rt_rig,
+    bxcan_rig, bxcan_rig_with, flexcan_rig, flexcan_rig_quiet, flexcan_rig_quiet_with,
+    flexcan_rig_with, flexcan_rt_rig,
     run_script, sweep, BxHw, FlexHw, FlexRtHw, Rig, Step, Swept, RX,
 };
 
@@ -357,6 +358,17 @@ fn flex_masks(rig: &Rig<FlexHw, FifoQueue<4>, 0, Lean>) -> (bool, u32, u32) {
     (imask & 1 << 15 != 0, imask & fifo, imask & remote_bits(rig))
 }
 
+/// Whether the data mailbox (MB15) of a FlexCAN rig holds a pending frame (code `DATA`)
+/// with its flag set: a stale flag from the end of an earlier frame, which would keep
+/// the message-buffer line raised and make the handler take the new frame for ended.
+fn stale_flag(rig: &Rig<FlexHw, FifoQueue<4>, 0, Lean>) -> bool {
+    let hw = rig.state.hardware().unwrap();
+    let r = hw.registers();
+    let pending = twocan_flexcan::regs::cs::CODE.get(r.read32(twocan_flexcan::regs::mb_cs(15)))
+        == twocan_flexcan::regs::code::TX_DATA;
+    pending && r.read32(twocan_flexcan::regs::IFLAG1) & 1 << 15 != 0
+}
+
 /// The remote-frame mailboxes' bits of a FlexCAN rig (MB12–MB14 in ACAN's default
 /// configuration).
 fn remote_bits(rig: &Rig<FlexHw, FifoQueue<4>, 0, Lean>) -> u32 {
@@ -394,6 +406,7 @@ fn flexcan_quiet_mode_enables_the_data_mailbox_interrupt_only_while_frames_wait(
     for k in 0..6u8 {
         let f = Frame::standard(0x200, &[k]).unwrap();
         rig.tx.try_send(&f).unwrap();
+        assert!(!stale_flag(&rig), "frame {k}: loaded with its flag clear");
         for _ in 0..4 {
             bus.borrow_mut().step();
             assert!(
@@ -419,6 +432,7 @@ fn flexcan_quiet_mode_enables_the_data_mailbox_interrupt_only_while_frames_wait(
     for _ in 0..40 {
         bus.borrow_mut().step();
         entries += rig.preemption.run_handlers() as usize;
+        assert!(!stale_flag(&rig), "a refilled mailbox loaded with its flag clear");
     }
     assert_eq!(entries, 4, "one interrupt per refill");
     assert_eq!(rig.peer.borrow().received_frames(), burst);
@@ -428,7 +442,8 @@ fn flexcan_quiet_mode_enables_the_data_mailbox_interrupt_only_while_frames_wait(
 /// The quiet mode keeps FlexCAN's remote-frame path: `try_send_now` puts a remote frame
 /// straight into a remote-frame mailbox beside a pending data frame (and it leaves first
 /// when its identifier wins), while `try_send` keeps one frame of the request order in a
-/// mailbox at a time (the remote frame behind the data frame waits in the queue).
+/// mailbox at a time (a frame behind a pending one waits in the queue, whatever their
+/// identifiers).
 #[test]
 fn flexcan_quiet_mode_keeps_the_remote_frame_mailboxes() {
     let mut rig = flex_quiet();
@@ -445,6 +460,22 @@ fn flexcan_quiet_mode_keeps_the_remote_frame_mailboxes() {
     }
     assert_eq!(rig.peer.borrow().received_frames(), vec![now, data, later]);
     assert_eq!(rig.tx.stats().count, 0);
+    // A data frame whose identifier would win behind a pending remote frame of the
+    // request order waits for it too.
+    let remote = Frame::remote(0x300, false, 0).unwrap();
+    let urgent = Frame::standard(0x050, &[2]).unwrap();
+    rig.tx.try_send(&remote).unwrap();
+    rig.tx.try_send(&urgent).unwrap();
+    assert_eq!(rig.tx.stats().count, 1, "the data frame waits for the remote frame");
+    for _ in 0..40 {
+        rig.bus.borrow_mut().step();
+        rig.preemption.run_handlers();
+    }
+    assert_eq!(
+        rig.peer.borrow().received_frames()[3..],
+        [remote, urgent],
+        "request order"
+    );
     // Every remote-frame mailbox made inactive again (their interrupt stayed on).
     let first = rig.state.hardware().unwrap().configuration().first_remote_mailbox();
     let hw = rig.state.hardware().unwrap();
@@ -480,4 +511,60 @@ fn flexcan_quiet_mode_refuses_to_send_in_listen_only_and_sleep() {
     rig.rx.set_mode(Mode::Normal).unwrap();
     assert!(rig.tx.try_send(&f).is_ok());
     assert_eq!(rig.state.traffic().queued, 0, "Lean: no counters");
+}
+
+/// In the quiet mode `loaded` keeps mailboxes whose end was never acknowledged, and every
+/// query confirms with the mailbox: the abort of a frame already sent finds nothing
+/// (`NotFound`) and the mailbox reads empty; the abort of a pending one is requested,
+/// and the aborted data mailbox (code ABORT, its flag set, no interrupt to acknowledge
+/// it) takes the next frame at once, from `try_send` and from `try_send_now`.
+#[test]
+fn flexcan_quiet_mode_queries_confirm_with_the_mailbox() {
+    use twocan_core::{AbortRequest, Hardware, MailboxId, MailboxState};
+    use twocan_flexcan::regs::{cs, code, mb_cs, mb_id, IFLAG1};
+    let state_of = |rig: &Rig<FlexHw, FifoQueue<4>, 0, Lean>| {
+        rig.state.hardware().unwrap().mailbox_state(MailboxId(0))
+    };
+    let mut rig = flex_quiet();
+    let bus = rig.bus.clone();
+    let sent = Frame::standard(0x123, &[1]).unwrap();
+    let t = rig.tx.try_send(&sent).unwrap();
+    assert_eq!(state_of(&rig), MailboxState::Pending);
+    for _ in 0..4 {
+        bus.borrow_mut().step();
+        assert!(!rig.preemption.run_handlers());
+    }
+    assert_eq!(rig.peer.borrow().received_frames(), vec![sent]);
+    assert_eq!(state_of(&rig), MailboxState::Empty, "sent, not acknowledged");
+    assert_eq!(rig.tx.abort(t), AbortRequest::NotFound);
+
+    // Nobody acknowledges: a frame stays pending (retried) until aborted.
+    let mut rig = flexcan_rig_quiet_with::<FifoQueue<4>, 0, Lean>(
+        twocan_sim::SimNode::new().with_listen_only(true),
+    );
+    let regs = |rig: &Rig<FlexHw, FifoQueue<4>, 0, Lean>, offset| {
+        rig.state.hardware().unwrap().registers().read32(offset)
+    };
+    let a = rig.tx.try_send(&Frame::standard(0x124, &[2]).unwrap()).unwrap();
+    rig.bus.borrow_mut().run_bits(300);
+    assert_eq!(state_of(&rig), MailboxState::Pending);
+    assert_eq!(rig.tx.abort(a), AbortRequest::Requested);
+    rig.bus.borrow_mut().run_bits(100);
+    assert_eq!(state_of(&rig), MailboxState::Empty);
+    assert_eq!(cs::CODE.get(regs(&rig, mb_cs(15))), code::TX_ABORT);
+    assert_ne!(regs(&rig, IFLAG1) & 1 << 15, 0, "aborted, not acknowledged");
+    let b = Frame::standard(0x125, &[3]).unwrap();
+    rig.tx.try_send(&b).expect("the aborted mailbox, at once");
+    assert_eq!(rig.tx.stats().count, 0, "loaded directly");
+    assert_eq!(regs(&rig, mb_id(15)) >> 18, 0x125);
+    let c = rig.tx.try_send(&Frame::standard(0x126, &[4]).unwrap()).unwrap();
+    assert_eq!(rig.tx.abort(c), AbortRequest::Dequeued);
+    rig.tx.abort_all();
+    rig.bus.borrow_mut().run_bits(100);
+    assert_eq!(cs::CODE.get(regs(&rig, mb_cs(15))), code::TX_ABORT);
+    let d = Frame::standard(0x127, &[5]).unwrap();
+    rig.tx.try_send_now(&d).expect("the aborted mailbox, at once");
+    assert_eq!(regs(&rig, mb_id(15)) >> 18, 0x127);
+    assert_eq!(state_of(&rig), MailboxState::Pending);
+    assert_eq!(rig.tx.stats().count, 0);
 }
