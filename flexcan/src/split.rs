@@ -267,8 +267,7 @@ impl<R: Registers, O: Options> FlexCanHw<R, O> {
         } else {
             (0xFFFF_u32 >> first << first) & 0xFFFF
         };
-        let tx_imask = if tx_flag_base::<O::Layout>(last_mailbox::<O::Layout>(configuration)) == 0
-        {
+        let tx_imask = if tx_flag_base::<O::Layout>(last_mailbox::<O::Layout>(configuration)) == 0 {
             RX_FIFO_IMASK | tx_mask
         } else {
             tx_mask

@@ -430,8 +430,24 @@ type QuietState = State<FlexCanHw<Traced, Full<Imxrt1062>>, 32, FifoQueue<8>, 0,
 /// counting the entries.
 struct QuietLine {
     model: twocan_flexcan::model::FlexCanModel,
-    tx_irq: twocan_core::split::TxIrq<'static, FlexCanHw<Traced, Full<Imxrt1062>>, 32, FifoQueue<8>, 0, 0, Lean>,
-    rx_irq: twocan_core::split::Rx0Irq<'static, FlexCanHw<Traced, Full<Imxrt1062>>, 32, FifoQueue<8>, 0, 0, Lean>,
+    tx_irq: twocan_core::split::TxIrq<
+        'static,
+        FlexCanHw<Traced, Full<Imxrt1062>>,
+        32,
+        FifoQueue<8>,
+        0,
+        0,
+        Lean,
+    >,
+    rx_irq: twocan_core::split::Rx0Irq<
+        'static,
+        FlexCanHw<Traced, Full<Imxrt1062>>,
+        32,
+        FifoQueue<8>,
+        0,
+        0,
+        Lean,
+    >,
     entries: usize,
 }
 
@@ -487,7 +503,11 @@ fn the_quiet_mode_clears_the_flag_before_each_activation_and_keeps_the_e5829_wri
             rx_irq: parts.rx0_irq,
             entries: 0,
         };
-        assert_eq!(model.read32(mask) & bit, 0, "{c:?}: split with the data mailbox's interrupt off");
+        assert_eq!(
+            model.read32(mask) & bit,
+            0,
+            "{c:?}: split with the data mailbox's interrupt off"
+        );
         log.borrow_mut().clear();
         let mut bus = bus_with(500_000, &[&model]);
 
@@ -498,7 +518,11 @@ fn the_quiet_mode_clears_the_flag_before_each_activation_and_keeps_the_e5829_wri
                 .unwrap();
             run(&mut bus, &mut [&mut line], 300);
             assert_eq!(line.entries, 0, "{c:?}: frame {k} raised an interrupt");
-            assert_ne!(model.read32(flags) & bit, 0, "{c:?}: frame {k} ended, not acknowledged");
+            assert_ne!(
+                model.read32(flags) & bit,
+                0,
+                "{c:?}: frame {k} ended, not acknowledged"
+            );
             assert_eq!(code_of(&model, data), code::TX_INACTIVE);
         }
         // A remote frame straight into its mailbox (its interrupt stays on: it is made
@@ -508,11 +532,19 @@ fn the_quiet_mode_clears_the_flag_before_each_activation_and_keeps_the_e5829_wri
         for f in &burst {
             tx_half.try_send(f).unwrap();
         }
-        assert_ne!(model.read32(mask) & bit, 0, "{c:?}: frames wait: the interrupt is on");
+        assert_ne!(
+            model.read32(mask) & bit,
+            0,
+            "{c:?}: frames wait: the interrupt is on"
+        );
         run(&mut bus, &mut [&mut line], 300 * 12);
         assert!(line.entries > 0);
         assert_eq!(tx_half.stats().count, 0);
-        assert_eq!(model.read32(mask) & bit, 0, "{c:?}: queue empty: the interrupt is off");
+        assert_eq!(
+            model.read32(mask) & bit,
+            0,
+            "{c:?}: queue empty: the interrupt is off"
+        );
         let got: Vec<Frame> = std::iter::from_fn(|| rx_half.receive().ok())
             .map(|r| r.frame)
             .collect();
@@ -567,15 +599,26 @@ fn unsplit_after_the_quiet_mode_gives_back_the_masks_and_no_stale_end() {
             .split(controller.into_split())
             .map_err(|(e, _)| e)
             .unwrap();
-        assert_ne!((model.read32(regs::IMASK1), model.read32(regs::IMASK2)), masks);
+        assert_ne!(
+            (model.read32(regs::IMASK1), model.read32(regs::IMASK2)),
+            masks
+        );
         let mut bus = bus_with(500_000, &[&model]);
         parts.tx.try_send(&std_data(0x300, &[3])).unwrap();
         // The bus alone (the frame comes back through the Rx FIFO; no handler runs).
         bus.run_bits(300);
-        assert_ne!(model.read32(flags) & bit, 0, "{c:?}: ended, not acknowledged");
+        assert_ne!(
+            model.read32(flags) & bit,
+            0,
+            "{c:?}: ended, not acknowledged"
+        );
         let (hw, left) = state.unsplit(parts).map_err(|(e, _)| e).unwrap();
         assert_eq!(left.completions, 0);
-        assert_eq!(model.read32(flags) & bit, 0, "{c:?}: acknowledged by unsplit");
+        assert_eq!(
+            model.read32(flags) & bit,
+            0,
+            "{c:?}: acknowledged by unsplit"
+        );
         assert_eq!(
             (model.read32(regs::IMASK1), model.read32(regs::IMASK2)),
             masks,

@@ -162,7 +162,11 @@ fn can3_entry_point_runs_the_quiet_transmit_mode() {
     // Default RFFN 2: reserved MB12, remote-frame mailboxes MB13–MB15, data mailbox MB16.
     let data = 1u32 << 16;
     let configured = iflag1::BUF5I | iflag1::BUF7I | 0xF << 13;
-    assert_eq!(regs.read32(regs::IMASK1), configured & !data, "split: data enable off");
+    assert_eq!(
+        regs.read32(regs::IMASK1),
+        configured & !data,
+        "split: data enable off"
+    );
     let code_of = |mb| cs::CODE.get(regs.read32(regs::mb_cs(mb)));
     // The module sends the data mailbox's frame: INACTIVE, flag set (no interrupt: the
     // enable is off).
@@ -177,13 +181,21 @@ fn can3_entry_point_runs_the_quiet_transmit_mode() {
     // Not acknowledged, yet the next direct send takes the mailbox (its flag cleared).
     tx.try_send(&f(1)).unwrap();
     assert_eq!(code_of(16), regs::code::TX_DATA);
-    assert_eq!(regs.read32(IFLAG1) & data, 0, "flag cleared before the load");
+    assert_eq!(
+        regs.read32(IFLAG1) & data,
+        0,
+        "flag cleared before the load"
+    );
     assert_eq!(tx.stats().count, 0);
     // Busy: two frames queue, the enable goes on.
     tx.try_send(&f(2)).unwrap();
     tx.try_send(&f(3)).unwrap();
     assert_eq!(tx.stats().count, 2);
-    assert_eq!(regs.read32(regs::IMASK1), configured, "frames wait: data enable on");
+    assert_eq!(
+        regs.read32(regs::IMASK1),
+        configured,
+        "frames wait: data enable on"
+    );
     // Each end runs the entry point: the refill loads the next frame.
     end();
     rt_imxrt::can3();
@@ -195,5 +207,9 @@ fn can3_entry_point_runs_the_quiet_transmit_mode() {
     rt_imxrt::can3();
     assert_eq!(tx.stats().count, 0);
     assert_eq!(regs.read32(regs::mb_id(16)), regs::id::STD.val(0x103));
-    assert_eq!(regs.read32(regs::IMASK1), configured & !data, "queue empty: off");
+    assert_eq!(
+        regs.read32(regs::IMASK1),
+        configured & !data,
+        "queue empty: off"
+    );
 }

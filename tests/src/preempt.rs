@@ -367,8 +367,8 @@ pub fn flexcan_rig_with<Q: TxQueue + 'static>(peer: SimNode) -> Rig<FlexHw, Q> {
 /// FlexCAN can0 of a Teensy 3.6 with the completion ring `D` and feature set `Fe`
 /// chosen (`D` = 0 with [`twocan_core::Lean`] and a request-order queue: the quiet
 /// transmit mode).
-pub fn flexcan_rig_quiet<Q: TxQueue + 'static, const D: usize, Fe: Features>() -> Rig<FlexHw, Q, D, Fe>
-{
+pub fn flexcan_rig_quiet<Q: TxQueue + 'static, const D: usize, Fe: Features>(
+) -> Rig<FlexHw, Q, D, Fe> {
     flexcan_rig_quiet_with(SimNode::new())
 }
 

@@ -11,8 +11,8 @@ use twocan_core::{FifoQueue, Frame, Lean, PriorityQueue, Registers, State, TxPol
 use twocan_flexcan::Configuration;
 use twocan_tests::preempt::{
     bxcan_rig, bxcan_rig_with, flexcan_rig, flexcan_rig_quiet, flexcan_rig_quiet_with,
-    flexcan_rig_with, flexcan_rt_rig,
-    run_script, sweep, BxHw, FlexHw, FlexRtHw, Rig, Step, Swept, RX,
+    flexcan_rig_with, flexcan_rt_rig, run_script, sweep, BxHw, FlexHw, FlexRtHw, Rig, Step, Swept,
+    RX,
 };
 
 /// Frames of one identifier, told apart by their data.
@@ -398,7 +398,11 @@ fn flexcan_quiet_mode_enables_the_data_mailbox_interrupt_only_while_frames_wait(
     let rig = flex_quiet();
     let remote = remote_bits(&rig);
     assert_ne!(remote, 0);
-    assert_eq!(flex_masks(&rig), (false, fifo, remote), "split: the data mailbox's off");
+    assert_eq!(
+        flex_masks(&rig),
+        (false, fifo, remote),
+        "split: the data mailbox's off"
+    );
 
     // One at a time, the bus idle in between: the line never rises.
     let mut rig = flex_quiet();
@@ -432,7 +436,10 @@ fn flexcan_quiet_mode_enables_the_data_mailbox_interrupt_only_while_frames_wait(
     for _ in 0..40 {
         bus.borrow_mut().step();
         entries += rig.preemption.run_handlers() as usize;
-        assert!(!stale_flag(&rig), "a refilled mailbox loaded with its flag clear");
+        assert!(
+            !stale_flag(&rig),
+            "a refilled mailbox loaded with its flag clear"
+        );
     }
     assert_eq!(entries, 4, "one interrupt per refill");
     assert_eq!(rig.peer.borrow().received_frames(), burst);
@@ -451,9 +458,15 @@ fn flexcan_quiet_mode_keeps_the_remote_frame_mailboxes() {
     let now = Frame::remote(0x100, false, 0).unwrap();
     let later = Frame::remote(0x101, false, 0).unwrap();
     rig.tx.try_send(&data).unwrap();
-    rig.tx.try_send_now(&now).expect("a remote-frame mailbox, whatever is loaded");
+    rig.tx
+        .try_send_now(&now)
+        .expect("a remote-frame mailbox, whatever is loaded");
     rig.tx.try_send(&later).unwrap();
-    assert_eq!(rig.tx.stats().count, 1, "the request order's remote frame waits");
+    assert_eq!(
+        rig.tx.stats().count,
+        1,
+        "the request order's remote frame waits"
+    );
     for _ in 0..40 {
         rig.bus.borrow_mut().step();
         rig.preemption.run_handlers();
@@ -466,7 +479,11 @@ fn flexcan_quiet_mode_keeps_the_remote_frame_mailboxes() {
     let urgent = Frame::standard(0x050, &[2]).unwrap();
     rig.tx.try_send(&remote).unwrap();
     rig.tx.try_send(&urgent).unwrap();
-    assert_eq!(rig.tx.stats().count, 1, "the data frame waits for the remote frame");
+    assert_eq!(
+        rig.tx.stats().count,
+        1,
+        "the data frame waits for the remote frame"
+    );
     for _ in 0..40 {
         rig.bus.borrow_mut().step();
         rig.preemption.run_handlers();
@@ -477,7 +494,12 @@ fn flexcan_quiet_mode_keeps_the_remote_frame_mailboxes() {
         "request order"
     );
     // Every remote-frame mailbox made inactive again (their interrupt stayed on).
-    let first = rig.state.hardware().unwrap().configuration().first_remote_mailbox();
+    let first = rig
+        .state
+        .hardware()
+        .unwrap()
+        .configuration()
+        .first_remote_mailbox();
     let hw = rig.state.hardware().unwrap();
     for mb in usize::from(first)..15 {
         let cs = hw.registers().read32(twocan_flexcan::regs::mb_cs(mb));
@@ -500,14 +522,23 @@ fn flexcan_quiet_mode_refuses_to_send_in_listen_only_and_sleep() {
     rig.rx.set_bus_mode(BusMode::ListenOnly).unwrap();
     rig.rx.set_mode(Mode::Normal).unwrap();
     assert_eq!(rig.tx.try_send(&f), Err(nb::Error::Other(Error::WrongMode)));
-    assert_eq!(rig.tx.try_send_now(&f), Err(nb::Error::Other(Error::WrongMode)));
+    assert_eq!(
+        rig.tx.try_send_now(&f),
+        Err(nb::Error::Other(Error::WrongMode))
+    );
     let r = Frame::remote(0x10, false, 0).unwrap();
-    assert_eq!(rig.tx.try_send_now(&r), Err(nb::Error::Other(Error::WrongMode)));
+    assert_eq!(
+        rig.tx.try_send_now(&r),
+        Err(nb::Error::Other(Error::WrongMode))
+    );
     rig.rx.set_mode(Mode::Stopped).unwrap();
     rig.rx.set_bus_mode(BusMode::Normal).unwrap();
     rig.rx.set_mode(Mode::Sleep).unwrap();
     assert_eq!(rig.tx.try_send(&f), Err(nb::Error::Other(Error::WrongMode)));
-    assert_eq!(rig.tx.try_send_now(&f), Err(nb::Error::Other(Error::WrongMode)));
+    assert_eq!(
+        rig.tx.try_send_now(&f),
+        Err(nb::Error::Other(Error::WrongMode))
+    );
     rig.rx.set_mode(Mode::Normal).unwrap();
     assert!(rig.tx.try_send(&f).is_ok());
     assert_eq!(rig.state.traffic().queued, 0, "Lean: no counters");
@@ -521,7 +552,7 @@ fn flexcan_quiet_mode_refuses_to_send_in_listen_only_and_sleep() {
 #[test]
 fn flexcan_quiet_mode_queries_confirm_with_the_mailbox() {
     use twocan_core::{AbortRequest, Hardware, MailboxId, MailboxState};
-    use twocan_flexcan::regs::{cs, code, mb_cs, mb_id, IFLAG1};
+    use twocan_flexcan::regs::{code, cs, mb_cs, mb_id, IFLAG1};
     let state_of = |rig: &Rig<FlexHw, FifoQueue<4>, 0, Lean>| {
         rig.state.hardware().unwrap().mailbox_state(MailboxId(0))
     };
@@ -535,7 +566,11 @@ fn flexcan_quiet_mode_queries_confirm_with_the_mailbox() {
         assert!(!rig.preemption.run_handlers());
     }
     assert_eq!(rig.peer.borrow().received_frames(), vec![sent]);
-    assert_eq!(state_of(&rig), MailboxState::Empty, "sent, not acknowledged");
+    assert_eq!(
+        state_of(&rig),
+        MailboxState::Empty,
+        "sent, not acknowledged"
+    );
     assert_eq!(rig.tx.abort(t), AbortRequest::NotFound);
 
     // Nobody acknowledges: a frame stays pending (retried) until aborted.
@@ -545,7 +580,10 @@ fn flexcan_quiet_mode_queries_confirm_with_the_mailbox() {
     let regs = |rig: &Rig<FlexHw, FifoQueue<4>, 0, Lean>, offset| {
         rig.state.hardware().unwrap().registers().read32(offset)
     };
-    let a = rig.tx.try_send(&Frame::standard(0x124, &[2]).unwrap()).unwrap();
+    let a = rig
+        .tx
+        .try_send(&Frame::standard(0x124, &[2]).unwrap())
+        .unwrap();
     rig.bus.borrow_mut().run_bits(300);
     assert_eq!(state_of(&rig), MailboxState::Pending);
     assert_eq!(rig.tx.abort(a), AbortRequest::Requested);
@@ -557,13 +595,18 @@ fn flexcan_quiet_mode_queries_confirm_with_the_mailbox() {
     rig.tx.try_send(&b).expect("the aborted mailbox, at once");
     assert_eq!(rig.tx.stats().count, 0, "loaded directly");
     assert_eq!(regs(&rig, mb_id(15)) >> 18, 0x125);
-    let c = rig.tx.try_send(&Frame::standard(0x126, &[4]).unwrap()).unwrap();
+    let c = rig
+        .tx
+        .try_send(&Frame::standard(0x126, &[4]).unwrap())
+        .unwrap();
     assert_eq!(rig.tx.abort(c), AbortRequest::Dequeued);
     rig.tx.abort_all();
     rig.bus.borrow_mut().run_bits(100);
     assert_eq!(cs::CODE.get(regs(&rig, mb_cs(15))), code::TX_ABORT);
     let d = Frame::standard(0x127, &[5]).unwrap();
-    rig.tx.try_send_now(&d).expect("the aborted mailbox, at once");
+    rig.tx
+        .try_send_now(&d)
+        .expect("the aborted mailbox, at once");
     assert_eq!(regs(&rig, mb_id(15)) >> 18, 0x127);
     assert_eq!(state_of(&rig), MailboxState::Pending);
     assert_eq!(rig.tx.stats().count, 0);
