@@ -272,8 +272,10 @@ pub struct Rig<
 pub type BxHw = BxCan<Preempted<PollClock<BxCanModel>>>;
 /// The FlexCAN controller of a rig.
 pub type FlexHw = FlexCanHw<Preempted<PollClock<FlexCanModel>>>;
+/// The FlexCAN controller of a rig in the layout `L`.
+pub type FlexHwIn<L> = FlexCanHw<Preempted<PollClock<FlexCanModel>>, FullOptions<L>>;
 /// The FlexCAN controller of a rig in the RT1062 layout (a Teensy 4.1's CAN3).
-pub type FlexRtHw = FlexCanHw<Preempted<PollClock<FlexCanModel>>, FullOptions<Imxrt1062>>;
+pub type FlexRtHw = FlexHwIn<Imxrt1062>;
 
 fn bus_and_peer() -> (SharedBus, Rc<RefCell<SimNode>>) {
     let bus = Rc::new(RefCell::new(Bus::new(BIT_RATE).expect("bus")));
@@ -405,7 +407,7 @@ fn flexcan_rig_in<L: Layout, Q: TxQueue + 'static, const D: usize, Fe: Features>
     peer: SimNode,
     target: Target,
     configuration: usize,
-) -> Rig<FlexCanHw<Preempted<PollClock<FlexCanModel>>, FullOptions<L>>, Q, D, Fe>
+) -> Rig<FlexHwIn<L>, Q, D, Fe>
 where
     FullOptions<L>: twocan_flexcan::options::Options<Layout = L, Table = L::Table>,
 {
@@ -440,8 +442,7 @@ where
         &[],
     )
     .expect("begin");
-    type Hw<L> = FlexCanHw<Preempted<PollClock<FlexCanModel>>, FullOptions<L>>;
-    let state: &'static State<Hw<L>, RX, Q, RX, D, Fe> = Box::leak(Box::new(State::new()));
+    let state: &'static State<FlexHwIn<L>, RX, Q, RX, D, Fe> = Box::leak(Box::new(State::new()));
     let parts = state
         .split(controller.into_split())
         .map_err(|(e, _)| e)
