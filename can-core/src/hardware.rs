@@ -35,7 +35,7 @@
 //! | receive half | `Rx` (thread/task) | [`Hardware::decode`], [`Hardware::install_filters`], [`Hardware::take_filter_switch_discards`], [`Hardware::filter_map`]; a backend's [`ReceiveContext`] methods |
 //! | control | `Rx` too (the receive half is the controller's one control context, so that configuration never races a filter switch), or the one-struct driver | [`Hardware::set_mode`], [`Hardware::recover`], [`Hardware::set_timing`], [`Hardware::set_bus_mode`] |
 //! | status interrupt | `StatusIrq` | [`Hardware::take_status`] |
-//! | any (safe, reads or self-contained) | every handle, [`crate::State`], `&H` | [`Hardware::free_mailbox`], [`Hardware::tx_policy`], [`Hardware::mailbox_count`], [`Hardware::mailbox_state`], [`Hardware::error_status`], [`Hardware::on_bus`], [`Hardware::raw_timestamp`], [`Hardware::timer_now`], [`Hardware::rx_pending`], [`Hardware::capabilities`], [`Hardware::bus_mode`], [`Hardware::bus_off_recovery`] |
+//! | any (safe, reads or self-contained) | every handle, [`crate::State`], `&H` | [`Hardware::free_mailbox`], [`Hardware::free_mailbox_now`], [`Hardware::free_mailbox_quiet`], [`Hardware::free_mailbox_now_quiet`], [`Hardware::tx_policy`], [`Hardware::mailbox_count`], [`Hardware::mailbox_state`], [`Hardware::error_status`], [`Hardware::on_bus`], [`Hardware::raw_timestamp`], [`Hardware::timer_now`], [`Hardware::rx_pending`], [`Hardware::capabilities`], [`Hardware::bus_mode`], [`Hardware::bus_off_recovery`] |
 //!
 //! # Portable semantics every backend keeps
 //!
