@@ -597,7 +597,8 @@ impl Report {
              (`twocan_core::Fixed`); FlexCAN: the controller's compile-time \
              `options::Lean` (no time stamps, no filter switch while running: \
              `into_split_with::<Lean>()`), but `begin` still compiles the list at run \
-             time.\n\n\
+             time, and the split driver's `Lean` feature set, its quiet transmit mode \
+             there too.\n\n\
              Both bxCAN variants configure the controller in place in the `static` state \
              (`State::split_with`, `BxCan::can1_in`: no controller, plan or map moves \
              through the configuration); full plans at run time into a `static` scratch \
@@ -896,10 +897,10 @@ impl Report {
              8 bytes. **Round trips** are summed from the regions the firmware names for \
              its configuration (the `roundtrip` lines it prints): the send, every handler \
              the configuration runs per frame (our transmit handler runs in the full \
-             variants and in FlexCAN's lean one, which enable the transmit interrupt; \
-             bxCAN's lean variant is the quiet transmit mode, whose transmit interrupt is \
-             off while nothing is queued — the firmware checks `CAN_IER.TMEIE` after each \
-             direct send — so a frame sent directly runs no handler; the lean \
+             variants, which enable the transmit interrupt; the lean variants are the \
+             quiet transmit mode, whose transmit interrupt is off while nothing is queued \
+             — the firmware checks `CAN_IER.TMEIE` on bxCAN, MB15's `IMASK1` bit on \
+             FlexCAN, after each direct send — so a frame sent directly runs no handler; the lean \
              equivalents have none — fire-and-forget needs none), the take, and with completions the \
              completion's take. On FlexCAN one interrupt line runs both handlers; each is \
              measured on its own, on both sides.\n",
@@ -1205,10 +1206,10 @@ fn render_targets(s: &mut String, f: &Figures) {
              hand over the crate's frame and the FMI. Lean flash: the transmit queue, its \
              critical-section path and the error and state handling that every split \
              driver links. FlexCAN's lean and full controllers \
-             (`twocan_flexcan::options`) configure within the bound; FlexCAN has no quiet \
-             transmit mode yet, so its lean round trip still runs the transmit handler \
-             (and twocan-core's shared work: ring peaks, frame decoding), and in flash its \
-             transmit machinery.\n",
+             (`twocan_flexcan::options`) configure within the bound; like bxCAN's, FlexCAN's \
+             lean variant is the quiet transmit mode (no transmit handler per frame sent \
+             directly), and its lean round trip still runs twocan-core's shared work (ring \
+             peaks, frame decoding) and in flash its transmit machinery.\n",
             missed.len()
         );
     }

@@ -35,7 +35,7 @@
 //! | receive half | `Rx` (thread/task) | [`Hardware::decode`], [`Hardware::install_filters`], [`Hardware::take_filter_switch_discards`], [`Hardware::filter_map`]; a backend's [`ReceiveContext`] methods |
 //! | control | `Rx` too (the receive half is the controller's one control context, so that configuration never races a filter switch), or the one-struct driver | [`Hardware::set_mode`], [`Hardware::recover`], [`Hardware::set_timing`], [`Hardware::set_bus_mode`] |
 //! | status interrupt | `StatusIrq` | [`Hardware::take_status`] |
-//! | any (safe, reads or self-contained) | every handle, [`crate::State`], `&H` | [`Hardware::free_mailbox`], [`Hardware::tx_policy`], [`Hardware::mailbox_count`], [`Hardware::mailbox_state`], [`Hardware::error_status`], [`Hardware::on_bus`], [`Hardware::raw_timestamp`], [`Hardware::timer_now`], [`Hardware::rx_pending`], [`Hardware::capabilities`], [`Hardware::bus_mode`], [`Hardware::bus_off_recovery`] |
+//! | any (safe, reads or self-contained) | every handle, [`crate::State`], `&H` | [`Hardware::free_mailbox`], [`Hardware::free_mailbox_now`], [`Hardware::free_mailbox_quiet`], [`Hardware::free_mailbox_now_quiet`], [`Hardware::tx_policy`], [`Hardware::mailbox_count`], [`Hardware::mailbox_state`], [`Hardware::error_status`], [`Hardware::on_bus`], [`Hardware::raw_timestamp`], [`Hardware::timer_now`], [`Hardware::rx_pending`], [`Hardware::capabilities`], [`Hardware::bus_mode`], [`Hardware::bus_off_recovery`] |
 //!
 //! # Portable semantics every backend keeps
 //!
@@ -232,11 +232,23 @@ pub unsafe trait Hardware {
 
     /// Quiet mode ([`Hardware::QUIET_TX`], request order): an empty mailbox for
     /// `frame`, whether or not its last end was acknowledged (the outcome is not
-    /// reported). In the quiet mode it replaces both [`Hardware::free_mailbox`] and
-    /// [`Hardware::free_mailbox_now`] (a backend whose `free_mailbox_now` differs must
-    /// keep that difference here). The default is [`Hardware::free_mailbox`].
+    /// reported), **in the transmit order**, as [`Hardware::free_mailbox`]. In the quiet
+    /// mode it replaces [`Hardware::free_mailbox`] (the direct path of
+    /// [`crate::split::Tx::try_send`], the queue's refill). The default is
+    /// [`Hardware::free_mailbox`].
     fn free_mailbox_quiet(&self, frame: &Frame) -> Result<Option<u8>, Error> {
         self.free_mailbox(frame)
+    }
+
+    /// Quiet mode: the mailbox for [`crate::split::Tx::try_send_now`], which may overtake
+    /// frames loaded or queued before it, whether or not its last end was acknowledged.
+    /// It replaces [`Hardware::free_mailbox_now`], so a backend whose
+    /// `free_mailbox_now` differs from its `free_mailbox` keeps that difference here
+    /// (FlexCAN: a remote frame takes any free remote-frame mailbox whatever else is
+    /// loaded). The default is [`Hardware::free_mailbox_quiet`] (bxCAN: in request order
+    /// every mailbox leaves in the order of its request, so any empty one will do).
+    fn free_mailbox_now_quiet(&self, frame: &Frame) -> Result<Option<u8>, Error> {
+        self.free_mailbox_quiet(frame)
     }
 
     /// Quiet mode: acknowledges every ended mailbox without reporting it. The default
@@ -261,7 +273,8 @@ pub unsafe trait Hardware {
 
     /// Loads `frame` into `mailbox` (returned by [`Hardware::free_mailbox`],
     /// [`Hardware::free_mailbox_now`] or, in the quiet mode,
-    /// [`Hardware::free_mailbox_quiet`]), remembers
+    /// [`Hardware::free_mailbox_quiet`] or [`Hardware::free_mailbox_now_quiet`]; the
+    /// value is the backend's, passed back unchanged), remembers
     /// `token` for its completion, and requests transmission.
     ///
     /// # Safety

@@ -1106,7 +1106,7 @@ impl<
         let token = Token(self.next);
         let free = || {
             if State::<H, RX, Q, RX1, DONE, Fe>::QUIET_TX {
-                hw.free_mailbox_quiet(frame)
+                hw.free_mailbox_now_quiet(frame)
             } else {
                 hw.free_mailbox_now(frame)
             }

@@ -387,7 +387,7 @@ fn configure<R: Registers, L: Layout>(
     } else {
         (0, tx_flags)
     };
-    regs.write32(IMASK1, iflag1::BUF5I | iflag1::BUF7I | low);
+    regs.write32(IMASK1, RX_FIFO_IMASK | low);
     if plan.message_buffers > 32 {
         // MB32 and above: the transmit mailboxes of the RT1062's larger tables, or
         // beyond `MAXMB` (never flagged, masked anyway).
@@ -396,6 +396,11 @@ fn configure<R: Registers, L: Layout>(
     }
     handshake::unfreeze(regs, polls)
 }
+
+/// The Rx FIFO's enables in `IMASK1` as `begin` writes them: frames available
+/// (`BUF5I`) and overflow (`BUF7I`); the warning (`BUF6I`) stays masked (Kinetis RM,
+/// "Rx FIFO": with the FIFO on, IMASK1 bits 5–7 enable its three flags).
+pub(crate) const RX_FIFO_IMASK: u32 = iflag1::BUF5I | iflag1::BUF7I;
 
 /// The first message buffer of the flag register that holds the transmit mailboxes'
 /// flags, the data mailbox being `data`: 0 (`IFLAG1`), or 32 (`IFLAG2`) for a data

@@ -11,6 +11,12 @@
 //! - transmit half and transmit handler: `IFLAG1` read, the words of one transmit
 //!   mailbox that is inactive and settled (code `INACTIVE`, its `IFLAG1` bit clear);
 //! - transmit handler: `IFLAG1` write-1-to-clear of the transmit mailboxes' bits;
+//! - in the quiet transmit mode (`State::QUIET_TX`: no completions, see
+//!   [`Hardware::QUIET_TX`] below): the transmit half and the transmit handler's refill
+//!   write `IFLAG1` write-1-to-clear of the one mailbox they load, before loading it
+//!   (Kinetis RM, "Transmit process", step 1); the transmit handler (inside the
+//!   driver's critical section) writes `IMASK1` (`IMASK2` above MB31), as `begin`
+//!   configured it, with or without the data mailbox's bit;
 //!
 //! (With the RT1062 layout, [`crate::layout::Imxrt1062`], the transmit mailboxes of the
 //! tables from RFFN 8 on are MB32–MB46: what is said here of their `IFLAG1` bits holds
@@ -53,7 +59,7 @@ use twocan_core::{
 };
 use twocan_core::{MailboxId, MailboxState};
 
-use crate::begin::{last_mailbox, tx_flag_base};
+use crate::begin::{last_mailbox, tx_flag_base, RX_FIFO_IMASK};
 use crate::configuration::Configuration;
 use crate::controller::FlexCan;
 use crate::filters::{OwnedTable, UNKNOWN_FILTER};
@@ -63,7 +69,9 @@ use crate::instance::Target;
 use crate::layout::Layout;
 use crate::message_buffer::MbWords;
 use crate::options::{Full, Options};
-use crate::regs::{self, code, cs, ctrl1, esr1, iflag1, rxfir, ECR, ESR1, IFLAG1, IFLAG2, RXFIR};
+use crate::regs::{
+    self, code, cs, ctrl1, esr1, iflag1, rxfir, ECR, ESR1, IFLAG1, IFLAG2, IMASK1, IMASK2, RXFIR,
+};
 use crate::status;
 use crate::system::SystemPlan;
 
@@ -73,6 +81,14 @@ pub type RawFrame = [u32; 5];
 
 /// Frames the Rx FIFO holds (Kinetis RM, "Rx FIFO": six deep).
 const RX_FIFO_DEPTH: usize = 6;
+
+/// Marks a mailbox number given by the quiet mode's [`Hardware::free_mailbox_quiet`] or
+/// [`Hardware::free_mailbox_now_quiet`] (message buffers are numbered below 64): the
+/// mailbox may have ended without its flag being acknowledged, so [`Hardware::load`]
+/// clears the flag before it writes the mailbox (Kinetis RM, "Transmit process", step
+/// 1: "check whether the respective interrupt bit is set and clear it"). The mailboxes
+/// of [`Hardware::free_mailbox`] are settled (flag clear): nothing to clear.
+const QUIET_LOAD: u8 = 0x80;
 
 /// Transmit mailboxes at most (the data mailbox, MB15 in ACAN's configurations, and up
 /// to seven remote-frame mailboxes: [`Configuration::data_mailbox`]).
@@ -119,6 +135,12 @@ pub struct FlexCanHw<R: Registers, O: Options = Full> {
     /// the data mailbox; `IFLAG1`, or `IFLAG2` above MB31: [`FlexCanHw::tx_flags`]),
     /// from the configuration.
     tx_mask: u32,
+    /// The interrupt mask register of the transmit mailboxes (`IMASK1`, or `IMASK2` above
+    /// MB31) as `begin` writes it: the Rx FIFO's enables and every transmit mailbox's
+    /// ([`RX_FIFO_IMASK`] | `tx_mask`), or the transmit mailboxes' alone in `IMASK2`.
+    /// The quiet transmit mode writes it with or without the data mailbox's bit
+    /// ([`Hardware::set_tx_interrupt`]).
+    tx_imask: u32,
     /// The installed filter table (ID table, masks, map from `IDHIT` to the user's
     /// index): touched only from the receive half's context (`decode`,
     /// `install_filters`), so one copy.
@@ -149,6 +171,16 @@ pub struct FlexCanHw<R: Registers, O: Options = Full> {
     unresolved: AtomicU32,
     /// Transmit mailboxes loaded and not settled yet (bit per MB): a flag raised by a
     /// remote-frame mailbox that became a receive mailbox is not a completion.
+    ///
+    /// In the quiet transmit mode (no completions; [`Hardware::acknowledge_ended`]) a bit
+    /// is cleared when the mailbox's end is acknowledged, and the data mailbox may be
+    /// loaded again before that: the bits are then the mailboxes loaded since their last
+    /// acknowledged end, a superset of the pending ones. Every reader that needs
+    /// "pending" confirms it with the mailbox (flag clear and code `DATA`):
+    /// `abort_mailboxes` (so `request_abort`, `abort_all_mailboxes`, `retry_aborts`),
+    /// `pending_among` (the quiet mode's request order); `mailbox_state` reads the
+    /// mailbox alone; `prepare_abort` at worst polls `ESR1[TX]` for a frame already
+    /// sent, which reads 0 at once unless another of ours is on the wire.
     loaded: AtomicU32,
     /// Transmit mailboxes whose abort was requested while the module was transmitting
     /// (bit per MB), written inside the driver's critical section only
@@ -235,12 +267,18 @@ impl<R: Registers, O: Options> FlexCanHw<R, O> {
         } else {
             (0xFFFF_u32 >> first << first) & 0xFFFF
         };
+        let tx_imask = if tx_flag_base::<O::Layout>(last_mailbox::<O::Layout>(configuration)) == 0 {
+            RX_FIFO_IMASK | tx_mask
+        } else {
+            tx_mask
+        };
         let srxdis =
             p.bus_mode != BusMode::LoopBack && regs.read32(regs::MCR) & regs::mcr::SRXDIS != 0;
         FlexCanHw {
             regs,
             target,
             tx_mask,
+            tx_imask,
             configuration,
             table: core::cell::UnsafeCell::new(table),
             bus_mode: AtomicU8::new(bus_mode_code(p.bus_mode)),
@@ -497,6 +535,72 @@ impl<R: Registers, O: Options> FlexCanHw<R, O> {
         }
         let first = self.first_remote();
         Ok((first..data).find(|&mb| free(mb)).map(|mb| mb as u8))
+    }
+
+    /// The quiet mode's data mailbox (MB15 in ACAN's configurations), tagged
+    /// [`QUIET_LOAD`]: free when its code reads `INACTIVE` — never loaded, or its frame
+    /// sent (Kinetis RM, "Transmit process": after a successful transmission the code
+    /// goes back to INACTIVE and the flag is set) — or `ABORT` with its flag set (aborted,
+    /// "Transmission abort mechanism"), whether or not the flag was acknowledged. The
+    /// control word first: a mailbox that reads INACTIVE or ABORT stays so until
+    /// software writes it, and `ABORT` with the flag clear is an abort still waiting
+    /// for the frame on the wire (not free).
+    #[inline(always)]
+    fn data_free_quiet(&self) -> Option<u8> {
+        let data = self.data_mb();
+        let c = cs::CODE.get(self.regs.read32(regs::mb_cs(data)));
+        let free = c == code::TX_INACTIVE
+            || (c == code::TX_ABORT && self.regs.read32(self.tx_flags()) & self.tx_bit(data) != 0);
+        free.then_some(data as u8 | QUIET_LOAD)
+    }
+
+    /// Whether a transmit mailbox among `mask` (bits of [`FlexCanHw::tx_flags`]) holds a
+    /// frame that has not ended: flag clear and code `DATA`, as `abort_mailboxes` and
+    /// `mailbox_state` judge (a transmit mailbox ends with its flag set and its code
+    /// INACTIVE, ABORT, or Rx EMPTY for a remote frame: Kinetis RM, "Transmit process",
+    /// "Transmission abort mechanism"). The quiet mode's slow path (`loaded` keeps
+    /// mailboxes whose end was not acknowledged): the flags once, then the control
+    /// word of each mailbox of `mask` whose flag is clear.
+    #[cold]
+    #[inline(never)]
+    fn pending_among(&self, mask: u32) -> bool {
+        let flags = self.regs.read32(self.tx_flags());
+        (self.tx_base()..=self.data_mb()).any(|mb| {
+            mask & !flags & self.tx_bit(mb) != 0
+                && cs::CODE.get(self.regs.read32(regs::mb_cs(mb))) == code::TX_DATA
+        })
+    }
+
+    /// The quiet mode's acknowledgement of the transmit mailboxes `ended` (their flags
+    /// read set; inside the driver's critical section): as [`FlexCanHw::settle_one`]
+    /// without the completion — the `loaded` bit cleared, a frame caught by a
+    /// remote-frame mailbox turned receive mailbox counted, the flag acknowledged (write
+    /// 1 to clear, Kinetis RM "Interrupt Flags 1 register"), the mailbox made INACTIVE
+    /// again unless it is. A mailbox that reads `DATA` was loaded again after the end its
+    /// flag reported (`load` cleared that flag before activating it; only a context
+    /// running beside this one, not one it preempts, can get there between the two
+    /// reads): it is pending, and left as it is — a stale flag never deactivates a
+    /// newly loaded mailbox.
+    fn acknowledge(&self, ended: u32) {
+        let mut rest = ended;
+        while rest != 0 {
+            let mb = self.tx_base() + rest.trailing_zeros() as usize;
+            rest &= rest - 1;
+            let c = cs::CODE.get(self.regs.read32(regs::mb_cs(mb)));
+            if c == code::TX_DATA {
+                continue;
+            }
+            let bit = self.tx_bit(mb);
+            self.loaded.fetch_and(!bit, Ordering::Relaxed);
+            if c == code::RX_FULL || c == code::RX_OVERRUN {
+                self.count_caught(c);
+            }
+            self.regs.write32(self.tx_flags(), bit);
+            if c != code::TX_INACTIVE {
+                self.regs
+                    .write32(regs::mb_cs(mb), cs::CODE.val(code::TX_INACTIVE));
+            }
+        }
     }
 
     /// Requests the abort of the pending mailboxes among `mask` (transmit half or
@@ -829,6 +933,100 @@ unsafe impl<R: Registers, O: Options> Hardware for FlexCanHw<R, O> {
         self.check_can_send()?;
         self.free_now(frame)
     }
+
+    /// The quiet transmit mode is offered (Kinetis RM, FlexCAN "Interrupts": a message
+    /// buffer raises the ORed message-buffer interrupt only while its `IMASK1` bit is
+    /// set, and "setting or clearing a bit in the IMASK1 register can assert or negate
+    /// an interrupt request, if the corresponding IFLAG1 bit is set", CANx_IMASK1; a
+    /// mailbox may be written again once inactive, its flag cleared first, "Transmit
+    /// process"). The data mailbox's interrupt is enabled only while frames are queued
+    /// ([`Hardware::set_tx_interrupt`]); the remote-frame mailboxes keep theirs, so that a
+    /// remote frame's mailbox, which becomes a receive mailbox once its frame is sent
+    /// ("Transmit process"), is still made inactive again at once, as without the quiet
+    /// mode. FlexCAN's transmit order is the request order ([`Hardware::tx_policy`]), as
+    /// the quiet mode needs.
+    const QUIET_TX: bool = true;
+
+    /// The quiet mode's [`Hardware::free_mailbox`]: in request order, only while no other
+    /// transmit mailbox holds a frame that has not ended (the module picks among loaded
+    /// mailboxes by identifier, Kinetis RM "Arbitration process", so one frame of the
+    /// request order is in a mailbox at a time). `loaded` is checked first (a superset
+    /// of the pending mailboxes in this mode); the mailboxes it names other than the one
+    /// wanted are confirmed from their flag and code (`pending_among`). A data frame
+    /// takes the data mailbox once it has ended, its flag acknowledged or not (`load`
+    /// clears it first); a remote frame takes a free remote-frame mailbox as
+    /// [`Hardware::free_mailbox_now`] picks it (INACTIVE and settled: their interrupt stays
+    /// on). Refused with [`Error::WrongMode`] in listen-only mode and while disabled
+    /// (sleep), as [`Hardware::free_mailbox`] is.
+    #[inline(always)]
+    fn free_mailbox_quiet(&self, frame: &Frame) -> Result<Option<u8>, Error> {
+        self.check_can_send()?;
+        let loaded = self.loaded.load(Ordering::Relaxed);
+        if !frame.is_remote() {
+            let others = loaded & !self.tx_bit(self.data_mb());
+            if others != 0 && self.pending_among(others) {
+                return Ok(None);
+            }
+            return Ok(self.data_free_quiet());
+        }
+        if loaded != 0 && self.pending_among(loaded) {
+            return Ok(None);
+        }
+        self.free_now(frame)
+    }
+
+    /// The quiet mode's [`Hardware::free_mailbox_now`], keeping its difference (ACAN's
+    /// path, which may overtake): a data frame takes the data mailbox once it has ended
+    /// (acknowledged or not), a remote frame the first free remote-frame mailbox,
+    /// whatever else is loaded. Refused as [`Hardware::free_mailbox_now`] is.
+    #[inline(always)]
+    fn free_mailbox_now_quiet(&self, frame: &Frame) -> Result<Option<u8>, Error> {
+        self.check_can_send()?;
+        if frame.is_remote() {
+            self.free_now(frame)
+        } else {
+            Ok(self.data_free_quiet())
+        }
+    }
+
+    /// Acknowledges every transmit mailbox whose flag is set, without a report
+    /// (`acknowledge`: flag written back, remote-frame mailboxes made inactive, caught
+    /// frames counted), then retries the aborts that waited (as [`Hardware::settle`]).
+    /// Nothing while disabled (sleep).
+    unsafe fn acknowledge_ended(&self) {
+        if self.mode() == MODE_SLEEP {
+            return;
+        }
+        let ended = self.regs.read32(self.tx_flags()) & self.tx_mask;
+        if ended != 0 {
+            self.acknowledge(ended);
+        }
+        self.retry_aborts();
+    }
+
+    /// Writes the transmit mailboxes' interrupt mask register (`IMASK1`, or `IMASK2`
+    /// with them above MB31, IMXRT1060RM "Interrupt Masks 2 register") as `begin`
+    /// configured it, the data mailbox's bit cleared when `on` is false: the Rx FIFO's
+    /// bits (`BUF5I`, `BUF7I`) and the remote-frame mailboxes' bits are written as
+    /// configured, never changed (the register is written by `begin`, by `end`, and once
+    /// split only here, inside the driver's critical section). Nothing while disabled
+    /// (sleep: the driver touches no register but `MCR` then); the mask stays as it was
+    /// and the transmit service after waking writes it again.
+    unsafe fn set_tx_interrupt(&self, on: bool) {
+        if self.mode() == MODE_SLEEP {
+            return;
+        }
+        let reg = if self.tx_base() == 0 { IMASK1 } else { IMASK2 };
+        let data = self.tx_bit(self.data_mb());
+        self.regs.write32(
+            reg,
+            if on {
+                self.tx_imask
+            } else {
+                self.tx_imask & !data
+            },
+        );
+    }
     /// Identifier and data first, the control word (CODE `DATA`) last (Kinetis RM,
     /// "Transmit process"). With [`Layout::E5829`] (the RT1062 layout), the workaround
     /// of i.MX RT1060 chip errata, ERR005829 (a mailbox activated at a specific moment
@@ -837,10 +1035,20 @@ unsafe impl<R: Registers, O: Options> Hardware for FlexCanHw<R, O> {
     /// ([`Configuration::reserved_mailbox`], the first valid mailbox after the Rx FIFO
     /// area, INACTIVE since `begin`). Two contexts may do it at once (the transmit half
     /// and the transmit interrupt's refill); both write the same value.
+    ///
+    /// A mailbox of the quiet mode ([`QUIET_LOAD`]) may have ended without its flag
+    /// being acknowledged: its flag is cleared first (write 1 to clear; Kinetis RM,
+    /// "Transmit process", step 1), before its `loaded` bit is set and its words are
+    /// written, so that a transmit handler preempting the load sees either the old end
+    /// (and acknowledges it before the bit is set) or no flag at all — never a stale
+    /// flag on the newly activated mailbox.
     #[inline(always)]
     unsafe fn load(&self, mailbox: u8, frame: &Frame, token: Token) {
-        let mb = mailbox as usize;
+        let mb = (mailbox & !QUIET_LOAD) as usize;
         self.tokens[self.data_mb() - mb].store(token.0, Ordering::Release);
+        if mailbox & QUIET_LOAD != 0 {
+            self.regs.write32(self.tx_flags(), self.tx_bit(mb));
+        }
         self.loaded.fetch_or(self.tx_bit(mb), Ordering::Relaxed);
         MbWords::transmit(frame).write(&self.regs, mb);
         if O::Layout::E5829 {

@@ -20,8 +20,8 @@ use std::rc::Rc;
 
 use common::*;
 use twocan_core::{
-    AbortRequest, Driver, Filter, Frame, Hardware, MailboxId, MailboxState, Registers, Token,
-    TxOutcome,
+    AbortRequest, Driver, FifoQueue, Filter, Frame, Hardware, Lean, MailboxId, MailboxState,
+    Registers, State, Token, TxOutcome,
 };
 use twocan_flexcan::layout::{Imxrt1062, Kinetis, Layout};
 use twocan_flexcan::options::Full;
@@ -92,6 +92,16 @@ fn begin_traced<L: Layout>(
     c: Configuration,
     loop_back: bool,
 ) -> (twocan_flexcan::model::FlexCanModel, Log, Rt<L>) {
+    let (model, log, controller) = begin_traced_with::<L>(c, loop_back, &[Filter::pass_all()]);
+    (model, log, Driver::new(controller.into_split()))
+}
+
+/// [`begin_traced`]'s controller, not yet split, with the filter list `filters`.
+fn begin_traced_with<L: Layout>(
+    c: Configuration,
+    loop_back: bool,
+    filters: &[Filter],
+) -> (twocan_flexcan::model::FlexCanModel, Log, FlexCan<Traced, L>) {
     let model = model_of(T41);
     model.scramble_ram(0x000E_5829);
     let log = Rc::new(RefCell::new(Vec::new()));
@@ -104,11 +114,11 @@ fn begin_traced<L: Layout>(
         &mut HostSystem::new(),
         T41,
         &settings(c, loop_back),
-        &[Filter::pass_all()],
+        filters,
         &[],
     )
     .unwrap_or_else(|e| panic!("{c:?}: {e:?}"));
-    (model, log, Driver::new(controller.into_split()))
+    (model, log, controller)
 }
 
 fn code_of(model: &twocan_flexcan::model::FlexCanModel, mb: usize) -> u32 {
@@ -410,4 +420,216 @@ fn the_kinetis_layout_is_refused_on_the_rt1062() {
     );
     assert!(log.borrow().is_empty(), "no register written");
     assert!(sys.written().is_empty());
+}
+
+/// The split driver in the quiet transmit mode over the traced RT1062 layout: no
+/// completion ring, `Lean`, request order.
+type QuietState = State<FlexCanHw<Traced, Full<Imxrt1062>>, 32, FifoQueue<8>, 0, 0, Lean>;
+
+/// The message-buffer line as `rt_imxrt` runs it (transmit handler, then the Rx FIFO's),
+/// counting the entries.
+struct QuietLine {
+    model: twocan_flexcan::model::FlexCanModel,
+    tx_irq: twocan_core::split::TxIrq<
+        'static,
+        FlexCanHw<Traced, Full<Imxrt1062>>,
+        32,
+        FifoQueue<8>,
+        0,
+        0,
+        Lean,
+    >,
+    rx_irq: twocan_core::split::Rx0Irq<
+        'static,
+        FlexCanHw<Traced, Full<Imxrt1062>>,
+        32,
+        FifoQueue<8>,
+        0,
+        0,
+        Lean,
+    >,
+    entries: usize,
+}
+
+impl Service for QuietLine {
+    fn service(&mut self) {
+        if self.model.irq_pending() {
+            self.entries += 1;
+            self.tx_irq.on_interrupt();
+            self.rx_irq.on_interrupt();
+        }
+    }
+}
+
+/// In the quiet transmit mode the data mailbox is loaded again while the end of its last
+/// frame is not acknowledged (no transmit interrupt ran: its flag is still set). Each
+/// such load clears the flag first (Kinetis RM / IMXRT1060RM, "Transmit process", step
+/// 1: the write just before the identifier word), and each activation — direct or from
+/// the queue, data or remote — is still followed at once by exactly the two INACTIVE
+/// writes of the ERR005829 workaround. A direct send raises no interrupt; frames that
+/// had to queue are refilled from the interrupt, whose data-mailbox enable is off again
+/// once the queue is empty.
+#[test]
+fn the_quiet_mode_clears_the_flag_before_each_activation_and_keeps_the_e5829_writes() {
+    use twocan_core::{Format, FrameKind};
+    const { assert!(QuietState::QUIET_TX) };
+    for c in [
+        Configuration::Filters8_0,
+        Configuration::Filters24_48,
+        Configuration::Filters32_96,
+    ] {
+        // Loop-back; the filter takes 0x200–0x2FF only, so the direct frames (0x1xx)
+        // raise no Rx FIFO interrupt either.
+        let accept = Filter::masked(FrameKind::Data, Format::Standard, 0x700, 0x200);
+        let (model, log, controller) = begin_traced_with::<Imxrt1062>(c, true, &[accept]);
+        let reserved = usize::from(c.reserved_mailbox());
+        let data = usize::from(Imxrt1062::data_mailbox(c));
+        let tx = usize::from(Imxrt1062::first_remote_mailbox(c))..=data;
+        let (flags, mask, bit) = if data < 32 {
+            (regs::IFLAG1, regs::IMASK1, 1u32 << data)
+        } else {
+            (regs::IFLAG2, regs::IMASK2, 1u32 << (data - 32))
+        };
+        let state: &'static QuietState = Box::leak(Box::new(State::new()));
+        let parts = state
+            .split(controller.into_split())
+            .map_err(|(e, _)| e)
+            .unwrap();
+        let mut tx_half = parts.tx;
+        let mut rx_half = parts.rx;
+        let mut line = QuietLine {
+            model: model.clone(),
+            tx_irq: parts.tx_irq,
+            rx_irq: parts.rx0_irq,
+            entries: 0,
+        };
+        assert_eq!(
+            model.read32(mask) & bit,
+            0,
+            "{c:?}: split with the data mailbox's interrupt off"
+        );
+        log.borrow_mut().clear();
+        let mut bus = bus_with(500_000, &[&model]);
+
+        // Direct sends, the bus idle in between: no interrupt, the end never acknowledged.
+        for k in 0..4u8 {
+            tx_half
+                .try_send(&std_data(0x100 + u16::from(k), &[k]))
+                .unwrap();
+            run(&mut bus, &mut [&mut line], 300);
+            assert_eq!(line.entries, 0, "{c:?}: frame {k} raised an interrupt");
+            assert_ne!(
+                model.read32(flags) & bit,
+                0,
+                "{c:?}: frame {k} ended, not acknowledged"
+            );
+            assert_eq!(code_of(&model, data), code::TX_INACTIVE);
+        }
+        // A remote frame straight into its mailbox (its interrupt stays on: it is made
+        // inactive again), then a burst through the queue.
+        tx_half.try_send_now(&remote(0x2F0, false)).unwrap();
+        let burst: Vec<Frame> = (0..8u16).map(|i| std_data(0x200 + i, &[i as u8])).collect();
+        for f in &burst {
+            tx_half.try_send(f).unwrap();
+        }
+        assert_ne!(
+            model.read32(mask) & bit,
+            0,
+            "{c:?}: frames wait: the interrupt is on"
+        );
+        run(&mut bus, &mut [&mut line], 300 * 12);
+        assert!(line.entries > 0);
+        assert_eq!(tx_half.stats().count, 0);
+        assert_eq!(
+            model.read32(mask) & bit,
+            0,
+            "{c:?}: queue empty: the interrupt is off"
+        );
+        let got: Vec<Frame> = std::iter::from_fn(|| rx_half.receive().ok())
+            .map(|r| r.frame)
+            .collect();
+        assert_eq!(got, burst, "{c:?}: the burst, in order");
+
+        // The trace: the data mailbox's flag cleared right before each of its loads (the
+        // write before the identifier word), two INACTIVE writes after each activation.
+        let log = log.borrow();
+        let acts = activations(&log, tx.clone());
+        assert_eq!(acts.len(), 4 + 1 + burst.len(), "{c:?}");
+        let inactive = cs::CODE.val(code::TX_INACTIVE);
+        let pair = [(regs::mb_cs(reserved), inactive); 2];
+        for (mb, after) in &acts {
+            assert_eq!(after.get(..2), Some(&pair[..]), "{c:?}: after MB{mb}");
+            assert_ne!(after.get(2).map(|w| w.0), Some(regs::mb_cs(reserved)));
+        }
+        let mut loads = 0;
+        for (i, &(offset, _)) in log.iter().enumerate() {
+            if offset == regs::mb_id(data) {
+                loads += 1;
+                assert_eq!(
+                    log[i - 1],
+                    (flags, bit),
+                    "{c:?}: the data mailbox's flag cleared before load {loads}"
+                );
+            }
+        }
+        assert_eq!(loads, 4 + burst.len(), "{c:?}");
+        assert_eq!(code_of(&model, reserved), code::TX_INACTIVE, "{c:?}");
+    }
+}
+
+/// `unsplit` leaves the controller as a driver with completions expects it: the end the
+/// quiet mode left unacknowledged is acknowledged (its flag clear, so the next driver
+/// reports no completion for it) and the interrupt masks are `begin`'s again (the data
+/// mailbox's enable back on). A driver with completions over it then reports exactly
+/// its own frame.
+#[test]
+fn unsplit_after_the_quiet_mode_gives_back_the_masks_and_no_stale_end() {
+    for c in [Configuration::Filters8_0, Configuration::Filters24_48] {
+        let (model, _log, controller) =
+            begin_traced_with::<Imxrt1062>(c, true, &[Filter::pass_all()]);
+        let data = usize::from(Imxrt1062::data_mailbox(c));
+        let (flags, bit) = if data < 32 {
+            (regs::IFLAG1, 1u32 << data)
+        } else {
+            (regs::IFLAG2, 1u32 << (data - 32))
+        };
+        let masks = (model.read32(regs::IMASK1), model.read32(regs::IMASK2));
+        let state: &'static QuietState = Box::leak(Box::new(State::new()));
+        let mut parts = state
+            .split(controller.into_split())
+            .map_err(|(e, _)| e)
+            .unwrap();
+        assert_ne!(
+            (model.read32(regs::IMASK1), model.read32(regs::IMASK2)),
+            masks
+        );
+        let mut bus = bus_with(500_000, &[&model]);
+        parts.tx.try_send(&std_data(0x300, &[3])).unwrap();
+        // The bus alone (the frame comes back through the Rx FIFO; no handler runs).
+        bus.run_bits(300);
+        assert_ne!(
+            model.read32(flags) & bit,
+            0,
+            "{c:?}: ended, not acknowledged"
+        );
+        let (hw, left) = state.unsplit(parts).map_err(|(e, _)| e).unwrap();
+        assert_eq!(left.completions, 0);
+        assert_eq!(
+            model.read32(flags) & bit,
+            0,
+            "{c:?}: acknowledged by unsplit"
+        );
+        assert_eq!(
+            (model.read32(regs::IMASK1), model.read32(regs::IMASK2)),
+            masks,
+            "{c:?}: begin's masks"
+        );
+        let mut can: Rt<Imxrt1062> = Driver::new(hw.into_controller().into_split());
+        let token = can.try_send(&std_data(0x301, &[4])).unwrap();
+        run(&mut bus, &mut [&mut can], 500);
+        let done: Vec<_> = std::iter::from_fn(|| can.take_completion())
+            .map(|d| (d.token, d.outcome))
+            .collect();
+        assert_eq!(done, vec![(token, TxOutcome::Sent)], "{c:?}");
+    }
 }

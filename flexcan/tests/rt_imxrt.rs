@@ -121,3 +121,95 @@ fn can2_one_line_runs_every_handler() {
     rt_imxrt::can3();
     assert!(!rt::is_wired(Instance::Can1));
 }
+
+/// The quiet transmit mode through the entry point (`CAN3` here; `can2_one_line_runs_every_handler`, which
+/// may run beside this test, calls it too: one more interrupt for this state, which
+/// leaves every state checked below as it is): an `IrqState` with no
+/// completion ring, the portable `Lean` features and a request-order queue runs it
+/// (`State::QUIET_TX`), and the one line's handler takes the quiet path — the data
+/// mailbox's enable off after the split and whenever the queue is empty, on while
+/// frames wait; an end no interrupt acknowledged does not keep the next direct send
+/// out; the refill from the entry point clears the data mailbox's flag before loading
+/// it. The Rx FIFO's enables and the remote-frame mailboxes' are never touched.
+#[test]
+fn can3_entry_point_runs_the_quiet_transmit_mode() {
+    use twocan_core::{FifoQueue, Lean, State};
+    type H = twocan_flexcan::FlexCanHw<&'static SyncRegs, Full<BoardLayout>>;
+    type Quiet = IrqState<&'static SyncRegs, 32, FifoQueue<4>, 0, Full<BoardLayout>, Lean>;
+    const { assert!(State::<H, 32, FifoQueue<4>, 0, 0, Lean>::QUIET_TX) };
+    let regs: &'static SyncRegs = Box::leak(Box::new(SyncRegs {
+        words: (0..regs::IMXRT_BLOCK_END / 4)
+            .map(|_| AtomicU32::new(0))
+            .collect(),
+    }));
+    let settings = Settings::with_clock(500_000, CanClock::IMXRT_24MHZ);
+    let target = Target::new(Board::Teensy41, Instance::Can3);
+    let hw = FlexCan::<_, Imxrt1062>::begin_with_layout(
+        regs,
+        &mut HostSystem::new(),
+        target,
+        &settings,
+        &[],
+        &[],
+    )
+    .expect("begin")
+    .into_split();
+    let state: &'static Quiet = Box::leak(Box::new(Quiet::new()));
+    let (mut tx, _rx) = state
+        .start(hw, &mut Recorder::default())
+        .map_err(|(e, _)| e)
+        .unwrap();
+    // Default RFFN 2: reserved MB12, remote-frame mailboxes MB13–MB15, data mailbox MB16.
+    let data = 1u32 << 16;
+    let configured = iflag1::BUF5I | iflag1::BUF7I | 0xF << 13;
+    assert_eq!(
+        regs.read32(regs::IMASK1),
+        configured & !data,
+        "split: data enable off"
+    );
+    let code_of = |mb| cs::CODE.get(regs.read32(regs::mb_cs(mb)));
+    // The module sends the data mailbox's frame: INACTIVE, flag set (no interrupt: the
+    // enable is off).
+    let end = || {
+        regs.write32(regs::mb_cs(16), cs::CODE.val(regs::code::TX_INACTIVE));
+        regs.words[IFLAG1 / 4].fetch_or(data, Ordering::SeqCst);
+    };
+    let f = |k: u8| Frame::standard(0x100 + u16::from(k), &[k]).unwrap();
+    tx.try_send(&f(0)).unwrap();
+    assert_eq!(code_of(16), regs::code::TX_DATA);
+    end();
+    // Not acknowledged, yet the next direct send takes the mailbox (its flag cleared).
+    tx.try_send(&f(1)).unwrap();
+    assert_eq!(code_of(16), regs::code::TX_DATA);
+    assert_eq!(
+        regs.read32(IFLAG1) & data,
+        0,
+        "flag cleared before the load"
+    );
+    assert_eq!(tx.stats().count, 0);
+    // Busy: two frames queue, the enable goes on.
+    tx.try_send(&f(2)).unwrap();
+    tx.try_send(&f(3)).unwrap();
+    assert_eq!(tx.stats().count, 2);
+    assert_eq!(
+        regs.read32(regs::IMASK1),
+        configured,
+        "frames wait: data enable on"
+    );
+    // Each end runs the entry point: the refill loads the next frame.
+    end();
+    rt_imxrt::can3();
+    assert_eq!(tx.stats().count, 1);
+    assert_eq!(regs.read32(regs::mb_id(16)), regs::id::STD.val(0x102));
+    assert_eq!(regs.read32(IFLAG1) & data, 0);
+    assert_eq!(regs.read32(regs::IMASK1), configured);
+    end();
+    rt_imxrt::can3();
+    assert_eq!(tx.stats().count, 0);
+    assert_eq!(regs.read32(regs::mb_id(16)), regs::id::STD.val(0x103));
+    assert_eq!(
+        regs.read32(regs::IMASK1),
+        configured & !data,
+        "queue empty: off"
+    );
+}

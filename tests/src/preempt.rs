@@ -46,8 +46,10 @@ use twocan_core::{
     AbortRequest, Completion, Features, Filter, Frame, Full, Hardware, Priority, Registers, State,
     Token, TxOutcome, TxPolicy,
 };
+use twocan_flexcan::layout::{Imxrt1062, Kinetis, Layout};
 use twocan_flexcan::model::FlexCanModel;
-use twocan_flexcan::{FlexCan, FlexCanHw, HostSystem, Settings};
+use twocan_flexcan::options::Full as FullOptions;
+use twocan_flexcan::{Board, CanClock, FlexCan, FlexCanHw, HostSystem, Instance, Settings, Target};
 use twocan_sim::{Bus, PollClock, SharedBus, SimNode};
 
 /// Receive ring capacity (both queues) of the rigs.
@@ -261,7 +263,8 @@ pub struct Rig<
     /// For messages.
     pub name: &'static str,
     /// Whether the controller's transmit interrupt is enabled now (bxCAN
-    /// `CAN_IER.TMEIE`), read from the model without going through the preemption.
+    /// `CAN_IER.TMEIE`; FlexCAN: the data mailbox's `IMASK1`/`IMASK2` bit, the one the
+    /// quiet mode switches), read from the model without going through the preemption.
     pub tx_interrupt_on: Option<Box<dyn Fn() -> bool>>,
 }
 
@@ -269,6 +272,10 @@ pub struct Rig<
 pub type BxHw = BxCan<Preempted<PollClock<BxCanModel>>>;
 /// The FlexCAN controller of a rig.
 pub type FlexHw = FlexCanHw<Preempted<PollClock<FlexCanModel>>>;
+/// The FlexCAN controller of a rig in the layout `L`.
+pub type FlexHwIn<L> = FlexCanHw<Preempted<PollClock<FlexCanModel>>, FullOptions<L>>;
+/// The FlexCAN controller of a rig in the RT1062 layout (a Teensy 4.1's CAN3).
+pub type FlexRtHw = FlexHwIn<Imxrt1062>;
 
 fn bus_and_peer() -> (SharedBus, Rc<RefCell<SimNode>>) {
     let bus = Rc::new(RefCell::new(Bus::new(BIT_RATE).expect("bus")));
@@ -356,10 +363,58 @@ pub fn flexcan_rig<Q: TxQueue + 'static>() -> Rig<FlexHw, Q> {
 
 /// [`flexcan_rig`] with another peer (a listen-only one acknowledges nothing).
 pub fn flexcan_rig_with<Q: TxQueue + 'static>(peer: SimNode) -> Rig<FlexHw, Q> {
+    flexcan_rig_in::<Kinetis, Q, DONE, Full>(peer, crate::backend::teensy36_can0(), 0)
+}
+
+/// FlexCAN can0 of a Teensy 3.6 with the completion ring `D` and feature set `Fe`
+/// chosen (`D` = 0 with [`twocan_core::Lean`] and a request-order queue: the quiet
+/// transmit mode).
+pub fn flexcan_rig_quiet<Q: TxQueue + 'static, const D: usize, Fe: Features>(
+) -> Rig<FlexHw, Q, D, Fe> {
+    flexcan_rig_quiet_with(SimNode::new())
+}
+
+/// [`flexcan_rig_quiet`] with another peer (a listen-only one acknowledges nothing).
+pub fn flexcan_rig_quiet_with<Q: TxQueue + 'static, const D: usize, Fe: Features>(
+    peer: SimNode,
+) -> Rig<FlexHw, Q, D, Fe> {
+    flexcan_rig_in::<Kinetis, Q, D, Fe>(peer, crate::backend::teensy36_can0(), 0)
+}
+
+/// CAN3 of a Teensy 4.1 in the RT1062 layout (the ERR005829 reserved mailbox after the
+/// Rx FIFO area, the transmit mailboxes after it; `configuration` 0 is ACAN's
+/// `Filters8_0`, others per [`twocan_flexcan::Configuration::EVERY`]: from RFFN 8 the
+/// transmit mailboxes lie above MB31, in `IFLAG2`/`IMASK2`), with the completion ring
+/// `D` and the feature set `Fe` chosen.
+pub fn flexcan_rt_rig<Q: TxQueue + 'static, const D: usize, Fe: Features>(
+    configuration: twocan_flexcan::Configuration,
+) -> Rig<FlexRtHw, Q, D, Fe> {
+    let index = twocan_flexcan::Configuration::EVERY
+        .iter()
+        .position(|c| *c == configuration)
+        .expect("a configuration");
+    flexcan_rig_in::<Imxrt1062, Q, D, Fe>(
+        SimNode::new(),
+        Target::new(Board::Teensy41, Instance::Can3),
+        index,
+    )
+}
+
+/// A FlexCAN rig of layout `L` on `target`, its settings ACAN's defaults at
+/// [`BIT_RATE`] (on a Teensy 4, the 24 MHz oscillator and the configuration
+/// `Configuration::EVERY[configuration]`), receiving everything.
+fn flexcan_rig_in<L: Layout, Q: TxQueue + 'static, const D: usize, Fe: Features>(
+    peer: SimNode,
+    target: Target,
+    configuration: usize,
+) -> Rig<FlexHwIn<L>, Q, D, Fe>
+where
+    FullOptions<L>: twocan_flexcan::options::Options<Layout = L, Table = L::Table>,
+{
     let bus = Rc::new(RefCell::new(Bus::new(BIT_RATE).expect("bus")));
     let peer = peer.shared();
-    let model = FlexCanModel::mk66fx1m0();
-    bus.borrow_mut().attach("can0", model.clone());
+    let model = FlexCanModel::new(target.model_chip());
+    bus.borrow_mut().attach("can", model.clone());
     bus.borrow_mut().attach("peer", peer.clone());
     let preemption = Preemption::new(&bus);
     let regs = Preempted::new(
@@ -370,20 +425,37 @@ pub fn flexcan_rig_with<Q: TxQueue + 'static>(peer: SimNode) -> Rig<FlexHw, Q> {
         ),
         &preemption,
     );
-    let controller = FlexCan::begin(
+    let rt = L::IFLAG2;
+    let settings = if rt {
+        let mut s = Settings::with_clock(BIT_RATE, CanClock::IMXRT_24MHZ);
+        s.configuration = twocan_flexcan::Configuration::EVERY[configuration];
+        s
+    } else {
+        Settings::new(BIT_RATE)
+    };
+    let controller = FlexCan::<_, L>::begin_with_layout(
         regs,
         &mut HostSystem::new(),
-        crate::backend::teensy36_can0(),
-        &Settings::new(BIT_RATE),
+        target,
+        &settings,
         &[Filter::pass_all()],
         &[],
     )
     .expect("begin");
-    let state: &'static State<FlexHw, RX, Q, RX, DONE> = Box::leak(Box::new(State::new()));
+    let state: &'static State<FlexHwIn<L>, RX, Q, RX, D, Fe> = Box::leak(Box::new(State::new()));
     let parts = state
         .split(controller.into_split())
         .map_err(|(e, _)| e)
         .expect("split");
+    let configuration = settings.configuration;
+    let data = usize::from(L::data_mailbox(configuration));
+    let (mask, bit) = if data < 32 {
+        (twocan_flexcan::regs::IMASK1, data)
+    } else {
+        (twocan_flexcan::regs::IMASK2, data - 32)
+    };
+    let imask = model.clone();
+    let tx_interrupt_on = move || twocan_core::Registers::read32(&imask, mask) & 1 << bit != 0;
     let (mut tx_irq, mut rx0, mut status) = (parts.tx_irq, parts.rx0_irq, parts.status_irq);
     preemption.set_handlers(move || {
         let l = model.irq();
@@ -404,8 +476,12 @@ pub fn flexcan_rig_with<Q: TxQueue + 'static>(peer: SimNode) -> Rig<FlexHw, Q> {
         preemption,
         bus,
         peer,
-        name: "FlexCAN, request order",
-        tx_interrupt_on: None,
+        name: if rt {
+            "FlexCAN RT1062 layout, request order"
+        } else {
+            "FlexCAN, request order"
+        },
+        tx_interrupt_on: Some(Box::new(tx_interrupt_on)),
     }
 }
 
@@ -660,19 +736,23 @@ impl Outcome {
     }
 
     /// Our frames (indices into `accepted`, in wire order) left in an order `policy`
-    /// allows.
+    /// allows. A frame of `try_send_now` is ordered with no other: it may leave before
+    /// frames accepted earlier (FlexCAN: a remote frame's mailbox beside the loaded data
+    /// mailbox, the module picking by identifier), and where the order is by priority a
+    /// later frame may leave before it.
     fn check_order(&self, ours: &[usize], policy: TxPolicy, what: &str) {
         for (a, &i) in ours.iter().enumerate() {
             for &j in &ours[a + 1..] {
                 let (fi, fj) = (self.accepted[i].1, self.accepted[j].1);
-                let ordered = !self.overtaking.contains(&j)
+                let ordered = !self.overtaking.contains(&i)
+                    && !self.overtaking.contains(&j)
                     && match policy {
                         TxPolicy::Fifo => true,
                         TxPolicy::Priority => Priority::of(&fi) == Priority::of(&fj),
                     };
                 assert!(
                     !ordered || i < j,
-                    "{what}: frame {j} ({fj:?}) left before frame {i} ({fi:?}); wire {:?}",
+                    "{what}: frame {i} ({fi:?}) left before frame {j} ({fj:?}); wire {:?}",
                     self.wire
                 );
             }

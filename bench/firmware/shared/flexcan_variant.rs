@@ -17,8 +17,10 @@
 //!   (`twocan_flexcan::options::Lean`: no time stamps, no filter switch while running,
 //!   the filter table planned at compile time by `const_plan!` and the settings checked
 //!   at compile time (`BeginPlan`), written by `FlexCan::begin_checked`, which keeps a
-//!   few words pointing into the plan).
-//!   Statistics stay on (twocan-core's counters).
+//!   few words pointing into the plan) and the split driver's `Lean` feature set (no
+//!   traffic statistics, no time stamps read), which with the request-order queue is
+//!   its quiet transmit mode (`State::QUIET_TX`: MB15's interrupt enabled only while
+//!   frames wait in the queue, so a frame sent directly costs no transmit handler).
 
 // Each firmware that includes this module uses a part of it.
 #![allow(dead_code)]
@@ -68,6 +70,9 @@ pub const DONE: usize = 0;
 /// The controller's compile-time choices: no time stamps, no filter switch.
 #[cfg(feature = "lean")]
 pub type Opts = twocan_flexcan::options::Lean;
+/// The split driver's features: no statistics, no time stamps (the quiet transmit mode).
+#[cfg(feature = "lean")]
+pub type Fe = twocan_core::Lean;
 
 // ------------------------------------------------------------------ full
 
@@ -79,6 +84,9 @@ pub const DONE: usize = 8;
 /// `static` slot that `begin_in` compiles into.
 #[cfg(feature = "full")]
 pub type Opts = twocan_flexcan::options::FullInSlot;
+/// The split driver's features: statistics and time stamps.
+#[cfg(feature = "full")]
+pub type Fe = twocan_core::Full;
 
 // ------------------------------------------------------------------ both
 
@@ -87,12 +95,12 @@ pub type Hw<R> = FlexCanHw<R, Opts>;
 /// The transmit queue.
 pub type Q = FifoQueue<TXQ>;
 /// The shared state a `static` holds.
-pub type OurState<R> = State<Hw<R>, RX, Q, 0, DONE>;
-pub type OurParts<R> = Parts<'static, Hw<R>, RX, Q, 0, DONE>;
-pub type OurTx<R> = Tx<'static, Hw<R>, RX, Q, 0, DONE>;
-pub type OurRx<R> = Rx<'static, Hw<R>, RX, Q, 0, DONE>;
-pub type OurTxIrq<R> = TxIrq<'static, Hw<R>, RX, Q, 0, DONE>;
-pub type OurRxIrq<R> = Rx0Irq<'static, Hw<R>, RX, Q, 0, DONE>;
+pub type OurState<R> = State<Hw<R>, RX, Q, 0, DONE, Fe>;
+pub type OurParts<R> = Parts<'static, Hw<R>, RX, Q, 0, DONE, Fe>;
+pub type OurTx<R> = Tx<'static, Hw<R>, RX, Q, 0, DONE, Fe>;
+pub type OurRx<R> = Rx<'static, Hw<R>, RX, Q, 0, DONE, Fe>;
+pub type OurTxIrq<R> = TxIrq<'static, Hw<R>, RX, Q, 0, DONE, Fe>;
+pub type OurRxIrq<R> = Rx0Irq<'static, Hw<R>, RX, Q, 0, DONE, Fe>;
 
 /// `begin` with [`SETTINGS`] and [`FILTERS`] on the registers `regs()` gives and the
 /// SIM/PORT registers `sys`, then the controller for the split driver. `RETRIES` more
