@@ -3,7 +3,7 @@
 //! [`FlexCan::into_split`].
 //!
 //! Interrupt lines (Kinetis RM, FlexCAN "Interrupts"): the ORed message-buffer vector
-//! runs both the transmit handler ([`twocan_core::split::TxIrq`]: settle MB15 and the
+//! runs both the transmit handler ([`twocan_core::split::TxIrq`]: settle the data mailbox (MB15 in the Kinetis layout) and the
 //! remote-frame mailboxes, refill) and the receive handler
 //! ([`twocan_core::split::Rx0Irq`]: the Rx FIFO); the bus-off, error,
 //! Tx/Rx-warning and wake-up vectors run the status handler
@@ -90,7 +90,7 @@ const RX_FIFO_DEPTH: usize = 6;
 /// of [`Hardware::free_mailbox`] are settled (flag clear): nothing to clear.
 const QUIET_LOAD: u8 = 0x80;
 
-/// Transmit mailboxes at most (the data mailbox, MB15 in ACAN's configurations, and up
+/// Transmit mailboxes at most (the data mailbox, MB15 in ACAN's configurations in the Kinetis layout, MB16 in the RT1062 layout, and up
 /// to seven remote-frame mailboxes: [`Configuration::data_mailbox`]).
 const MAX_TX: usize = 8;
 
@@ -517,7 +517,7 @@ impl<R: Registers, O: Options> FlexCanHw<R, O> {
         self.tx_refused.store(refused, Ordering::Relaxed);
     }
 
-    /// The data mailbox (MB15 in ACAN's configurations) for a data frame, the first free
+    /// The data mailbox (MB15 in ACAN's configurations in the Kinetis layout, MB16 in the RT1062 layout) for a data frame, the first free
     /// remote-frame mailbox for a remote frame.
     #[inline(always)]
     fn free_now(&self, frame: &Frame) -> Result<Option<u8>, Error> {
@@ -537,7 +537,7 @@ impl<R: Registers, O: Options> FlexCanHw<R, O> {
         Ok((first..data).find(|&mb| free(mb)).map(|mb| mb as u8))
     }
 
-    /// The quiet mode's data mailbox (MB15 in ACAN's configurations), tagged
+    /// The quiet mode's data mailbox (MB15 in ACAN's configurations in the Kinetis layout, MB16 in the RT1062 layout), tagged
     /// [`QUIET_LOAD`]: free when its code reads `INACTIVE` — never loaded, or its frame
     /// sent (Kinetis RM, "Transmit process": after a successful transmission the code
     /// goes back to INACTIVE and the flag is set) — or `ABORT` with its flag set (aborted,
@@ -903,7 +903,7 @@ unsafe impl<R: Registers, O: Options> Hardware for FlexCanHw<R, O> {
     type FilterMap = ();
     type Filters = <O::Layout as Layout>::Table;
 
-    /// One data mailbox (MB15 in ACAN's configurations): request order (ACAN §3
+    /// One data mailbox (MB15 in ACAN's configurations in the Kinetis layout, MB16 in the RT1062 layout): request order (ACAN §3
     /// "sequentiality").
     fn tx_policy(&self) -> TxPolicy {
         TxPolicy::Fifo
@@ -925,7 +925,7 @@ unsafe impl<R: Registers, O: Options> Hardware for FlexCanHw<R, O> {
         self.free_now(frame)
     }
 
-    /// Data frames: the data mailbox (MB15 in ACAN's configurations); remote frames: the first free remote-frame mailbox (ACAN §9),
+    /// Data frames: the data mailbox (MB15 in ACAN's configurations in the Kinetis layout, MB16 in the RT1062 layout); remote frames: the first free remote-frame mailbox (ACAN §9),
     /// whatever else is loaded. Free means code `INACTIVE` and its `IFLAG1` bit clear
     /// (settled). Refused with [`Error::WrongMode`] in listen-only mode and while
     /// disabled (sleep).
@@ -1036,7 +1036,7 @@ unsafe impl<R: Registers, O: Options> Hardware for FlexCanHw<R, O> {
     /// area, INACTIVE since `begin`). Two contexts may do it at once (the transmit half
     /// and the transmit interrupt's refill); both write the same value.
     ///
-    /// A mailbox of the quiet mode ([`QUIET_LOAD`]) may have ended without its flag
+    /// A mailbox of the quiet mode (tagged `QUIET_LOAD`) may have ended without its flag
     /// being acknowledged: its flag is cleared first (write 1 to clear; Kinetis RM,
     /// "Transmit process", step 1), before its `loaded` bit is set and its words are
     /// written, so that a transmit handler preempting the load sees either the old end
@@ -1069,7 +1069,7 @@ unsafe impl<R: Registers, O: Options> Hardware for FlexCanHw<R, O> {
         }
         let ended = self.regs.read32(self.tx_flags()) & self.tx_mask;
         if ended & ended.wrapping_sub(1) != 0 {
-            // Several mailboxes ended (remote frames beside MB15): out of line.
+            // Several mailboxes ended (remote frames beside the data mailbox): out of line.
             self.settle_many(ended, &mut f);
         } else if ended != 0 {
             // One mailbox: no sorting, no list.
@@ -1086,7 +1086,7 @@ unsafe impl<R: Registers, O: Options> Hardware for FlexCanHw<R, O> {
         (1 + self.data_mb() - self.first_remote()) as u8
     }
 
-    /// `MailboxId(0)` is the data mailbox (MB15 in ACAN's configurations), `MailboxId(1..=n)` the remote-frame mailboxes in
+    /// `MailboxId(0)` is the data mailbox (MB15 in ACAN's configurations in the Kinetis layout, MB16 in the RT1062 layout), `MailboxId(1..=n)` the remote-frame mailboxes in
     /// increasing MB order: `Pending` while loaded (code `DATA`, flag clear), else
     /// `Empty` (FlexCAN shows no scheduled or transmitting state per mailbox).
     fn mailbox_state(&self, mailbox: MailboxId) -> MailboxState {
@@ -1402,13 +1402,12 @@ unsafe impl<R: Registers, O: Options> Hardware for FlexCanHw<R, O> {
         Ok(())
     }
 
-    /// The driver's one bit-timing rule ([`crate::settings::timing_rule`] with the bus
-    /// clock `begin` was given): the 16 MHz oscillator, [`Limits::FLEXCAN_KINETIS`]
-    /// (8..=25 quanta per bit) and 16 bus clocks per CAN bit (Kinetis RM, FlexCAN
-    /// chapter, "Arbitration and matching timing"; 1 Mbit/s from a 16 MHz bus clock,
-    /// 2 Mbit/s from 32 MHz and above; with the RT1062 layout's larger tables 17 or 30
-    /// for `MCR[MAXMB]` + 1 buffers, IMXRT1060RM same section,
-    /// [`crate::settings::timing_rule_for_buffers`]); one ID table element per exact
+    /// The driver's one bit-timing rule ([`crate::begin::timing_rule_in`] with the CAN
+    /// clock and the bus clock `begin` was given): [`Limits::FLEXCAN_KINETIS`] (8..=25
+    /// quanta per bit) and 16 bus clocks per CAN bit (Kinetis RM, FlexCAN chapter,
+    /// "Arbitration and matching timing"; 1 Mbit/s from a 16 MHz bus clock, 2 Mbit/s
+    /// from 32 MHz and above; with the RT1062 layout's larger tables 17 or 30 for
+    /// `MCR[MAXMB]` + 1 buffers, IMXRT1060RM same section); one ID table element per exact
     /// filter of either format (format A), as many as the configuration's primary and
     /// secondary elements (ACAN §11, table 4; up to 128 with the RT1062 layout); the data
     /// mailbox and the remote-frame mailboxes;
@@ -1437,15 +1436,11 @@ unsafe impl<R: Registers, O: Options> Hardware for FlexCanHw<R, O> {
             RX_FIFO_DEPTH as u8,
             Some(16),
         )
-        .with_timing_rule(if O::Layout::IFLAG2 {
-            crate::settings::timing_rule_for_buffers(
-                self.system.can_clock_hz(),
-                Some(self.bus_clock_hz),
-                c.message_buffers_used_in(O::Layout::E5829),
-            )
-        } else {
-            crate::settings::timing_rule_for(self.system.can_clock_hz(), Some(self.bus_clock_hz))
-        })
+        .with_timing_rule(crate::begin::rule_in::<O::Layout>(
+            self.system.can_clock_hz(),
+            Some(self.bus_clock_hz),
+            c,
+        ))
     }
 
     fn bus_mode(&self) -> BusMode {
