@@ -31,6 +31,7 @@ pub const CHIPS: [Chip; 6] = [
 /// calling file): `body::mk20dx256`, `body::mk64fx512`, `body::mk66fx1m0`,
 /// `body::rt1062_can1`, `body::rt1062_can2`, `body::rt1062_can3`. `cargo test rt1062`
 /// runs the i.MX RT1062 half.
+#[allow(unused_macros)]
 macro_rules! on_every_chip {
     ($($body:ident),* $(,)?) => {$(
         mod $body {
