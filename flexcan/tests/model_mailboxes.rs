@@ -341,16 +341,33 @@ fn time_stamps_come_from_the_free_running_timer(chip: Chip) {
     );
 }
 
+/// The message buffer interrupt line from MB1 and from the last message buffer (MB15, or
+/// MB63 on the RT1062, whose flag is IFLAG2 bit 31: [`mb_flag`]), MCR\[MAXMB\] raised to it.
 fn message_buffer_interrupt_line(chip: Chip) {
     let mut r = rig(chip);
-    r.load_mb(1, &std(0x1, &[]), code::TX_DATA);
-    r.transmit_all();
-    assert!(!r.m.irq().message_buffer, "IMASK1 clear");
-    r.wr(regs::IMASK1, 1 << 1);
-    assert!(r.m.irq().message_buffer && r.m.irq_pending());
-    r.wr(regs::IFLAG1, 1 << 1);
-    assert!(!r.m.irq_pending());
-    assert_eq!(r.rd(regs::IMASK1), 1 << 1);
+    let last = r.manual().message_buffers - 1;
+    r.freeze();
+    r.wr(regs::MCR, mcr::MAXMB.replace(r.rd(regs::MCR), last as u32));
+    r.clear_bits(regs::MCR, mcr::HALT);
+    r.idle(11);
+    for n in [1, last] {
+        let (flags, imask, bit) = mb_flag(n);
+        let iflag = if imask == regs::IMASK1 {
+            regs::IFLAG1
+        } else {
+            layout::IFLAG2
+        };
+        r.load_mb(n, &std(n as u16, &[]), code::TX_DATA);
+        r.transmit_all();
+        assert_eq!((r.rd(regs::IFLAG1), r.rd(layout::IFLAG2)), flags, "MB{n}");
+        assert!(!r.m.irq().message_buffer, "MB{n}: its mask bit clear");
+        r.wr(imask, bit);
+        assert!(r.m.irq().message_buffer && r.m.irq_pending(), "MB{n}");
+        r.wr(iflag, bit);
+        assert!(!r.m.irq_pending(), "MB{n}");
+        assert_eq!(r.rd(imask), bit);
+        r.wr(imask, 0);
+    }
     // One bit per message buffer: MB0–MB15 on the Kinetis parts; MB0–MB31 in IMASK1 and
     // MB32–MB63 in IMASK2 on the RT1062 (IMXRT1060RM "Interrupt Masks 1/2 register"),
     // IMASK2 reserved on the Kinetis parts.

@@ -187,6 +187,18 @@ impl Manual {
     }
 }
 
+/// `(IFLAG1, IFLAG2)` with only message buffer `n`'s flag set, and the mask register
+/// (`IMASK1` or `IMASK2`) and bit that enable its interrupt: MB0–MB31 in IFLAG1/IMASK1
+/// bit n, MB32–MB63 in IFLAG2/IMASK2 bit n − 32 (IMXRT1060RM "Interrupt Flags 2 register
+/// (IFLAG2)", "Interrupt Masks 2 register (IMASK2)"; the Kinetis parts stop at MB15).
+pub fn mb_flag(n: usize) -> ((u32, u32), usize, u32) {
+    if n < 32 {
+        ((1 << n, 0), regs::IMASK1, 1 << n)
+    } else {
+        ((0, 1 << (n - 32)), twocan_flexcan::model::layout::IMASK2, 1 << (n - 32))
+    }
+}
+
 /// Takes `m` out of module disable and sets up what the bus tests start from, still
 /// halted in freeze: the Rx FIFO (`RFEN`) with its eight ID filters accepting everything
 /// (individual masks 0, `IRMQ`), the mailboxes after the FIFO (MB8 up to `MCR[MAXMB]`,
