@@ -21,7 +21,6 @@ on_every_chip!(
     extreme_bus_times_do_not_overflow,
 );
 
-
 /// A started module with the Rx FIFO accepting everything; `srxdis` and CTRL1 `bits`
 /// as given.
 fn rig(chip: Chip, srxdis: bool, bits: u32) -> Rig {

@@ -23,7 +23,6 @@ on_every_chip!(
     soft_reset_clears_the_error_state,
 );
 
-
 fn rig(chip: Chip, wrnen: bool) -> Rig {
     let mut r = Rig::on(chip);
     r.enable_into_freeze();

@@ -31,7 +31,6 @@ on_every_chip!(
     maxmb_limits_the_active_mailboxes,
 );
 
-
 /// An enabled module in normal mode without the FIFO (every MB is a mailbox; MB0–MB15
 /// take part, MCR\[MAXMB\] = 0xF out of reset on every module), self reception off.
 fn rig(chip: Chip) -> Rig {

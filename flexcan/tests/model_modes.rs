@@ -54,11 +54,11 @@ fn reset_state_per_the_manual(chip: Chip) {
     assert!(!m.listens() && !m.acknowledges());
 }
 
-/// From Disable mode (the RT1062 gets there first: [`Rig::into_disable`]), negating MDIS
+/// From Disable mode (the RT1062 gets there first: [`Rig::enter_disable`]), negating MDIS
 /// with FRZ and HALT set enters Freeze mode.
 fn enable_enters_freeze_then_normal_after_eleven_recessive_bits(chip: Chip) {
     let mut r = Rig::on(chip);
-    r.into_disable();
+    r.enter_disable();
     r.clear_bits(regs::MCR, mcr::MDIS);
     let v = r.rd(regs::MCR);
     assert_eq!(v & (mcr::LPMACK | mcr::MDIS), 0);
@@ -178,7 +178,7 @@ fn freeze_only_fields_ignore_writes_outside_freeze(chip: Chip) {
         ecr::TXERRCNT.val(100) | ecr::RXERRCNT.val(7)
     );
     // Disable mode: CLKSRC, where the module has it.
-    r.into_disable();
+    r.enter_disable();
     r.set_bits(regs::CTRL1, ctrl1::CLKSRC);
     assert_eq!(r.rd(regs::CTRL1) & ctrl1::CLKSRC != 0, want.clksrc);
 }
@@ -248,7 +248,7 @@ fn soft_reset_resets_the_listed_registers_only(chip: Chip) {
 
 fn soft_reset_requested_while_disabled_completes_when_enabled(chip: Chip) {
     let mut r = Rig::on(chip);
-    r.into_disable();
+    r.enter_disable();
     r.set_bits(regs::MCR, mcr::SOFTRST);
     assert_ne!(
         r.rd(regs::MCR) & mcr::SOFTRST,
@@ -262,7 +262,7 @@ fn soft_reset_requested_while_disabled_completes_when_enabled(chip: Chip) {
 
 fn stuck_freeze_acknowledge_never_comes(chip: Chip) {
     let mut r = Rig::on(chip);
-    r.into_disable();
+    r.enter_disable();
     r.m.set_freeze_ack_stuck(true);
     r.clear_bits(regs::MCR, mcr::MDIS);
     for _ in 0..1000 {

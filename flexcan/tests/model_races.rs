@@ -31,7 +31,6 @@ on_every_chip!(
     freeze_request_waits_for_the_frame_in_flight_at_the_lowest_bit_rate,
 );
 
-
 const MB: usize = 8;
 
 /// A module with the Rx FIFO accepting everything, `extra` MCR bits, optionally a TEC

@@ -21,7 +21,6 @@ on_every_chip!(
     remote_request_matching_the_fifo_is_stored_not_answered,
 );
 
-
 fn loop_back_data_and_remote_frames_through_the_fifo(chip: Chip) {
     let mut r = Rig::loopback_fifo(chip);
     let data = std(0x542, &[1, 2, 3, 4, 5, 6, 7, 8]);
@@ -70,7 +69,10 @@ fn filter_table_split_for_each_rffn(chip: Chip) {
         let elements = 8 * (rffn as usize + 1);
         let mut r = Rig::on(chip);
         r.enable_into_freeze();
-        r.wr(regs::MCR, mcr::MAXMB.replace(r.rd(regs::MCR), mbs as u32 - 1));
+        r.wr(
+            regs::MCR,
+            mcr::MAXMB.replace(r.rd(regs::MCR), mbs as u32 - 1),
+        );
         // Every element accepts standard data frames with ID 0 under its mask; every
         // RXIMR compares all bits (also those of buffers past the individually masked
         // elements: they must not be used for the elements under RXFGMASK).

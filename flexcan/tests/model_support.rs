@@ -94,8 +94,10 @@ pub struct Manual {
     pub ctrl2_reserved_low: u32,
     /// `IMASK1`/`IFLAG1` bits that exist: one per MB0–MB15 (Kinetis) or MB0–MB31.
     pub flags1: u32,
-    /// `IMASK2`/`IFLAG2` bits that exist: none on the Kinetis parts (reserved), one per
-    /// MB32–MB63 on the RT1062 ("Interrupt Masks 2 register (IMASK2)").
+    /// `IMASK2`/`IFLAG2` bits that exist: one per MB32–MB63 on the RT1062 ("Interrupt
+    /// Masks 2 register (IMASK2)"); none on the 16-buffer Kinetis parts (there is no
+    /// MB32–MB63 for a bit to stand for; the MK20D7 SVD lists the two registers all the
+    /// same).
     pub flags2: u32,
     /// `MCR[WAKSRC]` is implemented (reserved on the MK20DX256: K20P64M72SF1RM MCR
     /// field description; present on the K64, K66 and the RT1062 modules).
@@ -195,7 +197,11 @@ pub fn mb_flag(n: usize) -> ((u32, u32), usize, u32) {
     if n < 32 {
         ((1 << n, 0), regs::IMASK1, 1 << n)
     } else {
-        ((0, 1 << (n - 32)), twocan_flexcan::model::layout::IMASK2, 1 << (n - 32))
+        (
+            (0, 1 << (n - 32)),
+            twocan_flexcan::model::layout::IMASK2,
+            1 << (n - 32),
+        )
     }
 }
 
@@ -283,7 +289,7 @@ impl Rig {
     /// Enters Module Disable mode (MDIS = 1, acknowledged by LPMACK): the Kinetis reset
     /// state already; the RT1062 leaves reset in Freeze mode (IMXRT1060RM MCR reset
     /// 0x5980_000F) and gets there by MDIS = 1 ("Module disable mode").
-    pub fn into_disable(&mut self) {
+    pub fn enter_disable(&mut self) {
         self.set_bits(regs::MCR, mcr::MDIS);
         assert_ne!(self.rd(regs::MCR) & mcr::LPMACK, 0, "disable acknowledged");
         assert_eq!(self.m.mode(), ModelMode::Disabled);
@@ -559,4 +565,3 @@ fn support_builds() {
     let r = Rig::new();
     assert_eq!(r.now, 0);
 }
-
