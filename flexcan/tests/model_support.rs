@@ -88,9 +88,11 @@ pub struct Manual {
     /// `RXMGMASK`, `RX14MASK`, `RX15MASK`, `RXFGMASK` reset value: all ones, except on
     /// the RT1062's CAN3 (0; SVD reset values).
     pub reset_masks: u32,
-    /// `CTRL2` bits 15–0 that are reserved (read 0): all of them on the Kinetis parts and
-    /// on CAN1/CAN2; bits 5–0 on CAN3, whose bits 15–6 are the CAN FD and time stamp
-    /// fields (`TIMER_SRC` … `TSTAMPCAP`, SVD `can3::CTRL2`).
+    /// `CTRL2` bits 15–0 that are reserved (read 0): all of them on the Kinetis parts
+    /// (MK20D7 SVD: no field below bit 16) and on CAN1/CAN2 (SVD `can::CTRL2`); bits 10
+    /// and 5–0 on CAN3, whose other low bits are the CAN FD and time stamp fields
+    /// (`TIMER_SRC`, `PREXCEN`, `BTE`, `ISOCANFDEN`, `EDFLTDIS`, `MBTSBASE`, `TSTAMPCAP`:
+    /// SVD `can3::CTRL2`).
     pub ctrl2_reserved_low: u32,
     /// `IMASK1`/`IFLAG1` bits that exist: one per MB0–MB15 (Kinetis) or MB0–MB31.
     pub flags1: u32,
@@ -175,7 +177,7 @@ impl Manual {
             Chip::Imxrt1062(Rt1062Can::Can3) => Manual {
                 reset_ctrl2: 0x0080_0000,
                 reset_masks: 0,
-                ctrl2_reserved_low: 0x003F,
+                ctrl2_reserved_low: 0x043F,
                 clksrc: true,
                 ..RT1062_CAN1
             },
