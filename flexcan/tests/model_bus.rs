@@ -1,19 +1,30 @@
 //! The bus side: self reception, listen-only, loop-back ("Self reception", "Listen-only
-//! mode", "Loop-back mode"), and modules on the simulated bus of `twocan_sim`.
+//! mode", "Loop-back mode"), and modules on the simulated bus of `twocan_sim`, on every
+//! module of `support::CHIPS`.
 
 #[path = "model_support.rs"]
 mod support;
 
 use support::*;
 use twocan_core::registers::Registers;
-use twocan_flexcan::model::FlexCanModel;
+use twocan_flexcan::model::{Chip, FlexCanModel};
 use twocan_flexcan::regs::{self, code, ctrl1, mcr};
 use twocan_sim::{Bus, BusNode, SimNode, TxResult};
 
+on_every_chip!(
+    self_reception_on_and_off,
+    listen_only_receives_but_never_acknowledges_nor_transmits,
+    loop_back_is_internal_and_deaf_to_the_bus,
+    loop_back_synchronises_on_its_own_recessive_output,
+    two_modules_and_a_plain_node_on_the_simulated_bus,
+    a_lone_module_stops_at_error_passive_on_the_simulated_bus,
+    extreme_bus_times_do_not_overflow,
+);
+
 /// A started module with the Rx FIFO accepting everything; `srxdis` and CTRL1 `bits`
 /// as given.
-fn rig(srxdis: bool, bits: u32) -> Rig {
-    let mut r = Rig::new();
+fn rig(chip: Chip, srxdis: bool, bits: u32) -> Rig {
+    let mut r = Rig::on(chip);
     r.enable_into_freeze();
     r.setup_fifo(0, true, &[0; 8], &[0; 8], 0);
     if srxdis {
@@ -26,26 +37,24 @@ fn rig(srxdis: bool, bits: u32) -> Rig {
     r
 }
 
-#[test]
-fn self_reception_on_and_off() {
+fn self_reception_on_and_off(chip: Chip) {
     let frame = std(0x123, &[1, 2]);
-    let mut r = rig(false, 0);
+    let mut r = rig(chip, false, 0);
     r.load_mb(8, &frame, code::TX_DATA);
     let req = r.m.poll_tx(r.now).unwrap();
     assert!(!req.internal && !req.self_ack, "on the wire");
     r.transmit_all();
     assert_eq!(r.drain_fifo(), vec![(frame, 0)]);
 
-    let mut r = rig(true, 0);
+    let mut r = rig(chip, true, 0);
     r.load_mb(8, &frame, code::TX_DATA);
     r.transmit_all();
     assert_eq!(r.m.fifo_len(), 0);
     assert_eq!(r.rd(regs::IFLAG1), 1 << 8, "transmitted all the same");
 }
 
-#[test]
-fn listen_only_receives_but_never_acknowledges_nor_transmits() {
-    let mut r = rig(true, ctrl1::LOM);
+fn listen_only_receives_but_never_acknowledges_nor_transmits(chip: Chip) {
+    let mut r = rig(chip, true, ctrl1::LOM);
     assert!(r.m.listens());
     assert!(!r.m.acknowledges());
     assert!(!r.m.error_active(), "listen-only behaves as error passive");
@@ -63,9 +72,8 @@ fn listen_only_receives_but_never_acknowledges_nor_transmits() {
     assert_eq!(r.code(8), code::TX_DATA, "still pending");
 }
 
-#[test]
-fn loop_back_is_internal_and_deaf_to_the_bus() {
-    let mut r = rig(false, ctrl1::LPB);
+fn loop_back_is_internal_and_deaf_to_the_bus(chip: Chip) {
+    let mut r = rig(chip, false, ctrl1::LPB);
     assert!(!r.m.listens() && !r.m.acknowledges());
     r.deliver(&std(0x7, &[]));
     assert_eq!(r.m.fifo_len(), 0, "the bus is not sampled");
@@ -75,15 +83,14 @@ fn loop_back_is_internal_and_deaf_to_the_bus() {
     assert_eq!(r.transmit(TxResult::Acked), Some(std(0x8, &[8])));
     assert_eq!(r.drain_fifo(), vec![(std(0x8, &[8]), 0)]);
     // Loop-back with self reception disabled: sent, not received.
-    let mut r = rig(true, ctrl1::LPB);
+    let mut r = rig(chip, true, ctrl1::LPB);
     r.load_mb(8, &std(0x8, &[8]), code::TX_DATA);
     r.transmit_all();
     assert_eq!(r.m.fifo_len(), 0);
 }
 
-#[test]
-fn loop_back_synchronises_on_its_own_recessive_output() {
-    let mut r = Rig::new();
+fn loop_back_synchronises_on_its_own_recessive_output(chip: Chip) {
+    let mut r = Rig::on(chip);
     r.enable_into_freeze();
     r.ctrl1(ctrl1::LPB);
     r.clear_bits(regs::MCR, mcr::HALT);
@@ -113,11 +120,10 @@ fn fifo_frames(m: &mut FlexCanModel) -> Vec<twocan_core::Frame> {
     out
 }
 
-#[test]
-fn two_modules_and_a_plain_node_on_the_simulated_bus() {
+fn two_modules_and_a_plain_node_on_the_simulated_bus(chip: Chip) {
     let mut bus = Bus::new(500_000).unwrap();
-    let mut a = FlexCanModel::mk20dx256();
-    let mut b = FlexCanModel::mk66fx1m0();
+    let mut a = FlexCanModel::new(chip);
+    let mut b = FlexCanModel::new(chip);
     let sniffer = SimNode::new().with_listen_only(true).shared();
     module(&mut a, true);
     module(&mut b, false);
@@ -191,10 +197,9 @@ fn two_modules_and_a_plain_node_on_the_simulated_bus() {
     );
 }
 
-#[test]
-fn a_lone_module_stops_at_error_passive_on_the_simulated_bus() {
+fn a_lone_module_stops_at_error_passive_on_the_simulated_bus(chip: Chip) {
     let mut bus = Bus::new(125_000).unwrap();
-    let mut a = FlexCanModel::mk64fx512();
+    let mut a = FlexCanModel::new(chip);
     module(&mut a, true);
     bus.attach("a", a.clone());
     start(&mut a);
@@ -213,15 +218,14 @@ fn a_lone_module_stops_at_error_passive_on_the_simulated_bus() {
     assert_eq!(r.code(8), code::TX_DATA);
 }
 
-#[test]
-fn extreme_bus_times_do_not_overflow() {
+fn extreme_bus_times_do_not_overflow(chip: Chip) {
     use twocan_sim::BusTime;
     let end = BusTime {
         sof: u64::MAX,
         now: u64::MAX,
     };
     // Received and transmitted frames stamped at the very end of time.
-    let mut r = rig(false, 0);
+    let mut r = rig(chip, false, 0);
     r.m.rx(&std(0x10, &[1]), false, end);
     assert_eq!(r.m.fifo_len(), 1);
     let frame = std(0x11, &[2]);
@@ -230,7 +234,7 @@ fn extreme_bus_times_do_not_overflow() {
     assert_eq!(r.code(8), code::TX_INACTIVE);
     r.m.advance(u64::MAX, true, u64::MAX);
     // Waiting for synchronisation with a frame pending: the wake-up saturates.
-    let mut r = rig(false, 0);
+    let mut r = rig(chip, false, 0);
     r.freeze();
     r.clear_bits(regs::MCR, mcr::HALT);
     assert!(!r.m.is_synchronised());
@@ -238,7 +242,7 @@ fn extreme_bus_times_do_not_overflow() {
     assert_eq!(r.m.next_wakeup(u64::MAX - 1), Some(u64::MAX));
     assert_eq!(r.m.next_wakeup(u64::MAX), Some(u64::MAX));
     // Bus-off with a frame pending: the recovery wake-up saturates too.
-    let mut r = rig(false, 0);
+    let mut r = rig(chip, false, 0);
     r.load_mb(8, &frame, code::TX_DATA);
     for _ in 0..32 {
         r.m.tx_result(

@@ -1,25 +1,37 @@
 //! Error counters, ESR1, fault confinement, bus-off and its recovery, and the error
 //! interrupt lines ("Error Counter (CANx_ECR)", "Error and Status 1 register (CANx_ESR1)",
-//! CTRL1[BOFFREC], CTRL1 interrupt masks, MCR[WRNEN]).
+//! CTRL1[BOFFREC], CTRL1 interrupt masks, MCR[WRNEN]), on every module of
+//! `support::CHIPS`.
 
 #[path = "model_support.rs"]
 mod support;
 
 use support::*;
 use twocan_core::{ErrorCounters, LastErrorCode};
-use twocan_flexcan::model::FlexCanIrq;
+use twocan_flexcan::model::{Chip, FlexCanIrq};
 use twocan_flexcan::regs::{self, code, ctrl1, ecr, esr1, mcr};
 use twocan_sim::{BusNode, BusTime, TxResult};
 
-fn rig(wrnen: bool) -> Rig {
-    let mut r = Rig::new();
+on_every_chip!(
+    lone_transmitter_goes_passive_with_warning_on_the_way,
+    esr1_error_bits_clear_on_read_and_errint_is_write_one_to_clear,
+    receive_errors_warning_and_passive,
+    warning_interrupts_need_wrnen,
+    bus_off_and_automatic_recovery,
+    bus_off_recovery_held_by_boffrec,
+    error_counters_written_in_freeze,
+    soft_reset_clears_the_error_state,
+);
+
+fn rig(chip: Chip, wrnen: bool) -> Rig {
+    let mut r = Rig::on(chip);
     r.enable_into_freeze();
     let mut m = r.rd(regs::MCR) | mcr::SRXDIS;
     if wrnen {
         m |= mcr::WRNEN;
     }
     r.wr(regs::MCR, m);
-    for n in 0..16 {
+    for n in 0..Manual::of(chip).message_buffers {
         r.wr(regs::mb_cs(n), 0);
     }
     r.start();
@@ -30,9 +42,8 @@ fn fltconf(r: &Rig) -> u32 {
     esr1::FLTCONF.get(r.m.peek32(regs::ESR1))
 }
 
-#[test]
-fn lone_transmitter_goes_passive_with_warning_on_the_way() {
-    let mut r = rig(true);
+fn lone_transmitter_goes_passive_with_warning_on_the_way(chip: Chip) {
+    let mut r = rig(chip, true);
     r.ctrl1(ctrl1::ERRMSK | ctrl1::TWRNMSK | ctrl1::RWRNMSK | ctrl1::BOFFMSK);
     r.load_mb(8, &std(0x100, &[1]), code::TX_DATA);
     for k in 1..=11 {
@@ -72,9 +83,8 @@ fn lone_transmitter_goes_passive_with_warning_on_the_way() {
     assert!(r.m.error_active());
 }
 
-#[test]
-fn esr1_error_bits_clear_on_read_and_errint_is_write_one_to_clear() {
-    let mut r = rig(false);
+fn esr1_error_bits_clear_on_read_and_errint_is_write_one_to_clear(chip: Chip) {
+    let mut r = rig(chip, false);
     r.ctrl1(ctrl1::ERRMSK);
     let t = BusTime {
         sof: r.now,
@@ -113,9 +123,8 @@ fn esr1_error_bits_clear_on_read_and_errint_is_write_one_to_clear() {
     );
 }
 
-#[test]
-fn receive_errors_warning_and_passive() {
-    let mut r = rig(true);
+fn receive_errors_warning_and_passive(chip: Chip) {
+    let mut r = rig(chip, true);
     r.ctrl1(ctrl1::RWRNMSK);
     let t = BusTime {
         sof: r.now,
@@ -147,9 +156,8 @@ fn receive_errors_warning_and_passive() {
     assert_eq!(fltconf(&r), esr1::FLTCONF_ERROR_ACTIVE);
 }
 
-#[test]
-fn warning_interrupts_need_wrnen() {
-    let mut r = rig(false);
+fn warning_interrupts_need_wrnen(chip: Chip) {
+    let mut r = rig(chip, false);
     r.ctrl1(ctrl1::RWRNMSK | ctrl1::TWRNMSK);
     let t = BusTime {
         sof: r.now,
@@ -174,9 +182,8 @@ fn go_bus_off(r: &mut Rig) {
     assert_eq!(r.m.error_counters().tec, 256);
 }
 
-#[test]
-fn bus_off_and_automatic_recovery() {
-    let mut r = rig(false);
+fn bus_off_and_automatic_recovery(chip: Chip) {
+    let mut r = rig(chip, false);
     r.ctrl1(ctrl1::BOFFMSK);
     go_bus_off(&mut r);
     assert_ne!(r.m.peek32(regs::ESR1) & esr1::BOFFINT, 0);
@@ -210,9 +217,8 @@ fn bus_off_and_automatic_recovery() {
     );
 }
 
-#[test]
-fn bus_off_recovery_held_by_boffrec() {
-    let mut r = rig(false);
+fn bus_off_recovery_held_by_boffrec(chip: Chip) {
+    let mut r = rig(chip, false);
     r.ctrl1(ctrl1::BOFFREC);
     go_bus_off(&mut r);
     r.idle(128 * 11 + 50);
@@ -233,7 +239,7 @@ fn bus_off_recovery_held_by_boffrec() {
     assert_eq!(r.transmit_all().len(), 1);
 
     // Negated before the 128 sequences: recovery as if automatic.
-    let mut r = rig(false);
+    let mut r = rig(chip, false);
     r.ctrl1(ctrl1::BOFFREC);
     go_bus_off(&mut r);
     r.idle(50 * 11);
@@ -243,16 +249,15 @@ fn bus_off_recovery_held_by_boffrec() {
     assert_eq!(fltconf(&r), esr1::FLTCONF_ERROR_ACTIVE);
 
     // Set after bus-off was entered: effective only the next time.
-    let mut r = rig(false);
+    let mut r = rig(chip, false);
     go_bus_off(&mut r);
     r.set_bits(regs::CTRL1, ctrl1::BOFFREC);
     r.idle(128 * 11);
     assert_eq!(fltconf(&r), esr1::FLTCONF_ERROR_ACTIVE);
 }
 
-#[test]
-fn error_counters_written_in_freeze() {
-    let mut r = rig(true);
+fn error_counters_written_in_freeze(chip: Chip) {
+    let mut r = rig(chip, true);
     r.freeze();
     r.wr(regs::ECR, ecr::TXERRCNT.val(130) | ecr::RXERRCNT.val(99));
     assert_eq!(
@@ -264,9 +269,8 @@ fn error_counters_written_in_freeze() {
     assert_ne!(v & (esr1::TXWRN | esr1::RXWRN), 0);
 }
 
-#[test]
-fn soft_reset_clears_the_error_state() {
-    let mut r = rig(false);
+fn soft_reset_clears_the_error_state(chip: Chip) {
+    let mut r = rig(chip, false);
     go_bus_off(&mut r);
     r.set_bits(regs::MCR, mcr::SOFTRST);
     assert_eq!(r.rd(regs::ECR), 0);

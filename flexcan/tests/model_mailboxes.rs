@@ -1,23 +1,43 @@
 //! Mailboxes: transmit arbitration, abort, remote frames and answers, receive matching,
 //! locking, overrun, time stamps ("Transmit process", "Arbitration process", "Transmission
 //! abort mechanism", "Remote frames", "Receive process", "Matching process", "Mailbox lock
-//! mechanism", "Time stamp", "Free Running Timer").
+//! mechanism", "Time stamp", "Free Running Timer"), on every module of `support::CHIPS`.
 
 #[path = "model_support.rs"]
 mod support;
 
 use support::*;
 use twocan_core::Frame;
+use twocan_flexcan::model::layout;
+use twocan_flexcan::model::Chip;
 use twocan_flexcan::regs::{self, code, cs, ctrl1, ctrl2, mcr};
 use twocan_sim::{BusNode, BusTime, TxResult};
 
-/// An enabled module in normal mode without the FIFO (all 16 MBs are mailboxes),
-/// self reception off.
-fn rig() -> Rig {
-    let mut r = Rig::new();
+on_every_chip!(
+    lowest_id_first_by_default,
+    lowest_buffer_first_with_lbuf,
+    local_priority_goes_before_the_id,
+    lost_arbitration_and_errors_retry,
+    abort_with_aen,
+    inactivation_without_aen,
+    remote_answer_mailbox,
+    remote_requests_are_stored_with_rrs,
+    sent_remote_frame_becomes_a_receive_mailbox_for_the_answer,
+    receive_queue_overrun_and_masks,
+    eacen_compares_rtr_under_the_mask,
+    a_locked_mailbox_receives_after_unlock,
+    time_stamps_come_from_the_free_running_timer,
+    message_buffer_interrupt_line,
+    maxmb_limits_the_active_mailboxes,
+);
+
+/// An enabled module in normal mode without the FIFO (every MB is a mailbox; MB0–MB15
+/// take part, MCR\[MAXMB\] = 0xF out of reset on every module), self reception off.
+fn rig(chip: Chip) -> Rig {
+    let mut r = Rig::on(chip);
     r.enable_into_freeze();
     r.set_bits(regs::MCR, mcr::SRXDIS | mcr::IRMQ);
-    for n in 0..16 {
+    for n in 0..Manual::of(chip).message_buffers {
         r.wr(regs::rximr(n), u32::MAX);
         r.wr(regs::mb_cs(n), 0);
     }
@@ -25,9 +45,8 @@ fn rig() -> Rig {
     r
 }
 
-#[test]
-fn lowest_id_first_by_default() {
-    let mut r = rig();
+fn lowest_id_first_by_default(chip: Chip) {
+    let mut r = rig(chip);
     let frames = [
         (3, std(0x300, &[3])),
         (4, ext(0x100 << 18, &[4])), // same base ID as a standard 0x100: standard first
@@ -51,9 +70,8 @@ fn lowest_id_first_by_default() {
     assert_eq!(r.code(6), code::RX_EMPTY);
 }
 
-#[test]
-fn lowest_buffer_first_with_lbuf() {
-    let mut r = rig();
+fn lowest_buffer_first_with_lbuf(chip: Chip) {
+    let mut r = rig(chip);
     r.freeze();
     r.ctrl1(ctrl1::LBUF);
     r.clear_bits(regs::MCR, mcr::HALT);
@@ -65,9 +83,8 @@ fn lowest_buffer_first_with_lbuf() {
     assert_eq!(ids, vec![0x700, 0x010, 0x001]);
 }
 
-#[test]
-fn local_priority_goes_before_the_id() {
-    let mut r = rig();
+fn local_priority_goes_before_the_id(chip: Chip) {
+    let mut r = rig(chip);
     r.freeze();
     r.set_bits(regs::MCR, mcr::LPRIOEN);
     r.clear_bits(regs::MCR, mcr::HALT);
@@ -79,9 +96,8 @@ fn local_priority_goes_before_the_id() {
     assert_eq!(ids, vec![0x700, 0x001, 0x010]);
 }
 
-#[test]
-fn lost_arbitration_and_errors_retry() {
-    let mut r = rig();
+fn lost_arbitration_and_errors_retry(chip: Chip) {
+    let mut r = rig(chip);
     r.load_mb(4, &std(0x123, &[1]), code::TX_DATA);
     assert_eq!(
         r.transmit(TxResult::ArbitrationLost),
@@ -95,9 +111,8 @@ fn lost_arbitration_and_errors_retry() {
     assert_eq!(r.rd(regs::IFLAG1), 1 << 4);
 }
 
-#[test]
-fn abort_with_aen() {
-    let mut r = rig();
+fn abort_with_aen(chip: Chip) {
+    let mut r = rig(chip);
     r.freeze();
     r.set_bits(regs::MCR, mcr::AEN);
     r.clear_bits(regs::MCR, mcr::HALT);
@@ -115,9 +130,8 @@ fn abort_with_aen() {
     assert_eq!(r.transmit_all(), vec![std(0x124, &[1])]);
 }
 
-#[test]
-fn inactivation_without_aen() {
-    let mut r = rig();
+fn inactivation_without_aen(chip: Chip) {
+    let mut r = rig(chip);
     r.load_mb(4, &std(0x123, &[1]), code::TX_DATA);
     r.wr(regs::mb_cs(4), code::TX_INACTIVE << 24);
     assert_eq!(r.rd(regs::IFLAG1), 0);
@@ -128,9 +142,8 @@ fn inactivation_without_aen() {
     assert!(r.transmit_all().is_empty());
 }
 
-#[test]
-fn remote_answer_mailbox() {
-    let mut r = rig();
+fn remote_answer_mailbox(chip: Chip) {
+    let mut r = rig(chip);
     let answer = std(0x300, &[0xDE, 0xAD]);
     r.load_mb(6, &answer, code::RX_RANSWER);
     // A request for another ID, even under open masks, does nothing.
@@ -154,9 +167,8 @@ fn remote_answer_mailbox() {
     assert_eq!(r.transmit_all(), vec![answer]);
 }
 
-#[test]
-fn remote_requests_are_stored_with_rrs() {
-    let mut r = rig();
+fn remote_requests_are_stored_with_rrs(chip: Chip) {
+    let mut r = rig(chip);
     r.freeze();
     r.set_bits(regs::CTRL2, ctrl2::RRS);
     r.clear_bits(regs::MCR, mcr::HALT);
@@ -169,9 +181,8 @@ fn remote_requests_are_stored_with_rrs() {
     assert_eq!((f, c), (remote(0x300, false, 4), code::RX_FULL));
 }
 
-#[test]
-fn sent_remote_frame_becomes_a_receive_mailbox_for_the_answer() {
-    let mut r = rig();
+fn sent_remote_frame_becomes_a_receive_mailbox_for_the_answer(chip: Chip) {
+    let mut r = rig(chip);
     r.load_mb(2, &remote(0x77, false, 2), code::TX_REMOTE);
     assert_eq!(r.transmit_all(), vec![remote(0x77, false, 2)]);
     assert_eq!(r.code(2), code::RX_EMPTY);
@@ -183,9 +194,8 @@ fn sent_remote_frame_becomes_a_receive_mailbox_for_the_answer() {
     assert_eq!((f, c), (std(0x77, &[5, 6]), code::RX_FULL));
 }
 
-#[test]
-fn receive_queue_overrun_and_masks() {
-    let mut r = rig();
+fn receive_queue_overrun_and_masks(chip: Chip) {
+    let mut r = rig(chip);
     r.rx_mb(3, 0x55, false);
     r.rx_mb(9, 0x55, false);
     r.rx_mb(10, 0x55, true);
@@ -246,9 +256,8 @@ fn receive_queue_overrun_and_masks() {
     assert_eq!(r.read_mb(14).0, std(0x66, &[9]));
 }
 
-#[test]
-fn eacen_compares_rtr_under_the_mask() {
-    let mut r = rig();
+fn eacen_compares_rtr_under_the_mask(chip: Chip) {
+    let mut r = rig(chip);
     r.freeze();
     r.set_bits(regs::CTRL2, ctrl2::EACEN | ctrl2::RRS);
     r.clear_bits(regs::MCR, mcr::HALT);
@@ -259,7 +268,7 @@ fn eacen_compares_rtr_under_the_mask() {
     r.deliver(&std(0x42, &[]));
     assert_eq!(r.code(5), code::RX_FULL);
     // EACEN = 0: RTR never compared.
-    let mut r = rig();
+    let mut r = rig(chip);
     r.freeze();
     r.set_bits(regs::CTRL2, ctrl2::RRS);
     r.clear_bits(regs::MCR, mcr::HALT);
@@ -269,9 +278,8 @@ fn eacen_compares_rtr_under_the_mask() {
     assert_eq!(r.code(5), code::RX_FULL);
 }
 
-#[test]
-fn a_locked_mailbox_receives_after_unlock() {
-    let mut r = rig();
+fn a_locked_mailbox_receives_after_unlock(chip: Chip) {
+    let mut r = rig(chip);
     r.rx_mb(3, 0x10, false);
     let _ = r.rd(regs::mb_cs(3)); // lock
     assert_eq!(r.m.locked_mailbox(), Some(3));
@@ -292,9 +300,8 @@ fn a_locked_mailbox_receives_after_unlock() {
     assert_eq!(r.read_mb(3).0, std(0x10, &[2]));
 }
 
-#[test]
-fn time_stamps_come_from_the_free_running_timer() {
-    let mut r = Rig::new();
+fn time_stamps_come_from_the_free_running_timer(chip: Chip) {
+    let mut r = Rig::on(chip);
     r.enable_into_freeze();
     r.set_bits(regs::MCR, mcr::SRXDIS | mcr::IRMQ);
     r.wr(regs::rximr(1), u32::MAX);
@@ -333,24 +340,45 @@ fn time_stamps_come_from_the_free_running_timer() {
     );
 }
 
-#[test]
-fn message_buffer_interrupt_line() {
-    let mut r = rig();
-    r.load_mb(1, &std(0x1, &[]), code::TX_DATA);
-    r.transmit_all();
-    assert!(!r.m.irq().message_buffer, "IMASK1 clear");
-    r.wr(regs::IMASK1, 1 << 1);
-    assert!(r.m.irq().message_buffer && r.m.irq_pending());
-    r.wr(regs::IFLAG1, 1 << 1);
-    assert!(!r.m.irq_pending());
-    assert_eq!(r.rd(regs::IMASK1), 1 << 1);
+/// The message buffer interrupt line from MB1 and from the last message buffer (MB15, or
+/// MB63 on the RT1062, whose flag is IFLAG2 bit 31: [`mb_flag`]), MCR\[MAXMB\] raised to it.
+fn message_buffer_interrupt_line(chip: Chip) {
+    let mut r = rig(chip);
+    let last = r.manual().message_buffers - 1;
+    r.freeze();
+    r.wr(regs::MCR, mcr::MAXMB.replace(r.rd(regs::MCR), last as u32));
+    r.clear_bits(regs::MCR, mcr::HALT);
+    r.idle(11);
+    for n in [1, last] {
+        let (flags, imask, bit) = mb_flag(n);
+        let iflag = if imask == regs::IMASK1 {
+            regs::IFLAG1
+        } else {
+            layout::IFLAG2
+        };
+        r.load_mb(n, &std(n as u16, &[]), code::TX_DATA);
+        r.transmit_all();
+        assert_eq!((r.rd(regs::IFLAG1), r.rd(layout::IFLAG2)), flags, "MB{n}");
+        assert!(!r.m.irq().message_buffer, "MB{n}: its mask bit clear");
+        r.wr(imask, bit);
+        assert!(r.m.irq().message_buffer && r.m.irq_pending(), "MB{n}");
+        r.wr(iflag, bit);
+        assert!(!r.m.irq_pending(), "MB{n}");
+        assert_eq!(r.rd(imask), bit);
+        r.wr(imask, 0);
+    }
+    // One bit per message buffer: MB0–MB15 on the Kinetis parts; MB0–MB31 in IMASK1 and
+    // MB32–MB63 in IMASK2 on the RT1062 (IMXRT1060RM "Interrupt Masks 1/2 register"),
+    // IMASK2 reserved on the Kinetis parts.
     r.wr(regs::IMASK1, u32::MAX);
-    assert_eq!(r.rd(regs::IMASK1), 0xFFFF, "16 mailboxes");
+    r.wr(layout::IMASK2, u32::MAX);
+    let want = r.manual();
+    assert_eq!(r.rd(regs::IMASK1), want.flags1);
+    assert_eq!(r.rd(layout::IMASK2), want.flags2);
 }
 
-#[test]
-fn maxmb_limits_the_active_mailboxes() {
-    let mut r = rig();
+fn maxmb_limits_the_active_mailboxes(chip: Chip) {
+    let mut r = rig(chip);
     r.freeze();
     r.wr(regs::MCR, mcr::MAXMB.replace(r.rd(regs::MCR), 3));
     r.clear_bits(regs::MCR, mcr::HALT);

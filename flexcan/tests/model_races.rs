@@ -10,23 +10,33 @@
 //!   application sends it again).
 //! - ESR1: its interrupt flags are write-1-to-clear. Writing back every flag instead of
 //!   exactly those read clears a flag raised between the read and the write.
+//!
+//! On every module of `support::CHIPS`.
 
 #[path = "model_support.rs"]
 mod support;
 
-use support::Rig;
+use support::{on_every_chip, Rig};
 use twocan_core::registers::Registers;
 use twocan_core::Frame;
-use twocan_flexcan::model::FlexCanModel;
+use twocan_flexcan::model::{Chip, FlexCanModel};
 use twocan_flexcan::regs::{self, code, cs, ecr, esr1, mcr};
 use twocan_sim::{Bus, Fault, SimNode};
+
+on_every_chip!(
+    abort_written_while_the_frame_is_on_the_wire_does_not_abort_a_successful_frame,
+    abort_written_while_the_frame_is_on_the_wire_aborts_it_if_the_attempt_fails,
+    abort_of_a_mailbox_not_yet_on_the_wire_is_immediate,
+    writing_back_every_esr1_flag_loses_one_raised_after_the_read,
+    freeze_request_waits_for_the_frame_in_flight_at_the_lowest_bit_rate,
+);
 
 const MB: usize = 8;
 
 /// A module with the Rx FIFO accepting everything, `extra` MCR bits, optionally a TEC
 /// written in freeze, on `bus`, synchronised.
-fn module(bus: &mut Bus, extra: u32, tec: Option<u32>) -> FlexCanModel {
-    let m = FlexCanModel::mk20dx256();
+fn module(chip: Chip, bus: &mut Bus, extra: u32, tec: Option<u32>) -> FlexCanModel {
+    let m = FlexCanModel::new(chip);
     support::accept_all_into_fifo(&m, mcr::SRXDIS | extra);
     if let Some(tec) = tec {
         m.write32(regs::ECR, ecr::TXERRCNT.val(tec));
@@ -56,10 +66,9 @@ fn write_abort(m: &mut FlexCanModel) {
     m.write32(regs::mb_cs(MB), cs::CODE.replace(c, code::TX_ABORT));
 }
 
-#[test]
-fn abort_written_while_the_frame_is_on_the_wire_does_not_abort_a_successful_frame() {
+fn abort_written_while_the_frame_is_on_the_wire_does_not_abort_a_successful_frame(chip: Chip) {
     let mut bus = Bus::new(500_000).unwrap();
-    let mut m = module(&mut bus, mcr::AEN, None);
+    let mut m = module(chip, &mut bus, mcr::AEN, None);
     let peer = SimNode::new().shared();
     bus.attach("peer", peer.clone());
     let f = Frame::standard(0x123, &[1, 2, 3]).unwrap();
@@ -91,10 +100,9 @@ fn abort_written_while_the_frame_is_on_the_wire_does_not_abort_a_successful_fram
     assert_ne!(m.read32(regs::ESR1) & esr1::IDLE, 0);
 }
 
-#[test]
-fn abort_written_while_the_frame_is_on_the_wire_aborts_it_if_the_attempt_fails() {
+fn abort_written_while_the_frame_is_on_the_wire_aborts_it_if_the_attempt_fails(chip: Chip) {
     let mut bus = Bus::new(500_000).unwrap();
-    let mut m = module(&mut bus, mcr::AEN, None);
+    let mut m = module(chip, &mut bus, mcr::AEN, None);
     let peer = SimNode::new().shared();
     bus.attach("peer", peer.clone());
     let f = Frame::standard(0x124, &[4]).unwrap();
@@ -110,10 +118,9 @@ fn abort_written_while_the_frame_is_on_the_wire_aborts_it_if_the_attempt_fails()
     assert_eq!(bus.trace().records().len(), 1);
 }
 
-#[test]
-fn abort_of_a_mailbox_not_yet_on_the_wire_is_immediate() {
+fn abort_of_a_mailbox_not_yet_on_the_wire_is_immediate(chip: Chip) {
     let mut bus = Bus::new(500_000).unwrap();
-    let mut m = module(&mut bus, mcr::AEN, None);
+    let mut m = module(chip, &mut bus, mcr::AEN, None);
     let f = Frame::standard(0x125, &[]).unwrap();
     load(&m, &f);
     write_abort(&mut m);
@@ -123,12 +130,11 @@ fn abort_of_a_mailbox_not_yet_on_the_wire_is_immediate() {
     assert!(bus.trace().records().is_empty());
 }
 
-#[test]
-fn writing_back_every_esr1_flag_loses_one_raised_after_the_read() {
+fn writing_back_every_esr1_flag_loses_one_raised_after_the_read(chip: Chip) {
     for exact in [false, true] {
         let mut bus = Bus::new(500_000).unwrap();
         // TEC 240 (ECR written in Freeze mode): one error → 248, the next → bus-off.
-        let m = module(&mut bus, 0, Some(240));
+        let m = module(chip, &mut bus, 0, Some(240));
         let peer = SimNode::new().shared();
         bus.attach("peer", peer.clone());
         let f = Frame::standard(0x126, &[6]).unwrap();
@@ -173,12 +179,11 @@ fn writing_back_every_esr1_flag_loses_one_raised_after_the_read() {
     }
 }
 
-#[test]
-fn freeze_request_waits_for_the_frame_in_flight_at_the_lowest_bit_rate() {
+fn freeze_request_waits_for_the_frame_in_flight_at_the_lowest_bit_rate(chip: Chip) {
     use twocan_core::timing::frame_time::{bits_to_micros, MAX_FRAME_IN_FLIGHT_BITS};
     use twocan_sim::frame_bits;
     let mut bus = Bus::new(2_500).unwrap();
-    let m = module(&mut bus, 0, None);
+    let m = module(chip, &mut bus, 0, None);
     let peer = SimNode::new().shared();
     bus.attach("peer", peer.clone());
     let f = Frame::extended(0, &[0; 8]).unwrap();

@@ -1,15 +1,28 @@
 //! Rx FIFO and ID filter table ("Rx FIFO structure", "Rx FIFO", CTRL2[RFFN] table "Rx FIFO
-//! filter: possible structures", RXIMR/RXMGMASK/RXFGMASK, RXFIR, "Matching process").
+//! filter: possible structures", RXIMR/RXMGMASK/RXFGMASK, RXFIR, "Matching process"), on
+//! every module of `support::CHIPS`.
 
 #[path = "model_support.rs"]
 mod support;
 
 use support::*;
+use twocan_flexcan::model::Chip;
 use twocan_flexcan::regs::{self, code, cs, ctrl1, ctrl2, iflag1, mcr};
 
-#[test]
-fn loop_back_data_and_remote_frames_through_the_fifo() {
-    let mut r = Rig::loopback_fifo();
+on_every_chip!(
+    loop_back_data_and_remote_frames_through_the_fifo,
+    fifo_output_window_and_table_area_are_not_mailboxes,
+    filter_table_split_for_each_rffn,
+    idhit_numbers_every_element_of_the_14_18_table,
+    rtr_and_ide_bits_of_format_a_elements,
+    fifo_is_six_deep_warns_at_five_and_overflows,
+    mailbox_reception_priority_against_the_fifo,
+    format_b_and_c_and_d,
+    remote_request_matching_the_fifo_is_stored_not_answered,
+);
+
+fn loop_back_data_and_remote_frames_through_the_fifo(chip: Chip) {
+    let mut r = Rig::loopback_fifo(chip);
     let data = std(0x542, &[1, 2, 3, 4, 5, 6, 7, 8]);
     let rtr = remote(0x1FFF_5678, true, 3);
     // RFFN = 0: the FIFO and its table take MB0–MB7, MB8 is the first mailbox.
@@ -29,9 +42,8 @@ fn loop_back_data_and_remote_frames_through_the_fifo() {
     assert_eq!(r.m.fifo_len(), 0);
 }
 
-#[test]
-fn fifo_output_window_and_table_area_are_not_mailboxes() {
-    let mut r = Rig::loopback_fifo();
+fn fifo_output_window_and_table_area_are_not_mailboxes(chip: Chip) {
+    let mut r = Rig::loopback_fifo(chip);
     r.freeze();
     // MB0–MB5 are the FIFO engine: writes ignored.
     r.wr(regs::mb_word0(1), 0x1234_5678);
@@ -43,18 +55,29 @@ fn fifo_output_window_and_table_area_are_not_mailboxes() {
     assert!(r.transmit(twocan_sim::TxResult::Acked).is_none());
 }
 
-/// Every RFFN value: the split between individually and globally masked elements, and
-/// lowest-element-wins (IDHIT).
-#[test]
-fn filter_table_split_for_each_rffn() {
-    for rffn in 0..4u32 {
+/// Every RFFN value of the manual's table ([`Manual::fifo_individual`]: RFFN 0–3 on the
+/// Kinetis parts, 0–0xF on the RT1062, whose elements 32–127 are never individually
+/// masked): the split between individually and globally masked elements, and
+/// lowest-element-wins (IDHIT). MCR\[MAXMB\] is raised to the last message buffer first:
+/// CTRL2\[RFFN\] "cannot be programmed with values that make the number of Message
+/// Buffers occupied by Rx FIFO and ID Filter exceed the number of Mailboxes present,
+/// defined by MCR\[MAXMB\]" (RFFN ≥ 5 occupies more than MB0–MB15 on the RT1062).
+fn filter_table_split_for_each_rffn(chip: Chip) {
+    let want = Manual::of(chip);
+    let mbs = want.message_buffers;
+    for &(rffn, individual) in want.fifo_individual {
         let elements = 8 * (rffn as usize + 1);
-        let individual = [8, 10, 12, 14][rffn as usize];
-        let mut r = Rig::new();
+        let mut r = Rig::on(chip);
         r.enable_into_freeze();
-        // Every element accepts standard data frames with ID 0 under its mask.
+        r.wr(
+            regs::MCR,
+            mcr::MAXMB.replace(r.rd(regs::MCR), mbs as u32 - 1),
+        );
+        // Every element accepts standard data frames with ID 0 under its mask; every
+        // RXIMR compares all bits (also those of buffers past the individually masked
+        // elements: they must not be used for the elements under RXFGMASK).
         let table = vec![elem_a(0, false, false); elements];
-        let exact = vec![exact_mask_a(false); 16];
+        let exact = vec![exact_mask_a(false); mbs];
         r.setup_fifo(rffn, true, &table, &exact, 0);
         r.start();
         // ID 0 matches element 0 first.
@@ -75,7 +98,7 @@ fn filter_table_split_for_each_rffn() {
         // IRMQ = 0: RXMGMASK replaces the individual masks.
         r.freeze();
         r.clear_bits(regs::MCR, mcr::IRMQ);
-        for n in 0..16 {
+        for n in 0..mbs {
             r.wr(regs::rximr(n), 0);
         }
         r.wr(regs::RXMGMASK, exact_mask_a(false));
@@ -105,9 +128,8 @@ fn filter_table_split_for_each_rffn() {
     }
 }
 
-#[test]
-fn idhit_numbers_every_element_of_the_14_18_table() {
-    let mut r = Rig::new();
+fn idhit_numbers_every_element_of_the_14_18_table(chip: Chip) {
+    let mut r = Rig::on(chip);
     r.enable_into_freeze();
     let table: Vec<u32> = (0..32).map(|k| elem_a(0x100 + k, false, false)).collect();
     r.setup_fifo(
@@ -129,7 +151,8 @@ fn idhit_numbers_every_element_of_the_14_18_table() {
         "a frame matching nothing is discarded"
     );
     assert_eq!(r.m.frames_discarded(), 1);
-    // MB14 and MB15 are the remaining mailboxes.
+    // MB14 and MB15 are the remaining mailboxes (up to MCR[MAXMB], 0xF out of reset on
+    // the RT1062 too: IMXRT1060RM MCR reset 0x5980_000F).
     r.freeze();
     r.load_mb(14, &std(0x10, &[]), code::TX_DATA);
     r.load_mb(13, &std(0x01, &[]), code::TX_DATA); // table storage: ignored as a mailbox
@@ -138,9 +161,8 @@ fn idhit_numbers_every_element_of_the_14_18_table() {
     assert_eq!(r.transmit_all(), vec![std(0x10, &[])]);
 }
 
-#[test]
-fn rtr_and_ide_bits_of_format_a_elements() {
-    let mut r = Rig::new();
+fn rtr_and_ide_bits_of_format_a_elements(chip: Chip) {
+    let mut r = Rig::on(chip);
     r.enable_into_freeze();
     let table = [
         elem_a(0x555, false, true),       // 0: standard remote 0x555
@@ -184,9 +206,8 @@ fn rtr_and_ide_bits_of_format_a_elements() {
     }
 }
 
-#[test]
-fn fifo_is_six_deep_warns_at_five_and_overflows() {
-    let mut r = Rig::new();
+fn fifo_is_six_deep_warns_at_five_and_overflows(chip: Chip) {
+    let mut r = Rig::on(chip);
     r.enable_into_freeze();
     r.setup_fifo(0, true, &[0; 8], &[0; 8], 0);
     r.wr(regs::IMASK1, iflag1::BUF5I | iflag1::BUF6I | iflag1::BUF7I);
@@ -225,9 +246,8 @@ fn fifo_is_six_deep_warns_at_five_and_overflows() {
     assert_eq!(r.rd(regs::IFLAG1), 0);
 }
 
-#[test]
-fn mailbox_reception_priority_against_the_fifo() {
-    let mut r = Rig::new();
+fn mailbox_reception_priority_against_the_fifo(chip: Chip) {
+    let mut r = Rig::on(chip);
     r.enable_into_freeze();
     r.setup_fifo(0, true, &[0; 8], &[0; 8], 0);
     r.wr(regs::rximr(8), u32::MAX);
@@ -277,9 +297,8 @@ fn mailbox_reception_priority_against_the_fifo() {
     assert_eq!(r.m.fifo_overflows(), 1);
 }
 
-#[test]
-fn format_b_and_c_and_d() {
-    let mut r = Rig::new();
+fn format_b_and_c_and_d(chip: Chip) {
+    let mut r = Rig::on(chip);
     r.enable_into_freeze();
     r.setup_fifo(0, true, &[], &[u32::MAX; 8], u32::MAX);
     // Format B: element 0 = {std data 0x123, std remote 0x456}; element 1 = {ext 14 MSBs}.
@@ -331,9 +350,8 @@ fn format_b_and_c_and_d() {
     assert_eq!(r.m.fifo_len(), 0);
 }
 
-#[test]
-fn remote_request_matching_the_fifo_is_stored_not_answered() {
-    let mut r = Rig::loopback_fifo();
+fn remote_request_matching_the_fifo_is_stored_not_answered(chip: Chip) {
+    let mut r = Rig::loopback_fifo(chip);
     r.freeze();
     r.load_mb(10, &std(0x300, &[0xAA]), code::RX_RANSWER);
     r.clear_bits(regs::MCR, mcr::HALT);

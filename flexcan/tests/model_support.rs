@@ -1,19 +1,221 @@
 //! Helpers shared by the model tests (included with `#[path]`; as a test target of its own
 //! it only checks that it builds). The tests use the model as software does, through its
 //! registers, and act as the bus by calling its `BusNode` methods.
+//!
+//! The behaviour tests (`model_modes`, `model_rx_fifo`, `model_mailboxes`, `model_errors`,
+//! `model_bus`, `model_races`) are written once, as functions of the [`Chip`], and
+//! [`on_every_chip!`] makes one `#[test]` per module of [`CHIPS`] from each. Where a rule's
+//! outcome differs between the modules, the test reads the expectation from [`Manual`]
+//! (the reference manuals' values, kept here independently of the model's own
+//! `Variant` table so that a wrong entry there fails a test).
 #![allow(dead_code)]
 
 use twocan_core::registers::Registers;
 use twocan_core::Frame;
-use twocan_flexcan::model::FlexCanModel;
+use twocan_flexcan::model::{Chip, FlexCanModel, ModelMode, Rt1062Can};
 use twocan_flexcan::regs::{self, code, cs, ctrl1, ctrl2, id, iflag1, mcr, rxfir};
 use twocan_sim::{BusNode, BusTime, TxResult};
 
+/// Every FlexCAN module the model covers: the Kinetis K20, K64 and K66 modules and the
+/// i.MX RT1062's CAN1, CAN2 and CAN3.
+pub const CHIPS: [Chip; 6] = [
+    Chip::Mk20dx256,
+    Chip::Mk64fx512,
+    Chip::Mk66fx1m0,
+    Chip::Imxrt1062(Rt1062Can::Can1),
+    Chip::Imxrt1062(Rt1062Can::Can2),
+    Chip::Imxrt1062(Rt1062Can::Can3),
+];
+
+/// One `#[test]` per module of [`CHIPS`] for each named test body (a `fn(Chip)` of the
+/// calling file): `body::mk20dx256`, `body::mk64fx512`, `body::mk66fx1m0`,
+/// `body::rt1062_can1`, `body::rt1062_can2`, `body::rt1062_can3`. `cargo test rt1062`
+/// runs the i.MX RT1062 half.
+#[allow(unused_macros)]
+macro_rules! on_every_chip {
+    ($($body:ident),* $(,)?) => {$(
+        mod $body {
+            use twocan_flexcan::model::{Chip, Rt1062Can};
+            #[test]
+            fn mk20dx256() {
+                super::$body(Chip::Mk20dx256)
+            }
+            #[test]
+            fn mk64fx512() {
+                super::$body(Chip::Mk64fx512)
+            }
+            #[test]
+            fn mk66fx1m0() {
+                super::$body(Chip::Mk66fx1m0)
+            }
+            #[test]
+            fn rt1062_can1() {
+                super::$body(Chip::Imxrt1062(Rt1062Can::Can1))
+            }
+            #[test]
+            fn rt1062_can2() {
+                super::$body(Chip::Imxrt1062(Rt1062Can::Can2))
+            }
+            #[test]
+            fn rt1062_can3() {
+                super::$body(Chip::Imxrt1062(Rt1062Can::Can3))
+            }
+        }
+    )*};
+}
+#[allow(unused_imports)]
+pub(crate) use on_every_chip;
+
+/// What the reference manual gives for one module where the behaviour tests' outcomes
+/// differ between modules. Kinetis: K20P64M72SF1RM, K64P144M120SF5RM,
+/// K66P144M180SF5RMV2, chapter "FlexCAN"; i.MX RT1062: IMXRT1060RM chapter "Flexible
+/// Controller Area Network (FLEXCAN)" (CAN1, CAN2 and the CAN FD capable CAN3), with the
+/// reset values and fields of the NXP SVD as `imxrt-ral` 0.6 (`imxrt1062`) carries them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Manual {
+    /// Message buffers: 16 (Kinetis "Message buffer structure") or 64 (IMXRT1060RM
+    /// "Message buffer structure": MB0–MB63 at 0x80–0x47F).
+    pub message_buffers: usize,
+    /// `MCR` reset value ("Module Configuration Register"): Kinetis 0xD890_000F (MDIS,
+    /// LPMACK: Disable mode); RT1062 0x5980_000F (MDIS = 0, FRZACK: enabled, in Freeze
+    /// mode).
+    pub reset_mcr: u32,
+    /// The mode that reset value means.
+    pub reset_mode: ModelMode,
+    /// `CTRL2` reset value: Kinetis 0x00B0_0000 (TASD = 0x16); RT1062 CAN1/CAN2 0, CAN3
+    /// 0x0080_0000 (TASD = 0x10) (SVD reset values).
+    pub reset_ctrl2: u32,
+    /// `RXMGMASK`, `RX14MASK`, `RX15MASK`, `RXFGMASK` reset value: all ones, except on
+    /// the RT1062's CAN3 (0; SVD reset values).
+    pub reset_masks: u32,
+    /// `CTRL2` bits 15–0 that are reserved (read 0): all of them on the Kinetis parts
+    /// (MK20D7 SVD: no field below bit 16) and on CAN1/CAN2 (SVD `can::CTRL2`); bits 10
+    /// and 5–0 on CAN3, whose other low bits are the CAN FD and time stamp fields
+    /// (`TIMER_SRC`, `PREXCEN`, `BTE`, `ISOCANFDEN`, `EDFLTDIS`, `MBTSBASE`, `TSTAMPCAP`:
+    /// SVD `can3::CTRL2`).
+    pub ctrl2_reserved_low: u32,
+    /// `IMASK1`/`IFLAG1` bits that exist: one per MB0–MB15 (Kinetis) or MB0–MB31.
+    pub flags1: u32,
+    /// `IMASK2`/`IFLAG2` bits that exist: one per MB32–MB63 on the RT1062 ("Interrupt
+    /// Masks 2 register (IMASK2)"); none on the 16-buffer Kinetis parts (there is no
+    /// MB32–MB63 for a bit to stand for; the MK20D7 SVD lists the two registers all the
+    /// same).
+    pub flags2: u32,
+    /// `MCR[WAKSRC]` is implemented (reserved on the MK20DX256: K20P64M72SF1RM MCR
+    /// field description; present on the K64, K66 and the RT1062 modules).
+    pub waksrc: bool,
+    /// `CTRL1[CLKSRC]` is implemented (Kinetis, RT1062 CAN3); reserved on CAN1/CAN2
+    /// (SVD `can::CTRL1` has no CLKSRC; NXP feature list "engine clock selection
+    /// removed").
+    pub clksrc: bool,
+    /// Rows (RFFN, filter elements under the individual masks) of table "Rx FIFO filter:
+    /// possible structures" (CTRL2\[RFFN\] field description), last column ("Rx FIFO ID
+    /// filter table elements affected by Rx Individual Masks"): elements 0 … 7 + 2·RFFN,
+    /// never beyond element 31. The Kinetis rows end where a mailbox is still left
+    /// (RFFN 3: MB14, MB15); the RT1062 rows cover the whole table (RFFN 0xF: MB0–MB37).
+    pub fifo_individual: &'static [(u32, usize)],
+}
+
+const KINETIS_FIFO_ROWS: &[(u32, usize)] = &[(0, 8), (1, 10), (2, 12), (3, 14)];
+const RT1062_FIFO_ROWS: &[(u32, usize)] = &[
+    (0x0, 8),
+    (0x1, 10),
+    (0x2, 12),
+    (0x3, 14),
+    (0x4, 16),
+    (0x5, 18),
+    (0x6, 20),
+    (0x7, 22),
+    (0x8, 24),
+    (0x9, 26),
+    (0xA, 28),
+    (0xB, 30),
+    (0xC, 32),
+    (0xD, 32),
+    (0xE, 32),
+    (0xF, 32),
+];
+
+const KINETIS: Manual = Manual {
+    message_buffers: 16,
+    reset_mcr: 0xD890_000F,
+    reset_mode: ModelMode::Disabled,
+    reset_ctrl2: 0x00B0_0000,
+    reset_masks: u32::MAX,
+    ctrl2_reserved_low: 0xFFFF,
+    flags1: 0xFFFF,
+    flags2: 0,
+    waksrc: true,
+    clksrc: true,
+    fifo_individual: KINETIS_FIFO_ROWS,
+};
+
+const RT1062_CAN1: Manual = Manual {
+    message_buffers: 64,
+    reset_mcr: 0x5980_000F,
+    reset_mode: ModelMode::Freeze,
+    reset_ctrl2: 0,
+    reset_masks: u32::MAX,
+    ctrl2_reserved_low: 0xFFFF,
+    flags1: u32::MAX,
+    flags2: u32::MAX,
+    waksrc: true,
+    clksrc: false,
+    fifo_individual: RT1062_FIFO_ROWS,
+};
+
+impl Manual {
+    /// The manual's values for `chip`.
+    pub const fn of(chip: Chip) -> Manual {
+        match chip {
+            Chip::Mk20dx256 => Manual {
+                waksrc: false,
+                ..KINETIS
+            },
+            Chip::Mk64fx512 | Chip::Mk66fx1m0 => KINETIS,
+            Chip::Imxrt1062(Rt1062Can::Can1 | Rt1062Can::Can2) => RT1062_CAN1,
+            Chip::Imxrt1062(Rt1062Can::Can3) => Manual {
+                reset_ctrl2: 0x0080_0000,
+                reset_masks: 0,
+                ctrl2_reserved_low: 0x043F,
+                clksrc: true,
+                ..RT1062_CAN1
+            },
+        }
+    }
+
+    /// `MCR` once the module is enabled and frozen (MDIS and LPMACK negated, FRZACK
+    /// asserted, the rest as out of reset): what a soft reset leaves in Freeze mode.
+    pub const fn frozen_mcr(&self) -> u32 {
+        self.reset_mcr & !(mcr::MDIS | mcr::LPMACK) | mcr::FRZACK
+    }
+}
+
+/// `(IFLAG1, IFLAG2)` with only message buffer `n`'s flag set, and the mask register
+/// (`IMASK1` or `IMASK2`) and bit that enable its interrupt: MB0–MB31 in IFLAG1/IMASK1
+/// bit n, MB32–MB63 in IFLAG2/IMASK2 bit n − 32 (IMXRT1060RM "Interrupt Flags 2 register
+/// (IFLAG2)", "Interrupt Masks 2 register (IMASK2)"; the Kinetis parts stop at MB15).
+pub fn mb_flag(n: usize) -> ((u32, u32), usize, u32) {
+    if n < 32 {
+        ((1 << n, 0), regs::IMASK1, 1 << n)
+    } else {
+        (
+            (0, 1 << (n - 32)),
+            twocan_flexcan::model::layout::IMASK2,
+            1 << (n - 32),
+        )
+    }
+}
+
 /// Takes `m` out of module disable and sets up what the bus tests start from, still
 /// halted in freeze: the Rx FIFO (`RFEN`) with its eight ID filters accepting everything
-/// (individual masks 0, `IRMQ`), MB8..15 inactive and matching nothing (masks all ones),
-/// and `mcr_bits` besides (`SRXDIS`, ...). Kinetis RM, FlexCAN "Rx FIFO structure" and
-/// "Rx Individual Mask Registers".
+/// (individual masks 0, `IRMQ`), the mailboxes after the FIFO (MB8 up to `MCR[MAXMB]`,
+/// 0xF out of reset on every module: MB8..15) inactive and matching nothing (masks all
+/// ones), and `mcr_bits` besides (`SRXDIS`, ...). Kinetis RM, FlexCAN "Rx FIFO structure"
+/// and "Rx Individual Mask Registers"; on the RT1062 MB16..MB63 stay out of matching and
+/// arbitration above `MAXMB` (IMXRT1060RM MCR\[MAXMB\]), and RFFN = 0 puts all eight
+/// elements under `RXIMR0–7`, so CAN3's zero reset masks (`RXMGMASK`, `RXFGMASK`) play no
+/// part.
 pub fn accept_all_into_fifo(m: &FlexCanModel, mcr_bits: u32) {
     m.modify32(regs::MCR, |v| v & !mcr::MDIS);
     m.modify32(regs::MCR, |v| v | mcr::RFEN | mcr::IRMQ | mcr_bits);
@@ -21,7 +223,8 @@ pub fn accept_all_into_fifo(m: &FlexCanModel, mcr_bits: u32) {
         m.write32(regs::rx_fifo_filter(n), 0);
         m.write32(regs::rximr(n), 0);
     }
-    for n in 8..16 {
+    let last = mcr::MAXMB.get(m.read32(regs::MCR)) as usize;
+    for n in 8..=last {
         m.write32(regs::mb_cs(n), 0);
         m.write32(regs::rximr(n), u32::MAX);
     }
@@ -41,10 +244,20 @@ pub struct Rig {
 impl Rig {
     /// A K20 module straight from reset.
     pub fn new() -> Self {
+        Self::on(Chip::Mk20dx256)
+    }
+
+    /// A module of `chip` straight from reset.
+    pub fn on(chip: Chip) -> Self {
         Rig {
-            m: FlexCanModel::mk20dx256(),
+            m: FlexCanModel::new(chip),
             now: 0,
         }
+    }
+
+    /// The manual's values for this module.
+    pub fn manual(&self) -> Manual {
+        Manual::of(self.m.chip())
     }
 
     /// Reads a register as software does.
@@ -67,11 +280,21 @@ impl Rig {
         self.m.modify32(offset, |v| v & !bits);
     }
 
-    /// Leaves Disable mode into Freeze mode (FRZ and HALT are set by reset).
+    /// Leaves Disable mode into Freeze mode (FRZ and HALT are set by reset); on the
+    /// RT1062, which leaves reset in Freeze mode, it asserts that mode.
     pub fn enable_into_freeze(&mut self) {
         self.set_bits(regs::MCR, mcr::FRZ | mcr::HALT);
         self.clear_bits(regs::MCR, mcr::MDIS);
         assert_ne!(self.rd(regs::MCR) & mcr::FRZACK, 0, "freeze acknowledged");
+    }
+
+    /// Enters Module Disable mode (MDIS = 1, acknowledged by LPMACK): the Kinetis reset
+    /// state already; the RT1062 leaves reset in Freeze mode (IMXRT1060RM MCR reset
+    /// 0x5980_000F) and gets there by MDIS = 1 ("Module disable mode").
+    pub fn enter_disable(&mut self) {
+        self.set_bits(regs::MCR, mcr::MDIS);
+        assert_ne!(self.rd(regs::MCR) & mcr::LPMACK, 0, "disable acknowledged");
+        assert_eq!(self.m.mode(), ModelMode::Disabled);
     }
 
     /// Leaves Freeze mode and lets 11 recessive bits pass for synchronisation.
@@ -266,8 +489,8 @@ impl Rig {
 
     /// A module configured the ACAN way for loop-back tests: enabled, Rx FIFO with all
     /// eight format-A elements accepting everything, self reception, loop-back, started.
-    pub fn loopback_fifo() -> Self {
-        let mut r = Rig::new();
+    pub fn loopback_fifo(chip: Chip) -> Self {
+        let mut r = Rig::on(chip);
         r.enable_into_freeze();
         r.setup_fifo(0, true, &[0; 8], &[0; 8], 0);
         r.clear_bits(regs::MCR, mcr::SRXDIS);
