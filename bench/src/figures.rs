@@ -3,8 +3,9 @@
 //! variant of each backend; and `target/bench/summary.json` built from them.
 
 use crate::cmd::{Error, Result};
-use crate::firmware::VARIANTS;
+use crate::firmware::{FEATURE_VARIANTS, VARIANTS};
 use crate::report::{ExampleSection, InsnSection, SizeSection};
+use crate::sizes::StateFigures;
 
 /// Which backend a figure is of.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -141,10 +142,69 @@ impl Target {
     }
 }
 
+/// A round-trip step (region) whose count differs between a one-feature variant and
+/// lean, or that only one of them runs.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct StepChange {
+    /// The region.
+    pub key: String,
+    /// Its net count in the variant's round trip (`None`: not in it).
+    pub ours: Option<u64>,
+    /// Its net count in lean's round trip (`None`: not in it).
+    pub lean: Option<u64>,
+}
+
+impl StepChange {
+    /// The variant's count minus lean's (a step missing on one side counts 0 there).
+    pub fn delta(&self) -> i64 {
+        self.ours.unwrap_or(0) as i64 - self.lean.unwrap_or(0) as i64
+    }
+}
+
+/// One opt-level of a one-feature variant against lean.
+#[derive(Debug, Clone)]
+pub struct FeatureOpt {
+    /// Opt-level.
+    pub opt: String,
+    /// Round trip, instructions: (the variant, lean).
+    pub roundtrip: (u64, u64),
+    /// The steps that changed, in round-trip order.
+    pub steps: Vec<StepChange>,
+    /// Flash, driver + application (`loopback-twocan`): (the variant, lean).
+    pub flash: (u64, u64),
+    /// RAM of `loopback-twocan` (data + bss): (the variant, lean).
+    pub ram: (u64, u64),
+    /// Configuration stack (`twocan.config` of `insn-count`): (the variant, lean).
+    pub config_stack: (u64, u64),
+}
+
+/// What one compile-time choice costs: its one-feature variant against lean (our
+/// bxCAN driver; issue 21, "each with its measured cost").
+#[derive(Debug, Clone)]
+pub struct FeatureCost {
+    /// The variant (`lean+done` ...).
+    pub variant: &'static str,
+    /// Its cargo feature (`done` ...).
+    pub feature: &'static str,
+    /// Per opt-level, in build order.
+    pub per_opt: Vec<FeatureOpt>,
+    /// The `State` static: (the variant, lean).
+    pub state: (StateFigures, StateFigures),
+}
+
+impl FeatureCost {
+    /// The figures at `opt`.
+    pub fn at(&self, opt: &str) -> Option<&FeatureOpt> {
+        self.per_opt.iter().find(|o| o.opt == opt)
+    }
+}
+
 /// Every figure of issue 21.
 pub struct Figures {
     /// The targets, by backend and variant.
     pub targets: Vec<Target>,
+    /// The cost of each compile-time choice (bxCAN), in [`FEATURE_VARIANTS`] order.
+    pub feature_costs: Vec<FeatureCost>,
     /// The largest configuration stack of every firmware example and bench firmware,
     /// and where it was measured.
     pub config_stack_max: Option<(u64, String)>,
@@ -302,6 +362,7 @@ impl Figures {
         }
         Ok(Figures {
             targets,
+            feature_costs: feature_costs(insn, sizes)?,
             config_stack_max: config_stack_max(insn, sizes, examples),
         })
     }
@@ -395,13 +456,120 @@ impl Figures {
             }
         }
         m.insert("issue21".into(), serde_json::Value::Object(all));
+        m.insert("feature_costs".into(), self.feature_costs_json()?);
         Ok(m)
+    }
+
+    /// `feature_costs`: per one-feature variant, the round trip at opt s and opt 3,
+    /// the flash (driver + application) at opt s, the driver state beyond the rings
+    /// and the whole `State` static, and the configuration stack (the larger of the
+    /// two opt-levels).
+    fn feature_costs_json(&self) -> Result<serde_json::Value> {
+        let mut m = serde_json::Map::new();
+        for c in &self.feature_costs {
+            let at = |opt: &str| {
+                c.at(opt)
+                    .ok_or_else(|| Error::new(format!("no figures of {} at opt {opt}", c.variant)))
+            };
+            let (s, three) = (at("s")?, at("3")?);
+            m.insert(
+                c.variant.into(),
+                serde_json::json!({
+                    "roundtrip_s": s.roundtrip.0,
+                    "roundtrip_3": three.roundtrip.0,
+                    "flash_equiv_s": s.flash.0,
+                    "state_bytes": c.state.0.state_bytes(),
+                    "state_static_bytes": c.state.0.static_bytes,
+                    "config_stack_bytes": c.per_opt.iter().map(|o| o.config_stack.0).max(),
+                }),
+            );
+        }
+        Ok(serde_json::Value::Object(m))
     }
 }
 
+/// The one-feature variants against lean: round trips and their changed steps and the
+/// configuration stack from `insn-count`, flash and RAM from `loopback-twocan`, the
+/// `State` figures from both.
+fn feature_costs(insn: &InsnSection, sizes: &SizeSection) -> Result<Vec<FeatureCost>> {
+    let b = Backend::BxCan;
+    let lean_state = sizes
+        .state("lean")
+        .ok_or_else(|| Error::new("no lean state figures"))?
+        .bxcan;
+    let mut costs = Vec::new();
+    for (variant, feature) in FEATURE_VARIANTS {
+        let state = sizes
+            .feature_states
+            .iter()
+            .find(|(v, _)| v == variant)
+            .map(|(_, st)| *st)
+            .ok_or_else(|| Error::new(format!("no {variant} state figures")))?;
+        let mut per_opt = Vec::new();
+        for opt in insn.opts() {
+            let ours = insn.get_feature(variant, &opt)?;
+            let lean = insn.get(b, "lean", &opt)?;
+            let ours_keys = ours.roundtrip_keys("twocan")?;
+            let lean_keys = lean.roundtrip_keys("twocan")?;
+            let mut keys: Vec<&String> = ours_keys.iter().collect();
+            for k in lean_keys {
+                if !keys.contains(&k) {
+                    keys.push(k);
+                }
+            }
+            let mut steps = Vec::new();
+            for k in keys {
+                let count = |c: &crate::qemu::Counts, in_it: &[String]| -> Result<Option<u64>> {
+                    Ok(if in_it.contains(k) {
+                        Some(c.net(k)?.0)
+                    } else {
+                        None
+                    })
+                };
+                let change = StepChange {
+                    key: k.clone(),
+                    ours: count(ours, ours_keys)?,
+                    lean: count(lean, lean_keys)?,
+                };
+                if change.ours != change.lean {
+                    steps.push(change);
+                }
+            }
+            let build = sizes
+                .build(&opt)
+                .ok_or_else(|| Error::new(format!("no loop-back sizes at opt {opt}")))?;
+            let size = build
+                .features
+                .iter()
+                .find(|(v, _)| v == variant)
+                .map(|(_, z)| z)
+                .ok_or_else(|| Error::new(format!("no {variant} loop-back size at opt {opt}")))?;
+            let lean_size = &build
+                .variant("lean")
+                .ok_or_else(|| Error::new(format!("no lean loop-back sizes at opt {opt}")))?
+                .ours;
+            per_opt.push(FeatureOpt {
+                opt: opt.clone(),
+                roundtrip: (ours.roundtrip("twocan")?, lean.roundtrip("twocan")?),
+                steps,
+                flash: (size.app_flash(), lean_size.app_flash()),
+                ram: (size.ram(), lean_size.ram()),
+                config_stack: (ours.stack("twocan.config")?, lean.stack("twocan.config")?),
+            });
+        }
+        costs.push(FeatureCost {
+            variant,
+            feature,
+            per_opt,
+            state: (state, lean_state),
+        });
+    }
+    Ok(costs)
+}
+
 /// The largest configuration stack: every `*.config` stack figure of every run of the
-/// instruction-count firmwares (ours and the equivalents, both variants, both
-/// profiles), every example's configuration figure under can-fil, and every loop-back
+/// instruction-count firmwares (ours and the equivalents, both variants and our
+/// bxCAN driver's one-feature variants, both profiles), every example's configuration figure under can-fil, and every loop-back
 /// firmware's whole run under can-fil (start-up, configuration and one polled frame:
 /// they enable no interrupt line, so their whole run stands for their configuration).
 fn config_stack_max(
@@ -415,7 +583,7 @@ fn config_stack_max(
             best = Some((v, what));
         }
     };
-    for r in &insn.runs {
+    for r in insn.runs.iter().chain(&insn.feature_runs) {
         for (k, v) in &r.counts.stacks {
             if k.ends_with(".config") {
                 consider(

@@ -111,8 +111,10 @@ pub fn ensure_target(install: bool) -> Result<()> {
 
 /// Builds the bench firmware workspace with cargo profile `profile`; returns the
 /// directory holding its ELFs. The packages of [`VARIANT_PACKAGES`] are built once per
-/// variant of [`VARIANTS`] (cargo feature of the same name) and their ELFs copied to
-/// `<bin>-<variant>` in that directory.
+/// variant of [`VARIANTS`] (cargo feature of the same name), those of
+/// [`FEATURE_PACKAGES`] once more per one-feature variant of [`FEATURE_VARIANTS`]
+/// (features `lean` and the choice's), and their ELFs copied to `<bin>-<variant>` in
+/// that directory.
 pub fn bench_firmware(paths: &Paths, profile: &str) -> Result<PathBuf> {
     let target_dir = paths.scratch("bench-firmware");
     let manifest = paths.firmware().join("Cargo.toml");
@@ -120,7 +122,7 @@ pub fn bench_firmware(paths: &Paths, profile: &str) -> Result<PathBuf> {
     // One cargo invocation per feature set: cargo unifies features over the packages of
     // one build, so the `async` feature of the async firmwares and each variant's
     // features must not meet the other firmwares.
-    let mut selections: Vec<(Vec<String>, Option<&str>)> = Vec::new();
+    let mut selections: Vec<(Vec<String>, Option<(&str, &[(&str, &str)])>)> = Vec::new();
     let mut rest = vec!["--workspace".to_string()];
     for p in ASYNC_PACKAGES
         .iter()
@@ -148,7 +150,20 @@ pub fn bench_firmware(paths: &Paths, profile: &str) -> Result<PathBuf> {
         // Each variant package's default is `full`: the variant is chosen explicitly.
         sel.push("--no-default-features".to_string());
         sel.extend(["--features".to_string(), features.join(",")]);
-        selections.push((sel, Some(variant)));
+        selections.push((sel, Some((variant, &VARIANT_PACKAGES[..]))));
+    }
+    for (variant, feature) in FEATURE_VARIANTS {
+        let mut sel: Vec<String> = FEATURE_PACKAGES
+            .iter()
+            .flat_map(|(p, _)| ["-p".to_string(), p.to_string()])
+            .collect();
+        let features: Vec<String> = FEATURE_PACKAGES
+            .iter()
+            .flat_map(|(p, _)| [format!("{p}/lean"), format!("{p}/{feature}")])
+            .collect();
+        sel.push("--no-default-features".to_string());
+        sel.extend(["--features".to_string(), features.join(",")]);
+        selections.push((sel, Some((variant, &FEATURE_PACKAGES[..]))));
     }
     for (selection, variant) in selections {
         let mut c = cargo();
@@ -162,8 +177,8 @@ pub fn bench_firmware(paths: &Paths, profile: &str) -> Result<PathBuf> {
             .args(&selection);
         eprintln!("can-bench: {}", cmd::display(&c));
         cmd::run_ok(&mut c, BUILD_LIMIT).context("building the bench firmware")?;
-        if let Some(v) = variant {
-            for (_, bin) in VARIANT_PACKAGES {
+        if let Some((v, packages)) = variant {
+            for (_, bin) in packages {
                 let from = out.join(bin);
                 let to = out.join(variant_elf(bin, v));
                 std::fs::copy(&from, &to).context(format!(
@@ -190,6 +205,28 @@ pub const ASYNC_PACKAGES: [&str; 2] = ["bench-insn-count-async", "bench-loopback
 /// (completions, time stamps, statistics, runtime planner), each against an equivalent
 /// doing the same service. The cargo feature of each package in [`VARIANT_PACKAGES`].
 pub const VARIANTS: [&str; 2] = ["lean", "full"];
+
+/// The one-feature variants of issue 21 ("each choice with its own measured cost"):
+/// (variant name, cargo feature). Each is `lean` with exactly one per-frame choice
+/// switched to its full setting (`bench/firmware/shared/bxcan_variant.rs`): transmit
+/// completions, receive time stamps, traffic statistics, filters replaceable while
+/// running, the run-time planner. Built for our bxCAN driver only
+/// ([`FEATURE_PACKAGES`]); the variant name is also what the firmware prints.
+pub const FEATURE_VARIANTS: [(&str, &str); 5] = [
+    ("lean+done", "done"),
+    ("lean+stamps", "stamps"),
+    ("lean+counts", "counts"),
+    ("lean+switch", "switch"),
+    ("lean+planner", "planner"),
+];
+
+/// (package, binary) of the bench firmware built once more per one-feature variant of
+/// [`FEATURE_VARIANTS`]: our bxCAN driver's instruction counts and loop-back firmware
+/// (variant packages too, so the `--workspace` build leaves them out).
+pub const FEATURE_PACKAGES: [(&str, &str); 2] = [
+    ("bench-insn-count", "insn-count"),
+    ("bench-loopback-twocan", "loopback-twocan"),
+];
 
 /// (package, binary) of the bench firmware built once per variant.
 pub const VARIANT_PACKAGES: [(&str, &str); 7] = [
@@ -372,4 +409,26 @@ pub fn locked_version(lock: &Path, package: &str) -> Option<String> {
         }
     }
     None
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn feature_packages_are_variant_packages_and_feature_variants_extend_lean() {
+        // The `--workspace` build excludes the variant packages only: a feature package
+        // outside them would be built there with its default features.
+        for p in FEATURE_PACKAGES {
+            assert!(VARIANT_PACKAGES.contains(&p), "{p:?}");
+        }
+        for (variant, feature) in FEATURE_VARIANTS {
+            assert_eq!(variant, format!("lean+{feature}"));
+            assert!(!VARIANTS.contains(&variant));
+        }
+        assert_eq!(
+            variant_elf("insn-count", "lean+done"),
+            "insn-count-lean+done"
+        );
+    }
 }

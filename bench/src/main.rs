@@ -51,7 +51,7 @@ use clap::{Parser, ValueEnum};
 use cmd::{Context, Result};
 use figures::Backend;
 use firmware::Paths;
-use firmware::{variant_elf, VARIANTS};
+use firmware::{variant_elf, FEATURE_VARIANTS, VARIANTS};
 use report::{
     ExampleBuild, ExampleSection, InsnRun, InsnSection, LoopbackStack, Report, SizeBuild,
     SizeSection, StateSet, VariantSizes,
@@ -229,12 +229,18 @@ fn run() -> Result<()> {
                     flexcan_hand: sizes::measure(&elf("loopback-flexcan-hand"))?,
                 });
             }
+            let mut features = Vec::new();
+            for (v, _) in FEATURE_VARIANTS {
+                let elf = dir.join(variant_elf("loopback-twocan", v));
+                features.push((v.to_string(), sizes::measure(&elf)?));
+            }
             builds.push(SizeBuild {
                 profile: profile.to_string(),
                 opt: opt.to_string(),
                 bare: sizes::measure(&dir.join("loopback-bxcan"))?,
                 async_fw: sizes::measure(&dir.join("loopback-async"))?,
                 variants,
+                features,
             });
         }
         let dir = &firmware_dirs[0].1;
@@ -261,6 +267,18 @@ fn run() -> Result<()> {
             );
             states.push(set);
         }
+        let mut feature_states = Vec::new();
+        for (v, _) in FEATURE_VARIANTS {
+            let elf = |bin: &str| dir.join(variant_elf(bin, v));
+            let st = sizes::state_figures(&elf("loopback-twocan"), &elf("insn-count"))?;
+            eprintln!(
+                "can-bench: {v}: bxCAN State {} B = rings {} B + state {} B",
+                st.static_bytes,
+                st.ring_bytes,
+                st.state_bytes()
+            );
+            feature_states.push((v.to_string(), st));
+        }
         let mut fil = Vec::new();
         if let Some(can_fil) = &can_fil {
             step("the loop-back firmwares under can-fil (they must work; their stack)");
@@ -273,6 +291,9 @@ fn run() -> Result<()> {
                     for (bin, board) in LOOPBACK_BOARDS {
                         elfs.push((variant_elf(bin, v), board));
                     }
+                }
+                for (v, _) in FEATURE_VARIANTS {
+                    elfs.push((variant_elf("loopback-twocan", v), "nucleo-f767zi"));
                 }
                 for (elf, board) in elfs {
                     let st = stack::measure_loopback(can_fil, board, &dir.join(&elf))?;
@@ -292,6 +313,7 @@ fn run() -> Result<()> {
         report.sizes = Some(SizeSection {
             builds,
             states,
+            feature_states,
             fil,
         });
     }
@@ -356,6 +378,31 @@ fn run() -> Result<()> {
                 }
             }
         }
+        // The one-feature variants of our bxCAN driver: `insn-count` alone (their cost
+        // is against lean, not against an equivalent).
+        let mut feature_runs = Vec::new();
+        for ((profile, opt), (_, dir)) in COUNT_PROFILES.iter().zip(&firmware_dirs) {
+            for (v, _) in FEATURE_VARIANTS {
+                let fw = Backend::BxCan.firmware();
+                let elf = dir.join(variant_elf(fw, v));
+                let tag = format!("{profile}-{fw}-{v}");
+                let counts = qemu::run(&paths, &tools, &plugin, &elf, &tag)
+                    .context(format!("{fw} {v} ({profile} profile)"))?;
+                if counts.variant.as_deref() != Some(v) {
+                    return Err(cmd::Error::new(format!(
+                        "{} says it is variant {:?}, built as {v}",
+                        elf.display(),
+                        counts.variant
+                    )));
+                }
+                feature_runs.push(InsnRun {
+                    backend: Backend::BxCan,
+                    variant: v.to_string(),
+                    opt: opt.to_string(),
+                    counts,
+                });
+            }
+        }
         let mut async_runs = Vec::new();
         for ((profile, opt), (_, dir)) in COUNT_PROFILES.iter().zip(&firmware_dirs) {
             let elf = dir.join("insn-count-async");
@@ -371,6 +418,7 @@ fn run() -> Result<()> {
         report.insn = Some(InsnSection {
             tools,
             runs,
+            feature_runs,
             async_runs,
             window,
         });

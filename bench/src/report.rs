@@ -39,6 +39,9 @@ pub struct SizeBuild {
     pub async_fw: Size,
     /// Per variant.
     pub variants: Vec<VariantSizes>,
+    /// `loopback-twocan` per one-feature variant (`firmware::FEATURE_VARIANTS`):
+    /// (variant, size).
+    pub features: Vec<(String, Size)>,
 }
 
 impl SizeBuild {
@@ -76,6 +79,9 @@ pub struct SizeSection {
     pub builds: Vec<SizeBuild>,
     /// State figures per variant (size-optimised build).
     pub states: Vec<StateSet>,
+    /// Our bxCAN driver's state figures per one-feature variant (size-optimised build):
+    /// (variant, figures).
+    pub feature_states: Vec<(String, StateFigures)>,
     /// The loop-back firmwares under can-fil (empty with `--skip fil`).
     pub fil: Vec<LoopbackStack>,
 }
@@ -136,6 +142,9 @@ pub struct InsnSection {
     pub tools: Tools,
     /// Every run.
     pub runs: Vec<InsnRun>,
+    /// The runs of `insn-count` per one-feature variant (`firmware::FEATURE_VARIANTS`,
+    /// our bxCAN driver alone).
+    pub feature_runs: Vec<InsnRun>,
     /// (opt-level, counts) of `insn-count-async` per build.
     pub async_runs: Vec<(String, Counts)>,
     /// The marker window address.
@@ -155,6 +164,15 @@ impl InsnSection {
                     backend.firmware()
                 ))
             })
+    }
+
+    /// The counts of `insn-count` built as the one-feature variant `variant`, at `opt`.
+    pub fn get_feature(&self, variant: &str, opt: &str) -> Result<&Counts> {
+        self.feature_runs
+            .iter()
+            .find(|r| r.variant == variant && r.opt == opt)
+            .map(|r| &r.counts)
+            .ok_or_else(|| cmd::Error::new(format!("no insn-count {variant} run at opt {opt}")))
     }
 
     /// The opt-levels measured, in build order.
@@ -533,6 +551,7 @@ impl Report {
         let figures = self.figures()?;
         if let Some(f) = &figures {
             render_targets(&mut s, f);
+            render_feature_costs(&mut s, f);
         }
         if let Some(sizes) = &self.sizes {
             self.render_sizes(&mut s, sizes);
@@ -1213,6 +1232,183 @@ fn render_targets(s: &mut String, f: &Figures) {
             missed.len()
         );
     }
+}
+
+/// A signed difference: `+12`, `−3`, `±0`.
+fn delta(ours: u64, lean: u64) -> String {
+    match ours.cmp(&lean) {
+        std::cmp::Ordering::Greater => format!("+{}", thousands(ours - lean)),
+        std::cmp::Ordering::Less => format!("−{}", thousands(lean - ours)),
+        std::cmp::Ordering::Equal => "±0".into(),
+    }
+}
+
+/// What a one-feature variant switches on and what its per-frame code then does (the
+/// mechanism; the measured figures follow it in the document).
+fn feature_note(feature: &str) -> &'static str {
+    match feature {
+        "done" => {
+            "transmit completions, a completion ring of 8 (`DONE` = 8): the send records \
+             the frame's token with its mailbox; with a completion to report the split \
+             driver leaves its quiet transmit mode, so the transmit interrupt stays \
+             enabled and every frame runs the transmit handler, which settles the \
+             mailbox into the ring, and the application takes the completion"
+        }
+        "stamps" => {
+            "receive time stamps (`CAN_MCR.TTCM` = 1, a feature set with `TIMESTAMPS` \
+             and without counts): the receive path keeps the frame's time stamp and the \
+             take widens it; a time stamp to record per frame sent ends the quiet \
+             transmit mode (`State::QUIET_TX` needs neither time stamps nor counts), so \
+             every frame also runs the transmit handler"
+        }
+        "counts" => {
+            "traffic statistics (a feature set with `COUNTS` and twocan-core's \
+             counting `Counter`, no time stamps): the handlers count the frames \
+             received and sent; a count to record per frame sent ends the quiet \
+             transmit mode, so every frame also runs the transmit handler"
+        }
+        "switch" => {
+            "filters replaceable while running (`SWITCH` = true, the filter map sized \
+             as lean): each frame carries the filter list generation, read with it \
+             into the ring by the receive handler and compared with the current one \
+             by the take"
+        }
+        "planner" => {
+            "the run-time planner (`planner::plan_in`, its working memory in a \
+             `static`) instead of the `const` plan, the map sized to the same plan: its \
+             cost is the planner's code in flash, its working memory in RAM and the \
+             planning on the configuration's stack; the per-frame code is lean's"
+        }
+        _ => "",
+    }
+}
+
+/// Issue 21's "each choice with its own measured cost": every one-feature variant of
+/// our bxCAN driver against lean.
+fn render_feature_costs(s: &mut String, f: &Figures) {
+    if f.feature_costs.is_empty() {
+        return;
+    }
+    let _ = writeln!(s, "## What each per-frame choice costs (bxCAN)\n");
+    let _ = writeln!(
+        s,
+        "Each compile-time choice measured on its own: a **one-feature variant** is the \
+         lean variant of our bxCAN driver with exactly one choice switched to its full \
+         setting (cargo feature `lean` plus one of `done`, `stamps`, `counts`, `switch`, \
+         `planner` of `bench/firmware/insn-count` and `loopback-twocan`; \
+         `shared/bxcan_variant.rs`), built with both profiles and measured as lean is: \
+         the round trip from `insn-count` under QEMU (the regions the firmware names \
+         for its configuration, section 2; a choice that ends the quiet transmit mode \
+         adds the transmit handler), flash and RAM from `loopback-twocan` (section 1), \
+         the `State` static (`BENCH_CAN_STATE`, and the driver state beyond its ring \
+         and queue slots) and the configuration stack from `insn-count`. Every Δ is \
+         against lean at the same opt-level; \"steps that changed\" lists each round-trip \
+         region whose count differs from lean's (\"new\": lean's round trip does not \
+         run it).\n"
+    );
+    let _ = writeln!(
+        s,
+        "| variant | opt | round trip | Δ | steps that changed (Δ) | driver + application flash | Δ | RAM | Δ | `State` / driver state, B | Δ | configuration stack, B | Δ |\n\
+         |---|---|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|"
+    );
+    let opts: Vec<String> = f.feature_costs[0]
+        .per_opt
+        .iter()
+        .map(|o| o.opt.clone())
+        .collect();
+    let lean_state = f.feature_costs[0].state.1;
+    for opt in &opts {
+        if let Some(o) = f.feature_costs[0].at(opt) {
+            let _ = writeln!(
+                s,
+                "| lean | {opt} | **{}** | | | **{}** | | {} | | {} / **{}** | | {} | |",
+                thousands(o.roundtrip.1),
+                thousands(o.flash.1),
+                thousands(o.ram.1),
+                thousands(lean_state.static_bytes),
+                thousands(lean_state.state_bytes()),
+                thousands(o.config_stack.1)
+            );
+        }
+    }
+    for c in &f.feature_costs {
+        let (st, lean) = c.state;
+        for o in &c.per_opt {
+            let steps = if o.steps.is_empty() {
+                "none".to_string()
+            } else {
+                o.steps
+                    .iter()
+                    .map(|st| {
+                        let d = st.delta();
+                        let d = if d >= 0 {
+                            delta(d as u64, 0)
+                        } else {
+                            delta(0, d.unsigned_abs())
+                        };
+                        match (st.ours, st.lean) {
+                            (Some(_), None) => format!("`{}` {d} (new)", st.key),
+                            (None, Some(_)) => format!("`{}` {d} (not run)", st.key),
+                            _ => format!("`{}` {d}", st.key),
+                        }
+                    })
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            };
+            let _ = writeln!(
+                s,
+                "| {} | {} | **{}** | {} | {steps} | **{}** | {} | {} | {} | {} / **{}** | {} / {} | {} | {} |",
+                c.variant,
+                o.opt,
+                thousands(o.roundtrip.0),
+                delta(o.roundtrip.0, o.roundtrip.1),
+                thousands(o.flash.0),
+                delta(o.flash.0, o.flash.1),
+                thousands(o.ram.0),
+                delta(o.ram.0, o.ram.1),
+                thousands(st.static_bytes),
+                thousands(st.state_bytes()),
+                delta(st.static_bytes, lean.static_bytes),
+                delta(st.state_bytes(), lean.state_bytes()),
+                thousands(o.config_stack.0),
+                delta(o.config_stack.0, o.config_stack.1)
+            );
+        }
+    }
+    let _ = writeln!(s);
+    for c in &f.feature_costs {
+        let figures: Vec<String> = c
+            .per_opt
+            .iter()
+            .map(|o| {
+                format!(
+                    "round trip {} instructions at opt {}",
+                    delta(o.roundtrip.0, o.roundtrip.1),
+                    o.opt
+                )
+            })
+            .chain(c.per_opt.first().map(|o| {
+                format!(
+                    "flash {} B and RAM {} B at opt {}",
+                    delta(o.flash.0, o.flash.1),
+                    delta(o.ram.0, o.ram.1),
+                    o.opt
+                )
+            }))
+            .chain([format!(
+                "`State` {} B",
+                delta(c.state.0.static_bytes, c.state.1.static_bytes)
+            )])
+            .collect();
+        let _ = writeln!(
+            s,
+            "- **{}** — {}: {}.",
+            c.variant,
+            feature_note(c.feature),
+            figures.join(", ")
+        );
+    }
+    let _ = writeln!(s);
 }
 
 /// The step of a round trip a region is (send, handlers, takes), for lining ours up

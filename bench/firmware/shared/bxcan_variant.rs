@@ -18,6 +18,25 @@
 //!   set (no traffic statistics, no time stamps read); the filter map holds exactly
 //!   the plan's match indices ([`FMIS`]), and the filters fixed ([`SWITCH`] = false: no
 //!   filter generation per frame).
+//!
+//! **One-feature variants** (issue 21: each compile-time choice with its own measured
+//! cost): `lean` plus exactly one of the additive features below switches that one
+//! choice to its full setting and leaves every other as lean. They are valid only with
+//! `lean`, one at a time (a `compile_error!` says so otherwise):
+//!
+//! - `done`: transmit completions ([`DONE`] = 8; with a completion ring the split
+//!   driver's quiet transmit mode is off, so every frame runs the transmit handler);
+//! - `stamps`: receive time stamps (`CAN_MCR.TTCM` = 1 and the split driver's
+//!   [`StampsOnly`] feature set: time stamps read, nothing counted);
+//! - `counts`: traffic statistics (the [`CountsOnly`] feature set: counted, no time
+//!   stamps read);
+//! - `switch`: filters replaceable while running ([`SWITCH`] = true: the filter
+//!   generation checked per frame; the map sized as lean);
+//! - `planner`: the filters compiled at run time by the planner (`planner::plan_in`,
+//!   its working memory in a `static`) instead of the `const` plan; the map sized to
+//!   the same plan as lean (no lookup key, the plan's match indices).
+//!
+//! [`TakeOnce`]: twocan_core::TakeOnce
 
 // Each firmware that includes this module uses a part of it.
 #![allow(dead_code)]
@@ -26,6 +45,30 @@
 compile_error!("features `lean` and `full` are exclusive");
 #[cfg(not(any(feature = "lean", feature = "full")))]
 compile_error!("enable feature `lean` or `full`");
+#[cfg(all(
+    any(
+        feature = "done",
+        feature = "stamps",
+        feature = "counts",
+        feature = "switch",
+        feature = "planner"
+    ),
+    not(feature = "lean")
+))]
+compile_error!(
+    "features `done`, `stamps`, `counts`, `switch` and `planner` switch one choice of \
+     `lean` to its full setting: enable them with `lean` only"
+);
+#[cfg(any(
+    all(feature = "done", any(feature = "stamps", feature = "counts", feature = "switch", feature = "planner")),
+    all(feature = "stamps", any(feature = "counts", feature = "switch", feature = "planner")),
+    all(feature = "counts", any(feature = "switch", feature = "planner")),
+    all(feature = "switch", feature = "planner"),
+))]
+compile_error!(
+    "enable at most one of `done`, `stamps`, `counts`, `switch`, `planner`: each \
+     one-feature variant measures one choice alone"
+);
 
 use twocan_bxcan::{BxCan, Config, PlanOptions, PlanRef};
 use twocan_core::split::{Parts, Rx, Rx0Irq, State, Tx, TxIrq};
@@ -56,26 +99,78 @@ pub const CONFIG: Config = match Config::from_bitrate(APB1_HZ, BITRATE) {
 // ------------------------------------------------------------------ lean
 
 /// The variant's name in the bench output.
-#[cfg(feature = "lean")]
+#[cfg(all(
+    feature = "lean",
+    not(any(
+        feature = "done",
+        feature = "stamps",
+        feature = "counts",
+        feature = "switch",
+        feature = "planner"
+    ))
+))]
 pub const VARIANT: &str = "lean";
-/// Completion ring capacity (0: completions off).
+#[cfg(feature = "done")]
+pub const VARIANT: &str = "lean+done";
+#[cfg(feature = "stamps")]
+pub const VARIANT: &str = "lean+stamps";
+#[cfg(feature = "counts")]
+pub const VARIANT: &str = "lean+counts";
+#[cfg(feature = "switch")]
+pub const VARIANT: &str = "lean+switch";
+#[cfg(feature = "planner")]
+pub const VARIANT: &str = "lean+planner";
+/// Completion ring capacity (0: completions off; 8 with `done`).
 #[cfg(feature = "lean")]
-pub const DONE: usize = 0;
-/// Receive time stamps (`CAN_MCR.TTCM`).
+pub const DONE: usize = if cfg!(feature = "done") { 8 } else { 0 };
+/// Receive time stamps (`CAN_MCR.TTCM`; on with `stamps`).
 #[cfg(feature = "lean")]
-pub const TIMESTAMPS: bool = false;
+pub const TIMESTAMPS: bool = cfg!(feature = "stamps");
 /// Identifiers of the filter map's merged-filter lookup.
 #[cfg(feature = "lean")]
 pub const KEYS: usize = 0;
 /// The split driver's compile-time feature set: no statistics, no time stamps.
-#[cfg(feature = "lean")]
+#[cfg(all(feature = "lean", not(any(feature = "stamps", feature = "counts"))))]
 pub type Fe = twocan_core::Lean;
+/// The split driver's compile-time feature set of `lean+stamps`: time stamps only.
+#[cfg(feature = "stamps")]
+pub type Fe = StampsOnly;
+/// The split driver's compile-time feature set of `lean+counts`: statistics only.
+#[cfg(feature = "counts")]
+pub type Fe = CountsOnly;
+
+/// A split-driver feature set with receive and transmit time stamps read and widened,
+/// and no traffic statistics (`twocan_core::Features`, issue 21's `lean+stamps`).
+#[cfg(feature = "stamps")]
+#[derive(Debug, Clone, Copy)]
+pub enum StampsOnly {}
+
+#[cfg(feature = "stamps")]
+impl twocan_core::Features for StampsOnly {
+    const TIMESTAMPS: bool = true;
+    const COUNTS: bool = false;
+    type Counter = twocan_core::features::NoTally;
+}
+
+/// A split-driver feature set with the traffic statistics counted, as
+/// `twocan_core::Full` counts them, and no time stamps read (issue 21's
+/// `lean+counts`).
+#[cfg(feature = "counts")]
+#[derive(Debug, Clone, Copy)]
+pub enum CountsOnly {}
+
+#[cfg(feature = "counts")]
+impl twocan_core::Features for CountsOnly {
+    const TIMESTAMPS: bool = false;
+    const COUNTS: bool = true;
+    type Counter = twocan_core::spsc::Counter;
+}
 
 /// Planner options: CAN1's banks at reset (`CAN2SB` = 14, RM0410 §40.9.4), FIFO 0.
 pub const OPTIONS: PlanOptions = PlanOptions::new(14);
 
 /// The filters: [`FILTERS`] planned at compile time (one accept-all mask bank to FIFO 0).
-#[cfg(feature = "lean")]
+#[cfg(all(feature = "lean", not(feature = "planner")))]
 #[inline(always)]
 fn with_plan<T>(f: impl FnOnce(PlanRef<'_>) -> Result<T, Error>) -> Result<T, Error> {
     f(twocan_bxcan::const_plan!(FILTERS, OPTIONS).as_ref())
@@ -90,9 +185,9 @@ pub const FILTER_INDEX: u16 = 0;
 pub const FMIS: usize = twocan_bxcan::const_plan!(FILTERS, OPTIONS).match_indices();
 
 /// The filters stay as configured (`set_filters` refused): no filter generation per
-/// frame.
+/// frame. With `switch`: replaceable while running, each frame carries the generation.
 #[cfg(feature = "lean")]
-pub const SWITCH: bool = false;
+pub const SWITCH: bool = cfg!(feature = "switch");
 
 // ------------------------------------------------------------------ full
 
@@ -109,12 +204,12 @@ pub const KEYS: usize = twocan_bxcan::filters::LOOKUP_KEYS;
 pub type Fe = twocan_core::Full;
 
 /// The planner's working memory (about 90 KB of `.bss`), lent once.
-#[cfg(feature = "full")]
+#[cfg(any(feature = "full", feature = "planner"))]
 static SCRATCH: twocan_core::TakeOnce<twocan_bxcan::planner::Scratch<KEYS>> =
     twocan_core::TakeOnce::new(twocan_bxcan::planner::Scratch::new());
 
 /// The filters: [`FILTERS`] compiled by the run-time planner into [`SCRATCH`].
-#[cfg(feature = "full")]
+#[cfg(any(feature = "full", feature = "planner"))]
 #[inline(always)]
 fn with_plan<T>(f: impl FnOnce(PlanRef<'_>) -> Result<T, Error>) -> Result<T, Error> {
     let scratch = SCRATCH.take().ok_or(Error::WrongMode)?;

@@ -2,7 +2,9 @@
 //! backend) and of the bare `bxcan` crate 0.8, on a Cortex-M4 under QEMU
 //! (`-machine mps2-an386`), counted by the TCG plugin `bench/plugin/insn_count.c`
 //! between marker stores. Built twice, with feature `lean` and with feature `full`
-//! (`shared/bxcan_variant.rs`). The register block stand-in and its snapshots are in
+//! (`shared/bxcan_variant.rs`), and, for issue 21's cost of each choice, once per
+//! one-feature variant (`lean` plus one of `done`, `stamps`, `counts`, `switch`,
+//! `planner`). The register block stand-in and its snapshots are in
 //! `shared/ram_can.rs`, the markers and the stack painting in `shared/qemu.rs`. The
 //! feature-equivalent service is measured by `insn-count-equiv` (a separate image, so
 //! that the crate's `transmit` is not shared by two callers and stays inlined in each,
@@ -13,7 +15,7 @@
 //! - **ours**: a `static State` of the variant's type (zero-initialised, `.bss`), split
 //!   once; the transmit half's `try_send`, the transmit and FIFO 0 receive interrupt
 //!   handlers, the receive half's `receive` (decoded frame with the user's filter index)
-//!   and, full, `take_completion` are measured;
+//!   and, with completions (full, `lean+done`), `take_completion` are measured;
 //! - **bxcan**: the `bxcan` crate's `Can::transmit`, `Can::receive` and `Rx0::receive`,
 //!   bare.
 //!
@@ -58,11 +60,11 @@ use ram_can::{
 };
 use variant::{OurParts, OurRx, OurRxIrq, OurState, OurTx, OurTxIrq, DONE, RX, TXQ};
 
-/// The measured regions, in the order of their numbers; the full variant measures the
-/// completion's take too.
-#[cfg(feature = "lean")]
+/// The measured regions, in the order of their numbers; a variant with completions
+/// (full, `lean+done`) measures the completion's take too.
+#[cfg(not(any(feature = "full", feature = "done")))]
 const REGIONS: &[&str] = REGIONS_ALL.split_at(13).0;
-#[cfg(feature = "full")]
+#[cfg(any(feature = "full", feature = "done"))]
 const REGIONS: &[&str] = &REGIONS_ALL;
 
 const REGIONS_ALL: [&str; 14] = [
@@ -79,7 +81,7 @@ const REGIONS_ALL: [&str; 14] = [
     "bxcan.receive",
     "bxcan.rx0.receive",
     "twocan.tx_irq.done.unloaded",
-    // full only
+    // with completions only
     "twocan.take_completion",
 ];
 
@@ -99,7 +101,7 @@ const THEIRS_TRANSMIT_ONE_BUSY: usize = 9;
 const THEIRS_RECEIVE: usize = 10;
 const THEIRS_RX0_RECEIVE: usize = 11;
 const OURS_TX_IRQ_UNLOADED: usize = 12;
-#[cfg(feature = "full")]
+#[cfg(any(feature = "full", feature = "done"))]
 const OURS_TAKE_COMPLETION: usize = 13;
 
 /// What a frame's round trip runs, per side: the send, the handlers the configuration
@@ -108,9 +110,24 @@ const OURS_TAKE_COMPLETION: usize = 13;
 /// queued its transmit interrupt is off (`CAN_IER.TMEIE` = 0, checked after each direct
 /// send), so a frame sent directly costs no transmit handler; the handler's cost when
 /// frames are queued is still measured (`twocan.tx_irq.refill`, `.done`).
-#[cfg(feature = "lean")]
+///
+/// The one-feature variants: `lean+stamps` and `lean+counts` leave the quiet mode too
+/// (a time stamp or a count to record per frame sent: `State::QUIET_TX`), so their
+/// frames run the transmit handler; `lean+done` runs it and takes the completion, as
+/// full; `lean+switch` and `lean+planner` stay quiet.
+#[cfg(all(
+    feature = "lean",
+    not(any(feature = "done", feature = "stamps", feature = "counts"))
+))]
 const ROUNDTRIP_OURS: &[&str] = &["twocan.tx.direct", "twocan.rx_irq", "twocan.rx.receive"];
-#[cfg(feature = "full")]
+#[cfg(any(feature = "stamps", feature = "counts"))]
+const ROUNDTRIP_OURS: &[&str] = &[
+    "twocan.tx.direct",
+    "twocan.tx_irq.done",
+    "twocan.rx_irq",
+    "twocan.rx.receive",
+];
+#[cfg(any(feature = "full", feature = "done"))]
 const ROUNDTRIP_OURS: &[&str] = &[
     "twocan.tx.direct",
     "twocan.tx_irq.done",
@@ -118,6 +135,14 @@ const ROUNDTRIP_OURS: &[&str] = &[
     "twocan.rx.receive",
     "twocan.take_completion",
 ];
+/// Whether the variant is the split driver's quiet transmit mode (checked against
+/// `State::QUIET_TX`): lean, and the one-feature variants that record nothing per frame
+/// sent.
+const QUIET: bool = cfg!(all(
+    feature = "lean",
+    not(any(feature = "done", feature = "stamps", feature = "counts"))
+));
+
 // ------------------------------------------------------------------ ours
 
 /// The driver's shared state: all zeros, in `.bss`. The same type as `loopback-twocan`'s.
@@ -167,7 +192,7 @@ fn ours_receive(rx: &mut OurRx) -> Option<RxFrame> {
     rx.receive().ok()
 }
 
-#[cfg(feature = "full")]
+#[cfg(any(feature = "full", feature = "done"))]
 #[inline(never)]
 fn ours_take_completion(tx: &mut OurTx) -> Option<Completion> {
     tx.take_completion()
@@ -210,14 +235,14 @@ fn run_ours(snap: &Snapshots, p: &mut OurParts) {
             "twocan try_send direct",
         );
         // The quiet mode (lean) leaves the transmit interrupt off after a direct send;
-        // with completions it stays on.
+        // with completions, time stamps or statistics it stays on.
         check(
             OurState::QUIET_TX
                 == (reg_read(twocan_bxcan::regs::IER) & twocan_bxcan::regs::ier::TMEIE == 0),
             "twocan transmit interrupt off exactly in the quiet mode",
         );
         check(
-            OurState::QUIET_TX == cfg!(feature = "lean"),
+            OurState::QUIET_TX == QUIET,
             "the lean variant is the quiet mode",
         );
 
@@ -230,12 +255,12 @@ fn run_ours(snap: &Snapshots, p: &mut OurParts) {
             "twocan tx irq acknowledged RQCP0",
         );
         let done = {
-            #[cfg(feature = "full")]
+            #[cfg(any(feature = "full", feature = "done"))]
             {
                 let t = black_box(&mut p.tx);
                 measure::<OURS_TAKE_COMPLETION, _>(|| ours_take_completion(t))
             }
-            #[cfg(feature = "lean")]
+            #[cfg(not(any(feature = "full", feature = "done")))]
             {
                 p.tx.take_completion()
             }
@@ -307,7 +332,7 @@ fn run_ours(snap: &Snapshots, p: &mut OurParts) {
     restore(&snap.tx_done);
     let ((), bytes, _) = stack_depth(|| ours_tx_irq(&mut p.tx_irq));
     report_stack("twocan.tx_irq.done", bytes);
-    #[cfg(feature = "full")]
+    #[cfg(any(feature = "full", feature = "done"))]
     {
         let (c, bytes, _) = stack_depth(|| ours_take_completion(&mut p.tx));
         check(c.is_some(), "twocan stack take_completion");
