@@ -637,4 +637,16 @@ mod tests {
         assert_eq!(Measured::Bytes(64).verdict(64.0), "met");
         assert!(Measured::Ratio { ours: 1, theirs: 0 }.value().is_nan());
     }
+
+    #[test]
+    fn a_step_only_one_side_runs_counts_zero_on_the_other() {
+        let step = |ours, lean| StepChange {
+            key: "twocan.tx_irq.done".into(),
+            ours,
+            lean,
+        };
+        assert_eq!(step(Some(50), None).delta(), 50);
+        assert_eq!(step(None, Some(7)).delta(), -7);
+        assert_eq!(step(Some(40), Some(43)).delta(), -3);
+    }
 }

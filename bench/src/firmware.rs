@@ -122,7 +122,7 @@ pub fn bench_firmware(paths: &Paths, profile: &str) -> Result<PathBuf> {
     // One cargo invocation per feature set: cargo unifies features over the packages of
     // one build, so the `async` feature of the async firmwares and each variant's
     // features must not meet the other firmwares.
-    let mut selections: Vec<(Vec<String>, Option<(&str, &[(&str, &str)])>)> = Vec::new();
+    let mut selections: Vec<(Vec<String>, Option<Copies>)> = Vec::new();
     let mut rest = vec!["--workspace".to_string()];
     for p in ASYNC_PACKAGES
         .iter()
@@ -191,6 +191,9 @@ pub fn bench_firmware(paths: &Paths, profile: &str) -> Result<PathBuf> {
     }
     Ok(out)
 }
+
+/// What a variant build leaves to copy: the variant and its (package, binary) pairs.
+type Copies = (&'static str, &'static [(&'static str, &'static str)]);
 
 /// The ELF name of `bin` built as `variant`.
 pub fn variant_elf(bin: &str, variant: &str) -> String {

@@ -1235,12 +1235,17 @@ fn render_targets(s: &mut String, f: &Figures) {
 }
 
 /// A signed difference: `+12`, `−3`, `±0`.
-fn delta(ours: u64, lean: u64) -> String {
-    match ours.cmp(&lean) {
-        std::cmp::Ordering::Greater => format!("+{}", thousands(ours - lean)),
-        std::cmp::Ordering::Less => format!("−{}", thousands(lean - ours)),
+fn signed(d: i64) -> String {
+    match d.cmp(&0) {
+        std::cmp::Ordering::Greater => format!("+{}", thousands(d.unsigned_abs())),
+        std::cmp::Ordering::Less => format!("−{}", thousands(d.unsigned_abs())),
         std::cmp::Ordering::Equal => "±0".into(),
     }
+}
+
+/// `ours` against `lean`, signed.
+fn delta(ours: u64, lean: u64) -> String {
+    signed(ours as i64 - lean as i64)
 }
 
 /// What a one-feature variant switches on and what its per-frame code then does (the
@@ -1340,12 +1345,7 @@ fn render_feature_costs(s: &mut String, f: &Figures) {
                 o.steps
                     .iter()
                     .map(|st| {
-                        let d = st.delta();
-                        let d = if d >= 0 {
-                            delta(d as u64, 0)
-                        } else {
-                            delta(0, d.unsigned_abs())
-                        };
+                        let d = signed(st.delta());
                         match (st.ours, st.lean) {
                             (Some(_), None) => format!("`{}` {d} (new)", st.key),
                             (None, Some(_)) => format!("`{}` {d} (not run)", st.key),
@@ -1864,6 +1864,17 @@ mod tests {
         assert_eq!(rate(1_000_000), "1 Mbit/s");
         assert_eq!(rate(500_000), "500 kbit/s");
         assert_eq!(rate(33_333), "33,333 bit/s");
+        assert_eq!(delta(1_205, 3), "+1,202");
+        assert_eq!(delta(3, 5), "−2");
+        assert_eq!(delta(4, 4), "±0");
+    }
+
+    #[test]
+    fn every_one_feature_variant_says_what_it_switches() {
+        for (_, feature) in firmware::FEATURE_VARIANTS {
+            assert!(!feature_note(feature).is_empty(), "{feature}");
+        }
+        assert!(feature_note("frob").is_empty());
     }
 
     #[test]

@@ -60,8 +60,19 @@ compile_error!(
      `lean` to its full setting: enable them with `lean` only"
 );
 #[cfg(any(
-    all(feature = "done", any(feature = "stamps", feature = "counts", feature = "switch", feature = "planner")),
-    all(feature = "stamps", any(feature = "counts", feature = "switch", feature = "planner")),
+    all(
+        feature = "done",
+        any(
+            feature = "stamps",
+            feature = "counts",
+            feature = "switch",
+            feature = "planner"
+        )
+    ),
+    all(
+        feature = "stamps",
+        any(feature = "counts", feature = "switch", feature = "planner")
+    ),
     all(feature = "counts", any(feature = "switch", feature = "planner")),
     all(feature = "switch", feature = "planner"),
 ))]

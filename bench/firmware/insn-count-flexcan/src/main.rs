@@ -198,7 +198,9 @@ fn run_ours(snap: &Snapshots, p: &mut variant::OurParts<R>) {
         // completions it stays on.
         check(
             variant::OurState::<R>::QUIET_TX
-                == (reg_read(twocan_flexcan::regs::IMASK1) & twocan_flexcan::regs::iflag1::buf(ram_flexcan::TX_MB) == 0),
+                == (reg_read(twocan_flexcan::regs::IMASK1)
+                    & twocan_flexcan::regs::iflag1::buf(ram_flexcan::TX_MB)
+                    == 0),
             "twocan MB15 interrupt off exactly in the quiet mode",
         );
         check(

@@ -140,7 +140,11 @@ const ROUNDTRIP_OURS: &[&str] = &[
 /// sent.
 const QUIET: bool = cfg!(all(
     feature = "lean",
-    not(any(feature = "done", feature = "stamps", feature = "counts"))
+    not(any(
+        feature = "done",
+        feature = "stamps",
+        feature = "counts"
+    ))
 ));
 
 // ------------------------------------------------------------------ ours
@@ -161,7 +165,8 @@ static BENCH_HW_BYTES: u32 = size_of::<variant::Hw>() as u32;
 /// Size of the filter map inside it (`FmiMap`), read by can-bench.
 #[no_mangle]
 #[used]
-static BENCH_FMI_BYTES: u32 = size_of::<twocan_bxcan::filters::FmiMap<{ variant::KEYS }, { variant::FMIS }>>() as u32;
+static BENCH_FMI_BYTES: u32 =
+    size_of::<twocan_bxcan::filters::FmiMap<{ variant::KEYS }, { variant::FMIS }>>() as u32;
 
 /// Bytes of [`OurState`] that are ring and queue slots (receive ring, transmit queue,
 /// completion ring, state-change ring), read by can-bench: the rest is driver state.
