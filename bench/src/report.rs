@@ -1195,7 +1195,8 @@ fn render_targets(s: &mut String, f: &Figures) {
             "**Largest configuration stack** (`config_stack_bytes_max`) of every firmware \
              example (can-fil, up to the first CAN interrupt line unmasked; section 1), \
              every loop-back bench firmware (can-fil, whole run; section 1) and every \
-             instruction-count bench firmware (QEMU, the configuration call; section 2): \
+             instruction-count bench firmware (QEMU, the configuration call; section 2 and, \
+             for the one-feature variants, the next section): \
              **{} B**, {what} ({}).\n",
             thousands(*v),
             Measured::Bytes(*v).verdict(figures::CONFIG_STACK_BOUND as f64)
