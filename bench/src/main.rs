@@ -10,8 +10,8 @@
 //!    bxCAN and FlexCAN drivers in a lean and a full variant (and our bxCAN driver in
 //!    one-feature variants: lean with one choice switched to full, for each choice's
 //!    own cost), the `bxcan` crate 0.8 bare and with the service that makes it
-//!    feature-equivalent, a hand-written FlexCAN service ([`sizes`], [`firmware`]); the examples' stack under `can-fil --stack`
-//!    ([`stack`]);
+//!    feature-equivalent, a hand-written FlexCAN service ([`sizes`], [`firmware`]);
+//!    the examples' stack under `can-fil --stack` ([`stack`]);
 //! 2. instructions per frame and stack high-water marks on a Cortex-M4 under QEMU,
 //!    counted by the TCG plugin `bench/plugin/insn_count.c` ([`qemu`]);
 //! 3. the bit-timing solver against an exhaustive search ([`timing`]);
