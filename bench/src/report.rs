@@ -615,9 +615,11 @@ impl Report {
              while frames wait in the queue), registers at a compile-time base \
              (`twocan_core::Fixed`); FlexCAN: the controller's compile-time \
              `options::Lean` (no time stamps, no filter switch while running: \
-             `into_split_with::<Lean>()`), but `begin` still compiles the list at run \
-             time, and the split driver's `Lean` feature set, its quiet transmit mode \
-             there too.\n\n\
+             `into_split_with::<Lean>()`), the filter table planned with `const_plan!` \
+             and the settings checked at compile time (`BeginPlan::new_or_panic`, written \
+             by `begin_checked`: no check or planner links in), and the split driver's \
+             `Lean` feature set, its quiet transmit mode there too (full: `begin` with \
+             the list, the checks and the planner at run time).\n\n\
              Both bxCAN variants configure the controller in place in the `static` state \
              (`State::split_with`, `BxCan::can1_in`: no controller, plan or map moves \
              through the configuration); full plans at run time into a `static` scratch \
@@ -647,8 +649,10 @@ impl Report {
              flash configuration field, watchdog off, 16 MHz crystal oscillator on), \
              FlexCAN0 in loop-back mode with self reception at 500 kbit/s from the \
              oscillator clock, one pass-all filter, one frame by polling:\n\n\
-             - `loopback-flexcan`: our FlexCAN split driver (`begin` with the 8-filter Rx \
-             FIFO partition, `into_split`, a `static State`), as `loopback-twocan`;\n\
+             - `loopback-flexcan`: our FlexCAN split driver on the 8-filter Rx FIFO \
+             partition (lean: `begin_checked` with the compile-time plan, \
+             `into_split_with::<Lean>()`; full: `begin` with the list, `into_split`), a \
+             `static State`, as `loopback-twocan`;\n\
              - `loopback-flexcan-hand`: the hand-written register-level service of \
              `shared/flexcan_hand.rs` (there is no crate peer for Teensy 3.x): the K66 \
              manual's initialization sequence, MB15 as the transmit mailbox, an Rx FIFO \
