@@ -9,8 +9,6 @@
 //! `rt::AcanState` holds it on a Teensy 4.
 #![cfg(all(feature = "rt", any(feature = "teensy40", feature = "teensy41")))]
 
-use std::sync::atomic::{AtomicU32, Ordering};
-
 use twocan_core::{Frame, Registers};
 use twocan_flexcan::layout::{BoardLayout, Imxrt1062};
 use twocan_flexcan::options::Full;
@@ -18,35 +16,9 @@ use twocan_flexcan::regs::{self, cs, esr1, iflag1, mcr, ESR1, IFLAG1, MCR};
 use twocan_flexcan::rt::{self, IrqNumber, IrqState, Nvic};
 use twocan_flexcan::{rt_imxrt, Board, CanClock, FlexCan, HostSystem, Instance, Settings, Target};
 
-struct SyncRegs {
-    words: Vec<AtomicU32>,
-}
-
-impl Registers for SyncRegs {
-    fn read32(&self, offset: usize) -> u32 {
-        let v = self.words[offset / 4].load(Ordering::SeqCst);
-        match offset {
-            MCR if v & mcr::MDIS != 0 => v | mcr::LPMACK | mcr::NOTRDY,
-            MCR if v & mcr::FRZ != 0 && v & mcr::HALT != 0 => v | mcr::FRZACK | mcr::NOTRDY,
-            ESR1 => v | esr1::SYNCH,
-            _ => v,
-        }
-    }
-
-    fn write32(&self, offset: usize, value: u32) {
-        let w = &self.words[offset / 4];
-        match offset {
-            MCR => w.store(
-                value & !(mcr::FRZACK | mcr::LPMACK | mcr::NOTRDY | mcr::SOFTRST),
-                Ordering::SeqCst,
-            ),
-            IFLAG1 | ESR1 => {
-                w.fetch_and(!value, Ordering::SeqCst);
-            }
-            _ => w.store(value, Ordering::SeqCst),
-        }
-    }
-}
+#[path = "common/sync_regs.rs"]
+mod sync_regs;
+use sync_regs::SyncRegs;
 
 #[derive(Default)]
 struct Recorder {
@@ -69,11 +41,7 @@ impl Nvic for Recorder {
 
 #[test]
 fn can2_one_line_runs_every_handler() {
-    let regs: &'static SyncRegs = Box::leak(Box::new(SyncRegs {
-        words: (0..regs::IMXRT_BLOCK_END / 4)
-            .map(|_| AtomicU32::new(0))
-            .collect(),
-    }));
+    let regs: &'static SyncRegs = Box::leak(Box::new(SyncRegs::imxrt()));
     let mut settings = Settings::with_clock(500_000, CanClock::IMXRT_24MHZ);
     settings.message_irq_priority = 0x40;
     let target = Target::new(Board::Teensy41, Instance::Can2);
@@ -109,8 +77,8 @@ fn can2_one_line_runs_every_handler() {
     regs.write32(regs::mb_cs(0), cs::DLC.val(2));
     regs.write32(regs::mb_id(0), regs::id::STD.val(0x2A));
     regs.write32(regs::mb_word0(0), 0x0102_0000);
-    regs.words[IFLAG1 / 4].fetch_or(iflag1::BUF5I, Ordering::SeqCst);
-    regs.words[ESR1 / 4].fetch_or(esr1::ERRINT | esr1::STFERR, Ordering::SeqCst);
+    regs.raise(IFLAG1, iflag1::BUF5I);
+    regs.raise(ESR1, esr1::ERRINT | esr1::STFERR);
     rt_imxrt::can2();
     assert_eq!(regs.read32(IFLAG1) & iflag1::BUF5I, 0, "FIFO popped");
     assert_eq!(regs.read32(ESR1) & esr1::ERRINT, 0, "error flag cleared");
@@ -137,11 +105,7 @@ fn can3_entry_point_runs_the_quiet_transmit_mode() {
     type H = twocan_flexcan::FlexCanHw<&'static SyncRegs, Full<BoardLayout>>;
     type Quiet = IrqState<&'static SyncRegs, 32, FifoQueue<4>, 0, Full<BoardLayout>, Lean>;
     const { assert!(State::<H, 32, FifoQueue<4>, 0, 0, Lean>::QUIET_TX) };
-    let regs: &'static SyncRegs = Box::leak(Box::new(SyncRegs {
-        words: (0..regs::IMXRT_BLOCK_END / 4)
-            .map(|_| AtomicU32::new(0))
-            .collect(),
-    }));
+    let regs: &'static SyncRegs = Box::leak(Box::new(SyncRegs::imxrt()));
     let settings = Settings::with_clock(500_000, CanClock::IMXRT_24MHZ);
     let target = Target::new(Board::Teensy41, Instance::Can3);
     let hw = FlexCan::<_, Imxrt1062>::begin_with_layout(
@@ -172,7 +136,7 @@ fn can3_entry_point_runs_the_quiet_transmit_mode() {
     // enable is off).
     let end = || {
         regs.write32(regs::mb_cs(16), cs::CODE.val(regs::code::TX_INACTIVE));
-        regs.words[IFLAG1 / 4].fetch_or(data, Ordering::SeqCst);
+        regs.raise(IFLAG1, data);
     };
     let f = |k: u8| Frame::standard(0x100 + u16::from(k), &[k]).unwrap();
     tx.try_send(&f(0)).unwrap();

@@ -10,46 +10,18 @@
 //! written 1.
 #![cfg(all(feature = "rt", any(feature = "teensy40", feature = "teensy41")))]
 
-use std::sync::atomic::{AtomicU32, Ordering};
-
 use twocan_core::{Frame, Registers};
 use twocan_flexcan::layout::{Imxrt1062, Layout};
 use twocan_flexcan::options::Full;
-use twocan_flexcan::regs::{self, code, cs, esr1, iflag1, mcr, ESR1, IFLAG1, IFLAG2, IMASK2, MCR};
+use twocan_flexcan::regs::{self, code, cs, iflag1, IFLAG1, IFLAG2, IMASK2};
 use twocan_flexcan::rt::{self, IrqNumber, IrqState, Nvic};
 use twocan_flexcan::{
     rt_imxrt, Board, CanClock, Configuration, FlexCan, HostSystem, Instance, Settings, Target,
 };
 
-struct SyncRegs {
-    words: Vec<AtomicU32>,
-}
-
-impl Registers for SyncRegs {
-    fn read32(&self, offset: usize) -> u32 {
-        let v = self.words[offset / 4].load(Ordering::SeqCst);
-        match offset {
-            MCR if v & mcr::MDIS != 0 => v | mcr::LPMACK | mcr::NOTRDY,
-            MCR if v & mcr::FRZ != 0 && v & mcr::HALT != 0 => v | mcr::FRZACK | mcr::NOTRDY,
-            ESR1 => v | esr1::SYNCH,
-            _ => v,
-        }
-    }
-
-    fn write32(&self, offset: usize, value: u32) {
-        let w = &self.words[offset / 4];
-        match offset {
-            MCR => w.store(
-                value & !(mcr::FRZACK | mcr::LPMACK | mcr::NOTRDY | mcr::SOFTRST),
-                Ordering::SeqCst,
-            ),
-            IFLAG1 | IFLAG2 | ESR1 => {
-                w.fetch_and(!value, Ordering::SeqCst);
-            }
-            _ => w.store(value, Ordering::SeqCst),
-        }
-    }
-}
+#[path = "common/sync_regs.rs"]
+mod sync_regs;
+use sync_regs::SyncRegs;
 
 #[derive(Default)]
 struct Recorder {
@@ -72,10 +44,7 @@ impl Nvic for Recorder {
 
 #[test]
 fn can3_settles_a_mailbox_above_mb31_from_iflag2() {
-    let regs: &'static SyncRegs = Box::leak(Box::new(SyncRegs {
-        // The RT1062 block: 64 message buffers, RXIMR0–63 (up to 0x97C).
-        words: (0..0xA00 / 4).map(|_| AtomicU32::new(0)).collect(),
-    }));
+    let regs: &'static SyncRegs = Box::leak(Box::new(SyncRegs::imxrt()));
     let mut settings = Settings::with_clock(500_000, CanClock::IMXRT_24MHZ);
     settings.configuration = Configuration::Filters32_96;
     let target = Target::new(Board::Teensy41, Instance::Can3);
@@ -114,12 +83,12 @@ fn can3_settles_a_mailbox_above_mb31_from_iflag2() {
     );
     assert_eq!(regs.read32(IMASK2) & 1 << (38 - 32), 0);
     regs.write32(regs::mb_cs(data), cs::CODE.val(code::TX_INACTIVE));
-    regs.words[IFLAG2 / 4].fetch_or(1 << (data - 32), Ordering::SeqCst);
+    regs.raise(IFLAG2, 1 << (data - 32));
     // And a frame at the Rx FIFO output (IFLAG1) in the same interrupt.
     regs.write32(regs::mb_cs(0), cs::DLC.val(1));
     regs.write32(regs::mb_id(0), regs::id::STD.val(0x2A));
     regs.write32(regs::mb_word0(0), 0x0900_0000);
-    regs.words[IFLAG1 / 4].fetch_or(iflag1::BUF5I, Ordering::SeqCst);
+    regs.raise(IFLAG1, iflag1::BUF5I);
     rt_imxrt::can3();
     assert_eq!(regs.read32(IFLAG2), 0, "MB46's flag acknowledged in IFLAG2");
     assert_eq!(regs.read32(IFLAG1) & iflag1::BUF5I, 0, "FIFO popped");

@@ -8,63 +8,19 @@
 //! A test binary of its own: the entry points of FlexCAN0 and FlexCAN1 are process-wide.
 #![cfg(feature = "rt")]
 
-use std::sync::atomic::{AtomicU32, Ordering};
-
 use twocan_core::{Error, Filter, Frame, Registers};
 use twocan_flexcan::filters::TableSlot;
 use twocan_flexcan::options::{FullInSlot, Lean};
 use twocan_flexcan::planner::PlanOptions;
-use twocan_flexcan::regs::{self, cs, esr1, iflag1, mcr, ESR1, IFLAG1, MCR};
+use twocan_flexcan::regs::{self, cs, iflag1, mcr, IFLAG1, MCR};
 use twocan_flexcan::rt::{self, InPlaceError, IrqNumber, IrqState, Line, Nvic, StartError};
 use twocan_flexcan::{
     const_plan, BeginError, BeginPlan, Board, FlexCan, HostSystem, Instance, Settings, Target,
 };
 
-/// FlexCAN registers as plain memory, with the handshakes acknowledged at once.
-struct SyncRegs {
-    words: Vec<AtomicU32>,
-}
-
-impl SyncRegs {
-    fn new() -> Self {
-        SyncRegs {
-            words: (0..regs::BLOCK_END / 4)
-                .map(|_| AtomicU32::new(0))
-                .collect(),
-        }
-    }
-
-    /// Sets bits as the hardware would (an interrupt cause).
-    fn raise(&self, offset: usize, bits: u32) {
-        self.words[offset / 4].fetch_or(bits, Ordering::SeqCst);
-    }
-}
-
-impl Registers for SyncRegs {
-    fn read32(&self, offset: usize) -> u32 {
-        let v = self.words[offset / 4].load(Ordering::SeqCst);
-        match offset {
-            MCR if v & mcr::MDIS != 0 => v | mcr::LPMACK | mcr::NOTRDY,
-            MCR if v & mcr::FRZ != 0 && v & mcr::HALT != 0 => v | mcr::FRZACK | mcr::NOTRDY,
-            ESR1 => v | esr1::SYNCH,
-            _ => v,
-        }
-    }
-
-    fn write32(&self, offset: usize, value: u32) {
-        let w = &self.words[offset / 4];
-        match offset {
-            MCR => w.store(
-                value & !(mcr::FRZACK | mcr::LPMACK | mcr::NOTRDY | mcr::SOFTRST),
-                Ordering::SeqCst,
-            ),
-            IFLAG1 | ESR1 => {
-                w.fetch_and(!value, Ordering::SeqCst);
-            }
-            _ => w.store(value, Ordering::SeqCst),
-        }
-    }
-}
+#[path = "common/sync_regs.rs"]
+mod sync_regs;
+use sync_regs::SyncRegs;
 
 type Regs = &'static SyncRegs;
 type InSlot = IrqState<Regs, 32, twocan_core::FifoQueue<16>, 8, FullInSlot>;
