@@ -451,26 +451,12 @@ one_call!(
     end_can0,
     "can0"
 );
+// A Teensy 3.6's can1 (Kinetis layout) or a Teensy 4's CAN1 (RT1062 layout): the
+// board's layout either way.
 one_call!(
-    #[cfg(all(
-        feature = "teensy36",
-        not(any(feature = "teensy40", feature = "teensy41"))
-    ))]
+    #[cfg(any(feature = "teensy36", feature = "teensy40", feature = "teensy41"))]
     Can1,
-    Kinetis,
-    CAN1,
-    TABLE1,
-    SPARE1,
-    can1,
-    can1_with,
-    can1_checked,
-    end_can1,
-    "can1"
-);
-one_call!(
-    #[cfg(any(feature = "teensy40", feature = "teensy41"))]
-    Can1,
-    Imxrt1062,
+    crate::layout::BoardLayout,
     CAN1,
     TABLE1,
     SPARE1,
