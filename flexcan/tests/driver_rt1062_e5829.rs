@@ -424,30 +424,16 @@ fn the_kinetis_layout_is_refused_on_the_rt1062() {
 
 /// The split driver in the quiet transmit mode over the traced RT1062 layout: no
 /// completion ring, `Lean`, request order.
-type QuietState = State<FlexCanHw<Traced, Full<Imxrt1062>>, 32, FifoQueue<8>, 0, 0, Lean>;
+type QuietState = State<QuietHw, 32, FifoQueue<8>, 0, 0, Lean>;
+/// The controller [`QuietState`] holds.
+type QuietHw = FlexCanHw<Traced, Full<Imxrt1062>>;
 
 /// The message-buffer line as `rt_imxrt` runs it (transmit handler, then the Rx FIFO's),
 /// counting the entries.
 struct QuietLine {
     model: twocan_flexcan::model::FlexCanModel,
-    tx_irq: twocan_core::split::TxIrq<
-        'static,
-        FlexCanHw<Traced, Full<Imxrt1062>>,
-        32,
-        FifoQueue<8>,
-        0,
-        0,
-        Lean,
-    >,
-    rx_irq: twocan_core::split::Rx0Irq<
-        'static,
-        FlexCanHw<Traced, Full<Imxrt1062>>,
-        32,
-        FifoQueue<8>,
-        0,
-        0,
-        Lean,
-    >,
+    tx_irq: twocan_core::split::TxIrq<'static, QuietHw, 32, FifoQueue<8>, 0, 0, Lean>,
+    rx_irq: twocan_core::split::Rx0Irq<'static, QuietHw, 32, FifoQueue<8>, 0, 0, Lean>,
     entries: usize,
 }
 
