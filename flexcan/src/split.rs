@@ -590,16 +590,33 @@ impl<R: Registers, O: Options> FlexCanHw<R, O> {
             if c == code::TX_DATA {
                 continue;
             }
-            let bit = self.tx_bit(mb);
-            self.loaded.fetch_and(!bit, Ordering::Relaxed);
-            if c == code::RX_FULL || c == code::RX_OVERRUN {
-                self.count_caught(c);
-            }
-            self.regs.write32(self.tx_flags(), bit);
-            if c != code::TX_INACTIVE {
-                self.regs
-                    .write32(regs::mb_cs(mb), cs::CODE.val(code::TX_INACTIVE));
-            }
+            self.unload(mb, c);
+            self.deactivate(mb, c);
+        }
+    }
+
+    /// First half of settling the ended transmit mailbox `mb` (code `c`): its `loaded`
+    /// bit cleared, and a frame caught by a remote-frame mailbox turned receive mailbox
+    /// counted. Whether it was loaded.
+    #[inline(always)]
+    fn unload(&self, mb: usize, c: u32) -> bool {
+        let bit = self.tx_bit(mb);
+        let was_loaded = self.loaded.fetch_and(!bit, Ordering::Relaxed) & bit != 0;
+        if c == code::RX_FULL || c == code::RX_OVERRUN {
+            self.count_caught(c);
+        }
+        was_loaded
+    }
+
+    /// Second half: the flag acknowledged (write 1 to clear, Kinetis RM "Interrupt Flags
+    /// 1 register"), after which the transmit half may load `mb` again, and the mailbox
+    /// made INACTIVE unless it is.
+    #[inline(always)]
+    fn deactivate(&self, mb: usize, c: u32) {
+        self.regs.write32(self.tx_flags(), self.tx_bit(mb));
+        if c != code::TX_INACTIVE {
+            self.regs
+                .write32(regs::mb_cs(mb), cs::CODE.val(code::TX_INACTIVE));
         }
     }
 
@@ -691,11 +708,7 @@ impl<R: Registers, O: Options> FlexCanHw<R, O> {
         };
         let control = self.regs.read32(regs::mb_cs(mb));
         let c = cs::CODE.get(control);
-        let bit = self.tx_bit(mb);
-        let was_loaded = self.loaded.fetch_and(!bit, Ordering::Relaxed) & bit != 0;
-        if c == code::RX_FULL || c == code::RX_OVERRUN {
-            self.count_caught(c);
-        }
+        let was_loaded = self.unload(mb, c);
         // The token before the flag is acknowledged: once it is, the transmit half may
         // load the mailbox with the next frame and its token. Transmit mailboxes are the
         // data mailbox and at most seven before it in every configuration, so
@@ -705,11 +718,7 @@ impl<R: Registers, O: Options> FlexCanHw<R, O> {
                 self.tokens[self.data_mb().wrapping_sub(mb) & (MAX_TX - 1)].load(Ordering::Acquire),
             )
         });
-        self.regs.write32(self.tx_flags(), self.tx_bit(mb));
-        if c != code::TX_INACTIVE {
-            self.regs
-                .write32(regs::mb_cs(mb), cs::CODE.val(code::TX_INACTIVE));
-        }
+        self.deactivate(mb, c);
         // Without a frame of ours (an answer caught by a remote-frame mailbox turned
         // receive mailbox): acknowledged, deactivated, no completion.
         let token = token?;
