@@ -60,6 +60,22 @@ impl Backend {
         }
     }
 
+    /// Our loop-back firmware of this backend (flash, RAM and `State` figures).
+    pub fn loopback(self) -> &'static str {
+        match self {
+            Backend::BxCan => "loopback-twocan",
+            Backend::FlexCan => "loopback-flexcan",
+        }
+    }
+
+    /// The board `can-fil` runs [`Backend::loopback`] on.
+    pub fn board(self) -> &'static str {
+        match self {
+            Backend::BxCan => "nucleo-f767zi",
+            Backend::FlexCan => "teensy36",
+        }
+    }
+
     /// The equivalent in prose.
     pub fn equivalent_label(self) -> &'static str {
         match self {
@@ -178,10 +194,12 @@ pub struct FeatureOpt {
     pub config_stack: (u64, u64),
 }
 
-/// What one compile-time choice costs: its one-feature variant against lean (our
-/// bxCAN driver; issue 21, "each with its measured cost").
+/// What one compile-time choice costs: its one-feature variant against lean (one of
+/// our drivers; issue 21, "each with its measured cost").
 #[derive(Debug, Clone)]
 pub struct FeatureCost {
+    /// Whose driver.
+    pub backend: Backend,
     /// The variant (`lean+done` ...).
     pub variant: &'static str,
     /// Its cargo feature (`done` ...).
@@ -203,7 +221,8 @@ impl FeatureCost {
 pub struct Figures {
     /// The targets, by backend and variant.
     pub targets: Vec<Target>,
-    /// The cost of each compile-time choice (bxCAN), in [`FEATURE_VARIANTS`] order.
+    /// The cost of each compile-time choice, per backend ([`Backend::ALL`] order), in
+    /// [`FEATURE_VARIANTS`] order.
     pub feature_costs: Vec<FeatureCost>,
     /// The largest configuration stack of every firmware example and bench firmware,
     /// and where it was measured.
@@ -362,7 +381,13 @@ impl Figures {
         }
         Ok(Figures {
             targets,
-            feature_costs: feature_costs(insn, sizes)?,
+            feature_costs: {
+                let mut costs = Vec::new();
+                for backend in Backend::ALL {
+                    costs.extend(feature_costs(insn, sizes, backend)?);
+                }
+                costs
+            },
             config_stack_max: config_stack_max(insn, sizes, examples),
         })
     }
@@ -456,17 +481,31 @@ impl Figures {
             }
         }
         m.insert("issue21".into(), serde_json::Value::Object(all));
-        m.insert("feature_costs".into(), self.feature_costs_json()?);
+        m.insert(
+            "feature_costs".into(),
+            self.feature_costs_json(Backend::BxCan)?,
+        );
+        m.insert(
+            "flexcan_feature_costs".into(),
+            self.feature_costs_json(Backend::FlexCan)?,
+        );
         Ok(m)
     }
 
-    /// `feature_costs`: per one-feature variant, the round trip at opt s and opt 3,
-    /// the flash (driver + application) at opt s, the driver state beyond the rings
-    /// and the whole `State` static, and the configuration stack (the larger of the
-    /// two opt-levels).
-    fn feature_costs_json(&self) -> Result<serde_json::Value> {
+    /// The one-feature variants of `backend`.
+    pub fn feature_costs_of(&self, backend: Backend) -> impl Iterator<Item = &FeatureCost> {
+        self.feature_costs
+            .iter()
+            .filter(move |c| c.backend == backend)
+    }
+
+    /// `feature_costs` (bxCAN) and `flexcan_feature_costs`: per one-feature variant,
+    /// the round trip at opt s and opt 3, the flash (driver + application) at opt s,
+    /// the driver state beyond the rings and the whole `State` static, and the
+    /// configuration stack (the larger of the two opt-levels).
+    fn feature_costs_json(&self, backend: Backend) -> Result<serde_json::Value> {
         let mut m = serde_json::Map::new();
-        for c in &self.feature_costs {
+        for c in self.feature_costs_of(backend) {
             let at = |opt: &str| {
                 c.at(opt)
                     .ok_or_else(|| Error::new(format!("no figures of {} at opt {opt}", c.variant)))
@@ -488,26 +527,28 @@ impl Figures {
     }
 }
 
-/// The one-feature variants against lean: round trips and their changed steps and the
-/// configuration stack from `insn-count`, flash and RAM from `loopback-twocan`, the
-/// `State` figures from both.
-fn feature_costs(insn: &InsnSection, sizes: &SizeSection) -> Result<Vec<FeatureCost>> {
-    let b = Backend::BxCan;
-    let lean_state = sizes
+/// The one-feature variants of `b`'s driver against lean: round trips and their changed
+/// steps and the configuration stack from its instruction-count firmware, flash and RAM
+/// from its loop-back firmware, the `State` figures from both.
+fn feature_costs(insn: &InsnSection, sizes: &SizeSection, b: Backend) -> Result<Vec<FeatureCost>> {
+    let lean_states = sizes
         .state("lean")
-        .ok_or_else(|| Error::new("no lean state figures"))?
-        .bxcan;
+        .ok_or_else(|| Error::new("no lean state figures"))?;
+    let lean_state = match b {
+        Backend::BxCan => lean_states.bxcan,
+        Backend::FlexCan => lean_states.flexcan,
+    };
     let mut costs = Vec::new();
     for (variant, feature) in FEATURE_VARIANTS {
         let state = sizes
             .feature_states
             .iter()
-            .find(|(v, _)| v == variant)
-            .map(|(_, st)| *st)
+            .find(|(fb, v, _)| *fb == b && v == variant)
+            .map(|(_, _, st)| *st)
             .ok_or_else(|| Error::new(format!("no {variant} state figures")))?;
         let mut per_opt = Vec::new();
         for opt in insn.opts() {
-            let ours = insn.get_feature(variant, &opt)?;
+            let ours = insn.get_feature(b, variant, &opt)?;
             let lean = insn.get(b, "lean", &opt)?;
             let ours_keys = ours.roundtrip_keys("twocan")?;
             let lean_keys = lean.roundtrip_keys("twocan")?;
@@ -541,13 +582,16 @@ fn feature_costs(insn: &InsnSection, sizes: &SizeSection) -> Result<Vec<FeatureC
             let size = build
                 .features
                 .iter()
-                .find(|(v, _)| v == variant)
-                .map(|(_, z)| z)
+                .find(|(fb, v, _)| *fb == b && v == variant)
+                .map(|(_, _, z)| z)
                 .ok_or_else(|| Error::new(format!("no {variant} loop-back size at opt {opt}")))?;
-            let lean_size = &build
+            let lean_sizes = build
                 .variant("lean")
-                .ok_or_else(|| Error::new(format!("no lean loop-back sizes at opt {opt}")))?
-                .ours;
+                .ok_or_else(|| Error::new(format!("no lean loop-back sizes at opt {opt}")))?;
+            let lean_size = match b {
+                Backend::BxCan => &lean_sizes.ours,
+                Backend::FlexCan => &lean_sizes.flexcan,
+            };
             per_opt.push(FeatureOpt {
                 opt: opt.clone(),
                 roundtrip: (ours.roundtrip("twocan")?, lean.roundtrip("twocan")?),
@@ -558,6 +602,7 @@ fn feature_costs(insn: &InsnSection, sizes: &SizeSection) -> Result<Vec<FeatureC
             });
         }
         costs.push(FeatureCost {
+            backend: b,
             variant,
             feature,
             per_opt,
@@ -569,7 +614,8 @@ fn feature_costs(insn: &InsnSection, sizes: &SizeSection) -> Result<Vec<FeatureC
 
 /// The largest configuration stack: every `*.config` stack figure of every run of the
 /// instruction-count firmwares (ours and the equivalents, both variants and our
-/// bxCAN driver's one-feature variants, both profiles), every example's configuration figure under can-fil, and every loop-back
+/// drivers' one-feature variants, both profiles), every example's configuration
+/// figure under can-fil, and every loop-back
 /// firmware's whole run under can-fil (start-up, configuration and one polled frame:
 /// they enable no interrupt line, so their whole run stands for their configuration).
 fn config_stack_max(

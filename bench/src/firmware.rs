@@ -213,8 +213,9 @@ pub const VARIANTS: [&str; 2] = ["lean", "full"];
 /// (variant name, cargo feature). Each is `lean` with exactly one per-frame choice
 /// switched to its full setting (`bench/firmware/shared/bxcan_variant.rs`): transmit
 /// completions, receive time stamps, traffic statistics, filters replaceable while
-/// running, the run-time planner. Built for our bxCAN driver only
-/// ([`FEATURE_PACKAGES`]); the variant name is also what the firmware prints.
+/// running, the run-time planner (`bench/firmware/shared/flexcan_variant.rs` for
+/// FlexCAN). Built for both our drivers ([`FEATURE_PACKAGES`]); the variant name is also
+/// what the firmware prints.
 pub const FEATURE_VARIANTS: [(&str, &str); 5] = [
     ("lean+done", "done"),
     ("lean+stamps", "stamps"),
@@ -224,11 +225,13 @@ pub const FEATURE_VARIANTS: [(&str, &str); 5] = [
 ];
 
 /// (package, binary) of the bench firmware built once more per one-feature variant of
-/// [`FEATURE_VARIANTS`]: our bxCAN driver's instruction counts and loop-back firmware
-/// (variant packages too, so the `--workspace` build leaves them out).
-pub const FEATURE_PACKAGES: [(&str, &str); 2] = [
+/// [`FEATURE_VARIANTS`]: our bxCAN and FlexCAN drivers' instruction counts and loop-back
+/// firmware (variant packages too, so the `--workspace` build leaves them out).
+pub const FEATURE_PACKAGES: [(&str, &str); 4] = [
     ("bench-insn-count", "insn-count"),
     ("bench-loopback-twocan", "loopback-twocan"),
+    ("bench-insn-count-flexcan", "insn-count-flexcan"),
+    ("bench-loopback-flexcan", "loopback-flexcan"),
 ];
 
 /// (package, binary) of the bench firmware built once per variant.

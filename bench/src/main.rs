@@ -231,9 +231,11 @@ fn run() -> Result<()> {
                 });
             }
             let mut features = Vec::new();
-            for (v, _) in FEATURE_VARIANTS {
-                let elf = dir.join(variant_elf("loopback-twocan", v));
-                features.push((v.to_string(), sizes::measure(&elf)?));
+            for backend in Backend::ALL {
+                for (v, _) in FEATURE_VARIANTS {
+                    let elf = dir.join(variant_elf(backend.loopback(), v));
+                    features.push((backend, v.to_string(), sizes::measure(&elf)?));
+                }
             }
             builds.push(SizeBuild {
                 profile: profile.to_string(),
@@ -269,16 +271,19 @@ fn run() -> Result<()> {
             states.push(set);
         }
         let mut feature_states = Vec::new();
-        for (v, _) in FEATURE_VARIANTS {
-            let elf = |bin: &str| dir.join(variant_elf(bin, v));
-            let st = sizes::state_figures(&elf("loopback-twocan"), &elf("insn-count"))?;
-            eprintln!(
-                "can-bench: {v}: bxCAN State {} B = rings {} B + state {} B",
-                st.static_bytes,
-                st.ring_bytes,
-                st.state_bytes()
-            );
-            feature_states.push((v.to_string(), st));
+        for backend in Backend::ALL {
+            for (v, _) in FEATURE_VARIANTS {
+                let elf = |bin: &str| dir.join(variant_elf(bin, v));
+                let st = sizes::state_figures(&elf(backend.loopback()), &elf(backend.firmware()))?;
+                eprintln!(
+                    "can-bench: {v}: {} State {} B = rings {} B + state {} B",
+                    backend.name(),
+                    st.static_bytes,
+                    st.ring_bytes,
+                    st.state_bytes()
+                );
+                feature_states.push((backend, v.to_string(), st));
+            }
         }
         let mut fil = Vec::new();
         if let Some(can_fil) = &can_fil {
@@ -293,8 +298,10 @@ fn run() -> Result<()> {
                         elfs.push((variant_elf(bin, v), board));
                     }
                 }
-                for (v, _) in FEATURE_VARIANTS {
-                    elfs.push((variant_elf("loopback-twocan", v), "nucleo-f767zi"));
+                for backend in Backend::ALL {
+                    for (v, _) in FEATURE_VARIANTS {
+                        elfs.push((variant_elf(backend.loopback(), v), backend.board()));
+                    }
                 }
                 for (elf, board) in elfs {
                     let st = stack::measure_loopback(can_fil, board, &dir.join(&elf))?;
@@ -379,29 +386,31 @@ fn run() -> Result<()> {
                 }
             }
         }
-        // The one-feature variants of our bxCAN driver: `insn-count` alone (their cost
-        // is against lean, not against an equivalent).
+        // The one-feature variants of our drivers: `insn-count` and `insn-count-flexcan`
+        // alone (their cost is against lean, not against an equivalent).
         let mut feature_runs = Vec::new();
         for ((profile, opt), (_, dir)) in COUNT_PROFILES.iter().zip(&firmware_dirs) {
-            for (v, _) in FEATURE_VARIANTS {
-                let fw = Backend::BxCan.firmware();
-                let elf = dir.join(variant_elf(fw, v));
-                let tag = format!("{profile}-{fw}-{v}");
-                let counts = qemu::run(&paths, &tools, &plugin, &elf, &tag)
-                    .context(format!("{fw} {v} ({profile} profile)"))?;
-                if counts.variant.as_deref() != Some(v) {
-                    return Err(cmd::Error::new(format!(
-                        "{} says it is variant {:?}, built as {v}",
-                        elf.display(),
-                        counts.variant
-                    )));
+            for backend in Backend::ALL {
+                for (v, _) in FEATURE_VARIANTS {
+                    let fw = backend.firmware();
+                    let elf = dir.join(variant_elf(fw, v));
+                    let tag = format!("{profile}-{fw}-{v}");
+                    let counts = qemu::run(&paths, &tools, &plugin, &elf, &tag)
+                        .context(format!("{fw} {v} ({profile} profile)"))?;
+                    if counts.variant.as_deref() != Some(v) {
+                        return Err(cmd::Error::new(format!(
+                            "{} says it is variant {:?}, built as {v}",
+                            elf.display(),
+                            counts.variant
+                        )));
+                    }
+                    feature_runs.push(InsnRun {
+                        backend,
+                        variant: v.to_string(),
+                        opt: opt.to_string(),
+                        counts,
+                    });
                 }
-                feature_runs.push(InsnRun {
-                    backend: Backend::BxCan,
-                    variant: v.to_string(),
-                    opt: opt.to_string(),
-                    counts,
-                });
             }
         }
         let mut async_runs = Vec::new();

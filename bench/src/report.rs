@@ -5,7 +5,7 @@
 use std::fmt::Write as _;
 
 use crate::cmd::{self, Result};
-use crate::figures::{self, Backend, Figures, Measured};
+use crate::figures::{self, Backend, FeatureCost, Figures, Measured};
 use crate::firmware::{self, Paths, TARGET, VARIANTS};
 use crate::qemu::{self, Counts, Tools};
 use crate::simspeed::{self, SimRow};
@@ -39,9 +39,9 @@ pub struct SizeBuild {
     pub async_fw: Size,
     /// Per variant.
     pub variants: Vec<VariantSizes>,
-    /// `loopback-twocan` per one-feature variant (`firmware::FEATURE_VARIANTS`):
-    /// (variant, size).
-    pub features: Vec<(String, Size)>,
+    /// Our loop-back firmware per backend and one-feature variant
+    /// (`firmware::FEATURE_VARIANTS`): (backend, variant, size).
+    pub features: Vec<(Backend, String, Size)>,
 }
 
 impl SizeBuild {
@@ -79,9 +79,9 @@ pub struct SizeSection {
     pub builds: Vec<SizeBuild>,
     /// State figures per variant (size-optimised build).
     pub states: Vec<StateSet>,
-    /// Our bxCAN driver's state figures per one-feature variant (size-optimised build):
-    /// (variant, figures).
-    pub feature_states: Vec<(String, StateFigures)>,
+    /// Our drivers' state figures per one-feature variant (size-optimised build):
+    /// (backend, variant, figures).
+    pub feature_states: Vec<(Backend, String, StateFigures)>,
     /// The loop-back firmwares under can-fil (empty with `--skip fil`).
     pub fil: Vec<LoopbackStack>,
 }
@@ -142,8 +142,8 @@ pub struct InsnSection {
     pub tools: Tools,
     /// Every run.
     pub runs: Vec<InsnRun>,
-    /// The runs of `insn-count` per one-feature variant (`firmware::FEATURE_VARIANTS`,
-    /// our bxCAN driver alone).
+    /// The runs of `insn-count` and `insn-count-flexcan` per one-feature variant
+    /// (`firmware::FEATURE_VARIANTS`, our drivers alone).
     pub feature_runs: Vec<InsnRun>,
     /// (opt-level, counts) of `insn-count-async` per build.
     pub async_runs: Vec<(String, Counts)>,
@@ -166,13 +166,19 @@ impl InsnSection {
             })
     }
 
-    /// The counts of `insn-count` built as the one-feature variant `variant`, at `opt`.
-    pub fn get_feature(&self, variant: &str, opt: &str) -> Result<&Counts> {
+    /// The counts of `backend`'s firmware built as the one-feature variant `variant`,
+    /// at `opt`.
+    pub fn get_feature(&self, backend: Backend, variant: &str, opt: &str) -> Result<&Counts> {
         self.feature_runs
             .iter()
-            .find(|r| r.variant == variant && r.opt == opt)
+            .find(|r| r.backend == backend && r.variant == variant && r.opt == opt)
             .map(|r| &r.counts)
-            .ok_or_else(|| cmd::Error::new(format!("no insn-count {variant} run at opt {opt}")))
+            .ok_or_else(|| {
+                cmd::Error::new(format!(
+                    "no {} {variant} run at opt {opt}",
+                    backend.firmware()
+                ))
+            })
     }
 
     /// The opt-levels measured, in build order.
@@ -551,7 +557,9 @@ impl Report {
         let figures = self.figures()?;
         if let Some(f) = &figures {
             render_targets(&mut s, f);
-            render_feature_costs(&mut s, f);
+            for backend in Backend::ALL {
+                render_feature_costs(&mut s, f, backend);
+            }
         }
         if let Some(sizes) = &self.sizes {
             self.render_sizes(&mut s, sizes);
@@ -1253,82 +1261,113 @@ fn delta(ours: u64, lean: u64) -> String {
     signed(ours as i64 - lean as i64)
 }
 
-/// What a one-feature variant switches on and what its per-frame code then does (the
-/// mechanism; the measured figures follow it in the document).
-fn feature_note(feature: &str) -> &'static str {
-    match feature {
-        "done" => {
+/// What a one-feature variant of `backend`'s driver switches on and what its per-frame
+/// code then does (the mechanism; the measured figures follow it in the document).
+fn feature_note(backend: Backend, feature: &str) -> &'static str {
+    match (backend, feature) {
+        (_, "done") => {
             "transmit completions, a completion ring of 8 (`DONE` = 8): the send records \
              the frame's token with its mailbox; with a completion to report the split \
              driver leaves its quiet transmit mode, so the transmit interrupt stays \
              enabled and every frame runs the transmit handler, which settles the \
              mailbox into the ring, and the application takes the completion"
         }
-        "stamps" => {
+        (Backend::BxCan, "stamps") => {
             "receive time stamps (`CAN_MCR.TTCM` = 1, a feature set with `TIMESTAMPS` \
              and without counts): the receive path keeps the frame's time stamp and the \
              take widens it; a time stamp to record per frame sent ends the quiet \
              transmit mode (`State::QUIET_TX` needs neither time stamps nor counts), so \
              every frame also runs the transmit handler"
         }
-        "counts" => {
+        (Backend::FlexCan, "stamps") => {
+            "receive and transmit time stamps (controller options with `STAMPS`: the \
+             message buffer's 16-bit `TIME STAMP` read with the frame, and a feature set \
+             with `TIMESTAMPS` and without counts): the take widens it; a time stamp to \
+             record per frame sent ends the quiet transmit mode, so every frame also \
+             runs the transmit handler"
+        }
+        (_, "counts") => {
             "traffic statistics (a feature set with `COUNTS` and twocan-core's \
              counting `Counter`, no time stamps): the handlers count the frames \
              received and sent; a count to record per frame sent ends the quiet \
              transmit mode, so every frame also runs the transmit handler"
         }
-        "switch" => {
+        (Backend::BxCan, "switch") => {
             "filters replaceable while running (`SWITCH` = true, the filter map sized \
              as lean): each frame carries the filter list generation, read with it \
              into the ring by the receive handler and compared with the current one \
              by the take"
         }
-        "planner" => {
+        (Backend::FlexCan, "switch") => {
+            "filter lists replaceable while running (controller options with \
+             `FILTER_SWITCH`, the table still the `const` plan): each raw frame carries \
+             the filter list generation, read with it into the ring by the receive \
+             handler and compared with the current one by the take"
+        }
+        (Backend::BxCan, "planner") => {
             "the run-time planner (`planner::plan_in`, its working memory in a \
              `static`) instead of the `const` plan, the map sized to the same plan: its \
              cost is the planner's code in flash, its working memory in RAM and the \
              planning on the configuration's stack; the per-frame code is lean's"
+        }
+        (Backend::FlexCan, "planner") => {
+            "the filter list compiled at run time by `FlexCan::begin_in` straight into \
+             a `static` `TableSlot` (controller options with an owned table) instead of \
+             the `const` plan, and the settings checked at run time: its cost is the \
+             table compiler, the checks and the table in flash and RAM and the \
+             compilation on the configuration's stack; the per-frame code reads the \
+             owned table where lean reads the plan"
         }
         _ => "",
     }
 }
 
 /// Issue 21's "each choice with its own measured cost": every one-feature variant of
-/// our bxCAN driver against lean.
-fn render_feature_costs(s: &mut String, f: &Figures) {
-    if f.feature_costs.is_empty() {
+/// `backend`'s driver against lean.
+fn render_feature_costs(s: &mut String, f: &Figures, backend: Backend) {
+    let costs: Vec<&FeatureCost> = f.feature_costs_of(backend).collect();
+    let Some(first) = costs.first() else {
         return;
-    }
-    let _ = writeln!(s, "## What each per-frame choice costs (bxCAN)\n");
+    };
+    let (insn, loopback, shared) = match backend {
+        Backend::BxCan => ("insn-count", "loopback-twocan", "bxcan_variant.rs"),
+        Backend::FlexCan => (
+            "insn-count-flexcan",
+            "loopback-flexcan",
+            "flexcan_variant.rs",
+        ),
+    };
+    let _ = writeln!(
+        s,
+        "## What each per-frame choice costs ({})\n",
+        backend.name()
+    );
     let _ = writeln!(
         s,
         "Each compile-time choice measured on its own: a **one-feature variant** is the \
-         lean variant of our bxCAN driver with exactly one choice switched to its full \
+         lean variant of our {name} driver with exactly one choice switched to its full \
          setting (cargo feature `lean` plus one of `done`, `stamps`, `counts`, `switch`, \
-         `planner` of `bench/firmware/insn-count` and `loopback-twocan`; \
-         `shared/bxcan_variant.rs`), built with both profiles and measured as lean is: \
-         the round trip from `insn-count` under QEMU (the regions the firmware names \
+         `planner` of `bench/firmware/{insn}` and `{loopback}`; \
+         `shared/{shared}`), built with both profiles and measured as lean is: \
+         the round trip from `{insn}` under QEMU (the regions the firmware names \
          for its configuration, section 2; a choice that ends the quiet transmit mode \
-         adds the transmit handler), flash and RAM from `loopback-twocan` (section 1), \
+         adds the transmit handler), flash and RAM from `{loopback}` (section 1), \
          the `State` static (`BENCH_CAN_STATE`, and the driver state beyond its ring \
-         and queue slots) and the configuration stack from `insn-count`. Every Δ is \
+         and queue slots) and the configuration stack from `{insn}`. Every Δ is \
          against lean at the same opt-level; \"steps that changed\" lists each round-trip \
          region whose count differs from lean's (\"new\": lean's round trip does not \
-         run it).\n"
+         run it).\n",
+        name = backend.name()
     );
     let _ = writeln!(
         s,
         "| variant | opt | round trip | Δ | steps that changed (Δ) | driver + application flash | Δ | RAM | Δ | `State` / driver state, B | Δ | configuration stack, B | Δ |\n\
          |---|---|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|"
     );
-    let opts: Vec<String> = f.feature_costs[0]
-        .per_opt
-        .iter()
-        .map(|o| o.opt.clone())
-        .collect();
-    let lean_state = f.feature_costs[0].state.1;
+    let opts: Vec<String> = first.per_opt.iter().map(|o| o.opt.clone()).collect();
+    let lean_state = first.state.1;
     for opt in &opts {
-        if let Some(o) = f.feature_costs[0].at(opt) {
+        if let Some(o) = first.at(opt) {
             let _ = writeln!(
                 s,
                 "| lean | {opt} | **{}** | | | **{}** | | {} | | {} / **{}** | | {} | |",
@@ -1341,7 +1380,7 @@ fn render_feature_costs(s: &mut String, f: &Figures) {
             );
         }
     }
-    for c in &f.feature_costs {
+    for c in &costs {
         let (st, lean) = c.state;
         for o in &c.per_opt {
             let steps = if o.steps.is_empty() {
@@ -1381,7 +1420,7 @@ fn render_feature_costs(s: &mut String, f: &Figures) {
         }
     }
     let _ = writeln!(s);
-    for c in &f.feature_costs {
+    for c in &costs {
         let figures: Vec<String> = c
             .per_opt
             .iter()
@@ -1409,7 +1448,7 @@ fn render_feature_costs(s: &mut String, f: &Figures) {
             s,
             "- **{}** — {}: {}.",
             c.variant,
-            feature_note(c.feature),
+            feature_note(backend, c.feature),
             figures.join(", ")
         );
     }
@@ -1876,10 +1915,16 @@ mod tests {
 
     #[test]
     fn every_one_feature_variant_says_what_it_switches() {
-        for (_, feature) in firmware::FEATURE_VARIANTS {
-            assert!(!feature_note(feature).is_empty(), "{feature}");
+        for backend in Backend::ALL {
+            for (_, feature) in firmware::FEATURE_VARIANTS {
+                assert!(
+                    !feature_note(backend, feature).is_empty(),
+                    "{feature} of {}",
+                    backend.name()
+                );
+            }
+            assert!(feature_note(backend, "frob").is_empty());
         }
-        assert!(feature_note("frob").is_empty());
     }
 
     #[test]

@@ -27,8 +27,8 @@
 //! - `done`: transmit completions ([`DONE`] = 8; with a completion ring the split
 //!   driver's quiet transmit mode is off, so every frame runs the transmit handler);
 //! - `stamps`: receive time stamps (`CAN_MCR.TTCM` = 1 and the split driver's
-//!   [`StampsOnly`] feature set: time stamps read, nothing counted);
-//! - `counts`: traffic statistics (the [`CountsOnly`] feature set: counted, no time
+//!   `StampsOnly` feature set (`shared/feature_sets.rs`): time stamps read, nothing counted);
+//! - `counts`: traffic statistics (the `CountsOnly` feature set: counted, no time
 //!   stamps read);
 //! - `switch`: filters replaceable while running ([`SWITCH`] = true: the filter
 //!   generation checked per frame; the map sized as lean);
@@ -145,37 +145,10 @@ pub const KEYS: usize = 0;
 pub type Fe = twocan_core::Lean;
 /// The split driver's compile-time feature set of `lean+stamps`: time stamps only.
 #[cfg(feature = "stamps")]
-pub type Fe = StampsOnly;
+pub type Fe = crate::feature_sets::StampsOnly;
 /// The split driver's compile-time feature set of `lean+counts`: statistics only.
 #[cfg(feature = "counts")]
-pub type Fe = CountsOnly;
-
-/// A split-driver feature set with receive and transmit time stamps read and widened,
-/// and no traffic statistics (`twocan_core::Features`, issue 21's `lean+stamps`).
-#[cfg(feature = "stamps")]
-#[derive(Debug, Clone, Copy)]
-pub enum StampsOnly {}
-
-#[cfg(feature = "stamps")]
-impl twocan_core::Features for StampsOnly {
-    const TIMESTAMPS: bool = true;
-    const COUNTS: bool = false;
-    type Counter = twocan_core::features::NoTally;
-}
-
-/// A split-driver feature set with the traffic statistics counted, as
-/// `twocan_core::Full` counts them, and no time stamps read (issue 21's
-/// `lean+counts`).
-#[cfg(feature = "counts")]
-#[derive(Debug, Clone, Copy)]
-pub enum CountsOnly {}
-
-#[cfg(feature = "counts")]
-impl twocan_core::Features for CountsOnly {
-    const TIMESTAMPS: bool = false;
-    const COUNTS: bool = true;
-    type Counter = twocan_core::spsc::Counter;
-}
+pub type Fe = crate::feature_sets::CountsOnly;
 
 /// Planner options: CAN1's banks at reset (`CAN2SB` = 14, RM0410 §40.9.4), FIFO 0.
 pub const OPTIONS: PlanOptions = PlanOptions::new(14);

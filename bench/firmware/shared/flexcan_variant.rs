@@ -22,6 +22,24 @@
 //!   its quiet transmit mode (`State::QUIET_TX`: MB15's interrupt enabled only while
 //!   frames wait in the queue, so a frame sent directly costs no transmit handler).
 
+//!
+//! **One-feature variants** (issue 21: each compile-time choice with its own measured
+//! cost, as `shared/bxcan_variant.rs` for bxCAN): `lean` plus exactly one of the
+//! additive features below switches that one choice to its full setting and leaves every
+//! other as lean (a `compile_error!` says so otherwise):
+//!
+//! - `done`: transmit completions ([`DONE`] = 8; with a completion ring the quiet
+//!   transmit mode is off, so every frame runs the transmit handler);
+//! - `stamps`: receive and transmit time stamps (controller options [`LeanStamps`]:
+//!   the message buffer's `TIME STAMP` read, and the split driver's `StampsOnly`
+//!   feature set of `shared/feature_sets.rs`);
+//! - `counts`: traffic statistics (the `CountsOnly` feature set);
+//! - `switch`: filter lists replaceable while running (controller options
+//!   [`LeanSwitch`]: each raw frame carries the filter generation);
+//! - `planner`: the filter list compiled at run time by `FlexCan::begin_in` into a
+//!   `static` `TableSlot` (controller options [`LeanInSlot`]) instead of the `const`
+//!   plan, with the settings checked at run time too (`begin_in` checks them).
+
 // Each firmware that includes this module uses a part of it.
 #![allow(dead_code)]
 
@@ -29,6 +47,41 @@
 compile_error!("features `lean` and `full` are exclusive");
 #[cfg(not(any(feature = "lean", feature = "full")))]
 compile_error!("enable feature `lean` or `full`");
+#[cfg(all(
+    any(
+        feature = "done",
+        feature = "stamps",
+        feature = "counts",
+        feature = "switch",
+        feature = "planner"
+    ),
+    not(feature = "lean")
+))]
+compile_error!(
+    "features `done`, `stamps`, `counts`, `switch` and `planner` switch one choice of \
+     `lean` to its full setting: enable them with `lean` only"
+);
+#[cfg(any(
+    all(
+        feature = "done",
+        any(
+            feature = "stamps",
+            feature = "counts",
+            feature = "switch",
+            feature = "planner"
+        )
+    ),
+    all(
+        feature = "stamps",
+        any(feature = "counts", feature = "switch", feature = "planner")
+    ),
+    all(feature = "counts", any(feature = "switch", feature = "planner")),
+    all(feature = "switch", feature = "planner"),
+))]
+compile_error!(
+    "enable at most one of `done`, `stamps`, `counts`, `switch`, `planner`: each \
+     one-feature variant measures one choice alone"
+);
 
 use twocan_core::split::{Parts, Rx, Rx0Irq, State, Tx, TxIrq};
 use twocan_core::{Error, FifoQueue, Filter, Registers};
@@ -62,17 +115,95 @@ pub const SETTINGS: Settings = {
 
 // ------------------------------------------------------------------ lean
 
-#[cfg(feature = "lean")]
+/// The variant's name in the bench output.
+#[cfg(all(
+    feature = "lean",
+    not(any(
+        feature = "done",
+        feature = "stamps",
+        feature = "counts",
+        feature = "switch",
+        feature = "planner"
+    ))
+))]
 pub const VARIANT: &str = "lean";
-/// Completion ring capacity (0: completions off).
+#[cfg(feature = "done")]
+pub const VARIANT: &str = "lean+done";
+#[cfg(feature = "stamps")]
+pub const VARIANT: &str = "lean+stamps";
+#[cfg(feature = "counts")]
+pub const VARIANT: &str = "lean+counts";
+#[cfg(feature = "switch")]
+pub const VARIANT: &str = "lean+switch";
+#[cfg(feature = "planner")]
+pub const VARIANT: &str = "lean+planner";
+/// Completion ring capacity (0: completions off; 8 with `done`).
 #[cfg(feature = "lean")]
-pub const DONE: usize = 0;
-/// The controller's compile-time choices: no time stamps, no filter switch.
-#[cfg(feature = "lean")]
+pub const DONE: usize = if cfg!(feature = "done") { 8 } else { 0 };
+/// The controller's compile-time choices: no time stamps, no filter switch, the
+/// table planned at compile time.
+#[cfg(all(
+    feature = "lean",
+    not(any(feature = "stamps", feature = "switch", feature = "planner"))
+))]
 pub type Opts = twocan_flexcan::options::Lean;
+/// `lean+stamps`: time stamps read from the message buffers.
+#[cfg(feature = "stamps")]
+pub type Opts = LeanStamps;
+/// `lean+switch`: filter lists replaceable while running.
+#[cfg(feature = "switch")]
+pub type Opts = LeanSwitch;
+/// `lean+planner`: the table compiled at run time into a `static` slot.
+#[cfg(feature = "planner")]
+pub type Opts = LeanInSlot;
 /// The split driver's features: no statistics, no time stamps (the quiet transmit mode).
-#[cfg(feature = "lean")]
+#[cfg(all(feature = "lean", not(any(feature = "stamps", feature = "counts"))))]
 pub type Fe = twocan_core::Lean;
+/// The split driver's features of `lean+stamps`: time stamps only.
+#[cfg(feature = "stamps")]
+pub type Fe = crate::feature_sets::StampsOnly;
+/// The split driver's features of `lean+counts`: statistics only.
+#[cfg(feature = "counts")]
+pub type Fe = crate::feature_sets::CountsOnly;
+
+/// `lean` with the message buffers' time stamps read (`Options::STAMPS`).
+#[cfg(feature = "stamps")]
+#[derive(Debug, Clone, Copy)]
+pub enum LeanStamps {}
+
+#[cfg(feature = "stamps")]
+impl twocan_flexcan::options::Options for LeanStamps {
+    type Layout = twocan_flexcan::layout::Kinetis;
+    type Table = twocan_flexcan::installed::PlannedTable;
+    const STAMPS: bool = true;
+    const FILTER_SWITCH: bool = false;
+}
+
+/// `lean` with filter lists replaceable while running (`Options::FILTER_SWITCH`).
+#[cfg(feature = "switch")]
+#[derive(Debug, Clone, Copy)]
+pub enum LeanSwitch {}
+
+#[cfg(feature = "switch")]
+impl twocan_flexcan::options::Options for LeanSwitch {
+    type Layout = twocan_flexcan::layout::Kinetis;
+    type Table = twocan_flexcan::installed::PlannedTable;
+    const STAMPS: bool = false;
+    const FILTER_SWITCH: bool = true;
+}
+
+/// `lean` with the table compiled at run time into a `static` slot.
+#[cfg(feature = "planner")]
+#[derive(Debug, Clone, Copy)]
+pub enum LeanInSlot {}
+
+#[cfg(feature = "planner")]
+impl twocan_flexcan::options::Options for LeanInSlot {
+    type Layout = twocan_flexcan::layout::Kinetis;
+    type Table = &'static mut <twocan_flexcan::layout::Kinetis as twocan_flexcan::layout::Layout>::Table;
+    const STAMPS: bool = false;
+    const FILTER_SWITCH: bool = false;
+}
 
 // ------------------------------------------------------------------ full
 
@@ -111,7 +242,7 @@ pub fn configure<const RETRIES: u32, R: Registers, S: Registers>(
     regs: impl Fn() -> R,
     sys: &mut S,
 ) -> Result<Hw<R>, BeginError> {
-    #[cfg(feature = "lean")]
+    #[cfg(all(feature = "lean", not(feature = "planner")))]
     {
         // The filter table planned and the settings checked at compile time, written
         // by `begin_checked` (no check links into the firmware).
@@ -128,7 +259,7 @@ pub fn configure<const RETRIES: u32, R: Registers, S: Registers>(
             }
         }
     }
-    #[cfg(feature = "full")]
+    #[cfg(any(feature = "full", feature = "planner"))]
     {
         // `begin` compiles the list at run time straight into the table's `static`.
         let Some(mut slot) = TABLE.take() else {
@@ -148,6 +279,7 @@ pub fn configure<const RETRIES: u32, R: Registers, S: Registers>(
     }
 }
 
-/// The full variant's filter table (`begin_in` compiles into it).
-#[cfg(feature = "full")]
+/// The filter table of the full and `lean+planner` variants (`begin_in` compiles into
+/// it).
+#[cfg(any(feature = "full", feature = "planner"))]
 static TABLE: twocan_flexcan::filters::TableSlot = twocan_flexcan::filters::TableSlot::new();

@@ -41,6 +41,8 @@ use twocan_core::txqueue::Queued;
 use twocan_core::Completion;
 use twocan_core::{Frame, RxFrame, TxOutcome};
 
+#[path = "../../shared/feature_sets.rs"]
+mod feature_sets;
 #[path = "../../shared/qemu.rs"]
 mod qemu;
 #[path = "../../shared/ram_bxcan_crate.rs"]

@@ -17,6 +17,8 @@ use panic_halt as _;
 use twocan_core::{Frame, Mmio};
 use twocan_flexcan::regs::{Can0At, SystemRegs};
 
+#[path = "../../shared/feature_sets.rs"]
+mod feature_sets;
 #[path = "../../shared/kinetis.rs"]
 mod startup;
 #[path = "../../shared/flexcan_variant.rs"]

@@ -20,6 +20,8 @@ use panic_halt as _;
 use twocan_bxcan::regs::CAN1_BASE;
 use twocan_core::{Error, Frame};
 
+#[path = "../../shared/feature_sets.rs"]
+mod feature_sets;
 #[path = "../../shared/stm32f7.rs"]
 mod startup;
 #[path = "../../shared/bxcan_variant.rs"]
