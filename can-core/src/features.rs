@@ -14,7 +14,7 @@
 //! | | [`Full`] | [`Lean`] |
 //! |---|---|---|
 //! | traffic statistics ([`crate::TrafficStats`]: queued, sent, failed, aborted, received, dropped) | counted | zero-sized, read as 0 |
-//! | receive and transmit time stamps ([`crate::RxFrame::timestamp`], `Completion::timestamp`) | widened and reported | not read, `None` |
+//! | receive and transmit time stamps ([`crate::RxFrame::timestamp`], `Completion::timestamp`) | widened and reported | not read, `None`; no widening reference and no wraps per receive ring slot kept ([`Features::Clock`] = [`NoClock`]) |
 //!
 //! Transmit completions are the `DONE` parameter (0: no completion ring, fire and
 //! forget). With `DONE` = 0, [`Lean`] and a request-order queue ([`crate::FifoQueue`]),
@@ -32,6 +32,7 @@
 //! per-frame code does not read them either.
 
 use crate::spsc::Counter;
+use crate::timestamp::{Extender, Timestamp};
 
 /// A traffic counter as a feature set stores it: [`Counter`] (counted) or [`NoTally`]
 /// (zero-sized, nothing counted).
@@ -78,6 +79,142 @@ impl Tally for NoTally {
     }
 }
 
+/// What widening the hardware's 16-bit time stamps keeps in a split driver's state:
+/// an [`Extender`] (the reference each stamp is widened against, and the wraps of
+/// each frame waiting in a receive ring, a `u32` per ring slot) or [`NoClock`]
+/// (nothing: a feature set without time stamps pays no byte for them).
+///
+/// A feature set's clock must agree with its [`Features::TIMESTAMPS`]; a `State` of one
+/// that does not is refused when it is built:
+///
+/// ```compile_fail
+/// use twocan_core::features::{Features, NoClock, NoTally};
+/// use twocan_core::mock::MockHardware;
+/// use twocan_core::split::State;
+/// use twocan_core::FifoQueue;
+///
+/// enum StampsWithoutClock {}
+/// impl Features for StampsWithoutClock {
+///     const TIMESTAMPS: bool = true;
+///     const COUNTS: bool = false;
+///     type Counter = NoTally;
+///     type Clock = NoClock; // time stamps need the `Extender`
+/// }
+/// static CAN: State<MockHardware, 8, FifoQueue<4>, 0, 0, StampsWithoutClock> = State::new();
+/// ```
+///
+/// ```
+/// use twocan_core::features::{Features, NoTally};
+/// use twocan_core::mock::MockHardware;
+/// use twocan_core::split::State;
+/// use twocan_core::timestamp::Extender;
+/// use twocan_core::FifoQueue;
+///
+/// enum StampsOnly {}
+/// impl Features for StampsOnly {
+///     const TIMESTAMPS: bool = true;
+///     const COUNTS: bool = false;
+///     type Counter = NoTally;
+///     type Clock = Extender;
+/// }
+/// static CAN: State<MockHardware, 8, FifoQueue<4>, 0, 0, StampsOnly> = State::new();
+/// # let _ = &CAN;
+/// ```
+pub trait StampClock: Copy + Send + Sync + 'static {
+    /// Whether stamps are widened (must equal the feature set's
+    /// [`Features::TIMESTAMPS`]; `State::new` refuses to build otherwise).
+    const WIDENS: bool;
+    /// At the origin (all zeros: a `static` of it is `.bss`).
+    const NEW: Self;
+    /// The wraps of a received frame's stamp as a receive ring slot keeps them (`u32`,
+    /// or zero-sized).
+    type Wraps: Copy + Send + Sync + 'static;
+    /// `wraps` as a ring slot keeps them.
+    fn keep(wraps: u32) -> Self::Wraps;
+    /// The wraps a ring slot kept (0 when nothing is kept).
+    fn wraps(kept: Self::Wraps) -> u32;
+    /// A reading of the free-running counter ([`Extender::observe`]).
+    fn observe(&mut self, counter: u16);
+    /// A stamp taken at or before the latest reading ([`Extender::extend_before`]).
+    fn extend_before(&self, stamp: u16) -> Timestamp;
+    /// A completed transmission's stamp ([`Extender::extend_sent`]).
+    fn extend_sent(&mut self, stamp: u16, pending: impl Fn(usize) -> bool) -> Timestamp;
+    /// A received frame's stamp ([`Extender::extend_received`]).
+    fn extend_received(
+        &mut self,
+        queue: usize,
+        stamp: u16,
+        pending: impl Fn(usize) -> bool,
+    ) -> Timestamp;
+}
+
+impl StampClock for Extender {
+    const WIDENS: bool = true;
+    const NEW: Self = Extender::new();
+    type Wraps = u32;
+    #[inline(always)]
+    fn keep(wraps: u32) -> u32 {
+        wraps
+    }
+    #[inline(always)]
+    fn wraps(kept: u32) -> u32 {
+        kept
+    }
+    #[inline(always)]
+    fn observe(&mut self, counter: u16) {
+        Extender::observe(self, counter);
+    }
+    #[inline(always)]
+    fn extend_before(&self, stamp: u16) -> Timestamp {
+        Extender::extend_before(self, stamp)
+    }
+    #[inline(always)]
+    fn extend_sent(&mut self, stamp: u16, pending: impl Fn(usize) -> bool) -> Timestamp {
+        Extender::extend_sent(self, stamp, pending)
+    }
+    #[inline(always)]
+    fn extend_received(
+        &mut self,
+        queue: usize,
+        stamp: u16,
+        pending: impl Fn(usize) -> bool,
+    ) -> Timestamp {
+        Extender::extend_received(self, queue, stamp, pending)
+    }
+}
+
+/// No time stamps widened: zero-sized, and so are the wraps kept per receive ring slot.
+/// Its extensions place a stamp in the first period (never called by a split driver
+/// whose feature set reads no stamp).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct NoClock;
+
+impl StampClock for NoClock {
+    const WIDENS: bool = false;
+    const NEW: Self = NoClock;
+    type Wraps = ();
+    #[inline(always)]
+    fn keep(_: u32) {}
+    #[inline(always)]
+    fn wraps(_: ()) -> u32 {
+        0
+    }
+    #[inline(always)]
+    fn observe(&mut self, _: u16) {}
+    #[inline(always)]
+    fn extend_before(&self, stamp: u16) -> Timestamp {
+        Timestamp::from_parts(0, stamp)
+    }
+    #[inline(always)]
+    fn extend_sent(&mut self, stamp: u16, _: impl Fn(usize) -> bool) -> Timestamp {
+        Timestamp::from_parts(0, stamp)
+    }
+    #[inline(always)]
+    fn extend_received(&mut self, _: usize, stamp: u16, _: impl Fn(usize) -> bool) -> Timestamp {
+        Timestamp::from_parts(0, stamp)
+    }
+}
+
 /// A compile-time feature set of the split driver (see the [module docs](self)).
 pub trait Features: 'static {
     /// Receive and transmit time stamps are read from the hardware and widened.
@@ -86,6 +223,9 @@ pub trait Features: 'static {
     const COUNTS: bool;
     /// How the traffic counters are stored.
     type Counter: Tally;
+    /// What widening time stamps keeps: [`Extender`] with [`Features::TIMESTAMPS`],
+    /// [`NoClock`] without (20 B of state and 4 B per receive ring slot saved).
+    type Clock: StampClock;
 }
 
 /// Every feature (the default): statistics, time stamps.
@@ -96,6 +236,7 @@ impl Features for Full {
     const TIMESTAMPS: bool = true;
     const COUNTS: bool = true;
     type Counter = Counter;
+    type Clock = Extender;
 }
 
 /// No traffic statistics, no time stamps: the per-frame path does only the frame's work.
@@ -106,4 +247,5 @@ impl Features for Lean {
     const TIMESTAMPS: bool = false;
     const COUNTS: bool = false;
     type Counter = NoTally;
+    type Clock = NoClock;
 }

@@ -46,13 +46,14 @@ use core::sync::atomic::{AtomicU32, AtomicU8, Ordering};
 use crate::controller::{ErrorStatus, Mode};
 use crate::dispatch::Dispatcher;
 use crate::error::{Error, ErrorCounters, ErrorState, ErrorStatistics, LastErrorCode};
+use crate::features::StampClock;
 use crate::features::{Features, Full, Tally};
 use crate::frame::{Frame, RxFrame};
 use crate::hardware::{Completion, FifoEvents, Hardware, Settled, Token};
 use crate::mailbox::{TxOutcome, TxPolicy};
 use crate::once::{Lease, OnceSlot};
 use crate::spsc::{BufferStats, Counter, SpscRing};
-use crate::timestamp::{Extender, Timestamp};
+use crate::timestamp::Timestamp;
 use crate::txqueue::{FifoQueue, Queued, TxQueue};
 
 /// Capacity of the error-state change ring. Changes the thread side has not taken when
@@ -106,12 +107,16 @@ pub struct TrafficStats {
 }
 
 /// One raw frame in a receive ring, with the wraps of its time stamp counted by the
-/// receive interrupt (0 when the hardware records no stamp).
+/// receive interrupt (0 when the hardware records no stamp) as the feature set's clock
+/// keeps them (`W`: `u32`, or zero-sized without time stamps).
 #[derive(Clone, Copy)]
-pub(crate) struct Stamped<R> {
+pub(crate) struct Stamped<R, W> {
     raw: R,
-    wraps: u32,
+    wraps: W,
 }
+
+/// How a receive ring slot of feature set `Fe` keeps a stamp's wraps.
+type Wraps<Fe> = <<Fe as Features>::Clock as StampClock>::Wraps;
 
 /// No state recorded yet (0, so that a `static State` is all zeros and lives in `.bss`).
 const STATE_UNKNOWN: u8 = 0;
@@ -209,11 +214,11 @@ pub struct State<
 > {
     /// The controller, published once by `split` (see [`OnceSlot`]).
     hw: OnceSlot<H>,
-    rx0: SpscRing<Stamped<H::Raw>, RX>,
-    rx1: SpscRing<Stamped<H::Raw>, RX1>,
+    rx0: SpscRing<Stamped<H::Raw, Wraps<Fe>>, RX>,
+    rx1: SpscRing<Stamped<H::Raw, Wraps<Fe>>, RX1>,
     /// The time stamp extender shared by the receive and transmit interrupt sides (and
     /// `refresh_timestamps`), touched inside a critical section only.
-    clock: critical_section::Mutex<Cell<Extender>>,
+    clock: critical_section::Mutex<Cell<Fe::Clock>>,
     queue: critical_section::Mutex<UnsafeCell<Q>>,
     /// Entries in `queue` plus displaced frames on their way back into it.
     queue_len: AtomicU32,
@@ -327,14 +332,22 @@ impl<
     pub const QUIET_TX: bool =
         H::QUIET_TX && DONE == 0 && !Fe::COUNTS && !Fe::TIMESTAMPS && Q::ALWAYS_FIFO;
 
+    /// The feature set's clock widens stamps exactly when its time stamps are on
+    /// ([`Features::Clock`]): a `State` of a feature set that disagrees does not build.
+    const CLOCK_AGREES: () = assert!(
+        Fe::TIMESTAMPS == <Fe::Clock as StampClock>::WIDENS,
+        "Features::Clock must be Extender with TIMESTAMPS and NoClock without"
+    );
+
     crate::sync::const_fn! {
         /// Empty, with no controller yet: all zeros.
         pub fn new() -> Self {
+            let () = Self::CLOCK_AGREES;
             State {
                 hw: OnceSlot::new(),
                 rx0: SpscRing::new(),
                 rx1: SpscRing::new(),
-                clock: critical_section::Mutex::new(Cell::new(Extender::new())),
+                clock: critical_section::Mutex::new(Cell::new(<Fe::Clock as StampClock>::NEW)),
                 queue: critical_section::Mutex::new(UnsafeCell::new(Q::EMPTY)),
                 queue_len: AtomicU32::new(0),
                 queue_peak: AtomicU32::new(0),
@@ -869,7 +882,7 @@ impl<
                 Some(mut frame) => {
                     frame.timestamp = self
                         .raw_stamp(&raw.raw)
-                        .map(|t| Timestamp::from_parts(raw.wraps, t));
+                        .map(|t| Timestamp::from_parts(Fe::Clock::wraps(raw.wraps), t));
                     return Ok(frame);
                 }
                 None => self.dropped.inc(),
@@ -879,7 +892,7 @@ impl<
 
     /// # Safety
     /// Called from the receive rings' one consumer context.
-    unsafe fn pop_raw(&self) -> Option<Stamped<H::Raw>> {
+    unsafe fn pop_raw(&self) -> Option<Stamped<H::Raw, Wraps<Fe>>> {
         // SAFETY: the caller is the rings' only consumer.
         unsafe {
             if RX1 == 0 {
@@ -888,7 +901,9 @@ impl<
             match (self.rx0.peek(), self.rx1.peek()) {
                 (Some(a), Some(b)) => {
                     let first = match (self.raw_stamp(&a.raw), self.raw_stamp(&b.raw)) {
-                        (Some(ta), Some(tb)) => (a.wraps, ta) <= (b.wraps, tb),
+                        (Some(ta), Some(tb)) => {
+                            (Fe::Clock::wraps(a.wraps), ta) <= (Fe::Clock::wraps(b.wraps), tb)
+                        }
                         _ => true,
                     };
                     if first {
@@ -1576,7 +1591,7 @@ unsafe fn drain<
 >(
     s: &State<H, RX, Q, RX1, DONE, Fe>,
     q: usize,
-    ring: &SpscRing<Stamped<H::Raw>, N>,
+    ring: &SpscRing<Stamped<H::Raw, Wraps<Fe>>, N>,
 ) {
     let hw = s.hw();
     let counts = &s.per_queue[q];
@@ -1593,7 +1608,10 @@ unsafe fn drain<
                 Some(t) => s.widen_received(q, t).wraps(),
                 None => 0,
             };
-            let _ = ring.push(Stamped { raw, wraps });
+            let _ = ring.push(Stamped {
+                raw,
+                wraps: Fe::Clock::keep(wraps),
+            });
         }
     }
     if events != FifoEvents::default() {

@@ -16,6 +16,7 @@ impl twocan_core::Features for StampsOnly {
     const TIMESTAMPS: bool = true;
     const COUNTS: bool = false;
     type Counter = twocan_core::features::NoTally;
+    type Clock = twocan_core::timestamp::Extender;
 }
 
 /// A split-driver feature set with the traffic statistics counted, as
@@ -28,4 +29,5 @@ impl twocan_core::Features for CountsOnly {
     const TIMESTAMPS: bool = false;
     const COUNTS: bool = true;
     type Counter = twocan_core::spsc::Counter;
+    type Clock = twocan_core::features::NoClock;
 }
