@@ -825,30 +825,56 @@ impl Report {
             "**RAM of our drivers**: the `State` static (symbol size of `BENCH_CAN_STATE` \
              in the loop-back firmware), its ring and queue slots (receive ring 8 raw \
              frames, transmit queue 8 entries, completion ring `DONE` entries, state-change \
-             ring 8; the instruction-count firmware of the same variant holds a `State` of \
-             the same type and exports these sizes, checked equal), and the **driver \
-             state** beyond them. The halves and handlers (`split`'s `Parts`) live \
-             wherever the application keeps them.\n"
+             ring 8) and the **driver state** beyond them, broken down by \
+             `twocan_core::split::Footprint` (`State::FOOTPRINT`, `size_of` of each part on \
+             the target; the instruction-count firmware of the same variant holds a `State` \
+             of the same type and exports it as `BENCH_FOOTPRINT`, its total checked equal \
+             to the static's size). The controller value includes its publication stage \
+             and lease count (8 B); inside it, the filter map (bxCAN) or the filter table \
+             handle (FlexCAN: a planned table's slices, or a reference to a `static` slot) \
+             and FlexCAN's clock-gate and pin plan kept for `end`. A ring of capacity 0 \
+             (the second receive queue, `RX1` = 0; the completion ring with `DONE` = 0) \
+             still keeps its indices (16 B each). The halves and handlers (`split`'s \
+             `Parts`) live wherever the application keeps them.\n"
         );
         let _ = writeln!(
             s,
-            "| backend | variant | `State` | rings and queues | **driver state** | of which the controller value | of which its filter map |\n\
-             |---|---|---:|---:|---:|---:|---:|"
+            "| backend | variant | `State` | slots | **driver state** | controller | of which filters | of which pin plan | ring bookkeeping | queue bookkeeping | time-stamp clock | statistics | rare-event counts | wakers | padding |\n\
+             |---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
         );
+        let mut rows: Vec<(Backend, &str, &StateFigures)> = Vec::new();
         for st in &sz.states {
-            for (name, f) in [("bxCAN", &st.bxcan), ("FlexCAN", &st.flexcan)] {
-                let opt = |v: Option<u64>| v.map(thousands).unwrap_or_else(|| "–".into());
-                let _ = writeln!(
-                    s,
-                    "| {name} | {} | {} | {} | **{}** | {} | {} |",
-                    st.variant,
-                    thousands(f.static_bytes),
-                    thousands(f.ring_bytes),
-                    thousands(f.state_bytes()),
-                    opt(f.hw_bytes),
-                    opt(f.fmi_bytes)
-                );
+            rows.push((Backend::BxCan, &st.variant, &st.bxcan));
+            rows.push((Backend::FlexCan, &st.variant, &st.flexcan));
+        }
+        for b in Backend::ALL {
+            for (fb, v, st) in &sz.feature_states {
+                if *fb == b {
+                    rows.push((b, v, st));
+                }
             }
+        }
+        for (b, variant, f) in rows {
+            let opt = |v: Option<u64>| v.map(thousands).unwrap_or_else(|| "–".into());
+            let fp = &f.footprint;
+            let _ = writeln!(
+                s,
+                "| {} | {variant} | {} | {} | **{}** | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+                b.name(),
+                thousands(f.static_bytes),
+                thousands(f.ring_bytes),
+                thousands(f.state_bytes()),
+                thousands(fp.controller),
+                opt(f.fmi_bytes),
+                opt(f.system_bytes),
+                fp.ring_bookkeeping,
+                fp.queue_bookkeeping,
+                fp.clock,
+                fp.statistics,
+                fp.errors,
+                fp.wakers,
+                fp.padding
+            );
         }
         let _ = writeln!(s);
     }

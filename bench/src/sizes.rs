@@ -206,6 +206,29 @@ pub fn read_u32_symbol(path: &Path, symbol: &str) -> Result<u32> {
     )))
 }
 
+/// The `n` 32-bit little-endian values of the static array `symbol` in the ELF at `path`.
+pub fn read_u32_array_symbol(path: &Path, symbol: &str, n: usize) -> Result<Vec<u32>> {
+    let data = std::fs::read(path).context(format!("reading {}", path.display()))?;
+    let elf = parse(&data).context(path.display())?;
+    let sym = elf
+        .symbols()
+        .find(|s| s.name() == Ok(symbol))
+        .ok_or_else(|| Error::new(format!("{}: no symbol `{symbol}`", path.display())))?;
+    let addr = sym.address();
+    for section in elf.sections() {
+        if let Ok(Some(bytes)) = section.data_range(addr, 4 * n as u64) {
+            return Ok(bytes
+                .chunks_exact(4)
+                .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+                .collect());
+        }
+    }
+    Err(Error::new(format!(
+        "{}: symbol `{symbol}` at {addr:#x} has no {n} words of data",
+        path.display()
+    )))
+}
+
 /// The size of the symbol `symbol` in the ELF at `path` (its `st_size`).
 pub fn symbol_size(path: &Path, symbol: &str) -> Result<u64> {
     let data = std::fs::read(path).context(format!("reading {}", path.display()))?;
@@ -216,18 +239,94 @@ pub fn symbol_size(path: &Path, symbol: &str) -> Result<u64> {
         .ok_or_else(|| Error::new(format!("{}: no symbol `{symbol}`", path.display())))
 }
 
+/// What a split driver's `State` spends its bytes on (`twocan_core::split::Footprint`,
+/// exported by the instruction-count firmware as `BENCH_FOOTPRINT`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Footprint {
+    /// The whole `State`.
+    pub total: u64,
+    /// The controller value (with its publication stage and lease count).
+    pub controller: u64,
+    /// Receive, transmit, completion and state-change slots.
+    pub slots: [u64; 4],
+    /// The rings' indices, peaks and overflow counts.
+    pub ring_bookkeeping: u64,
+    /// The transmit queue's indices, length, peak and overflow count.
+    pub queue_bookkeeping: u64,
+    /// The time-stamp widening reference.
+    pub clock: u64,
+    /// Traffic statistics.
+    pub statistics: u64,
+    /// Rare-event counts and the error state.
+    pub errors: u64,
+    /// Async wakers.
+    pub wakers: u64,
+    /// Alignment padding.
+    pub padding: u64,
+}
+
+impl Footprint {
+    /// From the 13 words of `BENCH_FOOTPRINT`; refuses words that do not add up.
+    pub fn from_words(w: &[u32]) -> Result<Footprint> {
+        let w: Vec<u64> = w.iter().map(|&v| u64::from(v)).collect();
+        let [total, controller, rx, tx, done, changes, rings, queue, clock, statistics, errors, wakers, padding] =
+            w[..]
+        else {
+            return Err(Error::new(format!("BENCH_FOOTPRINT: {} words, not 13", w.len())));
+        };
+        let f = Footprint {
+            total,
+            controller,
+            slots: [rx, tx, done, changes],
+            ring_bookkeeping: rings,
+            queue_bookkeeping: queue,
+            clock,
+            statistics,
+            errors,
+            wakers,
+            padding,
+        };
+        let sum = controller
+            + f.slots.iter().sum::<u64>()
+            + rings
+            + queue
+            + clock
+            + statistics
+            + errors
+            + wakers
+            + padding;
+        if sum != total {
+            return Err(Error::new(format!(
+                "BENCH_FOOTPRINT parts add up to {sum} B, not the total {total} B"
+            )));
+        }
+        Ok(f)
+    }
+
+    /// The slots the capacities buy.
+    pub fn slot_bytes(&self) -> u64 {
+        self.slots.iter().sum()
+    }
+}
+
 /// What the driver's shared `State` static of the loop-back firmware holds.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct StateFigures {
     /// Size of the `State` static (`BENCH_CAN_STATE` of the loop-back firmware).
     pub static_bytes: u64,
-    /// Of which ring and queue slots (`BENCH_RING_BYTES` of `insn-count`, which holds a
-    /// `State` of the same type and checks its size in `BENCH_STATE_BYTES`).
+    /// Of which ring and queue slots (the footprint's slots, from `insn-count`, which
+    /// holds a `State` of the same type and checks its size in `BENCH_STATE_BYTES`).
     pub ring_bytes: u64,
+    /// The whole footprint (`BENCH_FOOTPRINT` of the instruction-count firmware).
+    pub footprint: Footprint,
     /// Of which the controller value (`BENCH_HW_BYTES`, where the firmware exports it).
     pub hw_bytes: Option<u64>,
-    /// Of which, inside the controller value, the filter map (`BENCH_FMI_BYTES`, bxCAN).
+    /// Of which, inside the controller value, the filter map (bxCAN) or the filter
+    /// table the controller keeps (FlexCAN) (`BENCH_FMI_BYTES`).
     pub fmi_bytes: Option<u64>,
+    /// Of which, inside the controller value, the clock gate and pin plan kept for
+    /// `end` (`BENCH_SYSTEM_BYTES`, FlexCAN).
+    pub system_bytes: Option<u64>,
 }
 
 impl StateFigures {
@@ -238,30 +337,36 @@ impl StateFigures {
 }
 
 /// Reads [`StateFigures`] from a loop-back firmware (its `BENCH_CAN_STATE` static) and
-/// the instruction-count firmware of the same variant (which exports the sizes of the
-/// same `State` type); refuses figures of two different sizes.
+/// the instruction-count firmware of the same variant (which exports the footprint of
+/// the same `State` type); refuses figures of two different sizes.
 pub fn state_figures(loopback: &Path, insn_count: &Path) -> Result<StateFigures> {
     let static_bytes = symbol_size(loopback, "BENCH_CAN_STATE")?;
     let same_type = u64::from(read_u32_symbol(insn_count, "BENCH_STATE_BYTES")?);
     if same_type != static_bytes {
         return Err(Error::new(format!(
-            "the State of insn-count is {same_type} B, that of loopback-twocan {static_bytes} B: \
-             they must be the same type"
+            "the State of {} is {same_type} B, that of {} {static_bytes} B: they must be \
+             the same type",
+            insn_count.display(),
+            loopback.display()
         )));
     }
-    let ring_bytes = u64::from(read_u32_symbol(insn_count, "BENCH_RING_BYTES")?);
-    if ring_bytes > static_bytes {
-        return Err(Error::new("ring bytes exceed the State's size"));
+    let footprint =
+        Footprint::from_words(&read_u32_array_symbol(insn_count, "BENCH_FOOTPRINT", 13)?)?;
+    if footprint.total != static_bytes {
+        return Err(Error::new(format!(
+            "the footprint of {} says {} B, the State is {static_bytes} B",
+            insn_count.display(),
+            footprint.total
+        )));
     }
+    let optional = |symbol: &str| read_u32_symbol(insn_count, symbol).ok().map(u64::from);
     Ok(StateFigures {
         static_bytes,
-        ring_bytes,
-        hw_bytes: read_u32_symbol(insn_count, "BENCH_HW_BYTES")
-            .ok()
-            .map(u64::from),
-        fmi_bytes: read_u32_symbol(insn_count, "BENCH_FMI_BYTES")
-            .ok()
-            .map(u64::from),
+        ring_bytes: footprint.slot_bytes(),
+        footprint,
+        hw_bytes: optional("BENCH_HW_BYTES"),
+        fmi_bytes: optional("BENCH_FMI_BYTES"),
+        system_bytes: optional("BENCH_SYSTEM_BYTES"),
     })
 }
 

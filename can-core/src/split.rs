@@ -118,6 +118,70 @@ pub(crate) struct Stamped<R, W> {
 /// How a receive ring slot of feature set `Fe` keeps a stamp's wraps.
 type Wraps<Fe> = <<Fe as Features>::Clock as StampClock>::Wraps;
 
+/// What a [`State`] of one type spends its bytes on ([`State::FOOTPRINT`]), on the
+/// target it is built for: `size_of` of each part's type, [`Footprint::padding`] the
+/// rest. The slots are what the capacities buy; everything else is the driver's own
+/// state, and each compile-time choice shows here as the bytes it adds.
+///
+/// ```
+/// use twocan_core::mock::MockHardware;
+/// use twocan_core::split::State;
+/// use twocan_core::{FifoQueue, Full, Lean};
+///
+/// type LeanState = State<MockHardware, 8, FifoQueue<4>, 0, 0, Lean>;
+/// type FullState = State<MockHardware, 8, FifoQueue<4>, 0, 8, Full>;
+/// let (lean, full) = (LeanState::FOOTPRINT, FullState::FOOTPRINT);
+/// assert_eq!(lean.total, core::mem::size_of::<LeanState>());
+/// assert_eq!((lean.clock, lean.statistics, lean.completion_slots), (0, 0, 0));
+/// assert!(full.clock > 0 && full.statistics > 0 && full.completion_slots > 0);
+/// assert!(lean.driver_state() < full.driver_state());
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Footprint {
+    /// The whole `State`.
+    pub total: usize,
+    /// The controller value, with its publication stage and lease count.
+    pub controller: usize,
+    /// Receive ring slots of both queues (`RX` + `RX1`): a raw frame each, with the
+    /// wraps of its time stamp when the feature set widens them.
+    pub receive_slots: usize,
+    /// Transmit queue slots (`Q::CAPACITY` entries).
+    pub transmit_slots: usize,
+    /// Completion ring slots (`DONE`).
+    pub completion_slots: usize,
+    /// State-change ring slots ([`STATE_CHANGES`]).
+    pub state_change_slots: usize,
+    /// The four rings' indices, peaks and overflow counts (kept by a ring of capacity
+    /// 0 as well).
+    pub ring_bookkeeping: usize,
+    /// The transmit queue's own indices, its length, peak and overflow count.
+    pub queue_bookkeeping: usize,
+    /// The time-stamp widening reference ([`Features::Clock`]).
+    pub clock: usize,
+    /// The traffic statistics ([`Features::Counter`]: queued, sent, failed, aborted,
+    /// received per queue, dropped).
+    pub statistics: usize,
+    /// The rare events, counted in every feature set: overruns and warnings per
+    /// queue, error counts, state changes, and the current error state.
+    pub errors: usize,
+    /// The wakers of the async API (feature `async`; 0 without).
+    pub wakers: usize,
+    /// Alignment padding: the total less every part above.
+    pub padding: usize,
+}
+
+impl Footprint {
+    /// The slots the capacities buy (receive, transmit, completion, state-change).
+    pub const fn slots(&self) -> usize {
+        self.receive_slots + self.transmit_slots + self.completion_slots + self.state_change_slots
+    }
+
+    /// Everything but the slots: the driver's own state.
+    pub const fn driver_state(&self) -> usize {
+        self.total - self.slots()
+    }
+}
+
 /// No state recorded yet (0, so that a `static State` is all zeros and lives in `.bss`).
 const STATE_UNKNOWN: u8 = 0;
 
@@ -331,6 +395,66 @@ impl<
     /// controller whose transmit order is not the request order in this mode.
     pub const QUIET_TX: bool =
         H::QUIET_TX && DONE == 0 && !Fe::COUNTS && !Fe::TIMESTAMPS && Q::ALWAYS_FIFO;
+
+    /// What this `State` type spends its bytes on ([`Footprint`]).
+    pub const FOOTPRINT: Footprint = {
+        use core::mem::size_of;
+        let total = size_of::<Self>();
+        let controller = size_of::<OnceSlot<H>>();
+        let slot = size_of::<Stamped<H::Raw, Wraps<Fe>>>();
+        let receive_slots = (RX + RX1) * slot;
+        let transmit_slots = Q::CAPACITY * size_of::<Queued>();
+        let completion_slots = DONE * size_of::<Completion>();
+        let state_change_slots = STATE_CHANGES * size_of::<StateChange>();
+        let ring_bookkeeping = size_of::<SpscRing<Stamped<H::Raw, Wraps<Fe>>, RX>>()
+            + size_of::<SpscRing<Stamped<H::Raw, Wraps<Fe>>, RX1>>()
+            + size_of::<SpscRing<Completion, DONE>>()
+            + size_of::<SpscRing<StateChange, STATE_CHANGES>>()
+            - receive_slots
+            - completion_slots
+            - state_change_slots;
+        // (Saturating: a queue type of its own may store its entries otherwise.)
+        let queue_bookkeeping = size_of::<critical_section::Mutex<UnsafeCell<Q>>>()
+            .saturating_sub(transmit_slots)
+            + 2 * size_of::<AtomicU32>()
+            + size_of::<Counter>();
+        let clock = size_of::<critical_section::Mutex<Cell<Fe::Clock>>>();
+        let statistics = 5 * size_of::<Fe::Counter>() + 2 * size_of::<Fe::Counter>();
+        let errors = 2 * 2 * size_of::<Counter>()
+            + size_of::<Counter>()
+            + size_of::<ErrorCounts>()
+            + size_of::<AtomicU8>();
+        #[cfg(feature = "async")]
+        let wakers = size_of::<crate::wakers::Wakers>() + size_of::<AtomicBool>();
+        #[cfg(not(feature = "async"))]
+        let wakers = 0;
+        let parts = controller
+            + receive_slots
+            + transmit_slots
+            + completion_slots
+            + state_change_slots
+            + ring_bookkeeping
+            + queue_bookkeeping
+            + clock
+            + statistics
+            + errors
+            + wakers;
+        Footprint {
+            total,
+            controller,
+            receive_slots,
+            transmit_slots,
+            completion_slots,
+            state_change_slots,
+            ring_bookkeeping,
+            queue_bookkeeping,
+            clock,
+            statistics,
+            errors,
+            wakers,
+            padding: total.saturating_sub(parts),
+        }
+    };
 
     /// The feature set's clock widens stamps exactly when its time stamps are on
     /// ([`Features::Clock`]): a `State` of a feature set that disagrees does not build.
@@ -1923,6 +2047,41 @@ mod tests {
         fn wake(self: Arc<Self>) {
             self.0.fetch_add(1, Ordering::Relaxed);
         }
+    }
+
+    /// Issue 21: the footprint accounts for every byte of the state, and a feature set
+    /// without time stamps keeps no clock and no wraps per receive ring slot.
+    #[test]
+    fn the_footprint_accounts_for_the_state_and_lean_keeps_no_clock() {
+        use core::mem::size_of;
+
+        use crate::{Full, Lean};
+
+        type L = State<MockHardware, 8, FifoQueue<4>, 2, 0, Lean>;
+        type F = State<MockHardware, 8, FifoQueue<4>, 2, 8, Full>;
+        for fp in [L::FOOTPRINT, F::FOOTPRINT] {
+            let parts = fp.controller
+                + fp.slots()
+                + fp.ring_bookkeeping
+                + fp.queue_bookkeeping
+                + fp.clock
+                + fp.statistics
+                + fp.errors
+                + fp.wakers;
+            assert_eq!(parts + fp.padding, fp.total, "{fp:?}");
+            assert!(fp.padding < 16, "{fp:?}");
+            assert_eq!(fp.transmit_slots, 4 * size_of::<super::Queued>());
+        }
+        let (lean, full) = (L::FOOTPRINT, F::FOOTPRINT);
+        assert_eq!(lean.total, size_of::<L>());
+        assert_eq!(lean.receive_slots, 10 * size_of::<Frame>());
+        assert!(full.receive_slots >= 10 * (size_of::<Frame>() + 4), "{full:?}");
+        assert_eq!((lean.clock, lean.statistics), (0, 0));
+        assert_eq!(full.clock, size_of::<crate::timestamp::Extender>());
+        assert_eq!(full.statistics, 7 * 4);
+        assert_eq!(lean.completion_slots, 0);
+        assert_eq!(full.completion_slots, 8 * size_of::<crate::Completion>());
+        assert_eq!(lean.errors, full.errors);
     }
 
     /// Item 7 of issue 26: the transmit handler woke the waiting task only when

@@ -321,3 +321,25 @@ fn panic(info: &core::panic::PanicInfo) -> ! {
         cortex_m::asm::bkpt();
     }
 }
+
+/// A split driver state's [`twocan_core::split::Footprint`] as the words can-bench reads
+/// from a `BENCH_FOOTPRINT` static, in this order: total, controller, receive slots,
+/// transmit slots, completion slots, state-change slots, ring bookkeeping, queue
+/// bookkeeping, clock, statistics, errors, wakers, padding.
+pub const fn footprint_words(f: twocan_core::split::Footprint) -> [u32; 13] {
+    [
+        f.total as u32,
+        f.controller as u32,
+        f.receive_slots as u32,
+        f.transmit_slots as u32,
+        f.completion_slots as u32,
+        f.state_change_slots as u32,
+        f.ring_bookkeeping as u32,
+        f.queue_bookkeeping as u32,
+        f.clock as u32,
+        f.statistics as u32,
+        f.errors as u32,
+        f.wakers as u32,
+        f.padding as u32,
+    ]
+}

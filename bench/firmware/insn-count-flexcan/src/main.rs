@@ -147,15 +147,29 @@ static CAN: variant::OurState<R> = variant::OurState::new();
 #[used]
 static BENCH_STATE_BYTES: u32 = size_of::<variant::OurState<R>>() as u32;
 
-/// Bytes of the state that are ring and queue slots (receive ring, transmit queue,
-/// completion ring, state-change ring), read by can-bench: the rest is driver state.
+/// What the state's bytes hold (`State::FOOTPRINT`, `qemu::footprint_words`), read by
+/// can-bench: its slots are the rings and queues, the rest is driver state.
 #[no_mangle]
 #[used]
-static BENCH_RING_BYTES: u32 = (variant::RX * size_of::<twocan_flexcan::split::RawFrame>()
-    + variant::TXQ * size_of::<twocan_core::txqueue::Queued>()
-    + variant::DONE * size_of::<twocan_core::Completion>()
-    + twocan_core::split::STATE_CHANGES * size_of::<twocan_core::split::StateChange>())
-    as u32;
+static BENCH_FOOTPRINT: [u32; 13] = qemu::footprint_words(variant::OurState::<R>::FOOTPRINT);
+
+/// Size of the controller value the state holds, read by can-bench.
+#[no_mangle]
+#[used]
+static BENCH_HW_BYTES: u32 = size_of::<variant::Hw<R>>() as u32;
+
+/// Size of the filter table the controller keeps (`Options::Table`: a planned table's
+/// slices, or a reference to a `static` slot), read by can-bench.
+#[no_mangle]
+#[used]
+static BENCH_FMI_BYTES: u32 =
+    size_of::<<variant::Opts as twocan_flexcan::options::Options>::Table>() as u32;
+
+/// Size of the clock gate and pin plan the controller keeps for `end`
+/// (`twocan_flexcan::SystemPlan`), read by can-bench.
+#[no_mangle]
+#[used]
+static BENCH_SYSTEM_BYTES: u32 = size_of::<twocan_flexcan::SystemPlan>() as u32;
 
 /// The SIM and PORT registers on QEMU: the board has none, so writes go nowhere (clock
 /// gates and pin mux are not measured).

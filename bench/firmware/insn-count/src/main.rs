@@ -35,9 +35,6 @@ use core::hint::black_box;
 
 use cortex_m_rt::entry;
 use twocan_bxcan::FilterPlan;
-use twocan_bxcan::RawFrame;
-use twocan_core::split::{StateChange, STATE_CHANGES};
-use twocan_core::txqueue::Queued;
 use twocan_core::Completion;
 use twocan_core::{Frame, RxFrame, TxOutcome};
 
@@ -170,14 +167,11 @@ static BENCH_HW_BYTES: u32 = size_of::<variant::Hw>() as u32;
 static BENCH_FMI_BYTES: u32 =
     size_of::<twocan_bxcan::filters::FmiMap<{ variant::KEYS }, { variant::FMIS }>>() as u32;
 
-/// Bytes of [`OurState`] that are ring and queue slots (receive ring, transmit queue,
-/// completion ring, state-change ring), read by can-bench: the rest is driver state.
+/// What [`OurState`]'s bytes hold (`State::FOOTPRINT`, `qemu::footprint_words`), read by
+/// can-bench: its slots are the rings and queues, the rest is driver state.
 #[no_mangle]
 #[used]
-static BENCH_RING_BYTES: u32 = (RX * size_of::<RawFrame>()
-    + TXQ * size_of::<Queued>()
-    + DONE * size_of::<Completion>()
-    + STATE_CHANGES * size_of::<StateChange>()) as u32;
+static BENCH_FOOTPRINT: [u32; 13] = qemu::footprint_words(OurState::FOOTPRINT);
 
 #[inline(never)]
 fn ours_try_send(tx: &mut OurTx, f: &Frame) -> bool {
