@@ -13,6 +13,7 @@
 
 pub mod app_bus;
 pub mod backend;
+pub mod lean;
 pub mod load;
 pub mod preempt;
 pub mod rng;
