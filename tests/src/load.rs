@@ -6,7 +6,10 @@
 //! The node under test is attached to the bus behind a [`Hooked`] wrapper that sees every
 //! frame the bus hands to the model. When a frame makes the model raise its receive
 //! interrupt, a latency is drawn (seeded [`XorShift64`], uniform in `0..=max_latency`):
-//! the interrupt handler (`Driver::on_interrupt`) "runs" at `due = arrival + latency`.
+//! the interrupt handler "runs" at `due = arrival + latency` (`Driver::on_interrupt` for
+//! the unsplit driver; for a lean split one, [`crate::lean`], the handlers of the raised
+//! lines as the chip's vectors run them, the receive handler `Rx0Irq::on_interrupt`
+//! among them), and the application then drains the receive ring ([`Loaded`]).
 //! The wrapper runs it just before the first later frame reaches the model (frames reach
 //! it at the end of their EOF, so a handler due at that very bit time goes first), or at
 //! the end of the run: the handler sees exactly the frames a handler running at `due`
@@ -226,8 +229,8 @@ impl Loaded for LeanFlexNode {
 impl LoadInstance for LeanFlexCan {
     type Node = LeanFlexNode;
     const NAME: &'static str = "FlexCAN (Teensy 3.6 can0), lean split";
-    // The Rx FIFO: 6 deep whatever the filter partition, a full FIFO discards the new
-    // frame.
+    // The Rx FIFO: 6 deep whatever the filter partition (the 8-filter one here), a full
+    // FIFO discards the new frame (Kinetis RM, "Rx FIFO").
     const RX_FIFO_DEPTH: usize = <FlexCanBackend as Backend>::RX_FIFO_DEPTH;
     const OVERRUN: OverrunPolicy = <FlexCanBackend as Backend>::OVERRUN;
     const COUNTS: bool = false;
