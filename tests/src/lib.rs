@@ -6,6 +6,8 @@
 //!   once and run on both controllers;
 //! - [`preempt`]: the transmit interrupt (and the others) preempting the thread at every
 //!   register access of `try_send` and `abort`, on both controllers;
+//! - [`lean`]: the lean split driver of each backend as a firmware example builds it
+//!   (`DONE` = 0, `Lean` features, `const` plans), over any registers and on the harness;
 //! - [`load`]: the full-load runner (back-to-back frames, interrupt serviced after a
 //!   random latency, losses predicted from the FIFO depth and checked exactly);
 //! - [`rng`]: a tiny seeded generator;
@@ -13,6 +15,7 @@
 
 pub mod app_bus;
 pub mod backend;
+pub mod lean;
 pub mod load;
 pub mod preempt;
 pub mod rng;

@@ -6,7 +6,10 @@
 //! The node under test is attached to the bus behind a [`Hooked`] wrapper that sees every
 //! frame the bus hands to the model. When a frame makes the model raise its receive
 //! interrupt, a latency is drawn (seeded [`XorShift64`], uniform in `0..=max_latency`):
-//! the interrupt handler (`Driver::on_interrupt`) "runs" at `due = arrival + latency`.
+//! the interrupt handler "runs" at `due = arrival + latency` (`Driver::on_interrupt` for
+//! the unsplit driver; for a lean split one, [`crate::lean`], the handlers of the raised
+//! lines as the chip's vectors run them, the receive handler `Rx0Irq::on_interrupt`
+//! among them), and the application then drains the receive ring ([`Loaded`]).
 //! The wrapper runs it just before the first later frame reaches the model (frames reach
 //! it at the end of their EOF, so a handler due at that very bit time goes first), or at
 //! the end of the run: the handler sees exactly the frames a handler running at `due`
@@ -28,9 +31,10 @@ use std::time::{Duration, Instant};
 
 use twocan_core::{Frame, LastErrorCode};
 use twocan_host::Harness;
-use twocan_sim::{BusNode, BusTime, SimNode, TxRequest, TxResult};
+use twocan_sim::{Bus, BusNode, BusTime, NodeId, SimNode, TxRequest, TxResult};
 
-use crate::backend::{Backend, Dut, NodeOptions, OverrunPolicy};
+use crate::backend::{Backend, BxCanBackend, Dut, FlexCanBackend, NodeOptions, OverrunPolicy};
+use crate::lean::{attach_bx_lean, attach_flex_lean, LeanBxNode, LeanFlexNode};
 use crate::rng::XorShift64;
 
 /// Bit times of the shortest classical CAN frame with its intermission: standard
@@ -52,6 +56,192 @@ pub const fn budget_bits(depth: usize) -> u64 {
     depth as u64 * MIN_FRAME_BITS
 }
 
+/// What the runner needs from the node under test: its interrupt request, its
+/// interrupt side, its thread side, and the counts of what it lost.
+pub trait Loaded: 'static {
+    /// Whether the model raises an interrupt line the driver services.
+    fn irq_pending(&self) -> bool;
+    /// The interrupt side: the handlers of the raised lines (as the chip's vectors run
+    /// them).
+    fn service(&mut self);
+    /// The thread side: the next frame of the receive ring.
+    fn receive(&mut self) -> Option<Frame>;
+    /// Frames lost in the hardware receive FIFOs, as the model counts them.
+    fn hw_lost(&self) -> u64;
+    /// Overruns the driver counted (`ErrorStatistics::hardware_overruns`).
+    fn overrun_events(&self) -> u64;
+    /// Frames the driver lost because its receive ring was full.
+    fn ring_overflows(&self) -> u64;
+    /// Frames the driver's traffic statistics count as received (0 without
+    /// statistics).
+    fn counted_received(&self) -> u64;
+}
+
+/// A node the full-load runner brings up: the unsplit driver of every [`Backend`]
+/// (every feature), and the lean split driver of each backend ([`LeanBxCan`],
+/// [`LeanFlexCan`]).
+pub trait LoadInstance {
+    /// The node.
+    type Node: Loaded;
+    /// For messages.
+    const NAME: &'static str;
+    /// Frames its receive FIFO holds.
+    const RX_FIFO_DEPTH: usize;
+    /// What its receive FIFO does when full.
+    const OVERRUN: OverrunPolicy;
+    /// Whether its driver counts traffic (statistics on).
+    const COUNTS: bool;
+    /// Brings the node up on `h`'s bus (at [`FULL_LOAD_BIT_RATE`]), receiving every
+    /// frame; `attach` puts the model on the bus.
+    fn attach_via(
+        h: &mut Harness,
+        attach: impl FnOnce(&mut Bus, &str, Box<dyn BusNode>) -> NodeId,
+    ) -> Self::Node;
+}
+
+/// The unsplit driver (`Driver::on_interrupt`, `Driver::receive`), every feature.
+impl<N: Dut + 'static> Loaded for N {
+    fn irq_pending(&self) -> bool {
+        Dut::irq_pending(self)
+    }
+    fn service(&mut self) {
+        self.driver().on_interrupt();
+    }
+    fn receive(&mut self) -> Option<Frame> {
+        self.driver().receive().ok().map(|rx| rx.frame)
+    }
+    fn hw_lost(&self) -> u64 {
+        Dut::hw_lost(self)
+    }
+    fn overrun_events(&self) -> u64 {
+        u64::from(self.driver_ref().error_stats().hardware_overruns)
+    }
+    fn ring_overflows(&self) -> u64 {
+        u64::from(self.driver_ref().traffic().rx_ring_overflows)
+    }
+    fn counted_received(&self) -> u64 {
+        u64::from(self.driver_ref().traffic().received)
+    }
+}
+
+impl<B: Backend> LoadInstance for B {
+    type Node = B::Node;
+    const NAME: &'static str = B::NAME;
+    const RX_FIFO_DEPTH: usize = B::RX_FIFO_DEPTH;
+    const OVERRUN: OverrunPolicy = B::OVERRUN;
+    const COUNTS: bool = true;
+    fn attach_via(
+        h: &mut Harness,
+        attach: impl FnOnce(&mut Bus, &str, Box<dyn BusNode>) -> NodeId,
+    ) -> Self::Node {
+        B::attach_via(h, &NodeOptions::pass_all(), attach).expect("node")
+    }
+}
+
+/// The lean split driver on bxCAN ([`crate::lean`]): the RX0 line runs the receive
+/// handler (`Rx0Irq`), the receive half drains the ring.
+pub struct LeanBxCan;
+
+impl Loaded for LeanBxNode {
+    fn irq_pending(&self) -> bool {
+        self.model.irq_lines().any()
+    }
+    fn service(&mut self) {
+        // One handler per line, as the four vectors of the chip run them.
+        let l = self.model.irq_lines();
+        if l.tx {
+            self.parts.tx_irq.on_interrupt();
+        }
+        if l.rx0 {
+            self.parts.rx0_irq.on_interrupt();
+        }
+        if l.rx1 {
+            self.parts.rx1_irq.on_interrupt();
+        }
+        if l.sce {
+            self.parts.status_irq.on_interrupt();
+        }
+    }
+    fn receive(&mut self) -> Option<Frame> {
+        self.parts.rx.receive().ok().map(|rx| rx.frame)
+    }
+    fn hw_lost(&self) -> u64 {
+        let s = self.model.state();
+        s.overruns[0] + s.overruns[1]
+    }
+    fn overrun_events(&self) -> u64 {
+        u64::from(self.state.error_stats().hardware_overruns)
+    }
+    fn ring_overflows(&self) -> u64 {
+        u64::from(self.state.traffic().rx_ring_overflows)
+    }
+    fn counted_received(&self) -> u64 {
+        u64::from(self.state.traffic().received)
+    }
+}
+
+impl LoadInstance for LeanBxCan {
+    type Node = LeanBxNode;
+    const NAME: &'static str = "bxCAN (STM32F767 CAN1), lean split";
+    // The same FIFO as the unsplit node: FIFO 0, 3 deep, RFLM = 0 (`bx_lean_config`).
+    const RX_FIFO_DEPTH: usize = <BxCanBackend as Backend>::RX_FIFO_DEPTH;
+    const OVERRUN: OverrunPolicy = <BxCanBackend as Backend>::OVERRUN;
+    const COUNTS: bool = false;
+    fn attach_via(
+        h: &mut Harness,
+        attach: impl FnOnce(&mut Bus, &str, Box<dyn BusNode>) -> NodeId,
+    ) -> LeanBxNode {
+        attach_bx_lean(h, attach).expect("lean bxCAN node")
+    }
+}
+
+/// The lean split driver on FlexCAN ([`crate::lean`]): the ORed message-buffer line
+/// runs the transmit, receive (`Rx0Irq`) and status handlers, the receive half drains
+/// the ring.
+pub struct LeanFlexCan;
+
+impl Loaded for LeanFlexNode {
+    fn irq_pending(&self) -> bool {
+        self.model.irq_pending()
+    }
+    fn service(&mut self) {
+        self.parts.tx_irq.on_interrupt();
+        self.parts.rx0_irq.on_interrupt();
+        self.parts.status_irq.on_interrupt();
+    }
+    fn receive(&mut self) -> Option<Frame> {
+        self.parts.rx.receive().ok().map(|rx| rx.frame)
+    }
+    fn hw_lost(&self) -> u64 {
+        self.model.frames_lost()
+    }
+    fn overrun_events(&self) -> u64 {
+        u64::from(self.state.error_stats().hardware_overruns)
+    }
+    fn ring_overflows(&self) -> u64 {
+        u64::from(self.state.traffic().rx_ring_overflows)
+    }
+    fn counted_received(&self) -> u64 {
+        u64::from(self.state.traffic().received)
+    }
+}
+
+impl LoadInstance for LeanFlexCan {
+    type Node = LeanFlexNode;
+    const NAME: &'static str = "FlexCAN (Teensy 3.6 can0), lean split";
+    // The Rx FIFO: 6 deep whatever the filter partition (the 8-filter one here), a full
+    // FIFO discards the new frame (Kinetis RM, "Rx FIFO").
+    const RX_FIFO_DEPTH: usize = <FlexCanBackend as Backend>::RX_FIFO_DEPTH;
+    const OVERRUN: OverrunPolicy = <FlexCanBackend as Backend>::OVERRUN;
+    const COUNTS: bool = false;
+    fn attach_via(
+        h: &mut Harness,
+        attach: impl FnOnce(&mut Bus, &str, Box<dyn BusNode>) -> NodeId,
+    ) -> LeanFlexNode {
+        attach_flex_lean::<FULL_LOAD_BIT_RATE>(h, attach).expect("lean FlexCAN node")
+    }
+}
+
 /// What a full-load run gave.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct LoadReport {
@@ -71,6 +261,9 @@ pub struct LoadReport {
     pub predicted_overrun_events: u64,
     /// Frames lost in the driver's receive ring.
     pub ring_overflows: u64,
+    /// Frames the driver's traffic statistics count as received (0 without
+    /// statistics).
+    pub counted_received: u64,
     /// Handler runs.
     pub isr_runs: u64,
     /// Largest latency drawn, bit times.
@@ -100,7 +293,7 @@ struct Ctx<N> {
     report: LoadReport,
 }
 
-impl<N: Dut> Ctx<N> {
+impl<N: Loaded> Ctx<N> {
     fn mismatch(&mut self, what: String) {
         self.report.mismatches += 1;
         if self.report.first_mismatch.is_none() {
@@ -142,10 +335,8 @@ impl<N: Dut> Ctx<N> {
         let Some(node) = self.node.as_mut() else {
             return;
         };
-        node.driver().on_interrupt();
-        let got: Vec<Frame> = std::iter::from_fn(|| node.driver().receive().ok())
-            .map(|rx| rx.frame)
-            .collect();
+        node.service();
+        let got: Vec<Frame> = std::iter::from_fn(|| node.receive()).collect();
         let n = self.interval.len();
         let d = self.depth;
         let kept: Vec<Frame> = if n <= d {
@@ -182,7 +373,7 @@ pub struct Hooked<N> {
     ctx: Rc<RefCell<Ctx<N>>>,
 }
 
-impl<N: Dut> BusNode for Hooked<N> {
+impl<N: Loaded> BusNode for Hooked<N> {
     fn poll_tx(&mut self, now: u64) -> Option<TxRequest> {
         self.inner.poll_tx(now)
     }
@@ -218,9 +409,9 @@ impl<N: Dut> BusNode for Hooked<N> {
 }
 
 /// Sends `frames` minimum-length frames back to back at 1 Mbit/s from a plain node into a
-/// pass-all node of backend `B`, its interrupt serviced after a latency uniform in
-/// `0..=max_latency` bit times (seeded by `seed`).
-pub fn full_load<B: Backend>(frames: u64, max_latency: u64, seed: u64) -> LoadReport {
+/// pass-all node of `B` (a backend's unsplit driver or a lean split one), its interrupt
+/// serviced after a latency uniform in `0..=max_latency` bit times (seeded by `seed`).
+pub fn full_load<B: LoadInstance>(frames: u64, max_latency: u64, seed: u64) -> LoadReport {
     let start = Instant::now();
     let mut h = Harness::new(FULL_LOAD_BIT_RATE).expect("bus");
     h.bus().borrow_mut().set_tracing(false);
@@ -236,10 +427,9 @@ pub fn full_load<B: Backend>(frames: u64, max_latency: u64, seed: u64) -> LoadRe
         report: LoadReport::default(),
     }));
     let hook = ctx.clone();
-    let node = B::attach_via(&mut h, &NodeOptions::pass_all(), move |bus, name, inner| {
+    let node = B::attach_via(&mut h, move |bus, name, inner| {
         bus.attach(name, Hooked { inner, ctx: hook })
-    })
-    .expect("node");
+    });
     ctx.borrow_mut().node = Some(node);
     let sender = SimNode::new().shared();
     let sender_id = h.bus().borrow_mut().attach("sender", sender.clone());
@@ -269,8 +459,9 @@ pub fn full_load<B: Backend>(frames: u64, max_latency: u64, seed: u64) -> LoadRe
     let mut report = std::mem::take(&mut c.report);
     report.sent = bus.node_stats(sender_id).map_or(0, |s| s.sent);
     report.hw_lost = node.hw_lost();
-    report.overrun_events = u64::from(node.driver_ref().error_stats().hardware_overruns);
-    report.ring_overflows = u64::from(node.driver_ref().traffic().rx_ring_overflows);
+    report.overrun_events = node.overrun_events();
+    report.ring_overflows = node.ring_overflows();
+    report.counted_received = node.counted_received();
     report.bus_bits = bus.now();
     report.wall = start.elapsed();
     report

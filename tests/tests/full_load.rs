@@ -2,26 +2,63 @@
 //! back at 1 Mbit/s from a plain node into each controller, the interrupt serviced after a
 //! seeded random latency (see `twocan_tests::load` for how, and for what is predicted).
 //!
+//! Issue 21: for every combination of the compile-time choices a firmware example uses.
+//! Four instances run, each with the same assertions:
+//!
+//! - the unsplit driver (`Driver`, every feature: statistics, time stamps, completions)
+//!   on FlexCAN (Teensy 3.6 can0, ACAN's 12/12 partition) and on bxCAN (STM32F767 CAN1,
+//!   run-time plan): `Driver::on_interrupt` at the drawn latency, then `receive`;
+//! - the lean split driver on each (`twocan_tests::lean`, as the bench's lean firmware
+//!   and `teensy-loopback-lean` build it: `DONE` = 0 and the quiet transmit mode,
+//!   `twocan_core::Lean` features, a `const` filter plan — bxCAN in place with the map
+//!   sized to the plan and the filters fixed, FlexCAN `options::Lean` begun with
+//!   `begin_checked` in the 8-filter partition): the line's receive handler
+//!   (`Rx0Irq::on_interrupt`, with the other handlers of the raised lines) at the drawn
+//!   latency, then the receive half drains its ring (8 frames).
+//!
+//! Assertions:
+//!
 //! - Within the FIFO budget (latency ≤ depth × minimum frame time: bxCAN one FIFO of 3,
 //!   FlexCAN's Rx FIFO of 6): zero lost, order kept.
 //! - Beyond it (latency up to 4 × the budget): frames are lost, and every loss is counted
 //!   — sent = received + counted lost, with the lost frames, their number and the
 //!   overrun events the driver sees all as predicted from the FIFO depth and overrun rule.
+//!   The lean driver counts what the full one counts of losses: hardware overruns
+//!   (`ErrorStatistics::hardware_overruns`) and receive ring overflows are counted
+//!   whatever the feature set; only the per-frame traffic statistics are off (checked: 0).
+//!   Neither controller counts the frames an overrun loses (bxCAN sets `FOVR`, FlexCAN
+//!   the Rx FIFO overflow flag), so the lost frames are the model's count.
 //!
-//! 100,000 frames per controller in the default (debug) run; the 1,000,000-frame runs are
+//! 100,000 frames per instance in the default (debug) run; the 1,000,000-frame runs are
 //! `#[ignore]`d: `cargo test --release -p twocan-tests --test full_load -- --ignored`.
 
-use twocan_tests::backend::{Backend, BxCanBackend, FlexCanBackend};
-use twocan_tests::load::{budget_bits, full_load, LoadReport, MIN_FRAME_BITS};
+use twocan_tests::backend::{BxCanBackend, FlexCanBackend};
+use twocan_tests::load::{
+    budget_bits, full_load, LeanBxCan, LeanFlexCan, LoadInstance, LoadReport, MIN_FRAME_BITS,
+};
 
 const DEFAULT_FRAMES: u64 = 100_000;
 const FULL_FRAMES: u64 = 1_000_000;
 
-fn within_budget<B: Backend>(frames: u64, seed: u64) -> LoadReport {
+/// What both runs check beyond `LoadReport::assert_accounted`: the traffic statistics
+/// count every frame taken from the hardware where the instance counts, and stay 0 where
+/// it does not (`Lean`).
+fn assert_statistics<B: LoadInstance>(r: &LoadReport) {
+    let counted = if B::COUNTS { r.received } else { 0 };
+    assert_eq!(
+        r.counted_received,
+        counted,
+        "{}: traffic statistics",
+        B::NAME
+    );
+}
+
+fn within_budget<B: LoadInstance>(frames: u64, seed: u64) -> LoadReport {
     let budget = budget_bits(B::RX_FIFO_DEPTH);
     let r = full_load::<B>(frames, budget, seed);
     println!("{} within budget ({budget} bits): {r:?}", B::NAME);
     r.assert_accounted(B::NAME);
+    assert_statistics::<B>(&r);
     assert_eq!(r.sent, frames, "{}: every frame sent", B::NAME);
     assert_eq!(r.hw_lost, 0, "{}: nothing lost within the budget", B::NAME);
     assert_eq!(r.received, frames, "{}", B::NAME);
@@ -35,11 +72,12 @@ fn within_budget<B: Backend>(frames: u64, seed: u64) -> LoadReport {
     r
 }
 
-fn beyond_budget<B: Backend>(frames: u64, seed: u64) -> LoadReport {
+fn beyond_budget<B: LoadInstance>(frames: u64, seed: u64) -> LoadReport {
     let budget = budget_bits(B::RX_FIFO_DEPTH);
     let r = full_load::<B>(frames, 4 * budget, seed);
     println!("{} beyond budget ({} bits): {r:?}", B::NAME, 4 * budget);
     r.assert_accounted(B::NAME);
+    assert_statistics::<B>(&r);
     assert_eq!(r.sent, frames);
     assert!(
         r.hw_lost > 0,
@@ -71,6 +109,26 @@ fn bxcan_full_load_beyond_budget_counts_every_loss() {
 }
 
 #[test]
+fn lean_flexcan_full_load_within_budget_loses_nothing() {
+    within_budget::<LeanFlexCan>(DEFAULT_FRAMES, 0xF1E7_CA11);
+}
+
+#[test]
+fn lean_bxcan_full_load_within_budget_loses_nothing() {
+    within_budget::<LeanBxCan>(DEFAULT_FRAMES, 0xB7CA_0011);
+}
+
+#[test]
+fn lean_flexcan_full_load_beyond_budget_counts_every_loss() {
+    beyond_budget::<LeanFlexCan>(DEFAULT_FRAMES / 2, 0xF1E7_CA12);
+}
+
+#[test]
+fn lean_bxcan_full_load_beyond_budget_counts_every_loss() {
+    beyond_budget::<LeanBxCan>(DEFAULT_FRAMES / 2, 0xB7CA_0012);
+}
+
+#[test]
 #[ignore = "full load: run with --release -- --ignored"]
 fn flexcan_full_load_1m_frames() {
     within_budget::<FlexCanBackend>(FULL_FRAMES, 0xF1E7_CA03);
@@ -82,4 +140,18 @@ fn flexcan_full_load_1m_frames() {
 fn bxcan_full_load_1m_frames() {
     within_budget::<BxCanBackend>(FULL_FRAMES, 0xB7CA_0003);
     beyond_budget::<BxCanBackend>(FULL_FRAMES, 0xB7CA_0004);
+}
+
+#[test]
+#[ignore = "full load: run with --release -- --ignored"]
+fn lean_flexcan_full_load_1m_frames() {
+    within_budget::<LeanFlexCan>(FULL_FRAMES, 0xF1E7_CA13);
+    beyond_budget::<LeanFlexCan>(FULL_FRAMES, 0xF1E7_CA14);
+}
+
+#[test]
+#[ignore = "full load: run with --release -- --ignored"]
+fn lean_bxcan_full_load_1m_frames() {
+    within_budget::<LeanBxCan>(FULL_FRAMES, 0xB7CA_0013);
+    beyond_budget::<LeanBxCan>(FULL_FRAMES, 0xB7CA_0014);
 }

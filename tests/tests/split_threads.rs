@@ -5,8 +5,10 @@
 //! the real drivers over their models, exchange sequenced frames both ways: nothing
 //! lost, duplicated or reordered, and the token/completion accounting is exact — with the
 //! default choices (completions, statistics, time stamps) and with the lean ones a
-//! firmware example uses (no completions, `Lean` features, FlexCAN `options::Lean`: the
-//! quiet transmit mode on both backends).
+//! firmware example uses (no completions, `Lean` features, `const` filter plans, FlexCAN
+//! `options::Lean` begun with `begin_checked`, bxCAN configured in place with the map
+//! sized to its plan and the filters fixed: the quiet transmit mode on both backends;
+//! built by `twocan_tests::lean`, the same definition `full_load` runs).
 //!
 //! The peripheral models are single-threaded (`Rc` handles, shared with the bus), so the
 //! bus and both models live in one [`World`] behind a mutex, and every register access
@@ -18,12 +20,13 @@ use std::sync::{Arc, Mutex};
 
 use twocan_bxcan::model::BxCanModel;
 use twocan_bxcan::{BxCan, Can, Config, FifoPolicy, Recovery};
-use twocan_core::split::State;
-use twocan_core::{Features, FifoQueue, Filter, Frame, Registers, TxOutcome, TxPolicy};
+use twocan_core::split::{Parts, State};
+use twocan_core::{Features, FifoQueue, Filter, Frame, Hardware, Registers, TxOutcome, TxPolicy};
 use twocan_flexcan::model::FlexCanModel;
 use twocan_flexcan::options::{Full, Lean, Options};
 use twocan_flexcan::{Board, FlexCan, FlexCanHw, HostSystem, Instance, Settings, Target};
 use twocan_sim::Bus;
+use twocan_tests::lean::{bx_lean_config, split_bx_lean, BxLeanHw};
 
 const RATE: u32 = 1_000_000;
 const APB1: u32 = 54_000_000;
@@ -171,37 +174,87 @@ impl FlexBegin for Full {
     }
 }
 
-/// The lean controller: the plan and the checks settled at compile time
-/// (`begin_checked`), no time stamps, no filter switch.
+/// The lean controller (`twocan_tests::lean`): the plan and the checks settled at
+/// compile time (`begin_checked`), no time stamps, no filter switch.
 impl FlexBegin for Lean {
     fn begin(regs: WorldRegs) -> FlexCanHw<WorldRegs, Self> {
-        use twocan_flexcan::planner::PlanOptions;
-        use twocan_flexcan::{const_plan, BeginPlan, Configuration};
-        const CHECKED: BeginPlan =
-            BeginPlan::new_or_panic(FLEX_TARGET, &FLEX_SETTINGS, Configuration::Filters8_0);
-        const FILTERS: [Filter; 1] = [Filter::pass_all()];
-        let plan = const_plan!(FILTERS, PlanOptions::new(Configuration::Filters8_0)).planned();
-        FlexCan::begin_checked(regs, &mut HostSystem::new(), &CHECKED, plan).unwrap()
+        twocan_tests::lean::begin_flex_lean::<RATE, _>(regs).unwrap()
+    }
+}
+
+/// How the bxCAN node is configured and split for one set of compile-time choices.
+trait BxBegin {
+    /// The controller the split driver holds.
+    type Hw: Hardware + Send + Sync;
+    /// Configures CAN1 over `regs` and splits `state` over it.
+    #[allow(clippy::type_complexity)]
+    fn split<const DONE: usize, Fe: Features>(
+        state: &State<Self::Hw, 256, FifoQueue<32>, 0, DONE, Fe>,
+        regs: WorldRegs,
+    ) -> Parts<'_, Self::Hw, 256, FifoQueue<32>, 0, DONE, Fe>;
+}
+
+/// Every feature: `Can::can1`, the run-time plan, `into_split` (the map with every
+/// lookup key and match index, the filters replaceable).
+enum FullBx {}
+
+impl BxBegin for FullBx {
+    type Hw = BxHw;
+    fn split<const DONE: usize, Fe: Features>(
+        state: &State<BxHw, 256, FifoQueue<32>, 0, DONE, Fe>,
+        regs: WorldRegs,
+    ) -> Parts<'_, BxHw, 256, FifoQueue<32>, 0, DONE, Fe> {
+        let config = Config::from_bitrate(APB1, RATE)
+            .unwrap()
+            .recovery(Recovery::Automatic)
+            .tx_policy(TxPolicy::Fifo);
+        let mut init = Can::can1(regs, &config).map_err(|f| f.error).unwrap();
+        let plan = init
+            .can()
+            .plan(&[Filter::pass_all()], FifoPolicy::Fifo0)
+            .unwrap();
+        init.set_filters(&plan).unwrap();
+        let can = init.enable().map_err(|f| f.error).unwrap();
+        state.split(can.into_split()).ok().unwrap()
+    }
+}
+
+/// The lean controller (`twocan_tests::lean`): configured in place from a `const` plan,
+/// the map sized to it, the filters fixed, time stamps off.
+enum LeanBx {}
+
+impl BxBegin for LeanBx {
+    type Hw = BxLeanHw<WorldRegs>;
+    fn split<const DONE: usize, Fe: Features>(
+        state: &State<Self::Hw, 256, FifoQueue<32>, 0, DONE, Fe>,
+        regs: WorldRegs,
+    ) -> Parts<'_, Self::Hw, 256, FifoQueue<32>, 0, DONE, Fe> {
+        let config = bx_lean_config(RATE).unwrap();
+        split_bx_lean(state, regs, &config).unwrap()
     }
 }
 
 /// Moves `per_direction` frames each way with the default driver (completions, time
 /// stamps, statistics); returns (frames received by the bxCAN node, by the FlexCAN node).
 fn exchange(per_direction: u32) -> (u32, u32) {
-    exchange_with::<64, twocan_core::Full, Full>(per_direction)
+    exchange_with::<64, twocan_core::Full, Full, FullBx>(per_direction)
 }
 
 /// [`exchange`] with the lean choices a firmware example makes (`teensy-loopback-lean`):
 /// no completion ring, the split driver's `Lean` features, FlexCAN's `options::Lean`,
-/// both controllers in request order (as in [`exchange`]) — the quiet transmit mode on
-/// both backends.
+/// bxCAN configured in place from a `const` plan with the map sized to it
+/// (`twocan_tests::lean`, one definition with `full_load`), both controllers in request
+/// order (as in [`exchange`]) — the quiet transmit mode on both backends.
 fn exchange_lean(per_direction: u32) -> (u32, u32) {
-    exchange_with::<0, twocan_core::Lean, Lean>(per_direction)
+    exchange_with::<0, twocan_core::Lean, Lean, LeanBx>(per_direction)
 }
 
-/// [`exchange`] for the compile-time choices `DONE`, `Fe`, `O`; both controllers send
-/// in request order (the quiet mode's condition, and the `FifoQueue`'s order).
-fn exchange_with<const DONE: usize, Fe: Features, O: FlexBegin>(per_direction: u32) -> (u32, u32) {
+/// [`exchange`] for the compile-time choices `DONE`, `Fe`, `O` (FlexCAN), `B` (bxCAN);
+/// both controllers send in request order (the quiet mode's condition, and the
+/// `FifoQueue`'s order).
+fn exchange_with<const DONE: usize, Fe: Features, O: FlexBegin, B: BxBegin>(
+    per_direction: u32,
+) -> (u32, u32) {
     let bx = BxCanModel::can1();
     let flex = FlexCanModel::mk66fx1m0();
     let mut bus = Bus::new(RATE).unwrap();
@@ -220,35 +273,24 @@ fn exchange_with<const DONE: usize, Fe: Features, O: FlexBegin>(per_direction: u
 
     const BX_POLLS: &[usize] = &[twocan_bxcan::regs::MSR];
     const FLEX_POLLS: &[usize] = &[twocan_flexcan::regs::MCR, twocan_flexcan::regs::ESR1];
-    let config = Config::from_bitrate(APB1, RATE)
-        .unwrap()
-        .recovery(Recovery::Automatic)
-        .tx_policy(TxPolicy::Fifo);
-    let mut init = Can::can1(regs(Which::Bx, BX_POLLS), &config)
-        .map_err(|f| f.error)
-        .unwrap();
-    let plan = init
-        .can()
-        .plan(&[Filter::pass_all()], FifoPolicy::Fifo0)
-        .unwrap();
-    init.set_filters(&plan).unwrap();
-    let bx_can = init.enable().map_err(|f| f.error).unwrap();
-    let flex_can = O::begin(regs(Which::Flex, FLEX_POLLS));
-    // Both synchronised to the idle bus before traffic.
-    world.lock().unwrap().bus.run_for(20);
-    setup.store(false, Ordering::Relaxed);
-
-    let bx_state: State<BxHw, 256, FifoQueue<32>, 0, DONE, Fe> = State::new();
+    let bx_state: State<B::Hw, 256, FifoQueue<32>, 0, DONE, Fe> = State::new();
     let flex_state: State<FlexCanHw<WorldRegs, O>, 256, FifoQueue<32>, 0, DONE, Fe> = State::new();
     assert_eq!(
-        State::<BxHw, 256, FifoQueue<32>, 0, DONE, Fe>::QUIET_TX,
+        State::<B::Hw, 256, FifoQueue<32>, 0, DONE, Fe>::QUIET_TX,
         DONE == 0
     );
     assert_eq!(
         State::<FlexCanHw<WorldRegs, O>, 256, FifoQueue<32>, 0, DONE, Fe>::QUIET_TX,
         DONE == 0
     );
-    let bx_parts = bx_state.split(bx_can.into_split()).ok().unwrap();
+    // bxCAN configured (in place, for the lean choices) and split, FlexCAN begun, while
+    // the polls let bus time pass.
+    let bx_parts = B::split(&bx_state, regs(Which::Bx, BX_POLLS));
+    let flex_can = O::begin(regs(Which::Flex, FLEX_POLLS));
+    // Both synchronised to the idle bus before traffic.
+    world.lock().unwrap().bus.run_for(20);
+    setup.store(false, Ordering::Relaxed);
+
     let flex_parts = flex_state.split(flex_can).ok().unwrap();
     let received = [AtomicU32::new(0), AtomicU32::new(0)];
     let done = AtomicBool::new(false);
