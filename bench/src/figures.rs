@@ -149,6 +149,10 @@ pub struct Target {
     pub bound: Option<f64>,
     /// (opt-level, figure).
     pub per_opt: Vec<(String, Measured)>,
+    /// Where the difference goes, measured (per opt-level where it differs): the
+    /// round trip's steps, the send's or handler's count, the flash by crate, the
+    /// driver state by part. Rendered for a missed bound.
+    pub cause: Vec<String>,
 }
 
 impl Target {
@@ -268,6 +272,7 @@ impl Figures {
                         per_opt: ratio_of(&|c| {
                             Ok((region(c, "twocan.tx.direct")?, region(c, tx_theirs)?))
                         })?,
+                        cause: Vec::new(),
                     });
                     targets.push(Target {
                         backend,
@@ -285,6 +290,7 @@ impl Figures {
                                 region(c, &format!("{eq}.rx_irq"))?,
                             ))
                         })?,
+                        cause: Vec::new(),
                     });
                 }
                 if backend == Backend::BxCan {
@@ -297,6 +303,7 @@ impl Figures {
                         per_opt: ratio_of(&|c| {
                             Ok((region(c, "twocan.rx_irq")?, region(c, "bxcan.rx0.receive")?))
                         })?,
+                        cause: Vec::new(),
                     });
                 }
                 targets.push(Target {
@@ -311,6 +318,7 @@ impl Figures {
                     ),
                     bound: Some(if lean { 1.0 } else { 1.5 }),
                     per_opt: ratio_of(&|c| Ok((c.roundtrip("twocan")?, c.roundtrip(eq)?)))?,
+                    cause: Vec::new(),
                 });
                 let flash = sizes
                     .builds
@@ -342,6 +350,7 @@ impl Figures {
                     ),
                     bound: Some(if lean { 1.3 } else { 3.0 }),
                     per_opt: flash,
+                    cause: Vec::new(),
                 });
                 if lean {
                     let st = sizes
@@ -361,6 +370,7 @@ impl Figures {
                         ),
                         bound: Some(STATE_BOUND as f64),
                         per_opt: vec![("s".into(), Measured::Bytes(fig.state_bytes()))],
+                        cause: Vec::new(),
                     });
                 }
                 targets.push(Target {
@@ -376,8 +386,12 @@ impl Figures {
                             Ok((opt.clone(), Measured::Bytes(c.stack("twocan.config")?)))
                         })
                         .collect::<Result<Vec<_>>>()?,
+                    cause: Vec::new(),
                 });
             }
+        }
+        for t in &mut targets {
+            t.cause = cause(t, insn, sizes)?;
         }
         Ok(Figures {
             targets,
@@ -524,6 +538,137 @@ impl Figures {
             );
         }
         Ok(serde_json::Value::Object(m))
+    }
+}
+
+/// Where a target's difference goes, measured: for an instruction target the regions
+/// of each side (per round-trip step for the round trip), for flash the code of each
+/// side by crate, for the driver state the state's parts. One line per opt-level for
+/// the measured ones; empty for a target without a bound.
+fn cause(t: &Target, insn: &InsnSection, sizes: &SizeSection) -> Result<Vec<String>> {
+    let mut lines = Vec::new();
+    if t.bound.is_none() {
+        return Ok(lines);
+    }
+    let eq = t.backend.equivalent();
+    match t.key {
+        "roundtrip" => {
+            for (opt, _) in &t.per_opt {
+                let c = insn.get(t.backend, t.variant, opt)?;
+                let mut steps: Vec<(u8, &'static str, i64, i64)> = Vec::new();
+                for (side, name) in [(0, "twocan"), (1, eq)] {
+                    for k in c.roundtrip_keys(name)? {
+                        let (n, label) = step_of(k);
+                        let v = c.net(k)?.0 as i64;
+                        match steps.iter_mut().find(|s| s.0 == n) {
+                            Some(s) if side == 0 => s.2 += v,
+                            Some(s) => s.3 += v,
+                            None if side == 0 => steps.push((n, label, v, 0)),
+                            None => steps.push((n, label, 0, v)),
+                        }
+                    }
+                }
+                steps.sort_by_key(|s| s.0);
+                let parts: Vec<String> = steps
+                    .iter()
+                    .map(|(_, label, o, th)| {
+                        format!(
+                            "{label} {o} / {th} ({})",
+                            crate::report::signed_text(o - th)
+                        )
+                    })
+                    .collect();
+                lines.push(format!("opt {opt}: {}", parts.join(", ")));
+            }
+        }
+        "flash" => {
+            for b in &sizes.builds {
+                let Some(v) = b.variant(t.variant) else {
+                    continue;
+                };
+                let (ours, theirs) = match t.backend {
+                    Backend::BxCan => (&v.ours, &v.equiv),
+                    Backend::FlexCan => (&v.flexcan, &v.flexcan_hand),
+                };
+                let list = |z: &crate::sizes::Size| {
+                    z.code_by_crate
+                        .iter()
+                        .filter(|(_, n)| *n >= 32)
+                        .map(|(k, n)| format!("{k} {}", crate::report::thousands(*n)))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                };
+                lines.push(format!(
+                    "opt {}: {} B more; code by crate, ours: {}; theirs: {}",
+                    b.opt,
+                    crate::report::thousands(ours.app_flash().saturating_sub(theirs.app_flash())),
+                    list(ours),
+                    list(theirs)
+                ));
+            }
+        }
+        "state" => {
+            if let Some(st) = sizes.state(t.variant) {
+                let f = match t.backend {
+                    Backend::BxCan => &st.bxcan,
+                    Backend::FlexCan => &st.flexcan,
+                };
+                let fp = &f.footprint;
+                let inside = [
+                    f.fmi_bytes.map(|b| format!("filters {b}")),
+                    f.system_bytes.map(|b| format!("pin plan {b}")),
+                ]
+                .into_iter()
+                .flatten()
+                .collect::<Vec<_>>();
+                lines.push(format!(
+                    "controller {} B{}, ring bookkeeping {} B (4 rings × 16 B, rings of \
+                     capacity 0 included), queue bookkeeping {} B, time-stamp clock {} B, \
+                     statistics {} B, rare-event counts {} B, wakers {} B, padding {} B",
+                    fp.controller,
+                    if inside.is_empty() {
+                        String::new()
+                    } else {
+                        format!(" (of which {})", inside.join(", "))
+                    },
+                    fp.ring_bookkeeping,
+                    fp.queue_bookkeeping,
+                    fp.clock,
+                    fp.statistics,
+                    fp.errors,
+                    fp.wakers,
+                    fp.padding
+                ));
+            }
+        }
+        "tx" | "rx_isr" => {
+            for (opt, m) in &t.per_opt {
+                if let Measured::Ratio { ours, theirs } = m {
+                    lines.push(format!(
+                        "opt {opt}: {ours} / {theirs} instructions ({})",
+                        crate::report::signed_text(*ours as i64 - *theirs as i64)
+                    ));
+                }
+            }
+        }
+        _ => {}
+    }
+    Ok(lines)
+}
+
+/// The step of a round trip a region is (send, handlers, takes), for lining ours up
+/// with the equivalent's: (order, label).
+pub fn step_of(key: &str) -> (u8, &'static str) {
+    if key.contains("tx_irq") {
+        (1, "transmit handler (completion)")
+    } else if key.contains("rx_irq") {
+        (2, "receive handler (one frame)")
+    } else if key.contains("take_completion") {
+        (4, "completion taken")
+    } else if key.ends_with(".receive") || key.ends_with(".take") {
+        (3, "frame taken (with filter index)")
+    } else {
+        (0, "send")
     }
 }
 

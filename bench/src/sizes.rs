@@ -63,6 +63,10 @@ pub struct Size {
     /// of more than cortex-m-rt's empty default ([`PRE_INIT`]). 0 for an ELF without
     /// them.
     pub startup: u64,
+    /// Code (function symbols) by the crate that defines it, largest first, start-up
+    /// module left out ([`crate_of`]): where the flash goes. Code inlined into another
+    /// crate's function counts for that function's crate.
+    pub code_by_crate: Vec<(String, u64)>,
 }
 
 /// The path component (in legacy Rust symbol mangling, length-prefixed) of the bench
@@ -182,7 +186,76 @@ pub fn measure(path: &Path) -> Result<Size> {
             startup += sym.size();
         }
     }
-    Ok(Size { sections, startup })
+    let mut by_crate: std::collections::BTreeMap<String, u64> = Default::default();
+    let mut seen_code = std::collections::BTreeSet::new();
+    for sym in elf.symbols() {
+        let Ok(name) = sym.name() else { continue };
+        if sym.kind() != SymbolKind::Text
+            || sym.size() == 0
+            || name.contains(STARTUP_MODULE)
+            || name == PRE_INIT
+            || !seen_code.insert(sym.address() & !1)
+        {
+            continue;
+        }
+        *by_crate.entry(crate_of(name)).or_default() += sym.size();
+    }
+    let mut code_by_crate: Vec<(String, u64)> = by_crate.into_iter().collect();
+    code_by_crate.sort_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(&b.0)));
+    Ok(Size {
+        sections,
+        startup,
+        code_by_crate,
+    })
+}
+
+/// The crate a function symbol belongs to: the first path component of a legacy Rust
+/// mangled name (`_ZN11twocan_core5split...` → `twocan_core`; for a trait method
+/// `<Type as Trait>::f`, the crate of `Type`), `compiler_builtins` for the unmangled
+/// memory and ARM EABI helpers it exports, `cortex_m_rt` for its exception handlers,
+/// the application for `main`, and `other` for the rest.
+pub fn crate_of(symbol: &str) -> String {
+    if let Some(rest) = symbol.strip_prefix("_ZN") {
+        let digits: String = rest.chars().take_while(char::is_ascii_digit).collect();
+        if let Ok(len) = digits.parse::<usize>() {
+            let ident = rest.get(digits.len()..digits.len() + len).unwrap_or("");
+            // `_$LT$Type$u20$as$u20$Trait$GT$`, `_$LT$impl$u20$...`: the type's crate.
+            let ident = ident
+                .trim_start_matches('_')
+                .trim_start_matches("$LT$")
+                .trim_start_matches("impl$u20$")
+                .trim_start_matches('&')
+                .trim_start_matches("$RF$")
+                .trim_start_matches("mut$u20$")
+                .trim_start_matches("$u5b$");
+            let krate: String = ident
+                .chars()
+                .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
+                .collect();
+            if !krate.is_empty() {
+                return krate;
+            }
+        }
+        return "other".into();
+    }
+    if symbol.starts_with("__aeabi_")
+        || symbol.starts_with("mem")
+        || symbol.starts_with("__udiv")
+        || symbol.starts_with("__div")
+        || symbol.starts_with("compiler_builtins")
+    {
+        return "compiler_builtins".into();
+    }
+    match symbol {
+        "main" => "application (main)".into(),
+        "Reset"
+        | "DefaultHandler"
+        | "DefaultHandler_"
+        | "HardFault_"
+        | "HardFaultTrampoline"
+        | "DefaultPreInit" => "cortex_m_rt".into(),
+        _ => "other".into(),
+    }
 }
 
 /// The 32-bit little-endian value of the static `symbol` in the ELF at `path`.
@@ -272,7 +345,10 @@ impl Footprint {
         let [total, controller, rx, tx, done, changes, rings, queue, clock, statistics, errors, wakers, padding] =
             w[..]
         else {
-            return Err(Error::new(format!("BENCH_FOOTPRINT: {} words, not 13", w.len())));
+            return Err(Error::new(format!(
+                "BENCH_FOOTPRINT: {} words, not 13",
+                w.len()
+            )));
         };
         let f = Footprint {
             total,
@@ -374,6 +450,25 @@ pub fn state_figures(loopback: &Path, insn_count: &Path) -> Result<StateFigures>
 mod tests {
     use super::*;
 
+    #[test]
+    fn symbols_are_charged_to_their_crate() {
+        assert_eq!(
+            crate_of("_ZN11twocan_core5split5State8try_send17h0123456789abcdefE"),
+            "twocan_core"
+        );
+        assert_eq!(
+            crate_of(
+                "_ZN83_$LT$twocan_bxcan..BxCan$LT$R$C$F$GT$$u20$as$u20$twocan_core..Hardware$GT$8try_load17h0123456789abcdefE"
+            ),
+            "twocan_bxcan"
+        );
+        assert_eq!(crate_of("__aeabi_memcpy"), "compiler_builtins");
+        assert_eq!(crate_of("memcpy"), "compiler_builtins");
+        assert_eq!(crate_of("main"), "application (main)");
+        assert_eq!(crate_of("Reset"), "cortex_m_rt");
+        assert_eq!(crate_of("CAN1_RX0"), "other");
+    }
+
     fn section(name: &str, size: u64, class: Class) -> Section {
         Section {
             name: name.into(),
@@ -385,6 +480,7 @@ mod tests {
     #[test]
     fn driver_and_application_flash_leaves_out_vectors_config_field_and_start_up() {
         let z = Size {
+            code_by_crate: Vec::new(),
             sections: vec![
                 section(".vector_table", 1024, Class::Code),
                 section(".flash_config", 16, Class::Code),

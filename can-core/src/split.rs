@@ -2075,7 +2075,10 @@ mod tests {
         let (lean, full) = (L::FOOTPRINT, F::FOOTPRINT);
         assert_eq!(lean.total, size_of::<L>());
         assert_eq!(lean.receive_slots, 10 * size_of::<Frame>());
-        assert!(full.receive_slots >= 10 * (size_of::<Frame>() + 4), "{full:?}");
+        assert!(
+            full.receive_slots >= 10 * (size_of::<Frame>() + 4),
+            "{full:?}"
+        );
         assert_eq!((lean.clock, lean.statistics), (0, 0));
         assert_eq!(full.clock, size_of::<crate::timestamp::Extender>());
         assert_eq!(full.statistics, 7 * 4);
