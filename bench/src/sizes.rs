@@ -212,7 +212,8 @@ pub fn measure(path: &Path) -> Result<Size> {
 /// The crate a function symbol belongs to: the first path component of a legacy Rust
 /// mangled name (`_ZN11twocan_core5split...` → `twocan_core`; for a trait method
 /// `<Type as Trait>::f`, the crate of `Type`), `compiler_builtins` for the unmangled
-/// memory and ARM EABI helpers it exports, `cortex_m_rt` for its exception handlers,
+/// memory and ARM EABI helpers it exports (a v0 mangled name, `_R...`: its first crate
+/// root), `cortex_m_rt` for its exception handlers,
 /// the application for `main`, and `other` for the rest.
 pub fn crate_of(symbol: &str) -> String {
     if let Some(rest) = symbol.strip_prefix("_ZN") {
@@ -235,6 +236,38 @@ pub fn crate_of(symbol: &str) -> String {
             if !krate.is_empty() {
                 return krate;
             }
+        }
+        return "other".into();
+    }
+    if let Some(rest) = symbol.strip_prefix("_R") {
+        // v0 mangling: the first crate root, `C` with an optional `s<hash>_`
+        // disambiguator, then the length-prefixed crate name.
+        let b = rest.as_bytes();
+        let mut i = 0;
+        while i < b.len() {
+            if b[i] == b'C' {
+                let mut j = i + 1;
+                if b.get(j) == Some(&b's') {
+                    while j < b.len() && b[j] != b'_' {
+                        j += 1;
+                    }
+                    j += 1;
+                }
+                let start = j;
+                while j < b.len() && b[j].is_ascii_digit() {
+                    j += 1;
+                }
+                if let Ok(len) = rest[start..j].parse::<usize>() {
+                    let ident = rest.get(j..j + len).unwrap_or("");
+                    let ident = ident.strip_prefix('_').unwrap_or(ident);
+                    if !ident.is_empty()
+                        && ident.chars().all(|c| c.is_ascii_alphanumeric() || c == '_')
+                    {
+                        return ident.to_string();
+                    }
+                }
+            }
+            i += 1;
         }
         return "other".into();
     }
@@ -463,6 +496,14 @@ mod tests {
             "twocan_bxcan"
         );
         assert_eq!(crate_of("__aeabi_memcpy"), "compiler_builtins");
+        assert_eq!(
+            crate_of("_RNvNtCs7NhdfSRABLd_17compiler_builtins3mem6memcpy"),
+            "compiler_builtins"
+        );
+        assert_eq!(
+            crate_of("_RNvNtCs7ldSeZOOJos_4core9panicking9panic_fmt"),
+            "core"
+        );
         assert_eq!(crate_of("memcpy"), "compiler_builtins");
         assert_eq!(crate_of("main"), "application (main)");
         assert_eq!(crate_of("Reset"), "cortex_m_rt");
