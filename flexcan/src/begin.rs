@@ -46,7 +46,6 @@ use crate::configuration::{Configuration, DATA_MAILBOX, MESSAGE_BUFFERS};
 use crate::controller::FlexCan;
 use crate::filters::OwnedTable;
 use crate::handshake;
-use crate::imxrt::ImxrtPlan;
 use crate::installed::PlannedTable;
 use crate::instance::Target;
 use crate::layout::{layout_accepts, Kinetis, Layout};
@@ -56,14 +55,14 @@ use crate::regs::{
 };
 use crate::settings::Settings;
 use crate::split::{FlexCanHw, Parts};
-use crate::system::{choose_pins, PortPlan, SystemPlan};
+use crate::system::{choose_pins, PortPlan, SystemKey};
 
 /// Everything `begin` will write but the filter table, computed before anything is
 /// written (the lists are checked; the table is built once, inside the controller
 /// `begin` returns, so that no table-sized value moves through the configuration).
 #[derive(Debug, Clone)]
 struct Plan {
-    system: SystemPlan,
+    system: SystemKey,
     mcr: u32,
     ctrl1: u32,
     configuration: Configuration,
@@ -212,7 +211,7 @@ const fn kinetis_system(
     gate: (usize, u32),
     settings: &Settings,
     errors: &mut ConfigErrors,
-) -> Option<SystemPlan> {
+) -> Option<SystemKey> {
     let Some(pins) = target.board.pins(target.instance) else {
         return None;
     };
@@ -221,7 +220,7 @@ const fn kinetis_system(
         settings.use_alternate_tx_pin,
         settings.use_alternate_rx_pin,
     ) {
-        Ok((tx, rx)) => Some(SystemPlan::Kinetis(PortPlan::new(
+        Ok((tx, rx)) => Some(SystemKey::Kinetis(PortPlan::new(
             gate,
             tx,
             rx,
@@ -248,8 +247,8 @@ const fn imxrt_system(
     gate: (usize, u32),
     settings: &Settings,
     errors: &mut ConfigErrors,
-) -> Option<SystemPlan> {
-    let Some(pins) = target.board.imx_pins(target.instance) else {
+) -> Option<SystemKey> {
+    let Some(pins) = target.board.imx_pins_ref(target.instance) else {
         return None;
     };
     if settings.use_alternate_tx_pin {
@@ -259,14 +258,13 @@ const fn imxrt_system(
         *errors = errors.union(ConfigErrors::NO_ALTERNATE_RX_PIN);
     }
     match settings.can_clock {
-        CanClock::Imxrt(root) if errors.is_empty() => Some(SystemPlan::Imxrt(ImxrtPlan::new(
-            gate,
+        CanClock::Imxrt(root) if errors.is_empty() => Some(SystemKey::Imxrt {
+            clock_gate: gate,
             root,
-            pins.tx,
-            pins.rx,
-            settings.tx_pin_open_collector,
-            settings.rx_pin_pull_up,
-        ))),
+            pins,
+            open_drain: settings.tx_pin_open_collector,
+            pull_up: settings.rx_pin_pull_up,
+        }),
         _ => None,
     }
 }
@@ -587,7 +585,7 @@ impl<R: Registers> FlexCan<R> {
         if filters != ConfigErrors::NONE {
             return Err((BeginError::Config(filters), slot));
         }
-        if let Err(e) = plan.system.apply(sys) {
+        if let Err(e) = plan.system.plan().apply(sys) {
             return Err((BeginError::Config(e), slot));
         }
         slot.fill_lists(plan.configuration, primary, secondary);
@@ -628,7 +626,7 @@ impl<R: Registers> FlexCan<R> {
             Ok(p) => p,
             Err(e) => return Err((BeginError::Config(e), slot)),
         };
-        if let Err(e) = plan.system.apply(sys) {
+        if let Err(e) = plan.system.plan().apply(sys) {
             return Err((BeginError::Config(e), slot));
         }
         let polls = settings.handshake_bound();
@@ -738,7 +736,7 @@ impl<R: Registers> FlexCan<R> {
         if table.configuration() != plan.configuration {
             return Err(BeginError::Hardware(Error::InvalidArgument));
         }
-        plan.system.apply(sys).map_err(BeginError::Config)?;
+        plan.system.plan().apply(sys).map_err(BeginError::Config)?;
         configure::<R, L>(
             &mut regs,
             plan,
@@ -799,7 +797,7 @@ impl<R: Registers, L: Layout> FlexCan<R, L> {
         let filters = L::Table::check_lists(settings.configuration, primary, secondary);
         let plan = plan::<L>(target, settings, settings.configuration, filters)
             .map_err(BeginError::Config)?;
-        plan.system.apply(sys).map_err(BeginError::Config)?;
+        plan.system.plan().apply(sys).map_err(BeginError::Config)?;
         let polls = settings.handshake_bound();
         let bus_mode = bus_mode_of(settings);
         // The table is built once, in the controller, and written from there.

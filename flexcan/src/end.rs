@@ -63,7 +63,7 @@ impl<R: Registers, L: Layout> FlexCan<R, L> {
         if let Err(e) = self.stop() {
             return Err((self, e));
         }
-        self.system.release(sys);
+        self.system.plan().release(sys);
         Ok(self.regs)
     }
 

@@ -15,7 +15,7 @@ use twocan_core::Registers;
 
 use crate::begin_error::ConfigErrors;
 use crate::board::InstancePins;
-use crate::imxrt::ImxrtPlan;
+use crate::imxrt::{ClockRoot, ImxPins, ImxrtPlan};
 use crate::regs::pins::CanPin;
 use crate::regs::port::{PCR_MUX, PCR_ODE, PCR_PE, PCR_PS};
 use crate::regs::sim;
@@ -143,6 +143,50 @@ impl SystemPlan {
         match self {
             SystemPlan::Kinetis(p) => p.release(sys),
             SystemPlan::Imxrt(p) => p.release(sys),
+        }
+    }
+}
+
+/// A [`SystemPlan`] as a begun controller keeps it: the Kinetis plan itself (32 B), or
+/// on the RT1062 the choices it is made of with a reference to the pad table (the
+/// pads' names and addresses are not copied: issue 21's driver state). `begin` makes it
+/// ([`SystemKey::plan`] gives the plan back, for `end` and [`crate::FlexCan::system`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum SystemKey {
+    /// Kinetis: SIM gates and PORT pin control.
+    Kinetis(PortPlan),
+    /// i.MX RT1062: CCM clock root and gates, IOMUXC pads.
+    Imxrt {
+        clock_gate: (usize, u32),
+        root: ClockRoot,
+        pins: &'static ImxPins,
+        open_drain: bool,
+        pull_up: bool,
+    },
+}
+
+impl SystemKey {
+    /// The plan.
+    pub(crate) const fn plan(&self) -> SystemPlan {
+        match *self {
+            SystemKey::Kinetis(p) => SystemPlan::Kinetis(p),
+            SystemKey::Imxrt {
+                clock_gate,
+                root,
+                pins,
+                open_drain,
+                pull_up,
+            } => SystemPlan::Imxrt(ImxrtPlan::new(
+                clock_gate, root, pins.tx, pins.rx, open_drain, pull_up,
+            )),
+        }
+    }
+
+    /// The protocol engine clock in Hz ([`SystemPlan::can_clock_hz`]).
+    pub(crate) const fn can_clock_hz(&self) -> u32 {
+        match self {
+            SystemKey::Kinetis(_) => crate::settings::CAN_CLOCK_HZ,
+            SystemKey::Imxrt { root, .. } => root.hz(),
         }
     }
 }
