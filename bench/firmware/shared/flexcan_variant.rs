@@ -86,7 +86,7 @@ compile_error!(
 use twocan_core::split::{Parts, Rx, Rx0Irq, State, Tx, TxIrq};
 use twocan_core::{Error, FifoQueue, Filter, Registers};
 use twocan_flexcan::{
-    BeginError, Board, Configuration, FlexCan, FlexCanHw, Instance, Settings, Target,
+    BeginError, BeginPlan, Board, Configuration, FlexCan, FlexCanHw, Instance, Settings, Target,
 };
 
 pub const BITRATE: u32 = 500_000;
@@ -233,48 +233,61 @@ pub type OurRx<R> = Rx<'static, Hw<R>, RX, Q, 0, DONE, Fe>;
 pub type OurTxIrq<R> = TxIrq<'static, Hw<R>, RX, Q, 0, DONE, Fe>;
 pub type OurRxIrq<R> = Rx0Irq<'static, Hw<R>, RX, Q, 0, DONE, Fe>;
 
+/// The settings checked at compile time for FlexCAN0 of the Teensy 3.6 (`BeginPlan`:
+/// settings `begin` would refuse do not build).
+pub const CHECKED: BeginPlan =
+    BeginPlan::new_or_panic(TARGET, &SETTINGS, Configuration::Filters8_0);
+
 /// `begin` with [`SETTINGS`] and [`FILTERS`] on the registers `regs()` gives and the
-/// SIM/PORT registers `sys`, then the controller for the split driver. `RETRIES` more
-/// attempts, each on a fresh register handle, after a handshake that timed out (the QEMU
-/// stand-in acknowledges from an interrupt whose rate follows host time; 0 on hardware).
+/// SIM/PORT registers `sys`, the controller written **in place** into `state`
+/// (`State::split_with`: no controller value moves through the configuration), then
+/// split. `RETRIES` more attempts (a failed `split_with` leaves the state empty), each
+/// on a fresh register handle, after a handshake that timed out (the QEMU stand-in
+/// acknowledges from an interrupt whose rate follows host time; 0 on hardware).
 #[inline(always)]
-pub fn configure<const RETRIES: u32, R: Registers, S: Registers>(
+pub fn start<const RETRIES: u32, R: Registers + Send + Sync, S: Registers>(
+    state: &'static OurState<R>,
     regs: impl Fn() -> R,
     sys: &mut S,
-) -> Result<Hw<R>, BeginError> {
-    #[cfg(all(feature = "lean", not(feature = "planner")))]
-    {
-        // The filter table planned and the settings checked at compile time, written
-        // by `begin_checked` (no check links into the firmware).
-        use twocan_flexcan::planner::PlanOptions;
-        use twocan_flexcan::{const_plan, BeginPlan};
-        const CHECKED: BeginPlan =
-            BeginPlan::new_or_panic(TARGET, &SETTINGS, Configuration::Filters8_0);
-        let plan = const_plan!(FILTERS, PlanOptions::new(Configuration::Filters8_0)).planned();
-        let mut retries = 0;
-        loop {
-            match FlexCan::begin_checked(regs(), sys, &CHECKED, plan) {
-                Err(BeginError::Hardware(Error::Timeout)) if retries < RETRIES => retries += 1,
-                attempt => return attempt,
-            }
-        }
-    }
+) -> Result<OurParts<R>, Error> {
+    let hardware = |e: BeginError| match e {
+        BeginError::Hardware(e) => e,
+        _ => Error::InvalidArgument,
+    };
     #[cfg(any(feature = "full", feature = "planner"))]
-    {
-        // `begin` compiles the list at run time straight into the table's `static`.
-        let Some(mut slot) = TABLE.take() else {
-            return Err(BeginError::Hardware(Error::InvalidArgument));
-        };
-        let mut retries = 0;
-        loop {
-            match FlexCan::begin_in(regs(), sys, TARGET, &SETTINGS, &FILTERS, &[], slot) {
-                Err((BeginError::Hardware(Error::Timeout), back)) if retries < RETRIES => {
-                    retries += 1;
-                    slot = back;
+    let mut table = TABLE.take();
+    let mut retries = 0;
+    loop {
+        #[cfg(all(feature = "lean", not(feature = "planner")))]
+        let attempt = state.split_with(|slot| {
+            // The filter table planned and the settings checked at compile time,
+            // written by `begin_checked_in_place` (no check links into the firmware).
+            use twocan_flexcan::const_plan;
+            use twocan_flexcan::planner::PlanOptions;
+            let plan =
+                const_plan!(FILTERS, PlanOptions::new(Configuration::Filters8_0)).planned();
+            FlexCan::begin_checked_in_place(slot, regs(), sys, &CHECKED, plan).map_err(hardware)
+        });
+        #[cfg(any(feature = "full", feature = "planner"))]
+        let attempt = {
+            // `begin` compiles the list at run time straight into the table's `static`;
+            // a failed attempt gives the table back for the next.
+            state.split_with(|slot| {
+                let Some(t) = table.take() else {
+                    return Err(Error::InvalidArgument);
+                };
+                match FlexCan::begin_in_place(slot, regs(), sys, &CHECKED, &FILTERS, &[], t) {
+                    Ok(hw) => Ok(hw),
+                    Err((e, t)) => {
+                        table = Some(t);
+                        Err(hardware(e))
+                    }
                 }
-                Err((e, _)) => return Err(e),
-                Ok(hw) => return Ok(hw),
-            }
+            })
+        };
+        match attempt {
+            Err(Error::Timeout) if retries < RETRIES => retries += 1,
+            attempt => return attempt,
         }
     }
 }

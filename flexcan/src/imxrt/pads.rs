@@ -145,6 +145,22 @@ pub const fn rx_pad(pull_up: bool) -> u32 {
     }
 }
 
+/// CAN1's pins (Teensy 4.x pins 22 and 23).
+pub const CAN1: ImxPins = ImxPins {
+    tx: CAN1_TX,
+    rx: CAN1_RX,
+};
+/// CAN2's pins (Teensy 4.x pins 1 and 0).
+pub const CAN2: ImxPins = ImxPins {
+    tx: CAN2_TX,
+    rx: CAN2_RX,
+};
+/// CAN3's pins (Teensy 4.x pins 31 and 30).
+pub const CAN3: ImxPins = ImxPins {
+    tx: CAN3_TX,
+    rx: CAN3_RX,
+};
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -165,19 +181,3 @@ mod tests {
         }
     }
 }
-
-/// CAN1's pins (Teensy 4.x pins 22 and 23).
-pub const CAN1: ImxPins = ImxPins {
-    tx: CAN1_TX,
-    rx: CAN1_RX,
-};
-/// CAN2's pins (Teensy 4.x pins 1 and 0).
-pub const CAN2: ImxPins = ImxPins {
-    tx: CAN2_TX,
-    rx: CAN2_RX,
-};
-/// CAN3's pins (Teensy 4.x pins 31 and 30).
-pub const CAN3: ImxPins = ImxPins {
-    tx: CAN3_TX,
-    rx: CAN3_RX,
-};

@@ -208,18 +208,15 @@ fn ours_take_completion(tx: &mut variant::OurTx<R>) -> Option<twocan_core::Compl
     tx.take_completion()
 }
 
-/// The application's configuration: `begin`, then the split into the `static` state.
+/// The application's configuration: `begin` in place in the `static` state, split.
 #[inline(never)]
 fn ours_configure() -> variant::OurParts<R> {
     // SAFETY: the stand-in is used by this driver alone from now on (the hand-written
     // service measured before has given it up).
     let regs = || unsafe { RamFlexCanRegs::new() };
-    let Ok(hw) = variant::configure::<20, _, _>(regs, &mut NoSystem) else {
-        fail("twocan: begin");
-    };
-    match CAN.split(hw) {
+    match variant::start::<20, _, _>(&CAN, regs, &mut NoSystem) {
         Ok(p) => p,
-        Err(_) => fail("twocan: split"),
+        Err(_) => fail("twocan: begin and split"),
     }
 }
 

@@ -36,21 +36,18 @@ type R = Can0At;
 #[no_mangle]
 static BENCH_CAN_STATE: variant::OurState<R> = variant::OurState::new();
 
-fn start() -> Option<variant::Hw<R>> {
+fn start() -> Option<variant::OurParts<R>> {
     // SAFETY: FlexCAN0's register block (K66 RM memory map "CAN0"); nothing else in this
     // firmware touches it.
     let regs = || unsafe { Can0At::new() };
     // SAFETY: base 0 with absolute offsets, the window SIM..PORTE: `begin` only touches
     // the clock gates and the PCRs of FlexCAN0's pins.
     let mut sys: SystemRegs = unsafe { Mmio::new(0) };
-    variant::configure::<0, _, _>(regs, &mut sys).ok()
+    variant::start::<0, _, _>(&BENCH_CAN_STATE, regs, &mut sys).ok()
 }
 
-fn loop_back(hw: variant::Hw<R>) -> bool {
+fn loop_back(mut p: variant::OurParts<R>) -> bool {
     let Ok(frame) = Frame::standard(ID, &DATA) else {
-        return false;
-    };
-    let Ok(mut p) = BENCH_CAN_STATE.split(hw) else {
         return false;
     };
     if p.tx.try_send(&frame).is_err() {
