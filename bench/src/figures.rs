@@ -293,6 +293,24 @@ impl Figures {
                         cause: Vec::new(),
                     });
                 }
+                targets.push(Target {
+                    backend,
+                    variant,
+                    key: "rx_overrun",
+                    label: "receive handler, one frame with the FIFO's overrun flag set / the \
+                            same frame without (error and overrun handling out of the hot \
+                            path: the event is counted out of line, paid only when it \
+                            happens; extra line)"
+                        .into(),
+                    bound: None,
+                    per_opt: ratio_of(&|c| {
+                        Ok((
+                            region(c, "twocan.rx_irq.overrun")?,
+                            region(c, "twocan.rx_irq")?,
+                        ))
+                    })?,
+                    cause: Vec::new(),
+                });
                 if backend == Backend::BxCan {
                     targets.push(Target {
                         backend,

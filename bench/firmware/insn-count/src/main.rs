@@ -35,7 +35,6 @@ use core::hint::black_box;
 
 use cortex_m_rt::entry;
 use twocan_bxcan::FilterPlan;
-use twocan_core::Completion;
 use twocan_core::{Frame, RxFrame, TxOutcome};
 
 #[path = "../../shared/feature_sets.rs"]
@@ -55,18 +54,19 @@ use qemu::{
 };
 use ram_bxcan_crate::RamCan1;
 use ram_can::{
-    loaded, reg_read, released, reset_block, restore, save, snapshots, Snapshots, DATA, ID, REGS,
+    loaded, reg_read, reg_write, released, reset_block, restore, save, snapshots, Snapshots, DATA,
+    ID, REGS,
 };
-use variant::{OurParts, OurRx, OurRxIrq, OurState, OurTx, OurTxIrq, DONE, RX, TXQ};
+use variant::{OurParts, OurRx, OurRxIrq, OurState, OurTx, OurTxIrq, DONE};
 
 /// The measured regions, in the order of their numbers; a variant with completions
 /// (full, `lean+done`) measures the completion's take too.
 #[cfg(not(any(feature = "full", feature = "done")))]
-const REGIONS: &[&str] = REGIONS_ALL.split_at(13).0;
+const REGIONS: &[&str] = REGIONS_ALL.split_at(14).0;
 #[cfg(any(feature = "full", feature = "done"))]
 const REGIONS: &[&str] = &REGIONS_ALL;
 
-const REGIONS_ALL: [&str; 14] = [
+const REGIONS_ALL: [&str; 15] = [
     "empty",
     "twocan.tx.direct",
     "twocan.tx.one_busy",
@@ -80,6 +80,7 @@ const REGIONS_ALL: [&str; 14] = [
     "bxcan.receive",
     "bxcan.rx0.receive",
     "twocan.tx_irq.done.unloaded",
+    "twocan.rx_irq.overrun",
     // with completions only
     "twocan.take_completion",
 ];
@@ -100,8 +101,11 @@ const THEIRS_TRANSMIT_ONE_BUSY: usize = 9;
 const THEIRS_RECEIVE: usize = 10;
 const THEIRS_RX0_RECEIVE: usize = 11;
 const OURS_TX_IRQ_UNLOADED: usize = 12;
+/// The receive handler with one frame and FIFO 0's overrun flag set (`FOVR0`, RM0410
+/// §40.8.5): the rare path, counted out of line.
+const OURS_RX_IRQ_OVERRUN: usize = 13;
 #[cfg(any(feature = "full", feature = "done"))]
-const OURS_TAKE_COMPLETION: usize = 13;
+const OURS_TAKE_COMPLETION: usize = 14;
 
 /// What a frame's round trip runs, per side: the send, the handlers the configuration
 /// has per frame, the take (and, with completions, the completion's take). The lean
@@ -195,7 +199,7 @@ fn ours_receive(rx: &mut OurRx) -> Option<RxFrame> {
 
 #[cfg(any(feature = "full", feature = "done"))]
 #[inline(never)]
-fn ours_take_completion(tx: &mut OurTx) -> Option<Completion> {
+fn ours_take_completion(tx: &mut OurTx) -> Option<twocan_core::Completion> {
     tx.take_completion()
 }
 
@@ -289,6 +293,24 @@ fn run_ours(snap: &Snapshots, p: &mut OurParts) {
                 && CAN.rx_stats().count == 0,
             "twocan receive",
         );
+
+        // The same frame with FIFO 0's overrun flag set: the handler takes the frame as
+        // above and counts the overrun out of line (`fifo_events`).
+        restore(&snap.rx_one);
+        reg_write(
+            twocan_bxcan::regs::RF0R,
+            reg_read(twocan_bxcan::regs::RF0R) | twocan_bxcan::regs::rfxr::FOVR,
+        );
+        let overruns = CAN.error_stats().hardware_overruns;
+        let h = black_box(&mut p.rx0_irq);
+        measure::<OURS_RX_IRQ_OVERRUN, _>(|| ours_rx_irq(h));
+        check(
+            released()
+                && CAN.rx_stats().count == 1
+                && CAN.error_stats().hardware_overruns == overruns.wrapping_add(1),
+            "twocan rx irq with an overrun: the frame taken, the overrun counted",
+        );
+        check(p.rx.receive().is_ok(), "twocan receive after an overrun");
 
         restore(&snap.tx_one_busy);
         let (t, f) = (black_box(&mut p.tx), black_box(&frame));
