@@ -53,8 +53,8 @@ mod firmware {
         twocan_teensy4::info!("teensy4-loopback-lean: CAN1 in loop-back, a frame every second");
         let token = Can1::take().unwrap_or_else(|| rt::halt(CAN_HALT));
         // The pass-all filter planned at compile time, for the settings' partition.
-        let table = const_plan_large!(LOOPBACK_FILTERS, PlanOptions::new(SETTINGS.configuration))
-            .planned();
+        let table =
+            const_plan_large!(LOOPBACK_FILTERS, PlanOptions::new(SETTINGS.configuration)).planned();
         let (mut tx, mut rx) = CAN1
             .start_in_place(
                 Can1::TARGET,
