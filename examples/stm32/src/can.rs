@@ -1,6 +1,7 @@
 //! The split driver of a bxCAN instance as the examples use it: its shared state and its
-//! four interrupt handlers in one `static` ([`CanState`], the library's
-//! `twocan_bxcan::rt::IrqState`, the same type as `twocan-stm32f7`'s), and `start`,
+//! four interrupt handlers in one `static` ([`CanState`], or the lean choice
+//! [`LeanState`]: the library's `twocan_bxcan::rt::IrqState`, the same types as
+//! `twocan-stm32f7`'s), and `start`,
 //! which configures the controller in place in the state and puts the handlers in
 //! place **before** it unmasks the part's lines. The vectors
 //! (`crate::can1_vectors!`, `crate::can2_vectors!`) call the library's

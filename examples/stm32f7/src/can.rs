@@ -1,6 +1,6 @@
 //! The split driver of a bxCAN instance as the examples use it: its shared state and
-//! its four interrupt handlers in one `static` ([`CanState`], the library's
-//! `twocan_bxcan::rt::IrqState`), run by the library's own entry points `CAN1_TX`,
+//! its four interrupt handlers in one `static` ([`CanState`], or the lean choice
+//! [`LeanState`]: the library's `twocan_bxcan::rt::IrqState`), run by the library's own entry points `CAN1_TX`,
 //! `CAN1_RX0`, `CAN1_RX1`, `CAN1_SCE` (and `CAN2_…`; one handler per line, RM0410
 //! §40.8): the examples define no CAN vector. `start` configures the controller **in
 //! place** in the state (an in-place constructor such as `BxCan::can1_in`: no
