@@ -30,7 +30,7 @@ done
 has stm32 && for board in nucleo-f767zi disco-f746g; do
     cargo build --quiet --release --target "$target" -p twocan-stm32f7 --features "$board" --bins
     mkdir -p "$out/$board"
-    for bin in loopback filters app async-echo can1-can2; do
+    for bin in loopback loopback-lean filters app async-echo can1-can2; do
         if [ -f "$rel/stm32f7-$bin" ] && { [ "$bin" != can1-can2 ] || [ "$board" = nucleo-f767zi ]; }; then
             cp "$rel/stm32f7-$bin" "$out/$board/"
         fi
@@ -42,7 +42,7 @@ has stm32 && for spec in bluepill:thumbv7m-none-eabi nucleo-f446re:thumbv7em-non
     IFS=: read -r board tgt <<<"$spec"
     cargo build --quiet --release --target "$tgt" -p twocan-stm32 --features "$board" --bins
     mkdir -p "$out/$board"
-    for bin in loopback filters app async-echo can1-can2; do
+    for bin in loopback loopback-lean filters app async-echo can1-can2; do
         if [ -f "$tdir/$tgt/release/stm32-$bin" ] && { [ "$bin" != can1-can2 ] || [ "$board" = nucleo-f446re ]; }; then
             cp "$tdir/$tgt/release/stm32-$bin" "$out/$board/"
         fi
@@ -99,7 +99,7 @@ if has teensy; then
     for board in teensy41; do
         cargo build --quiet --release --target "$target" -p twocan-teensy4 --features "$board" --bins
         mkdir -p "$out/$board"
-        for bin in loopback filters app async-echo can1-can2; do
+        for bin in loopback loopback-lean filters app async-echo can1-can2; do
             cp "$rel/teensy4-$bin" "$out/$board/"
         done
     done

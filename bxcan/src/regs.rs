@@ -84,9 +84,11 @@ const fn bit(n: u32) -> u32 {
 // register boundary addresses")
 // ---------------------------------------------------------------------------------------
 
-/// Base address of CAN1 (master; STM32F74x/F75x/F76x/F77x).
+/// Base address of CAN1 (master; STM32F74x/F75x/F76x/F77x). The same on the F446
+/// (RM0390 §2.2.2 "Memory map") and the F103's `CAN` (RM0008 §3.3 "Memory map": bxCAN1).
 pub const CAN1_BASE: usize = 0x4000_6400;
-/// Base address of CAN2 (slave of CAN1; STM32F74x/F75x/F76x/F77x).
+/// Base address of CAN2 (slave of CAN1; STM32F74x/F75x/F76x/F77x; the same on the F446,
+/// RM0390 §2.2.2, and the F105/F107, RM0008 §3.3).
 pub const CAN2_BASE: usize = 0x4000_6800;
 /// Base address of CAN3 (single CAN with its own filters; STM32F76x/F77x only).
 pub const CAN3_BASE: usize = 0x4000_3400;
@@ -106,6 +108,32 @@ pub type ControlRegs = twocan_core::Mmio<FILTERS_START>;
 /// §40.9.4): held in one `static` and lent to both (`&'static FilterRegs`), its
 /// writes made under a critical section.
 pub type FilterRegs = twocan_core::Mmio<BLOCK_END, FILTERS_START>;
+
+/// [`CanRegs`] with the base address a constant (`twocan_core::Fixed`): a zero-sized
+/// handle, so the per-frame code reaches each register at an address known at compile
+/// time, with no base to load (issue 21). The same window (`0..BLOCK_END`) and bounds.
+/// From the HAL hand-over's `into_registers_at` (no `unsafe` in the program), or
+/// `Fixed::new` (`unsafe`, the promise of [`twocan_core::Mmio::new`]).
+pub type CanRegsAt<const BASE: usize> = twocan_core::Fixed<BASE, BLOCK_END>;
+/// [`ControlRegs`] with the base address a constant: CAN2's registers, or CAN1's
+/// control and mailbox registers when it shares its filters with CAN2.
+pub type ControlRegsAt<const BASE: usize> = twocan_core::Fixed<BASE, FILTERS_START>;
+
+/// CAN1's whole block (CAN1 alone; the F103's `CAN`) at [`CAN1_BASE`].
+///
+/// ```
+/// use twocan_bxcan::regs::Can1At;
+/// assert_eq!(core::mem::size_of::<Can1At>(), 0);
+/// ```
+pub type Can1At = CanRegsAt<CAN1_BASE>;
+/// CAN1's control and mailbox registers (dual CAN: the filters shared with CAN2) at
+/// [`CAN1_BASE`].
+pub type Can1ControlAt = ControlRegsAt<CAN1_BASE>;
+/// CAN2's control and mailbox registers (it has no filters of its own) at
+/// [`CAN2_BASE`].
+pub type Can2At = ControlRegsAt<CAN2_BASE>;
+/// CAN3's whole block, with its own filters (STM32F76x/F77x), at [`CAN3_BASE`].
+pub type Can3At = CanRegsAt<CAN3_BASE>;
 
 /// Filter banks in the dual-CAN filter block of CAN1, shared by CAN1 and CAN2
 /// (RM0410 40.2: "28 filter banks shared between CAN1 and CAN2 for dual CAN").

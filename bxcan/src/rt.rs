@@ -75,7 +75,7 @@ use core::sync::atomic::{AtomicU8, Ordering};
 use twocan_core::irq_cell::IrqCell;
 use twocan_core::split::{Rx, Rx0Irq, Rx1Irq, State, StatusIrq, Tx, TxIrq};
 use twocan_core::txqueue::TxQueue;
-use twocan_core::{Error, Leftovers, Parts, Registers, UnsplitError};
+use twocan_core::{Error, Features, Leftovers, Parts, Registers, UnsplitError};
 
 use crate::filters::{FmiMap, LOOKUP_KEYS, MAX_FMI};
 use crate::instance::Instance;
@@ -264,7 +264,10 @@ type Hw<R, F, const K: usize, const M: usize, const SWITCH: bool> = BxCan<R, F, 
 /// The split driver's state of one bxCAN instance together with its four interrupt
 /// handlers, for a `static` (all zeros: `.bss`). `RX`/`RX1`: the FIFO 0 and FIFO 1
 /// receive rings (frames); `Q`: the transmit queue; `DONE`: the completion ring; `K`:
-/// the controller's lookup capacity.
+/// the controller's lookup capacity; `M`: the match indices its filter map holds per
+/// FIFO; `SWITCH`: whether the filters may be replaced while running; `Fe`: the split
+/// driver's compile-time feature set (`twocan_core::Full` by default,
+/// `twocan_core::Lean`: no statistics, no time stamps).
 pub struct IrqState<
     R: Registers + 'static,
     F: Registers + 'static,
@@ -275,12 +278,13 @@ pub struct IrqState<
     const K: usize = LOOKUP_KEYS,
     const M: usize = MAX_FMI,
     const SWITCH: bool = true,
+    Fe: Features = twocan_core::Full,
 > {
-    state: State<Hw<R, F, K, M, SWITCH>, RX, Q, RX1, DONE>,
-    tx: IrqCell<TxIrq<'static, Hw<R, F, K, M, SWITCH>, RX, Q, RX1, DONE>>,
-    rx0: IrqCell<Rx0Irq<'static, Hw<R, F, K, M, SWITCH>, RX, Q, RX1, DONE>>,
-    rx1: IrqCell<Rx1Irq<'static, Hw<R, F, K, M, SWITCH>, RX, Q, RX1, DONE>>,
-    sce: IrqCell<StatusIrq<'static, Hw<R, F, K, M, SWITCH>, RX, Q, RX1, DONE>>,
+    state: State<Hw<R, F, K, M, SWITCH>, RX, Q, RX1, DONE, Fe>,
+    tx: IrqCell<TxIrq<'static, Hw<R, F, K, M, SWITCH>, RX, Q, RX1, DONE, Fe>>,
+    rx0: IrqCell<Rx0Irq<'static, Hw<R, F, K, M, SWITCH>, RX, Q, RX1, DONE, Fe>>,
+    rx1: IrqCell<Rx1Irq<'static, Hw<R, F, K, M, SWITCH>, RX, Q, RX1, DONE, Fe>>,
+    sce: IrqCell<StatusIrq<'static, Hw<R, F, K, M, SWITCH>, RX, Q, RX1, DONE, Fe>>,
 }
 
 /// The transmit and receive halves [`IrqState::start_on`] gives the thread side.
@@ -294,9 +298,10 @@ pub type Halves<
     const K: usize,
     const M: usize,
     const SWITCH: bool,
+    Fe,
 > = (
-    Tx<'static, Hw<R, F, K, M, SWITCH>, RX, Q, RX1, DONE>,
-    Rx<'static, Hw<R, F, K, M, SWITCH>, RX, Q, RX1, DONE>,
+    Tx<'static, Hw<R, F, K, M, SWITCH>, RX, Q, RX1, DONE, Fe>,
+    Rx<'static, Hw<R, F, K, M, SWITCH>, RX, Q, RX1, DONE, Fe>,
 );
 
 /// Why [`IrqState::start_on`] did not start; the controller comes back with it, and
@@ -369,11 +374,13 @@ impl<
         const K: usize,
         const M: usize,
         const SWITCH: bool,
-    > Default for IrqState<R, F, RX, Q, RX1, DONE, K, M, SWITCH>
+        Fe,
+    > Default for IrqState<R, F, RX, Q, RX1, DONE, K, M, SWITCH, Fe>
 where
     R: Registers + 'static,
     F: Registers + 'static,
     Q: TxQueue + 'static,
+    Fe: Features,
 {
     fn default() -> Self {
         Self::new()
@@ -390,11 +397,13 @@ impl<
         const K: usize,
         const M: usize,
         const SWITCH: bool,
-    > IrqState<R, F, RX, Q, RX1, DONE, K, M, SWITCH>
+        Fe,
+    > IrqState<R, F, RX, Q, RX1, DONE, K, M, SWITCH, Fe>
 where
     R: Registers + 'static,
     F: Registers + 'static,
     Q: TxQueue + 'static,
+    Fe: Features,
 {
     /// Empty (all zeros: `.bss`).
     pub const fn new() -> Self {
@@ -408,7 +417,7 @@ where
     }
 
     /// The split driver's shared state (statistics, error state).
-    pub fn state(&self) -> &State<Hw<R, F, K, M, SWITCH>, RX, Q, RX1, DONE> {
+    pub fn state(&self) -> &State<Hw<R, F, K, M, SWITCH>, RX, Q, RX1, DONE, Fe> {
         &self.state
     }
 
@@ -433,11 +442,13 @@ impl<
         const K: usize,
         const M: usize,
         const SWITCH: bool,
-    > Handlers for IrqState<R, F, RX, Q, RX1, DONE, K, M, SWITCH>
+        Fe,
+    > Handlers for IrqState<R, F, RX, Q, RX1, DONE, K, M, SWITCH, Fe>
 where
     R: Registers + 'static,
     F: Registers + 'static,
     Q: TxQueue + 'static,
+    Fe: Features,
     Self: Sync,
 {
     #[inline]
@@ -461,11 +472,13 @@ impl<
         const K: usize,
         const M: usize,
         const SWITCH: bool,
-    > IrqState<R, F, RX, Q, RX1, DONE, K, M, SWITCH>
+        Fe,
+    > IrqState<R, F, RX, Q, RX1, DONE, K, M, SWITCH, Fe>
 where
     R: Registers + 'static,
     F: Registers + 'static,
     Q: TxQueue + 'static,
+    Fe: Features,
     FmiMap<K, M>: Send,
     Self: Sync,
 {
@@ -486,8 +499,10 @@ where
         lines: [L; 4],
         priorities: Priorities,
         nvic: &mut impl Nvic<L>,
-    ) -> Result<Halves<R, F, RX, Q, RX1, DONE, K, M, SWITCH>, (StartError, Hw<R, F, K, M, SWITCH>)>
-    {
+    ) -> Result<
+        Halves<R, F, RX, Q, RX1, DONE, K, M, SWITCH, Fe>,
+        (StartError, Hw<R, F, K, M, SWITCH>),
+    > {
         if self.state.hardware().is_some() {
             return Err((StartError::AlreadySplit, hw));
         }
@@ -537,7 +552,7 @@ where
         lines: [L; 4],
         priorities: Priorities,
         nvic: &mut impl Nvic<L>,
-    ) -> Result<Halves<R, F, RX, Q, RX1, DONE, K, M, SWITCH>, StartError> {
+    ) -> Result<Halves<R, F, RX, Q, RX1, DONE, K, M, SWITCH, Fe>, StartError> {
         if self.state.hardware().is_some() {
             return Err(StartError::AlreadySplit);
         }
@@ -577,13 +592,13 @@ where
     #[allow(clippy::type_complexity, clippy::result_large_err)]
     pub fn stop_on<L: Copy>(
         &'static self,
-        tx: Tx<'static, Hw<R, F, K, M, SWITCH>, RX, Q, RX1, DONE>,
-        rx: Rx<'static, Hw<R, F, K, M, SWITCH>, RX, Q, RX1, DONE>,
+        tx: Tx<'static, Hw<R, F, K, M, SWITCH>, RX, Q, RX1, DONE, Fe>,
+        rx: Rx<'static, Hw<R, F, K, M, SWITCH>, RX, Q, RX1, DONE, Fe>,
         lines: [L; 4],
         nvic: &mut impl Nvic<L>,
     ) -> Result<
         (Hw<R, F, K, M, SWITCH>, Leftovers),
-        (StopError, Halves<R, F, RX, Q, RX1, DONE, K, M, SWITCH>),
+        (StopError, Halves<R, F, RX, Q, RX1, DONE, K, M, SWITCH, Fe>),
     > {
         if !core::ptr::eq(tx.state(), &self.state) || !core::ptr::eq(rx.state(), &self.state) {
             return Err((StopError::Foreign, (tx, rx)));
@@ -712,11 +727,13 @@ mod f7 {
             const K: usize,
             const M: usize,
             const SWITCH: bool,
-        > IrqState<R, F, RX, Q, RX1, DONE, K, M, SWITCH>
+            Fe,
+        > IrqState<R, F, RX, Q, RX1, DONE, K, M, SWITCH, Fe>
     where
         R: Registers + 'static,
         F: Registers + 'static,
         Q: TxQueue + 'static,
+        Fe: Features,
         FmiMap<K, M>: Send,
         Self: Sync,
     {
@@ -729,7 +746,7 @@ mod f7 {
             priorities: Priorities,
             nvic: &mut impl Nvic<Interrupt>,
         ) -> Result<
-            Halves<R, F, RX, Q, RX1, DONE, K, M, SWITCH>,
+            Halves<R, F, RX, Q, RX1, DONE, K, M, SWITCH, Fe>,
             (StartError, Hw<R, F, K, M, SWITCH>),
         > {
             match lines(hw.instance()) {
@@ -748,7 +765,7 @@ mod f7 {
             ) -> Result<&mut Hw<R, F, K, M, SWITCH>, Error>,
             priorities: Priorities,
             nvic: &mut impl Nvic<Interrupt>,
-        ) -> Result<Halves<R, F, RX, Q, RX1, DONE, K, M, SWITCH>, StartError> {
+        ) -> Result<Halves<R, F, RX, Q, RX1, DONE, K, M, SWITCH, Fe>, StartError> {
             match lines(instance) {
                 Some(l) => self.start_in_place_on(instance, init, l, priorities, nvic),
                 None => Err(StartError::NoInterrupts),
@@ -759,12 +776,12 @@ mod f7 {
         #[allow(clippy::type_complexity, clippy::result_large_err)]
         pub fn stop(
             &'static self,
-            tx: Tx<'static, Hw<R, F, K, M, SWITCH>, RX, Q, RX1, DONE>,
-            rx: Rx<'static, Hw<R, F, K, M, SWITCH>, RX, Q, RX1, DONE>,
+            tx: Tx<'static, Hw<R, F, K, M, SWITCH>, RX, Q, RX1, DONE, Fe>,
+            rx: Rx<'static, Hw<R, F, K, M, SWITCH>, RX, Q, RX1, DONE, Fe>,
             nvic: &mut impl Nvic<Interrupt>,
         ) -> Result<
             (Hw<R, F, K, M, SWITCH>, Leftovers),
-            (StopError, Halves<R, F, RX, Q, RX1, DONE, K, M, SWITCH>),
+            (StopError, Halves<R, F, RX, Q, RX1, DONE, K, M, SWITCH, Fe>),
         > {
             let instance = tx.hardware().instance();
             match lines(instance) {

@@ -98,6 +98,35 @@ fn base_addresses_match_the_pac() {
     assert_eq!(Instance::Can3.filter_banks(), 14);
 }
 
+/// The window of a fixed-base register type: (base, start, end).
+fn window<const B: usize, const E: usize, const S: usize>(
+    _: std::marker::PhantomData<twocan_core::Fixed<B, E, S>>,
+) -> (usize, usize, usize) {
+    (B, S, E)
+}
+
+#[test]
+fn fixed_register_types_are_at_the_pac_s_addresses() {
+    use std::marker::PhantomData as T;
+    let (whole, control) = (regs::BLOCK_END, regs::FILTERS_START);
+    assert_eq!(
+        window(T::<regs::Can1At>),
+        (pac::CAN1::PTR as usize, 0, whole)
+    );
+    assert_eq!(
+        window(T::<regs::Can1ControlAt>),
+        (pac::CAN1::PTR as usize, 0, control)
+    );
+    assert_eq!(
+        window(T::<regs::Can2At>),
+        (pac::CAN2::PTR as usize, 0, control)
+    );
+    assert_eq!(
+        window(T::<regs::Can3At>),
+        (pac::CAN3::PTR as usize, 0, whole)
+    );
+}
+
 #[test]
 fn register_offsets_match_the_pac() {
     let rb = block();

@@ -98,3 +98,19 @@ fn the_driver_base_addresses_hold_on_the_f1() {
     // What the driver's register map assumes, on the F103: its CAN where the F7's CAN1 is.
     assert_eq!(f103::CAN::PTR as usize, twocan_bxcan::regs::CAN1_BASE);
 }
+
+/// The base of a fixed-base register type.
+fn base<const B: usize, const E: usize, const S: usize>(
+    _: std::marker::PhantomData<twocan_core::Fixed<B, E, S>>,
+) -> usize {
+    B
+}
+
+#[test]
+fn the_fixed_register_type_of_the_f103_s_can_is_at_the_pac_s_address() {
+    use std::marker::PhantomData as T;
+    assert_eq!(
+        base(T::<twocan_bxcan::regs::Can1At>),
+        f103::CAN::PTR as usize
+    );
+}

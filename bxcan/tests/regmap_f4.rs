@@ -123,3 +123,19 @@ fn the_driver_base_addresses_hold_on_the_f446() {
     assert_eq!(Instance::Can2.filter_base(), regs::CAN1_BASE);
     assert_eq!(Instance::Can1.filter_banks(), 28);
 }
+
+/// The base of a fixed-base register type.
+fn base<const B: usize, const E: usize, const S: usize>(
+    _: std::marker::PhantomData<twocan_core::Fixed<B, E, S>>,
+) -> usize {
+    B
+}
+
+#[test]
+fn the_fixed_register_types_of_the_f446_are_at_the_pac_s_addresses() {
+    use std::marker::PhantomData as T;
+    use twocan_bxcan::regs::{Can1At, Can1ControlAt, Can2At};
+    assert_eq!(base(T::<Can1At>), f446::CAN1::PTR as usize);
+    assert_eq!(base(T::<Can1ControlAt>), f446::CAN1::PTR as usize);
+    assert_eq!(base(T::<Can2At>), f446::CAN2::PTR as usize);
+}

@@ -94,6 +94,23 @@ impl<const END: usize, const START: usize> Mmio<END, START> {
         };
         (Mmio { base: self.base }, Mmio { base: self.base })
     }
+
+    /// The same window with its base a constant ([`Fixed`]), when `BASE` is this
+    /// window's base: the promise of [`Mmio::new`] moves to the zero-sized handle, and
+    /// this value is consumed, so the registers still have one owner (a HAL hand-over
+    /// that built the window from a consumed singleton gives a firmware the fixed
+    /// registers this way, with no `unsafe` in the program).
+    ///
+    /// Errors: the window back when its base is not `BASE`.
+    pub fn into_fixed<const BASE: usize>(self) -> Result<Fixed<BASE, END, START>, Self> {
+        if self.base != BASE {
+            return Err(self);
+        }
+        // SAFETY: `self` carried `Mmio::new`'s promise for `BASE + START .. BASE + END`
+        // (its base is `BASE`, checked above) and is consumed here: the promise passes
+        // to the one value returned.
+        Ok(unsafe { Fixed::new() })
+    }
 }
 
 impl<const END: usize, const START: usize> Registers for Mmio<END, START> {
@@ -204,5 +221,16 @@ mod tests {
         assert_eq!((low.read32(4), high.read32(20)), (7, 9));
         assert_eq!(block[1], 7);
         assert_eq!(block[5], 9);
+    }
+
+    #[test]
+    fn a_window_becomes_fixed_only_at_its_own_base() {
+        const AT: usize = 0x4000_6400;
+        // SAFETY: never read or written here (a device address on the host).
+        let w: Mmio<0x200> = unsafe { Mmio::new(AT) };
+        let w = w.into_fixed::<0x4000_6800>().unwrap_err();
+        assert_eq!(w.base(), AT, "another base: the window comes back");
+        let fixed: Fixed<AT, 0x200> = w.into_fixed().map_err(|w| w.base()).unwrap();
+        assert_eq!(core::mem::size_of_val(&fixed), 0);
     }
 }

@@ -66,7 +66,7 @@ use crate::controller::{Can, Failed, Init};
 use crate::filter_block;
 use crate::instance::Instance;
 use crate::planner::{FifoPolicy, PlanOptions};
-use crate::regs::{CanRegs, ControlRegs, FilterRegs};
+use crate::regs::{CanRegs, CanRegsAt, ControlRegs, ControlRegsAt, FilterRegs};
 
 #[cfg(feature = "hal-stm32f1")]
 pub mod f1;
@@ -466,6 +466,46 @@ impl<P> HandedOver<CanRegs, CanRegs, P> {
         self.into_single(config)
     }
 
+    /// [`HandedOver::into_registers`] with the base address a constant: the registers
+    /// as a zero-sized [`CanRegsAt`] (`Can1At`, `Can3At` of [`crate::regs`]), so that
+    /// the per-frame code reaches each register at an address known at compile time
+    /// (issue 21). The window the hand-over made from the consumed PAC singleton
+    /// becomes the fixed handle (`twocan_core::Mmio::into_fixed`), so the registers
+    /// still have one owner and the program needs no `unsafe`. The singleton and pins
+    /// this handle may hold are dropped with it (only the window of
+    /// [`HandedOver::into_registers`] buys them back from [`Parked::free`]).
+    ///
+    /// Errors, with this handle back: [`Error::InvalidArgument`] when `config` was
+    /// computed for another clock, or when `BASE` is not this instance's base address
+    /// (`let regs: Can1At = can3.into_registers_at(&config)?` is refused).
+    pub fn into_registers_at<const BASE: usize>(
+        self,
+        config: &Config,
+    ) -> Result<CanRegsAt<BASE>, Failed<Self>> {
+        if !self.accepts(config) {
+            return Err(self.refuse(Error::InvalidArgument));
+        }
+        let HandedOver {
+            regs,
+            filters,
+            instance,
+            apb1_hz,
+            chip,
+            parts,
+        } = self;
+        regs.into_fixed().map_err(|regs| Failed {
+            error: Error::InvalidArgument,
+            value: HandedOver {
+                regs,
+                filters,
+                instance,
+                apb1_hz,
+                chip,
+                parts,
+            },
+        })
+    }
+
     /// Configures the instance ([`Can::can1`] or [`Can::can3`]): initialization mode,
     /// options, bit timing.
     ///
@@ -487,6 +527,43 @@ impl<P> HandedOver<ControlRegs, Can1Filters, P> {
         config: &Config,
     ) -> Result<(ControlRegs, Can1Filters), Failed<Self>> {
         self.into_dual(config)
+    }
+
+    /// [`HandedOver::into_registers`] of a dual handle with the control registers' base
+    /// a constant ([`ControlRegsAt`]: `Can1ControlAt`, `Can2At` of [`crate::regs`]);
+    /// as the whole block's [`HandedOver::into_registers_at`], errors included.
+    pub fn into_registers_at<const BASE: usize>(
+        self,
+        config: &Config,
+    ) -> Result<(ControlRegsAt<BASE>, Can1Filters), Failed<Self>> {
+        let accepted = self.accepts(config);
+        let HandedOver {
+            regs,
+            filters,
+            instance,
+            apb1_hz,
+            chip,
+            parts,
+        } = self;
+        let back = |regs, filters| Failed {
+            error: Error::InvalidArgument,
+            value: HandedOver {
+                regs,
+                filters,
+                instance,
+                apb1_hz,
+                chip,
+                parts,
+            },
+        };
+        match filters {
+            Some(f) if accepted => match regs.into_fixed() {
+                Ok(fixed) => Ok((fixed, f)),
+                Err(regs) => Err(back(regs, Some(f))),
+            },
+            // Another clock, or no filter handle (not built by this module).
+            filters => Err(back(regs, filters)),
+        }
     }
 
     /// Configures CAN1 ([`Can::can1_dual`]: `CAN2SB` is written when `config` sets
@@ -786,5 +863,78 @@ mod tests {
             no_filters.into_dual(&base).unwrap_err().error,
             Error::InvalidArgument
         );
+    }
+
+    #[test]
+    fn into_registers_at_gives_the_instance_s_fixed_window_only() {
+        use crate::regs::{Can1At, Can1ControlAt, Can2At, Can3At, CAN1_BASE, CAN2_BASE, CAN3_BASE};
+        fn whole(base: usize, instance: Instance) -> HandedOver<CanRegs> {
+            HandedOver {
+                // SAFETY: never read or written here (device addresses on the host).
+                regs: unsafe { CanRegs::new(base) },
+                filters: None,
+                instance,
+                apb1_hz: 54_000_000,
+                chip: None,
+                parts: (),
+            }
+        }
+        fn dual(base: usize, filters: Option<Can1Filters>) -> HandedOver<ControlRegs, Can1Filters> {
+            HandedOver {
+                // SAFETY: as above.
+                regs: unsafe { ControlRegs::new(base) },
+                filters,
+                instance: Instance::Can2,
+                apb1_hz: 54_000_000,
+                chip: None,
+                parts: (),
+            }
+        }
+        let config = Config::from_bitrate(54_000_000, 500_000).unwrap();
+        let other = Config::from_bitrate(48_000_000, 500_000).unwrap();
+
+        // Whole block: another clock, then another instance's base, refused with the
+        // handle back; its own base accepted.
+        let Err(back) = whole(CAN1_BASE, Instance::Can1).into_registers_at::<CAN1_BASE>(&other)
+        else {
+            panic!("a config for another clock was accepted");
+        };
+        assert_eq!(back.error, Error::InvalidArgument);
+        let Err(back) = back.value.into_registers_at::<CAN3_BASE>(&config) else {
+            panic!("CAN1's window became CAN3's");
+        };
+        assert_eq!(back.error, Error::InvalidArgument);
+        assert_eq!(back.value.regs.base(), CAN1_BASE, "the window comes back");
+        let can1: Result<Can1At, _> = back.value.into_registers_at(&config);
+        assert!(can1.is_ok());
+        let can3: Result<Can3At, _> = whole(CAN3_BASE, Instance::Can3).into_registers_at(&config);
+        assert!(can3.is_ok());
+
+        // Dual: the filter handle goes with the control registers; without one, or at
+        // another base, refused with both back.
+        let filters = Can1Filters {
+            regs: &CAN1_FILTERS,
+        };
+        let Err(back) = dual(CAN2_BASE, None).into_registers_at::<CAN2_BASE>(&config) else {
+            panic!("a dual handle without filters was accepted");
+        };
+        assert_eq!(back.error, Error::InvalidArgument);
+        let Err(back) = dual(CAN2_BASE, Some(filters)).into_registers_at::<CAN1_BASE>(&config)
+        else {
+            panic!("CAN2's window became CAN1's");
+        };
+        assert_eq!(back.error, Error::InvalidArgument);
+        assert!(
+            back.value.filters.is_some(),
+            "the filter handle comes back too"
+        );
+        let Err(back) = back.value.into_registers_at::<CAN2_BASE>(&other) else {
+            panic!("a config for another clock was accepted");
+        };
+        let can2: Result<(Can2At, Can1Filters), _> = back.value.into_registers_at(&config);
+        assert!(can2.is_ok_and(|(_, f)| f.regs.base() == CAN1_BASE));
+        let can1: Result<(Can1ControlAt, Can1Filters), _> =
+            dual(CAN1_BASE, Some(filters)).into_registers_at(&config);
+        assert!(can1.is_ok());
     }
 }

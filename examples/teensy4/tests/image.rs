@@ -25,8 +25,9 @@ use std::path::PathBuf;
 
 use object::{Object, ObjectSection, ObjectSymbol};
 
-const BINS: [&str; 5] = [
+const BINS: [&str; 6] = [
     "teensy4-loopback",
+    "teensy4-loopback-lean",
     "teensy4-filters",
     "teensy4-app",
     "teensy4-async-echo",
