@@ -278,6 +278,34 @@ mod tests {
     use crate::instance::Instance;
     use crate::regs::port::Port;
 
+    /// Issue 21: the controller keeps the RT1062 plan as its choices and a reference to
+    /// the pad table, and gets the same plan back; the key is much smaller than the plan.
+    #[test]
+    fn a_system_key_gives_its_plan_back() {
+        for (od, pu) in [(false, false), (true, false), (false, true), (true, true)] {
+            for (instance, pins) in [
+                (Instance::Can1, &crate::imxrt::pads::CAN1),
+                (Instance::Can2, &crate::imxrt::pads::CAN2),
+                (Instance::Can3, &crate::imxrt::pads::CAN3),
+            ] {
+                let gate = crate::instance::Target::new(Board::Teensy41, instance)
+                    .clock_gate()
+                    .expect("an RT1062 module");
+                let key = SystemKey::Imxrt {
+                    clock_gate: gate,
+                    root: ClockRoot::PLL3_60MHZ,
+                    pins,
+                    open_drain: od,
+                    pull_up: pu,
+                };
+                let plan = ImxrtPlan::new(gate, ClockRoot::PLL3_60MHZ, pins.tx, pins.rx, od, pu);
+                assert_eq!(key.plan(), SystemPlan::Imxrt(plan));
+                assert_eq!(key.can_clock_hz(), 60_000_000);
+            }
+        }
+        assert!(core::mem::size_of::<SystemKey>() * 2 <= core::mem::size_of::<SystemPlan>());
+    }
+
     #[test]
     fn host_system_remembers() {
         let s = HostSystem::new();
