@@ -585,7 +585,7 @@ impl<R: Registers> FlexCan<R> {
         if filters != ConfigErrors::NONE {
             return Err((BeginError::Config(filters), slot));
         }
-        if let Err(e) = plan.system.plan().apply(sys) {
+        if let Err(e) = plan.system.apply(sys) {
             return Err((BeginError::Config(e), slot));
         }
         slot.fill_lists(plan.configuration, primary, secondary);
@@ -626,7 +626,7 @@ impl<R: Registers> FlexCan<R> {
             Ok(p) => p,
             Err(e) => return Err((BeginError::Config(e), slot)),
         };
-        if let Err(e) = plan.system.plan().apply(sys) {
+        if let Err(e) = plan.system.apply(sys) {
             return Err((BeginError::Config(e), slot));
         }
         let polls = settings.handshake_bound();
@@ -736,7 +736,7 @@ impl<R: Registers> FlexCan<R> {
         if table.configuration() != plan.configuration {
             return Err(BeginError::Hardware(Error::InvalidArgument));
         }
-        plan.system.plan().apply(sys).map_err(BeginError::Config)?;
+        plan.system.apply(sys).map_err(BeginError::Config)?;
         configure::<R, L>(
             &mut regs,
             plan,
@@ -797,7 +797,7 @@ impl<R: Registers, L: Layout> FlexCan<R, L> {
         let filters = L::Table::check_lists(settings.configuration, primary, secondary);
         let plan = plan::<L>(target, settings, settings.configuration, filters)
             .map_err(BeginError::Config)?;
-        plan.system.plan().apply(sys).map_err(BeginError::Config)?;
+        plan.system.apply(sys).map_err(BeginError::Config)?;
         let polls = settings.handshake_bound();
         let bus_mode = bus_mode_of(settings);
         // The table is built once, in the controller, and written from there.

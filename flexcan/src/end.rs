@@ -63,7 +63,7 @@ impl<R: Registers, L: Layout> FlexCan<R, L> {
         if let Err(e) = self.stop() {
             return Err((self, e));
         }
-        self.system.plan().release(sys);
+        self.system.release(sys);
         Ok(self.regs)
     }
 
@@ -86,7 +86,7 @@ impl<R: Registers, O: Options> FlexCanHw<R, O> {
         if let Err(e) = stop(self.registers(), self.handshake_polls(), upper) {
             return Err((self, e));
         }
-        self.system_plan().release(sys);
+        self.system_key().release(sys);
         Ok(self.into_registers_and_table())
     }
 }

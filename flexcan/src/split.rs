@@ -73,7 +73,7 @@ use crate::regs::{
     self, code, cs, ctrl1, esr1, iflag1, rxfir, ECR, ESR1, IFLAG1, IFLAG2, IMASK1, IMASK2, RXFIR,
 };
 use crate::status;
-use crate::system::{SystemKey, SystemPlan};
+use crate::system::SystemKey;
 
 /// One received frame: the Rx FIFO output's control/status, identifier and two data
 /// words, and `RXFIR.IDHIT`.
@@ -416,8 +416,8 @@ impl<R: Registers, O: Options> FlexCanHw<R, O> {
     }
 
     /// The clock gate and pins `begin` set up.
-    pub(crate) fn system_plan(&self) -> SystemPlan {
-        self.system.plan()
+    pub(crate) fn system_key(&self) -> SystemKey {
+        self.system
     }
 }
 

@@ -182,6 +182,26 @@ impl SystemKey {
         }
     }
 
+    /// [`SystemPlan::apply`] without making the plan on a Kinetis part (no
+    /// plan-sized temporary on the configuration's stack).
+    pub(crate) fn apply<S: Registers>(&self, sys: &mut S) -> Result<(), ConfigErrors> {
+        match self {
+            SystemKey::Kinetis(p) => {
+                p.apply(sys);
+                Ok(())
+            }
+            SystemKey::Imxrt { .. } => self.plan().apply(sys),
+        }
+    }
+
+    /// [`SystemPlan::release`], likewise.
+    pub(crate) fn release<S: Registers>(&self, sys: &mut S) {
+        match self {
+            SystemKey::Kinetis(p) => p.release(sys),
+            SystemKey::Imxrt { .. } => self.plan().release(sys),
+        }
+    }
+
     /// The protocol engine clock in Hz ([`SystemPlan::can_clock_hz`]).
     pub(crate) const fn can_clock_hz(&self) -> u32 {
         match self {
