@@ -182,24 +182,35 @@ impl SystemKey {
         }
     }
 
-    /// [`SystemPlan::apply`] without making the plan on a Kinetis part (no
-    /// plan-sized temporary on the configuration's stack).
+    /// [`SystemPlan::apply`] without making the plan on a Kinetis part; the RT1062's
+    /// plan is made out of line, so its temporary is no part of the caller's frame
+    /// (the configuration's stack, issue 21).
     pub(crate) fn apply<S: Registers>(&self, sys: &mut S) -> Result<(), ConfigErrors> {
         match self {
             SystemKey::Kinetis(p) => {
                 p.apply(sys);
                 Ok(())
             }
-            SystemKey::Imxrt { .. } => self.plan().apply(sys),
+            SystemKey::Imxrt { .. } => self.apply_imxrt(sys),
         }
+    }
+
+    #[inline(never)]
+    fn apply_imxrt<S: Registers>(&self, sys: &mut S) -> Result<(), ConfigErrors> {
+        self.plan().apply(sys)
     }
 
     /// [`SystemPlan::release`], likewise.
     pub(crate) fn release<S: Registers>(&self, sys: &mut S) {
         match self {
             SystemKey::Kinetis(p) => p.release(sys),
-            SystemKey::Imxrt { .. } => self.plan().release(sys),
+            SystemKey::Imxrt { .. } => self.release_imxrt(sys),
         }
+    }
+
+    #[inline(never)]
+    fn release_imxrt<S: Registers>(&self, sys: &mut S) {
+        self.plan().release(sys)
     }
 
     /// The protocol engine clock in Hz ([`SystemPlan::can_clock_hz`]).
