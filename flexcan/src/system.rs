@@ -184,7 +184,8 @@ impl SystemKey {
 
     /// [`SystemPlan::apply`] without making the plan on a Kinetis part; the RT1062's
     /// plan is made out of line, so its temporary is no part of the caller's frame
-    /// (the configuration's stack, issue 21).
+    /// (the configuration's stack, issue 21). Out of line itself, as the plan's.
+    #[inline(never)]
     pub(crate) fn apply<S: Registers>(&self, sys: &mut S) -> Result<(), ConfigErrors> {
         match self {
             SystemKey::Kinetis(p) => {
