@@ -15,6 +15,7 @@ use twocan_core::Registers;
 
 use crate::begin_error::ConfigErrors;
 use crate::board::InstancePins;
+use crate::imxrt::pads::{rx_pad, tx_pad};
 use crate::imxrt::{ClockRoot, ImxPins, ImxrtPlan};
 use crate::regs::pins::CanPin;
 use crate::regs::port::{PCR_MUX, PCR_ODE, PCR_PE, PCR_PS};
@@ -198,7 +199,21 @@ impl SystemKey {
 
     #[inline(never)]
     fn apply_imxrt<S: Registers>(&self, sys: &mut S) -> Result<(), ConfigErrors> {
-        self.plan().apply(sys)
+        match *self {
+            SystemKey::Imxrt {
+                clock_gate,
+                root,
+                pins,
+                open_drain,
+                pull_up,
+            } => crate::imxrt::plan::apply_parts(
+                clock_gate,
+                root,
+                [(&pins.tx, tx_pad(open_drain)), (&pins.rx, rx_pad(pull_up))],
+                sys,
+            ),
+            SystemKey::Kinetis(_) => Ok(()),
+        }
     }
 
     /// [`SystemPlan::release`], likewise.
@@ -211,7 +226,12 @@ impl SystemKey {
 
     #[inline(never)]
     fn release_imxrt<S: Registers>(&self, sys: &mut S) {
-        self.plan().release(sys)
+        if let SystemKey::Imxrt {
+            clock_gate, pins, ..
+        } = *self
+        {
+            crate::imxrt::plan::release_parts(clock_gate, [&pins.tx, &pins.rx], sys)
+        }
     }
 
     /// The protocol engine clock in Hz ([`SystemPlan::can_clock_hz`]).
