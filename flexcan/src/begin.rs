@@ -46,6 +46,7 @@ use crate::configuration::{Configuration, DATA_MAILBOX, MESSAGE_BUFFERS};
 use crate::controller::FlexCan;
 use crate::filters::OwnedTable;
 use crate::handshake;
+use crate::imxrt::ImxrtPlan;
 use crate::installed::PlannedTable;
 use crate::instance::Target;
 use crate::layout::{layout_accepts, Kinetis, Layout};
@@ -55,14 +56,14 @@ use crate::regs::{
 };
 use crate::settings::Settings;
 use crate::split::{FlexCanHw, Parts};
-use crate::system::{choose_pins, PortPlan, SystemKey};
+use crate::system::{choose_pins, PortPlan, SystemPlan};
 
 /// Everything `begin` will write but the filter table, computed before anything is
 /// written (the lists are checked; the table is built once, inside the controller
 /// `begin` returns, so that no table-sized value moves through the configuration).
 #[derive(Debug, Clone)]
 struct Plan {
-    system: SystemKey,
+    system: SystemPlan,
     mcr: u32,
     ctrl1: u32,
     configuration: Configuration,
@@ -211,7 +212,7 @@ const fn kinetis_system(
     gate: (usize, u32),
     settings: &Settings,
     errors: &mut ConfigErrors,
-) -> Option<SystemKey> {
+) -> Option<SystemPlan> {
     let Some(pins) = target.board.pins(target.instance) else {
         return None;
     };
@@ -220,7 +221,7 @@ const fn kinetis_system(
         settings.use_alternate_tx_pin,
         settings.use_alternate_rx_pin,
     ) {
-        Ok((tx, rx)) => Some(SystemKey::Kinetis(PortPlan::new(
+        Ok((tx, rx)) => Some(SystemPlan::Kinetis(PortPlan::new(
             gate,
             tx,
             rx,
@@ -247,8 +248,8 @@ const fn imxrt_system(
     gate: (usize, u32),
     settings: &Settings,
     errors: &mut ConfigErrors,
-) -> Option<SystemKey> {
-    let Some(pins) = target.board.imx_pins_ref(target.instance) else {
+) -> Option<SystemPlan> {
+    let Some(pins) = target.board.imx_pins(target.instance) else {
         return None;
     };
     if settings.use_alternate_tx_pin {
@@ -258,13 +259,14 @@ const fn imxrt_system(
         *errors = errors.union(ConfigErrors::NO_ALTERNATE_RX_PIN);
     }
     match settings.can_clock {
-        CanClock::Imxrt(root) if errors.is_empty() => Some(SystemKey::Imxrt {
-            clock_gate: gate,
+        CanClock::Imxrt(root) if errors.is_empty() => Some(SystemPlan::Imxrt(ImxrtPlan::new(
+            gate,
             root,
-            pins,
-            open_drain: settings.tx_pin_open_collector,
-            pull_up: settings.rx_pin_pull_up,
-        }),
+            pins.tx,
+            pins.rx,
+            settings.tx_pin_open_collector,
+            settings.rx_pin_pull_up,
+        ))),
         _ => None,
     }
 }

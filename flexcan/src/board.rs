@@ -197,19 +197,19 @@ impl Board {
     /// The pins of `instance` on a Teensy 4.x ([`crate::imxrt::pads`]); `None` on the
     /// other boards and for `Can0`.
     pub const fn imx_pins(self, instance: Instance) -> Option<ImxPins> {
-        match self.imx_pins_ref(instance) {
-            Some(pins) => Some(*pins),
-            None => None,
-        }
-    }
-
-    /// [`Board::imx_pins`] as a reference to the pad table, which a split
-    /// controller keeps instead of a copy.
-    pub(crate) const fn imx_pins_ref(self, instance: Instance) -> Option<&'static ImxPins> {
         match (self, instance) {
-            (Board::Teensy40 | Board::Teensy41, Instance::Can1) => Some(&pads::CAN1),
-            (Board::Teensy40 | Board::Teensy41, Instance::Can2) => Some(&pads::CAN2),
-            (Board::Teensy40 | Board::Teensy41, Instance::Can3) => Some(&pads::CAN3),
+            (Board::Teensy40 | Board::Teensy41, Instance::Can1) => Some(ImxPins {
+                tx: pads::CAN1_TX,
+                rx: pads::CAN1_RX,
+            }),
+            (Board::Teensy40 | Board::Teensy41, Instance::Can2) => Some(ImxPins {
+                tx: pads::CAN2_TX,
+                rx: pads::CAN2_RX,
+            }),
+            (Board::Teensy40 | Board::Teensy41, Instance::Can3) => Some(ImxPins {
+                tx: pads::CAN3_TX,
+                rx: pads::CAN3_RX,
+            }),
             _ => None,
         }
     }

@@ -86,7 +86,7 @@ impl<R: Registers, O: Options> FlexCanHw<R, O> {
         if let Err(e) = stop(self.registers(), self.handshake_polls(), upper) {
             return Err((self, e));
         }
-        self.system_key().release(sys);
+        self.system_plan().release(sys);
         Ok(self.into_registers_and_table())
     }
 }

@@ -73,7 +73,7 @@ use crate::regs::{
     self, code, cs, ctrl1, esr1, iflag1, rxfir, ECR, ESR1, IFLAG1, IFLAG2, IMASK1, IMASK2, RXFIR,
 };
 use crate::status;
-use crate::system::SystemKey;
+use crate::system::SystemPlan;
 
 /// One received frame: the Rx FIFO output's control/status, identifier and two data
 /// words, and `RXFIR.IDHIT`.
@@ -186,9 +186,8 @@ pub struct FlexCanHw<R: Registers, O: Options = Full> {
     /// (bit per MB), written inside the driver's critical section only
     /// (`abort_mailboxes`, `retry_aborts`).
     abort_wanted: AtomicU32,
-    /// The clock gate and pins `begin` set up (for `end` and
-    /// [`FlexCanHw::into_controller`]).
-    system: SystemKey,
+    /// The clock gate and pins `begin` set up (for [`FlexCanHw::into_controller`]).
+    system: SystemPlan,
     /// Frames caught by remote-frame mailboxes turned receive mailboxes (written by the
     /// transmit interrupt's `settle` only).
     caught: AtomicU32,
@@ -246,7 +245,7 @@ pub(crate) struct Parts {
     pub(crate) irq_priority: u8,
     pub(crate) mode: Mode,
     pub(crate) last_error: LastErrorCode,
-    pub(crate) system: SystemKey,
+    pub(crate) system: SystemPlan,
     pub(crate) bus_clock_hz: u32,
 }
 
@@ -416,8 +415,8 @@ impl<R: Registers, O: Options> FlexCanHw<R, O> {
     }
 
     /// The clock gate and pins `begin` set up.
-    pub(crate) fn system_key(&self) -> SystemKey {
-        self.system
+    pub(crate) fn system_plan(&self) -> &SystemPlan {
+        &self.system
     }
 }
 

@@ -15,8 +15,7 @@ use twocan_core::Registers;
 
 use crate::begin_error::ConfigErrors;
 use crate::board::InstancePins;
-use crate::imxrt::pads::{rx_pad, tx_pad};
-use crate::imxrt::{ClockRoot, ImxPins, ImxrtPlan};
+use crate::imxrt::ImxrtPlan;
 use crate::regs::pins::CanPin;
 use crate::regs::port::{PCR_MUX, PCR_ODE, PCR_PE, PCR_PS};
 use crate::regs::sim;
@@ -148,101 +147,6 @@ impl SystemPlan {
     }
 }
 
-/// A [`SystemPlan`] as a begun controller keeps it: the Kinetis plan itself (32 B), or
-/// on the RT1062 the choices it is made of with a reference to the pad table (the
-/// pads' names and addresses are not copied: issue 21's driver state). `begin` makes it
-/// ([`SystemKey::plan`] gives the plan back, for `end` and [`crate::FlexCan::system`]).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum SystemKey {
-    /// Kinetis: SIM gates and PORT pin control.
-    Kinetis(PortPlan),
-    /// i.MX RT1062: CCM clock root and gates, IOMUXC pads.
-    Imxrt {
-        clock_gate: (usize, u32),
-        root: ClockRoot,
-        pins: &'static ImxPins,
-        open_drain: bool,
-        pull_up: bool,
-    },
-}
-
-impl SystemKey {
-    /// The plan.
-    pub(crate) const fn plan(&self) -> SystemPlan {
-        match *self {
-            SystemKey::Kinetis(p) => SystemPlan::Kinetis(p),
-            SystemKey::Imxrt {
-                clock_gate,
-                root,
-                pins,
-                open_drain,
-                pull_up,
-            } => SystemPlan::Imxrt(ImxrtPlan::new(
-                clock_gate, root, pins.tx, pins.rx, open_drain, pull_up,
-            )),
-        }
-    }
-
-    /// [`SystemPlan::apply`] without making the plan on a Kinetis part; the RT1062's
-    /// plan is made out of line, so its temporary is no part of the caller's frame
-    /// (the configuration's stack, issue 21). Out of line itself, as the plan's.
-    #[inline(never)]
-    pub(crate) fn apply<S: Registers>(&self, sys: &mut S) -> Result<(), ConfigErrors> {
-        match self {
-            SystemKey::Kinetis(p) => {
-                p.apply(sys);
-                Ok(())
-            }
-            SystemKey::Imxrt { .. } => self.apply_imxrt(sys),
-        }
-    }
-
-    #[inline(never)]
-    fn apply_imxrt<S: Registers>(&self, sys: &mut S) -> Result<(), ConfigErrors> {
-        match *self {
-            SystemKey::Imxrt {
-                clock_gate,
-                root,
-                pins,
-                open_drain,
-                pull_up,
-            } => crate::imxrt::plan::apply_parts(
-                clock_gate,
-                root,
-                [(&pins.tx, tx_pad(open_drain)), (&pins.rx, rx_pad(pull_up))],
-                sys,
-            ),
-            SystemKey::Kinetis(_) => Ok(()),
-        }
-    }
-
-    /// [`SystemPlan::release`], likewise.
-    pub(crate) fn release<S: Registers>(&self, sys: &mut S) {
-        match self {
-            SystemKey::Kinetis(p) => p.release(sys),
-            SystemKey::Imxrt { .. } => self.release_imxrt(sys),
-        }
-    }
-
-    #[inline(never)]
-    fn release_imxrt<S: Registers>(&self, sys: &mut S) {
-        if let SystemKey::Imxrt {
-            clock_gate, pins, ..
-        } = *self
-        {
-            crate::imxrt::plan::release_parts(clock_gate, [&pins.tx, &pins.rx], sys)
-        }
-    }
-
-    /// The protocol engine clock in Hz ([`SystemPlan::can_clock_hz`]).
-    pub(crate) const fn can_clock_hz(&self) -> u32 {
-        match self {
-            SystemKey::Kinetis(_) => crate::settings::CAN_CLOCK_HZ,
-            SystemKey::Imxrt { root, .. } => root.hz(),
-        }
-    }
-}
-
 /// The Kinetis chip-level writes: SIM clock gates, PORT pin control.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct PortPlan {
@@ -329,34 +233,6 @@ mod tests {
     use crate::board::Board;
     use crate::instance::Instance;
     use crate::regs::port::Port;
-
-    /// Issue 21: the controller keeps the RT1062 plan as its choices and a reference to
-    /// the pad table, and gets the same plan back; the key is much smaller than the plan.
-    #[test]
-    fn a_system_key_gives_its_plan_back() {
-        for (od, pu) in [(false, false), (true, false), (false, true), (true, true)] {
-            for (instance, pins) in [
-                (Instance::Can1, &crate::imxrt::pads::CAN1),
-                (Instance::Can2, &crate::imxrt::pads::CAN2),
-                (Instance::Can3, &crate::imxrt::pads::CAN3),
-            ] {
-                let gate = crate::instance::Target::new(Board::Teensy41, instance)
-                    .clock_gate()
-                    .expect("an RT1062 module");
-                let key = SystemKey::Imxrt {
-                    clock_gate: gate,
-                    root: ClockRoot::PLL3_60MHZ,
-                    pins,
-                    open_drain: od,
-                    pull_up: pu,
-                };
-                let plan = ImxrtPlan::new(gate, ClockRoot::PLL3_60MHZ, pins.tx, pins.rx, od, pu);
-                assert_eq!(key.plan(), SystemPlan::Imxrt(plan));
-                assert_eq!(key.can_clock_hz(), 60_000_000);
-            }
-        }
-        assert!(core::mem::size_of::<SystemKey>() * 2 <= core::mem::size_of::<SystemPlan>());
-    }
 
     #[test]
     fn host_system_remembers() {

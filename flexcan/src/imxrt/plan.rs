@@ -69,15 +69,43 @@ impl ImxrtPlan {
         }
     }
 
+    /// Whether a module other than this plan's is in use on the root: its
+    /// register-access gate on (any `CGn` value but 00) and its `MCR` other than
+    /// [`MCR_RESET`]. A gated module is not read (its registers would answer with a bus
+    /// error).
+    fn another_module_in_use<S: Registers>(&self, sys: &S) -> bool {
+        let (own_gate, own_bits) = self.clock_gate;
+        MODULES_ON_ROOT.iter().any(|&(gate, bits, base)| {
+            let own = gate == own_gate && bits & own_bits != 0;
+            !own && sys.read32(gate) & bits != 0 && sys.read32(base + MCR) != MCR_RESET
+        })
+    }
+
     /// Steps 0–4 of the module documentation; step 0's refusal is
     /// [`ConfigErrors::CLOCK_ROOT_IN_USE`], with nothing written.
     pub fn apply<S: Registers>(&self, sys: &mut S) -> Result<(), ConfigErrors> {
-        apply_parts(
-            self.clock_gate,
-            self.root,
-            [(&self.tx.0, self.tx.1), (&self.rx.0, self.rx.1)],
-            sys,
-        )
+        let (gate, bits) = self.clock_gate;
+        critical_section::with(|_| {
+            let cscmr2 = sys.read32(CCM_CSCMR2);
+            let wanted = self.root.cscmr2(cscmr2);
+            if wanted != cscmr2 {
+                if self.another_module_in_use(sys) {
+                    return Err(ConfigErrors::CLOCK_ROOT_IN_USE);
+                }
+                sys.modify32(gate, |v| v & !bits);
+                sys.write32(CCM_CSCMR2, wanted);
+            }
+            sys.modify32(gate, |v| v | bits);
+            Ok(())
+        })?;
+        for (pin, pad) in [self.tx, self.rx] {
+            sys.write32(pin.mux, MUX_MODE.val(pin.alt));
+            sys.write32(pin.pad_ctl, pad);
+            if let Some((select, value)) = pin.daisy {
+                sys.write32(select, value);
+            }
+        }
+        Ok(())
     }
 
     /// Undoes [`ImxrtPlan::apply`] for the module (`end`): the pads back to their reset
@@ -85,64 +113,11 @@ impl ImxrtPlan {
     /// module must not be accessed afterwards). The clock root stays: the other modules
     /// may run on it.
     pub fn release<S: Registers>(&self, sys: &mut S) {
-        release_parts(self.clock_gate, [&self.tx.0, &self.rx.0], sys)
-    }
-}
-
-/// Whether a module other than the one of `own` gates is in use on the root: its
-/// register-access gate on (any `CGn` value but 00) and its `MCR` other than
-/// [`MCR_RESET`]. A gated module is not read (its registers would answer with a bus
-/// error).
-fn another_module_in_use<S: Registers>(own: (usize, u32), sys: &S) -> bool {
-    let (own_gate, own_bits) = own;
-    MODULES_ON_ROOT.iter().any(|&(gate, bits, base)| {
-        let own = gate == own_gate && bits & own_bits != 0;
-        !own && sys.read32(gate) & bits != 0 && sys.read32(base + MCR) != MCR_RESET
-    })
-}
-
-/// [`ImxrtPlan::apply`] from its parts, the pins by reference (a split controller keeps
-/// a reference to the pad table rather than a plan: no pin is copied).
-pub(crate) fn apply_parts<S: Registers>(
-    clock_gate: (usize, u32),
-    root: ClockRoot,
-    pads: [(&ImxPin, u32); 2],
-    sys: &mut S,
-) -> Result<(), ConfigErrors> {
-    let (gate, bits) = clock_gate;
-    critical_section::with(|_| {
-        let cscmr2 = sys.read32(CCM_CSCMR2);
-        let wanted = root.cscmr2(cscmr2);
-        if wanted != cscmr2 {
-            if another_module_in_use(clock_gate, sys) {
-                return Err(ConfigErrors::CLOCK_ROOT_IN_USE);
-            }
-            sys.modify32(gate, |v| v & !bits);
-            sys.write32(CCM_CSCMR2, wanted);
+        for (pin, _) in [self.tx, self.rx] {
+            sys.write32(pin.mux, MUX_RESET);
+            sys.write32(pin.pad_ctl, PAD_RESET);
         }
-        sys.modify32(gate, |v| v | bits);
-        Ok(())
-    })?;
-    for (pin, pad) in pads {
-        sys.write32(pin.mux, MUX_MODE.val(pin.alt));
-        sys.write32(pin.pad_ctl, pad);
-        if let Some((select, value)) = pin.daisy {
-            sys.write32(select, value);
-        }
+        let (gate, bits) = self.clock_gate;
+        critical_section::with(|_| sys.modify32(gate, |v| v & !bits));
     }
-    Ok(())
-}
-
-/// [`ImxrtPlan::release`] from its parts.
-pub(crate) fn release_parts<S: Registers>(
-    clock_gate: (usize, u32),
-    pins: [&ImxPin; 2],
-    sys: &mut S,
-) {
-    for pin in pins {
-        sys.write32(pin.mux, MUX_RESET);
-        sys.write32(pin.pad_ctl, PAD_RESET);
-    }
-    let (gate, bits) = clock_gate;
-    critical_section::with(|_| sys.modify32(gate, |v| v & !bits));
 }
