@@ -1306,9 +1306,21 @@ fn why_missed(backend: Backend, variant: &str, key: &str) -> &'static str {
              cleared, then the words and the code) and encodes the portable `Frame`; the \
              hand-written send writes a mailbox it knows is free."
         }
-        (_, _, "rx_isr") => {
-            "the handler pushes the raw words into the ring with its peak and overflow \
-             bookkeeping, and reads the FIFO's overrun and warning flags every time."
+        (Backend::BxCan, _, "rx_isr") => {
+            "the handler drains FIFO 0 in a loop, as the equivalent does: per pass one \
+             read of `CAN_RF0R` gives the pending count and the overrun and full flags \
+             (one branch to the out-of-line event count, see the overrun line above), \
+             the frame's four words go into the ring, and the ring keeps its peak (a \
+             load, a compare, a store) that the buffer statistics report; the \
+             equivalent's `heapless` queue keeps no peak."
+        }
+        (Backend::FlexCan, _, "rx_isr") => {
+            "the handler drains the Rx FIFO in a loop, as the hand-written one does: per \
+             pass it also loads the controller's mode word (no FIFO read while the \
+             module is disabled for sleep) and reaches the controller through the \
+             state's published slot, and the ring push keeps its peak (a load, a compare, \
+             a store) that the buffer statistics report; the hand-written ring keeps \
+             none."
         }
         (_, "lean", "roundtrip") => {
             "the send's checks and encoding (above) and, on the thread side, the take \
@@ -1323,23 +1335,39 @@ fn why_missed(backend: Backend, variant: &str, key: &str) -> &'static str {
              time stamps are widened in a critical section and the statistics counted; \
              the equivalents record a completion with fewer checks."
         }
-        (_, "lean", "flash") => {
+        (Backend::BxCan, "lean", "flash") => {
             "every split driver links its transmit queue (the path for a busy mailbox), \
              abort and mailbox-state queries, error-state and status handling and \
              configuration (mode changes with their time-outs, the filter writes), which \
-             the equivalent's loop-back does not call."
+             the equivalent's loop-back does not call; `compiler_builtins` adds the \
+             `memclr` that zeroes the controller's per-mailbox words when it is written \
+             in place."
+        }
+        (Backend::FlexCan, "lean", "flash") => {
+            "as bxCAN's, and `compiler_builtins` links `memcpy` (730 B) for the copy of \
+             the chip-level plan into the controller and `memclr` for its zeroed \
+             words when it is written in place."
         }
         (_, _, "flash") => {
             "the full variant links the run-time filter planner and table compiler, \
              which the equivalent does not have (it writes one fixed filter)."
         }
-        (_, _, "state") => {
+        (Backend::BxCan, _, "state") => {
             "the state is the portable driver's own bookkeeping: the controller value \
-             (register handle, filter map or table, mode and handshake bounds, \
-             error-state memory), the indices, peaks and overflow counts of four rings \
-             (also of the rings of capacity 0: a ring's bookkeeping does not depend on \
-             its capacity in stable Rust's types), the queue's, and the rare-event counts \
-             kept in every feature set."
+             (the filter map, the token and load order per mailbox, mode and handshake \
+             bounds, error-state memory), the indices, peaks and overflow counts of four \
+             rings (also of the rings of capacity 0: a ring's bookkeeping does not \
+             depend on its capacity in stable Rust's types), the queue's, and the \
+             rare-event counts kept in every feature set."
+        }
+        (Backend::FlexCan, _, "state") => {
+            "as bxCAN's, and the controller also keeps the chip-level plan `end` undoes \
+             (`SystemPlan`: clock gates and the pins with their names and addresses, \
+             sized for the RT1062's pads on every chip) and the planned table's slices. \
+             Keeping the plan as the choices it is made of (64 B less, and no `memcpy` \
+             linked for its copy) was tried and reverted: the controller's construction \
+             then moved onto `begin`'s frame and took the RT1062 examples' \
+             configuration stack over 1 KB."
         }
         _ => "see section 2.",
     }
