@@ -229,11 +229,105 @@ mod tokens {
 
     use super::{Instance, Target};
     use crate::board::Board;
+    use crate::regs::FlexCanRegs;
+
+    /// The register handles a token `T`'s `begin_in_place` and `begin_planned_in_place`
+    /// can give its module, and its `end_split` takes back: [`FlexCanRegs`] (the base
+    /// read at run time) for every token, and the module's fixed-base handle
+    /// ([`crate::regs::FlexCanAt`], issue 21) for its own token only — `Can0At` for
+    /// `Can0`, `Can1At` for the Teensy 3.6's `Can1` ([`crate::regs`]), and
+    /// [`crate::imxrt::Can1At`], `Can2At`, `Can3At` for the Teensy 4.x tokens. The
+    /// state's register type picks the handle, so a firmware names it once; another
+    /// module's fixed base does not compile with a token. Sealed: the crate pairs each
+    /// token with its module.
+    ///
+    /// The handle is made from the token's window ([`FlexCanRegs`] at the module's
+    /// reference-manual base, [`Target::base`]) by [`twocan_core::Mmio::into_fixed`],
+    /// the one rule for a fixed base: the window's base must be the handle's, or the
+    /// window comes back (and the token's `begin` gives
+    /// [`twocan_core::Error::InvalidArgument`] with the token).
+    #[cfg_attr(
+        not(any(feature = "teensy40", feature = "teensy41")),
+        doc = r#"
+```
+# fn main() {}
+use twocan_flexcan::{regs::Can0At, Can0, TokenRegisters};
+fn fixed<R: TokenRegisters<Can0>>() {}
+const _: fn() = fixed::<Can0At>; // FlexCAN0's own base
+```
+FlexCAN1's base does not compile with FlexCAN0's token:
+```compile_fail
+# fn main() {}
+use twocan_flexcan::{regs::Can1At, Can0, TokenRegisters};
+fn fixed<R: TokenRegisters<Can0>>() {}
+const _: fn() = fixed::<Can1At>;
+```"#
+    )]
+    #[cfg_attr(
+        any(feature = "teensy40", feature = "teensy41"),
+        doc = r#"
+```
+# fn main() {}
+use twocan_flexcan::{imxrt::Can1At, Can1, TokenRegisters};
+fn fixed<R: TokenRegisters<Can1>>() {}
+const _: fn() = fixed::<Can1At>; // CAN1's own base
+```
+CAN2's base does not compile with CAN1's token, nor the Kinetis FlexCAN1's:
+```compile_fail
+# fn main() {}
+use twocan_flexcan::{imxrt::Can2At, Can1, TokenRegisters};
+fn fixed<R: TokenRegisters<Can1>>() {}
+const _: fn() = fixed::<Can2At>;
+```
+```compile_fail
+# fn main() {}
+use twocan_flexcan::{regs::Can1At, Can1, TokenRegisters};
+fn fixed<R: TokenRegisters<Can1>>() {}
+const _: fn() = fixed::<Can1At>;
+```"#
+    )]
+    pub trait TokenRegisters<T>: twocan_core::Registers + Sized + sealed::Sealed<T> {
+        /// `window`, the registers of `T`'s module at its reference-manual base, as this
+        /// handle: the window itself, or its fixed-base form when the window's base is
+        /// the handle's ([`twocan_core::Mmio::into_fixed`]); otherwise the window back.
+        fn from_window(window: FlexCanRegs) -> Result<Self, FlexCanRegs>;
+    }
+
+    mod sealed {
+        /// Only the crate pairs a token with its register handles.
+        pub trait Sealed<T> {}
+    }
+
+    /// The Kinetis FlexCAN1 (Teensy 3.6) or the RT1062's CAN1 (Teensy 4.x) at its fixed
+    /// base: the handle of the one `Can1` token of the board.
+    #[cfg(any(feature = "teensy40", feature = "teensy41"))]
+    #[allow(dead_code)] // a type of `Can1`'s `TokenRegisters` impl only
+    type Can1Fixed = crate::imxrt::Can1At;
+    #[cfg(not(any(feature = "teensy40", feature = "teensy41")))]
+    #[allow(dead_code)] // a type of `Can1`'s `TokenRegisters` impl only
+    type Can1Fixed = crate::regs::Can1At;
 
     /// One ownership token per module: `take` gives it the first time only (an atomic
-    /// flag records the take), `returned` makes it again for `end`.
+    /// flag records the take), `returned` makes it again for `end`; its register
+    /// handles ([`TokenRegisters`]): the run-time window and `$at`, its module's fixed
+    /// base.
     macro_rules! token {
-        ($(#[$m:meta])* $name:ident, $flag:ident, $instance:expr) => {
+        ($(#[$m:meta])* $name:ident, $flag:ident, $instance:expr, $at:ty) => {
+            impl sealed::Sealed<$name> for FlexCanRegs {}
+            impl TokenRegisters<$name> for FlexCanRegs {
+                #[inline(always)]
+                fn from_window(window: FlexCanRegs) -> Result<Self, FlexCanRegs> {
+                    Ok(window)
+                }
+            }
+            impl sealed::Sealed<$name> for $at {}
+            impl TokenRegisters<$name> for $at {
+                #[inline(always)]
+                fn from_window(window: FlexCanRegs) -> Result<Self, FlexCanRegs> {
+                    window.into_fixed()
+                }
+            }
+
             static $flag: AtomicBool = AtomicBool::new(false);
 
             $(#[$m])*
@@ -276,7 +370,8 @@ mod tokens {
         /// Ownership of FlexCAN0 on [`Board::DEFAULT`] (ACAN `ACAN::can0`, §6).
         Can0,
         CAN0_TAKEN,
-        Instance::Can0
+        Instance::Can0,
+        crate::regs::Can0At
     );
 
     #[cfg(any(feature = "teensy36", feature = "teensy40", feature = "teensy41"))]
@@ -285,7 +380,8 @@ mod tokens {
         /// on a Teensy 4.x (pins 22/23).
         Can1,
         CAN1_TAKEN,
-        Instance::Can1
+        Instance::Can1,
+        Can1Fixed
     );
 
     #[cfg(any(feature = "teensy40", feature = "teensy41"))]
@@ -293,7 +389,8 @@ mod tokens {
         /// Ownership of CAN2 on a Teensy 4.x (pins 1/0).
         Can2,
         CAN2_TAKEN,
-        Instance::Can2
+        Instance::Can2,
+        crate::imxrt::Can2At
     );
 
     #[cfg(any(feature = "teensy40", feature = "teensy41"))]
@@ -301,7 +398,8 @@ mod tokens {
         /// Ownership of CAN3 on a Teensy 4.x (pins 31/30), driven in classic CAN.
         Can3,
         CAN3_TAKEN,
-        Instance::Can3
+        Instance::Can3,
+        crate::imxrt::Can3At
     );
 
     #[cfg(test)]
@@ -316,6 +414,52 @@ mod tokens {
             assert!(first.is_some());
             assert!(Can0::take().is_none());
             assert_eq!(first.unwrap().target().instance, Instance::Can0);
+        }
+
+        /// The token's window (at its module's base) and one at `base`.
+        fn windows(token: Target, base: usize) -> (FlexCanRegs, FlexCanRegs) {
+            // SAFETY: never read or written here (device addresses on the host); the
+            // handles only go through the base check.
+            unsafe {
+                (
+                    FlexCanRegs::new(token.base().expect("the board's module")),
+                    FlexCanRegs::new(base),
+                )
+            }
+        }
+
+        /// Every token's fixed handle is made from its own window only (the check of
+        /// `Mmio::into_fixed`), and the run-time window passes as it is.
+        fn fixed_only_from_its_own_window<T, R: TokenRegisters<T>>(token: Target, other: usize) {
+            let (own, foreign) = windows(token, other);
+            let fixed = R::from_window(own).map_err(|w| w.base());
+            assert!(fixed.is_ok(), "{token:?}: its own base");
+            assert_eq!(core::mem::size_of::<R>(), 0);
+            let back = R::from_window(foreign).map(|_| ()).unwrap_err();
+            assert_eq!(back.base(), other, "another base: the window comes back");
+            let (own, _) = windows(token, other);
+            let window = <FlexCanRegs as TokenRegisters<T>>::from_window(own).unwrap();
+            assert_eq!(Some(window.base()), token.base());
+        }
+
+        #[cfg(not(any(feature = "teensy40", feature = "teensy41")))]
+        #[test]
+        fn each_token_s_fixed_handle_is_at_its_module_s_base() {
+            use crate::regs::{self, Can0At};
+            fixed_only_from_its_own_window::<Can0, Can0At>(Can0::TARGET, regs::CAN1_BASE);
+            #[cfg(feature = "teensy36")]
+            fixed_only_from_its_own_window::<Can1, regs::Can1At>(Can1::TARGET, regs::CAN0_BASE);
+        }
+
+        #[cfg(any(feature = "teensy40", feature = "teensy41"))]
+        #[test]
+        fn each_token_s_fixed_handle_is_at_its_module_s_base() {
+            use crate::imxrt::{Can1At, Can2At, Can3At, CAN1_BASE, CAN2_BASE, CAN3_BASE};
+            fixed_only_from_its_own_window::<Can1, Can1At>(Can1::TARGET, CAN2_BASE);
+            fixed_only_from_its_own_window::<Can2, Can2At>(Can2::TARGET, CAN3_BASE);
+            fixed_only_from_its_own_window::<Can3, Can3At>(Can3::TARGET, CAN1_BASE);
+            // The Kinetis FlexCAN1's base is no RT1062 module's.
+            fixed_only_from_its_own_window::<Can1, Can1At>(Can1::TARGET, crate::regs::CAN1_BASE);
         }
 
         #[cfg(any(feature = "teensy40", feature = "teensy41"))]

@@ -203,6 +203,14 @@ pub use filters::{FilterTable, SizedTable, UNKNOWN_FILTER};
 pub use instance::Can0;
 #[cfg(any(feature = "teensy36", feature = "teensy40", feature = "teensy41"))]
 pub use instance::Can1;
+#[cfg(any(
+    feature = "teensy32",
+    feature = "teensy35",
+    feature = "teensy36",
+    feature = "teensy40",
+    feature = "teensy41"
+))]
+pub use instance::TokenRegisters;
 #[cfg(any(feature = "teensy40", feature = "teensy41"))]
 pub use instance::{Can2, Can3};
 pub use instance::{Instance, Irqs, Target};

@@ -102,72 +102,30 @@ pub const BOARD_BLOCK_END: usize = BLOCK_END;
 /// layout writes.
 pub type FlexCanRegs = twocan_core::Mmio<BOARD_BLOCK_END>;
 
-/// The Kinetis module's window (`0..BLOCK_END`), whatever the board feature.
-type KinetisRegs = twocan_core::Mmio<BLOCK_END>;
-
-/// Volatile access to the Kinetis FlexCAN module whose registers start at `BASE`, an
-/// address known at compile time (offsets `0..BLOCK_END`, as [`FlexCanRegs`] on a
-/// Teensy 3.x): the value is
-/// empty and every access is one load or store at `BASE + offset`, without reading a
-/// base address first. The window check of [`twocan_core::Mmio`] stays: an offset
-/// outside the module's registers reads 0 and writes nothing (a `debug_assert` in
-/// debug builds).
+/// [`twocan_core::Mmio`] with the base address a constant (`twocan_core::Fixed`): the
+/// FlexCAN module whose registers start at `BASE`, offsets `0..END` ([`BLOCK_END`], the
+/// Kinetis block, unless named; [`IMXRT_BLOCK_END`] for the RT1062's modules,
+/// [`crate::imxrt::Can1At`] ...). The value is empty and every access is one load or
+/// store at `BASE + offset`, without reading a base address first (issue 21). The window
+/// check of [`twocan_core::Mmio`] stays: an offset outside the module's registers reads 0
+/// and writes nothing (a `debug_assert` in debug builds).
+///
+/// A token gives its own module's handle, with no `unsafe` in the program: its
+/// `begin_planned_in_place` / `begin_in_place` into a state whose register type is the
+/// module's (`Can0At` for `Can0` ..., the tokens' `TokenRegisters`); otherwise
+/// `Fixed::new` (`unsafe`, the promise of [`twocan_core::Mmio::new`]).
 ///
 /// ```
-/// use twocan_flexcan::regs::{Can0At, FlexCanAt, CAN0_BASE};
+/// use twocan_flexcan::regs::{Can0At, FlexCanAt, BLOCK_END, CAN0_BASE};
 /// assert_eq!(core::mem::size_of::<Can0At>(), 0);
-/// let _ = CAN0_BASE;
+/// let _: Option<FlexCanAt<CAN0_BASE, BLOCK_END>> = None::<Can0At>;
 /// ```
-#[derive(Debug)]
-pub struct FlexCanAt<const BASE: usize> {
-    _owner: (),
-}
+pub type FlexCanAt<const BASE: usize, const END: usize = BLOCK_END> = twocan_core::Fixed<BASE, END>;
 
-/// FlexCAN0 at its compile-time address ([`CAN0_BASE`]).
-pub type Can0At = FlexCanAt<CAN0_BASE>;
-/// FlexCAN1 at its compile-time address ([`CAN1_BASE`], K66 only).
-pub type Can1At = FlexCanAt<CAN1_BASE>;
-
-impl<const BASE: usize> FlexCanAt<BASE> {
-    /// Access to the module at `BASE`.
-    ///
-    /// # Safety
-    /// `BASE .. BASE + BLOCK_END` must be the registers of one FlexCAN module (or memory
-    /// standing in for them), and nothing else may access them while this value lives
-    /// (as [`twocan_core::Mmio::new`]).
-    pub const unsafe fn new() -> Self {
-        FlexCanAt { _owner: () }
-    }
-}
-
-impl<const BASE: usize> twocan_core::Registers for FlexCanAt<BASE> {
-    #[inline(always)]
-    fn read32(&self, offset: usize) -> u32 {
-        if !KinetisRegs::owns(offset) {
-            debug_assert!(
-                false,
-                "register offset {offset:#x} outside 0..{BLOCK_END:#x}"
-            );
-            return 0;
-        }
-        // SAFETY: `FlexCanAt::new`'s contract covers every aligned offset of
-        // `0..BLOCK_END`, checked just above.
-        unsafe { core::ptr::read_volatile((BASE + offset) as *const u32) }
-    }
-
-    #[inline(always)]
-    fn write32(&self, offset: usize, value: u32) {
-        if !KinetisRegs::owns(offset) {
-            debug_assert!(
-                false,
-                "register offset {offset:#x} outside 0..{BLOCK_END:#x}"
-            );
-            return;
-        }
-        // SAFETY: as for `read32`; writes go to a register of the owned module.
-        unsafe { core::ptr::write_volatile((BASE + offset) as *mut u32, value) }
-    }
-}
+/// FlexCAN0 at its compile-time address ([`CAN0_BASE`]), the Kinetis window.
+pub type Can0At = FlexCanAt<CAN0_BASE, BLOCK_END>;
+/// FlexCAN1 at its compile-time address ([`CAN1_BASE`], K66 only), the Kinetis window.
+pub type Can1At = FlexCanAt<CAN1_BASE, BLOCK_END>;
 
 /// Volatile access to the SIM and PORT registers `begin` writes, by absolute address
 /// (base 0; the window from the SIM to the end of PORTE).

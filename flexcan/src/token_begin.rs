@@ -57,17 +57,21 @@ macro_rules! token_begin {
                 .map_err(|(e, slot)| (self, e, slot))
             }
 
-            /// The module's registers for a begin with `checked`: `None` when the plan
-            /// was made for another module (or the board has no such module).
-            fn checked_regs<L: $crate::layout::Layout>(
+            /// The module's registers for a begin with `checked`, as the handle `R`
+            /// ([`crate::TokenRegisters`]: the run-time window, or the module's fixed
+            /// base checked by `Mmio::into_fixed`): `None` when the plan was made for
+            /// another module (or the board has no such module), or `R`'s base is not
+            /// the module's.
+            fn checked_regs<L: $crate::layout::Layout, R: $crate::TokenRegisters<Self>>(
                 &self,
                 checked: &$crate::BeginPlan<L>,
-            ) -> Option<$crate::regs::FlexCanRegs> {
+            ) -> Option<R> {
                 let target = self.target();
                 let base = target.base().filter(|_| checked.target() == target)?;
                 // SAFETY: as for `begin_in`: the token is unique and the caller consumes
                 // it (giving it back only with an error, after the handle is gone).
-                Some(unsafe { $crate::regs::FlexCanRegs::new(base) })
+                let window = unsafe { $crate::regs::FlexCanRegs::new(base) };
+                R::from_window(window).ok()
             }
 
             /// [`Self::begin_in`] writing the split controller **in place** into `hw`,
@@ -78,21 +82,26 @@ macro_rules! token_begin {
             /// ([`crate::FlexCan::begin_in_place`]). A plan made for another module is
             /// [`twocan_core::Error::InvalidArgument`]. On error nothing is written, and
             /// the token and the slot come back.
+            ///
+            /// `R`, the state's register type, is [`crate::regs::FlexCanRegs`] or the
+            /// module's fixed base ([`crate::TokenRegisters`]: `Can0At` for `Can0` ...,
+            /// so the per-frame code loads no base, issue 21).
             #[allow(clippy::type_complexity)]
-            pub fn begin_in_place<'h, O, L>(
+            pub fn begin_in_place<'h, O, L, R>(
                 self,
-                hw: &'h mut core::mem::MaybeUninit<$crate::FlexCanHw<$crate::regs::FlexCanRegs, O>>,
+                hw: &'h mut core::mem::MaybeUninit<$crate::FlexCanHw<R, O>>,
                 checked: &$crate::BeginPlan<L>,
                 primary: &[twocan_core::Filter],
                 secondary: &[twocan_core::Filter],
                 slot: &'static mut L::Table,
             ) -> Result<
-                &'h mut $crate::FlexCanHw<$crate::regs::FlexCanRegs, O>,
+                &'h mut $crate::FlexCanHw<R, O>,
                 (Self, $crate::BeginError, &'static mut L::Table),
             >
             where
                 L: $crate::layout::Layout,
                 O: $crate::options::Options<Layout = L, Table = &'static mut L::Table>,
+                R: $crate::TokenRegisters<Self>,
             {
                 let Some(regs) = self.checked_regs(checked) else {
                     return Err((
@@ -114,19 +123,18 @@ macro_rules! token_begin {
             }
 
             /// [`Self::begin_planned`] writing the split controller **in place** into
-            /// `hw` ([`crate::FlexCan::begin_checked_in_place`]). On error nothing is
-            /// written and the token comes back.
-            pub fn begin_planned_in_place<'h, O>(
+            /// `hw` ([`crate::FlexCan::begin_checked_in_place`]), over the state's
+            /// register type `R` as [`Self::begin_in_place`] (the module's fixed base
+            /// for a lean state). On error nothing is written and the token comes back.
+            pub fn begin_planned_in_place<'h, O, R>(
                 self,
-                hw: &'h mut core::mem::MaybeUninit<$crate::FlexCanHw<$crate::regs::FlexCanRegs, O>>,
+                hw: &'h mut core::mem::MaybeUninit<$crate::FlexCanHw<R, O>>,
                 checked: &$crate::BeginPlan<O::Layout>,
                 table: $crate::installed::PlannedTable,
-            ) -> Result<
-                &'h mut $crate::FlexCanHw<$crate::regs::FlexCanRegs, O>,
-                (Self, $crate::BeginError),
-            >
+            ) -> Result<&'h mut $crate::FlexCanHw<R, O>, (Self, $crate::BeginError)>
             where
                 O: $crate::options::Options<Table = $crate::installed::PlannedTable>,
+                R: $crate::TokenRegisters<Self>,
             {
                 let Some(regs) = self.checked_regs(checked) else {
                     return Err((
@@ -153,7 +161,7 @@ macro_rules! token_begin {
             where
                 O: $crate::options::Options<Table = $crate::installed::PlannedTable>,
             {
-                let Some(regs) = self.checked_regs(checked) else {
+                let Some(regs) = self.checked_regs::<_, $crate::regs::FlexCanRegs>(checked) else {
                     return Err((
                         self,
                         $crate::BeginError::Hardware(twocan_core::Error::InvalidArgument),
@@ -177,19 +185,14 @@ macro_rules! token_end {
             /// `rt::IrqState::stop` or `State::unsplit`: stops the module, releases its
             /// pins and clock gate ([`crate::FlexCanHw::end`]) and gives the token and
             /// the table back (a `FullInSlot` controller's `static` table, to begin into
-            /// again). A controller of another module is
+            /// again), over either register handle of the token
+            /// ([`crate::TokenRegisters`]). A controller of another module is
             /// [`twocan_core::Error::InvalidArgument`]; either error gives the
             /// controller back.
             #[allow(clippy::result_large_err, clippy::type_complexity)]
-            pub fn end_split<O: $crate::options::Options>(
-                hw: $crate::FlexCanHw<$crate::regs::FlexCanRegs, O>,
-            ) -> Result<
-                ($token, O::Table),
-                (
-                    $crate::FlexCanHw<$crate::regs::FlexCanRegs, O>,
-                    twocan_core::Error,
-                ),
-            > {
+            pub fn end_split<O: $crate::options::Options, R: $crate::TokenRegisters<$token>>(
+                hw: $crate::FlexCanHw<R, O>,
+            ) -> Result<($token, O::Table), ($crate::FlexCanHw<R, O>, twocan_core::Error)> {
                 if hw.target() != $token::returned().target() {
                     return Err((hw, twocan_core::Error::InvalidArgument));
                 }

@@ -13,7 +13,7 @@
 
 use twocan_core::split::{Rx, Tx};
 use twocan_flexcan::options::{FullInSlot, Lean as LeanOptions};
-use twocan_flexcan::regs::FlexCanRegs;
+use twocan_flexcan::regs::{Can0At, FlexCanRegs};
 use twocan_flexcan::rt::IrqState;
 use twocan_flexcan::{FlexCanHw, RECEIVE_BUFFER_SIZE};
 
@@ -37,14 +37,18 @@ pub type CanRxHalf = Rx<'static, Hw, RECEIVE_BUFFER_SIZE, Queue, 0, COMPLETIONS>
 /// The lean choice (issue 21), one line away from [`CanState`]: fire-and-forget
 /// transmit (no completion ring, `DONE` = 0), no traffic statistics and no time stamps
 /// (`twocan_core::Lean`), the filter table planned at compile time and read from flash
-/// (`twocan_flexcan::options::Lean`: no filter switch while running). Configured with
-/// the token's `begin_planned_in_place` and a `const` [`twocan_flexcan::BeginPlan`]
-/// (`teensy-loopback-lean`).
-pub type LeanState =
-    IrqState<FlexCanRegs, RECEIVE_BUFFER_SIZE, Queue, 0, LeanOptions, twocan_core::Lean>;
+/// (`twocan_flexcan::options::Lean`: no filter switch while running), and FlexCAN0's
+/// registers at their fixed address ([`Can0At`]: the per-frame code loads no base; `R`
+/// = [`FlexCanRegs`] for the run-time base). Configured with the token's
+/// `begin_planned_in_place` (which gives the state's register type, from the consumed
+/// token) and a `const` [`twocan_flexcan::BeginPlan`] (`teensy-loopback-lean`).
+pub type LeanState<R = Can0At> =
+    IrqState<R, RECEIVE_BUFFER_SIZE, Queue, 0, LeanOptions, twocan_core::Lean>;
 /// The lean controller on target registers.
-pub type LeanHw = FlexCanHw<FlexCanRegs, LeanOptions>;
+pub type LeanHw<R = Can0At> = FlexCanHw<R, LeanOptions>;
 /// The lean transmit half.
-pub type LeanTxHalf = Tx<'static, LeanHw, RECEIVE_BUFFER_SIZE, Queue, 0, 0, twocan_core::Lean>;
+pub type LeanTxHalf<R = Can0At> =
+    Tx<'static, LeanHw<R>, RECEIVE_BUFFER_SIZE, Queue, 0, 0, twocan_core::Lean>;
 /// The lean receive half.
-pub type LeanRxHalf = Rx<'static, LeanHw, RECEIVE_BUFFER_SIZE, Queue, 0, 0, twocan_core::Lean>;
+pub type LeanRxHalf<R = Can0At> =
+    Rx<'static, LeanHw<R>, RECEIVE_BUFFER_SIZE, Queue, 0, 0, twocan_core::Lean>;

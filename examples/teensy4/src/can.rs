@@ -19,6 +19,7 @@
 //! module, which runs the transmit and Rx FIFO handlers, then the status handler.
 
 use twocan_core::split::{Rx, Tx};
+use twocan_flexcan::imxrt::Can1At;
 use twocan_flexcan::layout::{Imxrt1062, LargeFilterTable};
 use twocan_flexcan::options::{FullInSlot, Lean as LeanOptions};
 use twocan_flexcan::regs::FlexCanRegs;
@@ -49,14 +50,18 @@ pub type CanRxHalf = Rx<'static, Hw, RECEIVE_BUFFER_SIZE, Queue, 0, COMPLETIONS>
 /// fire-and-forget transmit (no completion ring, `DONE` = 0), no traffic statistics and
 /// no time stamps (`twocan_core::Lean`), the filter table planned at compile time
 /// (`twocan_flexcan::const_plan_large!`) and read from flash
-/// (`twocan_flexcan::options::Lean`: no filter switch while running), configured with
-/// the token's `begin_planned_in_place` and a `const`
-/// `twocan_flexcan::BeginPlan<Imxrt1062>`.
-pub type LeanState =
-    IrqState<FlexCanRegs, RECEIVE_BUFFER_SIZE, Queue, 0, LeanOptions<Imxrt1062>, twocan_core::Lean>;
+/// (`twocan_flexcan::options::Lean`: no filter switch while running), and CAN1's
+/// registers at their fixed address ([`Can1At`]: the per-frame code loads no base; `R`
+/// = [`FlexCanRegs`] for the run-time base), configured with the token's
+/// `begin_planned_in_place` (which gives the state's register type, from the consumed
+/// token) and a `const` `twocan_flexcan::BeginPlan<Imxrt1062>`.
+pub type LeanState<R = Can1At> =
+    IrqState<R, RECEIVE_BUFFER_SIZE, Queue, 0, LeanOptions<Imxrt1062>, twocan_core::Lean>;
 /// The lean controller on target registers.
-pub type LeanHw = FlexCanHw<FlexCanRegs, LeanOptions<Imxrt1062>>;
+pub type LeanHw<R = Can1At> = FlexCanHw<R, LeanOptions<Imxrt1062>>;
 /// The lean transmit half.
-pub type LeanTxHalf = Tx<'static, LeanHw, RECEIVE_BUFFER_SIZE, Queue, 0, 0, twocan_core::Lean>;
+pub type LeanTxHalf<R = Can1At> =
+    Tx<'static, LeanHw<R>, RECEIVE_BUFFER_SIZE, Queue, 0, 0, twocan_core::Lean>;
 /// The lean receive half.
-pub type LeanRxHalf = Rx<'static, LeanHw, RECEIVE_BUFFER_SIZE, Queue, 0, 0, twocan_core::Lean>;
+pub type LeanRxHalf<R = Can1At> =
+    Rx<'static, LeanHw<R>, RECEIVE_BUFFER_SIZE, Queue, 0, 0, twocan_core::Lean>;

@@ -35,6 +35,15 @@ pub const CAN2_BASE: usize = 0x401D_4000;
 /// CAN3 base address (FLEXCAN3, CAN FD capable, 0x401D_8000).
 pub const CAN3_BASE: usize = 0x401D_8000;
 
+/// CAN1 at its compile-time address ([`CAN1_BASE`]), the RT1062 window
+/// ([`crate::regs::IMXRT_BLOCK_END`]): the register type of a state begun from the
+/// `Can1` token's fixed path (issue 21, [`crate::regs::FlexCanAt`]).
+pub type Can1At = crate::regs::FlexCanAt<CAN1_BASE, { crate::regs::IMXRT_BLOCK_END }>;
+/// CAN2 at its compile-time address ([`CAN2_BASE`]), the RT1062 window.
+pub type Can2At = crate::regs::FlexCanAt<CAN2_BASE, { crate::regs::IMXRT_BLOCK_END }>;
+/// CAN3 at its compile-time address ([`CAN3_BASE`]), the RT1062 window.
+pub type Can3At = crate::regs::FlexCanAt<CAN3_BASE, { crate::regs::IMXRT_BLOCK_END }>;
+
 /// Interrupt numbers (IMXRT1060RM, "ARM Cortex M7 domain interrupt summary"): one line per
 /// module carries every FlexCAN source (message buffers, bus-off, error, warnings,
 /// wake-up).

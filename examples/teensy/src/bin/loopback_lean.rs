@@ -11,6 +11,8 @@
 //!   settings checked at compile time (a `const` `BeginPlan`): the token's
 //!   `begin_planned_in_place` writes the controller straight into the `static` state,
 //!   and no check, planner or table compiler links into the image.
+//! - FlexCAN0's registers at their fixed address (`twocan_flexcan::regs::Can0At`, the
+//!   state's register type, from the consumed token: the per-frame code loads no base).
 //!
 //! Blink codes when it stops: 2–4 clock start-up, 5 FlexCAN `begin`, 6 panic.
 #![cfg_attr(target_os = "none", no_std, no_main)]

@@ -13,6 +13,8 @@
 //!   (a `const` `BeginPlan<Imxrt1062>`): the token's `begin_planned_in_place` writes
 //!   the controller straight into the `static` state, and no check, planner or table
 //!   compiler links into the image.
+//! - CAN1's registers at their fixed address (`twocan_flexcan::imxrt::Can1At`, the
+//!   state's register type, from the consumed token: the per-frame code loads no base).
 //!
 //! The layout is the RT1062's (the ERR005829 workaround), as in `teensy4-loopback`.
 #![cfg_attr(target_os = "none", no_std, no_main)]
