@@ -256,7 +256,7 @@ fn fixed<R: TokenRegisters<Can0>>() {}
 const _: fn() = fixed::<Can0At>; // FlexCAN0's own base
 ```
 FlexCAN1's base does not compile with FlexCAN0's token:
-```compile_fail
+```compile_fail,E0277
 # fn main() {}
 use twocan_flexcan::{regs::Can1At, Can0, TokenRegisters};
 fn fixed<R: TokenRegisters<Can0>>() {}
@@ -273,13 +273,13 @@ fn fixed<R: TokenRegisters<Can1>>() {}
 const _: fn() = fixed::<Can1At>; // CAN1's own base
 ```
 CAN2's base does not compile with CAN1's token, nor the Kinetis FlexCAN1's:
-```compile_fail
+```compile_fail,E0277
 # fn main() {}
 use twocan_flexcan::{imxrt::Can2At, Can1, TokenRegisters};
 fn fixed<R: TokenRegisters<Can1>>() {}
 const _: fn() = fixed::<Can2At>;
 ```
-```compile_fail
+```compile_fail,E0277
 # fn main() {}
 use twocan_flexcan::{regs::Can1At, Can1, TokenRegisters};
 fn fixed<R: TokenRegisters<Can1>>() {}
@@ -430,7 +430,11 @@ const _: fn() = fixed::<Can1At>;
 
         /// Every token's fixed handle is made from its own window only (the check of
         /// `Mmio::into_fixed`), and the run-time window passes as it is.
-        fn fixed_only_from_its_own_window<T, R: TokenRegisters<T>>(token: Target, other: usize) {
+        fn fixed_only_from_its_own_window<T, R>(token: Target, other: usize)
+        where
+            R: TokenRegisters<T>,
+            FlexCanRegs: TokenRegisters<T>,
+        {
             let (own, foreign) = windows(token, other);
             let fixed = R::from_window(own).map_err(|w| w.base());
             assert!(fixed.is_ok(), "{token:?}: its own base");

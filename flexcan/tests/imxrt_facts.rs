@@ -45,6 +45,32 @@ fn bases_and_interrupts() {
     }
 }
 
+/// The window of a fixed-base register type: (base, start, end).
+fn window<const B: usize, const E: usize, const S: usize>(
+    _: std::marker::PhantomData<twocan_core::Fixed<B, E, S>>,
+) -> (usize, usize, usize) {
+    (B, S, E)
+}
+
+#[test]
+fn fixed_register_types_are_at_the_ral_s_addresses_with_the_rt1062_window() {
+    use std::marker::PhantomData as T;
+    use twocan_flexcan::imxrt::{Can1At, Can2At, Can3At};
+    use twocan_flexcan::regs::IMXRT_BLOCK_END;
+    let end = IMXRT_BLOCK_END;
+    assert_eq!(window(T::<Can1At>), (imxrt_ral::can::CAN1 as usize, 0, end));
+    assert_eq!(window(T::<Can2At>), (imxrt_ral::can::CAN2 as usize, 0, end));
+    assert_eq!(
+        window(T::<Can3At>),
+        (imxrt_ral::can3::CAN3 as usize, 0, end)
+    );
+    // The window ends after RXIMR63, the last individual mask (NXP SVD).
+    assert_eq!(
+        offset_of!(imxrt_ral::can3::RegisterBlock, RXIMR) + 64 * 4,
+        end
+    );
+}
+
 #[test]
 fn clock_root_and_gates() {
     use imxrt_ral::ccm::{CCGR0, CCGR7, CSCMR2};

@@ -263,6 +263,31 @@ fn base_addresses_match_the_svd() {
     assert_eq!(mk66f18::CAN1::ptr() as usize, regs::CAN1_BASE);
 }
 
+/// The window of a fixed-base register type: (base, start, end).
+fn window<const B: usize, const E: usize, const S: usize>(
+    _: std::marker::PhantomData<twocan_core::Fixed<B, E, S>>,
+) -> (usize, usize, usize) {
+    (B, S, E)
+}
+
+#[test]
+fn fixed_register_types_are_at_the_svd_s_addresses_with_the_kinetis_window() {
+    use std::marker::PhantomData as T;
+    assert_eq!(
+        window(T::<regs::Can0At>),
+        (mk66f18::CAN0::ptr() as usize, 0, regs::BLOCK_END)
+    );
+    assert_eq!(
+        window(T::<regs::Can1At>),
+        (mk66f18::CAN1::ptr() as usize, 0, regs::BLOCK_END)
+    );
+    // The window's last register is RXIMR15 (K66 SVD), the end of the block.
+    assert_eq!(
+        offset_of!(mk66f18::can0::RegisterBlock, rximr) + 16 * 4,
+        regs::BLOCK_END
+    );
+}
+
 #[test]
 fn k20_flexcan_matches_mk20d7() {
     let rb = flexcan_common!(mk20d7, can0);
