@@ -5,7 +5,10 @@
 //! whose table is a reference (to a [`crate::filters::TableSlot`] or to a plan made at
 //! compile time), so that no table-sized value moves through a firmware's
 //! configuration. The board difference (the chip-level registers) is the `$system`
-//! function each firmware module passes.
+//! function each firmware module passes. The in-place forms and `end_split` take the
+//! state's register type: the run-time window or the module's fixed base
+//! ([`crate::TokenRegisters`], made from the token's window by one check,
+//! `Mmio::into_fixed`).
 
 /// Defines `begin_in` and `begin_planned` on `$token`, whose chip-level registers
 /// `$system()` gives.
