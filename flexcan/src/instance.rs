@@ -242,7 +242,8 @@ mod tokens {
     /// token with its module.
     ///
     /// The handle is made from the token's window ([`FlexCanRegs`] at the module's
-    /// reference-manual base, [`Target::base`]) by [`twocan_core::Mmio::into_fixed`],
+    /// base, [`Target::base`]: the K20/K64/K66 memory maps, IMXRT1060RM "System Memory
+    /// Map") by [`twocan_core::Mmio::into_fixed`],
     /// the one rule for a fixed base: the window's base must be the handle's, or the
     /// window comes back (and the token's `begin` gives
     /// [`twocan_core::Error::InvalidArgument`] with the token).
