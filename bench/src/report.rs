@@ -1231,7 +1231,9 @@ fn render_targets(s: &mut String, f: &Figures) {
         let _ = writeln!(
             s,
             "**Largest configuration stack** (`config_stack_bytes_max`) of every firmware \
-             example (can-fil, up to the first CAN interrupt line unmasked; section 1), \
+             example (can-fil, up to the last CAN controller started having a line \
+             unmasked, the second controller of the two-controller examples included; \
+             section 1), \
              every loop-back bench firmware (can-fil, whole run; section 1) and every \
              instruction-count bench firmware (QEMU, the configuration call; section 2 and, \
              for the one-feature variants, the next section): \
@@ -1674,10 +1676,13 @@ fn render_examples(s: &mut String, e: &ExampleSection) {
                  --board BOARD` (the firmware-in-the-loop harness, `fil/`, with the CAN \
                  controllers on its models; `fil/src/stack.rs`): the RAM between the end of \
                  the statics (`_stack_end`) and the initial stack pointer is painted before \
-                 reset; **configuration** is the painted depth when the firmware first \
-                 unmasks a CAN interrupt line in the NVIC (the examples do so once the \
-                 driver is configured and split: start-up, configuration and everything \
-                 `main` holds by then), **whole run** the depth at the end (thread code, \
+                 reset; **configuration** is the painted depth when the last CAN \
+                 controller the firmware starts has its first interrupt line unmasked in \
+                 the NVIC (the examples unmask a controller's lines once its driver is \
+                 configured and split: start-up, the configuration of every controller — \
+                 the second of the two-controller examples included, with whatever the \
+                 first one's handlers pushed meanwhile — and everything `main` holds by \
+                 then), **whole run** the depth at the end (thread code, \
                  handlers and their exception frames). An example alone on the bus gets no \
                  acknowledgement; that does not change its configuration.\n",
                 crate::stack::SECONDS

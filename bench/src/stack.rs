@@ -1,8 +1,8 @@
 //! Stack high-water marks of the firmware examples: each example ELF runs under
 //! `can-fil --stack` (the firmware-in-the-loop harness, `fil/`, on the board it was
 //! built for), which paints the stack before reset and reports the painted depth when
-//! the firmware first unmasks a CAN interrupt line (configuration done) and at the end
-//! (`fil/src/stack.rs`).
+//! the last CAN controller the firmware starts has its first interrupt line unmasked
+//! (configuration done, of every controller) and at the end (`fil/src/stack.rs`).
 
 use std::path::Path;
 use std::process::Command;
@@ -16,8 +16,8 @@ pub const SECONDS: &str = "0.2";
 /// What `can-fil --stack` reported for one example.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct FilStack {
-    /// Bytes of stack written up to the first unmasking of a CAN interrupt line
-    /// (`None`: the firmware unmasked none in the run).
+    /// Bytes of stack written until the last CAN controller started had a line
+    /// unmasked (`None`: the firmware unmasked none in the run).
     pub configuration: Option<u64>,
     /// Bytes of stack written over the whole run.
     pub whole: u64,
@@ -108,7 +108,7 @@ mod tests {
     #[test]
     fn reads_the_stack_line() {
         let out = "bus: 500000 bit/s\n\n[teensy36] x\n  instructions: 5\n  stack: \
-                   configuration 1208 B (until a CAN interrupt line was first unmasked, \
+                   configuration 1208 B (until the last CAN controller started had a line unmasked, \
                    at 812 us), whole run 1376 B, painted 253952 B from 0x1FFF1000\n  \
                    faults: none\n";
         assert_eq!(

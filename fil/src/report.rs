@@ -71,7 +71,7 @@ pub fn render(world: &World<'_>) -> String {
         if let (Some(s), Some(whole)) = (&b.stack, m.stack_high_water()) {
             let config = match s.configuration {
                 Some((bytes, at_ns)) => format!(
-                    "configuration {bytes} B (until a CAN interrupt line was first unmasked, at {} us)",
+                    "configuration {bytes} B (until the last CAN controller started had a line unmasked, at {} us)",
                     at_ns / 1000
                 ),
                 None => "configuration not reached (no CAN interrupt line unmasked)".into(),

@@ -6,11 +6,12 @@
 //! deepest word that no longer holds the pattern: everything the firmware's stack
 //! (thread code, handlers and the exception frames the core pushed) ever wrote.
 //!
-//! Two marks are taken: at the first write to an NVIC `ISER` register that unmasks an
-//! interrupt line of a CAN controller — the examples unmask their lines once the driver
-//! is configured and split (`docs/architecture.md`), so this is the **configuration**
-//! figure: reset, start-up and configuration — and at the end of the run (**whole
-//! run**). Painting measures what is written: stack reserved and never written is not
+//! Two marks are taken: when the last CAN controller the firmware starts has its first
+//! interrupt line unmasked (an NVIC `ISER` write) — the examples unmask a controller's
+//! lines once its driver is configured and split (`docs/architecture.md`), so this is
+//! the **configuration** figure: reset, start-up and the configuration of every
+//! controller, the second of two included (with whatever the first one's handlers
+//! pushed meanwhile) — and at the end of the run (**whole run**). Painting measures what is written: stack reserved and never written is not
 //! seen.
 
 use unicorn_engine::Unicorn;
@@ -27,9 +28,11 @@ pub struct StackPaint {
     pub bottom: u32,
     /// The initial stack pointer (one past the highest painted word).
     pub top: u32,
-    /// The high-water mark when the first CAN interrupt line was unmasked, and the core
-    /// time then (ns).
+    /// The high-water mark when the last CAN controller started had its first
+    /// interrupt line unmasked, and the core time then (ns).
     pub configuration: Option<(u32, u64)>,
+    /// The controllers (index bits of the board's CAN ports) with a line unmasked so far.
+    pub started: u32,
 }
 
 impl StackPaint {
@@ -56,6 +59,7 @@ pub fn paint(uc: &mut Unicorn<'_, Board>, bottom: u32, top: u32) -> Result<Stack
         bottom,
         top,
         configuration: None,
+        started: 0,
     })
 }
 
@@ -71,18 +75,48 @@ pub fn high_water(uc: &Unicorn<'_, Board>, s: &StackPaint) -> u32 {
     s.painted() - 4 * untouched
 }
 
-/// Takes the configuration mark if the board paints its stack and has none yet (called
-/// when an `ISER` write unmasks a CAN interrupt line).
-pub fn mark_configuration(uc: &mut Unicorn<'_, Board>) {
+/// Takes the configuration mark again if the board paints its stack and `controllers`
+/// (index bits) has one whose lines were not unmasked before (called when an `ISER`
+/// write unmasks a CAN interrupt line): the mark of the last controller started stays.
+pub fn mark_configuration(uc: &mut Unicorn<'_, Board>, controllers: u32) {
     let Some(s) = uc.get_data().stack.clone() else {
         return;
     };
-    if s.configuration.is_some() {
+    if !starts_another(s.started, controllers) {
         return;
     }
     let mark = high_water(uc, &s);
     let now = uc.get_data().time_ns();
     if let Some(s) = uc.get_data_mut().stack.as_mut() {
         s.configuration = Some((mark, now));
+        s.started |= controllers;
+    }
+}
+
+/// Whether an `ISER` write unmasking lines of `controllers` (index bits) starts a
+/// controller none of whose lines was unmasked before (`started`).
+fn starts_another(started: u32, controllers: u32) -> bool {
+    controllers & !started != 0
+}
+
+#[cfg(test)]
+mod tests {
+    use super::starts_another;
+
+    /// The configuration mark follows each controller's first line, not its other
+    /// lines: a two-controller firmware's mark includes the second configuration.
+    #[test]
+    fn the_mark_moves_with_each_controller_started() {
+        assert!(starts_another(0, 0b01), "the first controller's first line");
+        assert!(!starts_another(0b01, 0b01), "its other lines");
+        assert!(
+            starts_another(0b01, 0b10),
+            "the second controller's first line"
+        );
+        assert!(
+            !starts_another(0b11, 0b10),
+            "the second controller's other lines"
+        );
+        assert!(!starts_another(0b01, 0), "no CAN line");
     }
 }

@@ -143,8 +143,9 @@ fn the_report_shows_the_decoded_defmt_log() {
     assert!(!out.contains("defmt log"), "{out}");
 }
 
-/// `--stack`: the painted stack's configuration mark (taken when the firmware unmasks its
-/// first CAN line) and the whole run's; without the option there is no stack line.
+/// `--stack`: the painted stack's configuration mark (taken when the last CAN controller
+/// the firmware starts has a line unmasked) and the whole run's; without the option
+/// there is no stack line.
 #[test]
 fn the_stack_option_reports_the_painted_depths() {
     let Some(t) = path("teensy36", "teensy-loopback") else {

@@ -185,20 +185,22 @@ pub(super) fn ppb_write(uc: &mut Unicorn<'_, Board>, addr: u32, size: usize, val
         0xE000_E100..=0xE000_E13C | 0xE000_E180..=0xE000_E1BC => {
             let set = word_addr < 0xE000_E180;
             let n = (word_addr & 0x7F) / 4;
-            let mut can_line = false;
+            // The controllers (index bits) with a line in this write.
+            let mut controllers = 0u32;
             for bit in 0..32 {
                 if value & (1 << bit) != 0 {
                     b.nvic.set_irq_enabled(n * 32 + bit, set);
-                    can_line |= b
-                        .cans
-                        .iter()
-                        .any(|p| p.instance.irqs.iter().any(|(_, irq)| *irq == n * 32 + bit));
+                    for (i, p) in b.cans.iter().enumerate().take(32) {
+                        if p.instance.irqs.iter().any(|(_, irq)| *irq == n * 32 + bit) {
+                            controllers |= 1 << i;
+                        }
+                    }
                 }
             }
             b.check_irq = true;
-            if set && can_line {
+            if set && controllers != 0 {
                 // `--stack`: the configuration mark (crate::stack).
-                crate::stack::mark_configuration(uc);
+                crate::stack::mark_configuration(uc, controllers);
             }
         }
         0xE000_E200..=0xE000_E23C | 0xE000_E280..=0xE000_E2BC => {
