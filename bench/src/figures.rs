@@ -616,12 +616,22 @@ fn cause(t: &Target, insn: &InsnSection, sizes: &SizeSection) -> Result<Vec<Stri
                         .collect::<Vec<_>>()
                         .join(", ")
                 };
+                let largest = |z: &crate::sizes::Size| {
+                    z.largest
+                        .iter()
+                        .map(|(k, n)| format!("`{k}` {}", crate::report::thousands(*n)))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                };
                 lines.push(format!(
-                    "opt {}: {} B more; code by crate, ours: {}; theirs: {}",
+                    "opt {}: {} B more; code by crate, ours: {}; theirs: {}; largest \
+                     functions, ours: {}; theirs: {}",
                     b.opt,
                     crate::report::thousands(ours.app_flash().saturating_sub(theirs.app_flash())),
                     list(ours),
-                    list(theirs)
+                    list(theirs),
+                    largest(ours),
+                    largest(theirs)
                 ));
             }
         }

@@ -625,13 +625,15 @@ impl Report {
              `options::Lean` (no time stamps, no filter switch while running: \
              `into_split_with::<Lean>()`), the filter table planned with `const_plan!` \
              and the settings checked at compile time (`BeginPlan::new_or_panic`, written \
-             by `begin_checked`: no check or planner links in), and the split driver's \
-             `Lean` feature set, its quiet transmit mode there too (full: `begin` with \
-             the list, the checks and the planner at run time).\n\n\
-             Both bxCAN variants configure the controller in place in the `static` state \
-             (`State::split_with`, `BxCan::can1_in`: no controller, plan or map moves \
-             through the configuration); full plans at run time into a `static` scratch \
-             (`twocan_core::TakeOnce`).\n\n\
+             by `begin_checked_in_place`: no check or planner links in), and the split \
+             driver's `Lean` feature set, its quiet transmit mode there too (full: the \
+             settings checked at compile time as well, the list compiled at run time by \
+             `begin_in_place` into a `static` `TableSlot`, `options::FullInSlot`).\n\n\
+             Every variant of both backends configures the controller in place in the \
+             `static` state (`State::split_with` with `BxCan::can1_in`, \
+             `FlexCan::begin_checked_in_place` or `FlexCan::begin_in_place`: no \
+             controller, plan or map moves through the configuration); bxCAN's full \
+             plans at run time into a `static` scratch (`twocan_core::TakeOnce`).\n\n\
              bxCAN (STM32F767ZI): the same start-up (`shared/stm32f7.rs`: SYSCLK 108 MHz \
              from the PLL, APB1 54 MHz, CAN1 clock on), CAN1 in loop-back mode at \
              500 kbit/s (the same `CAN_BTR`, solved at compile time), one accept-all filter \
@@ -658,9 +660,10 @@ impl Report {
              FlexCAN0 in loop-back mode with self reception at 500 kbit/s from the \
              oscillator clock, one pass-all filter, one frame by polling:\n\n\
              - `loopback-flexcan`: our FlexCAN split driver on the 8-filter Rx FIFO \
-             partition (lean: `begin_checked` with the compile-time plan, \
-             `into_split_with::<Lean>()`; full: `begin` with the list, `into_split`), a \
-             `static State`, as `loopback-twocan`;\n\
+             partition, begun in place in a `static State` (`State::split_with`; lean: \
+             `begin_checked_in_place` with the compile-time plan and `options::Lean`; \
+             full: `begin_in_place` compiling the list into a `static` `TableSlot`, \
+             `options::FullInSlot`), as `loopback-twocan`;\n\
              - `loopback-flexcan-hand`: the hand-written register-level service of \
              `shared/flexcan_hand.rs` (there is no crate peer for Teensy 3.x): the K66 \
              manual's initialization sequence, MB15 as the transmit mailbox, an Rx FIFO \
@@ -974,8 +977,10 @@ impl Report {
              callees'; an interrupt handler on hardware adds the 32-byte exception frame, \
              104 with FP context). The **configuration** figure is the same for the whole \
              configuration of a driver, from the register handle to the handles of the \
-             split (ours: `Can::can1`/`begin`, filters, `enable`, `into_split`, \
-             `State::split`; the equivalents: the crate's builder or the hand-written \
+             split (ours: the controller configured in place in the `State` by \
+             `State::split_with` — bxCAN `BxCan::can1_in`, FlexCAN \
+             `begin_checked_in_place` or `begin_in_place` — with the filters and the \
+             split; the equivalents: the crate's builder or the hand-written \
              initialization, the split). During it the handshake stand-in's SysTick \
              interrupts push their 8-word frames on the measured stack (FP context \
              stacking is turned off meanwhile, and the handler is assembly that pushes \
@@ -1338,17 +1343,19 @@ fn why_missed(backend: Backend, variant: &str, key: &str) -> &'static str {
              the equivalents record a completion with fewer checks."
         }
         (Backend::BxCan, "lean", "flash") => {
-            "every split driver links its transmit queue (the path for a busy mailbox), \
-             abort and mailbox-state queries, error-state and status handling and \
-             configuration (mode changes with their time-outs, the filter writes), which \
-             the equivalent's loop-back does not call; `compiler_builtins` adds the \
-             `memclr` that zeroes the controller's per-mailbox words when it is written \
-             in place."
+            "the split driver links the transmit path for a busy mailbox and queued \
+             frames (`service_tx`, `send_queued`), which the loop-back never takes but an \
+             application may, the error-state read its status handler and `split` use \
+             (`error_status`), and a configuration (mode requests with their time-outs, \
+             the filter block's programming) inlined into `main`; `compiler_builtins` \
+             adds the `memclr` that zeroes words of the controller written in place \
+             (the largest functions below)."
         }
         (Backend::FlexCan, "lean", "flash") => {
-            "as bxCAN's, and `compiler_builtins` links `memcpy` (730 B) for the copy of \
-             the chip-level plan into the controller and `memclr` for its zeroed \
-             words when it is written in place."
+            "as bxCAN's (`service_tx` is larger: the remote-frame mailboxes are served \
+             there too), and `compiler_builtins` links `memcpy` for the copy of the \
+             chip-level plan into the controller and `memclr` for its zeroed words when \
+             it is written in place (the largest functions below)."
         }
         (_, _, "flash") => {
             "the full variant links the run-time filter planner and table compiler, \
@@ -1444,11 +1451,11 @@ fn feature_note(backend: Backend, feature: &str) -> &'static str {
              planning on the configuration's stack; the per-frame code is lean's"
         }
         (Backend::FlexCan, "planner") => {
-            "the filter list compiled at run time by `FlexCan::begin_in` straight into \
-             a `static` `TableSlot` (controller options with an owned table) instead of \
-             the `const` plan, and the settings checked at run time: its cost is the \
-             table compiler, the checks and the table in flash and RAM and the \
-             compilation on the configuration's stack; the per-frame code reads the \
+            "the filter list compiled at run time by `FlexCan::begin_in_place` \
+             straight into a `static` `TableSlot` (controller options with a reference \
+             to it) instead of the `const` plan (the settings still checked at compile \
+             time): its cost is the table compiler and the table in flash and RAM and \
+             the compilation on the configuration's stack; the per-frame code reads the \
              owned table where lean reads the plan"
         }
         _ => "",
@@ -1744,6 +1751,10 @@ fn region_note(key: &str) -> &'static str {
             "`TxIrq::on_interrupt` with nothing to settle (the handler's fixed cost)"
         }
         "twocan.rx_irq" => "`RxIrq::on_interrupt`: one frame into the raw ring, FIFO released",
+        "twocan.rx_irq.overrun" => {
+            "`RxIrq::on_interrupt`: one frame with the FIFO's overrun flag set (the frame \
+             into the ring, the overrun counted out of line)"
+        }
         "twocan.rx.receive" => "`Rx::receive`: ring → decoded frame with filter index",
         "twocan.take_completion" => "`Tx::take_completion`: the frame's completion",
         "bxcan.transmit" => "`bxcan` `Can::transmit`, all mailboxes empty",

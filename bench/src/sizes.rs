@@ -67,7 +67,13 @@ pub struct Size {
     /// module left out ([`crate_of`]): where the flash goes. Code inlined into another
     /// crate's function counts for that function's crate.
     pub code_by_crate: Vec<(String, u64)>,
+    /// The largest functions (readable names, [`readable`]), largest first, start-up
+    /// module left out: up to [`LARGEST`].
+    pub largest: Vec<(String, u64)>,
 }
+
+/// How many of the largest functions [`Size::largest`] keeps.
+pub const LARGEST: usize = 6;
 
 /// The path component (in legacy Rust symbol mangling, length-prefixed) of the bench
 /// firmware's shared start-up module.
@@ -188,6 +194,7 @@ pub fn measure(path: &Path) -> Result<Size> {
     }
     let mut by_crate: std::collections::BTreeMap<String, u64> = Default::default();
     let mut seen_code = std::collections::BTreeSet::new();
+    let mut functions: Vec<(String, u64)> = Vec::new();
     for sym in elf.symbols() {
         let Ok(name) = sym.name() else { continue };
         if sym.kind() != SymbolKind::Text
@@ -199,14 +206,76 @@ pub fn measure(path: &Path) -> Result<Size> {
             continue;
         }
         *by_crate.entry(crate_of(name)).or_default() += sym.size();
+        functions.push((readable(name), sym.size()));
     }
+    functions.sort_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(&b.0)));
+    functions.truncate(LARGEST);
     let mut code_by_crate: Vec<(String, u64)> = by_crate.into_iter().collect();
     code_by_crate.sort_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(&b.0)));
     Ok(Size {
         sections,
         startup,
         code_by_crate,
+        largest: functions,
     })
+}
+
+/// A function symbol as a reader names it: a legacy Rust mangled name's last two path
+/// components, decoded (`State<H, _, Q, _, _, Fe>::service_tx`), the hash left out; a
+/// v0 mangled name's last identifier; any other name as it is.
+pub fn readable(symbol: &str) -> String {
+    let Some(mut rest) = symbol.strip_prefix("_ZN") else {
+        if symbol.starts_with("_R") {
+            // The last length-prefixed identifier.
+            let b = symbol.as_bytes();
+            let mut i = b.len();
+            while i > 0 && !b[i - 1].is_ascii_digit() {
+                i -= 1;
+            }
+            let tail = &symbol[i..];
+            return if tail.is_empty() {
+                symbol.into()
+            } else {
+                tail.into()
+            };
+        }
+        return symbol.into();
+    };
+    let mut parts: Vec<String> = Vec::new();
+    loop {
+        let digits: String = rest.chars().take_while(char::is_ascii_digit).collect();
+        let Ok(len) = digits.parse::<usize>() else {
+            break;
+        };
+        let Some(ident) = rest.get(digits.len()..digits.len() + len) else {
+            break;
+        };
+        parts.push(ident.to_string());
+        rest = &rest[digits.len() + len..];
+    }
+    if parts
+        .last()
+        .is_some_and(|p| p.len() == 17 && p.starts_with('h'))
+    {
+        parts.pop();
+    }
+    let decode = |p: &str| {
+        p.replace("$LT$", "<")
+            .replace("$GT$", ">")
+            .replace("$u20$", " ")
+            .replace("$C$", ",")
+            .replace("$RF$", "&")
+            .replace("..", "::")
+            .replace(',', ", ")
+            .trim_start_matches('_')
+            .to_string()
+    };
+    let n = parts.len();
+    parts[n.saturating_sub(2)..]
+        .iter()
+        .map(|p| decode(p))
+        .collect::<Vec<_>>()
+        .join("::")
 }
 
 /// The crate a function symbol belongs to: the first path component of a legacy Rust
@@ -508,6 +577,13 @@ mod tests {
         assert_eq!(crate_of("main"), "application (main)");
         assert_eq!(crate_of("Reset"), "cortex_m_rt");
         assert_eq!(crate_of("CAN1_RX0"), "other");
+        assert_eq!(
+            readable(
+                "_ZN11twocan_core5split35State$LT$H$C$_$C$Q$C$_$C$_$C$Fe$GT$10service_tx17h7cb210191959023fE"
+            ),
+            "State<H, _, Q, _, _, Fe>::service_tx"
+        );
+        assert_eq!(readable("main"), "main");
     }
 
     fn section(name: &str, size: u64, class: Class) -> Section {
@@ -522,6 +598,7 @@ mod tests {
     fn driver_and_application_flash_leaves_out_vectors_config_field_and_start_up() {
         let z = Size {
             code_by_crate: Vec::new(),
+            largest: Vec::new(),
             sections: vec![
                 section(".vector_table", 1024, Class::Code),
                 section(".flash_config", 16, Class::Code),

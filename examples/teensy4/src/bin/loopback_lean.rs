@@ -5,7 +5,8 @@
 //!
 //! What differs from `teensy4-loopback` (and from `teensy-loopback-lean`, the Teensy 3
 //! one) is the state's type, `can::LeanState` instead of the one call's `CanState` (one
-//! line), and the configuration it takes:
+//! line), and the configuration it takes (the token's planned begin instead of the one
+//! call):
 //! - fire-and-forget transmit: no completion ring (`DONE` = 0), nothing to take back;
 //! - no traffic statistics and no time stamps (`twocan_core::Lean`);
 //! - the filter list planned at compile time for the RT1062 layout
