@@ -56,7 +56,7 @@ use crate::regs::{
 };
 use crate::settings::Settings;
 use crate::split::{FlexCanHw, Parts};
-use crate::system::{choose_pins, PortPlan, SystemPlan};
+use crate::system::{choose_pins, LayoutSystem, PortPlan, SystemPlan};
 
 /// Everything `begin` will write but the filter table, computed before anything is
 /// written (the lists are checked; the table is built once, inside the controller
@@ -587,6 +587,10 @@ impl<R: Registers> FlexCan<R> {
         if filters != ConfigErrors::NONE {
             return Err((BeginError::Config(filters), slot));
         }
+        let parts = match checked.parts() {
+            Ok(p) => p,
+            Err(e) => return Err((e, slot)),
+        };
         if let Err(e) = plan.system.apply(sys) {
             return Err((BeginError::Config(e), slot));
         }
@@ -600,12 +604,7 @@ impl<R: Registers> FlexCan<R> {
         ) {
             return Err((BeginError::Hardware(e), slot));
         }
-        Ok(hw.write(FlexCanHw::from_parts(
-            regs,
-            checked.target,
-            slot,
-            checked.parts(),
-        )))
+        Ok(hw.write(FlexCanHw::from_parts(regs, checked.target, slot, parts)))
     }
 
     /// [`FlexCan::begin_in`] but the controller: the checks, the lists compiled into
@@ -619,7 +618,8 @@ impl<R: Registers> FlexCan<R> {
         primary: &[Filter],
         secondary: &[Filter],
         slot: &'static mut L::Table,
-    ) -> Result<(R, &'static mut L::Table, Parts), (BeginError, &'static mut L::Table)> {
+    ) -> Result<(R, &'static mut L::Table, Parts<L::System>), (BeginError, &'static mut L::Table)>
+    {
         if let Some(e) = bitrate_error::<L>(settings, settings.configuration) {
             return Err((BeginError::Timing(e), slot));
         }
@@ -627,6 +627,9 @@ impl<R: Registers> FlexCan<R> {
         let plan = match plan::<L>(target, settings, settings.configuration, filters) {
             Ok(p) => p,
             Err(e) => return Err((BeginError::Config(e), slot)),
+        };
+        let Some(system) = L::System::from_plan(&plan.system) else {
+            return Err((BeginError::Config(ConfigErrors::LAYOUT_NOT_FOR_CHIP), slot));
         };
         if let Err(e) = plan.system.apply(sys) {
             return Err((BeginError::Config(e), slot));
@@ -649,7 +652,7 @@ impl<R: Registers> FlexCan<R> {
             irq_priority: settings.message_irq_priority,
             mode: Mode::Normal,
             last_error: LastErrorCode::None,
-            system: plan.system,
+            system,
             bus_clock_hz: settings.bus_clock_hz.unwrap_or(settings.can_clock.hz()),
         };
         Ok((regs, slot, parts))
@@ -733,11 +736,12 @@ impl<R: Registers> FlexCan<R> {
         sys: &mut S,
         checked: &BeginPlan<L>,
         table: PlannedTable,
-    ) -> Result<(R, Parts), BeginError> {
+    ) -> Result<(R, Parts<L::System>), BeginError> {
         let plan = &checked.plan;
         if table.configuration() != plan.configuration {
             return Err(BeginError::Hardware(Error::InvalidArgument));
         }
+        let parts = checked.parts()?;
         plan.system.apply(sys).map_err(BeginError::Config)?;
         configure::<R, L>(
             &mut regs,
@@ -753,7 +757,7 @@ impl<R: Registers> FlexCan<R> {
             },
             checked.polls,
         )?;
-        Ok((regs, checked.parts()))
+        Ok((regs, parts))
     }
 }
 
@@ -799,6 +803,8 @@ impl<R: Registers, L: Layout> FlexCan<R, L> {
         let filters = L::Table::check_lists(settings.configuration, primary, secondary);
         let plan = plan::<L>(target, settings, settings.configuration, filters)
             .map_err(BeginError::Config)?;
+        let system = L::System::from_plan(&plan.system)
+            .ok_or(BeginError::Config(ConfigErrors::LAYOUT_NOT_FOR_CHIP))?;
         plan.system.apply(sys).map_err(BeginError::Config)?;
         let polls = settings.handshake_bound();
         let bus_mode = bus_mode_of(settings);
@@ -811,7 +817,7 @@ impl<R: Registers, L: Layout> FlexCan<R, L> {
             settings.bus_off_recovery,
             polls,
             settings.message_irq_priority,
-            plan.system,
+            system,
             settings.bus_clock_hz.unwrap_or(settings.can_clock.hz()),
         );
         let table = &controller.table;
@@ -934,19 +940,24 @@ impl<L: Layout> BeginPlan<L> {
         self.target
     }
 
-    /// The split controller's small values, as the module is right after `begin`.
+    /// The split controller's small values, as the module is right after `begin`
+    /// (a plan of the other chip family: [`ConfigErrors::LAYOUT_NOT_FOR_CHIP`], which
+    /// [`BeginPlan::new_with_layout`] already refuses).
     #[inline(always)]
-    fn parts(&self) -> Parts {
-        Parts {
+    fn parts(&self) -> Result<Parts<L::System>, BeginError> {
+        let Some(system) = L::System::from_plan(&self.plan.system) else {
+            return Err(BeginError::Config(ConfigErrors::LAYOUT_NOT_FOR_CHIP));
+        };
+        Ok(Parts {
             bus_mode: self.bus_mode,
             recovery: self.recovery,
             polls: self.polls,
             irq_priority: self.irq_priority,
             mode: Mode::Normal,
             last_error: LastErrorCode::None,
-            system: self.plan.system,
+            system,
             bus_clock_hz: self.bus_clock_hz,
-        }
+        })
     }
 }
 

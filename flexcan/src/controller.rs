@@ -42,7 +42,7 @@ use crate::filters::OwnedTable;
 use crate::instance::Target;
 use crate::layout::{Kinetis, Layout};
 use crate::regs::{self, TIMER};
-use crate::system::SystemPlan;
+use crate::system::{LayoutSystem, SystemPlan};
 
 /// A FlexCAN instance configured by `begin` (see [`crate::instance`]), over its
 /// registers `R`, in the message-buffer layout `L` ([`crate::layout`]: [`Kinetis`],
@@ -61,7 +61,7 @@ pub struct FlexCan<R: Registers, L: Layout = Kinetis> {
     /// The newest error `ESR1` reported.
     pub(crate) last_error: Cell<LastErrorCode>,
     /// The clock gate and pins `begin` set up, which [`FlexCan::end`] releases.
-    pub(crate) system: SystemPlan,
+    pub(crate) system: L::System,
     /// The peripheral (bus) clock `begin` checked the timing against
     /// ([`crate::Settings::bus_clock_hz`], the oscillator clock when not given): the
     /// Kinetis manual's clocks-per-bit rule is applied with it on every re-timing.
@@ -78,7 +78,7 @@ impl<R: Registers, L: Layout> FlexCan<R, L> {
         recovery: BusOffRecovery,
         polls: u32,
         irq_priority: u8,
-        system: SystemPlan,
+        system: L::System,
         bus_clock_hz: u32,
     ) -> Self {
         FlexCan {
@@ -117,8 +117,8 @@ impl<R: Registers, L: Layout> FlexCan<R, L> {
     }
 
     /// The clock gate and the Tx and Rx pins `begin` set up (ACAN §7).
-    pub const fn system(&self) -> SystemPlan {
-        self.system
+    pub fn system(&self) -> SystemPlan {
+        self.system.to_plan()
     }
 
     /// The mode the controller was last put in.

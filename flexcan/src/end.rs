@@ -31,6 +31,7 @@
 //! The state is empty again afterwards: the same `static` takes the controller begun
 //! anew.
 
+use crate::system::LayoutSystem;
 use twocan_core::{Error, Registers};
 
 use crate::controller::FlexCan;

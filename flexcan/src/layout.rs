@@ -96,6 +96,10 @@ pub trait Layout: Send + Sync + 'static {
     const E5829: bool;
     /// The table [`crate::options::Full`] keeps and `begin` compiles into.
     type Table: OwnedTable;
+    /// The chip-level plan a controller of this layout keeps for `end`
+    /// ([`crate::system::LayoutSystem`]): [`crate::PortPlan`] for [`Kinetis`],
+    /// [`crate::imxrt::ImxrtPlan`] for [`Imxrt1062`] (only its own chip family's).
+    type System: crate::system::LayoutSystem;
 
     /// The largest `CTRL2[RFFN]` accepted on `chip`: this layout's and the chip's
     /// ([`Chip::max_rffn`]), whichever is smaller — one rule for `begin`, `check`, the
@@ -204,6 +208,7 @@ impl Layout for Kinetis {
     const IFLAG2: bool = false;
     const E5829: bool = false;
     type Table = FilterTable;
+    type System = crate::system::PortPlan;
 }
 
 /// The i.MX RT1062's 64 message buffers: Rx FIFO tables up to RFFN 0xF, the transmit
@@ -217,6 +222,7 @@ impl Layout for Imxrt1062 {
     const IFLAG2: bool = true;
     const E5829: bool = true;
     type Table = LargeFilterTable;
+    type System = crate::imxrt::ImxrtPlan;
 }
 
 #[cfg(test)]

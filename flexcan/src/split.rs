@@ -73,7 +73,7 @@ use crate::regs::{
     self, code, cs, ctrl1, esr1, iflag1, rxfir, ECR, ESR1, IFLAG1, IFLAG2, IMASK1, IMASK2, RXFIR,
 };
 use crate::status;
-use crate::system::SystemPlan;
+use crate::system::LayoutSystem;
 
 /// One received frame: the Rx FIFO output's control/status, identifier and two data
 /// words, and `RXFIR.IDHIT`.
@@ -186,8 +186,9 @@ pub struct FlexCanHw<R: Registers, O: Options = Full> {
     /// (bit per MB), written inside the driver's critical section only
     /// (`abort_mailboxes`, `retry_aborts`).
     abort_wanted: AtomicU32,
-    /// The clock gate and pins `begin` set up (for [`FlexCanHw::into_controller`]).
-    system: SystemPlan,
+    /// The clock gate and pins `begin` set up (for [`FlexCanHw::into_controller`]): the
+    /// layout's chip family's plan only.
+    system: <O::Layout as Layout>::System,
     /// Frames caught by remote-frame mailboxes turned receive mailboxes (written by the
     /// transmit interrupt's `settle` only).
     caught: AtomicU32,
@@ -238,21 +239,26 @@ impl<R: Registers, L: Layout> FlexCan<R, L> {
 
 /// The small values a split controller starts from (a started [`FlexCan`]'s, or
 /// `begin_planned`'s).
-pub(crate) struct Parts {
+pub(crate) struct Parts<Sys> {
     pub(crate) bus_mode: BusMode,
     pub(crate) recovery: BusOffRecovery,
     pub(crate) polls: u32,
     pub(crate) irq_priority: u8,
     pub(crate) mode: Mode,
     pub(crate) last_error: LastErrorCode,
-    pub(crate) system: SystemPlan,
+    pub(crate) system: Sys,
     pub(crate) bus_clock_hz: u32,
 }
 
 impl<R: Registers, O: Options> FlexCanHw<R, O> {
     /// The split controller over `regs` with `table` installed.
     #[inline(always)]
-    pub(crate) fn from_parts(regs: R, target: Target, table: O::Table, p: Parts) -> Self {
+    pub(crate) fn from_parts(
+        regs: R,
+        target: Target,
+        table: O::Table,
+        p: Parts<<O::Layout as Layout>::System>,
+    ) -> Self {
         let configuration = table.configuration();
         let first = if O::Layout::E5829 {
             configuration.first_remote_mailbox_in(true)
@@ -415,7 +421,7 @@ impl<R: Registers, O: Options> FlexCanHw<R, O> {
     }
 
     /// The clock gate and pins `begin` set up.
-    pub(crate) fn system_plan(&self) -> &SystemPlan {
+    pub(crate) fn system_plan(&self) -> &<O::Layout as Layout>::System {
         &self.system
     }
 }

@@ -147,6 +147,61 @@ impl SystemPlan {
     }
 }
 
+/// The chip-level plan a controller of one message-buffer layout keeps for `end`
+/// ([`crate::layout::Layout::System`]): the Kinetis [`PortPlan`] or the RT1062's
+/// [`ImxrtPlan`]. A controller keeps only its own chip family's plan (issue 21: 32 B on
+/// a Kinetis part rather than a [`SystemPlan`] sized for the RT1062's pads).
+pub trait LayoutSystem: Copy + core::fmt::Debug + Send + Sync + 'static {
+    /// This layout's plan out of `plan` (`None`: a plan of the other chip family, which
+    /// `begin` refuses for this layout, [`ConfigErrors::LAYOUT_NOT_FOR_CHIP`]).
+    fn from_plan(plan: &SystemPlan) -> Option<Self>;
+    /// As a [`SystemPlan`].
+    fn to_plan(&self) -> SystemPlan;
+    /// Enables the clocks and muxes the pins ([`SystemPlan::apply`]).
+    fn apply<S: Registers>(&self, sys: &mut S) -> Result<(), ConfigErrors>;
+    /// Releases the pins and the module's clock gate ([`SystemPlan::release`]).
+    fn release<S: Registers>(&self, sys: &mut S);
+    /// The protocol engine clock in Hz ([`SystemPlan::can_clock_hz`]).
+    fn can_clock_hz(&self) -> u32;
+}
+
+impl LayoutSystem for PortPlan {
+    fn from_plan(plan: &SystemPlan) -> Option<Self> {
+        plan.kinetis().copied()
+    }
+    fn to_plan(&self) -> SystemPlan {
+        SystemPlan::Kinetis(*self)
+    }
+    fn apply<S: Registers>(&self, sys: &mut S) -> Result<(), ConfigErrors> {
+        PortPlan::apply(self, sys);
+        Ok(())
+    }
+    fn release<S: Registers>(&self, sys: &mut S) {
+        PortPlan::release(self, sys)
+    }
+    fn can_clock_hz(&self) -> u32 {
+        crate::settings::CAN_CLOCK_HZ
+    }
+}
+
+impl LayoutSystem for ImxrtPlan {
+    fn from_plan(plan: &SystemPlan) -> Option<Self> {
+        plan.imxrt().copied()
+    }
+    fn to_plan(&self) -> SystemPlan {
+        SystemPlan::Imxrt(*self)
+    }
+    fn apply<S: Registers>(&self, sys: &mut S) -> Result<(), ConfigErrors> {
+        ImxrtPlan::apply(self, sys)
+    }
+    fn release<S: Registers>(&self, sys: &mut S) {
+        ImxrtPlan::release(self, sys)
+    }
+    fn can_clock_hz(&self) -> u32 {
+        self.root.hz()
+    }
+}
+
 /// The Kinetis chip-level writes: SIM clock gates, PORT pin control.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct PortPlan {
