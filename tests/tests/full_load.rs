@@ -44,8 +44,13 @@
 use twocan_tests::backend::{BxCanBackend, FlexCanBackend};
 use twocan_tests::load::{
     budget_bits, full_load, LeanBxCan, LeanFlexCan, LeanRt1062, LoadInstance, LoadReport,
-    MIN_FRAME_BITS,
+    FULL_LOAD_BIT_RATE, MIN_FRAME_BITS,
 };
+
+use twocan_flexcan::layout::{Imxrt1062, Kinetis, Layout};
+use twocan_flexcan::regs::{self, code, cs, mcr};
+use twocan_flexcan::Configuration;
+use twocan_host::Harness;
 
 const DEFAULT_FRAMES: u64 = 100_000;
 const FULL_FRAMES: u64 = 1_000_000;
@@ -141,6 +146,27 @@ fn lean_bxcan_full_load_beyond_budget_counts_every_loss() {
 #[test]
 fn lean_rt1062_full_load_within_budget_loses_nothing() {
     within_budget::<LeanRt1062>(DEFAULT_FRAMES, 0xF1E7_CA21);
+}
+
+/// The RT1062 lean instance is the module `teensy4-loopback-lean` begins, in its layout:
+/// the RT1062 model (64 message buffers), `MCR[MAXMB]` at the RT1062 layout's data
+/// mailbox for the 12/12 partition (MB16: ACAN's layout stops at MB15), the ERR005829
+/// reserved mailbox after the Rx FIFO area INACTIVE with its interrupt masked (i.MX
+/// RT1060 chip errata, ERR005829; `twocan_flexcan::layout::Layout::E5829`).
+#[test]
+fn lean_rt1062_node_is_begun_in_the_rt1062_layout() {
+    let mut h = Harness::new(FULL_LOAD_BIT_RATE).expect("bus");
+    let node = LeanRt1062::attach_via(&mut h, |bus, name, n| bus.attach_boxed(name, n));
+    let c = Configuration::Filters12_12;
+    assert_eq!(node.model.message_buffers(), 64);
+    let maxmb = mcr::MAXMB.get(node.model.peek32(regs::MCR)) as usize;
+    assert_eq!(maxmb, Imxrt1062::data_mailbox(c) as usize);
+    assert_ne!(maxmb, Kinetis::data_mailbox(c) as usize);
+    let reserved = usize::from(Imxrt1062::reserved_mailbox(c).expect("ERR005829 mailbox"));
+    assert!(reserved < maxmb);
+    let reserved_cs = node.model.peek32(regs::mb_cs(reserved));
+    assert_eq!(cs::CODE.get(reserved_cs), code::TX_INACTIVE);
+    assert_eq!(node.model.peek32(regs::IMASK1) & (1 << reserved), 0);
 }
 
 #[test]
