@@ -351,6 +351,18 @@ impl FlexPart for Teensy41Can3 {
     type Layout = Imxrt1062;
 }
 
+/// CAN1 of a Teensy 4.1 (i.MX RT1062), the 24 MHz oscillator as CAN clock root, in the
+/// RT1062 layout ([`Imxrt1062`]): the module the Teensy 4 examples use
+/// (`teensy4-loopback-lean`, [`crate::lean`]).
+pub struct Teensy41Can1;
+
+impl FlexPart for Teensy41Can1 {
+    const NAME: &'static str = "FlexCAN (Teensy 4.1 CAN1)";
+    const TARGET: Target = Target::new(Board::Teensy41, Instance::Can1);
+    const CLOCK: CanClock = CanClock::IMXRT_24MHZ;
+    type Layout = Imxrt1062;
+}
+
 /// A FlexCAN module through ACAN's `begin`: the driver is the same for every part, the
 /// part is data ([`FlexPart`]).
 pub struct FlexCanBackendOf<P: FlexPart>(core::marker::PhantomData<P>);

@@ -34,8 +34,14 @@ use twocan_host::Harness;
 use twocan_sim::{Bus, BusNode, BusTime, NodeId, SimNode, TxRequest, TxResult};
 
 use crate::backend::{Backend, BxCanBackend, Dut, FlexCanBackend, NodeOptions, OverrunPolicy};
-use crate::lean::{attach_bx_lean, attach_flex_lean, LeanBxNode, LeanFlexNode};
+use crate::backend::{Teensy36Can0, Teensy41Can1};
+use crate::lean::{
+    attach_bx_lean, attach_flex_lean, FlexLeanModelHw, LeanBxNode, LeanFlexNode, LeanFlexPart,
+    LeanNode,
+};
 use crate::rng::XorShift64;
+use twocan_flexcan::layout::Layout;
+use twocan_flexcan::model::FlexCanModel;
 
 /// Bit times of the shortest classical CAN frame with its intermission: standard
 /// identifier, DLC 0, no stuff bit. SOF 1 + identifier 11 + RTR 1 + IDE 1 + r0 1 + DLC 4
@@ -79,7 +85,7 @@ pub trait Loaded: 'static {
 
 /// A node the full-load runner brings up: the unsplit driver of every [`Backend`]
 /// (every feature), and the lean split driver of each backend ([`LeanBxCan`],
-/// [`LeanFlexCan`]).
+/// [`LeanFlexCan`], [`LeanRt1062`]).
 pub trait LoadInstance {
     /// The node.
     type Node: Loaded;
@@ -195,12 +201,19 @@ impl LoadInstance for LeanBxCan {
     }
 }
 
-/// The lean split driver on FlexCAN ([`crate::lean`]): the ORed message-buffer line
-/// runs the transmit, receive (`Rx0Irq`) and status handlers, the receive half drains
-/// the ring.
-pub struct LeanFlexCan;
+/// The lean split driver on the FlexCAN module `P` ([`crate::lean`]): the ORed
+/// message-buffer line runs the transmit, receive (`Rx0Irq`) and status handlers, the
+/// receive half drains the ring.
+pub struct LeanFlexCanOf<P>(core::marker::PhantomData<P>);
 
-impl Loaded for LeanFlexNode {
+/// The lean split driver on Teensy 3.6 can0 (ACAN's layout, the 8-filter partition).
+pub type LeanFlexCan = LeanFlexCanOf<Teensy36Can0>;
+
+/// The lean split driver on Teensy 4.1 CAN1 (the RT1062 model in the RT1062 layout,
+/// the 12/12 partition): `teensy4-loopback-lean`.
+pub type LeanRt1062 = LeanFlexCanOf<Teensy41Can1>;
+
+impl<L: Layout> Loaded for LeanNode<FlexLeanModelHw<L>, FlexCanModel> {
     fn irq_pending(&self) -> bool {
         self.model.irq_pending()
     }
@@ -226,19 +239,20 @@ impl Loaded for LeanFlexNode {
     }
 }
 
-impl LoadInstance for LeanFlexCan {
-    type Node = LeanFlexNode;
-    const NAME: &'static str = "FlexCAN (Teensy 3.6 can0), lean split";
-    // The Rx FIFO: 6 deep whatever the filter partition (the 8-filter one here), a full
-    // FIFO discards the new frame (Kinetis RM, "Rx FIFO").
+impl<P: LeanFlexPart> LoadInstance for LeanFlexCanOf<P> {
+    type Node = LeanFlexNode<P>;
+    const NAME: &'static str = P::LEAN_NAME;
+    // The Rx FIFO: 6 deep whatever the filter partition and the chip, a full FIFO
+    // discards the new frame (Kinetis RM and IMXRT1060RM, FlexCAN "Rx FIFO"; the
+    // model's `regs::RX_FIFO_DEPTH` for every chip).
     const RX_FIFO_DEPTH: usize = <FlexCanBackend as Backend>::RX_FIFO_DEPTH;
     const OVERRUN: OverrunPolicy = <FlexCanBackend as Backend>::OVERRUN;
     const COUNTS: bool = false;
     fn attach_via(
         h: &mut Harness,
         attach: impl FnOnce(&mut Bus, &str, Box<dyn BusNode>) -> NodeId,
-    ) -> LeanFlexNode {
-        attach_flex_lean::<FULL_LOAD_BIT_RATE>(h, attach).expect("lean FlexCAN node")
+    ) -> LeanFlexNode<P> {
+        attach_flex_lean::<P, FULL_LOAD_BIT_RATE>(h, attach).expect("lean FlexCAN node")
     }
 }
 

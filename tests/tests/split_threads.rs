@@ -1,14 +1,22 @@
 //! The split halves used from several threads: std threads stand in for the interrupt
 //! context (one thread runs the bus and every interrupt handler) and for the thread
 //! context (a sender and a receiver per node), with the `critical-section` std
-//! implementation. A FlexCAN node (Teensy 3.6 can0) and a bxCAN node (STM32F767 CAN1),
-//! the real drivers over their models, exchange sequenced frames both ways: nothing
-//! lost, duplicated or reordered, and the token/completion accounting is exact — with the
-//! default choices (completions, statistics, time stamps) and with the lean ones a
-//! firmware example uses (no completions, `Lean` features, `const` filter plans, FlexCAN
-//! `options::Lean` begun with `begin_checked`, bxCAN configured in place with the map
-//! sized to its plan and the filters fixed: the quiet transmit mode on both backends;
-//! built by `twocan_tests::lean`, the same definition `full_load` runs).
+//! implementation. A FlexCAN node and a bxCAN node (STM32F767 CAN1), the real drivers
+//! over their models, exchange sequenced frames both ways: nothing lost, duplicated or
+//! reordered, and the token/completion accounting is exact. Three pairs run (each with
+//! 10,000 frames in the default run and 1,000,000 in its `#[ignore]`d release run):
+//!
+//! - the default choices (completions, statistics, time stamps), FlexCAN Teensy 3.6
+//!   can0 begun with `begin`, bxCAN with the run-time plan;
+//! - the lean choices a firmware example uses (no completions, `Lean` features, `const`
+//!   filter plans, the quiet transmit mode on both backends; built by
+//!   `twocan_tests::lean`, the same definitions `full_load` runs): bxCAN configured in
+//!   place with the map sized to its plan and the filters fixed, with
+//!   - FlexCAN Teensy 3.6 can0, `options::Lean` begun with `begin_checked` in the
+//!     8-filter partition (`teensy-loopback-lean`);
+//!   - FlexCAN Teensy 4.1 CAN1 over the RT1062 model, `options::Lean<Imxrt1062>` (the
+//!     ERR005829 reserved mailbox), `const_plan_large!`, a `const`
+//!     `BeginPlan<Imxrt1062>`, ACAN's 12/12 partition (`teensy4-loopback-lean`).
 //!
 //! The peripheral models are single-threaded (`Rc` handles, shared with the bus), so the
 //! bus and both models live in one [`World`] behind a mutex, and every register access
@@ -24,9 +32,10 @@ use twocan_core::split::{Parts, State};
 use twocan_core::{Features, FifoQueue, Filter, Frame, Hardware, Registers, TxOutcome, TxPolicy};
 use twocan_flexcan::model::FlexCanModel;
 use twocan_flexcan::options::{Full, Lean, Options};
-use twocan_flexcan::{Board, FlexCan, FlexCanHw, HostSystem, Instance, Settings, Target};
+use twocan_flexcan::{FlexCan, FlexCanHw, HostSystem, Settings};
 use twocan_sim::Bus;
-use twocan_tests::lean::{bx_lean_config, split_bx_lean, BxLeanHw};
+use twocan_tests::backend::{FlexPart, Teensy36Can0, Teensy41Can1};
+use twocan_tests::lean::{bx_lean_config, split_bx_lean, BxLeanHw, LeanFlexPart};
 
 const RATE: u32 = 1_000_000;
 const APB1: u32 = 54_000_000;
@@ -150,21 +159,33 @@ fn sender<H: twocan_core::Hardware, const DONE: usize, Fe: Features>(
 
 /// The FlexCAN node's settings (ACAN's defaults at the test's rate).
 const FLEX_SETTINGS: Settings = Settings::new(RATE);
-/// The FlexCAN node.
-const FLEX_TARGET: Target = Target::new(Board::Teensy36, Instance::Can0);
 
-/// How the FlexCAN node is begun for the split driver's options `O`.
-trait FlexBegin: Options + Sized + Send + Sync {
-    fn begin(regs: WorldRegs) -> FlexCanHw<WorldRegs, Self>;
+/// How the FlexCAN node is modelled and begun for one set of compile-time choices.
+trait FlexBegin {
+    /// The split driver's controller options.
+    type O: Options + Send + Sync;
+    /// The model of the node's chip, and its name on the bus.
+    fn model() -> (FlexCanModel, &'static str);
+    /// Begins the node over `regs`.
+    fn begin(regs: WorldRegs) -> FlexCanHw<WorldRegs, Self::O>;
 }
 
-/// Every feature: `begin` with the list at run time.
-impl FlexBegin for Full {
-    fn begin(regs: WorldRegs) -> FlexCanHw<WorldRegs, Self> {
+/// Every feature on Teensy 3.6 can0: `begin` with the list at run time.
+enum FullFlex {}
+
+impl FlexBegin for FullFlex {
+    type O = Full;
+    fn model() -> (FlexCanModel, &'static str) {
+        (
+            FlexCanModel::new(Teensy36Can0::TARGET.model_chip()),
+            "teensy36-can0",
+        )
+    }
+    fn begin(regs: WorldRegs) -> FlexCanHw<WorldRegs, Full> {
         FlexCan::begin(
             regs,
             &mut HostSystem::new(),
-            FLEX_TARGET,
+            Teensy36Can0::TARGET,
             &FLEX_SETTINGS,
             &[Filter::pass_all()],
             &[],
@@ -174,11 +195,19 @@ impl FlexBegin for Full {
     }
 }
 
-/// The lean controller (`twocan_tests::lean`): the plan and the checks settled at
-/// compile time (`begin_checked`), no time stamps, no filter switch.
-impl FlexBegin for Lean {
-    fn begin(regs: WorldRegs) -> FlexCanHw<WorldRegs, Self> {
-        twocan_tests::lean::begin_flex_lean::<RATE, _>(regs).unwrap()
+/// The lean controller of the part `P` (`twocan_tests::lean`: Teensy 3.6 can0 in ACAN's
+/// layout, or Teensy 4.1 CAN1 over the RT1062 model in the RT1062 layout): the plan and
+/// the checks settled at compile time (`begin_checked`), no time stamps, no filter
+/// switch.
+struct LeanFlex<P>(std::marker::PhantomData<P>);
+
+impl<P: LeanFlexPart> FlexBegin for LeanFlex<P> {
+    type O = Lean<P::Layout>;
+    fn model() -> (FlexCanModel, &'static str) {
+        (FlexCanModel::new(P::TARGET.model_chip()), P::BUS_NAME)
+    }
+    fn begin(regs: WorldRegs) -> FlexCanHw<WorldRegs, Self::O> {
+        twocan_tests::lean::begin_flex_lean::<P, RATE, _>(regs).unwrap()
     }
 }
 
@@ -237,7 +266,7 @@ impl BxBegin for LeanBx {
 /// Moves `per_direction` frames each way with the default driver (completions, time
 /// stamps, statistics); returns (frames received by the bxCAN node, by the FlexCAN node).
 fn exchange(per_direction: u32) -> (u32, u32) {
-    exchange_with::<64, twocan_core::Full, Full, FullBx>(per_direction)
+    exchange_with::<64, twocan_core::Full, FullFlex, FullBx>(per_direction)
 }
 
 /// [`exchange`] with the lean choices a firmware example makes (`teensy-loopback-lean`):
@@ -246,20 +275,28 @@ fn exchange(per_direction: u32) -> (u32, u32) {
 /// (`twocan_tests::lean`, one definition with `full_load`), both controllers in request
 /// order (as in [`exchange`]) — the quiet transmit mode on both backends.
 fn exchange_lean(per_direction: u32) -> (u32, u32) {
-    exchange_with::<0, twocan_core::Lean, Lean, LeanBx>(per_direction)
+    exchange_with::<0, twocan_core::Lean, LeanFlex<Teensy36Can0>, LeanBx>(per_direction)
 }
 
-/// [`exchange`] for the compile-time choices `DONE`, `Fe`, `O` (FlexCAN), `B` (bxCAN);
+/// [`exchange_lean`] with the FlexCAN node of `teensy4-loopback-lean`: Teensy 4.1 CAN1
+/// over the RT1062 model, `options::Lean<Imxrt1062>` (the ERR005829 reserved mailbox),
+/// the table of `const_plan_large!` in ACAN's 12/12 partition, a `const`
+/// `BeginPlan<Imxrt1062>` (`twocan_tests::lean`, one definition with `full_load`).
+fn exchange_lean_rt1062(per_direction: u32) -> (u32, u32) {
+    exchange_with::<0, twocan_core::Lean, LeanFlex<Teensy41Can1>, LeanBx>(per_direction)
+}
+
+/// [`exchange`] for the compile-time choices `DONE`, `Fe`, `F` (FlexCAN), `B` (bxCAN);
 /// both controllers send in request order (the quiet mode's condition, and the
 /// `FifoQueue`'s order).
-fn exchange_with<const DONE: usize, Fe: Features, O: FlexBegin, B: BxBegin>(
+fn exchange_with<const DONE: usize, Fe: Features, F: FlexBegin, B: BxBegin>(
     per_direction: u32,
 ) -> (u32, u32) {
     let bx = BxCanModel::can1();
-    let flex = FlexCanModel::mk66fx1m0();
+    let (flex, flex_name) = F::model();
     let mut bus = Bus::new(RATE).unwrap();
     bus.attach("stm32f767-can1", bx.clone());
-    bus.attach("teensy36-can0", flex.clone());
+    bus.attach(flex_name, flex.clone());
     let world = Arc::new(Mutex::new(World { bus, bx, flex }));
     let setup = Arc::new(AtomicBool::new(true));
     let regs = |which, polls| WorldRegs {
@@ -274,19 +311,20 @@ fn exchange_with<const DONE: usize, Fe: Features, O: FlexBegin, B: BxBegin>(
     const BX_POLLS: &[usize] = &[twocan_bxcan::regs::MSR];
     const FLEX_POLLS: &[usize] = &[twocan_flexcan::regs::MCR, twocan_flexcan::regs::ESR1];
     let bx_state: State<B::Hw, 256, FifoQueue<32>, 0, DONE, Fe> = State::new();
-    let flex_state: State<FlexCanHw<WorldRegs, O>, 256, FifoQueue<32>, 0, DONE, Fe> = State::new();
+    let flex_state: State<FlexCanHw<WorldRegs, F::O>, 256, FifoQueue<32>, 0, DONE, Fe> =
+        State::new();
     assert_eq!(
         State::<B::Hw, 256, FifoQueue<32>, 0, DONE, Fe>::QUIET_TX,
         DONE == 0
     );
     assert_eq!(
-        State::<FlexCanHw<WorldRegs, O>, 256, FifoQueue<32>, 0, DONE, Fe>::QUIET_TX,
+        State::<FlexCanHw<WorldRegs, F::O>, 256, FifoQueue<32>, 0, DONE, Fe>::QUIET_TX,
         DONE == 0
     );
     // bxCAN configured (in place, for the lean choices) and split, FlexCAN begun, while
     // the polls let bus time pass.
     let bx_parts = B::split(&bx_state, regs(Which::Bx, BX_POLLS));
-    let flex_can = O::begin(regs(Which::Flex, FLEX_POLLS));
+    let flex_can = F::begin(regs(Which::Flex, FLEX_POLLS));
     // Both synchronised to the idle bus before traffic.
     world.lock().unwrap().bus.run_for(20);
     setup.store(false, Ordering::Relaxed);
@@ -459,4 +497,19 @@ fn lean_split_halves_on_threads_move_frames_both_ways() {
 #[ignore]
 fn lean_split_halves_on_threads_move_a_million_frames() {
     assert_eq!(exchange_lean(500_000), (500_000, 500_000));
+}
+
+/// The lean choices with the FlexCAN node of `teensy4-loopback-lean` (Teensy 4.1 CAN1,
+/// RT1062 model and layout): frames both ways, none lost, duplicated or reordered.
+#[test]
+fn lean_rt1062_split_halves_on_threads_move_frames_both_ways() {
+    assert_eq!(exchange_lean_rt1062(5_000), (5_000, 5_000));
+}
+
+/// [`lean_rt1062_split_halves_on_threads_move_frames_both_ways`] with 1,000,000 frames
+/// (release, `--ignored` in CI).
+#[test]
+#[ignore]
+fn lean_rt1062_split_halves_on_threads_move_a_million_frames() {
+    assert_eq!(exchange_lean_rt1062(500_000), (500_000, 500_000));
 }
