@@ -169,11 +169,13 @@ static BENCH_HW_BYTES: u32 = size_of::<variant::Hw<R>>() as u32;
 static BENCH_FMI_BYTES: u32 =
     size_of::<<variant::Opts as twocan_flexcan::options::Options>::Table>() as u32;
 
-/// Size of the clock gate and pin plan the controller keeps for `end`
-/// (`twocan_flexcan::SystemPlan`), read by can-bench.
+/// Size of the clock gate and pin plan the controller keeps for `end` (its layout's
+/// own, `Layout::System`: the Kinetis `PortPlan`), read by can-bench.
 #[no_mangle]
 #[used]
-static BENCH_SYSTEM_BYTES: u32 = size_of::<twocan_flexcan::SystemPlan>() as u32;
+static BENCH_SYSTEM_BYTES: u32 = size_of::<
+    <<variant::Opts as twocan_flexcan::options::Options>::Layout as twocan_flexcan::layout::Layout>::System,
+>() as u32;
 
 /// The SIM and PORT registers on QEMU: the board has none, so writes go nowhere (clock
 /// gates and pin mux are not measured).
