@@ -198,18 +198,9 @@ impl Board {
     /// other boards and for `Can0`.
     pub const fn imx_pins(self, instance: Instance) -> Option<ImxPins> {
         match (self, instance) {
-            (Board::Teensy40 | Board::Teensy41, Instance::Can1) => Some(ImxPins {
-                tx: pads::CAN1_TX,
-                rx: pads::CAN1_RX,
-            }),
-            (Board::Teensy40 | Board::Teensy41, Instance::Can2) => Some(ImxPins {
-                tx: pads::CAN2_TX,
-                rx: pads::CAN2_RX,
-            }),
-            (Board::Teensy40 | Board::Teensy41, Instance::Can3) => Some(ImxPins {
-                tx: pads::CAN3_TX,
-                rx: pads::CAN3_RX,
-            }),
+            (Board::Teensy40 | Board::Teensy41, Instance::Can1) => Some(pads::CAN1),
+            (Board::Teensy40 | Board::Teensy41, Instance::Can2) => Some(pads::CAN2),
+            (Board::Teensy40 | Board::Teensy41, Instance::Can3) => Some(pads::CAN3),
             _ => None,
         }
     }

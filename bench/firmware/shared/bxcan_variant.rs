@@ -41,49 +41,13 @@
 // Each firmware that includes this module uses a part of it.
 #![allow(dead_code)]
 
-#[cfg(all(feature = "lean", feature = "full"))]
-compile_error!("features `lean` and `full` are exclusive");
-#[cfg(not(any(feature = "lean", feature = "full")))]
-compile_error!("enable feature `lean` or `full`");
-#[cfg(all(
-    any(
-        feature = "done",
-        feature = "stamps",
-        feature = "counts",
-        feature = "switch",
-        feature = "planner"
-    ),
-    not(feature = "lean")
-))]
-compile_error!(
-    "features `done`, `stamps`, `counts`, `switch` and `planner` switch one choice of \
-     `lean` to its full setting: enable them with `lean` only"
-);
-#[cfg(any(
-    all(
-        feature = "done",
-        any(
-            feature = "stamps",
-            feature = "counts",
-            feature = "switch",
-            feature = "planner"
-        )
-    ),
-    all(
-        feature = "stamps",
-        any(feature = "counts", feature = "switch", feature = "planner")
-    ),
-    all(feature = "counts", any(feature = "switch", feature = "planner")),
-    all(feature = "switch", feature = "planner"),
-))]
-compile_error!(
-    "enable at most one of `done`, `stamps`, `counts`, `switch`, `planner`: each \
-     one-feature variant measures one choice alone"
-);
-
 use twocan_bxcan::{BxCan, Config, PlanOptions, PlanRef};
 use twocan_core::split::{Parts, Rx, Rx0Irq, State, Tx, TxIrq};
 use twocan_core::{Error, FifoQueue, Filter, Fixed, TxPolicy};
+
+// (The loop-back firmwares print no variant name: `VARIANT` unused there.)
+#[allow(unused_imports)]
+pub use crate::feature_sets::{Fe, DONE, VARIANT};
 
 pub const APB1_HZ: u32 = 54_000_000;
 pub const BITRATE: u32 = 500_000;
@@ -109,47 +73,13 @@ pub const CONFIG: Config = match Config::from_bitrate(APB1_HZ, BITRATE) {
 
 // ------------------------------------------------------------------ lean
 
-/// The variant's name in the bench output.
-#[cfg(all(
-    feature = "lean",
-    not(any(
-        feature = "done",
-        feature = "stamps",
-        feature = "counts",
-        feature = "switch",
-        feature = "planner"
-    ))
-))]
-pub const VARIANT: &str = "lean";
-#[cfg(feature = "done")]
-pub const VARIANT: &str = "lean+done";
-#[cfg(feature = "stamps")]
-pub const VARIANT: &str = "lean+stamps";
-#[cfg(feature = "counts")]
-pub const VARIANT: &str = "lean+counts";
-#[cfg(feature = "switch")]
-pub const VARIANT: &str = "lean+switch";
-#[cfg(feature = "planner")]
-pub const VARIANT: &str = "lean+planner";
-/// Completion ring capacity (0: completions off; 8 with `done`).
-#[cfg(feature = "lean")]
-pub const DONE: usize = if cfg!(feature = "done") { 8 } else { 0 };
+// `VARIANT`, `DONE` and `Fe`: `crate::feature_sets` (the same for both drivers).
 /// Receive time stamps (`CAN_MCR.TTCM`; on with `stamps`).
 #[cfg(feature = "lean")]
 pub const TIMESTAMPS: bool = cfg!(feature = "stamps");
 /// Identifiers of the filter map's merged-filter lookup.
 #[cfg(feature = "lean")]
 pub const KEYS: usize = 0;
-/// The split driver's compile-time feature set: no statistics, no time stamps.
-#[cfg(all(feature = "lean", not(any(feature = "stamps", feature = "counts"))))]
-pub type Fe = twocan_core::Lean;
-/// The split driver's compile-time feature set of `lean+stamps`: time stamps only.
-#[cfg(feature = "stamps")]
-pub type Fe = crate::feature_sets::StampsOnly;
-/// The split driver's compile-time feature set of `lean+counts`: statistics only.
-#[cfg(feature = "counts")]
-pub type Fe = crate::feature_sets::CountsOnly;
-
 /// Planner options: CAN1's banks at reset (`CAN2SB` = 14, RM0410 §40.9.4), FIFO 0.
 pub const OPTIONS: PlanOptions = PlanOptions::new(14);
 
@@ -176,16 +106,9 @@ pub const SWITCH: bool = cfg!(feature = "switch");
 // ------------------------------------------------------------------ full
 
 #[cfg(feature = "full")]
-pub const VARIANT: &str = "full";
-#[cfg(feature = "full")]
-pub const DONE: usize = 8;
-#[cfg(feature = "full")]
 pub const TIMESTAMPS: bool = true;
 #[cfg(feature = "full")]
 pub const KEYS: usize = twocan_bxcan::filters::LOOKUP_KEYS;
-/// The split driver's compile-time feature set: statistics and time stamps.
-#[cfg(feature = "full")]
-pub type Fe = twocan_core::Full;
 
 /// The planner's working memory (about 90 KB of `.bss`), lent once.
 #[cfg(any(feature = "full", feature = "planner"))]

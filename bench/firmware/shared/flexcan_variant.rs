@@ -11,17 +11,19 @@
 //!
 //! - **full**: transmit completions (a completion ring of [`DONE`] = 8), receive and
 //!   transmit time stamps, traffic statistics, the filter list compiled at run time by
-//!   `FlexCan::begin_in` straight into a `static` `TableSlot`
+//!   `FlexCan::begin_in_place` straight into a `static` `TableSlot`
 //!   (`twocan_flexcan::options::FullInSlot`: filter switches too);
 //! - **lean**: no completion ring ([`DONE`] = 0) and the controller's lean choices
 //!   (`twocan_flexcan::options::Lean`: no time stamps, no filter switch while running,
 //!   the filter table planned at compile time by `const_plan!` and the settings checked
-//!   at compile time (`BeginPlan`), written by `FlexCan::begin_checked`, which keeps a
+//!   at compile time (`BeginPlan`), written by `FlexCan::begin_checked_in_place`, which keeps a
 //!   few words pointing into the plan) and the split driver's `Lean` feature set (no
 //!   traffic statistics, no time stamps read), which with the request-order queue is
 //!   its quiet transmit mode (`State::QUIET_TX`: MB15's interrupt enabled only while
 //!   frames wait in the queue, so a frame sent directly costs no transmit handler).
-
+//!
+//! Every variant writes the controller in place in the `static` state
+//! (`State::split_with`, [`start`]).
 //!
 //! **One-feature variants** (issue 21: each compile-time choice with its own measured
 //! cost, as `shared/bxcan_variant.rs` for bxCAN): `lean` plus exactly one of the
@@ -43,48 +45,12 @@
 // Each firmware that includes this module uses a part of it.
 #![allow(dead_code)]
 
-#[cfg(all(feature = "lean", feature = "full"))]
-compile_error!("features `lean` and `full` are exclusive");
-#[cfg(not(any(feature = "lean", feature = "full")))]
-compile_error!("enable feature `lean` or `full`");
-#[cfg(all(
-    any(
-        feature = "done",
-        feature = "stamps",
-        feature = "counts",
-        feature = "switch",
-        feature = "planner"
-    ),
-    not(feature = "lean")
-))]
-compile_error!(
-    "features `done`, `stamps`, `counts`, `switch` and `planner` switch one choice of \
-     `lean` to its full setting: enable them with `lean` only"
-);
-#[cfg(any(
-    all(
-        feature = "done",
-        any(
-            feature = "stamps",
-            feature = "counts",
-            feature = "switch",
-            feature = "planner"
-        )
-    ),
-    all(
-        feature = "stamps",
-        any(feature = "counts", feature = "switch", feature = "planner")
-    ),
-    all(feature = "counts", any(feature = "switch", feature = "planner")),
-    all(feature = "switch", feature = "planner"),
-))]
-compile_error!(
-    "enable at most one of `done`, `stamps`, `counts`, `switch`, `planner`: each \
-     one-feature variant measures one choice alone"
-);
-
 use twocan_core::split::{Parts, Rx, Rx0Irq, State, Tx, TxIrq};
 use twocan_core::{Error, FifoQueue, Filter, Registers};
+
+// (The loop-back firmwares print no variant name: `VARIANT` unused there.)
+#[allow(unused_imports)]
+pub use crate::feature_sets::{Fe, DONE, VARIANT};
 use twocan_flexcan::{
     BeginError, BeginPlan, Board, Configuration, FlexCan, FlexCanHw, Instance, Settings, Target,
 };
@@ -115,31 +81,7 @@ pub const SETTINGS: Settings = {
 
 // ------------------------------------------------------------------ lean
 
-/// The variant's name in the bench output.
-#[cfg(all(
-    feature = "lean",
-    not(any(
-        feature = "done",
-        feature = "stamps",
-        feature = "counts",
-        feature = "switch",
-        feature = "planner"
-    ))
-))]
-pub const VARIANT: &str = "lean";
-#[cfg(feature = "done")]
-pub const VARIANT: &str = "lean+done";
-#[cfg(feature = "stamps")]
-pub const VARIANT: &str = "lean+stamps";
-#[cfg(feature = "counts")]
-pub const VARIANT: &str = "lean+counts";
-#[cfg(feature = "switch")]
-pub const VARIANT: &str = "lean+switch";
-#[cfg(feature = "planner")]
-pub const VARIANT: &str = "lean+planner";
-/// Completion ring capacity (0: completions off; 8 with `done`).
-#[cfg(feature = "lean")]
-pub const DONE: usize = if cfg!(feature = "done") { 8 } else { 0 };
+// `VARIANT`, `DONE` and `Fe`: `crate::feature_sets` (the same for both drivers).
 /// The controller's compile-time choices: no time stamps, no filter switch, the
 /// table planned at compile time.
 #[cfg(all(
@@ -156,16 +98,6 @@ pub type Opts = LeanSwitch;
 /// `lean+planner`: the table compiled at run time into a `static` slot.
 #[cfg(feature = "planner")]
 pub type Opts = LeanInSlot;
-/// The split driver's features: no statistics, no time stamps (the quiet transmit mode).
-#[cfg(all(feature = "lean", not(any(feature = "stamps", feature = "counts"))))]
-pub type Fe = twocan_core::Lean;
-/// The split driver's features of `lean+stamps`: time stamps only.
-#[cfg(feature = "stamps")]
-pub type Fe = crate::feature_sets::StampsOnly;
-/// The split driver's features of `lean+counts`: statistics only.
-#[cfg(feature = "counts")]
-pub type Fe = crate::feature_sets::CountsOnly;
-
 /// `lean` with the message buffers' time stamps read (`Options::STAMPS`).
 #[cfg(feature = "stamps")]
 #[derive(Debug, Clone, Copy)]
@@ -207,17 +139,10 @@ impl twocan_flexcan::options::Options for LeanInSlot {
 
 // ------------------------------------------------------------------ full
 
-#[cfg(feature = "full")]
-pub const VARIANT: &str = "full";
-#[cfg(feature = "full")]
-pub const DONE: usize = 8;
 /// The controller's compile-time choices: time stamps, filter switches, the table in a
 /// `static` slot that `begin_in` compiles into.
 #[cfg(feature = "full")]
 pub type Opts = twocan_flexcan::options::FullInSlot;
-/// The split driver's features: statistics and time stamps.
-#[cfg(feature = "full")]
-pub type Fe = twocan_core::Full;
 
 // ------------------------------------------------------------------ both
 
