@@ -69,8 +69,11 @@ pub const fn lower_bound(keys: &[Key], x: Key) -> usize {
     lower_bound_in(keys, keys.len(), x)
 }
 
-/// [`lower_bound`] over `keys[..n]` (no sub-slice made: cheaper in `const` code).
+/// [`lower_bound`] over `keys[..n]` (no sub-slice made: cheaper in `const` code). `n`
+/// is clamped to the slice, so the search never indexes past it: with a table of
+/// capacity 0 (a lean filter map) it compiles to nothing, no bounds-check panic path.
 const fn lower_bound_in(keys: &[Key], n: usize, x: Key) -> usize {
+    let n = if n < keys.len() { n } else { keys.len() };
     let (mut lo, mut hi) = (0, n);
     while lo < hi {
         let mid = lo + (hi - lo) / 2;
@@ -90,6 +93,7 @@ pub const fn upper_bound(keys: &[Key], x: Key) -> usize {
 
 /// [`upper_bound`] over `keys[..n]`.
 const fn upper_bound_in(keys: &[Key], n: usize, x: Key) -> usize {
+    let n = if n < keys.len() { n } else { keys.len() };
     let (mut lo, mut hi) = (0, n);
     while lo < hi {
         let mid = lo + (hi - lo) / 2;
@@ -332,7 +336,7 @@ impl<const N: usize> KeyTable<N> {
     pub const fn position(&self, k: Key) -> Option<usize> {
         let n = self.len as usize;
         let at = lower_bound_in(&self.keys, n, k);
-        if at < n && self.keys[at] == k {
+        if at < n && at < N && self.keys[at] == k {
             Some(at)
         } else {
             None
@@ -342,8 +346,8 @@ impl<const N: usize> KeyTable<N> {
     /// The user index of `k` (binary search, at most 10 steps), `None` if absent.
     pub const fn lookup(&self, k: Key) -> Option<u16> {
         match self.position(k) {
-            Some(i) => Some(self.users[i]),
-            None => None,
+            Some(i) if i < N => Some(self.users[i]),
+            _ => None,
         }
     }
 
