@@ -345,10 +345,7 @@ impl Figures {
                         let v = b.variant(variant).ok_or_else(|| {
                             Error::new(format!("no {variant} loop-back sizes at opt {}", b.opt))
                         })?;
-                        let (ours, theirs) = match backend {
-                            Backend::BxCan => (&v.ours, &v.equiv),
-                            Backend::FlexCan => (&v.flexcan, &v.flexcan_hand),
-                        };
+                        let (ours, theirs) = v.of(backend);
                         Ok((
                             b.opt.clone(),
                             Measured::Ratio {
@@ -374,10 +371,7 @@ impl Figures {
                     let st = sizes
                         .state(variant)
                         .ok_or_else(|| Error::new(format!("no {variant} state figures")))?;
-                    let fig = match backend {
-                        Backend::BxCan => &st.bxcan,
-                        Backend::FlexCan => &st.flexcan,
-                    };
+                    let fig = st.of(backend);
                     targets.push(Target {
                         backend,
                         variant,
@@ -590,10 +584,7 @@ fn cause(t: &Target, insn: &InsnSection, sizes: &SizeSection) -> Result<Vec<Stri
                 let parts: Vec<String> = steps
                     .iter()
                     .map(|(_, label, o, th)| {
-                        format!(
-                            "{label} {o} / {th} ({})",
-                            crate::report::signed_text(o - th)
-                        )
+                        format!("{label} {o} / {th} ({})", crate::report::signed(o - th))
                     })
                     .collect();
                 lines.push(format!("opt {opt}: {}", parts.join(", ")));
@@ -604,10 +595,7 @@ fn cause(t: &Target, insn: &InsnSection, sizes: &SizeSection) -> Result<Vec<Stri
                 let Some(v) = b.variant(t.variant) else {
                     continue;
                 };
-                let (ours, theirs) = match t.backend {
-                    Backend::BxCan => (&v.ours, &v.equiv),
-                    Backend::FlexCan => (&v.flexcan, &v.flexcan_hand),
-                };
+                let (ours, theirs) = v.of(t.backend);
                 let list = |z: &crate::sizes::Size| {
                     z.code_by_crate
                         .iter()
@@ -637,10 +625,7 @@ fn cause(t: &Target, insn: &InsnSection, sizes: &SizeSection) -> Result<Vec<Stri
         }
         "state" => {
             if let Some(st) = sizes.state(t.variant) {
-                let f = match t.backend {
-                    Backend::BxCan => &st.bxcan,
-                    Backend::FlexCan => &st.flexcan,
-                };
+                let f = st.of(t.backend);
                 let fp = &f.footprint;
                 let inside = [
                     f.fmi_bytes.map(|b| format!("filters {b}")),
@@ -674,7 +659,7 @@ fn cause(t: &Target, insn: &InsnSection, sizes: &SizeSection) -> Result<Vec<Stri
                 if let Measured::Ratio { ours, theirs } = m {
                     lines.push(format!(
                         "opt {opt}: {ours} / {theirs} instructions ({})",
-                        crate::report::signed_text(*ours as i64 - *theirs as i64)
+                        crate::report::signed(*ours as i64 - *theirs as i64)
                     ));
                 }
             }
@@ -707,10 +692,7 @@ fn feature_costs(insn: &InsnSection, sizes: &SizeSection, b: Backend) -> Result<
     let lean_states = sizes
         .state("lean")
         .ok_or_else(|| Error::new("no lean state figures"))?;
-    let lean_state = match b {
-        Backend::BxCan => lean_states.bxcan,
-        Backend::FlexCan => lean_states.flexcan,
-    };
+    let lean_state = *lean_states.of(b);
     let mut costs = Vec::new();
     for (variant, feature) in FEATURE_VARIANTS {
         let state = sizes
@@ -761,10 +743,7 @@ fn feature_costs(insn: &InsnSection, sizes: &SizeSection, b: Backend) -> Result<
             let lean_sizes = build
                 .variant("lean")
                 .ok_or_else(|| Error::new(format!("no lean loop-back sizes at opt {opt}")))?;
-            let lean_size = match b {
-                Backend::BxCan => &lean_sizes.ours,
-                Backend::FlexCan => &lean_sizes.flexcan,
-            };
+            let lean_size = lean_sizes.of(b).0;
             per_opt.push(FeatureOpt {
                 opt: opt.clone(),
                 roundtrip: (ours.roundtrip("twocan")?, lean.roundtrip("twocan")?),

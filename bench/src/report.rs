@@ -27,6 +27,16 @@ pub struct VariantSizes {
     pub flexcan_hand: Size,
 }
 
+impl VariantSizes {
+    /// Our loop-back firmware of `backend` and its equivalent's.
+    pub fn of(&self, backend: Backend) -> (&Size, &Size) {
+        match backend {
+            Backend::BxCan => (&self.ours, &self.equiv),
+            Backend::FlexCan => (&self.flexcan, &self.flexcan_hand),
+        }
+    }
+}
+
 /// The loop-back comparison of one build profile.
 pub struct SizeBuild {
     /// Cargo profile.
@@ -59,6 +69,16 @@ pub struct StateSet {
     pub bxcan: StateFigures,
     /// FlexCAN (`loopback-flexcan` with `insn-count-flexcan`).
     pub flexcan: StateFigures,
+}
+
+impl StateSet {
+    /// The figures of `backend`'s driver.
+    pub fn of(&self, backend: Backend) -> &StateFigures {
+        match backend {
+            Backend::BxCan => &self.bxcan,
+            Backend::FlexCan => &self.flexcan,
+        }
+    }
 }
 
 /// A loop-back firmware run under `can-fil --stack`.
@@ -847,8 +867,9 @@ impl Report {
         );
         let mut rows: Vec<(Backend, &str, &StateFigures)> = Vec::new();
         for st in &sz.states {
-            rows.push((Backend::BxCan, &st.variant, &st.bxcan));
-            rows.push((Backend::FlexCan, &st.variant, &st.flexcan));
+            for b in Backend::ALL {
+                rows.push((b, &st.variant, st.of(b)));
+            }
         }
         for b in Backend::ALL {
             for (fb, v, st) in &sz.feature_states {
@@ -1380,12 +1401,7 @@ fn why_missed(backend: Backend, variant: &str, key: &str) -> &'static str {
 }
 
 /// A signed difference: `+12`, `−3`, `±0`.
-pub fn signed_text(d: i64) -> String {
-    signed(d)
-}
-
-/// A signed difference: `+12`, `−3`, `±0`.
-fn signed(d: i64) -> String {
+pub fn signed(d: i64) -> String {
     match d.cmp(&0) {
         std::cmp::Ordering::Greater => format!("+{}", thousands(d.unsigned_abs())),
         std::cmp::Ordering::Less => format!("−{}", thousands(d.unsigned_abs())),
@@ -1466,13 +1482,10 @@ fn render_feature_costs(s: &mut String, f: &Figures, backend: Backend) {
     let Some(first) = costs.first() else {
         return;
     };
-    let (insn, loopback, shared) = match backend {
-        Backend::BxCan => ("insn-count", "loopback-twocan", "bxcan_variant.rs"),
-        Backend::FlexCan => (
-            "insn-count-flexcan",
-            "loopback-flexcan",
-            "flexcan_variant.rs",
-        ),
+    let (insn, loopback) = (backend.firmware(), backend.loopback());
+    let shared = match backend {
+        Backend::BxCan => "bxcan_variant.rs",
+        Backend::FlexCan => "flexcan_variant.rs",
     };
     let _ = writeln!(
         s,

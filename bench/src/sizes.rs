@@ -362,23 +362,7 @@ pub fn crate_of(symbol: &str) -> String {
 
 /// The 32-bit little-endian value of the static `symbol` in the ELF at `path`.
 pub fn read_u32_symbol(path: &Path, symbol: &str) -> Result<u32> {
-    let data = std::fs::read(path).context(format!("reading {}", path.display()))?;
-    let elf = parse(&data).context(path.display())?;
-    let sym = elf
-        .symbols()
-        .find(|s| s.name() == Ok(symbol))
-        .ok_or_else(|| Error::new(format!("{}: no symbol `{symbol}`", path.display())))?;
-    let addr = sym.address();
-    for section in elf.sections() {
-        if let Ok(Some(bytes)) = section.data_range(addr, 4) {
-            let v = u32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]]);
-            return Ok(v);
-        }
-    }
-    Err(Error::new(format!(
-        "{}: symbol `{symbol}` at {addr:#x} has no data",
-        path.display()
-    )))
+    Ok(read_u32_array_symbol(path, symbol, 1)?[0])
 }
 
 /// The `n` 32-bit little-endian values of the static array `symbol` in the ELF at `path`.
