@@ -129,11 +129,8 @@ impl SystemPlan {
     /// under a running module ([`ConfigErrors::CLOCK_ROOT_IN_USE`], nothing written).
     pub fn apply<S: Registers>(&self, sys: &mut S) -> Result<(), ConfigErrors> {
         match self {
-            SystemPlan::Kinetis(p) => {
-                p.apply(sys);
-                Ok(())
-            }
-            SystemPlan::Imxrt(p) => p.apply(sys),
+            SystemPlan::Kinetis(p) => LayoutSystem::apply(p, sys),
+            SystemPlan::Imxrt(p) => LayoutSystem::apply(p, sys),
         }
     }
 
