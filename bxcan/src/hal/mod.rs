@@ -485,25 +485,7 @@ impl<P> HandedOver<CanRegs, CanRegs, P> {
         if !self.accepts(config) {
             return Err(self.refuse(Error::InvalidArgument));
         }
-        let HandedOver {
-            regs,
-            filters,
-            instance,
-            apb1_hz,
-            chip,
-            parts,
-        } = self;
-        regs.into_fixed().map_err(|regs| Failed {
-            error: Error::InvalidArgument,
-            value: HandedOver {
-                regs,
-                filters,
-                instance,
-                apb1_hz,
-                chip,
-                parts,
-            },
-        })
+        self.convert(|regs, filters| regs.into_fixed().map_err(|regs| (regs, filters)))
     }
 
     /// Configures the instance ([`Can::can1`] or [`Can::can3`]): initialization mode,
@@ -536,34 +518,17 @@ impl<P> HandedOver<ControlRegs, Can1Filters, P> {
         self,
         config: &Config,
     ) -> Result<(ControlRegsAt<BASE>, Can1Filters), Failed<Self>> {
-        let accepted = self.accepts(config);
-        let HandedOver {
-            regs,
-            filters,
-            instance,
-            apb1_hz,
-            chip,
-            parts,
-        } = self;
-        let back = |regs, filters| Failed {
-            error: Error::InvalidArgument,
-            value: HandedOver {
-                regs,
-                filters,
-                instance,
-                apb1_hz,
-                chip,
-                parts,
-            },
-        };
-        match filters {
-            Some(f) if accepted => match regs.into_fixed() {
-                Ok(fixed) => Ok((fixed, f)),
-                Err(regs) => Err(back(regs, Some(f))),
-            },
-            // Another clock, or no filter handle (not built by this module).
-            filters => Err(back(regs, filters)),
+        if !self.accepts(config) {
+            return Err(self.refuse(Error::InvalidArgument));
         }
+        self.convert(|regs, filters| match filters {
+            Some(f) => match regs.into_fixed() {
+                Ok(fixed) => Ok((fixed, f)),
+                Err(regs) => Err((regs, Some(f))),
+            },
+            // No filter handle (not built by this module).
+            None => Err((regs, None)),
+        })
     }
 
     /// Configures CAN1 ([`Can::can1_dual`]: `CAN2SB` is written when `config` sets
@@ -613,6 +578,33 @@ impl<R: Registers, P> HandedOver<R, R, P> {
 
 #[allow(clippy::result_large_err)]
 impl<R: Registers, F: Registers, P> HandedOver<R, F, P> {
+    /// `f` applied to the register handles, or this handle back with
+    /// [`Error::InvalidArgument`] when `f` gives them back (nothing is lost).
+    fn convert<T>(
+        self,
+        f: impl FnOnce(R, Option<F>) -> Result<T, (R, Option<F>)>,
+    ) -> Result<T, Failed<Self>> {
+        let HandedOver {
+            regs,
+            filters,
+            instance,
+            apb1_hz,
+            chip,
+            parts,
+        } = self;
+        f(regs, filters).map_err(|(regs, filters)| Failed {
+            error: Error::InvalidArgument,
+            value: HandedOver {
+                regs,
+                filters,
+                instance,
+                apb1_hz,
+                chip,
+                parts,
+            },
+        })
+    }
+
     fn into_dual(self, config: &Config) -> Result<(R, F), Failed<Self>> {
         if !self.accepts(config) {
             return Err(self.refuse(Error::InvalidArgument));
