@@ -113,7 +113,7 @@ fn the_example_apps_do_not_have_a_stuck_interrupt() {
             .instance
             .irqs
             .iter()
-            .map(|(_, line)| b.taken.get(&(16 + line)).copied().unwrap_or(0))
+            .map(|(_, line)| b.irq_taken(*line))
             .sum();
         assert!(
             can_irqs > 0,

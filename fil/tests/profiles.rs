@@ -25,7 +25,7 @@ fn with_peer(
 
 fn taken(w: &World<'_>, irq: u32) -> u64 {
     let b = w.machines[0].board();
-    b.taken.get(&(16 + irq)).copied().unwrap_or(0)
+    b.irq_taken(irq)
 }
 
 fn static_u32(w: &World<'_>, name: &str) -> u32 {

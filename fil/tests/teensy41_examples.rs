@@ -20,12 +20,7 @@ const CAN1_IRQ: u32 = 36;
 const CAN2_IRQ: u32 = 37;
 
 fn taken(w: &twocan_fil::world::World<'_>, board: usize, irq: u32) -> u64 {
-    w.machines[board]
-        .board()
-        .taken
-        .get(&(16 + irq))
-        .copied()
-        .unwrap_or(0)
+    w.machines[board].board().irq_taken(irq)
 }
 
 #[test]

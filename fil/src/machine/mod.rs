@@ -171,6 +171,11 @@ pub struct Machine<'a> {
 }
 
 impl Board {
+    /// How many times interrupt line `irq` was taken (exception 16 + `irq`).
+    pub fn irq_taken(&self, irq: u32) -> u64 {
+        self.taken.get(&(16 + irq)).copied().unwrap_or(0)
+    }
+
     /// Address of the last instruction executed.
     pub fn last_pc(&self) -> u32 {
         self.pc
