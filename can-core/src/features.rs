@@ -84,8 +84,8 @@ impl Tally for NoTally {
 /// each frame waiting in a receive ring, a `u32` per ring slot) or [`NoClock`]
 /// (nothing: a feature set without time stamps pays no byte for them).
 ///
-/// A feature set's clock must agree with its [`Features::TIMESTAMPS`]; a `State` of one
-/// that does not is refused when it is built:
+/// [`Features::TIMESTAMPS`] follows the clock; a feature set that sets it otherwise is
+/// refused when its `State` is built:
 ///
 /// ```compile_fail
 /// use twocan_core::features::{Features, NoClock, NoTally};
@@ -112,7 +112,6 @@ impl Tally for NoTally {
 ///
 /// enum StampsOnly {}
 /// impl Features for StampsOnly {
-///     const TIMESTAMPS: bool = true;
 ///     const COUNTS: bool = false;
 ///     type Counter = NoTally;
 ///     type Clock = Extender;
@@ -217,8 +216,10 @@ impl StampClock for NoClock {
 
 /// A compile-time feature set of the split driver (see the [module docs](self)).
 pub trait Features: 'static {
-    /// Receive and transmit time stamps are read from the hardware and widened.
-    const TIMESTAMPS: bool;
+    /// Receive and transmit time stamps are read from the hardware and widened: what
+    /// the clock says ([`StampClock::WIDENS`]; a feature set that sets it otherwise is
+    /// refused when its `State` is built).
+    const TIMESTAMPS: bool = <Self::Clock as StampClock>::WIDENS;
     /// Whether the traffic statistics count ([`Features::Counter`] is a [`Counter`]).
     const COUNTS: bool;
     /// How the traffic counters are stored.
@@ -233,7 +234,6 @@ pub trait Features: 'static {
 pub enum Full {}
 
 impl Features for Full {
-    const TIMESTAMPS: bool = true;
     const COUNTS: bool = true;
     type Counter = Counter;
     type Clock = Extender;
@@ -244,7 +244,6 @@ impl Features for Full {
 pub enum Lean {}
 
 impl Features for Lean {
-    const TIMESTAMPS: bool = false;
     const COUNTS: bool = false;
     type Counter = NoTally;
     type Clock = NoClock;

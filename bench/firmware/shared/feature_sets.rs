@@ -101,7 +101,6 @@ pub type Fe = twocan_core::Full;
 pub enum StampsOnly {}
 
 impl twocan_core::Features for StampsOnly {
-    const TIMESTAMPS: bool = true;
     const COUNTS: bool = false;
     type Counter = twocan_core::features::NoTally;
     type Clock = twocan_core::timestamp::Extender;
@@ -114,7 +113,6 @@ impl twocan_core::Features for StampsOnly {
 pub enum CountsOnly {}
 
 impl twocan_core::Features for CountsOnly {
-    const TIMESTAMPS: bool = false;
     const COUNTS: bool = true;
     type Counter = twocan_core::spsc::Counter;
     type Clock = twocan_core::features::NoClock;
